@@ -1,0 +1,41 @@
+# Toppling columns: `make run-all` runs the main job, `make test` the tests.
+# Every target depends on `setup`, which installs YADE (apt-get) and .venv when missing.
+SHELL := /bin/bash
+PY := .venv/bin/python
+SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
+JOBS ?= $(shell nproc)
+
+.PHONY: setup test run-all records campaigns bench clean
+
+setup: .venv/.installed
+	@command -v yade >/dev/null || { echo "installing YADE (apt-get install yade)"; \
+	  $(SUDO) env DEBIAN_FRONTEND=noninteractive apt-get update -qq && \
+	  $(SUDO) env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq yade; }
+
+.venv/.installed: pyproject.toml
+	test -x $(PY) || python3 -m venv .venv
+	$(PY) -m pip install -q --upgrade pip
+	$(PY) -m pip install -q -e '.[test]'
+	touch $@
+
+test: setup
+	$(PY) -m pytest -q tests
+
+records: setup
+	$(PY) -m pipeline records --all
+
+campaigns: records
+	$(PY) -m pipeline campaign verification --jobs $(JOBS)
+	$(PY) -m pipeline campaign slenderness --jobs $(JOBS)
+	$(PY) -m pipeline campaign friction --jobs $(JOBS)
+	$(PY) -m pipeline campaign records --jobs $(JOBS)
+	$(PY) -m pipeline campaign synthetic --jobs $(JOBS)
+
+run-all: campaigns
+	$(PY) -m pipeline report
+
+bench: setup
+	$(PY) bench/bench_yade.py
+
+clean:
+	rm -rf results/*/ results/REPORT.md
