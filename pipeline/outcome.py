@@ -1,0 +1,121 @@
+"""Outcome stage: turn a YADE trajectory into toppled/not, impact time, impact
+points and downfall azimuth per column.
+
+All positions are in the pedestal frame (pedestal top face z = 0, metres).
+A column has toppled when one of its bodies struck the pedestal other than
+by its base: any point of a drum above the bottom one, or the top rim of
+the bottom drum (or monolith).  The downfall azimuth points from the
+column's initial axis to the mass-weighted mean of the centres of mass of
+the struck bodies at their first strike (clockwise from North, degrees).
+"""
+import math
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+CONTACT_TOLERANCE_M = 0.02   # a rim this close to the pedestal top has struck it
+
+
+def body_axes(quat):
+    """Unit long axes (..., 3) of bodies from quaternions (..., 4) ordered (w, x, y, z)."""
+    q = np.asarray(quat, float)
+    flat = q.reshape(-1, 4)[:, [1, 2, 3, 0]]
+    return Rotation.from_quat(flat).apply([0.0, 0.0, 1.0]).reshape(q.shape[:-1] + (3,))
+
+
+def rim_lowest_z(pos, axis, half_height, radius):
+    """Lowest z (m) of a cylinder's bottom and top rim circles: arrays (..., 2)."""
+    az = np.clip(axis[..., 2], -1.0, 1.0)
+    spread = radius * np.sqrt(1.0 - az ** 2)
+    bottom = pos[..., 2] - half_height * az - spread
+    top = pos[..., 2] + half_height * az - spread
+    return np.stack([bottom, top], axis=-1)
+
+
+def azimuth_deg(d_east, d_north):
+    """Azimuth clockwise from North in [0, 360) of a horizontal vector."""
+    return float(np.degrees(np.arctan2(d_east, d_north)) % 360.0)
+
+
+def tilt_deg(axis):
+    return np.degrees(np.arccos(np.clip(axis[..., 2], -1.0, 1.0)))
+
+
+def column_outcomes(trajectory):
+    """List of per-column result dicts (see module docstring)."""
+    t = trajectory["t"]
+    pos = trajectory["pos"]
+    axes = body_axes(trajectory["quat"])
+    columns = {}
+    for j, body in enumerate(trajectory["bodies"]):
+        columns.setdefault(body["column"], []).append(j)
+    results = []
+    for name, members in columns.items():
+        origin = np.array(trajectory["bodies"][members[0]]["initial_pos"][:2])
+        bodies = []
+        for j in members:
+            b = trajectory["bodies"][j]
+            if b["shape"] != "cylinder":
+                continue
+            low = rim_lowest_z(pos[:, j], axes[:, j], b["height"] / 2, b["radius"])
+            struck = low[:, 1] if b["index"] == 0 else low.min(axis=1)
+            hits = np.flatnonzero(struck <= CONTACT_TOLERANCE_M)
+            entry = {"index": b["index"], "mass_kg": b["mass"], "struck": bool(hits.size),
+                     "impact_time_s": None, "impact_point_m": None, "azimuth_deg": None,
+                     "max_tilt_deg": float(tilt_deg(axes[:, j]).max()),
+                     "final_position_m": (pos[-1, j, :2] - origin).round(4).tolist()}
+            if hits.size:
+                k = hits[0]
+                point = pos[k, j, :2] - origin
+                entry.update(impact_time_s=float(t[k]), impact_point_m=point.round(4).tolist(),
+                             azimuth_deg=azimuth_deg(*point))
+            bodies.append(entry)
+        if not bodies:
+            continue
+        struck = [b for b in bodies if b["struck"]]
+        result = {"column": name, "toppled": bool(struck), "downfall_azimuth_deg": None,
+                  "impact_time_s": None, "impact_point_m": None,
+                  "max_tilt_deg": max(b["max_tilt_deg"] for b in bodies),
+                  "base_slip_m": float(np.hypot(*(pos[:, members[0], :2] - origin).T).max()),
+                  "position_m": origin.tolist(), "bodies": bodies}
+        if struck:
+            weights = np.array([b["mass_kg"] for b in struck])
+            points = np.array([b["impact_point_m"] for b in struck])
+            centre = weights @ points / weights.sum()
+            result.update(downfall_azimuth_deg=azimuth_deg(*centre),
+                          impact_time_s=min(b["impact_time_s"] for b in struck),
+                          impact_point_m=centre.round(4).tolist())
+        results.append(result)
+    return results
+
+
+def total_energy(trajectory, g=9.81):
+    """Kinetic + potential energy (J) of all bodies per sample, in the pedestal frame
+    (meaningful for a still pedestal)."""
+    axes_q = np.asarray(trajectory["quat"], float)
+    energy = np.zeros(len(trajectory["t"]))
+    for j, b in enumerate(trajectory["bodies"]):
+        m, h = b["mass"], b["height"]
+        if b["shape"] == "cylinder":
+            r = b["radius"]
+            inertia = np.array([m * (3 * r * r + h * h) / 12] * 2 + [m * r * r / 2])
+        else:
+            w, d = b["width"], b["depth"]
+            inertia = m / 12 * np.array([d * d + h * h, w * w + h * h, w * w + d * d])
+        rot = Rotation.from_quat(axes_q[:, j][:, [1, 2, 3, 0]])
+        omega_body = rot.inv().apply(trajectory["angvel"][:, j])
+        energy += (0.5 * m * (trajectory["vel"][:, j] ** 2).sum(axis=1)
+                   + 0.5 * (inertia * omega_body ** 2).sum(axis=1)
+                   + m * g * trajectory["pos"][:, j, 2])
+    return energy
+
+
+def summarise(trajectory, record=None, back_azimuth_deg=None, parameters=None):
+    """summary.json content of one run."""
+    back = None if back_azimuth_deg is None or not math.isfinite(back_azimuth_deg) else float(
+        back_azimuth_deg)
+    return {"record": record, "back_azimuth_deg": back, "parameters": parameters or {},
+            "columns": column_outcomes(trajectory),
+            "simulated_s": float(trajectory["t"][-1]) if len(trajectory["t"]) else 0.0,
+            "motion_end_s": trajectory["motion_end"], "stopped_early": trajectory["stopped_early"],
+            "time_step_s": trajectory["dt"], "wall_s": trajectory.get("wall_s")}
