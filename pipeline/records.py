@@ -52,7 +52,7 @@ COMPONENTS = ("e", "n", "z")
 def catalog():
     """The record catalogue ``records/catalog.csv`` as a DataFrame (one row per record)."""
     frame = pd.read_csv(CATALOG_PATH, dtype={"id": str, "source_key": str, "start_utc": str,
-                                             "azimuths_deg": str})
+                                             "end_utc": str, "azimuths_deg": str})
     return frame
 
 
@@ -204,8 +204,9 @@ def build_motion(source, back_azimuth=None, input_hash=None):
     row = source["row"] or {}
     stream, info = read_record(source["path"], row.get("source_key"))
     _apply_catalog_orientation(stream, row, source["path"])
-    if row.get("start_utc"):
-        stream.trim(starttime=UTCDateTime(row["start_utc"]))
+    if row.get("start_utc") or row.get("end_utc"):
+        stream.trim(starttime=UTCDateTime(row["start_utc"]) if row.get("start_utc") else None,
+                    endtime=UTCDateTime(row["end_utc"]) if row.get("end_utc") else None)
     needs_vertical = row.get("has_vertical", True) not in (False, "false", "False", 0)
     enz, dt = to_east_north_up(stream, source["path"].name, needs_vertical)
     lowest = info.get("lowest_usable_hz")
@@ -342,6 +343,7 @@ def _motion_meta(source, row, info, back_azimuth, has_vertical, enz):
             "event": pick("event"), "station": pick("station"), "magnitude": pick("magnitude"),
             "mechanism": row.get("mechanism"), "has_vertical": bool(has_vertical),
             "horizontals_compass": row.get("horizontals_compass", True),
+            "orientation": row.get("orientation", "as-recorded"),
             "source_file": _display_path(source["path"]), "source_key": row.get("source_key"),
             "units": {"dt": "s", "acc": "m/s^2", "vel": "m/s", "disp": "m"},
             "columns": ["East", "North", "Up"]}
