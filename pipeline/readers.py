@@ -17,6 +17,7 @@ same recording are found by their header), CSMIP/DMG Volume 1 text (``.V1``,
 the compact FEMA P695 file ``records/fema_p695.npz`` (needs a key, e.g.
 ``NF11``), and anything :func:`obspy.read` reads (MiniSEED, SAC, ...).
 """
+import glob
 import gzip
 import io
 import json
@@ -34,8 +35,16 @@ VERTICAL_UP, VERTICAL_DOWN = -90.0, 90.0
 
 
 def read_record(path, key=None):
-    """Read one 3-component (or FEMA 2-component) record file; see module doc."""
+    """Read one 3-component (or FEMA 2-component) record file; see module doc.
+
+    ``path`` may also be a glob pattern naming the single-channel files of one
+    record (e.g. ``rec.*.sac``), read together by obspy.
+    """
     path = Path(path)
+    if is_pattern(path):
+        if not glob.glob(str(path)):
+            raise InputError(f"no record files match {path}")
+        return read_obspy(path)
     if not path.is_file():
         raise InputError(f"record file not found: {path}")
     if path.suffix.lower() == ".npz":
@@ -56,6 +65,11 @@ def read_record(path, key=None):
     if first_line.startswith("PEER"):
         return read_at2_group(path)
     return read_obspy(path)
+
+
+def is_pattern(path):
+    """True if ``path`` is a glob pattern (contains *, ? or [)."""
+    return any(char in str(path) for char in "*?[")
 
 
 # ---------------------------------------------------------------- obspy formats
@@ -138,7 +152,7 @@ def read_at2_group(path):
         stream.append(trace)
     parts = [p.strip() for p in prefix.split(",")]
     info = {"event": parts[0]} if parts and parts[0] else {}
-    if len(parts) >= 3:
+    if len(parts) >= 2:
         info["station"] = parts[-1]
     return stream, info
 

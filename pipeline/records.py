@@ -14,6 +14,7 @@ stay mutually consistent (trapezoidal integrals of each other).
 Outputs in ``results/records/``: ``<id>.npz`` (format in README.md),
 ``records.csv`` (Table 1) and ``<id>.png`` (like the paper's Fig. 8).
 """
+import glob
 import json
 import re
 import sys
@@ -28,7 +29,7 @@ from scipy.integrate import cumulative_trapezoid, trapezoid
 
 from pipeline import files
 from pipeline.files import InputError
-from pipeline.readers import G, read_record
+from pipeline.readers import G, is_pattern, read_record
 
 REPO = Path(__file__).resolve().parents[1]
 RECORDS_DIR = REPO / "records"
@@ -72,8 +73,8 @@ def _clean(row):
 def processed_motion_path(record, back_azimuth=None, out_dir=None):
     """Path of the processed motion ``.npz`` of ``record``, processing it if needed.
 
-    ``record``: catalogue id, record file path, or processed ``.npz`` (returned as
-    is).  ``back_azimuth`` (degrees) is used only when neither the file nor the
+    ``record``: catalogue id, record file path (or glob pattern of single-channel
+    files such as ``rec.*.sac``), or processed ``.npz`` (returned as is).  ``back_azimuth`` (degrees) is used only when neither the file nor the
     catalogue gives coordinates or a back azimuth.  Results are cached by a hash
     of the input file(s), catalogue row, back azimuth and processing parameters.
     """
@@ -388,6 +389,9 @@ def _display_path(path):
 def _resolve(record):
     """dict(id, path, row, processed) for a catalogue id, record file or processed npz."""
     path = Path(record)
+    if is_pattern(path) and glob.glob(str(path)):
+        record_id = re.sub(r"[^A-Za-z0-9_.-]", "_", path.name.split("*")[0].strip("._") or "record")
+        return {"id": record_id, "path": path, "row": None, "processed": False}
     row = None if path.is_file() else _catalog_row(str(record))
     if row is not None:
         path = RECORDS_DIR / row["source_file"]
@@ -409,7 +413,9 @@ def _resolve(record):
 
 
 def _input_files(path):
-    """Files a record depends on (AT2: all sibling AT2 files)."""
+    """Files a record depends on (AT2: all sibling AT2 files; a glob: its matches)."""
+    if is_pattern(path):
+        return [Path(p) for p in sorted(glob.glob(str(path)))]
     if path.suffix.lower() == ".at2":
         return sorted(p for p in path.parent.iterdir() if p.suffix.lower() == ".at2")
     return [path]
