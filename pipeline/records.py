@@ -217,7 +217,7 @@ def build_motion(source, back_azimuth=None, input_hash=None):
         raise InputError(f"{source['path'].name}: sampling too coarse for the "
                          f"{freqmin:g}-{freqmax:g} Hz band")
     acc, vel, disp = process_acceleration(enz, dt, freqmin, freqmax)
-    meta = _motion_meta(source, row, info, back_azimuth, needs_vertical, enz)
+    meta = _motion_meta(source, row, info, back_azimuth, needs_vertical)
     meta["processing"] = dict(PROCESSING, freqmin_hz=freqmin, freqmax_hz=freqmax,
                               input_hash=input_hash)
     return {"dt": dt, "acc": acc, "vel": vel, "disp": disp, "meta": meta}
@@ -336,7 +336,7 @@ def _apply_catalog_orientation(stream, row, path):
         trace.stats.azimuth = azimuth % 360.0
 
 
-def _motion_meta(source, row, info, back_azimuth, has_vertical, enz):
+def _motion_meta(source, row, info, back_azimuth, has_vertical):
     def pick(key):
         return row.get(key) if row.get(key) is not None else info.get(key)
 
