@@ -1,0 +1,455 @@
+"""Rigid rectangular block rocking in a plane: the reference the YADE model is verified against.
+
+Theory after Housner (1963), Zhang & Makris (2000) and Augusti & Sinopoli (1992),
+as summarised in Hinzen (2009), eqs 1-8.  Pure numpy/scipy; the equations of
+motion are integrated with ``scipy.integrate.solve_ivp`` and its events
+(impacts, peaks, overturning, uplift).
+
+Block: width b (m, in the rocking plane), height h (m), homogeneous.
+alpha = atan(b/h) (rad), R = half-diagonal (m), p = sqrt(3 g / (4 R)) (1/s),
+I0 = (4/3) m R^2 about a base corner.
+
+Sign convention (x = East): theta (rad) > 0 is rotation about the East (+x) base
+corner, the block leaning East; theta < 0 about the West corner.  With the
+horizontal ground acceleration a_g (m/s^2, positive East) the equation is
+
+    I0 theta'' = -m R [ g sin(alpha sgn(theta) - theta) + a_g cos(alpha sgn(theta) - theta) ]
+
+so a positive (East) a_g, whose inertial force points West, rocks the block onto
+its West corner (theta < 0).  The block uplifts from rest when |a_g| > g tan(alpha),
+towards the side -sign(a_g).  At each impact (theta crossing 0) the angular
+velocity is multiplied by the coefficient of restitution eta; the block is put
+back to rest when the angular velocity after an impact drops below a tiny
+threshold (the impact sequence of a settling block is infinite but converges).
+It has overturned when |theta| reaches pi/2 (its side strikes the ground).
+
+Coefficient of restitution: Housner's exact rectangular-block value
+eta = 1 - 1.5 sin^2(alpha) (angular momentum conserved about the new corner),
+with the kinetic-energy ratio r = eta^2 (paper eq 4).  The paper's eq 5 is the
+slender-block form eta ~ 1 - 1.5 (b/h)^2 ~ 1 - 1.5 alpha^2; we use the exact
+sin^2(alpha) form everywhere (for alpha = 0.25: 0.9082 vs 0.9063).
+
+Time series returned by the integrators are sampled every ``dt_out`` seconds,
+plus the states at every event; at an impact the time appears twice, with the
+angular velocity before and after the impact.
+"""
+import math
+
+import numpy as np
+from scipy.integrate import solve_ivp
+
+from pipeline.files import InputError
+
+MODE_NO_OVERTURN = 0
+MODE_OVERTURN_AFTER_IMPACT = 1
+MODE_OVERTURN_WITHOUT_IMPACT = 2
+MODE_NAMES = {MODE_NO_OVERTURN: "no_overturn",
+              MODE_OVERTURN_AFTER_IMPACT: "overturn_after_impact",
+              MODE_OVERTURN_WITHOUT_IMPACT: "overturn_without_impact"}
+
+_RTOL = 1e-10
+_ATOL = 1e-12
+_REST_OMEGA_FRACTION = 1e-7   # rest when |omega| after impact < this * p * alpha
+_MAX_EVENTS = 5000
+_FREE_ROCKING_T_MAX = 1e4     # s, bound only: free rocking stops at its last peak
+
+
+def block_constants(height, width, g=9.81):
+    """Geometry and Housner constants of a rectangular block (h, b in m).
+
+    Returns dict: alpha (rad), R (m, half-diagonal), p (1/s), I0_per_mass
+    (m^2, (4/3) R^2), restitution (Housner eta = 1 - 1.5 sin^2 alpha, for the
+    angular velocity), energy_ratio (r = eta^2), uplift_acc (m/s^2, g tan alpha).
+    """
+    if not (height > 0 and width > 0 and g > 0):
+        raise InputError(f"block height {height}, width {width} and g {g} must be positive")
+    alpha = math.atan(width / height)
+    R = 0.5 * math.hypot(height, width)
+    eta = 1.0 - 1.5 * math.sin(alpha) ** 2
+    return dict(alpha=alpha, R=R, p=math.sqrt(3.0 * g / (4.0 * R)),
+                I0_per_mass=4.0 / 3.0 * R ** 2, restitution=eta,
+                energy_ratio=eta ** 2, uplift_acc=g * math.tan(alpha))
+
+
+def housner_closed_form(theta0_ratio, r, n):
+    """Paper eq 6 (Housner 1963, linearised block): amplitudes theta_k / alpha.
+
+    theta_k / alpha = 1 - sqrt(1 - r^k (1 - (1 - theta0/alpha)^2)) for
+    k = 0..n, k = number of impacts so far; r = kinetic-energy ratio per impact.
+    """
+    k = np.arange(n + 1)
+    return 1.0 - np.sqrt(1.0 - r ** k * (1.0 - (1.0 - theta0_ratio) ** 2))
+
+
+def housner_half_periods(height, width, theta0_ratio, n, r=None, g=9.81):
+    """Paper eq 7 (linearised block): duration (s) of half-cycles k = 0..n.
+
+    T_k / 2 = (2 / p) artanh( sqrt(r^k (1 - (1 - theta0/alpha)^2)) ), the time
+    the block needs to swing from theta = 0 out to amplitude theta_k and back.
+    Released from rest at theta0, the first impact comes after T_0 / 4; impact
+    k + 1 follows impact k after T_k / 2.  r defaults to Housner's eta^2.
+    """
+    c = block_constants(height, width, g)
+    r = c["energy_ratio"] if r is None else r
+    k = np.arange(n + 1)
+    return 2.0 / c["p"] * np.arctanh(np.sqrt(r ** k * (1.0 - (1.0 - theta0_ratio) ** 2)))
+
+
+def housner_free_rocking(height, width, theta0, n_impacts=10, restitution=None, g=9.81,
+                         linearised=False, dt_out=0.001):
+    """Free rocking released from rest at theta0 (rad, != 0), Housner's equation.
+
+    ``linearised`` uses theta'' = p^2 (theta - alpha sgn theta) instead of the
+    full nonlinear equation.  Integrates up to the peak after impact n_impacts.
+
+    Returns dict: t (s), theta (rad), omega (rad/s) samples; impact_times (s),
+    impact_omega_before, impact_omega_after (rad/s); peak_times (s), peak_theta
+    (rad, signed; index k = amplitude after k impacts, index 0 = theta0),
+    peak_ratio (|peak| / alpha); alpha, p, restitution, overturned (bool).
+    """
+    c = block_constants(height, width, g)
+    if theta0 == 0:
+        raise InputError("free rocking needs a non-zero initial tilt theta0")
+    out = _integrate(c, None, _FREE_ROCKING_T_MAX, theta0, 0.0, _restitution(c, restitution), g,
+                     max_impacts=n_impacts, still_after=None, linearised=linearised,
+                     dt_out=dt_out)
+    peak_t = np.concatenate([[0.0], out["peak_times"]])
+    peak_theta = np.concatenate([[float(theta0)], out["peak_theta"]])
+    return dict(t=out["t"], theta=out["theta"], omega=out["omega"],
+                impact_times=out["impact_times"],
+                impact_omega_before=out["impact_omega_before"],
+                impact_omega_after=out["impact_omega_after"],
+                peak_times=peak_t, peak_theta=peak_theta,
+                peak_ratio=np.abs(peak_theta) / c["alpha"], alpha=c["alpha"], p=c["p"],
+                restitution=out["restitution"], overturned=out["overturned"])
+
+
+def rocking_response(height, width, acc_func, t_end, restitution=None, g=9.81, theta0=0.0,
+                     omega0=0.0, still_after=None, dt_out=0.005, rest_max_step=1e-3):
+    """Rocking of the rigid block under a horizontal ground acceleration.
+
+    acc_func(t) -> a_g (m/s^2, positive East), called with scalar t (s).
+    Integrates from t = 0 to t_end (s) or until the block overturns.  If
+    ``still_after`` (s) is given, a_g is taken as 0 from then on and the run
+    stops early once the outcome is certain (a swing peaks below alpha, or the
+    block rests).  While resting, the uplift condition |a_g| > g tan(alpha) is
+    watched with steps of at most rest_max_step (s).
+
+    Returns dict: t (s), theta (rad), omega (rad/s) samples; impact_times (s);
+    uplift_times (s); peak_times (s), peak_theta (rad); overturned (bool);
+    overturn_direction (+1 East, -1 West, 0 none); overturn_time (s or nan);
+    n_impacts (before overturning, or in total); first_side (+1/-1 side of the
+    first uplift, 0 if none); max_abs_theta (rad); stop_reason (str);
+    alpha, p, restitution.
+    """
+    c = block_constants(height, width, g)
+    if not t_end > 0:
+        raise InputError(f"t_end must be positive, got {t_end}")
+    return _integrate(c, acc_func, t_end, theta0, omega0, _restitution(c, restitution), g,
+                      max_impacts=None, still_after=still_after, linearised=False,
+                      dt_out=dt_out, rest_max_step=rest_max_step)
+
+
+def sine_pulse(amplitude, omega, psi):
+    """One-sine ground acceleration (m/s^2): a(t) = A sin(omega t + psi) for
+    0 <= t <= (2 pi - psi) / omega, i.e. the sine cycle from phase psi up to
+    phase 2 pi, zero afterwards.  Returns (acc_func, pulse_end_s)."""
+    t_pulse = (2.0 * math.pi - psi) / omega
+
+    def acc(t):
+        return amplitude * math.sin(omega * t + psi) if 0.0 <= t <= t_pulse else 0.0
+    return acc, t_pulse
+
+
+def sine_pulse_response(height, width, amplitude_ratio, omega_ratio, psi=None,
+                        restitution=None, g=9.81, t_after=30.0, dt_out=0.005):
+    """Block under a one-sine pulse a_g = A sin(omega t + psi) (Zhang & Makris 2000).
+
+    A = amplitude_ratio * alpha * g (m/s^2, > 0: the first half-cycle pushes the
+    block West, theta < 0), omega = omega_ratio * p (rad/s).  psi (rad) defaults
+    to asin(g tan(alpha) / A), the phase at which uplift starts, placed at t = 0;
+    the pulse runs to phase 2 pi (the part before uplift moves nothing).  If
+    A <= g tan(alpha) the block never uplifts (psi = 0).
+
+    Returns the rocking_response dict plus: mode (int, MODE_*), mode_name,
+    relative_direction (+1 overturned towards the side of the first push,
+    -1 away from it, 0 not overturned), psi (rad), pulse_end (s),
+    amplitude (m/s^2), omega (rad/s).
+    """
+    c = block_constants(height, width, g)
+    amplitude = amplitude_ratio * c["alpha"] * g
+    omega = omega_ratio * c["p"]
+    if not (amplitude > 0 and omega > 0):
+        raise InputError("sine pulse amplitude and frequency ratios must be positive")
+    if psi is None:
+        psi = math.asin(c["uplift_acc"] / amplitude) if amplitude > c["uplift_acc"] else 0.0
+    acc, t_pulse = sine_pulse(amplitude, omega, psi)
+    out = _integrate(c, acc, t_pulse + t_after, 0.0, 0.0, _restitution(c, restitution), g,
+                     max_impacts=None, still_after=t_pulse, linearised=False, dt_out=dt_out,
+                     rest_max_step=min(1e-3, t_pulse / 200.0))
+    if not out["overturned"]:
+        mode = MODE_NO_OVERTURN
+    elif out["n_impacts"] > 0:
+        mode = MODE_OVERTURN_AFTER_IMPACT
+    else:
+        mode = MODE_OVERTURN_WITHOUT_IMPACT
+    out.update(mode=mode, mode_name=MODE_NAMES[mode],
+               relative_direction=out["overturn_direction"] * out["first_side"],
+               psi=psi, pulse_end=t_pulse, amplitude=amplitude, omega=omega)
+    return out
+
+
+def overturning_map(height, width, amplitude_ratios, omega_ratios, restitution=None, g=9.81):
+    """Outcome of one-sine pulses over a grid (like Zhang & Makris 2000, Fig. 6).
+
+    Returns dict: mode (int array, shape (len(omega_ratios), len(amplitude_ratios)),
+    MODE_* codes), n_impacts (int array, impacts before overturning or in total),
+    relative_direction (int array), amplitude_ratios, omega_ratios (1-D arrays),
+    mode_names (dict code -> name).
+    """
+    amps = np.asarray(amplitude_ratios, float)
+    omegas = np.asarray(omega_ratios, float)
+    shape = (omegas.size, amps.size)
+    mode = np.zeros(shape, int)
+    impacts = np.zeros(shape, int)
+    direction = np.zeros(shape, int)
+    for i, w in enumerate(omegas):
+        for j, a in enumerate(amps):
+            out = sine_pulse_response(height, width, a, w, restitution=restitution, g=g,
+                                      dt_out=None)
+            mode[i, j] = out["mode"]
+            impacts[i, j] = out["n_impacts"]
+            direction[i, j] = out["relative_direction"]
+    return dict(mode=mode, n_impacts=impacts, relative_direction=direction,
+                amplitude_ratios=amps, omega_ratios=omegas, mode_names=dict(MODE_NAMES))
+
+
+def mode_edges(height, width, omega_ratio, amplitude_ratios, restitution=None, g=9.81,
+               tol=1e-3):
+    """Amplitude ratios (A / (alpha g)) where the one-sine-pulse mode changes.
+
+    Scans ``amplitude_ratios`` (increasing) and bisects every change of mode to
+    ``tol``.  Returns a list of dicts: lower (ratio just below the edge),
+    upper (just above), mode_below, mode_above (names).
+    """
+    def mode_at(a):
+        return sine_pulse_response(height, width, a, omega_ratio, restitution=restitution,
+                                   g=g, dt_out=None)["mode"]
+
+    amps = np.asarray(amplitude_ratios, float)
+    modes = [mode_at(a) for a in amps]
+    edges = []
+    for k in range(len(amps) - 1):
+        lo, hi, m_lo, m_hi = amps[k], amps[k + 1], modes[k], modes[k + 1]
+        if m_lo == m_hi:
+            continue
+        while hi - lo > tol:
+            mid = 0.5 * (lo + hi)
+            if mode_at(mid) == m_lo:
+                lo = mid
+            else:
+                hi = mid
+        edges.append(dict(lower=lo, upper=hi, mode_below=MODE_NAMES[m_lo],
+                          mode_above=MODE_NAMES[mode_at(hi)]))
+    return edges
+
+
+def augusti_sinopoli_mu_min(width, height):
+    """Paper eq 8 (Augusti & Sinopoli 1992): static friction needed for pure rocking.
+
+    mu_s > 3 (b/h) / (4 + (b/h)^2) = 3 sin(alpha) cos(alpha) / (4 - 3 sin^2 alpha).
+    This is, for a rigid block rocking about a corner at theta = 0, both the
+    ratio of base friction to normal force when rocking starts from rest
+    (omega = 0; demand falls as the release angle grows) and the ratio of
+    horizontal to vertical base impulse of a Housner impact (see
+    impact_friction_demand).  Dimensionless.
+    """
+    ratio = width / height
+    return 3.0 * ratio / (4.0 + ratio ** 2)
+
+
+def impact_friction_demand(width, height, restitution=None):
+    """Horizontal / vertical base impulse of a rigid-block impact (dimensionless).
+
+    Linear momentum of the centre of mass before and after an impact with
+    angular velocity ratio eta gives |P_x| / P_z = (1 - eta) / ((1 + eta) tan alpha).
+    With Housner's eta = 1 - 1.5 sin^2 alpha this equals eq 8; a lossier impact
+    (smaller eta) demands more friction: the friction needed to avoid sliding
+    at impact in a model whose impacts dissipate more than Housner's.
+    """
+    c = block_constants(height, width)
+    eta = c["restitution"] if restitution is None else restitution
+    return (1.0 - eta) / ((1.0 + eta) * math.tan(c["alpha"]))
+
+
+def restitution_from_peaks(peaks, alpha):
+    """Effective restitution from successive peak amplitudes (rad) of free rocking.
+
+    peaks[k] = |theta| at the peak after k impacts.  Energy at impact
+    k+1 is proportional to cos(alpha - theta_k) - cos(alpha) (exact rigid block),
+    so the per-impact angular-velocity ratio is
+    eta_k = sqrt(E_{k+1} / E_k).  Returns dict: eta_per_impact, r_per_impact
+    (arrays), eta, r (overall geometric means over all impacts).
+    """
+    peaks = np.abs(np.asarray(peaks, float))
+    if peaks.size < 2 or np.any(peaks >= alpha) or np.any(peaks <= 0):
+        raise InputError("need >= 2 peak amplitudes, all between 0 and alpha")
+    energy = np.cos(alpha - peaks) - math.cos(alpha)
+    r_k = energy[1:] / energy[:-1]
+    r = (energy[-1] / energy[0]) ** (1.0 / (peaks.size - 1))
+    return dict(eta_per_impact=np.sqrt(r_k), r_per_impact=r_k, eta=math.sqrt(r), r=r)
+
+
+def _restitution(c, restitution):
+    eta = c["restitution"] if restitution is None else float(restitution)
+    if not 0.0 <= eta <= 1.0:
+        raise InputError(f"coefficient of restitution must lie in [0, 1], got {eta}")
+    return eta
+
+
+def _event(func, direction, terminal):
+    func.direction = direction
+    func.terminal = terminal
+    return func
+
+
+def _integrate(c, acc_func, t_end, theta0, omega0, eta, g, max_impacts, still_after,
+               linearised, dt_out, rest_max_step=1e-3):
+    """Hybrid integration: rest / rocking segments joined at impacts and uplifts."""
+    alpha, p2 = c["alpha"], c["p"] ** 2
+    omega_rest = _REST_OMEGA_FRACTION * c["p"] * alpha
+
+    def acc(t):
+        if acc_func is None or (still_after is not None and t >= still_after):
+            return 0.0
+        return float(acc_func(t))
+
+    samples_t, samples_y = [], []
+    impacts, omega_before, omega_after = [], [], []
+    uplifts, peak_t, peak_theta = [], [], []
+    t = 0.0
+    theta, omega = float(theta0), float(omega0)
+    side = int(np.sign(theta) or np.sign(omega))
+    resting = side == 0
+    overturned, overturn_time, stop_reason = False, math.nan, "t_end"
+    max_abs = abs(theta)
+
+    def sample_grid(t_a, t_b):
+        if dt_out is None:
+            return None
+        k0 = math.ceil(t_a / dt_out - 1e-9)
+        k1 = math.floor(t_b / dt_out + 1e-9)
+        return np.arange(k0, k1 + 1) * dt_out if k1 >= k0 else np.empty(0)
+
+    for _ in range(_MAX_EVENTS):
+        if t >= t_end:
+            break
+        if resting:
+            if abs(acc(t)) >= c["uplift_acc"] * (1.0 - 1e-12):
+                side = -int(np.sign(acc(t)))
+                resting = False
+                uplifts.append(t)
+                continue
+            if still_after is not None and t >= still_after:
+                stop_reason = "rest"
+                break
+            t_stop = t_end if still_after is None else min(t_end, still_after)
+            uplift = _event(lambda tt, y: abs(acc(tt)) - c["uplift_acc"], 1, True)
+            sol = solve_ivp(lambda tt, y: [0.0, 0.0], (t, t_stop), [0.0, 0.0],
+                            events=uplift, max_step=rest_max_step)
+            grid = sample_grid(t, sol.t[-1])
+            if grid is not None:
+                samples_t.append(grid)
+                samples_y.append(np.zeros((2, grid.size)))
+            if sol.status == 1:
+                t = float(sol.t_events[0][0])
+                side = -int(np.sign(acc(t)))
+                resting = False
+                uplifts.append(t)
+            else:
+                t = t_stop
+            continue
+
+        free = still_after is not None and t >= still_after
+        t_stop = t_end if (still_after is None or free) else min(t_end, still_after)
+        last_swing = max_impacts is not None and len(impacts) >= max_impacts
+        s = side
+
+        if linearised:
+            def rhs(tt, y):
+                return [y[1], -p2 * (s * alpha - y[0] + acc(tt) / g)]
+        else:
+            def rhs(tt, y):
+                phi = s * alpha - y[0]
+                return [y[1], -p2 * (math.sin(phi) + acc(tt) / g * math.cos(phi))]
+
+        impact = _event(lambda tt, y: y[0], -s, True)
+        fallen = _event(lambda tt, y: s * y[0] - 0.5 * math.pi, 1, True)
+        # a segment starting at rest would trigger its own peak event at once
+        peak = _event(lambda tt, y: y[1], -s, (free or last_swing) and omega != 0)
+        t_start = t
+        sol = solve_ivp(rhs, (t, t_stop), [theta, omega], method="DOP853", rtol=_RTOL,
+                        atol=_ATOL, events=(impact, fallen, peak), dense_output=True)
+        grid = sample_grid(t_start, sol.t[-1])
+        if grid is not None:
+            samples_t.append(grid)
+            samples_y.append(sol.sol(grid))
+        max_abs = max(max_abs, float(np.max(np.abs(sol.y[0]))))
+        for tp, yp in zip(sol.t_events[2], sol.y_events[2]):
+            if tp > t_start:
+                peak_t.append(float(tp))
+                peak_theta.append(float(yp[0]))
+                max_abs = max(max_abs, abs(float(yp[0])))
+        t, (theta, omega) = float(sol.t[-1]), sol.y[:, -1]
+        if sol.status != 1:  # reached t_stop: end of run or start of the still phase
+            continue
+        if sol.t_events[1].size:
+            overturned, overturn_time, stop_reason = True, float(sol.t_events[1][0]), "overturned"
+            max_abs = 0.5 * math.pi
+            break
+        if sol.t_events[2].size and sol.t_events[2][-1] > t_start and (free or last_swing):
+            stop_reason = "safe" if free else "max_impacts"
+            t, (theta, omega) = float(sol.t_events[2][-1]), sol.y_events[2][-1]
+            _append_state(samples_t, samples_y, dt_out, t, theta, omega)
+            break
+        # impact: theta = 0, angular velocity reduced, pivot changes side
+        t, omega_in = float(sol.t_events[0][0]), float(sol.y_events[0][0][1])
+        impacts.append(t)
+        omega_before.append(omega_in)
+        omega_out = eta * omega_in
+        omega_after.append(omega_out)
+        _append_state(samples_t, samples_y, dt_out, t, 0.0, omega_in)
+        theta, omega, side = 0.0, omega_out, -s
+        if abs(omega_out) < omega_rest:
+            omega, resting = 0.0, True
+        _append_state(samples_t, samples_y, dt_out, t, 0.0, omega)
+    else:
+        raise RuntimeError(f"rocking integration exceeded {_MAX_EVENTS} events")
+
+    if samples_t:
+        ts = np.concatenate(samples_t)
+        ys = np.concatenate(samples_y, axis=1)
+    else:
+        ts, ys = np.empty(0), np.empty((2, 0))
+    return dict(t=ts, theta=ys[0], omega=ys[1],
+                impact_times=np.array(impacts), impact_omega_before=np.array(omega_before),
+                impact_omega_after=np.array(omega_after), uplift_times=np.array(uplifts),
+                peak_times=np.array(peak_t), peak_theta=np.array(peak_theta),
+                overturned=overturned,
+                overturn_direction=int(np.sign(theta)) if overturned else 0,
+                overturn_time=overturn_time, n_impacts=len(impacts),
+                first_side=_first_side(uplifts, theta0, omega0, acc),
+                max_abs_theta=max_abs, stop_reason=stop_reason, alpha=alpha, p=c["p"],
+                restitution=eta)
+
+
+def _first_side(uplifts, theta0, omega0, acc):
+    if theta0 or omega0:
+        return int(np.sign(theta0) or np.sign(omega0))
+    return -int(np.sign(acc(uplifts[0]))) if uplifts else 0
+
+
+def _append_state(samples_t, samples_y, dt_out, t, theta, omega):
+    if dt_out is not None:
+        samples_t.append(np.array([t]))
+        samples_y.append(np.array([[theta], [omega]]))
