@@ -67,7 +67,7 @@ def column_outcomes(trajectory):
             if hits.size:
                 k = hits[0]
                 point = pos[k, j, :2] - origin
-                entry.update(impact_time_s=float(t[k]), impact_point_m=point.round(4).tolist(),
+                entry.update(impact_time_s=float(t[k]), impact_point_m=point.tolist(),
                              azimuth_deg=azimuth_deg(*point))
             bodies.append(entry)
         if not bodies:
@@ -84,7 +84,7 @@ def column_outcomes(trajectory):
             centre = weights @ points / weights.sum()
             result.update(downfall_azimuth_deg=azimuth_deg(*centre),
                           impact_time_s=min(b["impact_time_s"] for b in struck),
-                          impact_point_m=centre.round(4).tolist())
+                          impact_point_m=centre.tolist())
         results.append(result)
     return results
 

@@ -95,7 +95,7 @@ def add_command(subparsers):
     p.add_argument("--mu-s", type=float, default=0.7, help="static friction (default 0.7)")
     p.add_argument("--mu-k", type=float, default=0.6, help="kinetic friction (default 0.6)")
     p.add_argument("--kn", type=float, default=1.2e8,
-                   help="normal stiffness of a face contact, N/m (default 1.2e8)")
+                   help="normal stiffness per rim contact point, N/m (default 1.2e8)")
     p.add_argument("--damping", type=float, default=0.36, help="contact damping ratio (0.36)")
     p.add_argument("--back-azimuth", type=float, default=None, metavar="DEG",
                    help="back azimuth to the epicentre when the record does not give it")

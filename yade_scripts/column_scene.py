@@ -55,13 +55,14 @@ def yade_quaternion(R):
 
 
 def contact_material(mass, n_points):
-    """ViscElMat giving a face contact of total normal stiffness kn shared by n_points.
+    """ViscElMat for rim contact points of normal stiffness kn each (N/m per point).
 
     Two materials combine in series, so each carries twice the per-point values.
-    Damping: ratio zeta of critical for the body's mass on the whole face.
+    Damping: ratio zeta of critical for the body's mass on a face of n_points points,
+    c = 2 zeta sqrt(kn m / n_points) per point.
     """
-    k_point = CONTACT["kn"] / n_points
-    c_point = 2 * CONTACT["damping"] * math.sqrt(CONTACT["kn"] * mass) / n_points
+    k_point = CONTACT["kn"]
+    c_point = 2 * CONTACT["damping"] * math.sqrt(k_point * mass / n_points)
     return O.materials.append(ViscElMat(
         density=1e-3, kn=2 * k_point, ks=2 * k_point, cn=2 * c_point, cs=2 * c_point,
         frictionAngle=math.atan(CONTACT["mu_s"])))
@@ -178,7 +179,8 @@ if P.get("block"):
     bodies.append(dict(shape, name="block", column="block", index=0, initial_pos=list(centre)))
 
 # ---------------------------------------------------------------- time step
-k_face = CONTACT["kn"]
+# a body resting on a whole face of rim points: stiffness kn x points
+k_face = CONTACT["kn"] * P["rim_points"]
 m_min = min(b["mass"] for b in bodies)
 O.dt = P["dt_factor"] * math.sqrt(m_min / k_face)
 
@@ -263,15 +265,17 @@ def record_state():
 
 
 def check_stop():
-    """Stop once all bodies rest and either the motion is over or every column has fallen."""
+    """Stop once the standing bodies rest and either the motion is over or every column
+    has fallen.  Bodies lying on the pedestal (tilt > 60 deg) may roll on: their impact
+    is recorded already and a rolling cylinder takes long to stop."""
     v_rest, length = P["rest_velocity"], P["rest_length"]
     rel = pedestal_state.vel
-    at_rest = all((s.vel - rel).norm() < v_rest and s.angVel.norm() * length < v_rest
-                  for s in states)
-    fallen = {}
+    at_rest, fallen = True, {}
     for b, s, c in zip(bodies, states, clumps):
-        axis_z = (s.ori * body_offset[c] * Vector3(0, 0, 1))[2]
-        fallen[b["column"]] = fallen.get(b["column"], False) or axis_z < 0.5   # tilt > 60 deg
+        lying = (s.ori * body_offset[c] * Vector3(0, 0, 1))[2] < 0.5
+        fallen[b["column"]] = fallen.get(b["column"], False) or lying
+        if not lying and ((s.vel - rel).norm() >= v_rest or s.angVel.norm() * length >= v_rest):
+            at_rest = False
     if at_rest and (O.time > motion_end or all(fallen.values())):
         if state["rest_since"] is None:
             state["rest_since"] = O.time

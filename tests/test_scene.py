@@ -1,0 +1,112 @@
+"""YADE scene physics: symmetry, no uplift below g tan(alpha), energy, early stop.
+
+Each test runs YADE on a small scene for a few simulated seconds.
+"""
+import math
+
+import numpy as np
+import pytest
+
+from pipeline import outcome, scenario
+from pipeline.run import rotate_horizontal
+
+pytestmark = pytest.mark.yade
+G = 9.81
+
+
+def pulse(azimuth_deg, amplitude, period=1.0, duration=6.0, dt=0.005):
+    """One-sine acceleration pulse along an azimuth with its exact displacement."""
+    t = np.arange(0.0, duration, dt)
+    w = 2 * math.pi / period
+    on = t < period
+    acc = np.where(on, amplitude * np.sin(w * t), 0.0)
+    disp = np.where(on, amplitude / w * (t - np.sin(w * t) / w), amplitude / w * period)
+    u = np.array([math.sin(math.radians(azimuth_deg)), math.cos(math.radians(azimuth_deg)), 0.0])
+    return {"dt": dt, "acc": acc[:, None] * u, "disp": disp[:, None] * u}
+
+
+def run(tmp_path, name, columns, motion=None, **options):
+    duration = 0.0 if motion is None else (len(motion["acc"]) - 1) * motion["dt"]
+    params = scenario.scene_params(columns=columns, motion_duration=duration, **options)
+    scenario.write_scenario(tmp_path / name, params, motion)
+    return scenario.run_yade(tmp_path / name)
+
+
+def axial_gap(a, b):
+    """Angle (deg) between two azimuths regardless of sense, in [0, 90]."""
+    d = abs((a - b + 90) % 180 - 90)
+    return d
+
+
+@pytest.fixture(scope="module")
+def pulse_runs(tmp_path_factory):
+    """A single monolith shaken by the same strong pulse along N and turned by 90 deg."""
+    tmp = tmp_path_factory.mktemp("pulse")
+    base = pulse(0.0, 5.0)
+    turned = dict(base, acc=rotate_horizontal(base["acc"], 90.0),
+                  disp=rotate_horizontal(base["disp"], 90.0))
+    mono = scenario.column_specs("monolithic", hd=6.0)
+    return [outcome.column_outcomes(run(tmp, n, mono, m))[0] for n, m in (("n", base), ("e", turned))]
+
+
+def test_column_shaken_along_azimuth_falls_in_its_plane(pulse_runs):
+    north, _ = pulse_runs
+    assert north["toppled"]
+    assert axial_gap(north["downfall_azimuth_deg"], 0.0) < 5.0
+    # falling about its base edge (radius d/2) the centre of mass lands about
+    # d/2 + H/2 from the axis
+    assert math.hypot(*north["impact_point_m"]) == pytest.approx(3.5 / 12 + 1.75, abs=0.2)
+
+
+def test_turning_the_motion_turns_the_downfall_azimuth(pulse_runs):
+    north, east = pulse_runs
+    assert east["toppled"]
+    turned = (east["downfall_azimuth_deg"] - north["downfall_azimuth_deg"]) % 360
+    assert turned == pytest.approx(90.0, abs=2.0)
+
+
+def test_no_uplift_below_g_tan_alpha(tmp_path):
+    """A 2 Hz sine of 0.8 g tan(alpha) must not lift the monolith (rigid-block theory);
+    1.5 g tan(alpha) must."""
+    hd = 6.0
+    threshold = G / hd          # g tan(alpha), tan(alpha) = d / h
+    tilts = []
+    for factor in (0.8, 1.5):
+        t = np.arange(0, 3.0, 0.005)
+        a = factor * threshold * np.sin(2 * math.pi * 2.0 * t)
+        d = -a / (2 * math.pi * 2.0) ** 2
+        motion = {"dt": 0.005, "acc": np.column_stack([a, 0 * a, 0 * a]),
+                  "disp": np.column_stack([d, 0 * d, 0 * d])}
+        traj = run(tmp_path, f"f{factor}", scenario.column_specs("monolithic", hd=hd), motion)
+        tilts.append(outcome.column_outcomes(traj)[0]["max_tilt_deg"])
+    assert tilts[0] < 0.05          # elastic contact compression only
+    assert tilts[1] > 0.5
+
+
+def test_free_rocking_energy_never_grows_and_early_stop(tmp_path):
+    """A released block on a still base: kinetic + potential energy never rises above
+    its earlier maximum (beyond the contact spring's share) and the run stops at rest."""
+    h, b = 0.4, 0.08
+    alpha = math.atan(b / h)
+    params = scenario.scene_params(
+        block={"height": h, "width": b, "depth": 0.045, "density": 2960.0,
+               "theta0_rad": 0.8 * alpha}, t_max=20.0, kn=1.2e7, rest_duration_s=0.3)
+    scenario.write_scenario(tmp_path / "blk", params)
+    traj = scenario.run_yade(tmp_path / "blk")
+    energy = outcome.total_energy(traj)
+    released = energy[0] - energy.min()
+    rise = np.max(energy - np.maximum.accumulate(energy))
+    assert rise <= 0.01 * released
+    assert energy[-1] < energy[0] - 0.9 * released      # rocking dies out
+    assert traj["stopped_early"] and traj["t"][-1] < 10.0
+
+
+def test_twin_model_falls_in_the_pulse_plane_and_stops_early(tmp_path):
+    traj = run(tmp_path, "twin", scenario.column_specs("both"), pulse(30.0, 5.0))
+    cols = {c["column"]: c for c in outcome.column_outcomes(traj)}
+    for col in cols.values():
+        assert col["toppled"]
+        assert axial_gap(col["downfall_azimuth_deg"], 30.0) < 15.0
+    # the twin columns stand 3 m apart and start at their own positions
+    assert cols["drums"]["position_m"] == [-1.5, 0.0]
+    assert traj["stopped_early"]
