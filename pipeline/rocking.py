@@ -391,7 +391,7 @@ def _integrate(c, acc_func, t_end, theta0, omega0, eta, g, max_impacts, still_af
         sol = solve_ivp(rhs, (t, t_stop), [theta, omega], method="DOP853", rtol=_RTOL,
                         atol=_ATOL, events=(impact, fallen, peak), dense_output=True)
         grid = sample_grid(t_start, sol.t[-1])
-        if grid is not None:
+        if grid is not None and grid.size:
             samples_t.append(grid)
             samples_y.append(sol.sol(grid))
         max_abs = max(max_abs, float(np.max(np.abs(sol.y[0]))))
