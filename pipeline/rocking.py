@@ -137,7 +137,7 @@ def rocking_response(height, width, acc_func, t_end, restitution=None, g=9.81, t
 
     Returns dict: t (s), theta (rad), omega (rad/s) samples; impact_times (s);
     uplift_times (s); peak_times (s), peak_theta (rad); overturned (bool);
-    overturn_direction (+1 East, -1 West, 0 none); overturn_time (s or nan);
+    overturn_direction (+1 East, -1 West, 0 none); overturn_time (s, None if not);
     n_impacts (before overturning, or in total); first_side (+1/-1 side of the
     first uplift, 0 if none); max_abs_theta (rad); stop_reason (str);
     alpha, p, restitution.
@@ -249,7 +249,7 @@ def mode_edges(height, width, omega_ratio, amplitude_ratios, restitution=None, g
                 lo = mid
             else:
                 hi = mid
-        edges.append(dict(lower=lo, upper=hi, mode_below=MODE_NAMES[m_lo],
+        edges.append(dict(lower=float(lo), upper=float(hi), mode_below=MODE_NAMES[m_lo],
                           mode_above=MODE_NAMES[mode_at(hi)]))
     return edges
 
@@ -331,7 +331,7 @@ def _integrate(c, acc_func, t_end, theta0, omega0, eta, g, max_impacts, still_af
     theta, omega = float(theta0), float(omega0)
     side = int(np.sign(theta) or np.sign(omega))
     resting = side == 0
-    overturned, overturn_time, stop_reason = False, math.nan, "t_end"
+    overturned, overturn_time, stop_reason = False, None, "t_end"
     max_abs = abs(theta)
 
     def sample_grid(t_a, t_b):
