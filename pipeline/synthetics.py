@@ -39,7 +39,7 @@ from tqdm import tqdm
 from pipeline import files
 from pipeline.files import InputError
 
-GENERATOR_VERSION = 1
+GENERATOR_VERSION = 2  # bump when the written motions change
 PYPROP8_VERSION = importlib.metadata.version("pyprop8")
 DEFAULT_OUT_DIR = Path("results/synthetics")
 QUICK_OUT_DIR = Path("results/synthetics-quick")
