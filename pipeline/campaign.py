@@ -29,6 +29,7 @@ SLENDERNESS_HD = [round(3.0 + 0.5 * i, 1) for i in range(13)]          # 3.0 .. 
 FRICTION_MU_S = [round(0.1 * i, 1) for i in range(1, 10)]               # 0.1 .. 0.9
 MU_K_OVER_MU_S = 0.84
 PAPER_RECORD = "GM20"                                                   # Kocaeli, Izmit
+SYNTHETIC_SITE_KEYS = ("source", "station", "x_km", "y_km", "ring_km")  # from synthetic meta
 
 
 def code_version():
@@ -131,8 +132,11 @@ def collect(specs, campaign, campaign_dir):
             continue
         summary = json.loads(path.read_text())
         if spec["motion_file"] not in record_params:
-            record_params[spec["motion_file"]] = records.record_parameters(
-                records.load_motion(spec["motion_file"]))
+            motion = records.load_motion(spec["motion_file"])
+            site = {k: motion["meta"][k] for k in SYNTHETIC_SITE_KEYS if k in motion["meta"]}
+            if "station" in site:
+                site["site_id"] = site.pop("station")
+            record_params[spec["motion_file"]] = {**records.record_parameters(motion), **site}
         rp = record_params[spec["motion_file"]]
         p = summary["parameters"]
         base = {"campaign": campaign, "run_id": spec["run_id"], "record_id": summary["record"],
@@ -146,7 +150,7 @@ def collect(specs, campaign, campaign_dir):
                 "impact_time_s": _nan(col["impact_time_s"]), "impact_x_m": point[0],
                 "impact_y_m": point[1], "max_tilt_deg": col["max_tilt_deg"],
                 "base_slip_m": col.get("base_slip_m"),
-                **{k: _nan(v) for k, v in rp.items()},
+                **{k: v if isinstance(v, str) else _nan(v) for k, v in rp.items()},
                 "back_azimuth_deg": _nan(summary["back_azimuth_deg"]),
                 "motion_file": spec["motion_file"],
                 "run_dir": os.path.relpath(runs_dir / spec["run_id"], campaign_dir)})
@@ -195,6 +199,21 @@ def figures(name, runs, impacts, campaign_dir):
     return written
 
 
+def synthetic_outputs(runs, campaign_dir):
+    """Per source: downfall map; tables of downfall minus back azimuth and of the
+    source location inferred from the falls."""
+    from pipeline import synthetics
+    written = []
+    for source in sorted(runs["source"].dropna().unique()):
+        path = Path(campaign_dir) / f"map_{source}.png"
+        synthetics.plot_downfall_map(runs, source, path)
+        written.append(path)
+    write_csv(Path(campaign_dir) / "direction_table.csv", synthetics.direction_table(runs))
+    write_csv(Path(campaign_dir) / "source_location.csv",
+              synthetics.locate_source_from_falls(runs))
+    return written
+
+
 def animate_examples(runs, campaign_dir, count=1):
     """GIF animations of the first toppled runs (the paper's online movies)."""
     from pipeline import animate
@@ -225,9 +244,8 @@ def run_campaign(name, jobs=None, record_ids=None, campaign_dir=None, animations
     write_csv(campaign_dir / "runs.csv", runs)
     write_csv(campaign_dir / "impacts.csv", impacts)
     written = figures(name, runs, impacts, campaign_dir)
-    if name == "synthetic":
-        from pipeline import synthetics
-        written += synthetics.campaign_outputs(runs, campaign_dir)
+    if name == "synthetic" and not runs.empty:
+        written += synthetic_outputs(runs, campaign_dir)
     if animations:
         written += animate_examples(runs, campaign_dir, animations)
     if not runs.empty:
