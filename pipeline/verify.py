@@ -315,6 +315,10 @@ def run_verification_campaign(jobs=1, out_dir=None):
     summary["figures"] = [p.name for p in figures]
     summary["failed_runs"] = [s["run_id"] for s, _ in failures]
     write_json(out_dir / "verification.json", summary)
+    write_json(out_dir / "campaign.json", {"campaign": "verification", "runs": len(specs),
+                                           "code_version": version,
+                                           "failed": summary["failed_runs"],
+                                           "figures": summary["figures"]})
     for line in summary["lines"]:
         print(line)
     if failures:
