@@ -459,6 +459,11 @@ def direction_differences(runs):
     return frame
 
 
+def _wrap(angle_deg, period):
+    """``angle_deg`` wrapped to (-period/2, period/2]."""
+    return float(-((-angle_deg + period / 2) % period - period / 2))
+
+
 def direction_table(runs):
     """Counts and circular statistics of downfall minus back azimuth.
 
@@ -481,10 +486,10 @@ def direction_table(runs):
         for cls in ("toward", "away", "transverse"):
             row[cls] = int((group["direction_class"] == cls).sum())
         if diffs.size:
-            row["mean_diff_deg"] = float(np.degrees(circmean(diffs)))
+            row["mean_diff_deg"] = _wrap(np.degrees(circmean(diffs)), 360.0)
             row["resultant_length"] = float(1.0 - circvar(diffs))
             row["rayleigh_p"] = float(rayleightest(diffs))
-            row["axial_mean_diff_deg"] = float(np.degrees(circmean(2 * diffs)) / 2)
+            row["axial_mean_diff_deg"] = _wrap(np.degrees(circmean(2 * diffs)) / 2, 180.0)
             row["axial_resultant_length"] = float(1.0 - circvar(2 * diffs))
             row["axial_rayleigh_p"] = float(rayleightest(2 * diffs))
         rows.append(row)
@@ -513,8 +518,10 @@ def locate_source_from_falls(runs, extent_km=30.0, step_km=0.25):
     for both column types together ('all'), minimises :func:`axial_misfit`
     over a square grid of half-width ``extent_km`` around the epicentre.
     Returns a DataFrame: n_falls, best_x_km, best_y_km, error_km (to the
-    epicentre at the origin), misfit_best, misfit_epicentre and, for known
-    sources, error_rupture_centre_km (to the middle of the sub-event line).
+    epicentre at the origin), at_grid_edge (True: the minimum is not
+    constrained inside the grid), misfit_best, misfit_epicentre and, for
+    known sources, error_rupture_centre_km (to the middle of the sub-event
+    line).
     """
     frame = direction_differences(runs)
     frame = frame[frame["direction_class"] != "not toppled"]
@@ -532,6 +539,7 @@ def locate_source_from_falls(runs, extent_km=30.0, step_km=0.25):
                 best = np.unravel_index(np.argmin(misfit), misfit.shape)
                 bx, by = float(gx[best]), float(gy[best])
                 row.update({"best_x_km": bx, "best_y_km": by, "error_km": math.hypot(bx, by),
+                            "at_grid_edge": bool(max(abs(bx), abs(by)) >= grid[-1] - 1e-9),
                             "misfit_best": float(misfit[best]),
                             "misfit_epicentre": float(axial_misfit(*args, 0.0, 0.0))})
                 if source in SOURCES:
@@ -607,7 +615,8 @@ def plot_downfall_map(runs, source_name, path, arrow_km=3.0):
         handles += [Line2D([], [], color=colour, lw=2, label=f"{column}: downfall direction"),
                     Line2D([], [], marker="o", mfc="none", mec=colour, ls="none",
                            label=f"{column}: not toppled")]
-    ax.legend(handles=handles, loc="lower right", fontsize=8, framealpha=0.9)
+    ax.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, -0.08), ncol=3,
+              fontsize=8, frameon=False)
     ax.set_xlim(-reach, reach)
     ax.set_ylim(-reach, reach)
     ax.set_aspect("equal")

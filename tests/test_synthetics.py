@@ -249,6 +249,10 @@ def test_direction_table_classifies_hand_made_angles():
                                               "not toppled", "toward", "away"]
     table = syn.direction_table(runs).set_index("column")
     mono, drums = table.loc["monolithic"], table.loc["drums"]
+    # monolithic diffs -10, 180, -45, 135, 90: doubled -20, 0, -90, -90, 180 (by hand)
+    doubled = np.radians([-20, 0, -90, -90, 180])
+    resultant = np.hypot(np.cos(doubled).sum(), np.sin(doubled).sum()) / 5
+    assert mono.axial_resultant_length == pytest.approx(resultant)
     assert (mono.n_runs, mono.n_toppled, mono.toward, mono.away, mono.transverse) == (6, 5, 2, 2, 1)
     # drums: +10 and -170 lie on one axis 10 deg from the back azimuth, in opposite senses
     assert drums.axial_mean_diff_deg == pytest.approx(10.0)
@@ -269,6 +273,7 @@ def test_locate_source_from_falls_finds_the_point_the_falls_align_with():
     assert best.misfit_best == pytest.approx(0.0, abs=1e-12)
     assert best.error_km == pytest.approx(math.hypot(*target))
     assert best.misfit_epicentre > 0.01
+    assert not best.at_grid_edge
 
 
 def test_downfall_map_is_written(tmp_path):
