@@ -259,14 +259,17 @@ def _cache_key(source_name, cfg, num):
 
 
 def generate(source_name, rings_km=(5, 10, 20), azimuth_step_deg=30, duration_s=30.0,
-             sampling_hz=100.0, fmax_hz=10.0, out_dir=None, quick=False, jobs=1):
+             sampling_hz=100.0, fmax_hz=10.0, out_dir=None, quick=False, jobs=None):
     """Compute (or reuse) the synthetic motions of all sites of one source.
 
     ``quick`` lowers fmax to QUICK_FMAX_HZ and the duration to
     QUICK_DURATION_S and writes under results/synthetics-quick (unless
-    ``out_dir`` is given).  ``jobs`` processes share the sub-events.  Returns
-    the npz paths in site_table order; nothing is recomputed when the
-    manifest's cache key (hash of every parameter) matches and all files exist.
+    ``out_dir`` is given).  ``jobs`` processes (default: all cores) share the
+    sub-events.  Returns the npz paths in site_table order; nothing is
+    recomputed when the manifest's cache key (hash of every parameter) matches
+    and all files exist.  Also writes the source's ground-motion-model check
+    (``<source>/gmm_check_sites.csv``) and refreshes the summary of all
+    sources, ``gmm_check.csv``, in the output directory.
     """
     src = source_parameters(source_name)
     cfg = _settings(rings_km, azimuth_step_deg, duration_s, sampling_hz, fmax_hz, out_dir, quick)
@@ -276,9 +279,13 @@ def generate(source_name, rings_km=(5, 10, 20), azimuth_step_deg=30, duration_s=
     source_dir = cfg["base"] / source_name
     manifest_path = source_dir / "manifest.json"
     key = _cache_key(source_name, cfg, num)
-    if manifest_path.is_file() and all(p.is_file() for p in paths):
-        if json.loads(manifest_path.read_text()).get("cache_key") == key:
-            return paths
+    if (manifest_path.is_file() and all(p.is_file() for p in paths)
+            and json.loads(manifest_path.read_text()).get("cache_key") == key):
+        if not (source_dir / "gmm_check_sites.csv").is_file():
+            _write_gmm_check(source_name, cfg)
+        write_gmm_summary(cfg["base"])
+        return paths
+    jobs = jobs or os.cpu_count() or 1
 
     subs = subevents(source_name)
     mechanism = (src["strike_deg"], src["dip_deg"], src["rake_deg"])
@@ -290,7 +297,7 @@ def generate(source_name, rings_km=(5, 10, 20), azimuth_step_deg=30, duration_s=
     started = time.monotonic()
     total = 0.0
     progress = tqdm(total=len(tasks), desc=f"pyprop8 {source_name}", unit="sub-event")
-    if jobs > 1:
+    if jobs > 1 and len(tasks) > 1:
         with Pool(min(jobs, len(tasks))) as pool:
             for _, disp in pool.imap_unordered(_point_source_task, tasks):
                 total = total + disp
@@ -310,6 +317,7 @@ def generate(source_name, rings_km=(5, 10, 20), azimuth_step_deg=30, duration_s=
         meta = _site_meta(source_name, src, site, cfg, num, key)
         files.write_npz(path, dt=np.float64(1.0 / cfg["sampling_hz"]), acc=acc, vel=vel,
                         disp=disp, meta=np.array(json.dumps(meta)))
+    _write_gmm_check(source_name, cfg)
     files.write_json(manifest_path, {
         "cache_key": key, "source": source_name, "source_parameters": src,
         "crust_layers_thickness_vp_vs_rho": [  # thickness null: the half-space
@@ -317,7 +325,13 @@ def generate(source_name, rings_km=(5, 10, 20), azimuth_step_deg=30, duration_s=
         "settings": {k: v for k, v in cfg.items() if k != "base"}, "numerics": num,
         "compute_seconds": round(elapsed, 1), "jobs": jobs,
         "sites": [p.name for p in paths]})
+    write_gmm_summary(cfg["base"])
     return paths
+
+
+def _write_gmm_check(source_name, cfg):
+    files.write_csv(cfg["base"] / source_name / "gmm_check_sites.csv",
+                    gmm_check([source_name], cfg["rings_km"], cfg["azimuth_step_deg"], cfg["base"]))
 
 
 def _site_meta(source_name, src, site, cfg, num, key):
@@ -366,7 +380,7 @@ def rupture_distances(source_name, x_km, y_km):
 
     def to_segment(p, a, b):
         d = b - a
-        t = np.clip((p - a) @ d / (d @ d), 0.0, 1.0)
+        t = np.clip((p - a) @ d / max(d @ d, 1e-12), 0.0, 1.0)  # one sub-event: a point
         return np.linalg.norm(p - a - np.outer(t, d), axis=1)
 
     surface = np.array([1.0, 1.0, 0.0])
@@ -415,21 +429,34 @@ def gmm_check(source_names=tuple(SOURCES), rings_km=(5, 10, 20), azimuth_step_de
     return pd.DataFrame(rows)
 
 
+def write_gmm_summary(base):
+    """Summarise every ``<base>/<source>/gmm_check_sites.csv`` of a current
+    source into ``<base>/gmm_check.csv`` (see :func:`gmm_summary`); returns it."""
+    per_site = [pd.read_csv(path) for path in sorted(Path(base).glob("*/gmm_check_sites.csv"))
+                if (path.parent / "manifest.json").is_file()]
+    if not per_site:
+        return None
+    summary = gmm_summary(pd.concat(per_site, ignore_index=True))
+    files.write_csv(Path(base) / "gmm_check.csv", summary)
+    return summary
+
+
 def gmm_summary(per_site):
-    """Per source and ring: medians over sites of synthetic peaks and of the
-    synthetic/model ratios (RotD50 and geometric-mean definitions)."""
+    """Per source and ring: medians over sites of rupture distance, synthetic
+    RotD50 peaks, model medians, and of the synthetic/model ratios (RotD50;
+    ``geomean``: geometric mean of the East and North peaks, against CY14)."""
     frame = per_site.copy()
-    ratio_columns = []
-    for model in ("cy14", "bssa14"):
-        for peak, unit in (("pga", "g"), ("pgv", "cm_s")):
-            for definition in ("rotd50", "geomean"):
-                column = f"ratio_{peak}_{definition}_{model}"
-                frame[column] = frame[f"{peak}_{definition}_{unit}"] / frame[f"{model}_{peak}_{unit}"]
-                ratio_columns.append(column)
-    value_columns = ["rrup_km", "pga_rotd50_g", "pgv_rotd50_cm_s", "cy14_pga_g", "cy14_pgv_cm_s",
-                     "bssa14_pga_g", "bssa14_pgv_cm_s"] + ratio_columns
-    summary = frame.groupby(["source", "ring_km"])[value_columns].median().reset_index()
-    summary.insert(2, "n_sites", frame.groupby(["source", "ring_km"]).size().to_numpy())
+    for peak, unit in (("pga", "g"), ("pgv", "cm_s")):
+        for model in ("cy14", "bssa14"):
+            frame[f"ratio_{peak}_{model}"] = frame[f"{peak}_rotd50_{unit}"] / frame[f"{model}_{peak}_{unit}"]
+        frame[f"ratio_{peak}_geomean_cy14"] = frame[f"{peak}_geomean_{unit}"] / frame[f"cy14_{peak}_{unit}"]
+    columns = ["rrup_km",
+               "pga_rotd50_g", "cy14_pga_g", "bssa14_pga_g", "ratio_pga_cy14", "ratio_pga_bssa14",
+               "pgv_rotd50_cm_s", "cy14_pgv_cm_s", "bssa14_pgv_cm_s", "ratio_pgv_cy14",
+               "ratio_pgv_bssa14", "ratio_pga_geomean_cy14", "ratio_pgv_geomean_cy14"]
+    groups = frame.groupby(["source", "ring_km"])
+    summary = groups[columns].median().reset_index()
+    summary.insert(2, "n_sites", groups.size().to_numpy())
     return summary
 
 
@@ -668,15 +695,9 @@ def run_command(args):
         paths = generate(name, rings, args.step, quick=args.quick, jobs=max(1, args.jobs))
         print(f"{name}: {len(paths)} sites in {paths[0].parent} "
               f"({time.monotonic() - started:.0f} s, cached when ~0)")
-    per_site = gmm_check(names, rings, args.step, quick=args.quick)
-    summary = gmm_summary(per_site)
     base = paths[0].parent.parent
-    files.write_csv(base / "gmm_check.csv", summary)
-    files.write_csv(base / "gmm_check_sites.csv", per_site)
-    shown = summary[["source", "ring_km", "n_sites", "rrup_km", "pga_rotd50_g", "cy14_pga_g",
-                     "ratio_pga_rotd50_cy14", "ratio_pga_rotd50_bssa14", "pgv_rotd50_cm_s",
-                     "cy14_pgv_cm_s", "ratio_pgv_rotd50_cy14", "ratio_pgv_rotd50_bssa14",
-                     "ratio_pga_geomean_cy14", "ratio_pgv_geomean_cy14"]]
+    summary = write_gmm_summary(base)
+    shown = summary[summary["source"].isin(names)]
     print("synthetic / GMM median (median over sites of each ring; RotD50 unless 'geomean'; "
           f"Vs30 {GMM_VS30_M_S:g} m/s):")
     print(shown.to_string(index=False, float_format=lambda v: f"{v:.3g}"))

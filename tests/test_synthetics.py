@@ -192,6 +192,10 @@ def test_generate_writes_motions_with_exact_geometry_and_caches(tiny_source, tmp
         syn.generate(tiny_source, **dict(kwargs, fmax_hz=0.8))
     manifest = json.loads((tmp_path / tiny_source / "manifest.json").read_text())
     assert len(manifest["sites"]) == 8
+    summary = pd.read_csv(tmp_path / "gmm_check.csv")
+    assert list(summary["ring_km"]) == [4.0, 8.0] and list(summary["n_sites"]) == [4, 4]
+    ratios = summary.filter(like="ratio_").to_numpy()
+    assert np.isfinite(ratios).all() and (ratios > 0).all()
 
 
 def test_site_table_geometry():
