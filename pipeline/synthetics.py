@@ -183,9 +183,8 @@ def point_source_displacement(x_km, y_km, mechanism, sub, num, fmax_hz, layers=C
     return seis[0] * 1e3  # km -> m
 
 
-def _point_source_task(args):
-    index, call = args
-    return index, point_source_displacement(*call)
+def _point_source_task(call):
+    return point_source_displacement(*call)
 
 
 def band_limited_motion(disp, dt, upsample):
@@ -290,21 +289,21 @@ def generate(source_name, rings_km=(5, 10, 20), azimuth_step_deg=30, duration_s=
     subs = subevents(source_name)
     mechanism = (src["strike_deg"], src["dip_deg"], src["rake_deg"])
     tasks = []
-    for i, sub in subs.iterrows():
+    for _, sub in subs.iterrows():
         sub = dict(sub, rise_s=src["subevent_rise_s"], duration_s=src["subevent_duration_s"])
-        tasks.append((i, (sites["x_km"].to_numpy(), sites["y_km"].to_numpy(), mechanism, sub,
-                          num, cfg["fmax_hz"])))
+        tasks.append((sites["x_km"].to_numpy(), sites["y_km"].to_numpy(), mechanism, sub, num,
+                      cfg["fmax_hz"]))
     started = time.monotonic()
     total = 0.0
     progress = tqdm(total=len(tasks), desc=f"pyprop8 {source_name}", unit="sub-event")
     if jobs > 1 and len(tasks) > 1:
         with Pool(min(jobs, len(tasks))) as pool:
-            for _, disp in pool.imap_unordered(_point_source_task, tasks):
+            for disp in pool.imap(_point_source_task, tasks):  # in order: reproducible sum
                 total = total + disp
                 progress.update(1)
     else:
         for task in tasks:
-            total = total + _point_source_task(task)[1]
+            total = total + _point_source_task(task)
             progress.update(1)
     progress.close()
     elapsed = time.monotonic() - started
@@ -448,8 +447,10 @@ def gmm_summary(per_site):
     frame = per_site.copy()
     for peak, unit in (("pga", "g"), ("pgv", "cm_s")):
         for model in ("cy14", "bssa14"):
-            frame[f"ratio_{peak}_{model}"] = frame[f"{peak}_rotd50_{unit}"] / frame[f"{model}_{peak}_{unit}"]
-        frame[f"ratio_{peak}_geomean_cy14"] = frame[f"{peak}_geomean_{unit}"] / frame[f"cy14_{peak}_{unit}"]
+            frame[f"ratio_{peak}_{model}"] = (frame[f"{peak}_rotd50_{unit}"]
+                                              / frame[f"{model}_{peak}_{unit}"])
+        frame[f"ratio_{peak}_geomean_cy14"] = (frame[f"{peak}_geomean_{unit}"]
+                                               / frame[f"cy14_{peak}_{unit}"])
     columns = ["rrup_km",
                "pga_rotd50_g", "cy14_pga_g", "bssa14_pga_g", "ratio_pga_cy14", "ratio_pga_bssa14",
                "pgv_rotd50_cm_s", "cy14_pgv_cm_s", "bssa14_pgv_cm_s", "ratio_pgv_cy14",
@@ -668,7 +669,8 @@ def _float_list(text):
 
 def add_command(subparsers):
     parser = subparsers.add_parser(
-        "synthetics", help="generate synthetic near-field motions (pyprop8) around two M6.5 sources",
+        "synthetics",
+        help="generate synthetic near-field motions (pyprop8) around two M6.5 sources",
         description="Compute 3-component synthetic ground motions (pyprop8, layered crust) at "
         "sites on rings around a vertical strike-slip and a thrust source, write them as "
         "processed motions under results/synthetics/<source>/ (cached by parameter hash), and "

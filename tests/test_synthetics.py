@@ -211,7 +211,8 @@ def test_site_table_geometry():
 
 def test_rupture_distances_by_hand():
     # strike-slip: rupture segment x = 0, y from -4 to 12 km at 8 km depth
-    rrup, rjb, rx = syn.rupture_distances("strike_slip", np.array([5.0, 0.0]), np.array([0.0, 20.0]))
+    rrup, rjb, rx = syn.rupture_distances("strike_slip", np.array([5.0, 0.0]),
+                                          np.array([0.0, 20.0]))
     np.testing.assert_allclose(rjb, [5.0, 8.0])
     np.testing.assert_allclose(rrup, [math.hypot(5, 8), math.hypot(8, 8)])
     np.testing.assert_allclose(rx, [5.0, 0.0])
