@@ -71,7 +71,7 @@ def test_static_offset_sign_by_quadrant():
     plane, on which the same tensor is slip of the north side to the west:
     sites north move west, south move east.  The P axis (NE-SW) shortens and
     the T axis (NW-SE) lengthens, so sites NE and SW move toward the source,
-    NW and SE away.  (Okada 1985 confirms all eight in the test above.)
+    NW and SE away (the Okada comparison above checks this field in a half-space).
     """
     az = np.radians(np.arange(0, 360, 45))
     x, y = 6.0 * np.sin(az), 6.0 * np.cos(az)
