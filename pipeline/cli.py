@@ -18,6 +18,7 @@ COMMAND_MODULES = [
     "pipeline.campaign",
     "pipeline.synthetics",
     "pipeline.report",
+    "pipeline.animate",
 ]
 
 

@@ -1,0 +1,502 @@
+"""Downfall statistics and campaign figures.
+
+Circular statistics come from :mod:`astropy.stats` (angles in radians there,
+degrees here).  Azimuths are degrees clockwise from North in [0, 360); impact
+points are East/North offsets (m) from the column's initial axis.
+
+Input tables (see ``pipeline.campaign``): ``runs`` has one row per run and
+column type, ``impacts`` one row per body that struck the pedestal.
+"""
+import json
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+from astropy.stats import circcorrcoef, circmean, circstd, circvar, rayleightest
+from matplotlib import colormaps
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.colors import Normalize
+from matplotlib.figure import Figure
+
+from pipeline import files
+from pipeline.files import InputError
+
+COLUMN_TYPES = ("drums", "monolithic")
+COLUMN_LABELS = {"drums": "multi-drum column", "monolithic": "monolithic column"}
+COLUMN_COLOURS = {"drums": "tab:blue", "monolithic": "tab:red"}
+# reference direction name -> runs column holding its azimuth (deg)
+REFERENCE_AZIMUTHS = {
+    "back_azimuth": "back_azimuth_deg",
+    "max_acc": "az_max_acc_deg",
+    "max_vel": "az_max_vel_deg",
+    "max_disp": "az_max_disp_deg",
+}
+REFERENCE_LABELS = {
+    "back_azimuth": "back azimuth",
+    "max_acc": "azimuth of largest horizontal acceleration",
+    "max_vel": "azimuth of largest horizontal velocity",
+    "max_disp": "azimuth of largest horizontal displacement",
+}
+PARAMETER_LABELS = {"hd": "h/d", "mu_s": "μs"}
+GRAVITY = 9.81  # m/s^2
+
+
+# ---------------------------------------------------------------- statistics
+
+def angle_difference_deg(a, b):
+    """Angle a - b (deg) wrapped into (-180, 180]; NaN stays NaN."""
+    d = np.mod(np.asarray(a, dtype=float) - np.asarray(b, dtype=float), 360.0)
+    d = np.where(d > 180.0, d - 360.0, d)
+    return d if d.ndim else float(d)
+
+
+def circular_summary(angles_deg, axial=False):
+    """Summary of directions (deg; NaN entries are ignored).
+
+    Returns dict(n, mean_deg, resultant_length, circular_std_deg, rayleigh_p).
+    mean_deg is in [0, 360), or in [0, 180) when ``axial`` (angles doubled
+    before averaging, mean and spread halved after; the direction is then
+    known up to 180 deg).  circular_std_deg is sqrt(-2 ln R) (Mardia); NaN
+    entries when no angle is given.
+    """
+    angles = np.asarray(angles_deg, dtype=float).ravel()
+    angles = angles[np.isfinite(angles)]
+    n = int(angles.size)
+    if n == 0:
+        return dict(n=0, mean_deg=np.nan, resultant_length=np.nan,
+                    circular_std_deg=np.nan, rayleigh_p=np.nan)
+    factor = 2.0 if axial else 1.0
+    radians = np.deg2rad(angles * factor)
+    length = float(1.0 - circvar(radians))
+    length = min(max(length, 0.0), 1.0)  # rounding
+    period = 360.0 / factor
+    mean = np.rad2deg(float(circmean(radians))) / factor if length > 1e-12 else np.nan
+    std = np.rad2deg(float(circstd(radians, method="circular"))) / factor if length > 0 else np.inf
+    # astropy's small-sample series can dip below 0 for very concentrated data
+    p_value = min(max(float(rayleightest(radians)), 0.0), 1.0)
+    return dict(n=n, mean_deg=float(np.mod(mean, period)), resultant_length=length,
+                circular_std_deg=float(std), rayleigh_p=p_value)
+
+
+def circular_correlation(a_deg, b_deg):
+    """Circular-circular correlation (astropy circcorrcoef) of paired angles (deg).
+
+    Pairs with a NaN are dropped; NaN when fewer than 3 pairs remain or one
+    set has (almost) no spread, e.g. one back azimuth for all runs.
+    """
+    a = np.asarray(a_deg, dtype=float).ravel()
+    b = np.asarray(b_deg, dtype=float).ravel()
+    keep = np.isfinite(a) & np.isfinite(b)
+    if keep.sum() < 3:
+        return np.nan
+    a, b = np.deg2rad(a[keep]), np.deg2rad(b[keep])
+    if min(float(circvar(a)), float(circvar(b))) < 1e-9:
+        return np.nan
+    return float(circcorrcoef(a, b))
+
+
+def direction_statistics(runs):
+    """Table comparing downfall azimuths with the reference directions.
+
+    One row per campaign, column type, record (and ``record_id == "all"`` for
+    all records of the campaign together) and reference direction
+    (back_azimuth, max_acc, max_vel, max_disp).  Only toppled runs with a
+    finite downfall azimuth and reference azimuth are used.  Columns:
+    n_runs, n_toppled, n (pairs used), mean_downfall_deg, mean_reference_deg,
+    mean_difference_deg (downfall - reference, (-180, 180]),
+    resultant_length (of the differences), rayleigh_p, axial_mean_difference_deg
+    ([-90, 90)), axial_resultant_length, axial_rayleigh_p, circcorr and
+    axial_circcorr (NaN when n < 3).
+    """
+    needed = ["campaign", "record_id", "column", "toppled", "downfall_azimuth_deg",
+              *REFERENCE_AZIMUTHS.values()]
+    runs = _checked_runs(runs, needed)
+    rows = []
+    for (campaign, column), group in runs.groupby(["campaign", "column"], sort=True):
+        subsets = [(str(rec), sub) for rec, sub in group.groupby("record_id", sort=True)]
+        if len(subsets) > 1:
+            subsets.append(("all", group))
+        for record_id, sub in subsets:
+            for reference, ref_column in REFERENCE_AZIMUTHS.items():
+                rows.append(dict(campaign=campaign, column=column, record_id=record_id,
+                                 reference=reference,
+                                 **_difference_statistics(sub, ref_column)))
+    return pd.DataFrame(rows)
+
+
+def _difference_statistics(sub, ref_column):
+    toppled = sub[sub["toppled"]]
+    downfall = toppled["downfall_azimuth_deg"].to_numpy(float)
+    reference = toppled[ref_column].to_numpy(float)
+    keep = np.isfinite(downfall) & np.isfinite(reference)
+    downfall, reference = downfall[keep], reference[keep]
+    difference = angle_difference_deg(downfall, reference)
+    directional = circular_summary(difference)
+    axial = circular_summary(difference, axial=True)
+    return dict(
+        n_runs=len(sub), n_toppled=len(toppled), n=directional["n"],
+        mean_downfall_deg=circular_summary(downfall)["mean_deg"],
+        mean_reference_deg=circular_summary(reference)["mean_deg"],
+        mean_difference_deg=angle_difference_deg(directional["mean_deg"], 0.0),
+        resultant_length=directional["resultant_length"],
+        rayleigh_p=directional["rayleigh_p"],
+        axial_mean_difference_deg=float(np.mod(axial["mean_deg"] + 90.0, 180.0) - 90.0),
+        axial_resultant_length=axial["resultant_length"],
+        axial_rayleigh_p=axial["rayleigh_p"],
+        circcorr=circular_correlation(downfall, reference),
+        axial_circcorr=circular_correlation(2.0 * downfall, 2.0 * reference),
+    )
+
+
+# ---------------------------------------------------------------- input checks
+
+def _checked_runs(runs, columns):
+    """Return a copy of ``runs`` with ``toppled`` as bool, or raise InputError."""
+    if not isinstance(runs, pd.DataFrame):
+        raise InputError(f"runs table must be a pandas DataFrame, got {type(runs).__name__}")
+    if runs.empty:
+        raise InputError("runs table is empty")
+    missing = [c for c in columns if c not in runs.columns]
+    if missing:
+        raise InputError(f"runs table lacks column(s): {', '.join(missing)}")
+    runs = runs.copy()
+    if "column" in columns:
+        unknown = sorted(set(runs["column"].astype(str)) - set(COLUMN_TYPES))
+        if unknown:
+            raise InputError(f"runs table has unknown column type(s): {', '.join(unknown)}")
+    if "toppled" in columns:
+        runs["toppled"] = _as_bool(runs["toppled"], "toppled")
+    return runs
+
+
+def _as_bool(series, name):
+    mapping = {True: True, False: False, "True": True, "False": False, "true": True,
+               "false": False, 1: True, 0: False}
+    values = series.map(lambda v: mapping.get(v.item() if isinstance(v, np.generic) else v))
+    if values.isna().any():
+        raise InputError(f"runs column '{name}' must hold True/False only")
+    return values.astype(bool)
+
+
+def _checked_impacts(impacts, columns):
+    if impacts is None:
+        return pd.DataFrame(columns=columns)
+    if not isinstance(impacts, pd.DataFrame):
+        raise InputError(f"impacts table must be a pandas DataFrame, got {type(impacts).__name__}")
+    missing = [c for c in columns if c not in impacts.columns]
+    if missing and not impacts.empty:
+        raise InputError(f"impacts table lacks column(s): {', '.join(missing)}")
+    if impacts.empty:
+        return pd.DataFrame(columns=columns)
+    if not np.isfinite(impacts[["x_m", "y_m"]].to_numpy(float)).all():
+        raise InputError("impacts table has non-finite impact coordinates")
+    return impacts
+
+
+def load_motion(motion):
+    """Horizontal displacement (n, 2) m and meta dict from a processed-motion npz.
+
+    ``motion`` is the npz path or a mapping with ``disp`` and ``meta``.
+    """
+    if isinstance(motion, (str, Path)):
+        path = Path(motion)
+        if not path.is_file():
+            raise InputError(f"motion file not found: {path}")
+        try:
+            with np.load(path, allow_pickle=False) as data:
+                motion = {key: data[key] for key in data.files}
+        except (OSError, ValueError) as exc:
+            raise InputError(f"cannot read motion file {path}: {exc}") from None
+    if "disp" not in motion or "meta" not in motion:
+        raise InputError("motion lacks 'disp' or 'meta'")
+    disp = np.asarray(motion["disp"], dtype=float)
+    if disp.ndim != 2 or disp.shape[1] < 2 or len(disp) < 2:
+        raise InputError(f"motion 'disp' must have shape (n, 3), got {disp.shape}")
+    if not np.isfinite(disp[:, :2]).all():
+        raise InputError("motion 'disp' holds NaN or infinite samples")
+    meta = motion["meta"]
+    if not isinstance(meta, dict):
+        try:
+            meta = json.loads(str(np.asarray(meta).item() if np.ndim(meta) == 0 else meta))
+        except (ValueError, TypeError):
+            raise InputError("motion 'meta' is not a JSON object") from None
+    return disp[:, :2], meta
+
+
+# ---------------------------------------------------------------- figures
+
+def _new_figure(**kwargs):
+    fig = Figure(**kwargs)
+    FigureCanvasAgg(fig)
+    return fig
+
+
+def _north_arrow(ax, x=0.08, y=0.80):
+    ax.annotate("N", xy=(x, y + 0.12), xytext=(x, y), xycoords="axes fraction",
+                ha="center", va="top", fontsize=11, fontweight="bold",
+                arrowprops=dict(arrowstyle="-|>", color="k", lw=1.5))
+
+
+def _size_scale(values):
+    """Map parameter values to marker areas (pt^2), 20..220."""
+    values = np.asarray(values, dtype=float)
+    lo, hi = np.nanmin(values), np.nanmax(values)
+    span = hi - lo if hi > lo else 1.0
+
+    def size(v):
+        return 20.0 + 200.0 * (np.asarray(v, dtype=float) - lo) / span
+
+    return size
+
+
+def _legend_values(values, limit=7):
+    values = np.unique(np.asarray(values, dtype=float))
+    if len(values) <= limit:
+        return values
+    return values[np.unique(np.round(np.linspace(0, len(values) - 1, limit)).astype(int))]
+
+
+def plot_impact_map(runs, impacts, motion, path, size_by="hd", title=None):
+    """Bird's-eye impact map like Hinzen (2009) Figs 9/10 for one record.
+
+    Left panel multi-drum column (impact points of every drum's centre of
+    mass), right panel monolithic column; symbol size and colour by
+    ``size_by`` ('hd' or 'mu_s'); dashed ray towards the epicentre (back
+    azimuth); grey hodogram of the horizontal ground displacement, scaled,
+    with its dx/dy axes (cm) on top/right; North arrow.  ``runs`` and
+    ``impacts`` must hold one record only; ``motion`` is that record's
+    processed-motion npz (path or mapping).  Writes a PNG to ``path``.
+    """
+    if size_by not in PARAMETER_LABELS:
+        raise InputError(f"size_by must be one of {sorted(PARAMETER_LABELS)}, got {size_by!r}")
+    runs = _checked_runs(runs, ["record_id", "column", "toppled", size_by])
+    records = sorted(set(runs["record_id"].astype(str)))
+    if len(records) != 1:
+        raise InputError(f"impact map needs the runs of one record, got {len(records)}: "
+                         f"{', '.join(records[:5])}")
+    impacts = _checked_impacts(impacts, ["column", "x_m", "y_m", size_by])
+    if not impacts.empty:
+        if "record_id" in impacts.columns:
+            impacts = impacts[impacts["record_id"].astype(str) == records[0]]
+        if not np.isfinite(impacts[size_by].to_numpy(float)).all():
+            raise InputError(f"impacts table has non-finite '{size_by}' values")
+    disp, meta = load_motion(motion)
+    if not np.isfinite(runs[size_by].to_numpy(float)).all():
+        raise InputError(f"runs table has non-finite '{size_by}' values")
+
+    label = PARAMETER_LABELS[size_by]
+    size = _size_scale(runs[size_by])
+    norm = Normalize(runs[size_by].min(), runs[size_by].max())
+    cmap = colormaps["viridis"]
+    reach = float(np.max(np.abs(impacts[["x_m", "y_m"]].to_numpy(float)), initial=0.0))
+    limit = max(4.0, 1.1 * reach)
+    peak_disp = float(np.max(np.hypot(disp[:, 0], disp[:, 1])))
+    scale = 0.8 * limit / peak_disp if peak_disp > 0 else 1.0  # plot m per ground m
+    baz = meta.get("back_azimuth_deg")
+
+    fig = _new_figure(figsize=(12.5, 6.4))
+    axes = fig.subplots(1, 2)
+    for ax, column in zip(axes, COLUMN_TYPES):
+        col_runs = runs[runs["column"] == column]
+        ax.plot(disp[:, 0] * scale, disp[:, 1] * scale, color="0.6", lw=0.8,
+                label="ground displacement hodogram", zorder=1)
+        if baz is not None and np.isfinite(baz):
+            ray = np.array([0.0, 1.5 * limit])
+            ax.plot(ray * np.sin(np.deg2rad(baz)), ray * np.cos(np.deg2rad(baz)), "k--",
+                    lw=1.2, label=f"back azimuth {baz:.0f}° (to epicentre)", zorder=2)
+        ax.plot(0, 0, "k+", ms=12, mew=1.5, zorder=4, label="initial column axis")
+        pts = impacts[impacts["column"] == column]
+        ax.scatter(pts["x_m"], pts["y_m"], s=size(pts[size_by]),
+                   color=cmap(norm(pts[size_by].to_numpy(float))), edgecolors="k",
+                   linewidths=0.5, alpha=0.85, zorder=3)
+        for value in _legend_values(col_runs[size_by]):
+            ax.scatter([], [], s=size(value), color=cmap(norm(value)), edgecolors="k",
+                       linewidths=0.5, label=f"{label} = {value:g}")
+        standing = col_runs[~col_runs["toppled"]][size_by]
+        note = (f"not toppled: {label} = " + ", ".join(f"{v:g}" for v in sorted(set(standing)))
+                if len(standing) else "all toppled")
+        if pts.empty:
+            note = "no impact on the pedestal\n" + note
+        ax.text(0.02, 0.02, note, transform=ax.transAxes, fontsize=8, va="bottom",
+                bbox=dict(fc="white", ec="0.8", alpha=0.9))
+        ax.set_xlim(-limit, limit)
+        ax.set_ylim(-limit, limit)
+        ax.set_aspect("equal")
+        ax.set_xlabel("East (m)")
+        ax.set_ylabel("North (m)")
+        ax.set_title(f"{COLUMN_LABELS[column]}: centre-of-mass impact points", fontsize=10, pad=28)
+        ax.grid(True, lw=0.3)
+        top = ax.secondary_xaxis("top", functions=(lambda x: 100 * x / scale,
+                                                   lambda d: d * scale / 100))
+        top.set_xlabel("hodogram dx (cm)", fontsize=8, color="0.4")
+        top.tick_params(labelsize=7, colors="0.4")
+        right = ax.secondary_yaxis("right", functions=(lambda y: 100 * y / scale,
+                                                       lambda d: d * scale / 100))
+        right.set_ylabel("hodogram dy (cm)", fontsize=8, color="0.4")
+        right.tick_params(labelsize=7, colors="0.4")
+        _north_arrow(ax)
+        ax.legend(fontsize=7, loc="upper right", framealpha=0.9)
+    fig.suptitle(title or f"Impact points for record {records[0]}, swept {label}")
+    fig.tight_layout()
+    files.save_figure(fig, path, dpi=120)
+    return Path(path)
+
+
+def _polar_axes(fig, position):
+    ax = fig.add_subplot(*position, projection="polar")
+    ax.set_theta_zero_location("N")
+    ax.set_theta_direction(-1)
+    return ax
+
+
+def _rose(ax, angles_deg, colour, label, bin_deg=15.0, bottom=None):
+    edges = np.arange(0.0, 360.0 + bin_deg, bin_deg)
+    counts, _ = np.histogram(np.mod(angles_deg, 360.0), bins=edges)
+    centres = np.deg2rad(edges[:-1] + bin_deg / 2)
+    ax.bar(centres, counts, width=np.deg2rad(bin_deg), bottom=bottom, color=colour,
+           edgecolor="k", linewidth=0.4, alpha=0.8, label=label)
+    return counts
+
+
+def plot_rose(runs, path):
+    """Rose diagrams (North up, clockwise): downfall azimuths of each column
+    type with back-azimuth marks, and downfall minus back azimuth.  PNG."""
+    runs = _checked_runs(runs, ["column", "toppled", "downfall_azimuth_deg", "back_azimuth_deg"])
+    toppled = runs[runs["toppled"] & np.isfinite(runs["downfall_azimuth_deg"].astype(float))]
+    fig = _new_figure(figsize=(15, 5.6))
+    for k, column in enumerate(COLUMN_TYPES):
+        ax = _polar_axes(fig, (1, 3, k + 1))
+        sub = toppled[toppled["column"] == column]
+        counts = _rose(ax, sub["downfall_azimuth_deg"].to_numpy(float), COLUMN_COLOURS[column],
+                       "downfall azimuth")
+        rmax = max(1, int(counts.max(initial=0)))
+        bazs = np.unique(runs.loc[runs["column"] == column, "back_azimuth_deg"].dropna())
+        for j, baz in enumerate(bazs):
+            ax.plot([np.deg2rad(baz)] * 2, [0, rmax], "k--", lw=0.9,
+                    label="back azimuth" if j == 0 else None)
+        ax.set_rmax(rmax)
+        stats = circular_summary(sub["downfall_azimuth_deg"])
+        ax.set_title(f"{COLUMN_LABELS[column]}: downfall azimuth\n"
+                     f"n = {stats['n']}, mean = {stats['mean_deg']:.0f}°, "
+                     f"R = {stats['resultant_length']:.2f}", fontsize=10)
+        ax.legend(fontsize=7, loc="lower left", bbox_to_anchor=(-0.15, -0.15))
+    ax = _polar_axes(fig, (1, 3, 3))
+    bottom = None
+    for column in COLUMN_TYPES:
+        sub = toppled[toppled["column"] == column]
+        diff = angle_difference_deg(sub["downfall_azimuth_deg"].to_numpy(float),
+                                    sub["back_azimuth_deg"].to_numpy(float))
+        counts = _rose(ax, diff[np.isfinite(diff)], COLUMN_COLOURS[column],
+                       COLUMN_LABELS[column], bottom=bottom)
+        bottom = counts if bottom is None else bottom + counts
+    ax.set_title("downfall minus back azimuth\n(0° = falls towards the epicentre)", fontsize=10)
+    ax.legend(fontsize=7, loc="lower left", bbox_to_anchor=(-0.15, -0.15))
+    fig.suptitle(f"Downfall directions ({len(toppled)} toppled of {len(runs)} column runs; "
+                 "counts per 15° bin)")
+    fig.tight_layout()
+    files.save_figure(fig, path, dpi=120)
+    return Path(path)
+
+
+def plot_toppling_vs_parameters(runs, path):
+    """Toppled or not against PGA, PGV, PGD and PGV/PGA per column type, and a
+    PGA vs PGV/PGA scatter (Purvance et al. 2008).  PNG."""
+    params = [("pga_h", "PGA (m/s²)"), ("pgv_h", "PGV (m/s)"), ("pgd_h", "PGD (m)"),
+              ("pgv_pga_h", "PGV/PGA (s)")]
+    runs = _checked_runs(runs, ["column", "toppled", *[p for p, _ in params]])
+    values = runs[[p for p, _ in params]].to_numpy(float)
+    if not np.isfinite(values).all() or (values <= 0).any():
+        raise InputError("runs table has non-positive or non-finite ground-motion parameters")
+    fig = _new_figure(figsize=(14, 8))
+    grid = fig.add_gridspec(2, 4)
+    rows = {column: k for k, column in enumerate(COLUMN_TYPES)}
+    for j, (param, label) in enumerate(params):
+        ax = fig.add_subplot(grid[0, j])
+        for column, row in rows.items():
+            sub = runs[runs["column"] == column]
+            for toppled, offset, face in ((True, 0.12, COLUMN_COLOURS[column]), (False, -0.12, "none")):
+                pick = sub[sub["toppled"] == toppled]
+                ax.scatter(pick[param], np.full(len(pick), row + offset), marker="o", s=30,
+                           facecolors=face, edgecolors=COLUMN_COLOURS[column],
+                           label=(f"{column}, {'toppled' if toppled else 'standing'}"
+                                  if j == 0 else None))
+        ax.set_xscale("log")
+        ax.set_yticks(list(rows.values()), [COLUMN_LABELS[c].replace(" column", "") for c in rows])
+        ax.set_ylim(-0.6, len(rows) - 0.4)
+        ax.set_xlabel(label)
+        ax.set_title(f"toppling vs {label.split(' ')[0]}", fontsize=10)
+        ax.grid(True, axis="x", lw=0.3)
+    fig.legend(loc="upper center", ncol=4, fontsize=8, bbox_to_anchor=(0.5, 0.955))
+    ax = fig.add_subplot(grid[1, 1:3])
+    markers = {"drums": "s", "monolithic": "o"}
+    for column in COLUMN_TYPES:
+        sub = runs[runs["column"] == column]
+        for toppled, face in ((True, COLUMN_COLOURS[column]), (False, "none")):
+            pick = sub[sub["toppled"] == toppled]
+            ax.scatter(pick["pgv_pga_h"], pick["pga_h"], marker=markers[column], s=45,
+                       facecolors=face, edgecolors=COLUMN_COLOURS[column],
+                       label=f"{COLUMN_LABELS[column]}, {'toppled' if toppled else 'standing'}")
+    if "hd" in runs.columns and runs["hd"].nunique() == 1 and np.isfinite(runs["hd"].iloc[0]):
+        hd = float(runs["hd"].iloc[0])
+        ax.axhline(GRAVITY / hd, color="k", ls=":", lw=1,
+                   label=f"g·d/h = {GRAVITY / hd:.2f} m/s² (static uplift, h/d = {hd:g})")
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("PGV/PGA (s)")
+    ax.set_ylabel("PGA (m/s²)")
+    ax.set_title("PGA and PGV/PGA together govern overturning (Purvance et al. 2008)",
+                 fontsize=10)
+    ax.grid(True, which="both", lw=0.3)
+    ax.legend(fontsize=8)
+    fig.suptitle("Toppling against ground-motion parameters (horizontal vector peaks)", y=0.995)
+    fig.tight_layout(rect=(0, 0, 1, 0.93))
+    files.save_figure(fig, path, dpi=120)
+    return Path(path)
+
+
+def _wrapped_line(ax, offset, **kwargs):
+    """Draw downfall = reference + offset (mod 360) over 0..360 deg."""
+    x = np.linspace(0.0, 360.0, 721)
+    y = np.mod(x + offset, 360.0)
+    y[np.r_[False, np.diff(y) < 0]] = np.nan  # break at the wrap
+    ax.plot(x, y, **kwargs)
+
+
+def plot_downfall_vs_directions(runs, path):
+    """Downfall azimuth against back azimuth and against the azimuths of the
+    largest horizontal acceleration, velocity and displacement: 4 scatter
+    panels with 1:1, +-90 and 180 deg guide lines.  PNG."""
+    runs = _checked_runs(runs, ["column", "toppled", "downfall_azimuth_deg",
+                                *REFERENCE_AZIMUTHS.values()])
+    toppled = runs[runs["toppled"]]
+    fig = _new_figure(figsize=(11, 10))
+    axes = fig.subplots(2, 2).ravel()
+    markers = {"drums": "s", "monolithic": "o"}
+    for ax, (reference, ref_column) in zip(axes, REFERENCE_AZIMUTHS.items()):
+        _wrapped_line(ax, 0.0, color="k", lw=1.0, label="1:1 (same direction)")
+        _wrapped_line(ax, 90.0, color="0.5", ls="--", lw=0.8, label="±90°")
+        _wrapped_line(ax, -90.0, color="0.5", ls="--", lw=0.8)
+        _wrapped_line(ax, 180.0, color="0.5", ls=":", lw=1.0, label="180° (opposite)")
+        for column in COLUMN_TYPES:
+            sub = toppled[toppled["column"] == column]
+            stats = circular_summary(angle_difference_deg(sub["downfall_azimuth_deg"].to_numpy(float),
+                                                          sub[ref_column].to_numpy(float)))
+            ax.scatter(sub[ref_column], sub["downfall_azimuth_deg"], marker=markers[column], s=35,
+                       color=COLUMN_COLOURS[column], edgecolors="k", linewidths=0.4,
+                       label=f"{COLUMN_LABELS[column]} (n = {stats['n']}, "
+                             f"R of difference = {stats['resultant_length']:.2f})")
+        ax.set_xlim(0, 360)
+        ax.set_ylim(0, 360)
+        ax.set_xticks(range(0, 361, 90))
+        ax.set_yticks(range(0, 361, 90))
+        ax.set_aspect("equal")
+        ax.set_xlabel(f"{REFERENCE_LABELS[reference]} (°)")
+        ax.set_ylabel("downfall azimuth (°)")
+        ax.set_title(f"downfall vs {REFERENCE_LABELS[reference]}", fontsize=10)
+        ax.grid(True, lw=0.3)
+        ax.legend(fontsize=7, loc="upper left", framealpha=0.9)
+    fig.suptitle(f"Downfall directions of {len(toppled)} toppled column runs "
+                 "against ground-motion directions")
+    fig.tight_layout()
+    files.save_figure(fig, path, dpi=120)
+    return Path(path)

@@ -1,0 +1,179 @@
+"""Animations of runs (GIF, or MP4 when ffmpeg is present) and VTK export for ParaView.
+
+    python -m pipeline animate results/runs/GM20 --out gm20.gif --vtk gm20_vtk
+
+Bodies are drawn from the trajectory (centre of mass + quaternion, body z =
+long axis) in the absolute frame: pedestal-frame position + pedestal
+displacement, so the pedestal is seen to move with the ground.
+"""
+import math
+from pathlib import Path
+from xml.sax.saxutils import quoteattr
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from pipeline import scenario
+from pipeline.files import InputError, atomic_path, write_text
+
+CIRCLE_SEGMENTS = 24
+PEDESTAL_HALF = scenario.PEDESTAL["size"] / 2
+
+
+def load(run):
+    """Trajectory dict from a run directory, a trajectory.npz path or a dict."""
+    if isinstance(run, dict):
+        return run
+    path = Path(run)
+    if path.is_dir():
+        path = path / "trajectory.npz"
+    if not path.is_file():
+        raise InputError(f"no trajectory found: {path}")
+    return scenario.load_trajectory(path)
+
+
+def body_surface(body, centre, quat_wxyz):
+    """Vertices (2 x k x 3) of a body's bottom and top outline, world frame (m).
+
+    Cylinders: circles of CIRCLE_SEGMENTS points; boxes: their 4 corners."""
+    h = body["height"] / 2
+    if body["shape"] == "cylinder":
+        ang = 2 * math.pi * np.arange(CIRCLE_SEGMENTS) / CIRCLE_SEGMENTS
+        ring = np.column_stack([body["radius"] * np.cos(ang), body["radius"] * np.sin(ang)])
+    else:
+        w, d = body["width"] / 2, body["depth"] / 2
+        ring = np.array([[-w, -d], [w, -d], [w, d], [-w, d]])
+    local = np.stack([np.column_stack([ring, np.full(len(ring), z)]) for z in (-h, h)])
+    rot = Rotation.from_quat(np.asarray(quat_wxyz, float)[[1, 2, 3, 0]])
+    return rot.apply(local.reshape(-1, 3)).reshape(local.shape) + np.asarray(centre, float)
+
+
+def _frame_indices(t, fps, max_seconds):
+    end = t[-1] if max_seconds is None else min(t[-1], max_seconds)
+    times = np.arange(0.0, end + 1e-9, 1.0 / fps)
+    return np.unique(np.clip(np.searchsorted(t, times), 0, len(t) - 1))
+
+
+def animate_run(run, path, fps=20, max_seconds=None, max_frames=600):
+    """Write a 3-D animation of a run to ``path`` (.gif, or .mp4 with ffmpeg)."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from matplotlib import animation
+
+    traj = load(run)
+    path = Path(path)
+    if path.suffix not in (".gif", ".mp4"):
+        raise InputError(f"animation must be .gif or .mp4, got {path.name}")
+    if path.suffix == ".mp4" and not animation.writers.is_available("ffmpeg"):
+        raise InputError("MP4 needs ffmpeg, which is not installed: write a .gif instead")
+    t = traj["t"]
+    fps = min(fps, max_frames / max(t[-1], 1e-9)) if max_seconds is None else fps
+    frames = _frame_indices(t, fps, max_seconds)
+    bodies = traj["bodies"]
+    colours = {"drums": "tab:blue", "monolithic": "tab:red", "block": "tab:green"}
+    fig = plt.figure(figsize=(7, 6))
+    ax = fig.add_subplot(projection="3d")
+    height = max(b["height"] * (b["index"] + 1) for b in bodies)
+    reach = PEDESTAL_HALF + 1.0
+
+    def draw(k):
+        ax.cla()
+        disp = traj["pedestal_disp"][k]
+        sq = np.array([[-1, -1], [1, -1], [1, 1], [-1, 1], [-1, -1]]) * PEDESTAL_HALF
+        ax.plot(sq[:, 0] + disp[0], sq[:, 1] + disp[1], np.full(5, disp[2]), color="grey")
+        for j, body in enumerate(bodies):
+            rims = body_surface(body, traj["pos"][k, j] + disp, traj["quat"][k, j])
+            colour = colours.get(body["column"], "k")
+            for rim in rims:
+                closed = np.vstack([rim, rim[:1]])
+                ax.plot(closed[:, 0], closed[:, 1], closed[:, 2], color=colour, lw=1)
+            for a, b in zip(rims[0][::3], rims[1][::3]):
+                ax.plot(*np.column_stack([a, b]), color=colour, lw=0.6)
+        ax.set(xlim=(-reach, reach), ylim=(-reach, reach), zlim=(0, max(height, 1.0)),
+               xlabel="East (m)", ylabel="North (m)", zlabel="Up (m)")
+        ax.set_box_aspect((2 * reach, 2 * reach, max(height, 1.0)))
+        ax.set_title(f"t = {t[k]:5.2f} s")
+
+    anim = animation.FuncAnimation(fig, draw, frames=frames, interval=1000 / fps)
+    writer = (animation.PillowWriter(fps=fps) if path.suffix == ".gif"
+              else animation.FFMpegWriter(fps=fps))
+    with atomic_path(path) as tmp:
+        anim.save(tmp.with_suffix(path.suffix), writer=writer)
+        tmp.with_suffix(path.suffix).replace(tmp)
+    plt.close(fig)
+    return path
+
+
+def _vtp(points, polys):
+    """XML PolyData (ASCII) with the given points (n x 3) and polygons (lists of indices)."""
+    offsets = np.cumsum([len(p) for p in polys])
+    return (
+        '<?xml version="1.0"?>\n<VTKFile type="PolyData" version="0.1" byte_order="LittleEndian">\n'
+        f'<PolyData><Piece NumberOfPoints="{len(points)}" NumberOfPolys="{len(polys)}">\n'
+        '<Points><DataArray type="Float32" NumberOfComponents="3" format="ascii">\n'
+        + " ".join(f"{v:.5f}" for v in np.ravel(points)) +
+        '\n</DataArray></Points>\n<Polys>\n'
+        '<DataArray type="Int32" Name="connectivity" format="ascii">\n'
+        + " ".join(str(i) for p in polys for i in p) +
+        '\n</DataArray>\n<DataArray type="Int32" Name="offsets" format="ascii">\n'
+        + " ".join(str(o) for o in offsets) +
+        '\n</DataArray>\n</Polys>\n</Piece></PolyData>\n</VTKFile>\n')
+
+
+def frame_polydata(traj, k):
+    """Points and polygons of all body surfaces (and the pedestal top) at sample k."""
+    points, polys = [], []
+    disp = traj["pedestal_disp"][k]
+    sq = np.array([[-1, -1, 0], [1, -1, 0], [1, 1, 0], [-1, 1, 0]], float) * [PEDESTAL_HALF,
+                                                                              PEDESTAL_HALF, 1]
+    points.extend(sq + disp)
+    polys.append([0, 1, 2, 3])
+    for j, body in enumerate(traj["bodies"]):
+        bottom, top = body_surface(body, traj["pos"][k, j] + disp, traj["quat"][k, j])
+        n, base = len(bottom), len(points)
+        points.extend(bottom)
+        points.extend(top)
+        polys.append(list(range(base + n - 1, base - 1, -1)))            # bottom, facing down
+        polys.append(list(range(base + n, base + 2 * n)))                # top
+        polys.extend([[base + i, base + (i + 1) % n, base + n + (i + 1) % n, base + n + i]
+                      for i in range(n)])                                # sides
+    return np.array(points), polys
+
+
+def export_vtk(run, out_dir, every=5):
+    """Write frame_XXXXX.vtp files and run.pvd (time series) for ParaView; return the .pvd."""
+    traj = load(run)
+    if every < 1:
+        raise InputError(f"every must be at least 1, got {every}")
+    out_dir = Path(out_dir)
+    entries = []
+    for n, k in enumerate(range(0, len(traj["t"]), every)):
+        name = f"frame_{n:05d}.vtp"
+        write_text(out_dir / name, _vtp(*frame_polydata(traj, k)))
+        entries.append(f'<DataSet timestep="{traj["t"][k]:.4f}" file={quoteattr(name)}/>')
+    pvd = out_dir / "run.pvd"
+    write_text(pvd, '<?xml version="1.0"?>\n<VTKFile type="Collection" version="0.1">\n'
+               "<Collection>\n" + "\n".join(entries) + "\n</Collection>\n</VTKFile>\n")
+    return pvd
+
+
+def add_command(subparsers):
+    p = subparsers.add_parser("animate", help="animate a run (GIF/MP4) and export VTK",
+                              description=__doc__.splitlines()[0])
+    p.add_argument("run_dir", type=Path, help="run directory holding trajectory.npz")
+    p.add_argument("--out", type=Path, default=None, help="animation file (default RUN/animation.gif)")
+    p.add_argument("--fps", type=float, default=20.0, help="frames per second (20)")
+    p.add_argument("--max-seconds", type=float, default=None, help="animate only the start")
+    p.add_argument("--vtk", type=Path, default=None, metavar="DIR",
+                   help="also write a VTK time series (run.pvd) for ParaView")
+    p.set_defaults(func=animate_command)
+
+
+def animate_command(args):
+    out = animate_run(args.run_dir, args.out or args.run_dir / "animation.gif", fps=args.fps,
+                      max_seconds=args.max_seconds)
+    print(f"wrote {out}")
+    if args.vtk:
+        print(f"wrote {export_vtk(args.run_dir, args.vtk)}")
+    return 0
