@@ -223,7 +223,7 @@ def animate_examples(runs, campaign_dir, count=1):
     for _, row in toppled.iterrows():
         path = campaign_dir / f"animation_{row['record_id']}_{row['run_id']}.gif"
         if not path.exists():
-            animate.animate_run(campaign_dir / row["run_dir"], path, max_seconds=None)
+            animate.animate_run(campaign_dir / row["run_dir"], path, fps=10, max_frames=250)
         written.append(path)
     return written
 
