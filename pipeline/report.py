@@ -85,8 +85,15 @@ def records_section(results):
                          f"m/s^2 vs {stood['pga_h'].median():.2f} for the others; median PGV/PGA "
                          f"{fell['pgv_pga_h'].median():.3f} vs {stood['pgv_pga_h'].median():.3f} s.")
     stats = _read_csv(results / "records" / "direction_statistics.csv")
-    lines.append("\nDownfall directions against back azimuth and the directions of the largest "
-                 "motions (circular statistics):\n\n" + _table(stats) + "\n")
+    if stats is not None:
+        keep = ["column", "reference", "n", "mean_difference_deg", "resultant_length",
+                "rayleigh_p", "axial_mean_difference_deg", "axial_resultant_length",
+                "axial_rayleigh_p", "circcorr", "axial_circcorr"]
+        stats = stats[stats["record_id"] == "all"][[c for c in keep if c in stats.columns]]
+        stats = stats.round(2)
+    lines.append("\nDownfall directions of all toppled runs against back azimuth and the "
+                 "directions of the largest motions (differences downfall - reference, deg; "
+                 "per-record rows in records/direction_statistics.csv):\n\n" + _table(stats) + "\n")
     for fname, caption in (("rose.png", "rose diagrams"),
                            ("toppling_vs_parameters.png", "toppling vs PGA, PGV, PGD, PGV/PGA"),
                            ("downfall_vs_directions.png", "downfall vs directions")):
