@@ -10,6 +10,7 @@ processes, ``--jobs`` at a time.  The campaign then writes ``runs.csv`` (one
 row per run and column), ``impacts.csv`` (one row per struck body) and its
 figures.
 """
+import json
 import math
 import os
 import traceback
@@ -122,7 +123,6 @@ def execute(specs, campaign_dir, jobs, worker=run_column_spec, label="runs"):
 
 def collect(specs, campaign, campaign_dir):
     """runs and impacts tables (DataFrames) from the summaries of finished runs."""
-    import json
     runs_dir = Path(campaign_dir) / "runs"
     record_params = {}
     run_rows, impact_rows = [], []

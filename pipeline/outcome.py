@@ -92,7 +92,7 @@ def column_outcomes(trajectory):
 def total_energy(trajectory, g=9.81):
     """Kinetic + potential energy (J) of all bodies per sample, in the pedestal frame
     (meaningful for a still pedestal)."""
-    axes_q = np.asarray(trajectory["quat"], float)
+    quats = np.asarray(trajectory["quat"], float)
     energy = np.zeros(len(trajectory["t"]))
     for j, b in enumerate(trajectory["bodies"]):
         m, h = b["mass"], b["height"]
@@ -102,7 +102,7 @@ def total_energy(trajectory, g=9.81):
         else:
             w, d = b["width"], b["depth"]
             inertia = m / 12 * np.array([d * d + h * h, w * w + h * h, w * w + d * d])
-        rot = Rotation.from_quat(axes_q[:, j][:, [1, 2, 3, 0]])
+        rot = Rotation.from_quat(quats[:, j][:, [1, 2, 3, 0]])
         omega_body = rot.inv().apply(trajectory["angvel"][:, j])
         energy += (0.5 * m * (trajectory["vel"][:, j] ** 2).sum(axis=1)
                    + 0.5 * (inertia * omega_body ** 2).sum(axis=1)

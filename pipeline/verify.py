@@ -9,13 +9,14 @@ about its North-South bottom edges.  Its rotation theta (rad) is positive
 when it leans East (standing on its East edge).  References come from
 pipeline.rocking (Housner 1963; Zhang & Makris 2000; Augusti & Sinopoli 1992).
 """
+import json
 import math
 from pathlib import Path
 
 import numpy as np
 
 from pipeline import RESULTS_DIR, rocking, scenario
-from pipeline.files import InputError, write_json
+from pipeline.files import InputError, content_hash, write_json
 from pipeline.outcome import body_axes
 
 MARBLE_BLOCK = {"height": 0.40, "width": 0.08, "depth": 0.045}   # paper: 4267 g, h/b = 5, 8 cm base
@@ -295,9 +296,7 @@ def run_verification_spec(spec, run_dir):
 def run_verification_campaign(jobs=1, out_dir=None):
     """Housner, sine-pulse and sliding checks over ranges, with figures like the paper's
     Figs 4, 5 and 6; writes results/verification/verification.json."""
-    import json
     from pipeline import campaign
-    from pipeline.files import content_hash
     out_dir = Path(out_dir or RESULTS_DIR / "verification")
     specs = campaign_specs()
     version = content_hash(campaign.code_version(), Path(__file__), Path(rocking.__file__))
