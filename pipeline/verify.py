@@ -223,6 +223,9 @@ def add_command(subparsers):
     sl = sub.add_parser("sliding", help="rock-sliding test vs friction (paper Fig. 6)")
     sl.add_argument("--mu-s", type=float, nargs="+", default=None, help="static friction values")
     sl.add_argument("--theta0-deg", type=float, default=10.0, help="initial tilt (10 deg)")
+    sl.add_argument("--friction", choices=["switch", "static"], default="switch",
+                    help="switch: mu_s sticking, mu_k = 0.84 mu_s sliding (default); "
+                    "static: mu_s only, to see the effect of the kinetic coefficient")
     for q in (h, s, sl):
         q.add_argument("--kn", type=float, default=None, help="face contact stiffness N/m")
         q.add_argument("--damping", type=float, default=None,
@@ -250,7 +253,8 @@ def verify_command(args):
               f"{result['integration']['mode']} (direction {result['integration']['direction']:+d})")
     else:
         kwargs = {"mu_values": tuple(args.mu_s)} if args.mu_s else {}
-        result = verify_sliding(theta0_deg=args.theta0_deg, **kwargs, **contact)
+        result = verify_sliding(theta0_deg=args.theta0_deg, friction=args.friction, **kwargs,
+                                **contact)
         for r in result["runs"]:
             print(f"mu_s {r['mu_s']:.3f}: {'pure rocking' if r['pure_rocking'] else 'sliding':>12}"
                   f", slip at impacts {1000 * r['slip_at_impacts_m']:.1f} mm")
