@@ -17,6 +17,7 @@ from matplotlib import colormaps
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.colors import Normalize
 from matplotlib.figure import Figure
+from matplotlib.ticker import LogLocator, NullFormatter, ScalarFormatter
 
 from pipeline import files
 from pipeline.files import InputError
@@ -231,6 +232,13 @@ def _new_figure(**kwargs):
     return fig
 
 
+def _plain_log_ticks(axis):
+    """Log axis labelled with plain numbers at 1, 2, 5 x 10^k (no 2x10^0 clutter)."""
+    axis.set_major_locator(LogLocator(subs=(1.0, 2.0, 5.0)))
+    axis.set_major_formatter(ScalarFormatter())
+    axis.set_minor_formatter(NullFormatter())
+
+
 def _north_arrow(ax, x=0.08, y=0.80):
     ax.annotate("N", xy=(x, y + 0.12), xytext=(x, y), xycoords="axes fraction",
                 ha="center", va="top", fontsize=11, fontweight="bold",
@@ -421,6 +429,7 @@ def plot_toppling_vs_parameters(runs, path):
                            label=(f"{column}, {'toppled' if toppled else 'standing'}"
                                   if j == 0 else None))
         ax.set_xscale("log")
+        _plain_log_ticks(ax.xaxis)
         ax.set_yticks(list(rows.values()), [COLUMN_LABELS[c].replace(" column", "") for c in rows])
         ax.set_ylim(-0.6, len(rows) - 0.4)
         ax.set_xlabel(label)
@@ -442,6 +451,8 @@ def plot_toppling_vs_parameters(runs, path):
                    label=f"g·d/h = {GRAVITY / hd:.2f} m/s² (static uplift, h/d = {hd:g})")
     ax.set_xscale("log")
     ax.set_yscale("log")
+    _plain_log_ticks(ax.xaxis)
+    _plain_log_ticks(ax.yaxis)
     ax.set_xlabel("PGV/PGA (s)")
     ax.set_ylabel("PGA (m/s²)")
     ax.set_title("PGA and PGV/PGA together govern overturning (Purvance et al. 2008)",
