@@ -302,7 +302,7 @@ def plot_impact_map(runs, impacts, motion, path, size_by="hd", title=None):
     scale = 0.8 * limit / peak_disp if peak_disp > 0 else 1.0  # plot m per ground m
     baz = meta.get("back_azimuth_deg")
 
-    fig = _new_figure(figsize=(12.5, 6.4))
+    fig = _new_figure(figsize=(12.5, 8.0))
     axes = fig.subplots(1, 2)
     for ax, column in zip(axes, COLUMN_TYPES):
         col_runs = runs[runs["column"] == column]
@@ -343,7 +343,7 @@ def plot_impact_map(runs, impacts, motion, path, size_by="hd", title=None):
         right.set_ylabel("hodogram dy (cm)", fontsize=8, color="0.4")
         right.tick_params(labelsize=7, colors="0.4")
         _north_arrow(ax)
-        ax.legend(fontsize=7, loc="upper right", framealpha=0.9)
+        ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.1), ncol=3)
     fig.suptitle(title or f"Impact points for record {records[0]}, swept {label}")
     fig.tight_layout()
     files.save_figure(fig, path, dpi=120)
@@ -488,14 +488,17 @@ def plot_downfall_vs_directions(runs, path):
         _wrapped_line(ax, 90.0, color="0.5", ls="--", lw=0.8, label="±90°")
         _wrapped_line(ax, -90.0, color="0.5", ls="--", lw=0.8)
         _wrapped_line(ax, 180.0, color="0.5", ls=":", lw=1.0, label="180° (opposite)")
+        notes = []
         for column in COLUMN_TYPES:
             sub = toppled[toppled["column"] == column]
             stats = circular_summary(angle_difference_deg(sub["downfall_azimuth_deg"].to_numpy(float),
                                                           sub[ref_column].to_numpy(float)))
             ax.scatter(sub[ref_column], sub["downfall_azimuth_deg"], marker=markers[column], s=35,
                        color=COLUMN_COLOURS[column], edgecolors="k", linewidths=0.4,
-                       label=f"{COLUMN_LABELS[column]} (n = {stats['n']}, "
-                             f"R of difference = {stats['resultant_length']:.2f})")
+                       label=COLUMN_LABELS[column])
+            notes.append(f"{column}: n = {stats['n']}, mean difference = "
+                         f"{angle_difference_deg(stats['mean_deg'], 0.0):.0f}°, "
+                         f"R = {stats['resultant_length']:.2f}")
         ax.set_xlim(0, 360)
         ax.set_ylim(0, 360)
         ax.set_xticks(range(0, 361, 90))
@@ -505,9 +508,12 @@ def plot_downfall_vs_directions(runs, path):
         ax.set_ylabel("downfall azimuth (°)")
         ax.set_title(f"downfall vs {REFERENCE_LABELS[reference]}", fontsize=10)
         ax.grid(True, lw=0.3)
-        ax.legend(fontsize=7, loc="upper left", framealpha=0.9)
+        ax.text(0.02, 0.98, "\n".join(notes), transform=ax.transAxes, fontsize=7, va="top",
+                bbox=dict(fc="white", ec="0.8", alpha=0.9))
+    handles, labels = axes[0].get_legend_handles_labels()
+    fig.legend(handles, labels, loc="lower center", ncol=5, fontsize=8)
     fig.suptitle(f"Downfall directions of {len(toppled)} toppled column runs "
                  "against ground-motion directions")
-    fig.tight_layout()
+    fig.tight_layout(rect=(0, 0.04, 1, 1))
     files.save_figure(fig, path, dpi=120)
     return Path(path)
