@@ -77,23 +77,33 @@ def animate_run(run, path, fps=20, max_seconds=None, max_frames=600):
     height = max(b["height"] * (b["index"] + 1) for b in bodies)
     reach = PEDESTAL_HALF + 1.0
 
+    ax.set(xlim=(-reach, reach), ylim=(-reach, reach), zlim=(0, max(height, 1.0)),
+           xlabel="East (m)", ylabel="North (m)", zlabel="Up (m)")
+    ax.set_box_aspect((2 * reach, 2 * reach, max(height, 1.0)))
+    square = np.array([[-1, -1], [1, -1], [1, 1], [-1, 1], [-1, -1]]) * PEDESTAL_HALF
+    pedestal_line, = ax.plot([], [], [], color="grey")
+    body_lines = []  # per body: two rim lines, then the side lines
+    for body in bodies:
+        colour = colours.get(body["column"], "k")
+        rims = [ax.plot([], [], [], color=colour, lw=1)[0] for _ in range(2)]
+        sides = [ax.plot([], [], [], color=colour, lw=0.6)[0]
+                 for _ in range(len(body_surface(body, np.zeros(3), [1, 0, 0, 0])[0][::3]))]
+        body_lines.append(rims + sides)
+    title = ax.set_title("")
+
     def draw(k):
-        ax.cla()
         disp = traj["pedestal_disp"][k]
-        sq = np.array([[-1, -1], [1, -1], [1, 1], [-1, 1], [-1, -1]]) * PEDESTAL_HALF
-        ax.plot(sq[:, 0] + disp[0], sq[:, 1] + disp[1], np.full(5, disp[2]), color="grey")
+        pedestal_line.set_data_3d(square[:, 0] + disp[0], square[:, 1] + disp[1],
+                                  np.full(5, disp[2]))
         for j, body in enumerate(bodies):
             rims = body_surface(body, traj["pos"][k, j] + disp, traj["quat"][k, j])
-            colour = colours.get(body["column"], "k")
-            for rim in rims:
+            lines = body_lines[j]
+            for line, rim in zip(lines[:2], rims):
                 closed = np.vstack([rim, rim[:1]])
-                ax.plot(closed[:, 0], closed[:, 1], closed[:, 2], color=colour, lw=1)
-            for a, b in zip(rims[0][::3], rims[1][::3]):
-                ax.plot(*np.column_stack([a, b]), color=colour, lw=0.6)
-        ax.set(xlim=(-reach, reach), ylim=(-reach, reach), zlim=(0, max(height, 1.0)),
-               xlabel="East (m)", ylabel="North (m)", zlabel="Up (m)")
-        ax.set_box_aspect((2 * reach, 2 * reach, max(height, 1.0)))
-        ax.set_title(f"t = {t[k]:5.2f} s")
+                line.set_data_3d(closed[:, 0], closed[:, 1], closed[:, 2])
+            for line, a, b in zip(lines[2:], rims[0][::3], rims[1][::3]):
+                line.set_data_3d(*np.column_stack([a, b]))
+        title.set_text(f"t = {t[k]:5.2f} s")
 
     anim = animation.FuncAnimation(fig, draw, frames=frames, interval=1000 / fps)
     writer = (animation.PillowWriter(fps=fps) if path.suffix == ".gif"
