@@ -19,7 +19,7 @@ from matplotlib.colors import Normalize
 from matplotlib.figure import Figure
 from matplotlib.ticker import LogLocator, NullFormatter, ScalarFormatter
 
-from pipeline import files
+from pipeline import files, records
 from pipeline.files import InputError
 
 COLUMN_TYPES = ("drums", "monolithic")
@@ -195,19 +195,13 @@ def _checked_impacts(impacts, columns):
 
 
 def load_motion(motion):
-    """Horizontal displacement (n, 2) m and meta dict from a processed-motion npz.
+    """Horizontal displacement (n, 2) m and meta dict from a processed motion.
 
-    ``motion`` is the npz path or a mapping with ``disp`` and ``meta``.
+    ``motion`` is the npz path (read with :func:`pipeline.records.load_motion`) or a
+    mapping with ``disp`` and ``meta`` (a dict or its JSON text).
     """
     if isinstance(motion, (str, Path)):
-        path = Path(motion)
-        if not path.is_file():
-            raise InputError(f"motion file not found: {path}")
-        try:
-            with np.load(path, allow_pickle=False) as data:
-                motion = {key: data[key] for key in data.files}
-        except (OSError, ValueError) as exc:
-            raise InputError(f"cannot read motion file {path}: {exc}") from None
+        motion = records.load_motion(motion)
     if "disp" not in motion or "meta" not in motion:
         raise InputError("motion lacks 'disp' or 'meta'")
     disp = np.asarray(motion["disp"], dtype=float)
@@ -218,8 +212,8 @@ def load_motion(motion):
     meta = motion["meta"]
     if not isinstance(meta, dict):
         try:
-            meta = json.loads(str(np.asarray(meta).item() if np.ndim(meta) == 0 else meta))
-        except (ValueError, TypeError):
+            meta = json.loads(str(meta))
+        except ValueError:
             raise InputError("motion 'meta' is not a JSON object") from None
     return disp[:, :2], meta
 
