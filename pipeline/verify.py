@@ -14,6 +14,7 @@ import math
 from pathlib import Path
 
 import numpy as np
+from scipy.integrate import cumulative_trapezoid
 
 from pipeline import RESULTS_DIR, rocking, scenario
 from pipeline.files import InputError, content_hash, write_json
@@ -27,7 +28,6 @@ MARBLE_CONTACT = {"kn": 1.2e7, "damping": 0.36, "mu_s": 0.7, "mu_k": 0.6,
 # restitution within 0.2 %; the paper's 0.36 gives a 0.4 % higher one (see README)
 HOUSNER_DAMPING = 1.0
 TOLERANCE = 0.02            # relative, impact times and peak amplitudes
-G = 9.81
 
 
 def run_block(run_dir, height, width, depth, theta0=0.0, motion=None, duration=5.0,
@@ -102,17 +102,15 @@ def verify_housner(height=MARBLE_BLOCK["height"], width=MARBLE_BLOCK["width"],
     return result
 
 
-def sine_pulse_motion(height, width, amplitude_ratio, omega_ratio, dt=0.001, tail_s=4.0):
-    """One-sine ground acceleration along East as in pipeline.rocking.sine_pulse
-    (a = A sin(w t + psi) from the uplift phase psi to 2 pi), integrated to displacement."""
-    const = rocking.block_constants(height, width)
-    amplitude = amplitude_ratio * const["alpha"] * G
-    psi = math.asin(const["uplift_acc"] / amplitude) if amplitude > const["uplift_acc"] else 0.0
-    acc_func, t_pulse = rocking.sine_pulse(amplitude, omega_ratio * const["p"], psi)
+def sine_pulse_motion(reference, dt=0.001, tail_s=4.0):
+    """The one-sine ground acceleration of a rocking.sine_pulse_response result (amplitude,
+    omega, uplift phase psi; a = A sin(w t + psi) up to phase 2 pi) along East, integrated
+    to displacement."""
+    acc_func, t_pulse = rocking.sine_pulse(reference["amplitude"], reference["omega"],
+                                           reference["psi"])
     t = np.arange(0.0, t_pulse + tail_s, dt)
     acc_e = np.array([acc_func(ti) for ti in t])
-    vel_e = np.concatenate([[0.0], np.cumsum(0.5 * (acc_e[1:] + acc_e[:-1])) * dt])
-    disp_e = np.concatenate([[0.0], np.cumsum(0.5 * (vel_e[1:] + vel_e[:-1])) * dt])
+    disp_e = cumulative_trapezoid(cumulative_trapezoid(acc_e, dx=dt, initial=0), dx=dt, initial=0)
     zeros = np.zeros_like(t)
     return {"dt": dt, "acc": np.column_stack([acc_e, zeros, zeros]),
             "disp": np.column_stack([disp_e, zeros, zeros])}
@@ -142,7 +140,7 @@ def verify_sine_pulse(height=PULSE_BLOCK["height"], width=PULSE_BLOCK["width"],
     contact = {**scenario.CONTACT_DEFAULTS, **contact}
     const = rocking.block_constants(height, width)
     ref = rocking.sine_pulse_response(height, width, amplitude_ratio, omega_ratio)
-    motion = sine_pulse_motion(height, width, amplitude_ratio, omega_ratio)
+    motion = sine_pulse_motion(ref)
     run_dir = Path(run_dir or RESULTS_DIR / "verification" / "runs" /
                    f"pulse_{amplitude_ratio:g}_{omega_ratio:g}")
     t, theta, _ = run_block(run_dir, height, width, depth, motion=motion,
