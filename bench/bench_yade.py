@@ -9,11 +9,9 @@ Prints and writes results/bench/bench.json and results/bench/convergence.png:
   factor and in the number of rim contact points for a strong directed pulse.
 """
 import argparse
-import json
 import math
 import sys
 import tempfile
-import time
 from pathlib import Path
 
 import numpy as np

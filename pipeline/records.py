@@ -533,7 +533,7 @@ def run_command(args):
     out_dir = args.out if args.out is not None else DEFAULT_OUT
 
     # read and process everything in memory first: a bad input writes nothing
-    pending, motions = [], []
+    motions = []
     for spec in specs:
         source = _resolve(spec)
         if source["processed"]:

@@ -157,7 +157,7 @@ def build_report(results=RESULTS_DIR):
         meta = results / name / "campaign.json"
         if meta.exists():
             campaigns[name] = json.loads(meta.read_text())
-    head = [f"# Toppling columns: results report\n",
+    head = ["# Toppling columns: results report\n",
             f"Generated {datetime.datetime.now(datetime.timezone.utc):%Y-%m-%d %H:%M} UTC by "
             f"toppling-columns {__version__}, after Hinzen (2009), BSSA 99(5).\n",
             "Campaigns: " + (", ".join(f"{n} ({c.get('runs', '?')} runs)"

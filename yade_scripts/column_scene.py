@@ -310,7 +310,7 @@ def finish():
     if P["drive"] == "kinematic":
         disp = shift[:, 0, :]
     else:
-        disp = motion_at("disp", t) if motion is not None else np.zeros((len(t), 3))
+        disp = motion_at("disp", t)
     out = os.path.join(HERE, P["output"])
     tmp = out + ".tmp.npz"
     np.savez_compressed(
