@@ -1,4 +1,5 @@
-"""Shared file helpers: the input-error type and atomic writes.
+"""Shared file helpers: the input-error type, atomic writes, content and code hashes,
+and the software versions recorded as provenance.
 
 Every result file is written to a temporary file in the same directory and
 renamed into place, so an interrupted run never leaves a partial result.
@@ -14,7 +15,11 @@ from pathlib import Path
 import numpy as np
 
 
-class InputError(Exception):
+class ToolError(Exception):
+    """An error the command line reports as one line (exit status 1)."""
+
+
+class InputError(ToolError):
     """Bad user input (missing file, wrong format, NaN, impossible parameter).
 
     The message is one line naming the problem; the CLI prints it and exits 2.
@@ -30,11 +35,18 @@ def atomic_path(path):
     os.close(fd)
     try:
         yield Path(tmp)
+        os.chmod(tmp, 0o666 & ~_umask())          # like any tool: honour the user's umask
         os.replace(tmp, path)
     except BaseException:
         if os.path.exists(tmp):
             os.unlink(tmp)
         raise
+
+
+def _umask():
+    mask = os.umask(0)
+    os.umask(mask)
+    return mask
 
 
 def write_text(path, text):
@@ -76,6 +88,39 @@ def content_hash(*parts):
     return h.hexdigest()[:16]
 
 
+def code_hash(*packages):
+    """Hex digest (16 chars) of every ``*.py`` file under the named sub-packages of
+    :mod:`pipeline` (e.g. ``"scenario", "outcome"``) or project directories
+    (``"yade_scripts"``): a hash changes whenever the code of a stage changes."""
+    from pipeline import PROJECT_ROOT
+    h = hashlib.sha256()
+    for name in packages:
+        base = PROJECT_ROOT / name if (PROJECT_ROOT / name).is_dir() else \
+            PROJECT_ROOT / "pipeline" / name
+        paths = sorted(base.rglob("*.py")) if base.is_dir() else [base.with_suffix(".py")]
+        if not paths or not all(p.is_file() for p in paths):
+            raise FileNotFoundError(f"no code found for {name!r}")
+        for path in paths:
+            h.update(str(path.relative_to(PROJECT_ROOT)).encode())
+            h.update(path.read_bytes())
+    return h.hexdigest()[:16]
+
+
+def software_versions():
+    """Versions (dict) of the package, obspy, numpy, scipy and YADE, for provenance."""
+    import importlib.metadata
+    from pipeline import __version__
+    versions = {"toppling-columns": __version__}
+    for dist in ("obspy", "numpy", "scipy"):
+        try:
+            versions[dist] = importlib.metadata.version(dist)
+        except importlib.metadata.PackageNotFoundError:
+            versions[dist] = None
+    from pipeline.scenario.runner import yade_version
+    versions["yade"] = yade_version()
+    return versions
+
+
 def _json_default(obj):
     if isinstance(obj, np.generic):
         return obj.item()
@@ -84,3 +129,40 @@ def _json_default(obj):
     if isinstance(obj, Path):
         return str(obj)
     raise TypeError(f"not JSON serialisable: {type(obj).__name__}")
+
+
+class DirectoryLock:
+    """Exclusive lock of a directory (``DIR/.lock``, ``flock``) for the duration of a
+    ``with`` block.  A second user waits (``wait=True``) or gets a one-line
+    InputError.  The kernel releases the lock when its holder dies: no stale locks.
+    The open descriptor (``fd``) can be passed to a child process to share the lock.
+    """
+
+    def __init__(self, directory, wait=False):
+        self.directory, self.wait, self.fd = Path(directory), wait, None
+
+    def __enter__(self):
+        import fcntl
+        try:
+            self.directory.mkdir(parents=True, exist_ok=True)
+        except (FileExistsError, NotADirectoryError):
+            raise InputError(f"{self.directory} exists and is not a directory") from None
+        except PermissionError:
+            raise InputError(f"{self.directory}: not writable") from None
+        path = self.directory / ".lock"
+        try:
+            self.fd = os.open(path, os.O_RDWR | os.O_CREAT, 0o666)
+        except PermissionError:
+            raise InputError(f"{self.directory}: not writable") from None
+        try:
+            fcntl.flock(self.fd, fcntl.LOCK_EX | (0 if self.wait else fcntl.LOCK_NB))
+        except BlockingIOError:
+            os.close(self.fd)
+            raise InputError(f"{self.directory} is in use by another run or campaign; "
+                             "wait for it to finish") from None
+        return self
+
+    def __exit__(self, *exc):
+        os.close(self.fd)
+        self.fd = None
+        return False

@@ -32,7 +32,7 @@ def _figure(results, path, caption):
 
 def _spread(azimuths):
     """Axial spread (deg) of downfall azimuths: circular std of doubled angles, halved."""
-    from pipeline.analysis import circular_summary
+    from pipeline.stats.circular import circular_summary
     values = np.asarray([a for a in azimuths if math.isfinite(a)])
     if len(values) < 2:
         return None
@@ -177,10 +177,3 @@ def build_report(results=RESULTS_DIR):
     text = "\n".join(head + body)
     write_text(results / "REPORT.md", text)
     return results / "REPORT.md"
-
-
-def add_command(subparsers):
-    p = subparsers.add_parser("report", help="write results/REPORT.md from the campaigns",
-                              description=__doc__.splitlines()[0])
-    p.add_argument("--results", type=Path, default=RESULTS_DIR, help="results directory")
-    p.set_defaults(func=lambda args: print(f"wrote {build_report(args.results)}") or 0)

@@ -3,7 +3,7 @@
 # Run on its own with:  yade -n -x column_scene.py
 # It reads params.json (and the motion npz it names) from its own directory
 # and writes trajectory.npz there.  No value is ever pasted into this file:
-# pipeline/scenario.py copies it unchanged next to the data files.
+# pipeline/scenario/writer.py copies it unchanged next to the data files.
 #
 # Bodies are clumps (see ../shared/notes/yade-modeling.md): small spheres on
 # the bottom and top rims, a Box plate as the top face a drum above stands on,
@@ -27,12 +27,32 @@ from yade.wrapper import (Bo1_Box_Aabb, Bo1_Sphere_Aabb, ForceResetter, Ig2_Box_
                           Ip2_ViscElMat_ViscElMat_ViscElPhys, Law2_ScGeom_ViscElPhys_Basic,
                           NewtonIntegrator, PyRunner, ViscElMat)
 
+# ---------------------------------------------------------------- parameters
+# Every value comes from params.json beside this script (written by
+# pipeline/scenario/writer.py from the dataclasses of pipeline/scenario/parameters.py).
 HERE = os.path.dirname(os.path.abspath(sys.argv[0]))
 with open(os.path.join(HERE, "params.json")) as fh:
     P = json.load(fh)
-G = 9.81
-CONTACT = P["contact"]
-RIM_R = P["rim_sphere_radius"]
+G = 9.81                              # m/s^2, the model's gravity (pipeline.constants)
+COLUMNS = P["columns"]                # name, kind, x, y (m), height (m), diameter (m), n_drums, density (kg/m^3)
+BLOCK = P.get("block")                # test block: height, width, depth (m), density, theta0_rad; or None
+CONTACT = P["contact"]                # kn (N/m per rim point), damping (ratio), mu_s, mu_k
+PEDESTAL = P["pedestal"]              # thickness (m), contact_half_size (m)
+RIM_POINTS = P["rim_points"]          # contact spheres per rim
+RIM_R = P["rim_sphere_radius"]        # m
+DT_FACTOR = P["dt_factor"]            # dt = DT_FACTOR sqrt(m_min / (kn RIM_POINTS))
+DRIVE = P["drive"]                    # "inertial" (gravity table) or "kinematic"
+DRIVE_INTERVAL_S = P["drive_interval_s"]
+FRICTION = P["friction"]              # "switch" (mu_s sticking, mu_k sliding) or "static"
+FRICTION_INTERVAL_S = P["friction_interval_s"]
+RECORD_HZ = P["record_hz"]            # trajectory samples per second
+REST_VELOCITY = P["rest_velocity"]    # m/s
+REST_LENGTH = P["rest_length"]        # m
+REST_DURATION_S = P["rest_duration_s"]
+T_MAX = P["t_max"]                    # s, simulated time at most
+VERLET_DISTANCE = P["verlet_distance"]  # m
+MOTION_FILE = P.get("motion_file")    # processed-motion npz (dt, acc, disp; East, North, Up)
+OUTPUT = P["output"]                  # trajectory file name
 CORE_MASK = 1 << 29          # collides with nothing
 # the clump's reference point is its members' centre of mass: a tiny, very dense
 # core sphere at the body's centroid puts it there (mass set per density, not state.mass)
@@ -93,7 +113,7 @@ def add_body(shape, centre, R, mask_base, mask_top, material):
     def world(p):
         return tuple(centre + R @ np.asarray(p, float))
 
-    pts = rim_points(shape, P["rim_points"])
+    pts = rim_points(shape, RIM_POINTS)
     for x, y in pts:
         members.append(utils.sphere(world((x, y, -h / 2 + RIM_R)), RIM_R, material=material,
                                     mask=mask_base))
@@ -139,19 +159,19 @@ pedestal_ids = []
 
 
 def add_pedestal(mask, material):
-    half = P["pedestal"]["contact_half_size"]
-    thick = P["pedestal"]["thickness"]
+    half = PEDESTAL["contact_half_size"]
+    thick = PEDESTAL["thickness"]
     pid = O.bodies.append(utils.box((0, 0, -thick / 2), (half, half, thick / 2), fixed=True,
                                     material=material, mask=mask))
     pedestal_ids.append(pid)
 
 
-for c, col in enumerate(P["columns"]):
+for c, col in enumerate(COLUMNS):
     mask_base, mask_top = 1 << (2 * c), 1 << (2 * c + 1)
     n_bodies = col["n_drums"] if col["kind"] == "drums" else 1
     body_h = col["height"] / n_bodies
     mass = col["density"] * math.pi * (col["diameter"] / 2) ** 2 * body_h
-    material = contact_material(mass, P["rim_points"])
+    material = contact_material(mass, RIM_POINTS)
     add_pedestal(mask_base | mask_top, material)
     x0, y0 = col["x"], col["y"]
     for k in range(n_bodies):
@@ -162,12 +182,12 @@ for c, col in enumerate(P["columns"]):
         bodies.append(dict(shape, name=f"{col['name']}[{k}]", column=col["name"], index=k,
                            initial_pos=list(centre)))
 
-if P.get("block"):
-    blk = P["block"]
+if BLOCK:
+    blk = BLOCK
     shape = {"shape": "box", "width": blk["width"], "depth": blk["depth"], "height": blk["height"],
              "mass": blk["density"] * blk["width"] * blk["depth"] * blk["height"],
              "top_plate": False, "top_rim": False}
-    material = contact_material(shape["mass"], 2 * max(2, P["rim_points"] // 2))
+    material = contact_material(shape["mass"], 2 * max(2, RIM_POINTS // 2))
     add_pedestal(1, material)
     # initial tilt theta0 about the North (y) axis through the +x (East) bottom edge:
     # positive theta0 lifts the West edge, the block leans East.
@@ -180,15 +200,15 @@ if P.get("block"):
 
 # ---------------------------------------------------------------- time step
 # a body resting on a whole face of rim points: stiffness kn x points
-k_face = CONTACT["kn"] * P["rim_points"]
+k_face = CONTACT["kn"] * RIM_POINTS
 m_min = min(b["mass"] for b in bodies)
-O.dt = P["dt_factor"] * math.sqrt(m_min / k_face)
+O.dt = DT_FACTOR * math.sqrt(m_min / k_face)
 
 # ---------------------------------------------------------------- motion
 motion = None
 motion_end = 0.0
-if P.get("motion_file"):
-    with np.load(os.path.join(HERE, P["motion_file"])) as mf:
+if MOTION_FILE:
+    with np.load(os.path.join(HERE, MOTION_FILE)) as mf:
         motion = {"dt": float(mf["dt"]), "acc": np.array(mf["acc"], float),
                   "disp": np.array(mf["disp"], float)}
     motion["t"] = motion["dt"] * np.arange(len(motion["acc"]))
@@ -207,11 +227,11 @@ def motion_at(key, times):
     return out
 
 
-drive_steps = max(1, int(round(P["drive_interval_s"] / O.dt)))
+drive_steps = max(1, int(round(DRIVE_INTERVAL_S / O.dt)))
 newton = NewtonIntegrator(damping=0.0, gravity=(0, 0, -G))
 # inertial drive: gravity in the pedestal frame, -a(t) averaged over each drive interval
 # (sampled at its midpoint), precomputed so that each update is a table look-up
-n_drive = int((motion_end + P["drive_interval_s"]) / (drive_steps * O.dt)) + 2
+n_drive = int((motion_end + DRIVE_INTERVAL_S) / (drive_steps * O.dt)) + 2
 drive_acc = motion_at("acc", (np.arange(n_drive) + 0.5) * drive_steps * O.dt)
 GRAVITY_TABLE = [Vector3(-a[0], -a[1], -G - a[2]) for a in drive_acc] + [Vector3(0, 0, -G)]
 
@@ -249,7 +269,7 @@ def switch_friction():
 
 # ---------------------------------------------------------------- recording and stopping
 samples = []       # per record: (time, [(pos, ori, vel, angVel) per clump], pedestal pos, vel)
-record_steps = max(1, int(round(1.0 / (P["record_hz"] * O.dt))))
+record_steps = max(1, int(round(1.0 / (RECORD_HZ * O.dt))))
 state = {"rest_since": None, "stopped_early": False}
 states = [O.bodies[c].state for c in clumps]
 pedestal_state = O.bodies[pedestal_ids[0]].state
@@ -260,7 +280,7 @@ def record_state():
     samples.append((O.time, [(Vector3(s.pos), Quaternion(s.ori), Vector3(s.vel), Vector3(s.angVel))
                              for s in states],
                     pedestal_state.pos - pedestal_origin, Vector3(pedestal_state.vel)))
-    if O.time >= P["t_max"]:
+    if O.time >= T_MAX:
         O.pause()    # the main thread writes the output once the loop has stopped
 
 
@@ -268,7 +288,7 @@ def check_stop():
     """Stop once the standing bodies rest and either the motion is over or every column
     has fallen.  Bodies lying on the pedestal (tilt > 60 deg) may roll on: their impact
     is recorded already and a rolling cylinder takes long to stop."""
-    v_rest, length = P["rest_velocity"], P["rest_length"]
+    v_rest, length = REST_VELOCITY, REST_LENGTH
     rel = pedestal_state.vel
     at_rest, fallen = True, {}
     for b, s, c in zip(bodies, states, clumps):
@@ -279,7 +299,7 @@ def check_stop():
     if at_rest and (O.time > motion_end or all(fallen.values())):
         if state["rest_since"] is None:
             state["rest_since"] = O.time
-        elif O.time - state["rest_since"] >= P["rest_duration_s"]:
+        elif O.time - state["rest_since"] >= REST_DURATION_S:
             state["stopped_early"] = True
             record_state()
             O.pause()
@@ -307,11 +327,11 @@ def finish():
     ped_vel = np.array([list(s[3]) for s in samples])[:, None, :]
     offsets = np.array([[body_offset[c][3], body_offset[c][0], body_offset[c][1], body_offset[c][2]]
                         for c in clumps])
-    if P["drive"] == "kinematic":
+    if DRIVE == "kinematic":
         disp = shift[:, 0, :]
     else:
         disp = motion_at("disp", t)
-    out = os.path.join(HERE, P["output"])
+    out = os.path.join(HERE, OUTPUT)
     tmp = out + ".tmp.npz"
     np.savez_compressed(
         tmp, t=t, pedestal_disp=disp, pos=pos - shift,
@@ -321,24 +341,27 @@ def finish():
     os.replace(tmp, out)
 
 
-engines = [ForceResetter(),
-           InsertionSortCollider([Bo1_Sphere_Aabb(), Bo1_Box_Aabb()], verletDist=P["verlet_distance"]),
-           InteractionLoop([Ig2_Sphere_Sphere_ScGeom(), Ig2_Box_Sphere_ScGeom()],
-                           [Ip2_ViscElMat_ViscElMat_ViscElPhys()],
-                           [Law2_ScGeom_ViscElPhys_Basic()])]
-if P["friction"] == "switch" and TAN_K < TAN_S:
-    friction_steps = max(1, int(round(P["friction_interval_s"] / O.dt)))
-    engines.append(PyRunner(command="switch_friction()", iterPeriod=friction_steps))
-if motion is not None and P["drive"] == "inertial":
-    engines.append(PyRunner(command="drive_inertial()", iterPeriod=drive_steps))
-elif motion is not None and P["drive"] == "kinematic":
-    engines.append(PyRunner(command="drive_kinematic()", iterPeriod=1))
+# ---------------------------------------------------------------- engines
+friction_steps = max(1, int(round(FRICTION_INTERVAL_S / O.dt)))
+stop_steps = max(1, int(round(0.1 / O.dt)))
+driven = motion is not None
 # recorders run before NewtonIntegrator so that O.time and positions agree
-engines += [PyRunner(command="record_state()", iterPeriod=record_steps),
-            PyRunner(command="check_stop()", iterPeriod=max(1, int(round(0.1 / O.dt)))),
-            newton]
-O.engines = engines
-if motion is not None and P["drive"] == "inertial":
+O.engines = [
+    ForceResetter(),
+    InsertionSortCollider([Bo1_Sphere_Aabb(), Bo1_Box_Aabb()], verletDist=VERLET_DISTANCE),
+    InteractionLoop([Ig2_Sphere_Sphere_ScGeom(), Ig2_Box_Sphere_ScGeom()],
+                    [Ip2_ViscElMat_ViscElMat_ViscElPhys()],
+                    [Law2_ScGeom_ViscElPhys_Basic()]),
+    PyRunner(command="switch_friction()", iterPeriod=friction_steps,
+             dead=not (FRICTION == "switch" and TAN_K < TAN_S)),
+    PyRunner(command="drive_inertial()", iterPeriod=drive_steps,
+             dead=not (driven and DRIVE == "inertial")),
+    PyRunner(command="drive_kinematic()", iterPeriod=1, dead=not (driven and DRIVE == "kinematic")),
+    PyRunner(command="record_state()", iterPeriod=record_steps),
+    PyRunner(command="check_stop()", iterPeriod=stop_steps),
+    newton,
+]
+if driven and DRIVE == "inertial":
     drive_inertial()
 O.run()
 O.wait()

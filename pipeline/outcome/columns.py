@@ -1,5 +1,5 @@
-"""Outcome stage: turn a YADE trajectory into toppled/not, impact time, impact
-points and downfall azimuth per column.
+"""Per-column outcome of a :class:`~pipeline.outcome.Trajectory`: toppled or not,
+impact time, impact points and downfall azimuth.
 
 All positions are in the pedestal frame (pedestal top face z = 0, metres).
 A column has toppled when one of its bodies struck the pedestal other than
@@ -13,14 +13,21 @@ import math
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from pipeline.constants import MODEL_GRAVITY
+from pipeline.motion import azimuth_deg
+
 CONTACT_TOLERANCE_M = 0.02   # a rim this close to the pedestal top has struck it
 
 
 def body_axes(quat):
     """Unit long axes (..., 3) of bodies from quaternions (..., 4) ordered (w, x, y, z)."""
     q = np.asarray(quat, float)
-    flat = q.reshape(-1, 4)[:, [1, 2, 3, 0]]
-    return Rotation.from_quat(flat).apply([0.0, 0.0, 1.0]).reshape(q.shape[:-1] + (3,))
+    return rotations(q).apply([0.0, 0.0, 1.0]).reshape(q.shape[:-1] + (3,))
+
+
+def rotations(quat):
+    """scipy Rotation of quaternions (..., 4) ordered (w, x, y, z), flattened."""
+    return Rotation.from_quat(np.asarray(quat, float).reshape(-1, 4)[:, [1, 2, 3, 0]])
 
 
 def rim_lowest_z(pos, axis, half_height, radius):
@@ -32,29 +39,24 @@ def rim_lowest_z(pos, axis, half_height, radius):
     return np.stack([bottom, top], axis=-1)
 
 
-def azimuth_deg(d_east, d_north):
-    """Azimuth clockwise from North in [0, 360) of a horizontal vector."""
-    return float(np.degrees(np.arctan2(d_east, d_north)) % 360.0)
-
-
 def tilt_deg(axis):
     return np.degrees(np.arccos(np.clip(axis[..., 2], -1.0, 1.0)))
 
 
 def column_outcomes(trajectory):
     """List of per-column result dicts (see module docstring)."""
-    t = trajectory["t"]
-    pos = trajectory["pos"]
-    axes = body_axes(trajectory["quat"])
+    t = trajectory.t
+    pos = trajectory.pos
+    axes = body_axes(trajectory.quat)
     columns = {}
-    for j, body in enumerate(trajectory["bodies"]):
+    for j, body in enumerate(trajectory.bodies):
         columns.setdefault(body["column"], []).append(j)
     results = []
     for name, members in columns.items():
-        origin = np.array(trajectory["bodies"][members[0]]["initial_pos"][:2])
+        origin = np.array(trajectory.bodies[members[0]]["initial_pos"][:2])
         bodies = []
         for j in members:
-            b = trajectory["bodies"][j]
+            b = trajectory.bodies[j]
             if b["shape"] != "cylinder":
                 continue
             low = rim_lowest_z(pos[:, j], axes[:, j], b["height"] / 2, b["radius"])
@@ -89,12 +91,11 @@ def column_outcomes(trajectory):
     return results
 
 
-def total_energy(trajectory, g=9.81):
+def total_energy(trajectory, g=MODEL_GRAVITY):
     """Kinetic + potential energy (J) of all bodies per sample, in the pedestal frame
     (meaningful for a still pedestal)."""
-    quats = np.asarray(trajectory["quat"], float)
-    energy = np.zeros(len(trajectory["t"]))
-    for j, b in enumerate(trajectory["bodies"]):
+    energy = np.zeros(len(trajectory.t))
+    for j, b in enumerate(trajectory.bodies):
         m, h = b["mass"], b["height"]
         if b["shape"] == "cylinder":
             r = b["radius"]
@@ -102,20 +103,21 @@ def total_energy(trajectory, g=9.81):
         else:
             w, d = b["width"], b["depth"]
             inertia = m / 12 * np.array([d * d + h * h, w * w + h * h, w * w + d * d])
-        rot = Rotation.from_quat(quats[:, j][:, [1, 2, 3, 0]])
-        omega_body = rot.inv().apply(trajectory["angvel"][:, j])
-        energy += (0.5 * m * (trajectory["vel"][:, j] ** 2).sum(axis=1)
+        omega_body = rotations(trajectory.quat[:, j]).inv().apply(trajectory.angvel[:, j])
+        energy += (0.5 * m * (trajectory.vel[:, j] ** 2).sum(axis=1)
                    + 0.5 * (inertia * omega_body ** 2).sum(axis=1)
-                   + m * g * trajectory["pos"][:, j, 2])
+                   + m * g * trajectory.pos[:, j, 2])
     return energy
 
 
-def summarise(trajectory, record=None, back_azimuth_deg=None, parameters=None):
+def summarise(trajectory, record=None, back_azimuth_deg=None, parameters=None,
+              provenance=None):
     """summary.json content of one run."""
     back = None if back_azimuth_deg is None or not math.isfinite(back_azimuth_deg) else float(
         back_azimuth_deg)
     return {"record": record, "back_azimuth_deg": back, "parameters": parameters or {},
-            "columns": column_outcomes(trajectory),
-            "simulated_s": float(trajectory["t"][-1]) if len(trajectory["t"]) else 0.0,
-            "motion_end_s": trajectory["motion_end"], "stopped_early": trajectory["stopped_early"],
-            "time_step_s": trajectory["dt"], "wall_s": trajectory.get("wall_s")}
+            "columns": column_outcomes(trajectory), "simulated": True,
+            "simulated_s": trajectory.simulated_s,
+            "motion_end_s": trajectory.motion_end, "stopped_early": trajectory.stopped_early,
+            "time_step_s": trajectory.dt, "wall_s": trajectory.wall_s,
+            "provenance": provenance or {}}

@@ -1,37 +1,28 @@
-"""Downfall statistics and campaign figures.
+"""Campaign figures: impact maps (paper Figs 9-10), roses, toppling against
+ground-motion parameters, downfall against reference directions.
 
-Circular statistics come from :mod:`astropy.stats` (angles in radians there,
-degrees here).  Azimuths are degrees clockwise from North in [0, 360); impact
-points are East/North offsets (m) from the column's initial axis.
+Azimuths are degrees clockwise from North in [0, 360); impact points are
+East/North offsets (m) from the column's initial axis.
 
 Input tables (see ``pipeline.campaign``): ``runs`` has one row per run and
 column type, ``impacts`` one row per body that struck the pedestal.
 """
-import json
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
-from astropy.stats import circcorrcoef, circmean, circstd, circvar, rayleightest
 from matplotlib import colormaps
-from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.colors import Normalize
-from matplotlib.figure import Figure
 from matplotlib.ticker import LogLocator, NullFormatter, ScalarFormatter
 
-from pipeline import files, records
+from pipeline import files
+from pipeline.constants import MODEL_GRAVITY
+from pipeline.figures.style import COLUMN_COLOURS, COLUMN_LABELS, COLUMN_MARKERS, figure
 from pipeline.files import InputError
+from pipeline.motion import Motion
+from pipeline.stats.circular import (COLUMN_TYPES, REFERENCE_AZIMUTHS, angle_difference_deg,
+                                     checked_runs, circular_summary)
 
-COLUMN_TYPES = ("drums", "monolithic")
-COLUMN_LABELS = {"drums": "multi-drum column", "monolithic": "monolithic column"}
-COLUMN_COLOURS = {"drums": "tab:blue", "monolithic": "tab:red"}
-# reference direction name -> runs column holding its azimuth (deg)
-REFERENCE_AZIMUTHS = {
-    "back_azimuth": "back_azimuth_deg",
-    "max_acc": "az_max_acc_deg",
-    "max_vel": "az_max_vel_deg",
-    "max_disp": "az_max_disp_deg",
-}
 REFERENCE_LABELS = {
     "back_azimuth": "back azimuth",
     "max_acc": "azimuth of largest horizontal acceleration",
@@ -39,144 +30,6 @@ REFERENCE_LABELS = {
     "max_disp": "azimuth of largest horizontal displacement",
 }
 PARAMETER_LABELS = {"hd": "h/d", "mu_s": "μs"}
-GRAVITY = 9.81  # m/s^2
-
-
-# ---------------------------------------------------------------- statistics
-
-def angle_difference_deg(a, b):
-    """Angle a - b (deg) wrapped into (-180, 180]; NaN stays NaN."""
-    d = np.mod(np.asarray(a, dtype=float) - np.asarray(b, dtype=float), 360.0)
-    d = np.where(d > 180.0, d - 360.0, d)
-    return d if d.ndim else float(d)
-
-
-def circular_summary(angles_deg, axial=False):
-    """Summary of directions (deg; NaN entries are ignored).
-
-    Returns dict(n, mean_deg, resultant_length, circular_std_deg, rayleigh_p).
-    mean_deg is in [0, 360), or in [0, 180) when ``axial`` (angles doubled
-    before averaging, mean and spread halved after; the direction is then
-    known up to 180 deg).  circular_std_deg is sqrt(-2 ln R) (Mardia); NaN
-    entries when no angle is given.
-    """
-    angles = np.asarray(angles_deg, dtype=float).ravel()
-    angles = angles[np.isfinite(angles)]
-    n = int(angles.size)
-    if n == 0:
-        return dict(n=0, mean_deg=np.nan, resultant_length=np.nan,
-                    circular_std_deg=np.nan, rayleigh_p=np.nan)
-    factor = 2.0 if axial else 1.0
-    radians = np.deg2rad(angles * factor)
-    length = float(1.0 - circvar(radians))
-    length = min(max(length, 0.0), 1.0)  # rounding
-    period = 360.0 / factor
-    mean = np.rad2deg(float(circmean(radians))) / factor if length > 1e-12 else np.nan
-    std = np.rad2deg(float(circstd(radians, method="circular"))) / factor if length > 0 else np.inf
-    # astropy's small-sample series can dip below 0 for very concentrated data
-    p_value = min(max(float(rayleightest(radians)), 0.0), 1.0)
-    return dict(n=n, mean_deg=float(np.mod(mean, period)), resultant_length=length,
-                circular_std_deg=float(std), rayleigh_p=p_value)
-
-
-def circular_correlation(a_deg, b_deg):
-    """Circular-circular correlation (astropy circcorrcoef) of paired angles (deg).
-
-    Pairs with a NaN are dropped; NaN when fewer than 3 pairs remain or one
-    set has (almost) no spread, e.g. one back azimuth for all runs.
-    """
-    a = np.asarray(a_deg, dtype=float).ravel()
-    b = np.asarray(b_deg, dtype=float).ravel()
-    keep = np.isfinite(a) & np.isfinite(b)
-    if keep.sum() < 3:
-        return np.nan
-    a, b = np.deg2rad(a[keep]), np.deg2rad(b[keep])
-    if min(float(circvar(a)), float(circvar(b))) < 1e-9:
-        return np.nan
-    return float(circcorrcoef(a, b))
-
-
-def direction_statistics(runs):
-    """Table comparing downfall azimuths with the reference directions.
-
-    One row per campaign, column type, record (and ``record_id == "all"`` for
-    all records of the campaign together) and reference direction
-    (back_azimuth, max_acc, max_vel, max_disp).  Only toppled runs with a
-    finite downfall azimuth and reference azimuth are used.  Columns:
-    n_runs, n_toppled, n (pairs used), mean_downfall_deg, mean_reference_deg,
-    mean_difference_deg (downfall - reference, (-180, 180]),
-    resultant_length (of the differences), rayleigh_p, axial_mean_difference_deg
-    ([-90, 90)), axial_resultant_length, axial_rayleigh_p, circcorr and
-    axial_circcorr (NaN when n < 3).
-    """
-    needed = ["campaign", "record_id", "column", "toppled", "downfall_azimuth_deg",
-              *REFERENCE_AZIMUTHS.values()]
-    runs = _checked_runs(runs, needed)
-    rows = []
-    for (campaign, column), group in runs.groupby(["campaign", "column"], sort=True):
-        subsets = [(str(rec), sub) for rec, sub in group.groupby("record_id", sort=True)]
-        if len(subsets) > 1:
-            subsets.append(("all", group))
-        for record_id, sub in subsets:
-            for reference, ref_column in REFERENCE_AZIMUTHS.items():
-                rows.append(dict(campaign=campaign, column=column, record_id=record_id,
-                                 reference=reference,
-                                 **_difference_statistics(sub, ref_column)))
-    return pd.DataFrame(rows)
-
-
-def _difference_statistics(sub, ref_column):
-    toppled = sub[sub["toppled"]]
-    downfall = toppled["downfall_azimuth_deg"].to_numpy(float)
-    reference = toppled[ref_column].to_numpy(float)
-    keep = np.isfinite(downfall) & np.isfinite(reference)
-    downfall, reference = downfall[keep], reference[keep]
-    difference = angle_difference_deg(downfall, reference)
-    directional = circular_summary(difference)
-    axial = circular_summary(difference, axial=True)
-    return dict(
-        n_runs=len(sub), n_toppled=len(toppled), n=directional["n"],
-        mean_downfall_deg=circular_summary(downfall)["mean_deg"],
-        mean_reference_deg=circular_summary(reference)["mean_deg"],
-        mean_difference_deg=angle_difference_deg(directional["mean_deg"], 0.0),
-        resultant_length=directional["resultant_length"],
-        rayleigh_p=directional["rayleigh_p"],
-        axial_mean_difference_deg=float(np.mod(axial["mean_deg"] + 90.0, 180.0) - 90.0),
-        axial_resultant_length=axial["resultant_length"],
-        axial_rayleigh_p=axial["rayleigh_p"],
-        circcorr=circular_correlation(downfall, reference),
-        axial_circcorr=circular_correlation(2.0 * downfall, 2.0 * reference),
-    )
-
-
-# ---------------------------------------------------------------- input checks
-
-def _checked_runs(runs, columns):
-    """Return a copy of ``runs`` with ``toppled`` as bool, or raise InputError."""
-    if not isinstance(runs, pd.DataFrame):
-        raise InputError(f"runs table must be a pandas DataFrame, got {type(runs).__name__}")
-    if runs.empty:
-        raise InputError("runs table is empty")
-    missing = [c for c in columns if c not in runs.columns]
-    if missing:
-        raise InputError(f"runs table lacks column(s): {', '.join(missing)}")
-    runs = runs.copy()
-    if "column" in columns:
-        unknown = sorted(set(runs["column"].astype(str)) - set(COLUMN_TYPES))
-        if unknown:
-            raise InputError(f"runs table has unknown column type(s): {', '.join(unknown)}")
-    if "toppled" in columns:
-        runs["toppled"] = _as_bool(runs["toppled"], "toppled")
-    return runs
-
-
-def _as_bool(series, name):
-    mapping = {True: True, False: False, "True": True, "False": False, "true": True,
-               "false": False, 1: True, 0: False}
-    values = series.map(lambda v: mapping.get(v.item() if isinstance(v, np.generic) else v))
-    if values.isna().any():
-        raise InputError(f"runs column '{name}' must hold True/False only")
-    return values.astype(bool)
 
 
 def _checked_impacts(impacts, columns):
@@ -194,37 +47,14 @@ def _checked_impacts(impacts, columns):
     return impacts
 
 
-def load_motion(motion):
-    """Horizontal displacement (n, 2) m and meta dict from a processed motion.
-
-    ``motion`` is the npz path (read with :func:`pipeline.records.load_motion`) or a
-    mapping with ``disp`` and ``meta`` (a dict or its JSON text).
-    """
+def horizontal_displacement(motion):
+    """Horizontal displacement (n, 2) m and meta of a Motion or a processed-motion path."""
     if isinstance(motion, (str, Path)):
-        motion = records.load_motion(motion)
-    if "disp" not in motion or "meta" not in motion:
-        raise InputError("motion lacks 'disp' or 'meta'")
-    disp = np.asarray(motion["disp"], dtype=float)
-    if disp.ndim != 2 or disp.shape[1] < 2 or len(disp) < 2:
-        raise InputError(f"motion 'disp' must have shape (n, 3), got {disp.shape}")
-    if not np.isfinite(disp[:, :2]).all():
-        raise InputError("motion 'disp' holds NaN or infinite samples")
-    meta = motion["meta"]
-    if not isinstance(meta, dict):
-        try:
-            meta = json.loads(str(meta))
-        except ValueError:
-            raise InputError("motion 'meta' is not a JSON object") from None
-    return disp[:, :2], meta
+        motion = Motion.load(motion)
+    return motion.disp[:, :2], motion.meta
 
 
 # ---------------------------------------------------------------- figures
-
-def _new_figure(**kwargs):
-    fig = Figure(**kwargs)
-    FigureCanvasAgg(fig)
-    return fig
-
 
 def _plain_log_ticks(axis):
     """Log axis labelled with plain numbers at 1, 2, 5 x 10^k (no 2x10^0 clutter)."""
@@ -271,7 +101,7 @@ def plot_impact_map(runs, impacts, motion, path, size_by="hd", title=None):
     """
     if size_by not in PARAMETER_LABELS:
         raise InputError(f"size_by must be one of {sorted(PARAMETER_LABELS)}, got {size_by!r}")
-    runs = _checked_runs(runs, ["record_id", "column", "toppled", size_by])
+    runs = checked_runs(runs, ["record_id", "column", "toppled", size_by])
     records = sorted(set(runs["record_id"].astype(str)))
     if len(records) != 1:
         raise InputError(f"impact map needs the runs of one record, got {len(records)}: "
@@ -282,7 +112,7 @@ def plot_impact_map(runs, impacts, motion, path, size_by="hd", title=None):
             impacts = impacts[impacts["record_id"].astype(str) == records[0]]
         if not np.isfinite(impacts[size_by].to_numpy(float)).all():
             raise InputError(f"impacts table has non-finite '{size_by}' values")
-    disp, meta = load_motion(motion)
+    disp, meta = horizontal_displacement(motion)
     if not np.isfinite(runs[size_by].to_numpy(float)).all():
         raise InputError(f"runs table has non-finite '{size_by}' values")
 
@@ -296,7 +126,7 @@ def plot_impact_map(runs, impacts, motion, path, size_by="hd", title=None):
     scale = 0.8 * limit / peak_disp if peak_disp > 0 else 1.0  # plot m per ground m
     baz = meta.get("back_azimuth_deg")
 
-    fig = _new_figure(figsize=(12.5, 8.0))
+    fig = figure(figsize=(12.5, 8.0))
     axes = fig.subplots(1, 2)
     for ax, column in zip(axes, COLUMN_TYPES):
         col_runs = runs[runs["column"] == column]
@@ -363,9 +193,9 @@ def _rose(ax, angles_deg, colour, label, bin_deg=15.0, bottom=None):
 def plot_rose(runs, path):
     """Rose diagrams (North up, clockwise): downfall azimuths of each column
     type with back-azimuth marks, and downfall minus back azimuth.  PNG."""
-    runs = _checked_runs(runs, ["column", "toppled", "downfall_azimuth_deg", "back_azimuth_deg"])
+    runs = checked_runs(runs, ["column", "toppled", "downfall_azimuth_deg", "back_azimuth_deg"])
     toppled = runs[runs["toppled"] & np.isfinite(runs["downfall_azimuth_deg"].astype(float))]
-    fig = _new_figure(figsize=(15, 5.6))
+    fig = figure(figsize=(15, 5.6))
     for k, column in enumerate(COLUMN_TYPES):
         ax = _polar_axes(fig, (1, 3, k + 1))
         sub = toppled[toppled["column"] == column]
@@ -405,11 +235,11 @@ def plot_toppling_vs_parameters(runs, path):
     PGA vs PGV/PGA scatter (Purvance et al. 2008).  PNG."""
     params = [("pga_h", "PGA (m/s²)"), ("pgv_h", "PGV (m/s)"), ("pgd_h", "PGD (m)"),
               ("pgv_pga_h", "PGV/PGA (s)")]
-    runs = _checked_runs(runs, ["column", "toppled", *[p for p, _ in params]])
+    runs = checked_runs(runs, ["column", "toppled", *[p for p, _ in params]])
     values = runs[[p for p, _ in params]].to_numpy(float)
     if not np.isfinite(values).all() or (values <= 0).any():
         raise InputError("runs table has non-positive or non-finite ground-motion parameters")
-    fig = _new_figure(figsize=(14, 8))
+    fig = figure(figsize=(14, 8))
     grid = fig.add_gridspec(2, 4)
     rows = {column: k for k, column in enumerate(COLUMN_TYPES)}
     for j, (param, label) in enumerate(params):
@@ -431,7 +261,7 @@ def plot_toppling_vs_parameters(runs, path):
         ax.grid(True, axis="x", lw=0.3)
     fig.legend(loc="upper center", ncol=4, fontsize=8, bbox_to_anchor=(0.5, 0.955))
     ax = fig.add_subplot(grid[1, 1:3])
-    markers = {"drums": "s", "monolithic": "o"}
+    markers = COLUMN_MARKERS
     for column in COLUMN_TYPES:
         sub = runs[runs["column"] == column]
         for toppled, face in ((True, COLUMN_COLOURS[column]), (False, "none")):
@@ -441,8 +271,8 @@ def plot_toppling_vs_parameters(runs, path):
                        label=f"{COLUMN_LABELS[column]}, {'toppled' if toppled else 'standing'}")
     if "hd" in runs.columns and runs["hd"].nunique() == 1 and np.isfinite(runs["hd"].iloc[0]):
         hd = float(runs["hd"].iloc[0])
-        ax.axhline(GRAVITY / hd, color="k", ls=":", lw=1,
-                   label=f"g·d/h = {GRAVITY / hd:.2f} m/s² (static uplift, h/d = {hd:g})")
+        ax.axhline(MODEL_GRAVITY / hd, color="k", ls=":", lw=1,
+                   label=f"g·d/h = {MODEL_GRAVITY / hd:.2f} m/s² (static uplift, h/d = {hd:g})")
     ax.set_xscale("log")
     ax.set_yscale("log")
     _plain_log_ticks(ax.xaxis)
@@ -471,12 +301,12 @@ def plot_downfall_vs_directions(runs, path):
     """Downfall azimuth against back azimuth and against the azimuths of the
     largest horizontal acceleration, velocity and displacement: 4 scatter
     panels with 1:1, +-90 and 180 deg guide lines.  PNG."""
-    runs = _checked_runs(runs, ["column", "toppled", "downfall_azimuth_deg",
+    runs = checked_runs(runs, ["column", "toppled", "downfall_azimuth_deg",
                                 *REFERENCE_AZIMUTHS.values()])
     toppled = runs[runs["toppled"]]
-    fig = _new_figure(figsize=(11, 10))
+    fig = figure(figsize=(11, 10))
     axes = fig.subplots(2, 2).ravel()
-    markers = {"drums": "s", "monolithic": "o"}
+    markers = COLUMN_MARKERS
     for ax, (reference, ref_column) in zip(axes, REFERENCE_AZIMUTHS.items()):
         _wrapped_line(ax, 0.0, color="k", lw=1.0, label="1:1 (same direction)")
         _wrapped_line(ax, 90.0, color="0.5", ls="--", lw=0.8, label="±90°")

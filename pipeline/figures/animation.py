@@ -1,7 +1,5 @@
 """Animations of runs (GIF, or MP4 when ffmpeg is present) and VTK export for ParaView.
 
-    python -m pipeline animate results/runs/GM20 --out gm20.gif --vtk gm20_vtk
-
 Bodies are drawn from the trajectory (centre of mass + quaternion, body z =
 long axis) in the absolute frame: pedestal-frame position + pedestal
 displacement, so the pedestal is seen to move with the ground.
@@ -13,23 +11,25 @@ from xml.sax.saxutils import quoteattr
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from pipeline import scenario
+from pipeline.figures.style import COLUMN_COLOURS, figure
 from pipeline.files import InputError, atomic_path, write_text
+from pipeline.outcome import Trajectory
+from pipeline.scenario import PEDESTAL
 
 CIRCLE_SEGMENTS = 24
-PEDESTAL_HALF = scenario.PEDESTAL["size"] / 2
+PEDESTAL_HALF = PEDESTAL["size"] / 2
 
 
 def load(run):
-    """Trajectory dict from a run directory, a trajectory.npz path or a dict."""
-    if isinstance(run, dict):
+    """:class:`Trajectory` from a run directory, a trajectory.npz path or a Trajectory."""
+    if isinstance(run, Trajectory):
         return run
     path = Path(run)
     if path.is_dir():
         path = path / "trajectory.npz"
     if not path.is_file():
         raise InputError(f"no trajectory found: {path}")
-    return scenario.load_trajectory(path)
+    return Trajectory.load(path)
 
 
 def body_surface(body, centre, quat_wxyz):
@@ -56,9 +56,6 @@ def _frame_indices(t, fps, max_seconds):
 
 def animate_run(run, path, fps=20, max_seconds=None, max_frames=600):
     """Write a 3-D animation of a run to ``path`` (.gif, or .mp4 with ffmpeg)."""
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
     from matplotlib import animation
 
     traj = load(run)
@@ -67,12 +64,11 @@ def animate_run(run, path, fps=20, max_seconds=None, max_frames=600):
         raise InputError(f"animation must be .gif or .mp4, got {path.name}")
     if path.suffix == ".mp4" and not animation.writers.is_available("ffmpeg"):
         raise InputError("MP4 needs ffmpeg, which is not installed: write a .gif instead")
-    t = traj["t"]
+    t = traj.t
     fps = min(fps, max_frames / max(t[-1], 1e-9)) if max_seconds is None else fps
     frames = _frame_indices(t, fps, max_seconds)
-    bodies = traj["bodies"]
-    colours = {"drums": "tab:blue", "monolithic": "tab:red", "block": "tab:green"}
-    fig = plt.figure(figsize=(7, 6))
+    bodies = traj.bodies
+    fig = figure(figsize=(7, 6))
     ax = fig.add_subplot(projection="3d")
     height = max(b["height"] * (b["index"] + 1) for b in bodies)
     reach = PEDESTAL_HALF + 1.0
@@ -84,7 +80,7 @@ def animate_run(run, path, fps=20, max_seconds=None, max_frames=600):
     pedestal_line, = ax.plot([], [], [], color="grey")
     body_lines = []  # per body: two rim lines, then the side lines
     for body in bodies:
-        colour = colours.get(body["column"], "k")
+        colour = COLUMN_COLOURS.get(body["column"], "k")
         rims = [ax.plot([], [], [], color=colour, lw=1)[0] for _ in range(2)]
         sides = [ax.plot([], [], [], color=colour, lw=0.6)[0]
                  for _ in range(len(body_surface(body, np.zeros(3), [1, 0, 0, 0])[0][::3]))]
@@ -92,11 +88,11 @@ def animate_run(run, path, fps=20, max_seconds=None, max_frames=600):
     title = ax.set_title("")
 
     def draw(k):
-        disp = traj["pedestal_disp"][k]
+        disp = traj.pedestal_disp[k]
         pedestal_line.set_data_3d(square[:, 0] + disp[0], square[:, 1] + disp[1],
                                   np.full(5, disp[2]))
         for j, body in enumerate(bodies):
-            rims = body_surface(body, traj["pos"][k, j] + disp, traj["quat"][k, j])
+            rims = body_surface(body, traj.pos[k, j] + disp, traj.quat[k, j])
             lines = body_lines[j]
             for line, rim in zip(lines[:2], rims):
                 closed = np.vstack([rim, rim[:1]])
@@ -111,7 +107,6 @@ def animate_run(run, path, fps=20, max_seconds=None, max_frames=600):
     with atomic_path(path) as tmp:
         anim.save(tmp.with_suffix(path.suffix), writer=writer)
         tmp.with_suffix(path.suffix).replace(tmp)
-    plt.close(fig)
     return path
 
 
@@ -134,13 +129,13 @@ def _vtp(points, polys):
 def frame_polydata(traj, k):
     """Points and polygons of all body surfaces (and the pedestal top) at sample k."""
     points, polys = [], []
-    disp = traj["pedestal_disp"][k]
+    disp = traj.pedestal_disp[k]
     sq = np.array([[-1, -1, 0], [1, -1, 0], [1, 1, 0], [-1, 1, 0]], float) * [PEDESTAL_HALF,
                                                                               PEDESTAL_HALF, 1]
     points.extend(sq + disp)
     polys.append([0, 1, 2, 3])
-    for j, body in enumerate(traj["bodies"]):
-        bottom, top = body_surface(body, traj["pos"][k, j] + disp, traj["quat"][k, j])
+    for j, body in enumerate(traj.bodies):
+        bottom, top = body_surface(body, traj.pos[k, j] + disp, traj.quat[k, j])
         n, base = len(bottom), len(points)
         points.extend(bottom)
         points.extend(top)
@@ -158,32 +153,11 @@ def export_vtk(run, out_dir, every=5):
         raise InputError(f"every must be at least 1, got {every}")
     out_dir = Path(out_dir)
     entries = []
-    for n, k in enumerate(range(0, len(traj["t"]), every)):
+    for n, k in enumerate(range(0, len(traj.t), every)):
         name = f"frame_{n:05d}.vtp"
         write_text(out_dir / name, _vtp(*frame_polydata(traj, k)))
-        entries.append(f'<DataSet timestep="{traj["t"][k]:.4f}" file={quoteattr(name)}/>')
+        entries.append(f'<DataSet timestep="{traj.t[k]:.4f}" file={quoteattr(name)}/>')
     pvd = out_dir / "run.pvd"
     write_text(pvd, '<?xml version="1.0"?>\n<VTKFile type="Collection" version="0.1">\n'
                "<Collection>\n" + "\n".join(entries) + "\n</Collection>\n</VTKFile>\n")
     return pvd
-
-
-def add_command(subparsers):
-    p = subparsers.add_parser("animate", help="animate a run (GIF/MP4) and export VTK",
-                              description=__doc__.splitlines()[0])
-    p.add_argument("run_dir", type=Path, help="run directory holding trajectory.npz")
-    p.add_argument("--out", type=Path, default=None, help="animation file (default RUN/animation.gif)")
-    p.add_argument("--fps", type=float, default=20.0, help="frames per second (20)")
-    p.add_argument("--max-seconds", type=float, default=None, help="animate only the start")
-    p.add_argument("--vtk", type=Path, default=None, metavar="DIR",
-                   help="also write a VTK time series (run.pvd) for ParaView")
-    p.set_defaults(func=animate_command)
-
-
-def animate_command(args):
-    out = animate_run(args.run_dir, args.out or args.run_dir / "animation.gif", fps=args.fps,
-                      max_seconds=args.max_seconds)
-    print(f"wrote {out}")
-    if args.vtk:
-        print(f"wrote {export_vtk(args.run_dir, args.vtk)}")
-    return 0

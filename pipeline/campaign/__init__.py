@@ -1,0 +1,85 @@
+"""Campaign stage: a registry of campaign definitions and one way to run them.
+
+A :class:`Campaign` names its run specs (``specs(records)``), the worker that
+performs one run and the outputs written from the finished runs.  Every
+campaign, verification included, goes through :func:`run_campaign`: the
+executor (:mod:`pipeline.campaign.executor`) runs what is not finished yet,
+then the campaign writes its tables and figures.
+
+A run spec is a dict with ``run_id`` (content hash of its inputs and of the code
+that turns them into an outcome), ``record``/``record_id`` and the parameters.
+"""
+import os
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Callable
+
+from pipeline import RESULTS_DIR
+from pipeline.files import DirectoryLock, InputError, write_json
+
+CAMPAIGNS = {}
+
+
+@dataclass(frozen=True)
+class Campaign:
+    """name: command-line name; help: one line; specs(records, campaign_dir) -> run specs;
+    worker(spec, run_dir) writes run_dir/summary.json; outputs(specs, campaign_dir,
+    failures, animations) writes tables and figures and returns a dict for campaign.json."""
+    name: str
+    help: str
+    specs: Callable
+    worker: Callable
+    outputs: Callable
+    label: str = "runs"
+
+
+def register(campaign):
+    """Add a campaign to the registry (one definition per module of definitions)."""
+    CAMPAIGNS[campaign.name] = campaign
+    return campaign
+
+
+def get(name):
+    from pipeline.campaign import definitions  # noqa: F401  (fills the registry)
+    try:
+        return CAMPAIGNS[name]
+    except KeyError:
+        raise InputError(f"unknown campaign {name!r} (known: {', '.join(CAMPAIGNS)})") from None
+
+
+def names():
+    from pipeline.campaign import definitions  # noqa: F401
+    return list(CAMPAIGNS)
+
+
+def run_campaign(name, jobs=None, records=None, campaign_dir=None, animations=1):
+    """Run (or resume) a campaign and write its outputs; return the outputs dict.
+
+    Ctrl-C stops within seconds: no new run starts, running YADE processes end,
+    the tables of the finished runs are written, then KeyboardInterrupt propagates.
+    """
+    from pipeline.campaign.executor import execute
+    campaign = get(name)
+    jobs = jobs or os.cpu_count() or 1
+    if jobs < 1:
+        raise InputError(f"--jobs must be at least 1, got {jobs}")
+    campaign_dir = Path(campaign_dir or RESULTS_DIR / name)
+    if campaign_dir.exists() and not campaign_dir.is_dir():
+        raise InputError(f"--out {campaign_dir} is a file, not a directory")
+    specs = campaign.specs(records, campaign_dir)
+    with DirectoryLock(campaign_dir, wait=False):
+        failures, interrupted = execute(specs, campaign_dir, jobs, campaign.worker,
+                                        campaign.label)
+        result = campaign.outputs(specs, campaign_dir, failures,
+                                  0 if interrupted else animations)
+        write_json(campaign_dir / "campaign.json", {
+            "campaign": name, "runs": len(specs), "interrupted": interrupted,
+            "failed": [{"run_id": s["run_id"], "record": s.get("record"), "error": str(e)}
+                       for s, e in failures], **result})
+    if interrupted:
+        raise KeyboardInterrupt
+    if failures:
+        from pipeline.files import ToolError
+        raise ToolError(f"{len(failures)} run(s) failed; see error.txt in their run "
+                        "directories; rerun the campaign to retry them")
+    return result

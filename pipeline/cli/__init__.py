@@ -1,0 +1,57 @@
+"""Command line: ``python -m pipeline <command>`` (or ``toppling <command>``).
+
+Each module of this package is one command and defines ``NAME``, ``HELP``,
+``setup(parser)`` and ``run(args) -> int``; commands are found with pkgutil, so
+a new command is one new module.  A :class:`~pipeline.files.ToolError` becomes
+one line on stderr: exit status 2 for bad input, 1 for other failures; Ctrl-C
+exits 130 after finished results are written.
+"""
+import argparse
+import errno
+import importlib
+import pkgutil
+import sys
+
+from pipeline.files import InputError, ToolError
+
+
+def commands():
+    """Command modules, in the order they are listed."""
+    modules = [importlib.import_module(f"{__name__}.{m.name}")
+               for m in pkgutil.iter_modules(__path__) if not m.name.startswith("_")]
+    return sorted(modules, key=lambda m: getattr(m, "ORDER", 50))
+
+
+def build_parser():
+    parser = argparse.ArgumentParser(
+        prog="python -m pipeline",
+        description="Simulate toppling columns (Hinzen 2009) with YADE: records, runs, "
+        "verification, campaigns, synthetics and the report.")
+    subparsers = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
+    for module in commands():
+        sub = subparsers.add_parser(module.NAME, help=module.HELP,
+                                    description=getattr(module, "DESCRIPTION", module.HELP))
+        module.setup(sub)
+        sub.set_defaults(func=module.run)
+    return parser
+
+
+def main(argv=None):
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    try:
+        return int(args.func(args) or 0)
+    except InputError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+    except ToolError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 1
+    except KeyboardInterrupt:
+        print("interrupted: finished results are kept", file=sys.stderr)
+        return 130
+    except OSError as exc:
+        what = "disk full" if exc.errno == errno.ENOSPC else exc.strerror or str(exc)
+        where = f": {exc.filename}" if exc.filename else ""
+        print(f"error: {what}{where} (nothing partial was written)", file=sys.stderr)
+        return 1

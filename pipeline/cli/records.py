@@ -1,0 +1,107 @@
+"""``records``: process strong-motion records into npz, Table 1 (records.csv) and figures."""
+from pathlib import Path
+
+import pandas as pd
+
+from pipeline import RESULTS_DIR, files
+from pipeline.files import InputError
+from pipeline.motion import Motion
+from pipeline.motion.measures import record_parameters
+from pipeline.records import build_motion, catalog, resolve
+
+NAME = "records"
+ORDER = 10
+HELP = "process strong-motion records: npz, Table 1 (records.csv), figures"
+DESCRIPTION = ("Process strong-motion records (catalogue ids from records/catalog.csv or record "
+               "files: PEER AT2, DMG V1, ASDF, MiniSEED, SAC, ...) into <out>/<id>.npz, "
+               "records.csv (Table 1) and <id>.png.")
+DEFAULT_OUT = RESULTS_DIR / "records"
+
+
+def setup(parser):
+    parser.add_argument("records", nargs="*", metavar="ID_OR_PATH",
+                        help="catalogue id (e.g. GM20) or record file")
+    parser.add_argument("--all", action="store_true", help="process every catalogued record")
+    parser.add_argument("--back-azimuth", type=float, metavar="DEG",
+                        help="back azimuth (deg, [0, 360)) for files without coordinates")
+    parser.add_argument("--out", type=Path, default=None,
+                        help="output directory (default results/records)")
+    parser.add_argument("--no-figures", action="store_true", help="skip the per-record figures")
+
+
+def parameters_table(motions):
+    """Table 1 rows (DataFrame) for a list of (record id, Motion)."""
+    rows = []
+    for record_id, motion in motions:
+        meta = motion.meta
+        row = {"id": record_id, "label": meta.get("label"), "event": meta.get("event"),
+               "station": meta.get("station"), "magnitude": meta.get("magnitude"),
+               "mechanism": meta.get("mechanism"), "has_vertical": meta.get("has_vertical"),
+               "horizontals_compass": meta.get("horizontals_compass")}
+        row.update(record_parameters(motion))
+        rows.append(row)
+    return pd.DataFrame(rows)
+
+
+def run(args):
+    from pipeline.figures.records import plot_motion
+    specs = list(catalog()["id"]) if args.all else []
+    specs += [spec for spec in args.records if spec not in specs]
+    if not specs:
+        raise InputError("name records (ids or files) or use --all")
+    if args.back_azimuth is not None and not 0.0 <= args.back_azimuth < 360.0:
+        raise InputError(f"--back-azimuth {args.back_azimuth:g} not in [0, 360)")
+    out_dir = args.out if args.out is not None else DEFAULT_OUT
+    if out_dir.exists() and not out_dir.is_dir():
+        raise InputError(f"--out {out_dir} exists and is not a directory")
+
+    # read and process everything in memory first: a bad input writes nothing
+    motions, seen = [], {}
+    for spec in specs:
+        source = resolve(spec)
+        key = None if source.processed else source.key(args.back_azimuth)
+        record_id = source.id
+        if seen.get(record_id, key) != key:
+            record_id = f"{record_id}-{key[:6]}"          # two inputs with one name
+        seen[record_id] = key
+        out_path = out_dir / f"{record_id}.npz"
+        if source.processed:
+            motions.append((record_id, Motion.load(source.path), out_path, True))
+            continue
+        current = _load_current(out_path, key)
+        if current is not None:
+            motions.append((record_id, current, out_path, False))
+            print(f"{record_id}: up to date", flush=True)
+        else:
+            motions.append((record_id, build_motion(source, args.back_azimuth, key), out_path,
+                            True))
+            print(f"{record_id}: processed", flush=True)
+
+    for record_id, motion, out_path, fresh in motions:
+        if fresh:
+            motion.save(out_path)
+        figure = out_path.with_suffix(".png")
+        if not args.no_figures and (fresh or not figure.is_file()):
+            plot_motion(motion, figure)
+    table = parameters_table([(rid, motion) for rid, motion, _, _ in motions])
+    _update_table(Path(out_dir) / "records.csv", table)
+    print(f"wrote {len(motions)} records to {out_dir}", flush=True)
+    return 0
+
+
+def _load_current(path, key):
+    if not path.is_file():
+        return None
+    try:
+        motion = Motion.load(path)
+    except InputError:
+        return None
+    return motion if motion.meta.get("processing", {}).get("input_hash") == key else None
+
+
+def _update_table(path, table):
+    """Write records.csv: these rows replace same-id rows of an existing table."""
+    if path.is_file():
+        old = pd.read_csv(path, dtype={"id": str})
+        table = pd.concat([old[~old["id"].isin(table["id"])], table], ignore_index=True)
+    files.write_csv(path, table)

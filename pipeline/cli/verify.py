@@ -1,0 +1,74 @@
+"""``verify``: the YADE block model against analytic rocking theory.
+
+    python -m pipeline verify housner --height 0.4 --width 0.08 --theta0-ratio 0.5
+    python -m pipeline verify sine-pulse --height 3.113 --width 0.795 --amplitude-ratio 6.5
+    python -m pipeline verify sliding
+"""
+from pathlib import Path
+
+from pipeline import RESULTS_DIR
+from pipeline.files import write_json
+from pipeline.verification import (MARBLE_BLOCK, PULSE_BLOCK, verify_housner, verify_sine_pulse,
+                                   verify_sliding)
+
+NAME = "verify"
+ORDER = 30
+HELP = "verify the YADE model against rocking theory"
+
+
+def setup(p):
+    sub = p.add_subparsers(dest="test", metavar="TEST", required=True)
+    h = sub.add_parser("housner", help="free rocking of a block (Housner 1963)")
+    h.add_argument("--height", type=float, default=MARBLE_BLOCK["height"], help="m (0.40)")
+    h.add_argument("--width", type=float, default=MARBLE_BLOCK["width"], help="m (0.08)")
+    h.add_argument("--depth", type=float, default=MARBLE_BLOCK["depth"], help="m (0.045)")
+    h.add_argument("--theta0-ratio", type=float, default=0.5, help="theta0 / alpha (0.5)")
+    h.add_argument("--impacts", type=int, default=5, help="impacts compared (5)")
+    s = sub.add_parser("sine-pulse", help="one-sine pulse overturning (Zhang & Makris 2000)")
+    s.add_argument("--height", type=float, default=PULSE_BLOCK["height"], help="m (3.113)")
+    s.add_argument("--width", type=float, default=PULSE_BLOCK["width"], help="m (0.795)")
+    s.add_argument("--depth", type=float, default=PULSE_BLOCK["depth"], help="m (0.5)")
+    s.add_argument("--amplitude-ratio", type=float, required=True, help="A / (alpha g)")
+    s.add_argument("--omega-ratio", type=float, default=5.0, help="omega / p (5)")
+    sl = sub.add_parser("sliding", help="rock-sliding test vs friction (paper Fig. 6)")
+    sl.add_argument("--mu-s", type=float, nargs="+", default=None, help="static friction values")
+    sl.add_argument("--theta0-deg", type=float, default=10.0, help="initial tilt (10 deg)")
+    sl.add_argument("--friction", choices=["switch", "static"], default="switch",
+                    help="switch: mu_s sticking, mu_k = 0.84 mu_s sliding (default); "
+                    "static: mu_s only, to see the effect of the kinetic coefficient")
+    for q in (h, s, sl):
+        q.add_argument("--kn", type=float, default=None, help="face contact stiffness N/m")
+        q.add_argument("--damping", type=float, default=None,
+                       help="contact damping ratio (housner: 1.0, critical; others: 0.36)")
+        q.add_argument("--out", type=Path, default=None, metavar="FILE",
+                       help="JSON output (default results/verification/<test>.json)")
+
+
+def run(args):
+    contact = {k: v for k, v in (("kn", args.kn), ("damping", args.damping)) if v is not None}
+    if args.test == "housner":
+        result = verify_housner(args.height, args.width, args.depth, args.theta0_ratio,
+                                args.impacts, **contact)
+        print(f"impact times within {100 * result['max_rel_error_impact_times']:.2f} %, peaks "
+              f"within {100 * result['max_rel_error_peaks']:.2f} % of Housner's equation "
+              f"(closed form {100 * result['max_rel_error_peaks_closed_form']:.2f} %); "
+              f"restitution {result['effective_restitution']:.3f} vs Housner "
+              f"{result['housner_restitution']:.3f}")
+    elif args.test == "sine-pulse":
+        result = verify_sine_pulse(args.height, args.width, args.depth, args.amplitude_ratio,
+                                   args.omega_ratio, **contact)
+        print(f"YADE: {result['yade']['mode']} (direction {result['yade']['direction']:+d}, "
+              f"{result['yade']['impacts_before_overturning']} impacts); integration: "
+              f"{result['integration']['mode']} (direction {result['integration']['direction']:+d})")
+    else:
+        kwargs = {"mu_values": tuple(args.mu_s)} if args.mu_s else {}
+        result = verify_sliding(theta0_deg=args.theta0_deg, friction=args.friction, **kwargs,
+                                **contact)
+        for r in result["runs"]:
+            print(f"mu_s {r['mu_s']:.3f}: {'pure rocking' if r['pure_rocking'] else 'sliding':>12}"
+                  f", slip at impacts {1000 * r['slip_at_impacts_m']:.1f} mm")
+        print(f"Augusti & Sinopoli: pure rocking needs mu_s > {result['augusti_sinopoli_mu_min']:.3f}")
+    out = args.out or RESULTS_DIR / "verification" / f"{args.test}.json"
+    write_json(out, result)
+    print(f"{'PASSED' if result['passed'] else 'FAILED'}; wrote {out}")
+    return 0 if result["passed"] else 1

@@ -1,0 +1,75 @@
+"""Figures of the verification campaign like the paper's Figs 4, 5 and 6."""
+from pathlib import Path
+
+import numpy as np
+from matplotlib.colors import ListedColormap
+
+from pipeline import rocking
+from pipeline.figures.style import new_figure
+from pipeline.files import save_figure
+from pipeline.verification import (CAMPAIGN_DAMPING, CAMPAIGN_THETA0, MARBLE_BLOCK,
+                                   PULSE_BLOCK)
+
+
+def plot_verification(results, out_dir):
+    """Figures like the paper's Figs 4 (Housner decay), 5 (one-sine pulse) and 6 (sliding)."""
+    written = []
+    # Fig. 4: amplitude decay, closed form (lines) and YADE (markers)
+    fig, ax = new_figure(figsize=(7, 5), constrained_layout=True)
+    for r0 in CAMPAIGN_THETA0:
+        n = np.arange(0, 6)
+        const = rocking.block_constants(MARBLE_BLOCK["height"], MARBLE_BLOCK["width"])
+        ax.plot(n, rocking.housner_closed_form(r0, const["energy_ratio"], 5), "k-", lw=0.8)
+        for z, marker in zip(CAMPAIGN_DAMPING, ("x", "o")):
+            for s, r in results:
+                if s["kind"] == "housner" and s["theta0_ratio"] == r0 and s["damping"] == z:
+                    peaks = [r0] + r["yade"]["peaks_over_alpha"]
+                    ax.plot(np.arange(len(peaks)), peaks, marker, ms=6, mfc="none",
+                            color="C0" if z == CAMPAIGN_DAMPING[0] else "C3",
+                            label=f"YADE, damping {z}" if r0 == CAMPAIGN_THETA0[0] else None)
+    ax.plot([], [], "k-", lw=0.8, label="Housner (1963) eq. 6")
+    ax.set(xlabel="number of impacts", ylabel="amplitude theta / alpha",
+           title="Free rocking of the marble block (h/b = 5): amplitude decay")
+    ax.legend()
+    ax.grid(alpha=0.3)
+    path = Path(out_dir) / "fig4_housner.png"
+    save_figure(fig, path, dpi=120)
+    written.append(path)
+    # Fig. 5: overturning map (integration) with YADE outcomes
+    amps = np.linspace(1.0, 12.0, 45)
+    omegas = np.linspace(2.0, 10.0, 17)
+    grid = rocking.overturning_map(PULSE_BLOCK["height"], PULSE_BLOCK["width"], amps, omegas)
+    fig, ax = new_figure(figsize=(8, 5.5), constrained_layout=True)
+    cmap = ListedColormap(["#e8f0e8", "#f6c9a0", "#b9d3ee"])
+    ax.pcolormesh(amps, omegas, grid["mode"], cmap=cmap, vmin=-0.5, vmax=2.5, shading="nearest")
+    codes = {v: k for k, v in rocking.MODE_NAMES.items()}
+    markers = {0: "o", 1: "^", 2: "s"}
+    for name, code in codes.items():
+        pts = [(s["amplitude_ratio"], s["omega_ratio"]) for s, r in results
+               if s["kind"] == "sine-pulse" and r["yade"]["mode"] == name]
+        if pts:
+            ax.scatter(*zip(*pts), marker=markers[code], c="k", s=40, label=f"YADE: {name}")
+        ax.scatter([], [], marker="s", c=[cmap(code)], s=80, label=f"integration: {name}")
+    ax.set(xlabel="pulse amplitude A / (alpha g)", ylabel="pulse frequency omega / p",
+           title="One-sine pulse, block h 3.113 m, b 0.795 m (alpha 0.25, p 2.14 1/s)")
+    ax.legend(fontsize=8, loc="upper left")
+    path = Path(out_dir) / "fig5_sine_pulse.png"
+    save_figure(fig, path, dpi=120)
+    written.append(path)
+    # Fig. 6: horizontal position of the base centre for each mu_s
+    fig, ax = new_figure(figsize=(8, 5), constrained_layout=True)
+    for s, r in sorted([x for x in results if x[0]["kind"] == "sliding"],
+                       key=lambda x: -x[0]["mu_s"]):
+        run = r["runs"][0]
+        ax.plot(run["t"], 1000 * np.asarray(run["base_x_m"]), lw=1,
+                label=f"mu_s {run['mu_s']:g}" + ("" if run["pure_rocking"] else " (slides)"))
+    mu_min = next((r["augusti_sinopoli_mu_min"] for s, r in results if s["kind"] == "sliding"), None)
+    ax.set(xlabel="time (s)", ylabel="base centre, East (mm)",
+           title=f"Rock-sliding test, marble block from 10 deg (eq. 8: mu_s > {mu_min:.3f})"
+           if mu_min else "Rock-sliding test")
+    ax.legend(fontsize=7, ncol=2)
+    ax.grid(alpha=0.3)
+    path = Path(out_dir) / "fig6_sliding.png"
+    save_figure(fig, path, dpi=120)
+    written.append(path)
+    return written

@@ -1,0 +1,39 @@
+"""Analytic ground motions shared by the tests, the benchmark and the verification:
+one-sine acceleration pulses with their exact velocity and displacement."""
+import math
+
+import numpy as np
+from scipy.integrate import cumulative_trapezoid
+
+from pipeline.motion import Motion
+
+
+def one_sine_pulse(azimuth_deg=0.0, amplitude=5.0, period=1.0, duration=6.0, dt=0.005):
+    """a(t) = amplitude sin(2 pi t / period) (m/s^2) for t < period, zero after, along the
+    horizontal azimuth ``azimuth_deg``; velocity and displacement integrated exactly."""
+    t = np.arange(0.0, duration, dt)
+    w = 2 * math.pi / period
+    on = t < period
+    acc = np.where(on, amplitude * np.sin(w * t), 0.0)
+    vel = np.where(on, amplitude / w * (1 - np.cos(w * t)), 0.0)
+    disp = np.where(on, amplitude / w * (t - np.sin(w * t) / w), amplitude / w * period)
+    u = np.array([math.sin(math.radians(azimuth_deg)), math.cos(math.radians(azimuth_deg)), 0.0])
+    meta = {"record_id": f"pulse_{azimuth_deg:g}deg_{amplitude:g}ms2_{period:g}s",
+            "back_azimuth_deg": None, "has_vertical": False}
+    return Motion(dt, acc[:, None] * u, vel[:, None] * u, disp[:, None] * u, meta=meta)
+
+
+def phased_sine_pulse(amplitude, omega, psi, dt=0.001, tail_s=4.0):
+    """a(t) = A sin(omega t + psi) from phase psi to 2 pi along East, then zero for
+    ``tail_s`` seconds (the pulse of :func:`pipeline.rocking.sine_pulse`), integrated
+    to velocity and displacement (trapezoid)."""
+    from pipeline import rocking
+    acc_func, t_pulse = rocking.sine_pulse(amplitude, omega, psi)
+    t = np.arange(0.0, t_pulse + tail_s, dt)
+    acc_e = np.array([acc_func(ti) for ti in t])
+    vel_e = cumulative_trapezoid(acc_e, dx=dt, initial=0)
+    disp_e = cumulative_trapezoid(vel_e, dx=dt, initial=0)
+    zeros = np.zeros_like(t)
+    return Motion(dt, np.column_stack([acc_e, zeros, zeros]), np.column_stack([vel_e, zeros, zeros]),
+                  np.column_stack([disp_e, zeros, zeros]),
+                  meta={"record_id": "sine_pulse", "has_vertical": False})

@@ -1,0 +1,260 @@
+"""pyprop8 synthetics at sites on rings around a source, written as processed motions."""
+import importlib.metadata
+import json
+import math
+import os
+import time
+from multiprocessing import Pool
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pyprop8
+from pyprop8.utils import clp_filter, make_moment_tensor, rtf2xyz, stf_trapezoidal
+from threadpoolctl import threadpool_limits
+from tqdm import tqdm
+
+from pipeline import RESULTS_DIR, files
+from pipeline.files import InputError
+from pipeline.motion import Motion
+from pipeline.motion.synthetics.sources import (CRUST_LAYERS, LEAD_TIME_S, source_parameters,
+                                                subevents)
+
+GENERATOR_VERSION = 2  # bump when the written motions change
+PYPROP8_VERSION = importlib.metadata.version("pyprop8")
+DEFAULT_OUT_DIR = RESULTS_DIR / "synthetics"
+QUICK_OUT_DIR = RESULTS_DIR / "synthetics-quick"
+QUICK_FMAX_HZ = 2.5
+QUICK_DURATION_S = 20.0
+
+
+def numerics(duration_s, sampling_hz, fmax_hz, layers=CRUST_LAYERS):
+    """pyprop8 numerical parameters for content up to ``fmax_hz``.
+
+    The source spectrum is tapered to zero between fmax and 1.2 fmax; the
+    computation step puts the Nyquist frequency at >= 1.25 fmax and is an
+    integer fraction ``upsample`` of the output step.  Wavenumbers run to
+    kmax = 2 pi fmax / Vs_min (every propagating wave below fmax); the step
+    dk keeps the source images implied by the discrete wavenumber sum
+    (spacing 2 pi / dk) beyond the reach of the fastest wave in the padded
+    window plus 60 km.
+    """
+    if not (fmax_hz > 0 and duration_s > 0 and sampling_hz >= 2.5 * fmax_hz):
+        raise InputError(f"impossible synthetics numerics: duration {duration_s} s, sampling "
+                         f"{sampling_hz} Hz, fmax {fmax_hz} Hz (need sampling >= 2.5 fmax)")
+    upsample = int(sampling_hz // (2.5 * fmax_hz))
+    dt_calc = upsample / sampling_hz
+    nt = int(math.ceil(duration_s / dt_calc)) + 1
+    pad_frac = 0.5
+    vs_min = min(layer[2] for layer in layers)
+    vp_max = max(layer[1] for layer in layers)
+    kmax = 2 * math.pi * fmax_hz / vs_min
+    dk = 2 * math.pi / (vp_max * nt * (1 + pad_frac) * dt_calc + 60.0)
+    return {"dt_calc": dt_calc, "upsample": upsample, "nt": nt, "pad_frac": pad_frac,
+            "kmax": kmax, "nk": int(math.ceil(kmax / dk)) + 1}
+
+
+def moment_tensor_xyz(strike_deg, dip_deg, rake_deg, m0_nm):
+    """Double-couple moment tensor (East, North, Up) in pyprop8 units (1e18 N m)."""
+    return rtf2xyz(make_moment_tensor(strike_deg, dip_deg, rake_deg, m0_nm / 1e18))
+
+
+def point_source_displacement(x_km, y_km, mechanism, sub, num, fmax_hz, layers=CRUST_LAYERS):
+    """Surface displacement (m), shape (nsite, 3, nt), East/North/Up, of one sub-event.
+
+    ``mechanism`` = (strike, dip, rake) in degrees; ``sub`` a mapping with
+    x_km, y_km, depth_km, delay_s, m0_nm, rise_s, duration_s; ``num`` from
+    :func:`numerics`.  Sample 0 is LEAD_TIME_S before the hypocentral origin
+    time; the sub-event's moment release starts at its delay_s.
+    """
+    source = pyprop8.PointSource(
+        float(sub["x_km"]), float(sub["y_km"]), float(sub["depth_km"]),
+        moment_tensor_xyz(*mechanism, sub["m0_nm"]), np.zeros((3, 1)),
+        LEAD_TIME_S + float(sub["delay_s"]) + 0.5 * sub["duration_s"])
+    receivers = pyprop8.ListOfReceivers(np.asarray(x_km, float), np.asarray(y_km, float), depth=0)
+    w0, w1 = 2 * math.pi * fmax_hz, 2 * math.pi * 1.2 * fmax_hz
+
+    def moment_rate_spectrum(w):
+        return stf_trapezoidal(w, sub["rise_s"], sub["duration_s"]) * clp_filter(w, w0, w1)
+
+    with threadpool_limits(1):  # BLAS threads only slow pyprop8's small products
+        _, seis = pyprop8.compute_seismograms(
+            pyprop8.LayeredStructureModel([tuple(layer) for layer in layers]), source,
+            receivers, num["nt"], num["dt_calc"], source_time_function=moment_rate_spectrum,
+            pad_frac=num["pad_frac"], xyz=True, show_progress=False, squeeze_outputs=False,
+            stencil_kwargs={"kmin": 0.0, "kmax": num["kmax"], "nk": num["nk"]})
+    return seis[0] * 1e3  # km -> m
+
+
+def _point_source_task(call):
+    return point_source_displacement(*call)
+
+
+def band_limited_motion(disp, dt, upsample):
+    """(acc, vel, disp) at step dt/upsample from band-limited displacement (n, 3), m.
+
+    A ramp rising by the static offset (last minus first sample) over the FFT
+    period n dt is removed, which makes the periodic extension smooth when the
+    motion is at rest at both ends; the rest is interpolated and differentiated
+    in the frequency domain (exact below the Nyquist frequency) and the ramp
+    added back.  Output: n_out = (n - 1) * upsample + 1 samples.
+    """
+    n = disp.shape[0]
+    t = np.arange(n) * dt
+    slope = (disp[-1] - disp[0]) / (n * dt)
+    rest = disp - disp[0] - np.outer(t, slope)
+    spectrum = np.fft.rfft(rest, axis=0)
+    n_fine = n * upsample
+    dt_out = dt / upsample
+    omega = 2 * np.pi * np.fft.rfftfreq(n_fine, dt_out)[:, None]
+    padded = np.zeros((omega.shape[0], disp.shape[1]), dtype=complex)
+    padded[:spectrum.shape[0]] = spectrum * upsample
+    n_out = (n - 1) * upsample + 1
+    t_out = np.arange(n_out) * dt_out
+    out_disp = np.fft.irfft(padded, n_fine, axis=0)[:n_out] + disp[0] + np.outer(t_out, slope)
+    out_vel = np.fft.irfft(1j * omega * padded, n_fine, axis=0)[:n_out] + slope
+    out_acc = np.fft.irfft(-omega ** 2 * padded, n_fine, axis=0)[:n_out]
+    return out_acc, out_vel, out_disp
+
+
+def _settings(rings_km, azimuth_step_deg, duration_s, sampling_hz, fmax_hz, out_dir, quick):
+    if quick:
+        fmax_hz = min(fmax_hz, QUICK_FMAX_HZ)
+        duration_s = min(duration_s, QUICK_DURATION_S)
+    rings = tuple(float(r) for r in rings_km)
+    if not rings or min(rings) <= 0 or not 0 < azimuth_step_deg <= 360:
+        raise InputError(f"impossible site rings {rings_km} km / azimuth step {azimuth_step_deg}")
+    base = Path(out_dir) if out_dir is not None else (QUICK_OUT_DIR if quick else DEFAULT_OUT_DIR)
+    return {"rings_km": rings, "azimuth_step_deg": float(azimuth_step_deg),
+            "duration_s": float(duration_s), "sampling_hz": float(sampling_hz),
+            "fmax_hz": float(fmax_hz), "base": base}
+
+
+def site_table(source_name, rings_km=(5, 10, 20), azimuth_step_deg=30, out_dir=None,
+               quick=False):
+    """Sites on rings around the epicentre of ``source_name``.
+
+    Columns: site_id, x_km, y_km (East, North of the epicentre), ring_km,
+    site_azimuth_deg (epicentre to site), back_azimuth_deg (site to
+    epicentre), distance_km (epicentral), npz (path of the motion file).
+    """
+    source_parameters(source_name)
+    cfg = _settings(rings_km, azimuth_step_deg, 1.0, 100.0, 1.0, out_dir, quick)
+    azimuths = np.arange(0.0, 360.0 - 1e-9, cfg["azimuth_step_deg"])
+    rows = []
+    for ring in cfg["rings_km"]:
+        for az in azimuths:
+            x, y = ring * math.sin(math.radians(az)), ring * math.cos(math.radians(az))
+            site_id = f"r{ring:02g}_az{az:03g}"
+            rows.append({"site_id": site_id, "x_km": x, "y_km": y, "ring_km": ring,
+                         "site_azimuth_deg": float(az),
+                         "back_azimuth_deg": (float(az) + 180.0) % 360.0,
+                         "distance_km": math.hypot(x, y),
+                         "npz": cfg["base"] / source_name / f"{site_id}.npz"})
+    return pd.DataFrame(rows)
+
+
+def _cache_key(source_name, cfg, num):
+    params = {k: v for k, v in cfg.items() if k != "base"}
+    return files.content_hash(GENERATOR_VERSION, source_name, source_parameters(source_name),
+                              CRUST_LAYERS, LEAD_TIME_S, params, num)
+
+
+def generate(source_name, rings_km=(5, 10, 20), azimuth_step_deg=30, duration_s=30.0,
+             sampling_hz=100.0, fmax_hz=10.0, out_dir=None, quick=False, jobs=None):
+    """Compute (or reuse) the synthetic motions of all sites of one source.
+
+    ``quick`` lowers fmax to QUICK_FMAX_HZ and the duration to
+    QUICK_DURATION_S and writes under results/synthetics-quick (unless
+    ``out_dir`` is given).  ``jobs`` processes (default: all cores) share the
+    sub-events.  Returns the npz paths in site_table order; nothing is
+    recomputed when the manifest's cache key (hash of every parameter) matches
+    and all files exist.  Also writes the source's ground-motion-model check
+    (``<source>/gmm_check_sites.csv``) and refreshes the summary of all
+    sources, ``gmm_check.csv``, in the output directory.
+    """
+    src = source_parameters(source_name)
+    cfg = _settings(rings_km, azimuth_step_deg, duration_s, sampling_hz, fmax_hz, out_dir, quick)
+    num = numerics(cfg["duration_s"], cfg["sampling_hz"], cfg["fmax_hz"])
+    sites = site_table(source_name, cfg["rings_km"], cfg["azimuth_step_deg"], cfg["base"])
+    paths = [Path(p) for p in sites["npz"]]
+    source_dir = cfg["base"] / source_name
+    manifest_path = source_dir / "manifest.json"
+    key = _cache_key(source_name, cfg, num)
+    from pipeline.motion.synthetics.gmm import write_gmm_summary
+    if (manifest_path.is_file() and all(p.is_file() for p in paths)
+            and json.loads(manifest_path.read_text()).get("cache_key") == key):
+        if not (source_dir / "gmm_check_sites.csv").is_file():
+            _write_gmm_check(source_name, cfg)
+        write_gmm_summary(cfg["base"])
+        return paths
+    jobs = jobs or os.cpu_count() or 1
+
+    subs = subevents(source_name)
+    mechanism = (src["strike_deg"], src["dip_deg"], src["rake_deg"])
+    tasks = []
+    for _, sub in subs.iterrows():
+        sub = dict(sub, rise_s=src["subevent_rise_s"], duration_s=src["subevent_duration_s"])
+        tasks.append((sites["x_km"].to_numpy(), sites["y_km"].to_numpy(), mechanism, sub, num,
+                      cfg["fmax_hz"]))
+    started = time.monotonic()
+    total = 0.0
+    progress = tqdm(total=len(tasks), desc=f"pyprop8 {source_name}", unit="sub-event")
+    if jobs > 1 and len(tasks) > 1:
+        with Pool(min(jobs, len(tasks))) as pool:
+            for disp in pool.imap(_point_source_task, tasks):  # in order: reproducible sum
+                total = total + disp
+                progress.update(1)
+    else:
+        for task in tasks:
+            total = total + _point_source_task(task)
+            progress.update(1)
+    progress.close()
+    elapsed = time.monotonic() - started
+
+    manifest_path.unlink(missing_ok=True)
+    for stale in set(source_dir.glob("*.npz")) - set(paths):
+        stale.unlink()
+    for (_, site), path in zip(sites.iterrows(), paths):
+        acc, vel, disp = band_limited_motion(total[site.name].T, num["dt_calc"], num["upsample"])
+        meta = _site_meta(source_name, src, site, cfg, num, key)
+        Motion(1.0 / cfg["sampling_hz"], acc, vel, disp, meta=meta).save(path)
+    _write_gmm_check(source_name, cfg)
+    files.write_json(manifest_path, {
+        "cache_key": key, "source": source_name, "source_parameters": src,
+        "crust_layers_thickness_vp_vs_rho": [  # thickness null: the half-space
+            [None if math.isinf(layer[0]) else layer[0], *layer[1:]] for layer in CRUST_LAYERS],
+        "settings": {k: v for k, v in cfg.items() if k != "base"}, "numerics": num,
+        "compute_seconds": round(elapsed, 1), "jobs": jobs,
+        "sites": [p.name for p in paths]})
+    write_gmm_summary(cfg["base"])
+    return paths
+
+
+def _write_gmm_check(source_name, cfg):
+    from pipeline.motion.synthetics.gmm import gmm_check
+    files.write_csv(cfg["base"] / source_name / "gmm_check_sites.csv",
+                    gmm_check([source_name], cfg["rings_km"], cfg["azimuth_step_deg"], cfg["base"]))
+
+
+def _site_meta(source_name, src, site, cfg, num, key):
+    return {
+        "record_id": f"syn_{source_name}_{site.site_id}",
+        "label": f"synthetic {source_name} r={site.ring_km:g} km az={site.site_azimuth_deg:g}",
+        "event": f"synthetic {src['mechanism']} Mw {src['mw']:g}",
+        "station": site.site_id, "magnitude": src["mw"], "mechanism": src["mechanism"],
+        "back_azimuth_deg": float(site.back_azimuth_deg),
+        "epicentral_distance_km": float(site.distance_km),
+        "back_azimuth_source": "exact: synthetic site geometry (local frame, epicentre at origin)",
+        "has_vertical": True, "horizontals_compass": True, "orientation": "ENU",
+        "units": {"dt": "s", "acc": "m/s^2", "vel": "m/s", "disp": "m"},
+        "columns": ["East", "North", "Up"],
+        "source_file": f"pyprop8 {PYPROP8_VERSION} synthetic, cache key {key}",
+        "source": source_name, "ring_km": float(site.ring_km),
+        "site_azimuth_deg": float(site.site_azimuth_deg),
+        "x_km": float(site.x_km), "y_km": float(site.y_km),
+        "processing": {"freqmin_hz": 0.0, "freqmax_hz": cfg["fmax_hz"],
+                       "generator": "pyprop8", "lead_time_s": LEAD_TIME_S,
+                       "duration_s": cfg["duration_s"], **num, "cache_key": key,
+                       "version": GENERATOR_VERSION},
+    }

@@ -1,0 +1,242 @@
+"""Records stage: strong-motion records in, processed :class:`~pipeline.motion.Motion` out.
+
+A record is a catalogue id (``records/catalog.csv``), a record file (any format
+of :mod:`pipeline.records.readers`; a glob pattern for single-channel files) or
+an already processed ``.npz``.  :func:`processed_motion` reads, rotates to
+East/North/Up and processes it (:mod:`pipeline.records.processing`), caching
+the result by content: the input files' bytes, the catalogue row, the
+processing steps and the code of this package, never by name.
+"""
+import glob
+import re
+import sys
+from pathlib import Path
+
+import numpy as np
+from obspy import UTCDateTime
+from obspy.geodetics import gps2dist_azimuth
+from obspy.signal.rotate import rotate2zne
+
+from pipeline import PROJECT_ROOT, RECORDS_DIR, RESULTS_DIR
+from pipeline.files import InputError, code_hash, content_hash, software_versions
+from pipeline.motion import Motion
+from pipeline.records import processing
+from pipeline.records.catalog import catalog, catalog_row
+from pipeline.records.readers import is_pattern, read_record
+
+CACHE_DIR = RESULTS_DIR / "cache" / "motions"
+__all__ = ["processed_motion", "resolve", "build_motion", "catalog", "catalog_row",
+           "to_east_north_up", "CACHE_DIR"]
+
+
+class Source:
+    """A resolved record: ``id``, input ``path`` (file or glob), catalogue ``row`` (or None),
+    ``processed`` (an npz already processed) and the content ``key`` of its inputs."""
+
+    def __init__(self, record_id, path, row=None, processed=False):
+        self.id, self.path, self.row, self.processed = record_id, Path(path), row, processed
+
+    def input_files(self):
+        """Files the record depends on (AT2: the sibling AT2 files; a glob: its matches)."""
+        path = self.path
+        if is_pattern(path):
+            return [Path(p) for p in sorted(glob.glob(str(path)))]
+        if path.suffix.lower() in (".at2", ".gz") and ".at2" in path.name.lower():
+            return sorted(p for p in path.parent.iterdir() if ".at2" in p.name.lower())
+        return [path]
+
+    def key(self, back_azimuth=None, steps=processing.DEFAULT_STEPS):
+        """Content key (16 hex) of everything the processed motion depends on."""
+        return content_hash(self.row, back_azimuth, [list(s) for s in steps],
+                            code_hash("records", "motion"), *self.input_files())
+
+
+def resolve(record):
+    """A :class:`Source` for a catalogue id, record file, glob pattern or processed npz.
+
+    An existing file wins over a catalogue id of the same name; file-based ids are the
+    sanitised file stem (``same_stem_id`` makes them unique when needed).
+    """
+    path = Path(record)
+    if is_pattern(path) and glob.glob(str(path)):
+        return Source(_sanitise(path.name.split("*")[0].strip("._") or "record"), path)
+    if path.is_file():
+        if path.suffix.lower() == ".npz":
+            try:
+                with np.load(path, allow_pickle=False) as archive:
+                    names = set(archive.files)
+            except (ValueError, OSError, EOFError):
+                raise InputError(f"{path.name}: unreadable npz") from None
+            if {"dt", "acc", "vel", "disp", "meta"} <= names:
+                return Source(_sanitise(path.stem), path, processed=True)
+        return Source(_sanitise(path.stem), path)
+    row = catalog_row(str(record))
+    if row is not None:
+        path = RECORDS_DIR / row["source_file"]
+        if not (path.is_file() or (is_pattern(path) and glob.glob(str(path)))):
+            raise InputError(f"catalogue {row['id']}: source file missing: {path}")
+        return Source(row["id"], path, row=row)
+    if is_pattern(path):
+        raise InputError(f"no record files match {record}")
+    raise InputError(f"not a catalogue id and no such file: {record}")
+
+
+def _sanitise(stem):
+    text = re.sub(r"[^A-Za-z0-9_.-]", "_", stem).strip("._") or "record"
+    return text
+
+
+def processed_motion(record, back_azimuth=None, cache_dir=CACHE_DIR):
+    """The processed :class:`Motion` of ``record`` and the path of its cached npz.
+
+    Cached in ``cache_dir/<key>.npz`` (``cache_dir`` None: not cached, path None).
+    ``back_azimuth`` (deg) is used only when neither file nor catalogue gives one.
+    """
+    source = resolve(record)
+    if source.processed:
+        return Motion.load(source.path), source.path
+    key = source.key(back_azimuth)
+    path = None if cache_dir is None else Path(cache_dir) / f"{key}.npz"
+    if path is not None and path.is_file():
+        try:
+            motion = Motion.load(path)
+            if motion.meta.get("processing", {}).get("input_hash") == key:
+                return motion, path
+        except InputError:
+            pass
+    motion = build_motion(source, back_azimuth, key)
+    if path is not None:
+        motion.save(path)
+    return motion, path
+
+
+def build_motion(source, back_azimuth=None, key=None):
+    """Read and process one :class:`Source`; return its :class:`Motion` (not written)."""
+    row = source.row or {}
+    stream, info = read_record(source.path, row.get("source_key"))
+    _apply_catalog_orientation(stream, row, source.path)
+    if row.get("start_utc") or row.get("end_utc"):
+        stream.trim(starttime=UTCDateTime(row["start_utc"]) if row.get("start_utc") else None,
+                    endtime=UTCDateTime(row["end_utc"]) if row.get("end_utc") else None)
+    needs_vertical = row.get("has_vertical", True) not in (False, "false", "False", 0)
+    enz, dt = to_east_north_up(stream, source.path.name, needs_vertical)
+    band = (info.get("lowest_usable_hz"), info.get("highest_usable_hz"))
+    acc, vel, disp, steps = processing.process(enz, dt, band, name=source.path.name)
+    meta = _motion_meta(source, row, info, back_azimuth, needs_vertical)
+    meta["processing"] = {"steps": steps, "input_hash": key, "reader": info.get("format"),
+                          "software": software_versions()}
+    return Motion(dt, acc, vel, disp, meta=meta)
+
+
+def to_east_north_up(stream, name, needs_vertical=True):
+    """Check a raw acceleration stream and rotate it to an (n, 3) East, North, Up array.
+
+    Raises InputError for NaN or gaps, mixed sampling rates, missing or extra
+    components.  Returns (array in m/s^2, dt in s).
+    """
+    if len(stream) == 0:
+        raise InputError(f"{name}: no traces")
+    for trace in stream:
+        data = trace.data
+        if np.ma.isMaskedArray(data) and np.ma.is_masked(data):
+            raise InputError(f"{name}: trace {trace.id} has gaps")
+        if not np.all(np.isfinite(np.asarray(data, dtype=float))):
+            raise InputError(f"{name}: trace {trace.id} has NaN or infinite samples")
+    rates = {round(trace.stats.sampling_rate, 9) for trace in stream}
+    if len(rates) > 1:
+        raise InputError(f"{name}: components have different sampling rates "
+                         f"({', '.join(f'{r:g}' for r in sorted(rates))} Hz)")
+    horizontals = [tr for tr in stream if abs(tr.stats.dip) < 1e-6]
+    verticals = [tr for tr in stream if abs(abs(tr.stats.dip) - 90.0) < 1e-6]
+    if len(horizontals) != 2 or len(verticals) > 1 or len(horizontals) + len(verticals) != len(stream):
+        raise InputError(f"{name}: need 2 horizontal and 1 vertical component, found "
+                         f"{len(horizontals)} horizontal, {len(verticals)} vertical, "
+                         f"{len(stream) - len(horizontals) - len(verticals)} inclined")
+    if not verticals and needs_vertical:
+        raise InputError(f"{name}: missing vertical component")
+    start = max(tr.stats.starttime for tr in stream)
+    end = min(tr.stats.endtime for tr in stream)
+    if end - start <= 0:
+        raise InputError(f"{name}: components do not overlap in time")
+    stream = stream.copy().trim(start, end, nearest_sample=True)
+    n = min(tr.stats.npts for tr in stream)
+    if n < 100:
+        raise InputError(f"{name}: fewer than 100 common samples")
+    h1, h2 = (np.asarray(tr.data[:n], dtype=float) for tr in horizontals)
+    vertical = verticals[0] if verticals else None
+    z = np.asarray(vertical.data[:n], dtype=float) if vertical else np.zeros(n)
+    z_dip = vertical.stats.dip if vertical else -90.0
+    try:
+        up, north, east = rotate2zne(z, 0.0, z_dip,
+                                     h1, horizontals[0].stats.azimuth, 0.0,
+                                     h2, horizontals[1].stats.azimuth, 0.0)
+    except ValueError:
+        raise InputError(f"{name}: horizontal azimuths {horizontals[0].stats.azimuth:g} and "
+                         f"{horizontals[1].stats.azimuth:g} are not independent") from None
+    if vertical is None:
+        up = np.zeros(n)  # rotate2zne leaves round-off (1e-17) of the horizontals here
+    return np.column_stack([east, north, up]), stream[0].stats.delta
+
+
+def _apply_catalog_orientation(stream, row, path):
+    """Catalogue ``azimuths_deg`` ("a;b") sets the horizontal azimuths where the file has none."""
+    if not row.get("azimuths_deg"):
+        if any(tr.stats.azimuth is None for tr in stream):
+            raise InputError(f"{path.name}: horizontal azimuths unknown (catalogue azimuths_deg)")
+        return
+    azimuths = [float(v) for v in str(row["azimuths_deg"]).split(";")]
+    horizontals = [tr for tr in stream if tr.stats.dip == 0.0]
+    if len(azimuths) != len(horizontals):
+        raise InputError(f"catalogue {row['id']}: {len(azimuths)} azimuths for "
+                         f"{len(horizontals)} horizontal components")
+    for trace, azimuth in zip(horizontals, azimuths):
+        trace.stats.azimuth = azimuth % 360.0
+
+
+def _motion_meta(source, row, info, back_azimuth, has_vertical):
+    def pick(key):
+        return row.get(key) if row.get(key) is not None else info.get(key)
+
+    meta = {"record_id": source.id, "label": row.get("label") or source.id,
+            "event": pick("event"), "station": pick("station"), "magnitude": pick("magnitude"),
+            "mechanism": row.get("mechanism"), "has_vertical": bool(has_vertical),
+            "horizontals_compass": row.get("horizontals_compass", True),
+            "orientation": row.get("orientation", "as-recorded"),
+            "source_file": _display_path(source.path), "source_key": row.get("source_key"),
+            "units": {"dt": "s", "acc": "m/s^2", "vel": "m/s", "disp": "m"},
+            "columns": ["East", "North", "Up"]}
+    coords = {k: pick(k) for k in ("station_lat", "station_lon", "event_lat", "event_lon")}
+    meta.update(coords)
+    if None not in coords.values():
+        dist_m, _, baz = gps2dist_azimuth(coords["event_lat"], coords["event_lon"],
+                                          coords["station_lat"], coords["station_lon"])
+        meta["back_azimuth_deg"] = float(baz % 360.0)
+        meta["epicentral_distance_km"] = float(dist_m / 1000.0)
+        meta["back_azimuth_source"] = ("gps2dist_azimuth of station and epicentre coordinates from "
+                                       + (row.get("citation") or "the record file header"))
+        if back_azimuth is not None:
+            print(f"note: {source.id}: coordinates give the back azimuth; "
+                  f"--back-azimuth {back_azimuth:g} ignored", file=sys.stderr)
+    elif row.get("back_azimuth_deg") is not None:
+        meta["back_azimuth_deg"] = float(row["back_azimuth_deg"])
+        meta["epicentral_distance_km"] = row.get("epicentral_distance_km")
+        meta["back_azimuth_source"] = f"catalogue: {row.get('citation')}"
+    else:
+        meta["back_azimuth_deg"] = None if back_azimuth is None else float(back_azimuth) % 360.0
+        meta["epicentral_distance_km"] = row.get("epicentral_distance_km")
+        meta["back_azimuth_source"] = ("unknown" if back_azimuth is None
+                                       else "given by the user (--back-azimuth)")
+    if meta["epicentral_distance_km"] is not None:
+        meta["epicentral_distance_km"] = float(meta["epicentral_distance_km"])
+    if not has_vertical:
+        meta["notes"] = "no vertical component in the source: Up column is zero"
+    if row.get("notes"):
+        meta["notes"] = (meta.get("notes", "") + "; " + row["notes"]).lstrip("; ")
+    return meta
+
+
+def _display_path(path):
+    try:
+        return str(Path(path).resolve().relative_to(PROJECT_ROOT))
+    except ValueError:
+        return str(path)

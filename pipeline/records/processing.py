@@ -1,0 +1,156 @@
+"""Processing of a raw 3-component acceleration: an ordered list of named steps.
+
+Like gmprocess, the processing is configuration: ``DEFAULT_STEPS`` lists
+``(name, parameters)`` pairs; each name is a function registered with
+:func:`step`.  Every step returns what it actually did (e.g. the band used),
+which becomes the motion's ``meta["processing"]["steps"]`` provenance.
+
+Default: demean, linear detrend, Hann taper, zero-phase 4-pole Butterworth
+band-pass from max(0.1 Hz, the record's lowest usable frequency) to min(25 Hz,
+its highest usable frequency, 0.8 x Nyquist), double integration and removal
+of a displacement baseline t^2..t^6 (ending at rest) through its second
+derivative in the acceleration, so acceleration, velocity and displacement are
+trapezoidal integrals of each other.
+"""
+import numpy as np
+from obspy import Stream, Trace
+from scipy.integrate import cumulative_trapezoid
+
+from pipeline.files import InputError
+
+STEPS = {}
+
+DEFAULT_STEPS = (
+    ("demean", {}),
+    ("detrend", {"type": "linear"}),
+    ("taper", {"max_percentage": 0.05, "type": "hann"}),
+    ("bandpass", {"freqmin_hz": 0.1, "freqmax_hz": 25.0, "nyquist_fraction": 0.8,
+                  "corners": 4}),
+    ("integrate_baseline", {"max_power": 6}),
+)
+
+
+def step(func):
+    """Register a processing step under its function name."""
+    STEPS[func.__name__] = func
+    return func
+
+
+class Work:
+    """The record under processing: ``acc`` (n, 3) m/s^2 East/North/Up, ``dt`` s,
+    ``band`` the usable band (lo, hi) in Hz from the record's metadata (None if unknown);
+    ``vel`` and ``disp`` once integrated."""
+
+    def __init__(self, acc, dt, band=(None, None), name="record"):
+        self.acc, self.dt, self.band, self.name = np.array(acc, float), float(dt), band, name
+        self.vel = self.disp = None
+
+    def stream(self):
+        return Stream([Trace(np.array(self.acc[:, i]), header={"delta": self.dt})
+                       for i in range(3)])
+
+    def from_stream(self, stream):
+        self.acc = np.column_stack([tr.data for tr in stream])
+
+
+@step
+def demean(work):
+    stream = work.stream()
+    stream.detrend("demean")
+    work.from_stream(stream)
+    return {}
+
+
+@step
+def detrend(work, type="linear"):
+    stream = work.stream()
+    stream.detrend(type)
+    work.from_stream(stream)
+    return {"type": type}
+
+
+@step
+def taper(work, max_percentage=0.05, type="hann", max_length_s=None):
+    """obspy taper on both ends; records the length actually used (s)."""
+    stream = work.stream()
+    stream.taper(max_percentage=max_percentage, type=type, max_length=max_length_s)
+    work.from_stream(stream)
+    npts = len(work.acc)
+    # obspy: taper length = min(max_percentage * npts, max_length / dt) samples, per side
+    length = max_percentage * npts * work.dt
+    if max_length_s is not None:
+        length = min(length, max_length_s)
+    return {"type": type, "max_percentage": max_percentage, "max_length_s": max_length_s,
+            "taper_s": float(length)}
+
+
+@step
+def bandpass(work, freqmin_hz=0.1, freqmax_hz=25.0, nyquist_fraction=0.8, corners=4):
+    """Zero-phase Butterworth band-pass within the record's usable band."""
+    low, high = work.band
+    freqmin = max(freqmin_hz, low or 0.0)
+    freqmax = min(freqmax_hz, high or np.inf, nyquist_fraction * 0.5 / work.dt)
+    if freqmin >= freqmax:
+        raise InputError(f"{work.name}: sampling too coarse for the {freqmin:g}-{freqmax:g} Hz "
+                         "band")
+    stream = work.stream()
+    stream.filter("bandpass", freqmin=freqmin, freqmax=freqmax, corners=corners, zerophase=True)
+    work.from_stream(stream)
+    return {"freqmin_hz": float(freqmin), "freqmax_hz": float(freqmax), "corners": corners,
+            "zerophase": True}
+
+
+@step
+def integrate_baseline(work, max_power=6):
+    """Integrate twice, then remove a displacement baseline sum_{k=2..K} c_k (t/T)^k
+    (pinned to end at rest) through its second derivative in the acceleration and
+    integrate again, so acc, vel and disp stay consistent."""
+    dt = work.dt
+    vel = cumulative_trapezoid(work.acc, dx=dt, axis=0, initial=0.0)
+    disp = cumulative_trapezoid(vel, dx=dt, axis=0, initial=0.0)
+    work.acc = work.acc - baseline_acceleration(disp, vel, dt, max_power)
+    work.vel = cumulative_trapezoid(work.acc, dx=dt, axis=0, initial=0.0)
+    work.disp = cumulative_trapezoid(work.vel, dx=dt, axis=0, initial=0.0)
+    return {"max_power": max_power, "fit_window_s": [0.0, dt * (len(work.acc) - 1)]}
+
+
+def baseline_acceleration(disp, vel, dt, max_power=6):
+    """Second derivative of the least-squares baseline p(t) = sum_{k=2..K} c_k (t/T)^k of
+    each displacement column, with p(T) = disp(T) and p'(T) = vel(T) enforced by
+    heavily weighted rows; p(0) = p'(0) = 0 by construction."""
+    n = disp.shape[0]
+    duration = dt * (n - 1)
+    tau = np.arange(n) * dt / duration
+    powers = np.arange(2, max_power + 1)
+    design = tau[:, None] ** powers
+    end_value = np.ones_like(powers, dtype=float)              # tau = 1
+    end_slope = powers / duration                              # d/dt of (t/T)^k at t = T
+    weight = 1e3 * np.sqrt(n)
+    curvature = powers * (powers - 1) * tau[:, None] ** (powers - 2) / duration ** 2
+    result = np.zeros_like(disp)
+    scale = np.max(np.abs(disp), axis=0)
+    for i in range(disp.shape[1]):
+        if scale[i] == 0:
+            continue
+        matrix = np.vstack([design, weight * end_value, weight * duration * end_slope])
+        target = np.r_[disp[:, i], weight * disp[-1, i], weight * duration * vel[-1, i]]
+        coeffs = np.linalg.lstsq(matrix, target, rcond=None)[0]
+        result[:, i] = curvature @ coeffs
+    return result
+
+
+def process(enz, dt, band=(None, None), steps=DEFAULT_STEPS, name="record"):
+    """Run ``steps`` on an (n, 3) acceleration (m/s^2); return (acc, vel, disp, provenance).
+
+    provenance: list of {"step": name, **what it did}.  The last step must integrate.
+    """
+    unknown = [s for s, _ in steps if s not in STEPS]
+    if unknown:
+        raise InputError(f"unknown processing step(s): {', '.join(unknown)}")
+    work = Work(enz, dt, band, name)
+    provenance = []
+    for name_, params in steps:
+        provenance.append({"step": name_, **STEPS[name_](work, **params)})
+    if work.vel is None:
+        raise InputError("processing steps must end with an integration step")
+    return work.acc, work.vel, work.disp, provenance

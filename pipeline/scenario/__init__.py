@@ -1,0 +1,14 @@
+"""Scenario stage: parameters (dataclasses), the scene writer and the YADE runner.
+
+A scenario directory holds ``params.json`` (every parameter), ``motion.npz``
+(the pedestal's ground motion in the processed-motion format of
+:mod:`pipeline.motion`) and ``scene.py``, an unchanged copy of
+``yade_scripts/column_scene.py``; running it writes ``trajectory.npz``.
+"""
+from pipeline.scenario.parameters import (PEDESTAL, Block, Column, Contact, Numerics,
+                                          scene_params)
+from pipeline.scenario.runner import YadeError, run_yade
+from pipeline.scenario.writer import write_scenario
+
+__all__ = ["PEDESTAL", "Block", "Column", "Contact", "Numerics", "scene_params",
+           "write_scenario", "run_yade", "YadeError"]

@@ -1,0 +1,227 @@
+"""Scene parameters as dataclasses: one declaration gives each parameter's default,
+unit, allowed range and help text; the command line and ``params.json`` derive from it.
+
+Defaults are the paper's (:mod:`pipeline.paper`).  Ranges are what the model can
+represent and keep stable (see README, "Parameters"); a value outside raises an
+:class:`~pipeline.files.InputError` naming the option and its range.
+"""
+import dataclasses
+import math
+from dataclasses import dataclass, field
+
+from pipeline import paper
+from pipeline.files import InputError
+
+COLUMN_KINDS = ("both", "monolithic", "drums")
+RIM_SPHERE_RADIUS_M = 0.005   # rim contact spheres of the columns
+MIN_BODY_SIZE_M = 10 * RIM_SPHERE_RADIUS_M   # a drum must hold its two rims of spheres
+
+
+def param(default, unit, help, low=None, high=None, flag=None, low_open=False, choices=None):
+    """A dataclass field with unit, help text, bounds [low, high] (low excluded when
+    ``low_open``) and its command-line flag."""
+    return field(default=default, metadata={"unit": unit, "help": help, "low": low, "high": high,
+                                            "low_open": low_open, "flag": flag,
+                                            "choices": choices})
+
+
+def check_fields(obj):
+    """Validate every field of a parameter dataclass against its metadata."""
+    for f in dataclasses.fields(obj):
+        value, meta = getattr(obj, f.name), f.metadata
+        name = meta.get("flag") or f.name
+        if meta.get("choices"):
+            if value not in meta["choices"]:
+                raise InputError(f"{name} must be one of {', '.join(meta['choices'])}, "
+                                 f"got {value!r}")
+            continue
+        if meta.get("low") is None and meta.get("high") is None:
+            continue
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or \
+                not math.isfinite(value):
+            raise InputError(f"{name} must be a finite number, got {value!r}")
+        if f.type in (int, "int") and int(value) != value:
+            raise InputError(f"{name} must be an integer, got {value!r}")
+        low, high = meta.get("low"), meta.get("high")
+        too_low = low is not None and (value <= low if meta.get("low_open") else value < low)
+        if too_low or (high is not None and value > high):
+            bracket = "(" if meta.get("low_open") else "["
+            raise InputError(f"{name} {value:g} outside the allowed range "
+                             f"{bracket}{low:g}, {high:g}] {meta['unit']}".rstrip())
+
+
+@dataclass(frozen=True)
+class Contact:
+    """Frictional viscoelastic contact between bodies and with the pedestal."""
+    kn: float = param(paper.COLUMN_KN_N_M, "N/m", "normal stiffness per rim contact point",
+                      1e5, 1e11, "--kn")
+    damping: float = param(paper.DAMPING_RATIO, "", "contact damping ratio (1 = critical)",
+                           0.0, 1.0, "--damping")
+    mu_s: float = param(paper.MU_STATIC, "", "static friction coefficient", 0.01, 2.0, "--mu-s")
+    mu_k: float = param(None, "", "kinetic friction coefficient (default: 0.6 with the paper's "
+                        "mu_s 0.7, else 0.84 mu_s)", None, None, "--mu-k")
+
+    def __post_init__(self):
+        if self.mu_k is None:
+            ratio = paper.MU_KINETIC / paper.MU_STATIC if self.mu_s == paper.MU_STATIC \
+                else paper.MU_K_OVER_MU_S
+            object.__setattr__(self, "mu_k", round(ratio * self.mu_s, 4))
+        check_fields(self)
+        if not (isinstance(self.mu_k, (int, float)) and math.isfinite(self.mu_k)
+                and 0 < self.mu_k <= self.mu_s):
+            raise InputError(f"--mu-k must satisfy 0 < mu_k <= mu_s ({self.mu_s:g}), "
+                             f"got {self.mu_k!r}")
+
+
+@dataclass(frozen=True)
+class Numerics:
+    """How the YADE model discretises and integrates the bodies."""
+    rim_points: int = param(16, "", "contact spheres per rim", 8, 128, "--rim-points")
+    rim_sphere_radius: float = param(RIM_SPHERE_RADIUS_M, "m", "radius of the rim contact spheres",
+                                     0.0, 0.05, low_open=True)
+    verlet_distance: float = param(0.02, "m", "collider bound enlargement", 0.0, 1.0)
+    dt_factor: float = param(0.3, "", "time step as a fraction of sqrt(m_min / (kn x rim "
+                             "points)); converged up to 0.3 (make bench)", 0.0, 0.5,
+                             "--dt-factor", low_open=True)
+    drive: str = param("inertial", "", "pedestal drive: gravity table (inertial) or per-step "
+                       "velocity (kinematic, slow)", choices=("inertial", "kinematic"))
+    drive_interval_s: float = param(0.002, "s", "gravity update interval", 0.0, 0.1,
+                                    low_open=True)
+    friction: str = param("switch", "", "mu_s sticking / mu_k sliding (switch) or mu_s only",
+                          choices=("switch", "static"))
+    friction_interval_s: float = param(0.002, "s", "friction switch interval", 0.0, 0.1,
+                                       low_open=True)
+    record_hz: float = param(100.0, "Hz", "trajectory sampling rate", 1.0, 10000.0)
+    rest_velocity: float = param(0.005, "m/s", "bodies slower than this rest", 0.0, 1.0,
+                                 low_open=True)
+    rest_length: float = param(1.0, "m", "angular velocity times this counts as velocity",
+                               0.0, 100.0, low_open=True)
+    rest_duration_s: float = param(0.5, "s", "rest this long to stop early", 0.0, 1e9,
+                                   low_open=True)
+    tail_s: float = param(10.0, "s", "simulated time allowed after the motion ends", 0.0, 600.0)
+
+    def __post_init__(self):
+        check_fields(self)
+
+
+@dataclass(frozen=True)
+class Column:
+    """The column model: the paper's twin model (both), or one column."""
+    kind: str = param("both", "", "both = drums at x = -1.5 m and monolith at +1.5 m",
+                      choices=COLUMN_KINDS, flag="--column")
+    hd: float = param(paper.COLUMN_HD, "", "slenderness h/d", 1.0, 30.0, "--hd")
+    height: float = param(paper.COLUMN_HEIGHT_M, "m", "column height", 0.1, 30.0, "--height")
+    n_drums: int = param(paper.N_DRUMS, "", "number of drums", 1, 60, "--drums")
+    density: float = param(paper.MARBLE_DENSITY_KG_M3, "kg/m^3", "density", 100.0, 25000.0,
+                           "--density")
+    centred: bool = field(default=None, metadata={"help": "single column at the centre"})
+
+    def __post_init__(self):
+        check_fields(self)
+        drum_height = self.height / self.n_drums
+        diameter = self.height / self.hd
+        # a drum must be tall and wide enough for its two rims of contact spheres
+        if min(drum_height, diameter) < MIN_BODY_SIZE_M:
+            raise InputError(f"--drums {self.n_drums} with --height {self.height:g} and --hd "
+                             f"{self.hd:g} gives drums {drum_height:.3f} m high and "
+                             f"{diameter:.3f} m wide: at least {MIN_BODY_SIZE_M:g} m each needed")
+
+    @property
+    def diameter(self):
+        """Column diameter (m)."""
+        return self.height / self.hd
+
+    def specs(self):
+        """Column definitions for the scene (``params.json`` ``columns``): 'both' puts the
+        drums at x = -1.5 m and the monolith at +1.5 m; one column stands at the centre
+        unless centred=False."""
+        kinds = ["drums", "monolithic"] if self.kind == "both" else [self.kind]
+        centred = self.kind != "both" if self.centred is None else self.centred
+        out = []
+        for kind in kinds:
+            x = 0.0 if centred else (-paper.TWIN_OFFSET_M if kind == "drums"
+                                     else paper.TWIN_OFFSET_M)
+            out.append({"name": kind, "kind": kind, "x": x, "y": 0.0, "height": self.height,
+                        "diameter": self.diameter,
+                        "n_drums": int(self.n_drums) if kind == "drums" else 1,
+                        "density": self.density})
+        return out
+
+
+@dataclass(frozen=True)
+class Block:
+    """A rectangular test block (verification): width along East, depth along North."""
+    height: float = param(paper.MARBLE_BLOCK_M["height"], "m", "block height", 0.01, 30.0)
+    width: float = param(paper.MARBLE_BLOCK_M["width"], "m", "block width (East)", 0.005, 30.0)
+    depth: float = param(paper.MARBLE_BLOCK_M["depth"], "m", "block depth (North)", 0.005, 30.0)
+    density: float = param(paper.MARBLE_DENSITY_KG_M3, "kg/m^3", "density", 100.0, 25000.0)
+    theta0_rad: float = param(0.0, "rad", "initial tilt about North (+ leans East)", -1.5, 1.5)
+
+    def __post_init__(self):
+        check_fields(self)
+
+
+PEDESTAL = {"size": paper.PEDESTAL_SIZE_M, "thickness": paper.PEDESTAL_THICKNESS_M,
+            "mass": paper.PEDESTAL_MASS_KG,
+            # the top face extends beyond the 5 m block so that a column falling over
+            # the edge still lands at pedestal level (impact points up to ~4 m away)
+            "contact_half_size": 12.0}
+
+
+def scene_params(columns=(), block=None, contact=None, numerics=None, motion_duration=0.0,
+                 t_max=None):
+    """The ``params.json`` content of a scene (JSON-serialisable dict).
+
+    columns: list from :meth:`Column.specs`; block: a :class:`Block` or None;
+    contact, numerics: :class:`Contact`, :class:`Numerics` (defaults when None).
+    """
+    contact = contact or Contact()
+    numerics = numerics or Numerics()
+    if not columns and block is None:
+        raise InputError("a scene needs at least one column or a block")
+    if t_max is None:
+        t_max = motion_duration + numerics.tail_s
+    if not (math.isfinite(t_max) and t_max > 0):
+        raise InputError(f"simulated duration must be positive, got {t_max!r}")
+    return {"columns": list(columns),
+            "block": None if block is None else dataclasses.asdict(block),
+            "contact": dataclasses.asdict(contact), "pedestal": dict(PEDESTAL),
+            **dataclasses.asdict(numerics), "t_max": float(t_max),
+            "motion_file": None, "output": "trajectory.npz"}
+
+
+def add_arguments(parser, cls, names=None):
+    """Add the flagged fields of parameter dataclass ``cls`` to an argparse parser,
+    with their defaults, units and help (defaults None: the dataclass decides)."""
+    for f in dataclasses.fields(cls):
+        meta = f.metadata
+        if not meta.get("flag") or (names is not None and f.name not in names):
+            continue
+        unit = f" ({meta['unit']})" if meta.get("unit") else ""
+        default = "" if f.default is None else f"; default {f.default:g}" \
+            if isinstance(f.default, (int, float)) else f"; default {f.default}"
+        bounds = "" if meta.get("low") is None else f"; {meta['low']:g}-{meta['high']:g}"
+        kwargs = {"dest": f.name, "default": None, "help": f"{meta['help']}{unit}{default}{bounds}"}
+        if meta.get("choices"):
+            kwargs["choices"] = meta["choices"]
+        else:
+            kwargs["type"] = int if f.type in (int, "int") else float
+        parser.add_argument(meta["flag"], **kwargs)
+
+
+def from_args(cls, args, **fixed):
+    """An instance of ``cls`` from parsed arguments (fields left None keep defaults)."""
+    values = {f.name: getattr(args, f.name) for f in dataclasses.fields(cls)
+              if getattr(args, f.name, None) is not None}
+    return cls(**{**values, **fixed})
+
+
+def split_options(options):
+    """Split keyword options into (Contact kwargs, Numerics kwargs); InputError on unknown."""
+    contact_names = {f.name for f in dataclasses.fields(Contact)}
+    numerics_names = {f.name for f in dataclasses.fields(Numerics)}
+    unknown = set(options) - contact_names - numerics_names
+    if unknown:
+        raise InputError(f"unknown scene parameter(s): {', '.join(sorted(unknown))}")
+    return ({k: v for k, v in options.items() if k in contact_names},
+            {k: v for k, v in options.items() if k in numerics_names})

@@ -1,0 +1,64 @@
+"""One run: a processed motion through one YADE scenario to ``summary.json``.
+
+    record -> Motion (pipeline.records) -> scene directory (pipeline.scenario)
+           -> Trajectory -> per-column outcome (pipeline.outcome) -> summary.json
+"""
+import dataclasses
+import math
+from pathlib import Path
+
+from pipeline.files import InputError, code_hash, software_versions, write_json
+from pipeline.outcome.columns import summarise
+from pipeline.scenario import Column, Contact, Numerics, run_yade, scene_params, write_scenario
+
+
+def drive_motion(motion, window=None, rotate_deg=0.0, scale=1.0):
+    """The pedestal's motion: ``motion`` cut to ``window`` = (start_s, end_s), turned
+    clockwise by ``rotate_deg`` and scaled by ``scale``."""
+    if window is not None:
+        motion = motion.window(*window)
+    return motion.rotate(rotate_deg).scale(scale)
+
+
+def back_azimuth_of(motion, override=None):
+    """Back azimuth (deg) from the command line or the motion's metadata; None if unknown."""
+    if override is not None:
+        if not (math.isfinite(override) and 0.0 <= override < 360.0):
+            raise InputError(f"--back-azimuth {override:g} not in [0, 360)")
+        return float(override)
+    return motion.back_azimuth
+
+
+def simulate(motion, out_dir, column=None, contact=None, numerics=None, window=None,
+             rotate_deg=0.0, scale=1.0, back_azimuth=None, record=None, motion_file=None,
+             timeout_s=None):
+    """Run one scenario of ``motion`` (a processed :class:`~pipeline.motion.Motion`) and
+    write ``out_dir/summary.json`` last (atomically); return the summary dict.
+
+    column, contact, numerics: parameter dataclasses (defaults: the paper's).
+    """
+    column, contact, numerics = column or Column(), contact or Contact(), numerics or Numerics()
+    if back_azimuth is not None:
+        motion = dataclasses.replace(motion, meta=dict(motion.meta,
+                                                       back_azimuth_deg=back_azimuth_of(
+                                                           motion, back_azimuth)))
+    drive = drive_motion(motion, window, rotate_deg, scale)
+    params = scene_params(columns=column.specs(), contact=contact, numerics=numerics,
+                          motion_duration=drive.duration)
+    out_dir = Path(out_dir)
+    (out_dir / "summary.json").unlink(missing_ok=True)
+    write_scenario(out_dir, params, drive)
+    trajectory = run_yade(out_dir, timeout_s=timeout_s)
+    parameters = {"column": column.kind, "hd": column.hd, "height_m": column.height,
+                  "n_drums": column.n_drums, "density_kg_m3": column.density,
+                  **dataclasses.asdict(contact), "window_s": list(window) if window else None,
+                  "rotate_deg": rotate_deg, "scale": scale,
+                  "motion_file": None if motion_file is None else str(motion_file),
+                  "dt_factor": numerics.dt_factor, "rim_points": numerics.rim_points}
+    provenance = {"software": software_versions(), "motion": motion.meta.get("processing"),
+                  "code": {"scenario": code_hash("scenario", "outcome", "yade_scripts")}}
+    summary = summarise(trajectory, record=record or motion.record_id,
+                        back_azimuth_deg=drive.back_azimuth, parameters=parameters,
+                        provenance=provenance)
+    write_json(out_dir / "summary.json", summary)
+    return summary
