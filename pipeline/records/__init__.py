@@ -110,8 +110,9 @@ def processed_motion(record, back_azimuth=None, cache_dir=CACHE_DIR):
     return motion, path
 
 
-def build_motion(source, back_azimuth=None, key=None):
-    """Read and process one :class:`Source`; return its :class:`Motion` (not written)."""
+def read_east_north_up(source):
+    """Read a :class:`Source` and rotate it: (acc (n, 3) m/s^2 East/North/Up, dt s, info,
+    has_vertical), with the catalogue's orientation and time window applied."""
     row = source.row or {}
     stream, info = read_record(source.path, row.get("source_key"))
     _apply_catalog_orientation(stream, row, source.path)
@@ -120,11 +121,20 @@ def build_motion(source, back_azimuth=None, key=None):
                     endtime=UTCDateTime(row["end_utc"]) if row.get("end_utc") else None)
     needs_vertical = row.get("has_vertical", True) not in (False, "false", "False", 0)
     enz, dt = to_east_north_up(stream, source.path.name, needs_vertical)
+    return enz, dt, info, needs_vertical
+
+
+def build_motion(source, back_azimuth=None, key=None):
+    """Read and process one :class:`Source`; return its :class:`Motion` (not written)."""
+    row = source.row or {}
+    enz, dt, info, needs_vertical = read_east_north_up(source)
     band = (info.get("lowest_usable_hz"), info.get("highest_usable_hz"))
     acc, vel, disp, steps = processing.process(enz, dt, band, name=source.path.name)
     meta = _motion_meta(source, row, info, back_azimuth, needs_vertical)
     meta["processing"] = {"steps": steps, "input_hash": key, "reader": info.get("format"),
                           "software": software_versions()}
+    trims = [s["window_s"][0] for s in steps if s["step"] == "trim_to_signal"]
+    meta["start_in_file_s"] = float(trims[0]) if trims else 0.0
     return Motion(dt, acc, vel, disp, meta=meta)
 
 

@@ -5,12 +5,21 @@ Like gmprocess, the processing is configuration: ``DEFAULT_STEPS`` lists
 :func:`step`.  Every step returns what it actually did (e.g. the band used),
 which becomes the motion's ``meta["processing"]["steps"]`` provenance.
 
-Default: demean, linear detrend, Hann taper, zero-phase 4-pole Butterworth
-band-pass from max(0.1 Hz, the record's lowest usable frequency) to min(25 Hz,
-its highest usable frequency, 0.8 x Nyquist), double integration and removal
-of a displacement baseline t^2..t^6 (ending at rest) through its second
-derivative in the acceleration, so acceleration, velocity and displacement are
-trapezoidal integrals of each other.
+Default: cut the record to its signal window (0.1-99.5 % of the Arias
+intensity of a high-passed copy, plus 5 s each side; exact zeros at the file's
+ends count as no data), demean, linear detrend, Hann taper of at most 2 s per
+end (inside those quiet margins), zeros where the window reaches beyond the
+data, zero-phase
+4-pole Butterworth band-pass from max(0.1 Hz, the record's lowest usable
+frequency) to min(25 Hz, its highest usable frequency, 0.8 x Nyquist) on a
+zero-padded copy (1.5 x corners / freqmin seconds each side, Boore & Bommer
+2005), double integration and removal of a displacement baseline t^2..t^6
+(ending at rest) through its second derivative in the acceleration, so
+acceleration, velocity and displacement are trapezoidal integrals of each other.
+
+No step's extent scales with the file's length: the same strong motion gives
+the same processed motion however much quiet time surrounds it in the file
+(tests/records/test_processing_invariance.py).
 """
 import numpy as np
 from obspy import Stream, Trace
@@ -21,11 +30,14 @@ from pipeline.files import InputError
 STEPS = {}
 
 DEFAULT_STEPS = (
+    ("trim_to_signal", {"arias_fractions": (0.001, 0.995), "margin_s": 5.0,
+                        "highpass_hz": 0.1}),
     ("demean", {}),
     ("detrend", {"type": "linear"}),
-    ("taper", {"max_percentage": 0.05, "type": "hann"}),
+    ("taper", {"max_percentage": 0.05, "max_length_s": 2.0, "type": "hann"}),
+    ("pad_to_window", {}),
     ("bandpass", {"freqmin_hz": 0.1, "freqmax_hz": 25.0, "nyquist_fraction": 0.8,
-                  "corners": 4}),
+                  "corners": 4, "pad": True}),
     ("integrate_baseline", {"max_power": 6}),
 )
 
@@ -44,6 +56,8 @@ class Work:
     def __init__(self, acc, dt, band=(None, None), name="record"):
         self.acc, self.dt, self.band, self.name = np.array(acc, float), float(dt), band, name
         self.vel = self.disp = None
+        self.start_s = 0.0          # time of the first sample in the original record
+        self.pad = (0, 0)           # zero samples to add before and after (pad_to_window)
 
     def stream(self):
         return Stream([Trace(np.array(self.acc[:, i]), header={"delta": self.dt})
@@ -51,6 +65,42 @@ class Work:
 
     def from_stream(self, stream):
         self.acc = np.column_stack([tr.data for tr in stream])
+
+
+@step
+def trim_to_signal(work, arias_fractions=(0.001, 0.995), margin_s=5.0, highpass_hz=0.1):
+    """Cut the record to its signal window [t_lo - margin, t_hi + margin], t_lo and t_hi
+    where the Arias intensity (all components) of a demeaned, high-passed copy reaches
+    the given fractions.  Runs of exact zeros at either end (no data) are dropped first.
+    Where the window reaches beyond the data, ``pad_to_window`` later adds zeros, so the
+    processed motion spans the same window whatever surrounds the signal in the file."""
+    from scipy.signal import butter, sosfiltfilt
+    npts = len(work.acc)
+    nonzero = np.flatnonzero(np.any(work.acc != 0.0, axis=1))
+    if nonzero.size == 0:
+        return {"window_s": [0.0, work.dt * (npts - 1)], "trimmed": False}
+    first, last = int(nonzero[0]), int(nonzero[-1]) + 1
+    acc = work.acc[first:last] - work.acc[first:last].mean(axis=0)
+    if highpass_hz and highpass_hz < 0.5 / work.dt and len(acc) > 12:
+        sos = butter(2, highpass_hz, btype="highpass", fs=1.0 / work.dt, output="sos")
+        acc = sosfiltfilt(sos, acc, axis=0)
+    energy = np.cumsum((acc ** 2).sum(axis=1))
+    lo, hi = np.searchsorted(energy, np.array(arias_fractions) * energy[-1]) + first
+    margin = int(round(margin_s / work.dt))
+    i0, i1 = lo - margin, hi + margin + 1                  # may reach beyond the data
+    work.pad = (max(0, first - i0), max(0, i1 - last))
+    work.acc = work.acc[max(i0, first):min(i1, last)]
+    work.start_s = i0 * work.dt
+    return {"window_s": [i0 * work.dt, (i1 - 1) * work.dt], "arias_fractions": list(arias_fractions),
+            "margin_s": margin_s, "data_s": [max(i0, first) * work.dt, (min(i1, last) - 1) * work.dt]}
+
+
+@step
+def pad_to_window(work):
+    """Zeros before and after the data up to the signal window of ``trim_to_signal``."""
+    before, after = getattr(work, "pad", (0, 0))
+    work.acc = np.pad(work.acc, ((before, after), (0, 0)))
+    return {"zeros_before_s": before * work.dt, "zeros_after_s": after * work.dt}
 
 
 @step
@@ -75,9 +125,8 @@ def taper(work, max_percentage=0.05, type="hann", max_length_s=None):
     stream = work.stream()
     stream.taper(max_percentage=max_percentage, type=type, max_length=max_length_s)
     work.from_stream(stream)
-    npts = len(work.acc)
-    # obspy: taper length = min(max_percentage * npts, max_length / dt) samples, per side
-    length = max_percentage * npts * work.dt
+    # obspy: per side, min(max_percentage * npts, max_length / dt) samples
+    length = max_percentage * len(work.acc) * work.dt
     if max_length_s is not None:
         length = min(length, max_length_s)
     return {"type": type, "max_percentage": max_percentage, "max_length_s": max_length_s,
@@ -85,19 +134,25 @@ def taper(work, max_percentage=0.05, type="hann", max_length_s=None):
 
 
 @step
-def bandpass(work, freqmin_hz=0.1, freqmax_hz=25.0, nyquist_fraction=0.8, corners=4):
-    """Zero-phase Butterworth band-pass within the record's usable band."""
+def bandpass(work, freqmin_hz=0.1, freqmax_hz=25.0, nyquist_fraction=0.8, corners=4, pad=False):
+    """Zero-phase Butterworth band-pass within the record's usable band; with ``pad``,
+    on a copy padded with 1.5 corners / freqmin seconds of zeros on each side (the
+    filter's transient, Boore & Bommer 2005), removed afterwards."""
     low, high = work.band
     freqmin = max(freqmin_hz, low or 0.0)
     freqmax = min(freqmax_hz, high or np.inf, nyquist_fraction * 0.5 / work.dt)
     if freqmin >= freqmax:
         raise InputError(f"{work.name}: sampling too coarse for the {freqmin:g}-{freqmax:g} Hz "
                          "band")
+    npad = int(round(1.5 * corners / freqmin / work.dt)) if pad else 0
+    original = work.acc
+    work.acc = np.pad(original, ((npad, npad), (0, 0)))
     stream = work.stream()
     stream.filter("bandpass", freqmin=freqmin, freqmax=freqmax, corners=corners, zerophase=True)
     work.from_stream(stream)
+    work.acc = work.acc[npad:npad + len(original)]
     return {"freqmin_hz": float(freqmin), "freqmax_hz": float(freqmax), "corners": corners,
-            "zerophase": True}
+            "zerophase": True, "pad_s": npad * work.dt}
 
 
 @step
@@ -143,6 +198,7 @@ def process(enz, dt, band=(None, None), steps=DEFAULT_STEPS, name="record"):
     """Run ``steps`` on an (n, 3) acceleration (m/s^2); return (acc, vel, disp, provenance).
 
     provenance: list of {"step": name, **what it did}.  The last step must integrate.
+    A ``trim_to_signal`` step shortens the record: provenance gives its window.
     """
     unknown = [s for s, _ in steps if s not in STEPS]
     if unknown:

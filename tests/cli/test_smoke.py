@@ -7,24 +7,31 @@ import sys
 import numpy as np
 import pytest
 
-from pipeline import campaign, records
+from pipeline.campaign.definitions import column_specs, pulse_record, run_column_spec, twin
+from pipeline.campaign.executor import execute
+from pipeline.campaign.tables import collect
+from pipeline.motion import Motion
+from pipeline.motion.measures import record_parameters
+from pipeline.records import processed_motion
 
 pytestmark = pytest.mark.yade
-WINDOW = (9.0, 15.0)     # s: the displacement pulse of NF04 (Superstition Hills, Parachute)
+FILE_WINDOW = (9.0, 15.0)   # s in the file: the displacement pulse of NF04 (Superstition Hills)
 
 
 def test_chain_on_pulse_excerpt(tmp_path, capsys):
-    record = campaign.pulse_record()
-    specs = campaign.resolve_specs([campaign.column_spec(record, window=list(WINDOW))])
-    failures = campaign.execute(specs, tmp_path, jobs=1)
-    assert not failures
-    runs, impacts = campaign.collect(specs, "smoke", tmp_path)
+    record = pulse_record()
+    start = processed_motion(record, cache_dir=tmp_path / "motions")[0].meta["start_in_file_s"]
+    window = [t - start for t in FILE_WINDOW]       # processed motions start at start_in_file_s
+    specs = column_specs([(record, twin(window=window))], tmp_path)
+    failures, interrupted = execute(specs, tmp_path, 1, run_column_spec)
+    assert not failures and not interrupted
+    runs, impacts = collect(specs, "smoke", tmp_path)
     assert sorted(runs["column"]) == ["drums", "monolithic"]
 
-    motion = records.load_motion(specs[0]["motion_file"])
-    acc_h = np.hypot(motion["acc"][:, 0], motion["acc"][:, 1])
-    peak_time = acc_h.argmax() * motion["dt"] - WINDOW[0]
-    params = records.record_parameters(motion)
+    motion = Motion.load(specs[0]["motion_file"])
+    acc_h = np.hypot(motion.acc[:, 0], motion.acc[:, 1])
+    peak_time = acc_h.argmax() * motion.dt - window[0]
+    params = record_parameters(motion)
     for _, row in runs.iterrows():
         # the strongest pulse (about 0.5 g here, g tan(alpha) = 0.17 g) topples both columns
         assert row["toppled"]
@@ -43,15 +50,15 @@ def test_chain_on_pulse_excerpt(tmp_path, capsys):
     summary = tmp_path / "runs" / specs[0]["run_id"] / "summary.json"
     stamp = summary.stat().st_mtime_ns
     capsys.readouterr()
-    assert not campaign.execute(specs, tmp_path, jobs=1)
+    assert execute(specs, tmp_path, 1, run_column_spec) == ([], False)
     assert "1 already done, 0 to run" in capsys.readouterr().out
     assert summary.stat().st_mtime_ns == stamp
-    assert json.loads(summary.read_text())["parameters"]["window_s"] == list(WINDOW)
+    assert json.loads(summary.read_text())["parameters"]["window_s"] == window
 
 
 @pytest.mark.parametrize("args, message", [
     (["--record", "no/such/file.mseed"], "no such file"),
-    (["--record", "GM20", "--hd", "-6"], "h/d"),
+    (["--record", "GM20", "--hd", "-6"], "--hd"),
     (["--record", "GM20", "--mu-s", "0.5", "--mu-k", "0.6"], "mu_k"),
 ])
 def test_run_bad_input_one_line_and_nothing_written(tmp_path, args, message):

@@ -9,9 +9,13 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from pipeline import synthetics as syn
+from pipeline.figures.synthetic_map import plot_downfall_map
 from pipeline.files import InputError
-from pipeline.records import load_motion
+from pipeline.motion import Motion
+from pipeline.motion import synthetics as syn
+from pipeline.motion.synthetics import compute as generate_module
+from pipeline.stats.circular import direction_differences, direction_table
+from pipeline.stats.location import locate_source_from_falls
 
 RIGHT_LATERAL_NS = (0.0, 90.0, 180.0)  # strike N, vertical, rake 180
 
@@ -158,8 +162,8 @@ def test_generate_writes_motions_with_exact_geometry_and_caches(tiny_source, tmp
                                        for a in (0, 90, 180, 270)]
     hand = {0: 180.0, 90: 270.0, 180: 0.0, 270: 90.0}  # back azimuth of sites N, E, S, W
     for path in paths:
-        motion = load_motion(path)
-        meta = motion["meta"]
+        motion = Motion.load(path)
+        meta = motion.meta
         ring, azimuth = meta["ring_km"], meta["site_azimuth_deg"]
         x, y = ring * math.sin(math.radians(azimuth)), ring * math.cos(math.radians(azimuth))
         assert meta["back_azimuth_deg"] == pytest.approx(hand[int(azimuth)], abs=1e-9)
@@ -174,18 +178,17 @@ def test_generate_writes_motions_with_exact_geometry_and_caches(tiny_source, tmp
         reach = meta["epicentral_distance_km"]
         assert (x + reach * math.sin(baz), y + reach * math.cos(baz)) == pytest.approx((0, 0),
                                                                                          abs=1e-9)
-        assert motion["dt"] == pytest.approx(0.01)
-        assert motion["acc"].shape == motion["disp"].shape == (1001, 3)
-        assert np.isfinite(motion["acc"]).all()
-        np.testing.assert_allclose(np.gradient(motion["disp"], 0.01, axis=0), motion["vel"],
-                                   atol=0.01 * np.abs(motion["vel"]).max())
+        assert motion.dt == pytest.approx(0.01)
+        assert motion.acc.shape == motion.disp.shape == (1001, 3)
+        np.testing.assert_allclose(np.gradient(motion.disp, 0.01, axis=0), motion.vel,
+                                   atol=0.01 * np.abs(motion.vel).max())
 
     stamps = [p.stat().st_mtime_ns for p in paths]
 
     def no_pyprop8(*args, **kwargs):
         raise AssertionError("pyprop8 called although the cache is current")
 
-    monkeypatch.setattr(syn, "point_source_displacement", no_pyprop8)
+    monkeypatch.setattr(generate_module, "point_source_displacement", no_pyprop8)
     assert syn.generate(tiny_source, **kwargs) == paths
     assert [p.stat().st_mtime_ns for p in paths] == stamps
     with pytest.raises(AssertionError, match="cache is current"):
@@ -247,12 +250,12 @@ def test_direction_table_classifies_hand_made_angles():
         ("drums", True, 200.0, 190.0, 0, 5),  # diff 10
         ("drums", True, 20.0, 190.0, 0, 5),  # diff -170: away
     ])
-    diffs = syn.direction_differences(runs)
+    diffs = direction_differences(runs)
     np.testing.assert_allclose(diffs["diff_deg"].to_numpy()[[0, 1, 2, 3, 4, 6, 7]],
                                [-10, 180, -45, 135, 90, 10, -170])
     assert list(diffs["direction_class"]) == ["toward", "away", "toward", "away", "transverse",
                                               "not toppled", "toward", "away"]
-    table = syn.direction_table(runs).set_index("column")
+    table = direction_table(runs).set_index("column")
     mono, drums = table.loc["monolithic"], table.loc["drums"]
     # monolithic diffs -10, 180, -45, 135, 90: doubled -20, 0, -90, -90, 180 (by hand)
     doubled = np.radians([-20, 0, -90, -90, 180])
@@ -272,7 +275,7 @@ def test_locate_source_from_falls_finds_the_point_the_falls_align_with():
     toward = np.degrees(np.arctan2(target[0] - x, target[1] - y)) % 360
     falls = np.where(np.arange(len(az)) % 2, toward, (toward + 180) % 360)  # toward or away
     runs = _runs([("monolithic", True, f, 0.0, xi, yi) for f, xi, yi in zip(falls, x, y)])
-    result = syn.locate_source_from_falls(runs, extent_km=15, step_km=0.5).set_index("column")
+    result = locate_source_from_falls(runs, extent_km=15, step_km=0.5).set_index("column")
     best = result.loc["monolithic"]
     assert (best.best_x_km, best.best_y_km) == pytest.approx(target, abs=1e-9)
     assert best.misfit_best == pytest.approx(0.0, abs=1e-12)
@@ -290,7 +293,7 @@ def test_downfall_map_is_written(tmp_path):
     runs = pd.DataFrame(rows, columns=["site_id", "column", "toppled", "downfall_azimuth_deg"])
     runs = runs.merge(sites[["site_id", "back_azimuth_deg", "x_km", "y_km"]], on="site_id")
     path = tmp_path / "map.png"
-    syn.plot_downfall_map(runs, "strike_slip", path)
+    plot_downfall_map(runs, "strike_slip", path)
     assert path.stat().st_size > 10_000
     with pytest.raises(InputError, match="lacks columns"):
-        syn.plot_downfall_map(runs.drop(columns="x_km"), "strike_slip", path)
+        plot_downfall_map(runs.drop(columns="x_km"), "strike_slip", path)

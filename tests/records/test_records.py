@@ -8,8 +8,11 @@ from obspy import Stream, Trace, UTCDateTime
 from obspy.io.sac import SACTrace
 
 from pipeline import cli, records
+from pipeline.constants import STANDARD_GRAVITY as G
 from pipeline.files import InputError
-from pipeline.readers import G, read_record
+from pipeline.motion import Motion, measures
+from pipeline.records import processing
+from pipeline.records.readers import read_record
 
 RATE = 100.0
 
@@ -20,20 +23,20 @@ def test_arias_intensity_of_pure_sine():
     t = np.arange(0, duration + dt / 2, dt)
     acc = amplitude * np.sin(2 * np.pi * freq * t)
     expected = np.pi / (2 * G) * amplitude ** 2 * duration / 2
-    assert records.arias_intensity(acc, dt) == pytest.approx(expected, rel=1e-6)
+    assert measures.arias_intensity(acc, dt) == pytest.approx(expected, rel=1e-6)
 
 
 def test_mean_period_of_single_tone():
     dt, freq = 0.01, 2.5
     t = np.arange(2000) * dt                   # 20 s: 2.5 Hz is an exact FFT bin
-    assert records.mean_period(np.sin(2 * np.pi * freq * t), dt) == pytest.approx(1 / freq,
+    assert measures.mean_period(np.sin(2 * np.pi * freq * t), dt) == pytest.approx(1 / freq,
                                                                                   rel=1e-9)
 
 
 def test_significant_duration_of_linear_energy_build_up():
     dt = 0.01
     acc = np.r_[np.ones(1001), np.zeros(500)]  # a^2 constant for 10 s: Arias grows linearly
-    assert records.significant_duration(acc, dt) == pytest.approx(0.9 * 10.0, abs=2 * dt)
+    assert measures.significant_duration(acc, dt) == pytest.approx(0.9 * 10.0, abs=2 * dt)
 
 
 def test_peaks_of_analytically_integrated_pulse_survive_processing():
@@ -50,7 +53,7 @@ def test_peaks_of_analytically_integrated_pulse_survive_processing():
     vel = D * (gp * s + g * sp)
     acc = D * (gpp * s + 2 * gp * sp + g * spp)
     enz = np.column_stack([acc, 0.5 * acc, np.zeros_like(acc)])
-    a, v, d = records.process_acceleration(enz, dt, 0.1, 25.0)
+    a, v, d, _ = processing.process(enz, dt)
     assert np.max(np.abs(v[:, 0])) == pytest.approx(np.max(np.abs(vel)), rel=0.02)
     assert np.max(np.abs(d[:, 0])) == pytest.approx(np.max(np.abs(disp)), rel=0.02)
     assert np.max(np.abs(d[:, 1])) == pytest.approx(0.5 * np.max(np.abs(disp)), rel=0.02)
@@ -82,7 +85,7 @@ def test_rotation_recovers_known_azimuth(azimuth):
     assert dt == pytest.approx(1 / RATE)
     assert np.allclose(enz[:, 0], east, atol=1e-12) and np.allclose(enz[:, 1], north, atol=1e-12)
     assert np.allclose(enz[:, 2], 0.1 * pulse)
-    peak, found, _ = records.horizontal_peak(enz)
+    peak, found, _ = measures.horizontal_peak(enz)
     assert peak == pytest.approx(1.0, rel=1e-3)
     assert found == pytest.approx(azimuth, abs=1e-6)
 
@@ -108,20 +111,23 @@ def test_miniseed_round_trip(tmp_path):
     assert np.allclose(enz, np.column_stack([east, north, up]))
 
     out = tmp_path / "out"
-    motion_path = records.processed_motion_path(path, out_dir=out)
-    motion = records.load_motion(motion_path)
-    assert motion["acc"].shape == (3000, 3) and motion["dt"] == pytest.approx(0.01)
-    assert motion["meta"]["back_azimuth_deg"] is None
-    assert motion["meta"]["has_vertical"] is True
+    motion, motion_path = records.processed_motion(path, cache_dir=out)
+    assert motion.acc.shape[1] == 3 and motion.dt == pytest.approx(0.01)
+    assert motion.duration < 30.0        # trimmed to the signal window (Gaussian envelope)
+    assert motion.meta["back_azimuth_deg"] is None
+    assert motion.meta["has_vertical"] is True
     # cached: a second call does not rewrite; a given back azimuth is a new input
     mtime = motion_path.stat().st_mtime_ns
-    assert records.processed_motion_path(path, out_dir=out) == motion_path
+    assert records.processed_motion(path, cache_dir=out)[1] == motion_path
     assert motion_path.stat().st_mtime_ns == mtime
-    assert records.processed_motion_path(motion_path) == motion_path
-    with_baz = records.load_motion(records.processed_motion_path(path, back_azimuth=123.0,
-                                                                 out_dir=out))
-    assert with_baz["meta"]["back_azimuth_deg"] == 123.0
-    assert "user" in with_baz["meta"]["back_azimuth_source"]
+    assert records.processed_motion(motion_path)[1] == motion_path
+    with_baz, _ = records.processed_motion(path, back_azimuth=123.0, cache_dir=out)
+    assert with_baz.meta["back_azimuth_deg"] == 123.0
+    assert "user" in with_baz.meta["back_azimuth_source"]
+    # provenance: every processing step and the software versions
+    steps = [s["step"] for s in motion.meta["processing"]["steps"]]
+    assert steps == [name for name, _ in processing.DEFAULT_STEPS]
+    assert set(motion.meta["processing"]["software"]) >= {"obspy", "numpy", "scipy", "yade"}
 
 
 def test_sac_round_trip_with_coordinates_and_azimuths(tmp_path):
@@ -140,8 +146,8 @@ def test_sac_round_trip_with_coordinates_and_azimuths(tmp_path):
     assert np.allclose(enz[:, 0], 0.0, atol=1e-6)
     assert np.allclose(enz[:, 1], north, atol=1e-5)
     assert info["station_lat"] == 40.0 and info["event_lat"] == 41.0 and info["magnitude"] == pytest.approx(6.1)
-    meta = records.load_motion(records.processed_motion_path(
-        tmp_path / "rec.*.sac", back_azimuth=200.0, out_dir=tmp_path / "out"))["meta"]
+    meta = records.processed_motion(tmp_path / "rec.*.sac", back_azimuth=200.0,
+                                    cache_dir=tmp_path / "out")[0].meta
     assert min(meta["back_azimuth_deg"], 360 - meta["back_azimuth_deg"]) < 1e-6
     assert meta["epicentral_distance_km"] == pytest.approx(111.2, rel=0.01)
     assert "coordinates" in meta["back_azimuth_source"]
@@ -165,9 +171,8 @@ def test_at2_round_trip_finds_sibling_components(tmp_path):
     assert info["station"] == "Test Station"
     enz, _ = records.to_east_north_up(stream, "at2")
     assert np.allclose(enz, G * np.column_stack([east, north, up]), atol=1e-6)
-    motion = records.load_motion(records.processed_motion_path(tmp_path / "TEST090.AT2",
-                                                               out_dir=tmp_path / "out"))
-    assert np.all(np.isfinite(motion["disp"]))
+    motion, _ = records.processed_motion(tmp_path / "TEST090.AT2", cache_dir=tmp_path / "out")
+    assert np.all(np.isfinite(motion.disp))
 
 
 # ---------------------------------------------------------------- bad inputs
@@ -199,7 +204,7 @@ def test_bad_input_raises_one_line_error_and_writes_nothing(tmp_path, case, caps
     path = BAD_INPUTS[case](tmp_path)
     out = tmp_path / "out"
     with pytest.raises(InputError) as info:
-        records.processed_motion_path(path, out_dir=out)
+        records.processed_motion(path, cache_dir=out)
     message = str(info.value)
     assert message and "\n" not in message
     assert cli.main(["records", str(path), "--out", str(out)]) == 2
@@ -227,17 +232,15 @@ def test_every_catalogued_record_is_finite_and_plausible(catalogue_run):
     ids = list(records.catalog()["id"])
     assert sorted(table["id"]) == sorted(ids)
     for record_id in ids:
-        motion = records.load_motion(catalogue_run / f"{record_id}.npz")
-        for key in ("acc", "vel", "disp"):
-            assert np.all(np.isfinite(motion[key])), record_id
-        params = records.record_parameters(motion)
+        motion = Motion.load(catalogue_run / f"{record_id}.npz")
+        params = measures.record_parameters(motion)
         assert 0.5 < params["pga_h"] < 25.0, record_id              # m/s^2
         assert 0.05 < params["pgv_h"] < 3.0, record_id              # m/s
         assert 0.01 < params["pgd_h"] < 1.5, record_id              # m
         assert 0.1 < params["tm_e"] < 2.0 and 1.0 < params["ts_e"] < 60.0, record_id
-        end = np.hypot(*motion["disp"][-1, :2])
+        end = np.hypot(*motion.disp[-1, :2])
         assert end < 0.05 * params["pgd_h"], record_id           # ends at rest, no drift
-        assert (params["pga_z"] > 0) == motion["meta"]["has_vertical"], record_id
+        assert (params["pga_z"] > 0) == motion.meta["has_vertical"], record_id
     gm20 = table.set_index("id").loc["GM20"]
     assert 1.0 < gm20["pga_h"] < 3.0
 

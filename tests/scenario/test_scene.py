@@ -7,29 +7,21 @@ import math
 import numpy as np
 import pytest
 
-from pipeline import outcome, scenario
-from pipeline.run import rotate_horizontal
+from pipeline.constants import MODEL_GRAVITY as G
+from pipeline.motion import Motion
+from pipeline.motion.pulses import one_sine_pulse as pulse
+from pipeline.outcome.columns import column_outcomes, total_energy
+from pipeline.scenario import Block, Column, Contact, Numerics, run_yade, scene_params, \
+    write_scenario
 
 pytestmark = pytest.mark.yade
-G = 9.81
 
 
-def pulse(azimuth_deg, amplitude, period=1.0, duration=6.0, dt=0.005):
-    """One-sine acceleration pulse along an azimuth with its exact displacement."""
-    t = np.arange(0.0, duration, dt)
-    w = 2 * math.pi / period
-    on = t < period
-    acc = np.where(on, amplitude * np.sin(w * t), 0.0)
-    disp = np.where(on, amplitude / w * (t - np.sin(w * t) / w), amplitude / w * period)
-    u = np.array([math.sin(math.radians(azimuth_deg)), math.cos(math.radians(azimuth_deg)), 0.0])
-    return {"dt": dt, "acc": acc[:, None] * u, "disp": disp[:, None] * u}
-
-
-def run(tmp_path, name, columns, motion=None, **options):
-    duration = 0.0 if motion is None else (len(motion["acc"]) - 1) * motion["dt"]
-    params = scenario.scene_params(columns=columns, motion_duration=duration, **options)
-    scenario.write_scenario(tmp_path / name, params, motion)
-    return scenario.run_yade(tmp_path / name)
+def run(tmp_path, name, column, motion=None):
+    duration = 0.0 if motion is None else motion.duration
+    params = scene_params(columns=column.specs(), motion_duration=duration)
+    write_scenario(tmp_path / name, params, motion)
+    return run_yade(tmp_path / name)
 
 
 def axial_gap(a, b):
@@ -43,10 +35,9 @@ def pulse_runs(tmp_path_factory):
     """A single monolith shaken by the same strong pulse along N and turned by 90 deg."""
     tmp = tmp_path_factory.mktemp("pulse")
     base = pulse(0.0, 5.0)
-    turned = dict(base, acc=rotate_horizontal(base["acc"], 90.0),
-                  disp=rotate_horizontal(base["disp"], 90.0))
-    mono = scenario.column_specs("monolithic", hd=6.0)
-    return [outcome.column_outcomes(run(tmp, n, mono, m))[0] for n, m in (("n", base), ("e", turned))]
+    mono = Column("monolithic", hd=6.0)
+    return [column_outcomes(run(tmp, n, mono, m))[0]
+            for n, m in (("n", base), ("e", base.rotate(90.0)))]
 
 
 def test_column_shaken_along_azimuth_falls_in_its_plane(pulse_runs):
@@ -75,10 +66,11 @@ def test_no_uplift_below_g_tan_alpha(tmp_path):
         t = np.arange(0, 3.0, 0.005)
         a = factor * threshold * np.sin(2 * math.pi * 2.0 * t)
         d = -a / (2 * math.pi * 2.0) ** 2
-        motion = {"dt": 0.005, "acc": np.column_stack([a, 0 * a, 0 * a]),
-                  "disp": np.column_stack([d, 0 * d, 0 * d])}
-        traj = run(tmp_path, f"f{factor}", scenario.column_specs("monolithic", hd=hd), motion)
-        tilts.append(outcome.column_outcomes(traj)[0]["max_tilt_deg"])
+        v = np.cumsum(a) * 0.005
+        motion = Motion(0.005, np.column_stack([a, 0 * a, 0 * a]), np.column_stack([v, 0 * v, 0 * v]),
+                        np.column_stack([d, 0 * d, 0 * d]))
+        traj = run(tmp_path, f"f{factor}", Column("monolithic", hd=hd), motion)
+        tilts.append(column_outcomes(traj)[0]["max_tilt_deg"])
     assert tilts[0] < 0.05          # elastic contact compression only
     assert tilts[1] > 0.5
 
@@ -88,25 +80,25 @@ def test_free_rocking_energy_never_grows_and_early_stop(tmp_path):
     its earlier maximum (beyond the contact spring's share) and the run stops at rest."""
     h, b = 0.4, 0.08
     alpha = math.atan(b / h)
-    params = scenario.scene_params(
-        block={"height": h, "width": b, "depth": 0.045, "density": 2960.0,
-               "theta0_rad": 0.8 * alpha}, t_max=20.0, kn=1.2e7, rest_duration_s=0.3)
-    scenario.write_scenario(tmp_path / "blk", params)
-    traj = scenario.run_yade(tmp_path / "blk")
-    energy = outcome.total_energy(traj)
+    params = scene_params(
+        block=Block(height=h, width=b, depth=0.045, density=2960.0, theta0_rad=0.8 * alpha),
+        contact=Contact(kn=1.2e7), numerics=Numerics(rest_duration_s=0.3), t_max=20.0)
+    write_scenario(tmp_path / "blk", params)
+    traj = run_yade(tmp_path / "blk")
+    energy = total_energy(traj)
     released = energy[0] - energy.min()
     rise = np.max(energy - np.maximum.accumulate(energy))
     assert rise <= 0.01 * released
     assert energy[-1] < energy[0] - 0.9 * released      # rocking dies out
-    assert traj["stopped_early"] and traj["t"][-1] < 10.0
+    assert traj.stopped_early and traj.t[-1] < 10.0
 
 
 def test_twin_model_falls_in_the_pulse_plane_and_stops_early(tmp_path):
-    traj = run(tmp_path, "twin", scenario.column_specs("both"), pulse(30.0, 5.0))
-    cols = {c["column"]: c for c in outcome.column_outcomes(traj)}
+    traj = run(tmp_path, "twin", Column("both"), pulse(30.0, 5.0))
+    cols = {c["column"]: c for c in column_outcomes(traj)}
     for col in cols.values():
         assert col["toppled"]
         assert axial_gap(col["downfall_azimuth_deg"], 30.0) < 15.0
     # the twin columns stand 3 m apart and start at their own positions
     assert cols["drums"]["position_m"] == [-1.5, 0.0]
-    assert traj["stopped_early"]
+    assert traj.stopped_early

@@ -5,7 +5,7 @@ import sys
 
 import pytest
 
-from pipeline import verify
+from pipeline import verification as verify
 
 pytestmark = pytest.mark.yade
 

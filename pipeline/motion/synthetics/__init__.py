@@ -21,7 +21,7 @@ disp in m/s^2, m/s, m, columns East, North, Up, and a JSON meta) under
 ``results/synthetics/<source>/<site_id>.npz``, cached by a content hash of
 every generator parameter.
 """
-from pipeline.motion.synthetics.generate import (DEFAULT_OUT_DIR, QUICK_DURATION_S,
+from pipeline.motion.synthetics.compute import (DEFAULT_OUT_DIR, QUICK_DURATION_S,
                                                  QUICK_FMAX_HZ, QUICK_OUT_DIR, band_limited_motion,
                                                  generate, moment_tensor_xyz, numerics,
                                                  point_source_displacement, site_table)

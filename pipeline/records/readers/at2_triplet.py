@@ -44,7 +44,8 @@ from pipeline.records.readers._text import (
 FORMAT = "at2-triplet"
 PRIORITY = 40  # before the generic AT2 reader (50)
 
-SHIPPED_FLATFILE = Path(__file__).resolve().parents[3] / "records" / "ngawest2" / "flatfile_rows.csv"
+SHIPPED_FLATFILE = (Path(__file__).resolve().parents[3] / "records" / "ngawest2"
+                    / "flatfile_rows.csv")
 _NAME = re.compile(r"^RSN(\d+)_([123])\.AT2(\.gz)?$", re.I)
 _NPTS_DT = re.compile(r"NPTS\s*=\s*([^,]*?)\s*,\s*DT\s*=\s*(.*?)\s*SEC", re.I)
 

@@ -47,7 +47,8 @@ def read(path, key=None):
     lines = open_text(path).splitlines()
     starts = [i for i, line in enumerate(lines) if _START.match(line)]
     if not starts or starts[0] != next((i for i, l in enumerate(lines) if l.strip()), None):
-        raise InputError(f"{name}: does not start with 'CORRECTED ACCELEROGRAM' (not a DMG V2 file)")
+        raise InputError(f"{name}: does not start with 'CORRECTED ACCELEROGRAM' "
+                         "(not a DMG V2 file)")
     stream, info = Stream(), {}
     for n, start in enumerate(starts):
         end = starts[n + 1] if n + 1 < len(starts) else len(lines)
@@ -125,7 +126,8 @@ def _read_channel(block, offset, name, info):
     if repeat and repeat.group(1) != number_:
         raise InputError(f"{name}: {where}: header names channel {repeat.group(1)}")
 
-    station = _search(header, r"STATION\s+NO\.\s*(\S+)\s+([\d.]+)\s*([NS])\s*,\s*([\d.]+)\s*([EW])")
+    station = _search(header, r"STATION\s+NO\.\s*(\S+)\s+([\d.]+)\s*([NS])\s*,\s*"
+                              r"([\d.]+)\s*([EW])")
     if not station:
         raise InputError(f"{name}: {where}: no 'STATION NO. <id> <lat>N, <lon>W' line")
     code = station.group(1)
@@ -146,8 +148,8 @@ def _read_channel(block, offset, name, info):
     origin = _time(header, r"ORIGIN(?:\(\w+\))?", name, where)
     if origin is not None:
         channel_info["origin_time"] = origin.isoformat()
-    hypo = _search(header, r"HYPOCENTER(?:\(\w+\))?\s*:\s*([\d.]+)\s*([NS])\s*,\s*([\d.]+)\s*([EW])"
-                           r"(?:\s*,\s*H\s*=\s*([\d.]+)\s*KM)?")
+    hypo = _search(header, r"HYPOCENTER(?:\(\w+\))?\s*:\s*([\d.]+)\s*([NS])\s*,\s*"
+                           r"([\d.]+)\s*([EW])(?:\s*,\s*H\s*=\s*([\d.]+)\s*KM)?")
     if hypo:
         channel_info["event_lat"] = _coordinate(hypo.group(1), hypo.group(2), name, where)
         channel_info["event_lon"] = _coordinate(hypo.group(3), hypo.group(4), name, where)
@@ -192,8 +194,9 @@ def _coordinate(value, hemi, name, where):
 
 
 def _time(header, label, name, where):
-    match = _search(header, label + r"\s*:\s*(\d{1,2})/(\d{1,2})/(\d{2,4})\s*,\s*(\d{1,2}):(\d{1,2})"
-                                    r":(\d{1,2}(?:\.\d*)?)\s*(UTC|GMT|UT|PDT|PST)")
+    match = _search(header, label + r"\s*:\s*(\d{1,2})/(\d{1,2})/(\d{2,4})\s*,\s*"
+                                    r"(\d{1,2}):(\d{1,2}):(\d{1,2}(?:\.\d*)?)\s*"
+                                    r"(UTC|GMT|UT|PDT|PST)")
     if not match:
         return None
     month, day, year, hour, minute = (int(v) for v in match.groups()[:5])

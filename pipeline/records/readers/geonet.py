@@ -92,7 +92,8 @@ def read(path, key=None):
         info["notes"] = ("GeoNet Volume 2: instrument-corrected acceleration, band-pass "
                          + (f"transition bands {first['band_text']} Hz" if band else "filtered"))
     else:
-        info["notes"] = "GeoNet Volume 1: uncorrected acceleration, unfiltered, no baseline correction"
+        info["notes"] = ("GeoNet Volume 1: uncorrected acceleration, unfiltered, "
+                         "no baseline correction")
     return stream, info
 
 
@@ -219,7 +220,8 @@ def _scale(text, level, name, where):
     if level == "V1":
         unit = re.search(r"units of\s+([\d.]+)\s*mm/s/s", text[10])
         if not unit:
-            raise InputError(f"{name}: {where}: V1 sample unit unreadable ({one_line(text[10])!r})")
+            raise InputError(f"{name}: {where}: V1 sample unit unreadable "
+                             f"({one_line(text[10])!r})")
         factor = number(unit.group(1), "V1 unit", name)
         if factor <= 0:
             raise InputError(f"{name}: {where}: V1 unit {factor:g} mm/s/s is not positive")

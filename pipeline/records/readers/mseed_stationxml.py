@@ -21,6 +21,7 @@ The event file is ``event.json`` (flat ComCat-like ``{"id", "time", "lat",
 import glob
 import io
 import json
+import warnings
 from pathlib import Path
 
 import obspy
@@ -51,11 +52,24 @@ def read(path, key=None):
     origin_file = {}
     for file in files:
         raw = read_bytes(file)
-        try:
-            part = obspy.read(io.BytesIO(raw), format="MSEED")
-        except Exception as exc:  # obspy raises many types for broken input
-            raise InputError(f"{file.name}: not a readable MiniSEED file "
-                             f"({type(exc).__name__}: {one_line(exc)[:80]})") from None
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            try:
+                part = obspy.read(io.BytesIO(raw), format="MSEED")
+            except Exception as exc:  # obspy raises many types for broken input
+                raise InputError(f"{file.name}: not a readable MiniSEED file "
+                                 f"({type(exc).__name__})") from None
+        problems = [w for w in caught if "MSEED" in type(w.message).__name__.upper()
+                    or "mseed" in str(w.message).lower()]
+        if problems:  # obspy reads what it can of a truncated or corrupt file and warns
+            raise InputError(f"{file.name}: truncated or corrupt MiniSEED "
+                             f"({one_line(problems[0].message)[:100]})")
+        # a file cut between records reads without a warning: its records must fill it
+        in_records = sum(tr.stats.mseed.number_of_records * tr.stats.mseed.record_length
+                         for tr in part if "mseed" in tr.stats)
+        if in_records != len(raw):
+            raise InputError(f"{file.name}: truncated or corrupt MiniSEED ({in_records} of "
+                             f"{len(raw)} bytes in complete records)")
         for trace in part:
             origin_file.setdefault(trace.id, []).append(file.name)
         stream += part
@@ -220,7 +234,8 @@ def _event_json(path):
     if not isinstance(data, dict):
         raise InputError(f"{path.name}: not a JSON object")
     if data.get("type") == "Feature":  # ComCat GeoJSON
-        props, coords = data.get("properties") or {}, (data.get("geometry") or {}).get("coordinates")
+        props = data.get("properties") or {}
+        coords = (data.get("geometry") or {}).get("coordinates")
         if not coords or len(coords) < 2:
             raise InputError(f"{path.name}: GeoJSON feature without coordinates")
         time = props.get("time")

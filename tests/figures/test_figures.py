@@ -1,0 +1,73 @@
+"""Campaign figures, animation geometry and VTK export."""
+import math
+import xml.etree.ElementTree as ET
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from pipeline.figures import animation
+from pipeline.figures import campaign as campaign_figures
+from pipeline.files import InputError
+from pipeline.motion import Motion
+from pipeline.outcome import Trajectory
+
+
+def test_figures_write_pngs(tmp_path, runs_table):
+    runs = runs_table()
+    for func, name in ((campaign_figures.plot_rose, "rose.png"),
+                       (campaign_figures.plot_toppling_vs_parameters, "params.png"),
+                       (campaign_figures.plot_downfall_vs_directions, "dirs.png")):
+        func(runs, tmp_path / name)
+        assert (tmp_path / name).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    one = runs[runs["record_id"] == "R0"]
+    impacts = pd.DataFrame({"run_id": one["run_id"], "column": one["column"], "body_index": 0,
+                            "impact_time_s": 5.0, "x_m": one["impact_x_m"].fillna(0),
+                            "y_m": one["impact_y_m"].fillna(0), "hd": one["hd"], "mu_s": 0.7,
+                            "record_id": "R0"})
+    t = np.linspace(0, 10, 1001)
+    disp = np.column_stack([0.1 * np.sin(t), 0.05 * np.cos(t), 0 * t])
+    motion = Motion(0.01, disp, disp, disp, meta={"back_azimuth_deg": 240.0})
+    campaign_figures.plot_impact_map(one, impacts, motion, tmp_path / "map.png")
+    assert (tmp_path / "map.png").stat().st_size > 10_000
+
+
+def test_empty_runs_raise_and_write_nothing(tmp_path):
+    with pytest.raises(InputError):
+        campaign_figures.plot_rose(pd.DataFrame(), tmp_path / "rose.png")
+    assert not list(tmp_path.iterdir())
+
+
+def lying_east_trajectory():
+    """One monolith standing, then rotated 90 deg about the North axis (lying East)."""
+    q = [math.cos(math.pi / 4), 0.0, math.sin(math.pi / 4), 0.0]      # w, x, y, z
+    body = {"name": "m", "column": "monolithic", "index": 0, "shape": "cylinder",
+            "height": 3.5, "radius": 0.3, "mass": 2772.0}
+    return Trajectory(t=np.array([0.0, 1.0]), pedestal_disp=np.zeros((2, 3)),
+                      pos=np.array([[[0, 0, 1.75]], [[1.75, 0, 0.3]]]),
+                      quat=np.array([[[1.0, 0, 0, 0]], [q]]), bodies=[body])
+
+
+def test_body_rotated_about_north_lies_along_east():
+    traj = lying_east_trajectory()
+    bottom, top = animation.body_surface(traj.bodies[0], traj.pos[1, 0], traj.quat[1, 0])
+    axis = top.mean(axis=0) - bottom.mean(axis=0)
+    assert axis == pytest.approx([3.5, 0, 0], abs=1e-9)
+    assert bottom[:, 2].min() == pytest.approx(0.0, abs=1e-9)   # lies on the pedestal
+
+
+def test_vtk_export_is_valid_xml_with_all_frames(tmp_path):
+    pvd = animation.export_vtk(lying_east_trajectory(), tmp_path, every=1)
+    entries = ET.parse(pvd).getroot().find("Collection").findall("DataSet")
+    assert [float(e.get("timestep")) for e in entries] == [0.0, 1.0]
+    piece = ET.parse(tmp_path / entries[1].get("file")).getroot().find("PolyData/Piece")
+    n = animation.CIRCLE_SEGMENTS
+    assert int(piece.get("NumberOfPoints")) == 4 + 2 * n          # pedestal + two rims
+    assert int(piece.get("NumberOfPolys")) == 1 + 2 + n
+
+
+def test_animation_gif(tmp_path):
+    out = animation.animate_run(lying_east_trajectory(), tmp_path / "a.gif", fps=2)
+    assert out.read_bytes()[:6] in (b"GIF89a", b"GIF87a")
+    with pytest.raises(InputError):
+        animation.animate_run(lying_east_trajectory(), tmp_path / "a.avi")

@@ -1,0 +1,71 @@
+"""Scene parameters and the scene writer, without YADE."""
+import json
+import math
+
+import numpy as np
+import pytest
+
+from pipeline.files import InputError
+from pipeline.motion import Motion
+from pipeline.scenario import Column, Contact, Numerics, scene_params, write_scenario
+from pipeline.scenario.writer import SCENE_TEMPLATE
+
+
+@pytest.mark.parametrize("bad", [dict(hd=0), dict(hd=-6), dict(height=float("nan")),
+                                 dict(n_drums=0), dict(n_drums=2.5), dict(kind="pillar"),
+                                 dict(hd=1e6), dict(n_drums=1000)])
+def test_impossible_column_parameters(bad):
+    with pytest.raises(InputError) as info:
+        Column(**bad)
+    assert "\n" not in str(info.value)
+
+
+@pytest.mark.parametrize("cls, bad", [
+    (Contact, dict(mu_s=0.5, mu_k=0.6)), (Contact, dict(kn=-1.0)), (Contact, dict(damping=-0.1)),
+    (Contact, dict(damping=5.0)), (Contact, dict(mu_s=0.0)), (Contact, dict(mu_k=float("nan"))),
+    (Numerics, dict(drive="teleport")), (Numerics, dict(dt_factor=-1)),
+    (Numerics, dict(dt_factor=0)), (Numerics, dict(dt_factor=float("nan"))),
+    (Numerics, dict(rim_points=2))])
+def test_impossible_scene_parameters(cls, bad):
+    with pytest.raises(InputError) as info:
+        cls(**bad)
+    message = str(info.value)
+    assert "\n" not in message
+    assert any(key in message or key.replace("_", "-") in message for key in bad)
+
+
+def test_mu_k_follows_mu_s_unless_given():
+    assert Contact().mu_k == 0.6                       # the paper's pair 0.7 / 0.6
+    assert Contact(mu_s=0.5).mu_k == pytest.approx(0.42)   # 0.84 mu_s, as in the friction sweep
+    assert Contact(mu_s=0.5, mu_k=0.3).mu_k == 0.3
+
+
+def test_twin_model_geometry():
+    drums, mono = Column("both", hd=6.0, height=3.5).specs()
+    assert (drums["x"], mono["x"]) == (-1.5, 1.5)
+    assert drums["diameter"] == pytest.approx(3.5 / 6)
+    # paper: monolith 2772 kg for d = 0.58 m (d = H / (h/d) = 0.5833 m here); its
+    # "231 kg" per drum is 2772 / 12 and cannot belong to 7 equal drums of that column
+    mass = 2960 * math.pi * (drums["diameter"] / 2) ** 2 * 3.5
+    assert mass == pytest.approx(2772, rel=0.02)
+    (single,) = Column("monolithic").specs()
+    assert single["x"] == 0.0
+
+
+def test_generated_scene_never_contains_values(tmp_path):
+    evil = 'x"; import os; os.system("rm -rf /")  #\n\'\'\''
+    params = scene_params(columns=Column("both").specs(), motion_duration=1.0)
+    params["record_name"] = evil
+    zeros = np.zeros((101, 3))
+    script = write_scenario(tmp_path, params, Motion(0.01, zeros, zeros, zeros,
+                                                     meta={"record_id": evil}))
+    assert script.read_bytes() == SCENE_TEMPLATE.read_bytes()
+    assert json.loads((tmp_path / "params.json").read_text())["record_name"] == evil
+
+
+def test_motion_with_nan_is_rejected_and_nothing_written(tmp_path):
+    acc = np.zeros((10, 3))
+    acc[3, 1] = np.nan
+    with pytest.raises(InputError, match="NaN"):
+        Motion(0.01, acc, acc, acc)
+    assert not (tmp_path / "run").exists()
