@@ -5,8 +5,12 @@
 """
 import dataclasses
 import math
+import time
 from pathlib import Path
 
+import numpy as np
+
+from pipeline.constants import MODEL_GRAVITY
 from pipeline.files import InputError, code_hash, software_versions, write_json
 from pipeline.outcome.columns import summarise
 from pipeline.scenario import Column, Contact, Numerics, run_yade, scene_params, write_scenario
@@ -29,6 +33,28 @@ def back_azimuth_of(motion, override=None):
     return motion.back_azimuth
 
 
+PRECHECK_MARGIN = 0.9   # skip YADE only below 90 % of the rigid-block thresholds
+
+
+def can_move(drive, columns, contact):
+    """False when no body can rock or slide at any sample (rigid-block statics): the
+    horizontal acceleration stays below (g + a_up) min(tan alpha, mu_s) x margin, alpha
+    the slenderest column's d/h (a stack above any drum is stockier than the whole)."""
+    tan_alpha = min(c["diameter"] / c["height"] for c in columns)
+    effective_g = MODEL_GRAVITY + drive.acc[:, 2]
+    horizontal = np.hypot(drive.acc[:, 0], drive.acc[:, 1])
+    limit = PRECHECK_MARGIN * effective_g * min(tan_alpha, contact.mu_s)
+    return bool(np.any(effective_g <= 0) or np.any(horizontal >= limit))
+
+
+def still_outcome(columns):
+    """Per-column outcome of columns that never moved."""
+    return [{"column": c["name"], "toppled": False, "downfall_azimuth_deg": None,
+             "impact_time_s": None, "impact_point_m": None, "max_tilt_deg": 0.0,
+             "base_slip_m": 0.0, "position_m": [c["x"], c["y"]], "bodies": []}
+            for c in columns]
+
+
 def simulate(motion, out_dir, column=None, contact=None, numerics=None, window=None,
              rotate_deg=0.0, scale=1.0, back_azimuth=None, record=None, motion_file=None,
              timeout_s=None):
@@ -48,7 +74,9 @@ def simulate(motion, out_dir, column=None, contact=None, numerics=None, window=N
     out_dir = Path(out_dir)
     (out_dir / "summary.json").unlink(missing_ok=True)
     write_scenario(out_dir, params, drive)
-    trajectory = run_yade(out_dir, timeout_s=timeout_s)
+    started = time.perf_counter()
+    moves = can_move(drive, params["columns"], contact)
+    trajectory = run_yade(out_dir, timeout_s=timeout_s) if moves else None
     parameters = {"column": column.kind, "hd": column.hd, "height_m": column.height,
                   "n_drums": column.n_drums, "density_kg_m3": column.density,
                   **dataclasses.asdict(contact), "window_s": list(window) if window else None,
@@ -57,8 +85,18 @@ def simulate(motion, out_dir, column=None, contact=None, numerics=None, window=N
                   "dt_factor": numerics.dt_factor, "rim_points": numerics.rim_points}
     provenance = {"software": software_versions(), "motion": motion.meta.get("processing"),
                   "code": {"scenario": code_hash("scenario", "outcome", "yade_scripts")}}
-    summary = summarise(trajectory, record=record or motion.record_id,
-                        back_azimuth_deg=drive.back_azimuth, parameters=parameters,
-                        provenance=provenance)
+    if trajectory is None:
+        summary = {"record": record or motion.record_id, "back_azimuth_deg": drive.back_azimuth,
+                   "parameters": parameters, "columns": still_outcome(params["columns"]),
+                   "simulated": False,
+                   "note": "not simulated: the horizontal acceleration stays below the uplift "
+                   "and sliding thresholds at every sample, so no body can move",
+                   "simulated_s": 0.0, "motion_end_s": drive.duration, "stopped_early": False,
+                   "time_step_s": None, "wall_s": time.perf_counter() - started,
+                   "provenance": provenance}
+    else:
+        summary = summarise(trajectory, record=record or motion.record_id,
+                            back_azimuth_deg=drive.back_azimuth, parameters=parameters,
+                            provenance=provenance)
     write_json(out_dir / "summary.json", summary)
     return summary

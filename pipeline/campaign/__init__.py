@@ -24,7 +24,8 @@ CAMPAIGNS = {}
 class Campaign:
     """name: command-line name; help: one line; specs(records, campaign_dir) -> run specs;
     worker(spec, run_dir) writes run_dir/summary.json; outputs(specs, campaign_dir,
-    failures, animations) writes tables and figures and returns a dict for campaign.json."""
+    failures, animations, figures) writes tables (and figures unless ``figures`` is
+    False, after Ctrl-C) and returns a dict for campaign.json."""
     name: str
     help: str
     specs: Callable
@@ -70,8 +71,8 @@ def run_campaign(name, jobs=None, records=None, campaign_dir=None, animations=1)
     with DirectoryLock(campaign_dir, wait=False):
         failures, interrupted = execute(specs, campaign_dir, jobs, campaign.worker,
                                         campaign.label)
-        result = campaign.outputs(specs, campaign_dir, failures,
-                                  0 if interrupted else animations)
+        result = campaign.outputs(specs, campaign_dir, failures, animations,
+                                  figures=not interrupted)
         write_json(campaign_dir / "campaign.json", {
             "campaign": name, "runs": len(specs), "interrupted": interrupted,
             "failed": [{"run_id": s["run_id"], "record": s.get("record"), "error": str(e)}

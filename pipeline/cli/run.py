@@ -72,6 +72,10 @@ def run(args):
         summary = simulate(motion, out, column=column, contact=contact, numerics=numerics,
                            window=args.window, rotate_deg=args.rotate, scale=args.scale,
                            back_azimuth=args.back_azimuth)
+    if not summary["simulated"]:
+        print(f"note: {summary['note']}")
+    elif not any(c["max_tilt_deg"] > 0.1 for c in summary["columns"]):
+        print("note: the motion did not make any column rock (max tilt below 0.1 deg)")
     for col in summary["columns"]:
         if col["toppled"]:
             print(f"{col['column']:>10}: toppled toward {col['downfall_azimuth_deg']:.0f} deg "

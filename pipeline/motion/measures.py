@@ -103,5 +103,7 @@ def displacement_directionality(disp):
     # half cycles: runs of one sign; count the runs that contain a big sample
     run_id = np.cumsum(np.r_[0, np.diff(np.sign(along)) != 0])
     pulses = len(np.unique(run_id[big]))
-    return {"disp_perp_ratio": float(np.max(np.abs(along)) / np.max(np.abs(across))),
+    across_peak = np.max(np.abs(across))
+    return {"disp_perp_ratio": float(np.max(np.abs(along)) / across_peak) if across_peak > 0
+            else None,
             "disp_pulses": int(pulses)}

@@ -218,6 +218,11 @@ def _motion_meta(source, row, info, back_azimuth, has_vertical):
     coords = {k: pick(k) for k in ("station_lat", "station_lon", "event_lat", "event_lon")}
     meta.update(coords)
     if None not in coords.values():
+        bad = [k for k, v in coords.items() if not (isinstance(v, (int, float)) and
+                                                    abs(v) <= (90 if k.endswith("lat") else 180))]
+        if bad:
+            raise InputError(f"{source.path.name}: coordinate(s) out of range: "
+                             + ", ".join(f"{k} {coords[k]}" for k in bad))
         dist_m, _, baz = gps2dist_azimuth(coords["event_lat"], coords["event_lon"],
                                           coords["station_lat"], coords["station_lon"])
         meta["back_azimuth_deg"] = float(baz % 360.0)

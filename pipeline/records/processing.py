@@ -7,9 +7,9 @@ which becomes the motion's ``meta["processing"]["steps"]`` provenance.
 
 Default: cut the record to its signal window (0.1-99.5 % of the Arias
 intensity of a high-passed copy, plus 5 s each side; exact zeros at the file's
-ends count as no data), demean, linear detrend, Hann taper of at most 2 s per
-end (inside those quiet margins), zeros where the window reaches beyond the
-data, zero-phase
+ends count as no data), demean, linear detrend, zeros where the window reaches
+beyond the data, Hann taper of at most 2 s per end (inside the 5 s margins, so
+it never touches the strong motion), zero-phase
 4-pole Butterworth band-pass from max(0.1 Hz, the record's lowest usable
 frequency) to min(25 Hz, its highest usable frequency, 0.8 x Nyquist) on a
 zero-padded copy (1.5 x corners / freqmin seconds each side, Boore & Bommer
@@ -34,8 +34,8 @@ DEFAULT_STEPS = (
                         "highpass_hz": 0.1}),
     ("demean", {}),
     ("detrend", {"type": "linear"}),
-    ("taper", {"max_percentage": 0.05, "max_length_s": 2.0, "type": "hann"}),
     ("pad_to_window", {}),
+    ("taper", {"max_percentage": 0.05, "max_length_s": 2.0, "type": "hann"}),
     ("bandpass", {"freqmin_hz": 0.1, "freqmax_hz": 25.0, "nyquist_fraction": 0.8,
                   "corners": 4, "pad": True}),
     ("integrate_baseline", {"max_power": 6}),

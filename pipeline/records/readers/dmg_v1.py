@@ -66,8 +66,13 @@ def _dmg_channel(lines, start, name, info):
                            header[3].upper())
     if start_time:
         month, day, year, hour, minute = (int(v) for v in start_time.groups()[:5])
-        trace.stats.starttime = UTCDateTime(2000 + year if year < 70 else 1900 + year,
-                                            month, day, hour, minute) + float(start_time.group(6))
+        try:
+            trace.stats.starttime = UTCDateTime(2000 + year if year < 70 else 1900 + year,
+                                                month, day, hour, minute) + \
+                float(start_time.group(6))
+        except ValueError:
+            raise InputError(f"{name}: impossible start time in the DMG V1 header: "
+                             f"{header[3].strip()[:60]!r}") from None
     station = re.search(r"STATION ID\.\s+(\S+)", header[4].upper())
     chan = re.search(r"CHAN\s+(\d+):\s*(\d+\s*DEG|UP|DOWN)", header[6].upper())
     if not chan:

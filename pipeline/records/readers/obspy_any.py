@@ -36,7 +36,11 @@ def read_obspy(path):
     if len(stations) > 1:
         raise InputError(f"{Path(path).name}: holds {len(stations)} stations or instruments; "
                          "give one record per file")
-    stream.merge(method=0)  # gaps become masked arrays, rejected later
+    try:
+        stream.merge(method=0)  # gaps become masked arrays, rejected later
+    except Exception as exc:   # obspy: e.g. one channel at two sampling rates
+        raise InputError(f"{Path(path).name}: cannot merge the traces of one channel "
+                         f"({str(exc).splitlines()[0][:120]})") from None
     info = {}
     for tr in stream:
         sac = tr.stats.get("sac")

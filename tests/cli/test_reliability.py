@@ -1,0 +1,371 @@
+"""Reliability: every bad input one line, no silent wrong result, no orphan, no open port."""
+import json
+import os
+import signal
+import subprocess
+import sys
+import threading
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+from obspy import Stream, Trace
+
+from pipeline import cli
+from pipeline.files import InputError
+from pipeline.motion import Motion
+from pipeline.motion.pulses import one_sine_pulse
+
+PROJECT = Path(__file__).resolve().parents[2]
+
+
+def wavelet(azimuth_deg, peak_disp=0.4, freq=0.5, width=1.5, rate=100.0, duration=12.0):
+    """(n, 3) acceleration of d(t) = D exp(-((t-t0)/w)^2) sin(2 pi f (t-t0)) along an azimuth:
+    a strong two-sided displacement pulse (no permanent offset), PGA ~ (2 pi f)^2 D."""
+    t = np.arange(0, duration, 1 / rate) - duration / 2
+    g = np.exp(-(t / width) ** 2)
+    gp, gpp = -2 * t / width ** 2 * g, (4 * t ** 2 / width ** 4 - 2 / width ** 2) * g
+    w = 2 * np.pi * freq
+    s, sp, spp = np.sin(w * t), w * np.cos(w * t), -w ** 2 * np.sin(w * t)
+    acc = peak_disp * (gpp * s + 2 * gp * sp + g * spp)
+    u = np.array([np.sin(np.radians(azimuth_deg)), np.cos(np.radians(azimuth_deg)), 0.0])
+    return acc[:, None] * u
+
+
+def write_mseed(path, azimuth_deg, amplitude=0.4, rate=100.0, nan=False, rates=None):
+    """A strong displacement pulse (``amplitude`` m) along ``azimuth_deg`` as MiniSEED."""
+    acc = wavelet(azimuth_deg, amplitude, rate=rate)
+    traces = []
+    for i, code in enumerate("ENZ"):
+        data = acc[:, i].copy()
+        if nan:
+            data[50] = np.nan
+        r = rates[i] if rates else rate
+        traces.append(Trace(data, header={"station": "T", "channel": f"HN{code}",
+                                          "sampling_rate": r}))
+    path.parent.mkdir(parents=True, exist_ok=True)
+    Stream(traces).write(str(path), format="MSEED")
+    return path
+
+
+def write_motion_npz(path, azimuth_deg=0.0, amplitude=5.0, duration=5.0, **meta):
+    m = one_sine_pulse(azimuth_deg, amplitude, duration=duration)
+    Motion(m.dt, m.acc, m.vel, m.disp, meta={"record_id": path.stem, **meta}).save(path)
+    return path
+
+
+def at2(path, header_line4):
+    path.write_text("PEER NGA STRONG MOTION DATABASE RECORD\nQuake, 1/1/2000, Sta, 90\n"
+                    "ACCELERATION TIME SERIES IN UNITS OF G\n" + header_line4 + "\n"
+                    + "\n".join(" 0.1 0.2 -0.1 0.0 0.05" for _ in range(170)) + "\n")
+    return path
+
+
+def bad_npz(path, **arrays):
+    np.savez(path, **arrays)
+    return path
+
+
+# ---------------------------------------------------------------- bad inputs, one line each
+def _two_rate_channel(d):
+    t1 = Trace(np.zeros(500), header={"station": "T", "channel": "HNE", "sampling_rate": 100.0})
+    t2 = Trace(np.zeros(500), header={"station": "T", "channel": "HNE", "sampling_rate": 50.0,
+                                      "starttime": t1.stats.endtime + 1})
+    Stream([t1, t2]).write(str(d / "rates.mseed"), format="MSEED")
+    return d / "rates.mseed"
+
+
+def _sac_bad_coordinates(d):
+    from obspy.io.sac import SACTrace
+    for ch, az, inc in (("HN1", 0.0, 90.0), ("HN2", 90.0, 90.0), ("HNZ", 0.0, 0.0)):
+        SACTrace(data=np.random.default_rng(0).standard_normal(1000).astype(np.float32),
+                 delta=0.01, kstnm="S", kcmpnm=ch, cmpaz=az, cmpinc=inc, stla=123.0, stlo=20.0,
+                 evla=41.0, evlo=20.0).write(str(d / f"s.{ch}.sac"))
+    return d / "s.*.sac"
+
+
+def _dmg_impossible_time(d):
+    from pipeline import RECORDS_DIR
+    import gzip
+    text = gzip.decompress((RECORDS_DIR / "ridgecrest2019/CI.CLC.V1.gz").read_bytes()).decode(
+        "latin-1")
+    lines = text.splitlines()
+    import re
+    lines[3] = re.sub(r"start time:\s*\d+/\d+/\d+", "Start time: 13/45/19", lines[3], flags=re.I)
+    (d / "bad.v1").write_text("\n".join(lines) + "\n", encoding="latin-1")
+    return d / "bad.v1"
+
+
+FILE_CASES = {
+    "missing file": (lambda d: d / "nothing.mseed", "no such file"),
+    "wrong format": (lambda d: (d / "junk.mseed").write_bytes(b"hello" * 100) and d / "junk.mseed",
+                     "junk.mseed"),
+    "NaN samples": (lambda d: write_mseed(d / "nan.mseed", 0.0, nan=True), "NaN"),
+    "one channel at two sampling rates": (_two_rate_channel, "rates.mseed"),
+    "components at different rates": (lambda d: write_mseed(d / "r.mseed", 0.0,
+                                                              rates=(100.0, 50.0, 100.0)),
+                                       "sampling rates"),
+    "AT2 DT = .": (lambda d: at2(d / "a.AT2", "NPTS=  850, DT= .    SEC"), "DT"),
+    "AT2 DT = 0": (lambda d: at2(d / "b.AT2", "NPTS=  850, DT=   0.0000 SEC"), "DT"),
+    "AT2 DT negative": (lambda d: at2(d / "c.AT2", "NPTS=  850, DT=  -0.0100 SEC"), "DT"),
+    "V1 header with an impossible start time": (_dmg_impossible_time, "start time"),
+    "SAC coordinates out of range": (_sac_bad_coordinates, "out of range"),
+    "npz with bad meta": (lambda d: bad_npz(d / "m.npz", dt=0.01, acc=np.zeros((10, 3)),
+                                            vel=np.zeros((10, 3)), disp=np.zeros((10, 3)),
+                                            meta=np.array("{not json")), "meta"),
+    "npz with 1-D arrays": (lambda d: bad_npz(d / "o.npz", dt=0.01, acc=np.zeros(10),
+                                              vel=np.zeros(10), disp=np.zeros(10),
+                                              meta=np.array("{}")), "(n, 3)"),
+    "npz with dt 0": (lambda d: bad_npz(d / "z.npz", dt=0.0, acc=np.zeros((10, 3)),
+                                        vel=np.zeros((10, 3)), disp=np.zeros((10, 3)),
+                                        meta=np.array("{}")), "dt"),
+}
+
+PARAMETER_CASES = {
+    "h/d zero": (["--hd", "0"], "--hd"), "h/d absurd": (["--hd", "1e6"], "--hd"),
+    "height NaN": (["--height", "nan"], "--height"), "drums 1000": (["--drums", "1000"], "--drums"),
+    "mu_s negative": (["--mu-s", "-0.1"], "--mu-s"),
+    "mu_k above mu_s": (["--mu-s", "0.5", "--mu-k", "0.6"], "mu_k"),
+    "kn zero": (["--kn", "0"], "--kn"), "damping 5": (["--damping", "5"], "--damping"),
+    "dt factor -1": (["--dt-factor", "-1"], "--dt-factor"),
+    "dt factor 0": (["--dt-factor", "0"], "--dt-factor"),
+    "dt factor NaN": (["--dt-factor", "nan"], "--dt-factor"),
+    "rim points 2": (["--rim-points", "2"], "--rim-points"),
+    "window not finite": (["--window", "0", "inf"], "--window"),
+    "window reversed": (["--window", "5", "2"], "--window"),
+    "scale negative": (["--scale", "-1"], "--scale"), "scale NaN": (["--scale", "nan"], "--scale"),
+    "rotate NaN": (["--rotate", "nan"], "--rotate"),
+    "back azimuth 400": (["--back-azimuth", "400"], "--back-azimuth"),
+    "back azimuth NaN": (["--back-azimuth", "nan"], "--back-azimuth"),
+}
+
+
+def _one_line_error(capsys, code, expected_code=2):
+    err = capsys.readouterr().err
+    assert code == expected_code, err
+    assert err.count("\n") == 1 and err.startswith("error: "), err
+    return err
+
+
+@pytest.mark.parametrize("case", sorted(FILE_CASES))
+def test_bad_record_file_one_line_and_nothing_written(tmp_path, case, capsys):
+    make, words = FILE_CASES[case]
+    path = make(tmp_path)
+    out = tmp_path / "out"
+    err = _one_line_error(capsys, cli.main(["records", str(path), "--out", str(out)]))
+    assert words.lower() in err.lower()
+    assert not out.exists()
+    err = _one_line_error(capsys, cli.main(["run", "--record", str(path), "--out",
+                                            str(tmp_path / "run")]))
+    assert not (tmp_path / "run").exists()
+
+
+@pytest.mark.parametrize("case", sorted(PARAMETER_CASES))
+def test_impossible_parameter_one_line_naming_the_option(tmp_path, case, capsys):
+    args, option = PARAMETER_CASES[case]
+    record = write_motion_npz(tmp_path / "pulse.npz")
+    out = tmp_path / "run"
+    err = _one_line_error(capsys, cli.main(["run", "--record", str(record), *args,
+                                            "--out", str(out)]))
+    assert option in err
+    assert not out.exists()
+
+
+def test_out_that_is_a_file_is_refused(tmp_path, capsys):
+    record = write_motion_npz(tmp_path / "pulse.npz")
+    blocker = tmp_path / "file"
+    blocker.write_text("x")
+    _one_line_error(capsys, cli.main(["run", "--record", str(record), "--out", str(blocker)]))
+    _one_line_error(capsys, cli.main(["campaign", "records", "--records", str(record),
+                                      "--out", str(blocker)]))
+    _one_line_error(capsys, cli.main(["records", str(record), "--out", str(blocker)]))
+    assert blocker.read_text() == "x"
+
+
+def test_long_record_needs_a_window(tmp_path, capsys):
+    m = one_sine_pulse(0.0, 0.1, duration=400.0, dt=0.05)
+    record = Motion(m.dt, m.acc, m.vel, m.disp, meta={"record_id": "long"}).save(
+        tmp_path / "long.npz")
+    err = _one_line_error(capsys, cli.main(["run", "--record", str(record), "--out",
+                                            str(tmp_path / "o")]))
+    assert "--window" in err
+
+
+def test_default_out_stays_inside_results(tmp_path, monkeypatch):
+    from pipeline.records import resolve
+    odd = tmp_path / "...mseed"
+    write_mseed(odd, 0.0)
+    assert resolve(odd).id not in ("", ".", "..")
+    assert "/" not in resolve(odd).id
+
+
+def test_failed_rerun_leaves_no_old_summary(tmp_path, monkeypatch):
+    from pipeline import simulate as sim
+    from pipeline.scenario import YadeError
+    record = write_motion_npz(tmp_path / "pulse.npz")
+    out = tmp_path / "run"
+    out.mkdir()
+    (out / "summary.json").write_text(json.dumps({"old": True}))
+
+    def failing(*args, **kwargs):
+        raise YadeError("boom")
+
+    monkeypatch.setattr(sim, "run_yade", failing)
+    with pytest.raises(YadeError):
+        sim.simulate(Motion.load(record), out)
+    assert not (out / "summary.json").exists()
+
+
+def test_result_files_follow_the_umask(tmp_path):
+    from pipeline.files import write_json
+    old = os.umask(0o022)
+    try:
+        write_json(tmp_path / "a.json", {"x": 1})
+    finally:
+        os.umask(old)
+    assert (tmp_path / "a.json").stat().st_mode & 0o777 == 0o644
+
+
+# ---------------------------------------------------------------- runs with YADE
+def yade_processes(under):
+    """pids of scene processes whose working directory lies under ``under``."""
+    found = []
+    for pid in filter(str.isdigit, os.listdir("/proc")):
+        try:
+            cmd = Path(f"/proc/{pid}/cmdline").read_bytes()
+            cwd = os.readlink(f"/proc/{pid}/cwd")
+        except OSError:
+            continue
+        if b"run_scene.py" in cmd and cwd.startswith(str(under)):
+            found.append(int(pid))
+    return found
+
+
+def cli_process(*args, cwd=PROJECT):
+    return subprocess.Popen([sys.executable, "-m", "pipeline", *args], cwd=cwd,
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+
+
+@pytest.mark.yade
+def test_same_stem_records_give_two_outcomes(tmp_path, capsys):
+    north = write_mseed(tmp_path / "a" / "rec.mseed", 0.0)
+    east = write_mseed(tmp_path / "b" / "rec.mseed", 90.0)
+    out = tmp_path / "camp"
+    assert cli.main(["campaign", "records", "--records", f"{north},{east}", "--out", str(out),
+                     "--jobs", "2", "--animations", "0"]) == 0
+    import pandas as pd
+    runs = pd.read_csv(out / "runs.csv")
+    mono = runs[runs["column"] == "monolithic"].set_index("record_id")
+    assert len(mono) == 2 and mono.index.nunique() == 2
+    axes = sorted(min(a % 180, 180 - a % 180) for a in mono["downfall_azimuth_deg"])
+    assert axes[0] < 15 and abs(axes[1] - 90) < 15      # one falls N-S, the other E-W
+
+
+@pytest.mark.yade
+def test_two_runs_into_one_directory(tmp_path):
+    record = write_motion_npz(tmp_path / "rocking.npz", amplitude=1.7, duration=40.0)
+    out = tmp_path / "run"
+    first = cli_process("run", "--record", str(record), "--column", "monolithic", "--out",
+                        str(out))
+    deadline = time.monotonic() + 30
+    while not yade_processes(out) and time.monotonic() < deadline:
+        time.sleep(0.05)
+    assert yade_processes(out), "the first run did not start YADE"
+    second = cli_process("run", "--record", str(record), "--out", str(out))
+    _, err = second.communicate(timeout=60)
+    assert second.returncode == 2 and err.count("\n") == 1 and "in use" in err
+    first.communicate(timeout=120)
+    assert first.returncode == 0
+    summary = json.loads((out / "summary.json").read_text())
+    assert [c["column"] for c in summary["columns"]] == ["monolithic"]
+
+
+def _campaign_records(tmp_path, n=4):
+    return ",".join(str(write_motion_npz(tmp_path / f"p{k}.npz", 45.0 * k)) for k in range(n))
+
+
+@pytest.mark.yade
+def test_ctrl_c_stops_a_campaign_within_two_seconds_and_resume_completes(tmp_path):
+    records, out = _campaign_records(tmp_path), tmp_path / "camp"
+    proc = cli_process("campaign", "records", "--records", records, "--out", str(out),
+                       "--jobs", "2", "--animations", "0")
+    deadline = time.monotonic() + 60
+    while not yade_processes(out) and time.monotonic() < deadline:
+        time.sleep(0.05)
+    assert yade_processes(out), "no YADE run started"
+    sent = time.monotonic()
+    proc.send_signal(signal.SIGINT)
+    proc.communicate(timeout=30)
+    assert time.monotonic() - sent < 2.0
+    assert proc.returncode == 130
+    assert (out / "runs.csv").exists()
+    assert not yade_processes(out)
+    assert json.loads((out / "campaign.json").read_text())["interrupted"] is True
+    assert cli.main(["campaign", "records", "--records", records, "--out", str(out),
+                     "--jobs", "2", "--animations", "0"]) == 0
+    assert len(list(out.glob("runs/*/summary.json"))) == 4
+
+
+@pytest.mark.yade
+def test_kill_9_leaves_no_yade_behind_and_resume_completes(tmp_path):
+    records, out = _campaign_records(tmp_path), tmp_path / "camp"
+    proc = cli_process("campaign", "records", "--records", records, "--out", str(out),
+                       "--jobs", "2", "--animations", "0")
+    deadline = time.monotonic() + 60
+    while not yade_processes(out) and time.monotonic() < deadline:
+        time.sleep(0.05)
+    assert yade_processes(out)
+    proc.kill()
+    proc.communicate(timeout=30)
+    deadline = time.monotonic() + 5
+    while yade_processes(out) and time.monotonic() < deadline:
+        time.sleep(0.05)
+    assert not yade_processes(out)
+    assert cli.main(["campaign", "records", "--records", records, "--out", str(out),
+                     "--jobs", "2", "--animations", "0"]) == 0
+    assert len(list(out.glob("runs/*/summary.json"))) == 4
+
+
+def listening_sockets():
+    """Inodes of listening TCP sockets on this machine (/proc/net/tcp, tcp6)."""
+    inodes = set()
+    for name in ("tcp", "tcp6"):
+        path = Path("/proc/net") / name
+        if path.exists():
+            for line in path.read_text().splitlines()[1:]:
+                fields = line.split()
+                if fields[3] == "0A":
+                    inodes.add(fields[9])
+    return inodes
+
+
+@pytest.mark.yade
+def test_a_run_opens_no_listening_socket(tmp_path, capsys):
+    before = listening_sockets()
+    record = write_motion_npz(tmp_path / "pulse.npz")
+    seen, done = set(), threading.Event()
+
+    def watch():
+        while not done.is_set():
+            seen.update(listening_sockets() - before)
+            time.sleep(0.05)
+
+    watcher = threading.Thread(target=watch)
+    watcher.start()
+    try:
+        assert cli.main(["run", "--record", str(record), "--out", str(tmp_path / "r")]) == 0
+    finally:
+        done.set()
+        watcher.join()
+    assert not seen
+
+
+@pytest.mark.yade
+def test_sub_threshold_motion_is_not_simulated_and_says_so(tmp_path, capsys):
+    record = write_motion_npz(tmp_path / "weak.npz", amplitude=0.2)
+    assert cli.main(["run", "--record", str(record), "--out", str(tmp_path / "r")]) == 0
+    assert "not simulated" in capsys.readouterr().out
+    summary = json.loads((tmp_path / "r" / "summary.json").read_text())
+    assert summary["simulated"] is False
+    assert not any(c["toppled"] for c in summary["columns"])
