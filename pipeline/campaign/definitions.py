@@ -82,8 +82,8 @@ def pulse_record():
 def column_outputs(name, size_by=None):
     """Outputs of a column campaign: runs.csv, impacts.csv, direction statistics, figures."""
 
-    def outputs(specs, campaign_dir, failures, animations):
-        from pipeline import figures
+    def outputs(specs, campaign_dir, failures, animations, figures=True):
+        from pipeline import figures as figure_module
         from pipeline.stats.circular import direction_statistics
         campaign_dir = Path(campaign_dir)
         runs, impacts = collect(specs, name, campaign_dir)
@@ -92,8 +92,9 @@ def column_outputs(name, size_by=None):
         written = []
         if not runs.empty:
             write_csv(campaign_dir / "direction_statistics.csv", direction_statistics(runs))
-            written = figures.campaign_figures(name, runs, impacts, campaign_dir, size_by,
-                                               animations)
+            if figures:
+                written = figure_module.campaign_figures(name, runs, impacts, campaign_dir,
+                                                         size_by, animations)
         toppled = runs.groupby("column")["toppled"].agg(["sum", "count"]) if not runs.empty \
             else None
         print(f"wrote {campaign_dir / 'runs.csv'}" + (
@@ -140,16 +141,16 @@ def synthetic_specs(records, campaign_dir):
     return column_specs([(str(p), twin()) for p in paths], campaign_dir)
 
 
-def synthetic_outputs(specs, campaign_dir, failures, animations):
+def synthetic_outputs(specs, campaign_dir, failures, animations, figures=True):
     from pipeline.figures.synthetic_map import plot_downfall_map
     from pipeline.motion.synthetics import rupture_centre
     from pipeline.stats.circular import direction_table
     from pipeline.stats.location import locate_source_from_falls
-    result = column_outputs("synthetic")(specs, campaign_dir, failures, animations)
+    result = column_outputs("synthetic")(specs, campaign_dir, failures, animations, figures)
     runs, _ = collect(specs, "synthetic", campaign_dir)
     if runs.empty or "source" not in runs.columns:
         return result
-    for source in sorted(runs["source"].dropna().unique()):
+    for source in sorted(runs["source"].dropna().unique()) if figures else []:
         path = Path(campaign_dir) / f"map_{source}.png"
         plot_downfall_map(runs, source, path)
         result["figures"].append(path.name)
@@ -176,7 +177,7 @@ def verification_specs(records, campaign_dir):
     return specs
 
 
-def verification_outputs(specs, campaign_dir, failures, animations):
+def verification_outputs(specs, campaign_dir, failures, animations, figures=True):
     from pipeline import verification
     from pipeline.figures.verification import plot_verification
     from pipeline.files import write_json
@@ -186,7 +187,8 @@ def verification_outputs(specs, campaign_dir, failures, animations):
         if path.exists():
             results.append((spec, json.loads(path.read_text())))
     summary = verification.summarise_campaign(results)
-    summary["figures"] = [p.name for p in plot_verification(results, campaign_dir)]
+    summary["figures"] = ([p.name for p in plot_verification(results, campaign_dir)]
+                          if figures else [])
     summary["failed_runs"] = [s["run_id"] for s, _ in failures]
     write_json(Path(campaign_dir) / "verification.json", summary)
     for line in summary["lines"]:
