@@ -284,12 +284,50 @@ def record_state():
         O.pause()    # the main thread writes the output once the loop has stopped
 
 
+def overturning_barrier(col):
+    """Smallest energy (J) that tips any stack of drums (k..top) of a column over its edge:
+    M g (sqrt((H/2)^2 + r^2) - H/2) for the stack of mass M and height H."""
+    n, r = (col["n_drums"] if col["kind"] == "drums" else 1), col["diameter"] / 2
+    h = col["height"] / n
+    m = col["density"] * math.pi * r * r * h
+    return min((n - k) * m * G * (math.hypot((n - k) * h / 2, r) - (n - k) * h / 2)
+               for k in range(n))
+
+
+BARRIERS = {col["name"]: overturning_barrier(col) for col in COLUMNS}
+SETTLED_FRACTION = 0.5   # after the motion: energy below half the barrier cannot topple
+
+
+def settled(rel):
+    """True when, after the motion, every body still stands (tilt < 30 deg) and no column
+    holds more than half the energy it needs to tip any stack over: energy only
+    decreases then, so no column can fall.  Scenes with a test block (verification) or a
+    column that has begun to fall never count as settled."""
+    energy = dict.fromkeys(BARRIERS, 0.0)
+    for b, s, c in zip(bodies, states, clumps):
+        if b["column"] not in BARRIERS:
+            return False
+        if (s.ori * body_offset[c] * Vector3(0, 0, 1))[2] < 0.866:     # tilted > 30 deg
+            return False
+        w = s.ori.conjugate() * s.angVel                               # clump frame
+        energy[b["column"]] += (0.5 * b["mass"] * (s.vel - rel).squaredNorm()
+                                + 0.5 * sum(s.inertia[i] * w[i] ** 2 for i in range(3))
+                                + b["mass"] * G * (s.pos[2] - b["initial_pos"][2]))
+    return all(energy[k] < SETTLED_FRACTION * BARRIERS[k] for k in BARRIERS)
+
+
 def check_stop():
     """Stop once the standing bodies rest and either the motion is over or every column
-    has fallen.  Bodies lying on the pedestal (tilt > 60 deg) may roll on: their impact
-    is recorded already and a rolling cylinder takes long to stop."""
+    has fallen, or once the motion is over and no column can topple any more (energy).
+    Bodies lying on the pedestal (tilt > 60 deg) may roll on: their impact is recorded
+    already and a rolling cylinder takes long to stop."""
     v_rest, length = REST_VELOCITY, REST_LENGTH
     rel = pedestal_state.vel
+    if BARRIERS and O.time > motion_end and settled(rel):
+        state["stopped_early"] = True
+        record_state()
+        O.pause()
+        return
     at_rest, fallen = True, {}
     for b, s, c in zip(bodies, states, clumps):
         lying = (s.ori * body_offset[c] * Vector3(0, 0, 1))[2] < 0.5
