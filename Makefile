@@ -35,6 +35,7 @@ run-all: campaigns
 	$(PY) -m pipeline report
 
 bench: setup
+	@$(PY) -c "import mujoco" 2>/dev/null || $(PY) -m pip install -q -e '.[bench]'
 	$(PY) bench/bench_yade.py
 
 clean:
