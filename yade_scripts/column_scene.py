@@ -295,12 +295,12 @@ def overturning_barrier(col):
 
 
 BARRIERS = {col["name"]: overturning_barrier(col) for col in COLUMNS}
-SETTLED_FRACTION = 0.5   # after the motion: energy below half the barrier cannot topple
+SETTLED_FRACTION = 0.9   # after the motion, energy below the barrier cannot tip a stack (10 % margin)
 
 
 def settled(rel):
     """True when, after the motion, every body still stands (tilt < 30 deg) and no column
-    holds more than half the energy it needs to tip any stack over: energy only
+    holds more than 90 % of the energy it needs to tip any stack over: energy only
     decreases then, so no column can fall.  Scenes with a test block (verification) or a
     column that has begun to fall never count as settled."""
     energy = dict.fromkeys(BARRIERS, 0.0)
