@@ -89,14 +89,15 @@ def content_hash(*parts):
 
 
 def code_hash(*packages):
-    """Hex digest (16 chars) of every ``*.py`` file under the named sub-packages of
-    :mod:`pipeline` (e.g. ``"scenario", "outcome"``) or project directories
-    (``"yade_scripts"``): a hash changes whenever the code of a stage changes."""
+    """Hex digest (16 chars) of every ``*.py`` file under the named sub-packages or
+    modules of :mod:`pipeline` (e.g. ``"scenario", "simulate"``), else of project
+    directories (``"yade_scripts"``): it changes whenever the code of a stage changes."""
     from pipeline import PROJECT_ROOT
     h = hashlib.sha256()
     for name in packages:
-        base = PROJECT_ROOT / name if (PROJECT_ROOT / name).is_dir() else \
-            PROJECT_ROOT / "pipeline" / name
+        package = PROJECT_ROOT / "pipeline" / name
+        base = package if package.is_dir() or package.with_suffix(".py").is_file() \
+            else PROJECT_ROOT / name
         paths = sorted(base.rglob("*.py")) if base.is_dir() else [base.with_suffix(".py")]
         if not paths or not all(p.is_file() for p in paths):
             raise FileNotFoundError(f"no code found for {name!r}")

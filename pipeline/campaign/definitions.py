@@ -127,10 +127,17 @@ register(Campaign(
          for mu in paper.FRICTION_MU_S], d),
     run_column_spec, column_outputs("friction", "mu_s")))
 
+
+def _nearsource_records():
+    from pipeline.records import sets
+    return sets.record_ids("nearsource")
+
+
 register(Campaign(
-    "records", "the twin model under every catalogued record",
+    "records", "the twin model under the paper's record selection (record set nearsource; "
+    "--set all / fema for the others)",
     lambda records, d: column_specs(
-        [(r, twin()) for r in _records_or(records, catalog()["id"])], d),
+        [(r, twin()) for r in (list(records) if records else _nearsource_records())], d),
     run_column_spec, column_outputs("records")))
 
 

@@ -5,6 +5,8 @@
 from pathlib import Path
 
 from pipeline import campaign
+from pipeline.files import InputError
+from pipeline.records import sets
 
 NAME = "campaign"
 ORDER = 40
@@ -22,6 +24,10 @@ def setup(p):
                        help="parallel single-thread YADE processes (default: all cores)")
         q.add_argument("--records", default=None, metavar="ID,ID",
                        help="comma-separated record ids or paths instead of the campaign's own")
+        if name != "verification":
+            q.add_argument("--set", dest="record_set", choices=sets.names(), default=None,
+                           help="the records of a record set instead of the campaign's own ("
+                           + "; ".join(f"{k}: {v}" for k, v in sets.SETS.items()) + ")")
         q.add_argument("--out", type=Path, default=None, metavar="DIR",
                        help=f"campaign directory (default results/{name})")
         q.add_argument("--animations", type=int, default=1,
@@ -30,6 +36,11 @@ def setup(p):
 
 def run(args):
     records = [r for r in args.records.split(",") if r] if args.records else None
+    record_set = getattr(args, "record_set", None)
+    if record_set:
+        if records:
+            raise InputError("give either --records or --set, not both")
+        records = sets.record_ids(record_set)
     campaign.run_campaign(args.name, jobs=args.jobs, records=records, campaign_dir=args.out,
                           animations=args.animations)
     return 0

@@ -7,21 +7,25 @@ from pipeline import RESULTS_DIR, files
 from pipeline.files import InputError
 from pipeline.motion import Motion
 from pipeline.motion.measures import record_parameters
-from pipeline.records import build_motion, catalog, resolve
+from pipeline.records import CACHE_DIR, build_motion, processed_motion, resolve, sets
 
 NAME = "records"
 ORDER = 10
 HELP = "process strong-motion records: npz, Table 1 (records.csv), figures"
-DESCRIPTION = ("Process strong-motion records (catalogue ids from records/catalog.csv or record "
-               "files: PEER AT2, DMG V1, ASDF, MiniSEED, SAC, ...) into <out>/<id>.npz, "
-               "records.csv (Table 1) and <id>.png.")
+DESCRIPTION = ("Process strong-motion records (catalogue ids from records/catalog.csv, a record "
+               "set, or record files: PEER AT2, DMG V1, ASDF, MiniSEED, SAC, ...) into "
+               "<out>/<id>.npz, records.csv (Table 1) and <id>.png.  Sets: " + "; ".join(
+                   f"{name}: {text}" for name, text in sets.SETS.items()) + ".")
 DEFAULT_OUT = RESULTS_DIR / "records"
 
 
 def setup(parser):
     parser.add_argument("records", nargs="*", metavar="ID_OR_PATH",
                         help="catalogue id (e.g. GM20) or record file")
-    parser.add_argument("--all", action="store_true", help="process every catalogued record")
+    parser.add_argument("--all", action="store_true",
+                        help="process every usable catalogued record (= --set all)")
+    parser.add_argument("--set", dest="record_set", choices=sets.names(), default=None,
+                        help="process a record set: " + ", ".join(sets.names()))
     parser.add_argument("--back-azimuth", type=float, metavar="DEG",
                         help="back azimuth (deg, [0, 360)) for files without coordinates")
     parser.add_argument("--out", type=Path, default=None,
@@ -45,10 +49,12 @@ def parameters_table(motions):
 
 def run(args):
     from pipeline.figures.records import plot_motion
-    specs = list(catalog()["id"]) if args.all else []
+    specs = sets.record_ids("all") if args.all else []
+    if args.record_set:
+        specs += [i for i in sets.record_ids(args.record_set) if i not in specs]
     specs += [spec for spec in args.records if spec not in specs]
     if not specs:
-        raise InputError("name records (ids or files) or use --all")
+        raise InputError("name records (ids or files) or use --all or --set NAME")
     if args.back_azimuth is not None and not 0.0 <= args.back_azimuth < 360.0:
         raise InputError(f"--back-azimuth {args.back_azimuth:g} not in [0, 360)")
     out_dir = args.out if args.out is not None else DEFAULT_OUT
@@ -73,8 +79,8 @@ def run(args):
             motions.append((record_id, current, out_path, False))
             print(f"{record_id}: up to date", flush=True)
         else:
-            motions.append((record_id, build_motion(source, args.back_azimuth, key), out_path,
-                            True))
+            motions.append((record_id, _motion(spec, source, args.back_azimuth, key, out_dir),
+                            out_path, True))
             print(f"{record_id}: processed", flush=True)
 
     for record_id, motion, out_path, fresh in motions:
@@ -87,6 +93,21 @@ def run(args):
     _update_table(Path(out_dir) / "records.csv", table)
     print(f"wrote {len(motions)} records to {out_dir}", flush=True)
     return 0
+
+
+def _motion(spec, source, back_azimuth, key, out_dir):
+    """The processed motion: through the content-keyed motion cache (results/cache/motions)
+    when the output lies inside results/, else from the cache if there, else built here."""
+    if _inside_results(out_dir):
+        return processed_motion(spec, back_azimuth)[0]
+    cached = _load_current(CACHE_DIR / f"{key}.npz", key)
+    return cached if cached is not None else build_motion(source, back_azimuth, key)
+
+
+def _inside_results(path):
+    results = RESULTS_DIR.resolve()
+    path = Path(path).resolve()
+    return path == results or results in path.parents
 
 
 def _load_current(path, key):

@@ -25,6 +25,7 @@ from pipeline.records.catalog import catalog, catalog_row
 from pipeline.records.readers import is_pattern, read_record
 
 CACHE_DIR = RESULTS_DIR / "cache" / "motions"
+SIDECARS = ("*.xml", "*.xml.gz", "event.json", "*.quakeml", "flatfile_rows.csv")
 __all__ = ["processed_motion", "resolve", "build_motion", "catalog", "catalog_row",
            "to_east_north_up", "CACHE_DIR"]
 
@@ -37,13 +38,21 @@ class Source:
         self.id, self.path, self.row, self.processed = record_id, Path(path), row, processed
 
     def input_files(self):
-        """Files the record depends on (AT2: the sibling AT2 files; a glob: its matches)."""
+        """Files the record depends on: the file (a glob: its matches; an NGA triplet
+        RSN<n>_k.AT2: its three files; another AT2: the sibling AT2 files) and the
+        metadata beside it (StationXML, event.json, QuakeML, flatfile_rows.csv)."""
         path = self.path
         if is_pattern(path):
-            return [Path(p) for p in sorted(glob.glob(str(path)))]
-        if path.suffix.lower() in (".at2", ".gz") and ".at2" in path.name.lower():
-            return sorted(p for p in path.parent.iterdir() if ".at2" in p.name.lower())
-        return [path]
+            files = [Path(p) for p in sorted(glob.glob(str(path)))]
+        elif ".at2" in path.name.lower():
+            triplet = re.match(r"(RSN\d+)_[123]\.AT2", path.name, re.I)
+            prefix = triplet.group(1).upper() + "_" if triplet else ""
+            files = sorted(p for p in path.parent.iterdir() if ".at2" in p.name.lower()
+                           and p.name.upper().startswith(prefix))
+        else:
+            files = [path]
+        sidecars = [p for pattern in SIDECARS for p in sorted(path.parent.glob(pattern))]
+        return files + [p for p in sidecars if p not in files]
 
     def key(self, back_azimuth=None, steps=processing.DEFAULT_STEPS):
         """Content key (16 hex) of everything the processed motion depends on."""
