@@ -40,6 +40,7 @@ CONTACT = P["contact"]                # kn (N/m per rim point), damping (ratio),
 PEDESTAL = P["pedestal"]              # thickness (m), contact_half_size (m)
 RIM_POINTS = P["rim_points"]          # contact spheres per rim
 RIM_R = P["rim_sphere_radius"]        # m
+RIM_PHASE_DEG = P.get("rim_phase_deg", 0.0)  # angular phase of the rim points (deg)
 DT_FACTOR = P["dt_factor"]            # dt = DT_FACTOR sqrt(m_min / (kn RIM_POINTS))
 DRIVE = P["drive"]                    # "inertial" (gravity table) or "kinematic"
 DRIVE_INTERVAL_S = P["drive_interval_s"]
@@ -91,7 +92,7 @@ def contact_material(mass, n_points):
 def rim_points(shape, n):
     """Contact points of a base outline in the body frame (x, y), metres."""
     if shape["shape"] == "cylinder":
-        ang = 2 * math.pi * np.arange(n) / n
+        ang = 2 * math.pi * np.arange(n) / n + math.radians(RIM_PHASE_DEG)
         return np.column_stack([shape["radius"] * np.cos(ang), shape["radius"] * np.sin(ang)])
     half_w, half_d = shape["width"] / 2, shape["depth"] / 2
     ys = np.linspace(-half_d, half_d, max(2, n // 2))

@@ -32,6 +32,8 @@ class Campaign:
     worker: Callable
     outputs: Callable
     label: str = "runs"
+    options: Callable = None       # options(parser): campaign-specific command-line options
+    read_options: Callable = None  # read_options(args) -> dict of keyword options for specs
 
 
 def register(campaign):
@@ -53,7 +55,7 @@ def names():
     return list(CAMPAIGNS)
 
 
-def run_campaign(name, jobs=None, records=None, campaign_dir=None, animations=1):
+def run_campaign(name, jobs=None, records=None, campaign_dir=None, animations=1, options=None):
     """Run (or resume) a campaign and write its outputs; return the outputs dict.
 
     Ctrl-C stops within seconds: no new run starts, running YADE processes end,
@@ -67,7 +69,7 @@ def run_campaign(name, jobs=None, records=None, campaign_dir=None, animations=1)
     campaign_dir = Path(campaign_dir or RESULTS_DIR / name)
     if campaign_dir.exists() and not campaign_dir.is_dir():
         raise InputError(f"--out {campaign_dir} is a file, not a directory")
-    specs = campaign.specs(records, campaign_dir)
+    specs = campaign.specs(records, campaign_dir, **(options or {}))
     with DirectoryLock(campaign_dir, wait=False):
         failures, interrupted = execute(specs, campaign_dir, jobs, campaign.worker,
                                         campaign.label)

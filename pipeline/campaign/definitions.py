@@ -1,4 +1,5 @@
 """The campaigns: the paper's experiments and the verification, one definition each."""
+import dataclasses
 import json
 from pathlib import Path
 
@@ -8,9 +9,11 @@ from pipeline.campaign.tables import collect
 from pipeline.files import InputError, code_hash, content_hash, write_csv
 from pipeline.motion import Motion
 from pipeline.records import catalog, catalog_row, processed_motion, resolve
-from pipeline.scenario import Column, Contact
+from pipeline.scenario import Column, Contact, Numerics
 from pipeline.simulate import simulate
 
+
+NUMERICS_FIELDS = {f.name for f in dataclasses.fields(Numerics)}
 
 # ---------------------------------------------------------------- column runs
 def run_code_version():
@@ -60,8 +63,9 @@ def run_column_spec(spec, run_dir):
                                                      ("hd", "height", "n_drums", "density")
                                                      if k in p})
     contact = Contact(**{k: p.pop(k) for k in ("kn", "damping", "mu_s", "mu_k") if k in p})
+    numerics = Numerics(**{k: p.pop(k) for k in list(p) if k in NUMERICS_FIELDS})
     simulate(Motion.load(spec["motion_file"]), run_dir, column=column, contact=contact,
-             record=spec["record_id"], motion_file=spec["motion_file"], **p)
+             numerics=numerics, record=spec["record_id"], motion_file=spec["motion_file"], **p)
 
 
 def twin(**params):
@@ -211,3 +215,6 @@ def _verification_worker(spec, run_dir):
 register(Campaign("verification", "Housner, one-sine pulse and sliding checks over ranges",
                   verification_specs, _verification_worker, verification_outputs,
                   label="verification runs"))
+
+
+from pipeline.campaign import ensemble  # noqa: E402,F401  (registers the ensemble campaign)

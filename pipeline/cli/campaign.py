@@ -32,6 +32,8 @@ def setup(p):
                        help=f"campaign directory (default results/{name})")
         q.add_argument("--animations", type=int, default=1,
                        help="number of toppled runs to animate as GIF (default 1)")
+        if definition.options:
+            definition.options(q)
 
 
 def run(args):
@@ -41,6 +43,8 @@ def run(args):
         if records:
             raise InputError("give either --records or --set, not both")
         records = sets.record_ids(record_set)
+    definition = campaign.get(args.name)
+    options = definition.read_options(args) if definition.read_options else {}
     campaign.run_campaign(args.name, jobs=args.jobs, records=records, campaign_dir=args.out,
-                          animations=args.animations)
+                          animations=args.animations, options=options)
     return 0

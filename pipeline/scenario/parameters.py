@@ -79,6 +79,9 @@ class Numerics:
     rim_points: int = param(16, "", "contact spheres per rim", 8, 128, "--rim-points")
     rim_sphere_radius: float = param(RIM_SPHERE_RADIUS_M, "m", "radius of the rim contact spheres",
                                      0.0, 0.05, low_open=True)
+    rim_phase_deg: float = param(0.0, "deg", "angular phase of the rim contact points "
+                                 "(ensembles sample it: discretisation becomes noise)",
+                                 -360.0, 360.0)
     verlet_distance: float = param(0.02, "m", "collider bound enlargement", 0.0, 1.0)
     dt_factor: float = param(0.3, "", "time step as a fraction of sqrt(m_min / (kn x rim "
                              "points)); converged up to 0.3 (make bench)", 0.0, 0.5,

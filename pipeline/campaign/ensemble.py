@@ -1,0 +1,215 @@
+"""The ``ensemble`` campaign: probabilities instead of single runs.
+
+N members of one record and column model whose uncertain inputs are sampled
+reproducibly (scipy.stats.qmc Latin hypercube, the seed recorded), plus the
+nominal run with the paper's values.  Outputs per record: ``ensemble_summary.json``
+(toppling probability with its Wilson interval, mean downfall azimuth with a
+bootstrap interval, fractions toward / away from / across the epicentre),
+``members.csv`` and figures (rose with the circular density, impact times).
+
+Ranges (``ENSEMBLE_RANGES``, all around the paper's values; override with
+``--vary NAME=LO,HI``):
+
+- ``mu_s`` 0.55-0.85: marble on marble; Hinzen (2009) used 0.7, DEM studies of
+  classical marble columns use values in this band; mu_k = 0.84 mu_s (the
+  paper's ratio) unless given;
+- ``damping`` 0.2-0.5 around the paper's 0.36;
+- ``kn_factor`` 0.5-2 (log-uniform) on the paper's 1.2e8 N/m per point: the
+  rocking response changes < 0.5 % for kn 1.2e7-1.2e9 (measured on the block);
+- ``height_tolerance`` and ``diameter_tolerance`` +-1 % of the nominal column
+  (masonry tolerances of cut drums; real geometry: issue "Real columns");
+- ``rim_phase_deg`` 0 to one rim spacing: the rim discretisation moves a fall by
+  up to ~12 deg (make bench); sampling its phase turns that bias into noise;
+- ``scale`` (off by default): an amplitude scaling of the motion.
+
+Not yet sampled: an initial out-of-plumb tilt and drum offsets (they need the
+column description of the "Real columns" issue).
+"""
+import math
+from pathlib import Path
+
+import numpy as np
+from scipy.stats import qmc
+
+from pipeline import paper
+from pipeline.campaign import Campaign, register
+from pipeline.campaign.definitions import column_specs, run_code_version, run_column_spec
+from pipeline.campaign.tables import collect
+from pipeline.files import InputError, write_csv, write_json
+
+DEFAULT_MEMBERS = 16
+DEFAULT_SEED = 20091001        # BSSA 99(5), October 2009
+ENSEMBLE_RANGES = {            # name: (low, high, "uniform" | "log")
+    "mu_s": (0.55, 0.85, "uniform"),
+    "damping": (0.2, 0.5, "uniform"),
+    "kn_factor": (0.5, 2.0, "log"),
+    "height_tolerance": (-0.01, 0.01, "uniform"),
+    "diameter_tolerance": (-0.01, 0.01, "uniform"),
+    "rim_phase_deg": (0.0, 360.0 / 16, "uniform"),
+}
+
+
+def sample_members(members, seed, ranges=None, column="both", mu_k_ratio=paper.MU_K_OVER_MU_S):
+    """Parameters of ``members`` runs (list of dicts for run_column_spec), Latin hypercube."""
+    ranges = dict(ENSEMBLE_RANGES if ranges is None else ranges)
+    if not (isinstance(members, int) and 1 <= members <= 10000):
+        raise InputError(f"--members must be an integer in [1, 10000], got {members!r}")
+    names = sorted(ranges)
+    unit = qmc.LatinHypercube(d=len(names), seed=seed).random(members)
+    rows = []
+    for u in unit:
+        v = {}
+        for name, x in zip(names, u):
+            lo, hi, kind = ranges[name]
+            v[name] = float(math.exp(math.log(lo) + x * (math.log(hi) - math.log(lo)))
+                            if kind == "log" else lo + x * (hi - lo))
+        height = paper.COLUMN_HEIGHT_M * (1 + v.get("height_tolerance", 0.0))
+        diameter = paper.COLUMN_HEIGHT_M / paper.COLUMN_HD * (1 + v.get("diameter_tolerance", 0.0))
+        mu_s = round(v.get("mu_s", paper.MU_STATIC), 6)
+        params = {"column": column, "hd": round(height / diameter, 6), "height": round(height, 6),
+                  "mu_s": mu_s, "mu_k": round(mu_k_ratio * mu_s, 6),
+                  "damping": round(v.get("damping", paper.DAMPING_RATIO), 6),
+                  "kn": round(paper.COLUMN_KN_N_M * v.get("kn_factor", 1.0), 1),
+                  "rim_phase_deg": round(v.get("rim_phase_deg", 0.0), 6)}
+        if "scale" in v:
+            params["scale"] = round(v["scale"], 6)
+        rows.append(params)
+    return rows
+
+
+def nominal(column="both"):
+    return {"column": column, "hd": paper.COLUMN_HD, "mu_s": paper.MU_STATIC,
+            "mu_k": paper.MU_KINETIC}
+
+
+def ensemble_specs(records, campaign_dir, record=None, column="both", members=DEFAULT_MEMBERS,
+                   seed=DEFAULT_SEED, vary=None, **_):
+    records = list(records or []) + ([record] if record else [])
+    if not records:
+        raise InputError("campaign ensemble needs --record ID_OR_FILE (or --records/--set)")
+    if column not in ("both", "monolithic", "drums"):
+        raise InputError(f"--column must be both, monolithic or drums, got {column!r}")
+    ranges = dict(ENSEMBLE_RANGES, **(vary or {}))
+    member_params = sample_members(members, seed, ranges, column)
+    runs = []
+    for rec in records:
+        runs.append((rec, nominal(column)))
+        runs += [(rec, p) for p in member_params]
+    specs = column_specs(runs, campaign_dir)
+    per_record = members + 1
+    for k, spec in enumerate(specs):
+        spec["member"] = (k % per_record) - 1          # -1: the nominal run
+        spec["seed"] = seed
+    return specs
+
+
+def ensemble_outputs(specs, campaign_dir, failures, animations, figures=True):
+    from pipeline.figures.ensemble import plot_ensemble
+    campaign_dir = Path(campaign_dir)
+    runs, _ = collect(specs, "ensemble", campaign_dir)
+    if runs.empty:
+        return {"code_version": run_code_version(), "figures": []}
+    member_of = {s["run_id"]: s["member"] for s in specs}
+    runs.insert(1, "member", runs["run_id"].map(member_of))
+    records = list(dict.fromkeys(runs["record_id"]))
+    summaries, written = [], []
+    for record_id in records:
+        out = campaign_dir if len(records) == 1 else campaign_dir / record_id
+        sub = runs[runs["record_id"] == record_id].sort_values(["member", "column"])
+        write_csv(out / "members.csv", sub)
+        summary = summarise(sub, record_id, specs[0]["seed"])
+        write_json(out / "ensemble_summary.json", summary)
+        summaries.append(summary)
+        if figures:
+            written += plot_ensemble(sub, summary, out)
+        for col in summary["columns"]:
+            az = col["mean_downfall_azimuth_deg"]
+            print(f"{record_id} {col['column']:>10}: P(toppled) {col['p_toppled']:.2f} "
+                  f"[{col['p_toppled_ci95'][0]:.2f}, {col['p_toppled_ci95'][1]:.2f}]"
+                  + ("" if az is None else f", mean downfall {az:.0f} deg "
+                     f"(R {col['resultant_length']:.2f})"))
+    if len(records) > 1:
+        write_json(campaign_dir / "ensemble_summaries.json", summaries)
+    return {"code_version": run_code_version(),
+            "figures": [str(Path(p).relative_to(campaign_dir)) for p in written]}
+
+
+def summarise(runs, record_id, seed):
+    """``ensemble_summary.json`` content of one record (see the module docstring)."""
+    from pipeline.stats.circular import circular_summary
+    from pipeline.stats.ensemble import (bootstrap_mean_azimuth_ci, direction_fractions,
+                                         wilson_interval)
+    back = runs["back_azimuth_deg"].dropna()
+    back = float(back.iloc[0]) if len(back) else None
+    members = runs[runs["member"] >= 0]
+    columns = []
+    for column, group in members.groupby("column", sort=True):
+        fell = group[group["toppled"].astype(bool)]
+        az = fell["downfall_azimuth_deg"].to_numpy(float)
+        stats = circular_summary(az)
+        nominal_row = runs[(runs["member"] == -1) & (runs["column"] == column)]
+        nominal_az = (None if nominal_row.empty or not np.isfinite(
+            nominal_row["downfall_azimuth_deg"].iloc[0]) else
+            float(nominal_row["downfall_azimuth_deg"].iloc[0]))
+        columns.append({
+            "column": column, "members": int(len(group)), "toppled": int(len(fell)),
+            "p_toppled": float(len(fell) / len(group)),
+            "p_toppled_ci95": wilson_interval(len(fell), len(group)),
+            "mean_downfall_azimuth_deg": None if not len(fell) or not np.isfinite(
+                stats["mean_deg"]) else stats["mean_deg"],
+            "resultant_length": None if not len(fell) else stats["resultant_length"],
+            "mean_azimuth_ci95_deg": bootstrap_mean_azimuth_ci(az),
+            **direction_fractions(az, back),
+            "nominal_toppled": None if nominal_row.empty else bool(
+                nominal_row["toppled"].iloc[0]),
+            "nominal_downfall_azimuth_deg": nominal_az,
+            "impact_time_s_median": None if not len(fell) else float(
+                np.median(fell["impact_time_s"]))})
+    return {"record": record_id, "members": int(members["member"].nunique()), "seed": seed,
+            "back_azimuth_deg": back, "columns": columns}
+
+
+def ensemble_options(parser):
+    parser.add_argument("--record", metavar="ID_OR_FILE", default=None,
+                        help="catalogue id, record file or processed .npz")
+    parser.add_argument("--column", choices=("both", "monolithic", "drums"), default="both",
+                        help="column model (default both: the twin model)")
+    parser.add_argument("--members", type=int, default=DEFAULT_MEMBERS,
+                        help=f"ensemble members per record (default {DEFAULT_MEMBERS})")
+    parser.add_argument("--seed", type=int, default=DEFAULT_SEED,
+                        help=f"seed of the Latin hypercube (default {DEFAULT_SEED})")
+    parser.add_argument("--vary", action="append", default=[], metavar="NAME=LO,HI",
+                        help="override a range: " + ", ".join(
+                            f"{k} {v[0]:g}-{v[1]:g}" for k, v in ENSEMBLE_RANGES.items())
+                        + "; scale=LO,HI samples an amplitude scaling")
+
+
+def parse_vary(items):
+    ranges = {}
+    for item in items or []:
+        name, _, values = item.partition("=")
+        try:
+            lo, hi = (float(v) for v in values.split(","))
+        except ValueError:
+            raise InputError(f"--vary {item!r}: expected NAME=LO,HI") from None
+        if name not in ENSEMBLE_RANGES and name != "scale":
+            raise InputError(f"--vary: unknown parameter {name!r} (known: "
+                             f"{', '.join(ENSEMBLE_RANGES)}, scale)")
+        if not (math.isfinite(lo) and math.isfinite(hi) and lo <= hi):
+            raise InputError(f"--vary {item!r}: need finite LO <= HI")
+        kind = ENSEMBLE_RANGES.get(name, (0, 0, "uniform"))[2]
+        if kind == "log" and lo <= 0:
+            raise InputError(f"--vary {item!r}: {name} is sampled log-uniformly: LO > 0")
+        ranges[name] = (lo, hi, kind)
+    return ranges
+
+
+def read_options(args):
+    return {"record": args.record, "column": args.column, "members": args.members,
+            "seed": args.seed, "vary": parse_vary(args.vary)}
+
+
+register(Campaign("ensemble", "N members with sampled friction, damping, stiffness, "
+                  "geometry tolerances and rim phase: probabilities of toppling and direction",
+                  ensemble_specs, run_column_spec, ensemble_outputs, label="members",
+                  options=ensemble_options, read_options=read_options))
