@@ -9,11 +9,11 @@ from pathlib import Path
 from xml.sax.saxutils import quoteattr
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
 from pipeline.figures.style import COLUMN_COLOURS, figure
 from pipeline.files import InputError, atomic_path, write_text
 from pipeline.outcome import Trajectory
+from pipeline.outcome.columns import rotations
 from pipeline.scenario import PEDESTAL
 
 CIRCLE_SEGMENTS = 24
@@ -44,7 +44,7 @@ def body_surface(body, centre, quat_wxyz):
         w, d = body["width"] / 2, body["depth"] / 2
         ring = np.array([[-w, -d], [w, -d], [w, d], [-w, d]])
     local = np.stack([np.column_stack([ring, np.full(len(ring), z)]) for z in (-h, h)])
-    rot = Rotation.from_quat(np.asarray(quat_wxyz, float)[[1, 2, 3, 0]])
+    rot = rotations(quat_wxyz)
     return rot.apply(local.reshape(-1, 3)).reshape(local.shape) + np.asarray(centre, float)
 
 

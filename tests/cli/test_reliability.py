@@ -285,8 +285,8 @@ def _campaign_records(tmp_path, n=4):
     return ",".join(str(write_motion_npz(tmp_path / f"p{k}.npz", 45.0 * k)) for k in range(n))
 
 
-@pytest.mark.yade
-def test_ctrl_c_stops_a_campaign_within_two_seconds_and_resume_completes(tmp_path):
+def start_campaign_and_wait_for_yade(tmp_path):
+    """(records, campaign dir, CLI process) of a 4-run campaign once YADE runs."""
     records, out = _campaign_records(tmp_path), tmp_path / "camp"
     proc = cli_process("campaign", "records", "--records", records, "--out", str(out),
                        "--jobs", "2", "--animations", "0")
@@ -294,6 +294,18 @@ def test_ctrl_c_stops_a_campaign_within_two_seconds_and_resume_completes(tmp_pat
     while not yade_processes(out) and time.monotonic() < deadline:
         time.sleep(0.05)
     assert yade_processes(out), "no YADE run started"
+    return records, out, proc
+
+
+def resume_completes(records, out):
+    assert cli.main(["campaign", "records", "--records", records, "--out", str(out),
+                     "--jobs", "2", "--animations", "0"]) == 0
+    assert len(list(out.glob("runs/*/summary.json"))) == 4
+
+
+@pytest.mark.yade
+def test_ctrl_c_stops_a_campaign_within_two_seconds_and_resume_completes(tmp_path):
+    records, out, proc = start_campaign_and_wait_for_yade(tmp_path)
     sent = time.monotonic()
     proc.send_signal(signal.SIGINT)
     proc.communicate(timeout=30)
@@ -302,29 +314,19 @@ def test_ctrl_c_stops_a_campaign_within_two_seconds_and_resume_completes(tmp_pat
     assert (out / "runs.csv").exists()
     assert not yade_processes(out)
     assert json.loads((out / "campaign.json").read_text())["interrupted"] is True
-    assert cli.main(["campaign", "records", "--records", records, "--out", str(out),
-                     "--jobs", "2", "--animations", "0"]) == 0
-    assert len(list(out.glob("runs/*/summary.json"))) == 4
+    resume_completes(records, out)
 
 
 @pytest.mark.yade
 def test_kill_9_leaves_no_yade_behind_and_resume_completes(tmp_path):
-    records, out = _campaign_records(tmp_path), tmp_path / "camp"
-    proc = cli_process("campaign", "records", "--records", records, "--out", str(out),
-                       "--jobs", "2", "--animations", "0")
-    deadline = time.monotonic() + 60
-    while not yade_processes(out) and time.monotonic() < deadline:
-        time.sleep(0.05)
-    assert yade_processes(out)
+    records, out, proc = start_campaign_and_wait_for_yade(tmp_path)
     proc.kill()
     proc.communicate(timeout=30)
     deadline = time.monotonic() + 5
     while yade_processes(out) and time.monotonic() < deadline:
         time.sleep(0.05)
     assert not yade_processes(out)
-    assert cli.main(["campaign", "records", "--records", records, "--out", str(out),
-                     "--jobs", "2", "--animations", "0"]) == 0
-    assert len(list(out.glob("runs/*/summary.json"))) == 4
+    resume_completes(records, out)
 
 
 def listening_sockets():

@@ -65,12 +65,16 @@ def read_record(path, key=None):
 def read_bytes(path):
     """The file's bytes, gunzipped when it is gzip-compressed."""
     path = Path(path)
-    raw = path.read_bytes()
+    try:
+        raw = path.read_bytes()
+    except OSError as exc:
+        raise InputError(f"{path.name}: cannot read ({exc.strerror or exc})") from None
     if raw[:2] == b"\x1f\x8b":
         try:
             raw = gzip.decompress(raw)
         except (OSError, EOFError) as exc:
-            raise InputError(f"{path.name}: broken gzip file ({exc})") from None
+            raise InputError(f"{path.name}: broken gzip file ({str(exc).splitlines()[0]})") \
+                from None
     return raw
 
 

@@ -4,33 +4,15 @@ mseed_stationxml): transparent gzip, fixed-width numbers, one-line errors.
 Files may be stored gzip-compressed (``<name>.gz``): gzip is recognised by its
 magic bytes 1f 8b, not by the name.
 """
-import gzip
 import math
 import re
-from pathlib import Path
 
 import numpy as np
 
 from pipeline.files import InputError
 
-GZIP_MAGIC = b"\x1f\x8b"
-STANDARD_GRAVITY = 9.80665  # m/s^2 per g (unit conversion of records in g)
-VERTICAL_UP, VERTICAL_DOWN = -90.0, 90.0  # SEED dip of an up- / down-positive sensor
-
-
-def read_bytes(path):
-    """The bytes of ``path``, gunzipped when the file starts with the gzip magic bytes."""
-    path = Path(path)
-    try:
-        raw = path.read_bytes()
-    except OSError as exc:
-        raise InputError(f"{path.name}: cannot read ({exc.strerror or exc})") from None
-    if raw[:2] == GZIP_MAGIC:
-        try:
-            raw = gzip.decompress(raw)
-        except (OSError, EOFError) as exc:
-            raise InputError(f"{path.name}: broken gzip file ({one_line(exc)})") from None
-    return raw
+from pipeline.constants import STANDARD_GRAVITY  # noqa: F401  (used by the readers)
+from pipeline.records.readers import VERTICAL_DOWN, VERTICAL_UP, read_bytes  # noqa: F401
 
 
 def open_text(path):
