@@ -17,10 +17,10 @@ def figure(**kwargs):
     return fig
 
 
-def new_figure(nrows=1, ncols=1, subplot_kw=None, **kwargs):
+def new_figure(nrows=1, ncols=1, subplot_kw=None, squeeze=True, **kwargs):
     """(figure, axes) like pyplot.subplots, object-oriented."""
     fig = figure(**kwargs)
-    return fig, fig.subplots(nrows, ncols, subplot_kw=subplot_kw)
+    return fig, fig.subplots(nrows, ncols, subplot_kw=subplot_kw, squeeze=squeeze)
 
 
 def colour(column, k=0):
