@@ -13,7 +13,7 @@ import numpy as np
 import pandas as pd
 from matplotlib import colormaps
 from matplotlib.colors import Normalize
-from matplotlib.ticker import LogLocator, NullFormatter, ScalarFormatter
+from matplotlib.ticker import LogLocator, MaxNLocator, NullFormatter, ScalarFormatter
 
 from pipeline import files
 from pipeline.constants import MODEL_GRAVITY
@@ -202,11 +202,12 @@ def plot_rose(runs, path):
         counts = _rose(ax, sub["downfall_azimuth_deg"].to_numpy(float), COLUMN_COLOURS[column],
                        "downfall azimuth")
         rmax = max(1, int(counts.max(initial=0)))
-        bazs = np.unique(runs.loc[runs["column"] == column, "back_azimuth_deg"].dropna())
+        bazs = np.unique(sub["back_azimuth_deg"].dropna())      # of the toppled runs only
         for j, baz in enumerate(bazs):
-            ax.plot([np.deg2rad(baz)] * 2, [0, rmax], "k--", lw=0.9,
-                    label="back azimuth" if j == 0 else None)
+            ax.plot([np.deg2rad(baz)] * 2, [0, rmax], "--", color="0.35", lw=0.7,
+                    label="back azimuth of a toppled run" if j == 0 else None)
         ax.set_rmax(rmax)
+        ax.yaxis.set_major_locator(MaxNLocator(integer=True, nbins=4))
         stats = circular_summary(sub["downfall_azimuth_deg"])
         ax.set_title(f"{COLUMN_LABELS[column]}: downfall azimuth\n"
                      f"n = {stats['n']}, mean = {stats['mean_deg']:.0f}°, "
@@ -222,6 +223,7 @@ def plot_rose(runs, path):
                        COLUMN_LABELS[column], bottom=bottom)
         bottom = counts if bottom is None else bottom + counts
     ax.set_title("downfall minus back azimuth\n(0° = falls towards the epicentre)", fontsize=10)
+    ax.yaxis.set_major_locator(MaxNLocator(integer=True, nbins=4))
     ax.legend(fontsize=7, loc="lower left", bbox_to_anchor=(-0.15, -0.15))
     fig.suptitle(f"Downfall directions ({len(toppled)} toppled of {len(runs)} column runs; "
                  "counts per 15° bin)")
