@@ -5,7 +5,7 @@ PY := .venv/bin/python
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 JOBS ?= $(shell nproc)
 
-.PHONY: setup test run-all records campaigns bench clean
+.PHONY: setup test run-all records campaigns bench clean invert-demo
 
 setup: .venv/.installed
 	@command -v yade >/dev/null || { echo "installing YADE (apt-get install yade)"; \
@@ -37,6 +37,10 @@ run-all: campaigns
 bench: setup
 	@$(PY) -c "import mujoco" 2>/dev/null || $(PY) -m pip install -q -e '.[bench]'
 	$(PY) bench/bench_yade.py
+
+invert-demo: setup
+	$(PY) -m pipeline invert --demo --grid $(or $(INVERT_GRID),demo) --jobs $(JOBS) $(INVERT_ARGS)
+	$(PY) -m pipeline report
 
 clean:
 	rm -rf results/*/ results/REPORT.md

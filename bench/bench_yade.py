@@ -296,20 +296,79 @@ def plot_convergence(rows, path):
 
 
 # ---------------------------------------------------------------- 6. parallel runs
-def parallel(work, n_runs, t_max):
+def parallel_run(spec, run_dir):
+    """Campaign worker of the parallel bench: the twin model under the spec's pulse for
+    exactly ``t_max`` s (no early stop); summary.json holds YADE's wall time."""
+    traj = run_yade(prepare(run_dir, "both", Motion.load(spec["motion_file"]), spec["t_max"]))
+    write_json(Path(run_dir) / "summary.json", {"wall_s": traj.wall_s})
+
+
+def noop_run(spec, run_dir):
+    """A campaign worker that runs nothing: the executor's own cost per task."""
+    write_json(Path(run_dir) / "summary.json", {"run_id": spec["run_id"]})
+
+
+def parallel(work, n_runs, t_max, n_noop=40):
     """Runs per minute of ``n_runs`` twin-model pulse runs (azimuths 0, 30, ... deg,
-    ``t_max`` s each, start-up included) with 1 and 2 YADE processes at once."""
-    out = {"runs": n_runs, "t_max_s": t_max, "load_average_before": os.getloadavg()[0]}
+    ``t_max`` s each, YADE start-up included) through the campaign executor's Dask path,
+    a LocalCluster of 1 and 2 single-threaded worker processes on 127.0.0.1
+    (``jobs_1``, ``jobs_2``; each task carries its motion and returns the run's files,
+    trajectory included), the same runs with the thread executor for comparison
+    (``threads_jobs_N``), and Dask's overheads: the cluster's start-up until its workers
+    have imported what a campaign's worker imports (``cluster_startup_s``, not in the
+    runs per minute), its closing (``cluster_close_s``) and the wall time per task of
+    ``n_noop`` tasks that run no YADE on one worker (``task_overhead_ms``)."""
+    import importlib
+
+    from distributed import Client
+
+    from pipeline.campaign.executor import WORKER_CODE, close_dask, local_cluster, run_task
+    from pipeline.files import code_hash
+    out = {"runs": n_runs, "t_max_s": t_max, "executor": "dask",
+           "load_average_before": os.getloadavg()[0]}
+    motions = [one_sine_pulse(30.0 * k, PULSE["amplitude"], PULSE["period"], t_max).save(
+        work / f"parallel_motion_{k}.npz") for k in range(n_runs)]
+    specs = [{"run_id": f"parallel_{k}", "motion_file": str(m), "t_max": t_max}
+             for k, m in enumerate(motions)]
+    code = code_hash(*WORKER_CODE)
     for jobs in (1, 2):
-        dirs = [prepare(work / f"parallel{jobs}_{k}", "both",
-                        one_sine_pulse(30.0 * k, PULSE["amplitude"], PULSE["period"], t_max),
-                        t_max) for k in range(n_runs)]
+        start = time.perf_counter()
+        cluster = local_cluster(jobs)
+        client = Client(cluster)
+        client.run(importlib.import_module, "pipeline.campaign.definitions")   # as a campaign
+        startup = time.perf_counter() - start
+        try:
+            if jobs == 1:
+                start = time.perf_counter()
+                client.gather([client.submit(run_task, noop_run, dict(specs[0], run_id=str(k)),
+                                             motions[0].read_bytes(), "/bench", code, "bench",
+                                             pure=False) for k in range(n_noop)])
+                out["task_overhead_ms"] = 1e3 * (time.perf_counter() - start) / n_noop
+            start = time.perf_counter()
+            results = client.gather([client.submit(run_task, parallel_run, spec,
+                                                   Path(spec["motion_file"]).read_bytes(),
+                                                   str(work / spec["run_id"]), code, "bench",
+                                                   pure=False) for spec in specs])
+            wall = time.perf_counter() - start
+        finally:
+            start = time.perf_counter()
+            close_dask(client, cluster)                 # as a campaign closes it
+            close = time.perf_counter() - start
+        failed = [r["message"] for r in results if r["error"]]
+        if failed:
+            raise RuntimeError(f"parallel bench: {failed[0]}")
+        out[f"jobs_{jobs}"] = {"wall_s": wall, "runs_per_minute": 60.0 * n_runs / wall,
+                               "cluster_startup_s": startup, "cluster_close_s": close}
+        dirs = [prepare(work / f"parallel_threads{jobs}_{k}", "both", Motion.load(m), t_max)
+                for k, m in enumerate(motions)]
         start = time.perf_counter()
         with ThreadPoolExecutor(max_workers=jobs) as pool:
             list(pool.map(run_yade, dirs))
         wall = time.perf_counter() - start
-        out[f"jobs_{jobs}"] = {"wall_s": wall, "runs_per_minute": 60.0 * n_runs / wall}
+        out[f"threads_jobs_{jobs}"] = {"wall_s": wall, "runs_per_minute": 60.0 * n_runs / wall}
     out["scaling_2_vs_1"] = out["jobs_2"]["runs_per_minute"] / out["jobs_1"]["runs_per_minute"]
+    out["threads_scaling_2_vs_1"] = (out["threads_jobs_2"]["runs_per_minute"]
+                                     / out["threads_jobs_1"]["runs_per_minute"])
     return out
 
 

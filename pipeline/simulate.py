@@ -37,14 +37,31 @@ PRECHECK_MARGIN = 0.9   # skip YADE only below 90 % of the rigid-block threshold
 
 
 def can_move(drive, columns, contact):
-    """False when no body can rock or slide at any sample (rigid-block statics): the
-    horizontal acceleration stays below (g + a_up) min(tan alpha, mu_s) x margin, alpha
-    the slenderest column's d/h (a stack above any drum is stockier than the whole)."""
-    tan_alpha = min(c["diameter"] / c["height"] for c in columns)
+    """False when no body can rock or slide at any sample (rigid-body statics): the
+    horizontal acceleration stays below (g + a_up) min(uplift ratio, mu_s) x margin.
+
+    A column's uplift ratio (``params.json`` columns[].uplift_ratio, from
+    :mod:`pipeline.scenario.geometry`) is the smallest, over its joints, of the
+    horizontal distance from the rocking edge to the centre of mass of the stack above
+    over that centre's height: d/h for a cylinder; lower for a heavy wide capital."""
+    tan_alpha = min(c["uplift_ratio"] for c in columns)
     effective_g = MODEL_GRAVITY + drive.acc[:, 2]
     horizontal = np.hypot(drive.acc[:, 0], drive.acc[:, 1])
     limit = PRECHECK_MARGIN * effective_g * min(tan_alpha, contact.mu_s)
     return bool(np.any(effective_g <= 0) or np.any(horizontal >= limit))
+
+
+def geometry_parameters(column):
+    """Summary parameters of a described column (none for the paper's columns): hd,
+    height, drums and density of the description, its name and the description itself."""
+    g = column.geometry
+    if g is None:
+        return {}
+    drums, _ = column.geometries()
+    return {"hd": round(g.height / g.base_width, 6), "height_m": g.height,
+            "n_drums": len(drums.bodies()), "density_kg_m3": g.density,
+            "column_file": (column.column_file if isinstance(column.column_file, str)
+                            else g.name), "geometry": g.to_dict()}
 
 
 def still_outcome(columns):
@@ -79,6 +96,7 @@ def simulate(motion, out_dir, column=None, contact=None, numerics=None, window=N
     trajectory = run_yade(out_dir, timeout_s=timeout_s) if moves else None
     parameters = {"column": column.kind, "hd": column.hd, "height_m": column.height,
                   "n_drums": column.n_drums, "density_kg_m3": column.density,
+                  **geometry_parameters(column),
                   **dataclasses.asdict(contact), "window_s": list(window) if window else None,
                   "rotate_deg": rotate_deg, "scale": scale,
                   "motion_file": None if motion_file is None else str(motion_file),

@@ -1,14 +1,20 @@
-# YADE scene: rigid columns (monolithic or drums) or a test block on a pedestal.
+# YADE scene: rigid columns (stacks of drums, capitals, bases, monoliths) or a test
+# block on a pedestal.
 #
 # Run on its own with:  yade -n -x column_scene.py
 # It reads params.json (and the motion npz it names) from its own directory
 # and writes trajectory.npz there.  No value is ever pasted into this file:
 # pipeline/scenario/writer.py copies it unchanged next to the data files.
 #
-# Bodies are clumps (see ../shared/notes/yade-modeling.md): small spheres on
-# the bottom and top rims, a Box plate as the top face a drum above stands on,
-# and a tiny dense core sphere at the true centroid; mass and inertia are then
-# set to those of the solid body.  Contacts are ViscElMat (kn, cn explicit).
+# The geometry comes ready-made in params.json (pipeline/scenario/geometry.py): each
+# column is a list of bodies, each body with its world placement (centre of mass,
+# rotation), mass, inertia tensor about the centre of mass, rims and top plate.
+# Bodies are clumps (see ../shared/notes/yade-modeling.md): small spheres on their
+# rims (the base rim on the contact area with what is below, the other rims on the
+# outer edges: they let a falling body strike the pedestal), a Box plate as the top
+# face a body above stands on, and a tiny dense core sphere at the centre of mass;
+# mass and inertia are then set to those of the solid body.  Contacts are ViscElMat
+# (kn, cn explicit).
 #
 # Pedestal drive: "inertial" (default) keeps the pedestal still and sets
 # gravity to (-a_E, -a_N, -g - a_U), exact for a pedestal in pure
@@ -34,14 +40,18 @@ HERE = os.path.dirname(os.path.abspath(sys.argv[0]))
 with open(os.path.join(HERE, "params.json")) as fh:
     P = json.load(fh)
 G = 9.81                              # m/s^2, the model's gravity (pipeline.constants)
-COLUMNS = P["columns"]                # name, kind, x, y (m), height (m), diameter (m), n_drums, density (kg/m^3)
-BLOCK = P.get("block")                # test block: height, width, depth (m), density, theta0_rad; or None
+COLUMNS = P["columns"]                # name, x, y (m), bodies (see below), settles,
+#                                       overturning_barrier_j (J); a test block is a column
+#   body: name, column, index, mass (kg), inertia (3x3, kg m^2, body frame about the
+#   centre of mass), principal_axes (3x3, columns), centre (m), rotation (3x3 body ->
+#   world), rims [{role base|edge, z (m), normal (into the body), kind circle (radius,
+#   centre) | polygon (points)}], plate {centre, half_size} or null (body frame, m)
 CONTACT = P["contact"]                # kn (N/m per rim point), damping (ratio), mu_s, mu_k
 PEDESTAL = P["pedestal"]              # thickness (m), contact_half_size (m)
-RIM_POINTS = P["rim_points"]          # contact spheres per rim
+RIM_POINTS = P["rim_points"]          # contact spheres per circular rim
 RIM_R = P["rim_sphere_radius"]        # m
-RIM_PHASE_DEG = P.get("rim_phase_deg", 0.0)  # angular phase of the rim points (deg)
-DT_FACTOR = P["dt_factor"]            # dt = DT_FACTOR sqrt(m_min / (kn RIM_POINTS))
+RIM_PHASE_DEG = P.get("rim_phase_deg", 0.0)  # angular phase of circular rims (deg)
+DT_FACTOR = P["dt_factor"]            # dt = DT_FACTOR sqrt(m / (kn x base points)), smallest
 DRIVE = P["drive"]                    # "inertial" (gravity table) or "kinematic"
 DRIVE_INTERVAL_S = P["drive_interval_s"]
 FRICTION = P["friction"]              # "switch" (mu_s sticking, mu_k sliding) or "static"
@@ -54,10 +64,16 @@ T_MAX = P["t_max"]                    # s, simulated time at most
 VERLET_DISTANCE = P["verlet_distance"]  # m
 MOTION_FILE = P.get("motion_file")    # processed-motion npz (dt, acc, disp; East, North, Up)
 OUTPUT = P["output"]                  # trajectory file name
+PLATE_HALF_THICKNESS = 0.005          # m, the top plate (a Box clump member)
 CORE_MASK = 1 << 29          # collides with nothing
 # the clump's reference point is its members' centre of mass: a tiny, very dense
 # core sphere at the body's centroid puts it there (mass set per density, not state.mass)
 CORE = O.materials.append(ViscElMat(density=1e20, kn=0, ks=0, cn=0, cs=0))
+# bodies other than an upright cylinder (whose members already have its principal axes)
+# get pairs of dense "frame" spheres along the body's principal axes (masses 1:2, none
+# on the third axis), so that the clump's principal frame, computed by YADE from its
+# members, is the body's; they collide with nothing
+FRAME_ARM, FRAME_RADIUS = 0.01, 2e-4   # m
 
 
 def rotation_matrix(q):
@@ -89,67 +105,86 @@ def contact_material(mass, n_points):
         frictionAngle=math.atan(CONTACT["mu_s"])))
 
 
-def rim_points(shape, n):
-    """Contact points of a base outline in the body frame (x, y), metres."""
-    if shape["shape"] == "cylinder":
-        ang = 2 * math.pi * np.arange(n) / n + math.radians(RIM_PHASE_DEG)
-        return np.column_stack([shape["radius"] * np.cos(ang), shape["radius"] * np.sin(ang)])
-    half_w, half_d = shape["width"] / 2, shape["depth"] / 2
-    ys = np.linspace(-half_d, half_d, max(2, n // 2))
-    return np.vstack([np.column_stack([np.full_like(ys, -half_w), ys]),
-                      np.column_stack([np.full_like(ys, half_w), ys])])
+def rim_spheres(rim):
+    """Centres (n x 3, body frame) of a rim's contact spheres: circles get RIM_POINTS
+    points from the phase on, polygons their given points; each point lies in the rim's
+    face (the plane through z with the rim's normal, e.g. a wedge joint) and its sphere
+    one radius inside the body along that normal."""
+    if rim["kind"] == "circle":
+        ang = 2 * math.pi * np.arange(RIM_POINTS) / RIM_POINTS + math.radians(RIM_PHASE_DEG)
+        xy = np.column_stack([rim["radius"] * np.cos(ang), rim["radius"] * np.sin(ang)])
+        xy = xy + np.asarray(rim["centre"], float)
+    else:
+        xy = np.asarray(rim["points"], float)
+    n = np.asarray(rim["normal"], float)
+    z = rim["z"] - (n[0] * xy[:, 0] + n[1] * xy[:, 1]) / n[2]
+    return np.column_stack([xy + RIM_R * n[:2], z + RIM_R * n[2]])
 
 
-def add_body(shape, centre, R, mask_base, mask_top, material):
-    """Add one rigid body as a clump; return its clump id.
-
-    shape: dict with shape 'cylinder' (radius) or 'box' (width, depth), height, mass,
-    top_plate (bool), top_rim (bool).  centre: world position of the centroid (m);
-    R: 3x3 rotation body -> world; body z is the long axis.
-    """
-    h = shape["height"]
-    centre = np.asarray(centre, float)
-    members = []
+def add_body(body, mask_base, mask_top, material):
+    """Add one rigid body (a params.json body) as a clump; return its clump id and the
+    number of its base contact points."""
+    centre = np.asarray(body["centre"], float)
+    R = np.asarray(body["rotation"], float)
+    axes = R @ np.asarray(body["principal_axes"], float)          # world
+    plain = (len(body["parts"]) == 1 and body["shape"] == "frustum"
+             and body["parts"][0]["bottom_diameter"] == body["parts"][0]["top_diameter"]
+             and np.all(np.isin(np.abs(axes), (0.0, 1.0))))
 
     def world(p):
         return tuple(centre + R @ np.asarray(p, float))
 
-    pts = rim_points(shape, RIM_POINTS)
-    for x, y in pts:
-        members.append(utils.sphere(world((x, y, -h / 2 + RIM_R)), RIM_R, material=material,
-                                    mask=mask_base))
-    if shape.get("top_rim"):
-        for x, y in pts:
-            members.append(utils.sphere(world((x, y, h / 2 - RIM_R)), RIM_R, material=material,
-                                        mask=mask_top))
-    if shape.get("top_plate"):
-        half = (shape["radius"] + RIM_R if shape["shape"] == "cylinder"
-                else max(shape["width"], shape["depth"]) / 2 + RIM_R)
-        plate_ht = 0.005
-        members.append(utils.box(world((0, 0, h / 2 - plate_ht)), (half, half, plate_ht),
-                                 orientation=yade_quaternion(R), material=material,
-                                 mask=mask_base))
-    members.append(utils.sphere(world((0, 0, 0)), 1e-3, material=CORE, mask=CORE_MASK))
-    clump_id, _ = O.bodies.appendClumped(members)
-    clump = O.bodies[clump_id]
+    def clump_members(frame_spheres):
+        members, n_base = [], 0
+        for rim in body["rims"]:
+            points = rim_spheres(rim)
+            if rim["role"] == "base":
+                n_base += len(points)
+            for p in points:
+                members.append(utils.sphere(world(p), RIM_R, material=material,
+                                            mask=mask_base if rim["role"] == "base"
+                                            else mask_top))
+        plate = body["plate"]
+        if plate:
+            cx, cy, cz = plate["centre"]
+            hx, hy = plate["half_size"]
+            members.append(utils.box(world((cx, cy, cz - PLATE_HALF_THICKNESS)),
+                                     (hx + RIM_R, hy + RIM_R, PLATE_HALF_THICKNESS),
+                                     orientation=yade_quaternion(R), material=material,
+                                     mask=mask_base))
+        members.append(utils.sphere(world((0, 0, 0)), 1e-3, material=CORE, mask=CORE_MASK))
+        if frame_spheres:
+            for axis, radius in ((axes[:, 0], FRAME_RADIUS),
+                                 (axes[:, 1], FRAME_RADIUS * 2 ** (1 / 3))):
+                for sign in (1, -1):
+                    members.append(utils.sphere(tuple(centre + sign * FRAME_ARM * axis), radius,
+                                                material=CORE, mask=CORE_MASK))
+        return members, n_base
+
     # mass and inertia of the solid body, expressed in the clump's principal frame
-    m = shape["mass"]
-    if shape["shape"] == "cylinder":
-        r = shape["radius"]
-        i_body = np.diag([m * (3 * r * r + h * h) / 12] * 2 + [m * r * r / 2])
-    else:
-        w, d = shape["width"], shape["depth"]
-        i_body = np.diag([m * (d * d + h * h) / 12, m * (w * w + h * h) / 12, m * (w * w + d * d) / 12])
-    i_world = R @ i_body @ R.T
-    Rc = rotation_matrix(clump.state.ori)
-    i_clump = Rc.T @ i_world @ Rc
-    clump.state.mass = m
+    i_world = R @ np.asarray(body["inertia"], float) @ R.T
+    frame_spheres = not plain
+    while True:
+        members, n_base = clump_members(frame_spheres)
+        clump_id, _ = O.bodies.appendClumped(members)
+        clump = O.bodies[clump_id]
+        Rc = rotation_matrix(clump.state.ori)
+        i_clump = Rc.T @ i_world @ Rc
+        off_diagonal = np.abs(i_clump - np.diag(np.diag(i_clump))).max()
+        if off_diagonal <= 1e-3 * np.abs(i_clump).max():
+            break
+        if frame_spheres:
+            raise RuntimeError(f"body {body['name']}: the clump frame is not its principal "
+                               f"frame (off-diagonal inertia {off_diagonal:.3g} kg m^2)")
+        O.bodies.erase(clump_id, True)          # members nearly isotropic: add the frame
+        frame_spheres = True
+    clump.state.mass = body["mass"]
     clump.state.inertia = Vector3(*np.diag(i_clump))
     clump.state.pos = Vector3(*centre)          # exact centroid (core sphere ~ there already)
     # the clump frame is the members' principal frame (axes may be permuted):
     # body orientation = clump orientation * body_offset
     body_offset[clump_id] = yade_quaternion(Rc.T @ R)
-    return clump_id
+    return clump_id, n_base
 
 
 # ---------------------------------------------------------------- scene
@@ -157,6 +192,7 @@ bodies = []        # metadata for the trajectory file
 clumps = []        # clump ids in the same order
 body_offset = {}   # clump id -> Quaternion of the body frame in the clump frame
 pedestal_ids = []
+face_stiffness = []   # per body: (mass, kn x base contact points), for the time step
 
 
 def add_pedestal(mask, material):
@@ -167,43 +203,39 @@ def add_pedestal(mask, material):
     pedestal_ids.append(pid)
 
 
+def base_points(body):
+    """Number of contact points of a body's base rim."""
+    rim = next(r for r in body["rims"] if r["role"] == "base")
+    return RIM_POINTS if rim["kind"] == "circle" else len(rim["points"])
+
+
+# one material per (mass, base points): the contact damping follows the body resting
+# on the contact; the pedestal takes the bottom body's
+materials = {}
+
+
+def material_of(body):
+    key = (body["mass"], base_points(body))
+    if key not in materials:
+        materials[key] = contact_material(*key)
+    return materials[key]
+
+
 for c, col in enumerate(COLUMNS):
     mask_base, mask_top = 1 << (2 * c), 1 << (2 * c + 1)
-    n_bodies = col["n_drums"] if col["kind"] == "drums" else 1
-    body_h = col["height"] / n_bodies
-    mass = col["density"] * math.pi * (col["diameter"] / 2) ** 2 * body_h
-    material = contact_material(mass, RIM_POINTS)
-    add_pedestal(mask_base | mask_top, material)
-    x0, y0 = col["x"], col["y"]
-    for k in range(n_bodies):
-        shape = {"shape": "cylinder", "radius": col["diameter"] / 2, "height": body_h, "mass": mass,
-                 "top_plate": k < n_bodies - 1, "top_rim": True}
-        centre = (x0, y0, (k + 0.5) * body_h)
-        clumps.append(add_body(shape, centre, np.eye(3), mask_base, mask_top, material))
-        bodies.append(dict(shape, name=f"{col['name']}[{k}]", column=col["name"], index=k,
-                           initial_pos=list(centre)))
-
-if BLOCK:
-    blk = BLOCK
-    shape = {"shape": "box", "width": blk["width"], "depth": blk["depth"], "height": blk["height"],
-             "mass": blk["density"] * blk["width"] * blk["depth"] * blk["height"],
-             "top_plate": False, "top_rim": False}
-    material = contact_material(shape["mass"], 2 * max(2, RIM_POINTS // 2))
-    add_pedestal(1, material)
-    # initial tilt theta0 about the North (y) axis through the +x (East) bottom edge:
-    # positive theta0 lifts the West edge, the block leans East.
-    th = blk.get("theta0_rad", 0.0)
-    Ry = np.array([[math.cos(th), 0, math.sin(th)], [0, 1, 0], [-math.sin(th), 0, math.cos(th)]])
-    pivot = np.array([blk["width"] / 2, 0, 0])
-    centre = pivot + Ry @ (np.array([0, 0, blk["height"] / 2]) - pivot)
-    clumps.append(add_body(shape, centre, Ry, 1, 1, material))
-    bodies.append(dict(shape, name="block", column="block", index=0, initial_pos=list(centre)))
+    add_pedestal(mask_base | mask_top, material_of(col["bodies"][0]))
+    for body in col["bodies"]:
+        clump_id, n_base = add_body(body, mask_base, mask_top, material_of(body))
+        clumps.append(clump_id)
+        face_stiffness.append((body["mass"], CONTACT["kn"] * max(n_base, RIM_POINTS)))
+        meta = {k: v for k, v in body.items() if k not in ("centre", "rotation")}
+        bodies.append(dict(meta, initial_pos=list(body["centre"]),
+                           initial_rotation=body["rotation"]))
 
 # ---------------------------------------------------------------- time step
-# a body resting on a whole face of rim points: stiffness kn x points
-k_face = CONTACT["kn"] * RIM_POINTS
-m_min = min(b["mass"] for b in bodies)
-O.dt = DT_FACTOR * math.sqrt(m_min / k_face)
+# a body resting on its whole base rim: stiffness kn x its base points (at least
+# RIM_POINTS: a box on its four corners steps as finely as a drum on its rim)
+O.dt = DT_FACTOR * math.sqrt(min(m / k for m, k in face_stiffness))
 
 # ---------------------------------------------------------------- motion
 motion = None
@@ -285,17 +317,8 @@ def record_state():
         O.pause()    # the main thread writes the output once the loop has stopped
 
 
-def overturning_barrier(col):
-    """Smallest energy (J) that tips any stack of drums (k..top) of a column over its edge:
-    M g (sqrt((H/2)^2 + r^2) - H/2) for the stack of mass M and height H."""
-    n, r = (col["n_drums"] if col["kind"] == "drums" else 1), col["diameter"] / 2
-    h = col["height"] / n
-    m = col["density"] * math.pi * r * r * h
-    return min((n - k) * m * G * (math.hypot((n - k) * h / 2, r) - (n - k) * h / 2)
-               for k in range(n))
-
-
-BARRIERS = {col["name"]: overturning_barrier(col) for col in COLUMNS}
+# smallest energy (J) that tips any stack of a column's bodies over its edge
+BARRIERS = {col["name"]: col["overturning_barrier_j"] for col in COLUMNS if col["settles"]}
 SETTLED_FRACTION = 0.9   # after the motion, energy below the barrier cannot tip a stack (10 % margin)
 
 

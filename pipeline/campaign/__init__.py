@@ -55,16 +55,24 @@ def names():
     return list(CAMPAIGNS)
 
 
-def run_campaign(name, jobs=None, records=None, campaign_dir=None, animations=1, options=None):
+def run_campaign(name, jobs=None, records=None, campaign_dir=None, animations=1, options=None,
+                 executor=None, scheduler=None):
     """Run (or resume) a campaign and write its outputs; return the outputs dict.
 
+    executor: "threads" (default) or "dask" (a local Dask cluster, or the existing one
+    at ``scheduler``, e.g. "tcp://10.0.0.5:8786"); see :mod:`pipeline.campaign.executor`.
     Ctrl-C stops within seconds: no new run starts, running YADE processes end,
     the tables of the finished runs are written, then KeyboardInterrupt propagates.
     """
-    from pipeline.campaign.executor import execute
+    from pipeline.campaign.executor import EXECUTORS, execute
     campaign = get(name)
-    jobs = jobs or os.cpu_count() or 1
-    if jobs < 1:
+    if executor is not None and executor not in EXECUTORS:
+        raise InputError(f"--executor must be one of {', '.join(EXECUTORS)}, got {executor!r}")
+    if scheduler and executor == "threads":
+        raise InputError("--scheduler runs on a Dask cluster: drop --executor threads")
+    if jobs is None and not scheduler:      # on a cluster: as many as it has worker threads
+        jobs = os.cpu_count() or 1
+    if jobs is not None and jobs < 1:
         raise InputError(f"--jobs must be at least 1, got {jobs}")
     campaign_dir = Path(campaign_dir or RESULTS_DIR / name)
     if campaign_dir.exists() and not campaign_dir.is_dir():
@@ -72,7 +80,8 @@ def run_campaign(name, jobs=None, records=None, campaign_dir=None, animations=1,
     specs = campaign.specs(records, campaign_dir, **(options or {}))
     with DirectoryLock(campaign_dir, wait=False):
         failures, interrupted = execute(specs, campaign_dir, jobs, campaign.worker,
-                                        campaign.label)
+                                        campaign.label, executor=executor,
+                                        scheduler=scheduler)
         result = campaign.outputs(specs, campaign_dir, failures, animations,
                                   figures=not interrupted)
         write_json(campaign_dir / "campaign.json", {

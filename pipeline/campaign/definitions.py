@@ -57,10 +57,13 @@ def column_specs(runs, campaign_dir):
 
 
 def run_column_spec(spec, run_dir):
-    """Worker: one twin-model (or single column) run of a spec."""
+    """Worker: one twin-model (or single column) run of a spec; ``column_file`` in its
+    parameters is a column description (dict, so that the run id covers its content) or
+    a shipped example's name."""
     p = dict(spec["params"])
     column = Column(kind=p.pop("column", "both"), **{k: p.pop(k) for k in
-                                                     ("hd", "height", "n_drums", "density")
+                                                     ("hd", "height", "n_drums", "density",
+                                                      "column_file")
                                                      if k in p})
     contact = Contact(**{k: p.pop(k) for k in ("kn", "damping", "mu_s", "mu_k") if k in p})
     numerics = Numerics(**{k: p.pop(k) for k in list(p) if k in NUMERICS_FIELDS})
@@ -69,7 +72,9 @@ def run_column_spec(spec, run_dir):
 
 
 def twin(**params):
-    """Parameters of a twin-model run (paper defaults for what is not given)."""
+    """Parameters of a twin-model run (paper defaults for what is not given); with
+    ``column_file`` (a description dict) the described column and a monolith of its
+    outline take the drums' and the monolith's places."""
     return {"column": "both", "hd": paper.COLUMN_HD, "mu_s": paper.MU_STATIC,
             "mu_k": paper.MU_KINETIC, **params}
 
@@ -176,6 +181,145 @@ register(Campaign("synthetic", "the twin model at synthetic sites around two sou
                   synthetic_specs, run_column_spec, synthetic_outputs))
 
 
+# ---------------------------------------------------------------- real columns
+def matched_kn(geometry):
+    """Contact stiffness per point (N/m) that lets a column rock on its contact springs no
+    slower than the paper's column does with the paper's kn (13.5 Hz): the paper's kn for
+    columns of its size, more for heavier ones (kn scales with the square of the
+    frequency), rounded to two significant digits."""
+    from pipeline.scenario.geometry import ColumnGeometry
+    reference = ColumnGeometry.monolith(paper.COLUMN_HEIGHT_M,
+                                        paper.COLUMN_HEIGHT_M / paper.COLUMN_HD,
+                                        paper.MARBLE_DENSITY_KG_M3)
+    ratio = (reference.contact_rocking_hz(paper.COLUMN_KN_N_M)
+             / geometry.contact_rocking_hz(paper.COLUMN_KN_N_M)) ** 2
+    kn = paper.COLUMN_KN_N_M * max(1.0, ratio)
+    return float(f"{kn:.2g}")
+
+
+def columns_specs(records, campaign_dir, column_files=None, column="both",
+                  stiffness="matched"):
+    """Every column description (default: the shipped examples) on the same records
+    (default: the sweep record and the pulse record), each with a monolith of its
+    outline beside it (``column`` both); ``stiffness`` "matched" gives each column the
+    contact stiffness of :func:`matched_kn`, "paper" the paper's kn for all."""
+    from pipeline.scenario.geometry import ColumnGeometry, example_names
+    names = list(column_files) if column_files else example_names()
+    geometries = [ColumnGeometry.load(name) for name in names]
+    if column not in ("both", "monolithic", "drums"):
+        raise InputError(f"--column must be both, monolithic or drums, got {column!r}")
+    if stiffness not in ("matched", "paper"):
+        raise InputError(f"--stiffness must be matched or paper, got {stiffness!r}")
+    recs = _records_or(records, [paper.SWEEP_RECORD, pulse_record()])
+    runs = []
+    for g in geometries:
+        kn = matched_kn(g) if stiffness == "matched" else paper.COLUMN_KN_N_M
+        runs += [(r, twin(column=column, column_file=g.to_dict(), kn=kn)) for r in recs]
+    specs = column_specs(runs, campaign_dir)
+    for spec in specs:
+        spec["description"] = spec["params"]["column_file"]["name"]
+    return specs
+
+
+COLUMNS_TABLE = ["description", "record_id", "column", "toppled", "downfall_azimuth_deg",
+                 "impact_time_s", "first_to_strike", "first_to_strike_index",
+                 "struck_bodies", "bodies", "max_tilt_deg", "base_slip_m", "uplift_ratio",
+                 "height_m", "mass_kg", "kn", "back_azimuth_deg", "run_id"]
+
+
+def columns_table(specs, campaign_dir):
+    """One row per description, record and column (described or monolith): toppled,
+    direction and which block struck the pedestal first, with the column's rocking
+    threshold (g units, statics) beside them."""
+    import pandas as pd
+
+    from pipeline.scenario.geometry import ColumnGeometry
+    rows = []
+    for spec in specs:
+        path = Path(campaign_dir) / "runs" / spec["run_id"] / "summary.json"
+        if not path.exists():
+            continue
+        summary = json.loads(path.read_text())
+        geometry = ColumnGeometry.from_dict(spec["params"]["column_file"])
+        shapes = {"drums": geometry, "monolithic": geometry.monolithic()}
+        for col in summary["columns"]:
+            g = shapes[col["column"]]
+            struck = sorted((b for b in col["bodies"] if b["struck"]),
+                            key=lambda b: b["impact_time_s"])
+            first = struck[0] if struck else None
+            rows.append({
+                "description": geometry.name, "record_id": spec["record_id"],
+                "column": col["column"], "toppled": col["toppled"],
+                "downfall_azimuth_deg": col["downfall_azimuth_deg"],
+                "impact_time_s": col["impact_time_s"],
+                "first_to_strike": None if first is None else first.get(
+                    "name", f"body {first['index']}"),
+                "first_to_strike_index": None if first is None else first["index"],
+                "struck_bodies": len(struck), "bodies": len(g.bodies()),
+                "max_tilt_deg": col["max_tilt_deg"], "base_slip_m": col["base_slip_m"],
+                "uplift_ratio": round(g.uplift_ratio(), 4), "height_m": g.height,
+                "mass_kg": round(sum(b.mass for b in g.bodies())),
+                "kn": summary["parameters"]["kn"],
+                "back_azimuth_deg": summary["back_azimuth_deg"], "run_id": spec["run_id"]})
+    return pd.DataFrame(rows, columns=COLUMNS_TABLE)
+
+
+def columns_outputs(specs, campaign_dir, failures, animations, figures=True):
+    """runs.csv and impacts.csv like the other column campaigns, and columns.csv /
+    columns.md: the descriptions side by side on each record."""
+    campaign_dir = Path(campaign_dir)
+    runs, impacts = collect(specs, "columns", campaign_dir)
+    if not runs.empty:
+        names = {s["run_id"]: s["description"] for s in specs}
+        runs.insert(1, "description", runs["run_id"].map(names))
+    write_csv(campaign_dir / "runs.csv", runs)
+    write_csv(campaign_dir / "impacts.csv", impacts)
+    table = columns_table(specs, campaign_dir)
+    write_csv(campaign_dir / "columns.csv", table)
+    shown = table.drop(columns=["run_id", "back_azimuth_deg", "first_to_strike_index"])
+    text = shown.to_markdown(index=False, floatfmt=".3g") if not table.empty else "(no runs)"
+    from pipeline.files import write_text
+    write_text(campaign_dir / "columns.md", "# Real columns on the same records\n\n"
+               "uplift_ratio: rocking threshold / g from statics (d/h for a cylinder).\n\n"
+               + text + "\n")
+    print(text)
+    written = []
+    if figures and animations and not runs.empty:
+        from pipeline.figures import animate_examples
+        written = animate_examples(runs, campaign_dir, animations)
+    return {"code_version": run_code_version(),
+            "figures": [str(p.relative_to(campaign_dir)) for p in written]}
+
+
+def columns_options(parser):
+    from pipeline.scenario.geometry import example_names
+    parser.add_argument("--column-file", dest="column_files", default=None,
+                        metavar="NAME_OR_FILE,...",
+                        help="comma-separated column descriptions (shipped: "
+                        + ", ".join(example_names()) + "; default: all shipped)")
+    parser.add_argument("--column", choices=("both", "monolithic", "drums"), default="both",
+                        help="both (default): each description and a monolith of its "
+                        "outline; drums: the description only; monolithic: the monolith only")
+    parser.add_argument("--stiffness", choices=("matched", "paper"), default="matched",
+                        help="contact stiffness per point: matched (default) raises the "
+                        "paper's kn for heavy columns so that each rocks on its contact "
+                        "springs no slower than the paper's column (13.5 Hz); paper: "
+                        f"{paper.COLUMN_KN_N_M:g} N/m for all")
+
+
+def columns_read_options(args):
+    files = [f for f in (args.column_files or "").split(",") if f]
+    return {"column_files": files or None, "column": args.column, "stiffness": args.stiffness}
+
+
+register(Campaign(
+    "columns", "real columns from descriptions (shipped: the paper's two, a Doric peristyle "
+    "column, a Roman granite column) compared on the same records: toppled, direction, "
+    "which block falls first",
+    columns_specs, run_column_spec, columns_outputs, options=columns_options,
+    read_options=columns_read_options))
+
+
 # ---------------------------------------------------------------- verification
 def verification_specs(records, campaign_dir):
     from pipeline import verification
@@ -218,3 +362,4 @@ register(Campaign("verification", "Housner, one-sine pulse and sliding checks ov
 
 
 from pipeline.campaign import ensemble  # noqa: E402,F401  (registers the ensemble campaign)
+from pipeline.campaign import fragility  # noqa: E402,F401  (registers the fragility campaign)

@@ -21,7 +21,15 @@ def setup(p):
         definition = campaign.get(name)
         q = sub.add_parser(name, help=definition.help, description=definition.help)
         q.add_argument("--jobs", type=int, default=None,
-                       help="parallel single-thread YADE processes (default: all cores)")
+                       help="parallel single-thread YADE processes (default: all cores; "
+                       "with --scheduler: every worker thread of the cluster)")
+        q.add_argument("--executor", choices=("threads", "dask"), default=None,
+                       help="threads (default): a thread pool, no start-up cost, no port; "
+                       "dask: a local Dask cluster of --jobs worker processes on 127.0.0.1")
+        q.add_argument("--scheduler", default=None, metavar="ADDRESS",
+                       help="run on an existing Dask cluster (e.g. tcp://10.0.0.5:8786; "
+                       "workers: 'dask worker ADDRESS --nthreads 1' with this project "
+                       "and YADE installed)")
         q.add_argument("--records", default=None, metavar="ID,ID",
                        help="comma-separated record ids or paths instead of the campaign's own")
         if name != "verification":
@@ -46,5 +54,6 @@ def run(args):
     definition = campaign.get(args.name)
     options = definition.read_options(args) if definition.read_options else {}
     campaign.run_campaign(args.name, jobs=args.jobs, records=records, campaign_dir=args.out,
-                          animations=args.animations, options=options)
+                          animations=args.animations, options=options,
+                          executor=args.executor, scheduler=args.scheduler)
     return 0

@@ -9,6 +9,7 @@ from pipeline import RESULTS_DIR
 from pipeline.files import DirectoryLock, InputError
 from pipeline.records import processed_motion, resolve
 from pipeline.scenario import Column, Contact, Numerics
+from pipeline.scenario.geometry import example_names
 from pipeline.scenario.parameters import add_arguments, from_args
 from pipeline.simulate import back_azimuth_of, simulate
 
@@ -18,12 +19,19 @@ HELP = "simulate columns on a pedestal shaken by one record"
 DESCRIPTION = ("Process the record, write the YADE scenario, run it and write DIR/summary.json "
                "(toppled, downfall azimuth, impact time and points per column).")
 MAX_DURATION_S = 300.0   # longer motions need --window
+SOFT_CONTACT_HZ = 8.0    # a described column rocking on its contact springs slower: a note
 
 
 def setup(p):
     p.add_argument("--record", required=True, metavar="ID_OR_PATH",
                    help="catalogue id (records/catalog.csv), record file or processed .npz")
     add_arguments(p, Column)
+    p.add_argument("--column-file", default=None, metavar="NAME_OR_FILE",
+                   help="the column as found, from a description (JSON, or YAML with PyYAML; "
+                   "README 'Column files') or a shipped example by name ("
+                   + ", ".join(example_names()) + "); with --column both a monolith of "
+                   "the same outline stands beside it; excludes --hd, --height, --drums, "
+                   "--density")
     add_arguments(p, Contact)
     add_arguments(p, Numerics)
     p.add_argument("--back-azimuth", type=float, default=None, metavar="DEG",
@@ -48,6 +56,12 @@ def check_run_options(args):
         raise InputError(f"--rotate must be a finite angle, got {args.rotate}")
     if not (math.isfinite(args.scale) and 0.0 <= args.scale <= 20.0):
         raise InputError(f"--scale {args.scale:g} outside the allowed range [0, 20]")
+    if getattr(args, "column_file", None) is not None:
+        given = [flag for flag, name in (("--hd", "hd"), ("--height", "height"),
+                                         ("--drums", "n_drums"), ("--density", "density"))
+                 if getattr(args, name, None) is not None]
+        if given:
+            raise InputError(f"--column-file describes the column: drop {', '.join(given)}")
     if args.window is not None:
         start, end = args.window
         if not (math.isfinite(start) and math.isfinite(end) and 0 <= start < end):
@@ -76,10 +90,24 @@ def run(args):
         print(f"note: {summary['note']}")
     elif not any(c["max_tilt_deg"] > 0.1 for c in summary["columns"]):
         print("note: the motion did not make any column rock (max tilt below 0.1 deg)")
+    if column.geometry is not None:
+        roles = {"drums": "'drums' = as described",
+                 "monolithic": "'monolithic' = one stone of its outline"}
+        shown = ["drums", "monolithic"] if column.kind == "both" else [column.kind]
+        print(f"column {column.geometry.name!r}: " + ", ".join(roles[k] for k in shown))
+        hz = column.geometry.contact_rocking_hz(contact.kn, numerics.rim_points)
+        if hz < SOFT_CONTACT_HZ:
+            print(f"note: with --kn {contact.kn:g} this column rocks on its contact springs "
+                  f"at {hz:.1f} Hz (the paper's column at 13.5 Hz): raise --kn (campaign "
+                  "columns does) for rigid-block behaviour")
     for col in summary["columns"]:
         if col["toppled"]:
+            first = min((b for b in col["bodies"] if b["struck"]),
+                        key=lambda b: b["impact_time_s"])
+            label = first.get("name") or f"body {first['index']}"
+            more = f" (first to strike: {label})" if column.geometry is not None else ""
             print(f"{col['column']:>10}: toppled toward {col['downfall_azimuth_deg']:.0f} deg "
-                  f"at {col['impact_time_s']:.2f} s")
+                  f"at {col['impact_time_s']:.2f} s{more}")
         else:
             print(f"{col['column']:>10}: standing (max tilt {col['max_tilt_deg']:.1f} deg)")
     print(f"wrote {out / 'summary.json'} ({summary['simulated_s']:.1f} s simulated in "

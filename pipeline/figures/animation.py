@@ -1,8 +1,9 @@
 """Animations of runs (GIF, or MP4 when ffmpeg is present) and VTK export for ParaView.
 
-Bodies are drawn from the trajectory (centre of mass + quaternion, body z =
-long axis) in the absolute frame: pedestal-frame position + pedestal
-displacement, so the pedestal is seen to move with the ground.
+Bodies are drawn part by part (a drum, or a capital's echinus and abacus) from the
+trajectory (centre of mass + quaternion, body z = long axis) in the absolute frame:
+pedestal-frame position + pedestal displacement, so the pedestal is seen to move with
+the ground.
 """
 import math
 from pathlib import Path
@@ -32,20 +33,57 @@ def load(run):
     return Trajectory.load(path)
 
 
-def body_surface(body, centre, quat_wxyz):
-    """Vertices (2 x k x 3) of a body's bottom and top outline, world frame (m).
-
-    Cylinders: circles of CIRCLE_SEGMENTS points; boxes: their 4 corners."""
-    h = body["height"] / 2
+def body_parts(body):
+    """The solid parts of a trajectory body (body frame about its centre of mass): dicts
+    with shape frustum (bottom_diameter, top_diameter) or box (width, depth), height and
+    bottom_centre.  Trajectories written before column files carry cylinders and boxes."""
+    if "parts" in body:
+        return body["parts"]
+    h = body["height"]
     if body["shape"] == "cylinder":
+        d = 2 * body["radius"]
+        return [{"shape": "frustum", "height": h, "bottom_diameter": d, "top_diameter": d,
+                 "bottom_centre": [0.0, 0.0, -h / 2]}]
+    return [{"shape": "box", "height": h, "width": body["width"], "depth": body["depth"],
+             "bottom_centre": [0.0, 0.0, -h / 2]}]
+
+
+def part_rings(part):
+    """Bottom and top outline (2 x k x 3) of one part in the body frame: circles of
+    CIRCLE_SEGMENTS points, box faces by their 4 corners."""
+    cx, cy, z0 = part["bottom_centre"]
+    if part["shape"] == "frustum":
         ang = 2 * math.pi * np.arange(CIRCLE_SEGMENTS) / CIRCLE_SEGMENTS
-        ring = np.column_stack([body["radius"] * np.cos(ang), body["radius"] * np.sin(ang)])
+        unit = np.column_stack([np.cos(ang), np.sin(ang)])
+        rings = [unit * part["bottom_diameter"] / 2, unit * part["top_diameter"] / 2]
     else:
-        w, d = body["width"] / 2, body["depth"] / 2
-        ring = np.array([[-w, -d], [w, -d], [w, d], [-w, d]])
-    local = np.stack([np.column_stack([ring, np.full(len(ring), z)]) for z in (-h, h)])
+        w, d = part["width"] / 2, part["depth"] / 2
+        rings = [np.array([[-w, -d], [w, -d], [w, d], [-w, d]])] * 2
+    return np.stack([np.column_stack([ring + [cx, cy], np.full(len(ring), z)])
+                     for ring, z in zip(rings, (z0, z0 + part["height"]))])
+
+
+def body_surfaces(body, centre, quat_wxyz):
+    """Per part of a body: its bottom and top outline (2 x k x 3), world frame (m)."""
     rot = rotations(quat_wxyz)
-    return rot.apply(local.reshape(-1, 3)).reshape(local.shape) + np.asarray(centre, float)
+    out = []
+    for part in body_parts(body):
+        local = part_rings(part)
+        out.append(rot.apply(local.reshape(-1, 3)).reshape(local.shape)
+                   + np.asarray(centre, float))
+    return out
+
+
+def body_surface(body, centre, quat_wxyz):
+    """Vertices (2 x k x 3) of a single-part body's bottom and top outline, world frame
+    (m); bodies of several parts: the first part (see :func:`body_surfaces`)."""
+    return body_surfaces(body, centre, quat_wxyz)[0]
+
+
+def body_top_m(body):
+    """Initial height (m) of a body's highest face (upright bodies)."""
+    z = body["initial_pos"][2] if "initial_pos" in body else body["height"] / 2
+    return max(z + p["bottom_centre"][2] + p["height"] for p in body_parts(body))
 
 
 def _frame_indices(t, fps, max_seconds):
@@ -70,7 +108,7 @@ def animate_run(run, path, fps=20, max_seconds=None, max_frames=600):
     bodies = traj.bodies
     fig = figure(figsize=(7, 6))
     ax = fig.add_subplot(projection="3d")
-    height = max(b["height"] * (b["index"] + 1) for b in bodies)
+    height = max(body_top_m(b) for b in bodies)
     reach = PEDESTAL_HALF + 1.0
 
     ax.set(xlim=(-reach, reach), ylim=(-reach, reach), zlim=(0, max(height, 1.0)),
@@ -78,13 +116,16 @@ def animate_run(run, path, fps=20, max_seconds=None, max_frames=600):
     ax.set_box_aspect((2 * reach, 2 * reach, max(height, 1.0)))
     square = np.array([[-1, -1], [1, -1], [1, 1], [-1, 1], [-1, -1]]) * PEDESTAL_HALF
     pedestal_line, = ax.plot([], [], [], color="grey")
-    body_lines = []  # per body: two rim lines, then the side lines
+    body_lines = []  # per body, per part: two rim lines, then the side lines
     for body in bodies:
         colour = COLUMN_COLOURS.get(body["column"], "k")
-        rims = [ax.plot([], [], [], color=colour, lw=1)[0] for _ in range(2)]
-        sides = [ax.plot([], [], [], color=colour, lw=0.6)[0]
-                 for _ in range(len(body_surface(body, np.zeros(3), [1, 0, 0, 0])[0][::3]))]
-        body_lines.append(rims + sides)
+        parts = []
+        for rings in body_surfaces(body, np.zeros(3), [1, 0, 0, 0]):
+            rims = [ax.plot([], [], [], color=colour, lw=1)[0] for _ in range(2)]
+            sides = [ax.plot([], [], [], color=colour, lw=0.6)[0]
+                     for _ in range(len(rings[0][::3]))]
+            parts.append(rims + sides)
+        body_lines.append(parts)
     title = ax.set_title("")
 
     def draw(k):
@@ -92,13 +133,13 @@ def animate_run(run, path, fps=20, max_seconds=None, max_frames=600):
         pedestal_line.set_data_3d(square[:, 0] + disp[0], square[:, 1] + disp[1],
                                   np.full(5, disp[2]))
         for j, body in enumerate(bodies):
-            rims = body_surface(body, traj.pos[k, j] + disp, traj.quat[k, j])
-            lines = body_lines[j]
-            for line, rim in zip(lines[:2], rims):
-                closed = np.vstack([rim, rim[:1]])
-                line.set_data_3d(closed[:, 0], closed[:, 1], closed[:, 2])
-            for line, a, b in zip(lines[2:], rims[0][::3], rims[1][::3]):
-                line.set_data_3d(*np.column_stack([a, b]))
+            for rims, lines in zip(body_surfaces(body, traj.pos[k, j] + disp, traj.quat[k, j]),
+                                   body_lines[j]):
+                for line, rim in zip(lines[:2], rims):
+                    closed = np.vstack([rim, rim[:1]])
+                    line.set_data_3d(closed[:, 0], closed[:, 1], closed[:, 2])
+                for line, a, b in zip(lines[2:], rims[0][::3], rims[1][::3]):
+                    line.set_data_3d(*np.column_stack([a, b]))
         title.set_text(f"t = {t[k]:5.2f} s")
 
     anim = animation.FuncAnimation(fig, draw, frames=frames, interval=1000 / fps)
@@ -135,14 +176,14 @@ def frame_polydata(traj, k):
     points.extend(sq + disp)
     polys.append([0, 1, 2, 3])
     for j, body in enumerate(traj.bodies):
-        bottom, top = body_surface(body, traj.pos[k, j] + disp, traj.quat[k, j])
-        n, base = len(bottom), len(points)
-        points.extend(bottom)
-        points.extend(top)
-        polys.append(list(range(base + n - 1, base - 1, -1)))            # bottom, facing down
-        polys.append(list(range(base + n, base + 2 * n)))                # top
-        polys.extend([[base + i, base + (i + 1) % n, base + n + (i + 1) % n, base + n + i]
-                      for i in range(n)])                                # sides
+        for bottom, top in body_surfaces(body, traj.pos[k, j] + disp, traj.quat[k, j]):
+            n, base = len(bottom), len(points)
+            points.extend(bottom)
+            points.extend(top)
+            polys.append(list(range(base + n - 1, base - 1, -1)))        # bottom, facing down
+            polys.append(list(range(base + n, base + 2 * n)))            # top
+            polys.extend([[base + i, base + (i + 1) % n, base + n + (i + 1) % n, base + n + i]
+                          for i in range(n)])                            # sides
     return np.array(points), polys
 
 

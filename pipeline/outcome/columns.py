@@ -3,8 +3,11 @@ impact time, impact points and downfall azimuth.
 
 All positions are in the pedestal frame (pedestal top face z = 0, metres).
 A column has toppled when one of its bodies struck the pedestal other than
-by its base: any point of a drum above the bottom one, or the top rim of
-the bottom drum (or monolith).  The downfall azimuth points from the
+by its base: any rim of a body above the bottom one, or any rim of the bottom
+body but its base (the top rim of a drum or monolith; a capital's abacus
+edge on a monolith of that outline).  Rims are the outlines a body carries
+contact spheres on (``bodies[].rims`` of the trajectory, body frame about the
+centre of mass: circles and polygons).  The downfall azimuth points from the
 column's initial axis to the mass-weighted mean of the centres of mass of
 the struck bodies at their first strike (clockwise from North, degrees).
 """
@@ -30,13 +33,37 @@ def rotations(quat):
     return Rotation.from_quat(np.asarray(quat, float).reshape(-1, 4)[:, [1, 2, 3, 0]])
 
 
-def rim_lowest_z(pos, axis, half_height, radius):
-    """Lowest z (m) of a cylinder's bottom and top rim circles: arrays (..., 2)."""
+def body_rims(body):
+    """Rims of a trajectory body in its frame about the centre of mass: dicts with role
+    ("base" or "edge"), z, and kind "circle" (radius, centre) or "polygon" (vertices).
+    Trajectories written before column files carry cylinders and boxes instead."""
+    if "rims" in body:
+        return body["rims"]
+    h = body["height"] / 2
+    if body["shape"] == "cylinder":
+        face = {"kind": "circle", "radius": body["radius"], "centre": [0.0, 0.0]}
+    else:
+        w, d = body["width"] / 2, body["depth"] / 2
+        face = {"kind": "polygon", "vertices": [[-w, -d], [w, -d], [w, d], [-w, d]]}
+    return [dict(face, role="base", z=-h), dict(face, role="edge", z=h)]
+
+
+def rim_lowest(pos, quat, rim, axis=None):
+    """Lowest z (m, per sample) of one rim of a body at positions ``pos`` (n x 3) and
+    orientations ``quat`` (n x 4, w x y z)."""
+    axis = body_axes(quat) if axis is None else axis
     az = np.clip(axis[..., 2], -1.0, 1.0)
-    spread = radius * np.sqrt(1.0 - az ** 2)
-    bottom = pos[..., 2] - half_height * az - spread
-    top = pos[..., 2] + half_height * az - spread
-    return np.stack([bottom, top], axis=-1)
+    if rim["kind"] == "circle":
+        low = pos[..., 2] + rim["z"] * az - rim["radius"] * np.sqrt(1.0 - az ** 2)
+        cx, cy = rim["centre"]
+        if cx or cy:
+            row = rotations(quat).as_matrix()[:, 2, :]
+            low = low + row[:, 0] * cx + row[:, 1] * cy
+        return low
+    row = rotations(quat).as_matrix()[:, 2, :]
+    v = np.asarray(rim["vertices"], float)
+    heights = row[:, :2] @ v.T + (row[:, 2] * rim["z"])[:, None]
+    return pos[..., 2] + heights.min(axis=1)
 
 
 def tilt_deg(axis):
@@ -53,16 +80,20 @@ def column_outcomes(trajectory):
         columns.setdefault(body["column"], []).append(j)
     results = []
     for name, members in columns.items():
-        origin = np.array(trajectory.bodies[members[0]]["initial_pos"][:2])
+        first = trajectory.bodies[members[0]]
+        origin = np.array(first.get("column_position", first["initial_pos"][:2]), float)
         bodies = []
         for j in members:
             b = trajectory.bodies[j]
-            if b["shape"] != "cylinder":
+            rims = [r for r in body_rims(b) if b["index"] > 0 or r["role"] != "base"]
+            if not rims:
                 continue
-            low = rim_lowest_z(pos[:, j], axes[:, j], b["height"] / 2, b["radius"])
-            struck = low[:, 1] if b["index"] == 0 else low.min(axis=1)
+            struck = np.min([rim_lowest(pos[:, j], trajectory.quat[:, j], r, axes[:, j])
+                             for r in rims], axis=0)
             hits = np.flatnonzero(struck <= CONTACT_TOLERANCE_M)
-            entry = {"index": b["index"], "mass_kg": b["mass"], "struck": bool(hits.size),
+            entry = {"index": b["index"], **({"name": b["block_name"]} if b.get("block_name")
+                                             else {}),
+                     "mass_kg": b["mass"], "struck": bool(hits.size),
                      "impact_time_s": None, "impact_point_m": None, "azimuth_deg": None,
                      "max_tilt_deg": float(tilt_deg(axes[:, j]).max()),
                      "final_position_m": (pos[-1, j, :2] - origin).round(4).tolist()}
@@ -78,7 +109,8 @@ def column_outcomes(trajectory):
         result = {"column": name, "toppled": bool(struck), "downfall_azimuth_deg": None,
                   "impact_time_s": None, "impact_point_m": None,
                   "max_tilt_deg": max(b["max_tilt_deg"] for b in bodies),
-                  "base_slip_m": float(np.hypot(*(pos[:, members[0], :2] - origin).T).max()),
+                  "base_slip_m": float(np.hypot(*(pos[:, members[0], :2]
+                                                   - first["initial_pos"][:2]).T).max()),
                   "position_m": origin.tolist(), "bodies": bodies}
         if struck:
             weights = np.array([b["mass_kg"] for b in struck])
@@ -97,15 +129,17 @@ def total_energy(trajectory, g=MODEL_GRAVITY):
     energy = np.zeros(len(trajectory.t))
     for j, b in enumerate(trajectory.bodies):
         m, h = b["mass"], b["height"]
-        if b["shape"] == "cylinder":
+        if "inertia" in b:
+            inertia = np.asarray(b["inertia"], float)
+        elif b["shape"] == "cylinder":
             r = b["radius"]
-            inertia = np.array([m * (3 * r * r + h * h) / 12] * 2 + [m * r * r / 2])
+            inertia = np.diag([m * (3 * r * r + h * h) / 12] * 2 + [m * r * r / 2])
         else:
             w, d = b["width"], b["depth"]
-            inertia = m / 12 * np.array([d * d + h * h, w * w + h * h, w * w + d * d])
+            inertia = np.diag(m / 12 * np.array([d * d + h * h, w * w + h * h, w * w + d * d]))
         omega_body = rotations(trajectory.quat[:, j]).inv().apply(trajectory.angvel[:, j])
         energy += (0.5 * m * (trajectory.vel[:, j] ** 2).sum(axis=1)
-                   + 0.5 * (inertia * omega_body ** 2).sum(axis=1)
+                   + 0.5 * np.einsum("ni,ij,nj->n", omega_body, inertia, omega_body)
                    + m * g * trajectory.pos[:, j, 2])
     return energy
 

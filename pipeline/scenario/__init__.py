@@ -5,10 +5,12 @@ A scenario directory holds ``params.json`` (every parameter), ``motion.npz``
 :mod:`pipeline.motion`) and ``scene.py``, an unchanged copy of
 ``yade_scripts/column_scene.py``; running it writes ``trajectory.npz``.
 """
+from pipeline.scenario.geometry import ColumnGeometry, ColumnSpec
 from pipeline.scenario.parameters import (PEDESTAL, Block, Column, Contact, Numerics,
                                           scene_params)
 from pipeline.scenario.runner import YadeError, run_yade
 from pipeline.scenario.writer import write_scenario
 
-__all__ = ["PEDESTAL", "Block", "Column", "Contact", "Numerics", "scene_params",
+__all__ = ["PEDESTAL", "Block", "Column", "ColumnGeometry", "ColumnSpec", "Contact", "Numerics",
+           "scene_params",
            "write_scenario", "run_yade", "YadeError"]

@@ -11,6 +11,7 @@ from dataclasses import dataclass, field
 
 from pipeline import paper
 from pipeline.files import InputError
+from pipeline.scenario.geometry import ColumnGeometry, ColumnSpec
 
 COLUMN_KINDS = ("both", "monolithic", "drums")
 RIM_SPHERE_RADIUS_M = 0.005   # rim contact spheres of the columns
@@ -79,7 +80,7 @@ class Contact:
 @dataclass(frozen=True)
 class Numerics:
     """How the YADE model discretises and integrates the bodies."""
-    rim_points: int = param(16, "", "contact spheres per rim", 8, 128, "--rim-points")
+    rim_points: int = param(16, "", "contact spheres per circular rim", 8, 128, "--rim-points")
     rim_sphere_radius: float = param(RIM_SPHERE_RADIUS_M, "m", "radius of the rim contact spheres",
                                      0.0, 0.05, low_open=True)
     rim_phase_deg: float = param(0.0, "deg", "angular phase of the rim contact points "
@@ -112,7 +113,10 @@ class Numerics:
 
 @dataclass(frozen=True)
 class Column:
-    """The column model: the paper's twin model (both), or one column."""
+    """The column model: the paper's twin model (both), or one column; with
+    ``column_file`` (a shipped example's name or a JSON/YAML file, see
+    :mod:`pipeline.scenario.geometry`) the described column takes the drums' place and a
+    monolith of the same outline the monolith's."""
     kind: str = param("both", "", "both = drums at x = -1.5 m and monolith at +1.5 m",
                       choices=COLUMN_KINDS, flag="--column")
     hd: float = param(paper.COLUMN_HD, "", "slenderness h/d", 1.0, 30.0, "--hd")
@@ -121,9 +125,19 @@ class Column:
     density: float = param(paper.MARBLE_DENSITY_KG_M3, "kg/m^3", "density", 100.0, 25000.0,
                            "--density")
     centred: bool = field(default=None, metadata={"help": "single column at the centre"})
+    column_file: object = field(default=None, metadata={
+        "help": "column description: a shipped example's name, a .json/.yaml file or the "
+        "description as a dict"})
+    geometry: object = field(default=None, init=False, repr=False, compare=False)
 
     def __post_init__(self):
         check_fields(self)
+        if self.column_file is not None:
+            geometry = (ColumnGeometry.from_dict(self.column_file)
+                        if isinstance(self.column_file, dict)
+                        else ColumnGeometry.load(self.column_file))
+            object.__setattr__(self, "geometry", geometry)
+            return
         drum_height = self.height / self.n_drums
         diameter = self.height / self.hd
         # a drum must be tall and wide enough for its two rims of contact spheres
@@ -137,20 +151,27 @@ class Column:
         """Column diameter (m)."""
         return self.height / self.hd
 
+    def geometries(self):
+        """(drums, monolith) geometries: the paper's equal drums and cylinder, or the
+        described column and a monolith of its outline."""
+        if self.geometry is not None:
+            return self.geometry, self.geometry.monolithic()
+        return (ColumnGeometry.drums(self.height, self.diameter, int(self.n_drums),
+                                     self.density),
+                ColumnGeometry.monolith(self.height, self.diameter, self.density))
+
     def specs(self):
-        """Column definitions for the scene (``params.json`` ``columns``): 'both' puts the
-        drums at x = -1.5 m and the monolith at +1.5 m; one column stands at the centre
-        unless centred=False."""
+        """The columns of the scene (:class:`~pipeline.scenario.geometry.ColumnSpec`):
+        'both' puts the drums (or the described column) at x = -1.5 m and the monolith at
+        +1.5 m; one column stands at the centre unless centred=False."""
         kinds = ["drums", "monolithic"] if self.kind == "both" else [self.kind]
         centred = self.kind != "both" if self.centred is None else self.centred
+        drums, monolith = self.geometries()
         out = []
         for kind in kinds:
             x = 0.0 if centred else (-paper.TWIN_OFFSET_M if kind == "drums"
                                      else paper.TWIN_OFFSET_M)
-            out.append({"name": kind, "kind": kind, "x": x, "y": 0.0, "height": self.height,
-                        "diameter": self.diameter,
-                        "n_drums": int(self.n_drums) if kind == "drums" else 1,
-                        "density": self.density})
+            out.append(ColumnSpec(kind, kind, x, 0.0, drums if kind == "drums" else monolith))
         return out
 
 
@@ -178,8 +199,10 @@ def scene_params(columns=(), block=None, contact=None, numerics=None, motion_dur
                  t_max=None):
     """The ``params.json`` content of a scene (JSON-serialisable dict).
 
-    columns: list from :meth:`Column.specs`; block: a :class:`Block` or None;
-    contact, numerics: :class:`Contact`, :class:`Numerics` (defaults when None).
+    columns: list of :class:`~pipeline.scenario.geometry.ColumnSpec` (from
+    :meth:`Column.specs`); block: a :class:`Block` (placed as a column named "block" at
+    the centre) or None; contact, numerics: :class:`Contact`, :class:`Numerics`
+    (defaults when None).
     """
     contact = contact or Contact()
     numerics = numerics or Numerics()
@@ -189,11 +212,33 @@ def scene_params(columns=(), block=None, contact=None, numerics=None, motion_dur
         t_max = motion_duration + numerics.tail_s
     if not (math.isfinite(t_max) and t_max > 0):
         raise InputError(f"simulated duration must be positive, got {t_max!r}")
-    return {"columns": list(columns),
+    specs = list(columns)
+    if block is not None:
+        specs.append(ColumnSpec("block", "block", 0.0, 0.0, ColumnGeometry.block(
+            block.height, block.width, block.depth, block.density, block.theta0_rad)))
+    pedestal = dict(PEDESTAL)
+    for spec in specs:
+        check_rims(spec.geometry, numerics.rim_sphere_radius)
+        # a tall column falling over must still land at pedestal level
+        reach = math.hypot(spec.x, spec.y) + 1.1 * spec.geometry.height + 2.0
+        if reach > pedestal["contact_half_size"]:
+            pedestal["contact_half_size"] = float(math.ceil(reach))
+    return {"columns": [spec.scene(numerics.rim_points) for spec in specs],
             "block": None if block is None else dataclasses.asdict(block),
-            "contact": dataclasses.asdict(contact), "pedestal": dict(PEDESTAL),
+            "contact": dataclasses.asdict(contact), "pedestal": pedestal,
             **dataclasses.asdict(numerics), "t_max": float(t_max),
             "motion_file": None, "output": "trajectory.npz"}
+
+
+def check_rims(geometry, rim_sphere_radius):
+    """InputError when a block is too small for its rims of contact spheres."""
+    for k, block in enumerate(geometry.blocks):
+        s = block.solid
+        sizes = [s.height] + ([s.bottom_diameter, s.top_diameter] if s.shape == "frustum"
+                              else [s.width, s.depth])
+        if min(sizes) < 4 * rim_sphere_radius:
+            raise InputError(f"{geometry.name}: block {k} is {min(sizes):g} m thin, less "
+                             f"than 4 contact sphere radii ({rim_sphere_radius:g} m)")
 
 
 def add_arguments(parser, cls, names=None):

@@ -42,14 +42,17 @@ def test_mu_k_follows_mu_s_unless_given():
 
 def test_twin_model_geometry():
     drums, mono = Column("both", hd=6.0, height=3.5).specs()
-    assert (drums["x"], mono["x"]) == (-1.5, 1.5)
-    assert drums["diameter"] == pytest.approx(3.5 / 6)
+    assert (drums.x, mono.x) == (-1.5, 1.5)
+    assert {b.solid.bottom_diameter for b in drums.geometry.blocks} == {3.5 / 6}
+    assert len(drums.geometry.blocks) == 7 and len(mono.geometry.blocks) == 1
     # paper: monolith 2772 kg for d = 0.58 m (d = H / (h/d) = 0.5833 m here); its
     # "231 kg" per drum is 2772 / 12 and cannot belong to 7 equal drums of that column
-    mass = 2960 * math.pi * (drums["diameter"] / 2) ** 2 * 3.5
+    mass = 2960 * math.pi * (3.5 / 6 / 2) ** 2 * 3.5
     assert mass == pytest.approx(2772, rel=0.02)
+    (body,) = mono.geometry.bodies()
+    assert body.mass == pytest.approx(mass, rel=1e-15)
     (single,) = Column("monolithic").specs()
-    assert single["x"] == 0.0
+    assert single.x == 0.0
 
 
 def test_generated_scene_never_contains_values(tmp_path):

@@ -1,0 +1,282 @@
+"""``invert``: a posterior over earthquake sources from fallen and standing columns.
+
+    python -m pipeline invert OBSERVATIONS.json [--out DIR] [--quick] [--scheduler ADDRESS]
+    python -m pipeline invert --demo [--grid demo]          # make invert-demo
+"""
+import math
+import os
+import time
+from pathlib import Path
+
+from pipeline import RESULTS_DIR
+from pipeline.files import InputError
+from pipeline.inversion import forward as _forward  # noqa: F401  (registers the campaign
+#                                                     inversion-forward before `campaign`)
+
+NAME = "invert"
+ORDER = 45
+HELP = "invert fallen columns for the earthquake source (posterior map, back azimuth)"
+DESCRIPTION = (
+    "Bayesian source inversion: candidate epicentres on a grid around the sites, mechanisms "
+    "(strike sampled), depths and magnitudes; the likelihood of each observed column (fallen "
+    "toward an azimuth, or standing) from a forward table of twin-model ensembles shaken by "
+    "pyprop8 synthetics (campaign inversion-forward, cached by content: a second inversion "
+    "reuses every run). Writes posterior.csv, inversion_summary.json, posterior_map.png and "
+    "marginals.png. Observations schema: README 'Inverting fallen columns for the source'.")
+
+
+def _floats(name):
+    def parse(text):
+        try:
+            values = tuple(float(v) for v in text.split(",") if v.strip())
+        except ValueError:
+            raise InputError(f"--{name}: not a comma-separated list of numbers: {text!r}") \
+                from None
+        if not values or not all(math.isfinite(v) for v in values):
+            raise InputError(f"--{name}: give finite numbers, got {text!r}")
+        return values
+    return parse
+
+
+def _weights(text):
+    out = {}
+    for item in text.split(","):
+        name, _, value = item.partition("=")
+        try:
+            out[name.strip()] = float(value)
+        except ValueError:
+            raise InputError(f"--mechanism-prior {item!r}: expected NAME=WEIGHT") from None
+        if not (math.isfinite(out[name.strip()]) and out[name.strip()] >= 0):
+            raise InputError(f"--mechanism-prior {item!r}: weights must be >= 0")
+    if not any(out.values()):
+        raise InputError("--mechanism-prior: at least one weight must be positive")
+    return out
+
+
+def setup(p):
+    from pipeline.inversion.forward import GRIDS, MECHANISMS
+    from pipeline.inversion.likelihood import DEFAULT_FLOOR, DEFAULT_KERNEL_DEG
+    full, quick = GRIDS["full"], GRIDS["quick"]
+    p.add_argument("observations", nargs="?", type=Path, metavar="OBSERVATIONS.json",
+                   help="sites with their fallen and standing columns (README schema)")
+    p.add_argument("--out", type=Path, default=None, metavar="DIR",
+                   help="output directory (default results/inversion/<file stem>; "
+                   "--demo: results/inversion)")
+    p.add_argument("--quick", action="store_true",
+                   help=f"coarse smoke run (a few minutes): {len(quick.slices())} slices, "
+                   f"rings {','.join(f'{v:g}' for v in quick.distances_km)} km every "
+                   f"{quick.azimuth_step_deg:g} deg, {quick.members} members, "
+                   f"{quick.duration_s:g} s motions to {quick.fmax_hz:g} Hz; candidates "
+                   "within 12 km, strike every 90 deg")
+    p.add_argument("--grid", choices=sorted(GRIDS), default=None,
+                   help="forward-grid preset (default full; --quick = quick; the demo "
+                   "machine ran 'demo'); the options below override it")
+    p.add_argument("--demo", action="store_true",
+                   help="synthetic truth tests and the paper's scenario (make invert-demo)")
+    p.add_argument("--scheduler", default=None, metavar="ADDRESS",
+                   help="run the forward campaign on an existing Dask cluster")
+    p.add_argument("--jobs", type=int, default=None,
+                   help="parallel YADE runs / pyprop8 processes (default: all cores)")
+    p.add_argument("--table", type=Path, default=None, metavar="FILE",
+                   help="use this forward table file (tables/forward_table_<key>.npz) as it "
+                   "is: no pyprop8, no YADE (its code version is reported, not checked)")
+    p.add_argument("--forward-dir", type=Path, default=None, metavar="DIR",
+                   help="campaign directory of the forward runs (default "
+                   "results/inversion-forward)")
+    g = p.add_argument_group("forward grid (the table: one ensemble per node)")
+    g.add_argument("--mechanisms", default=None, metavar="LIST",
+                   help="comma-separated, of " + ", ".join(
+                       f"{k} (dip {v[0]:g}, rake {v[1]:g})" for k, v in MECHANISMS.items())
+                   + " or NAME:DIP:RAKE (default: " + ",".join(m[0] for m in full.mechanisms)
+                   + ")")
+    g.add_argument("--depths", default=None, metavar="KM,KM",
+                   help="hypocentre depths (default "
+                   + ",".join(f"{v:g}" for v in full.depths_km) + ")")
+    g.add_argument("--magnitudes", default=None, metavar="MW,MW",
+                   help="moment magnitudes 4.5-7.5 (default "
+                   + ",".join(f"{v:g}" for v in full.magnitudes) + ")")
+    g.add_argument("--distances", default=None, metavar="KM,KM",
+                   help="table rings: epicentral distances (default "
+                   + ",".join(f"{v:g}" for v in full.distances_km) + ")")
+    g.add_argument("--azimuth-step", type=float, default=None, metavar="DEG",
+                   help=f"table node spacing in azimuth from strike (default "
+                   f"{full.azimuth_step_deg:g})")
+    g.add_argument("--members", type=int, default=None,
+                   help=f"ensemble members per node (default {full.members}; plus the "
+                   "nominal run)")
+    g.add_argument("--seed", type=int, default=None, help="Latin-hypercube seed")
+    g.add_argument("--fmax", type=float, default=None, metavar="HZ",
+                   help=f"synthetics up to this frequency (default {full.fmax_hz:g})")
+    g.add_argument("--duration", type=float, default=None, metavar="S",
+                   help=f"motion duration (default {full.duration_s:g} s)")
+    c = p.add_argument_group("candidates and prior")
+    c.add_argument("--radius", type=float, default=None, metavar="KM",
+                   help="epicentres within this distance of a site (default 30; quick 12; "
+                   "demo 25)")
+    c.add_argument("--step", type=float, default=None, metavar="KM",
+                   help="epicentre grid spacing (default 1)")
+    c.add_argument("--strike-step", type=float, default=None, metavar="DEG",
+                   help="strikes sampled every DEG from 0 (default 30; quick 90)")
+    c.add_argument("--mechanism-prior", default=None, metavar="NAME=W,...",
+                   help="prior weights of the mechanisms (default: equal)")
+    c.add_argument("--gr-b", type=float, default=None, metavar="B",
+                   help="Gutenberg-Richter prior on magnitude, 10^(-B M) (default uniform)")
+    c.add_argument("--kernel-deg", type=float, default=DEFAULT_KERNEL_DEG,
+                   help=f"width of the von Mises kernel on ensemble falls (default "
+                   f"{DEFAULT_KERNEL_DEG:g})")
+    c.add_argument("--floor", type=float, default=DEFAULT_FLOOR,
+                   help=f"fraction of uniform density mixed into every direction density "
+                   f"(default {DEFAULT_FLOOR:g})")
+    c.add_argument("--trials", type=int, default=None,
+                   help="--demo: trials per configuration (default 20)")
+
+
+CANDIDATE_PRESETS = {"quick": {"radius_km": 12.0, "step_km": 1.0, "strike_step_deg": 90.0},
+                     "demo": {"radius_km": 25.0, "step_km": 1.0, "strike_step_deg": 30.0},
+                     "full": {"radius_km": 30.0, "step_km": 1.0, "strike_step_deg": 30.0}}
+
+
+def build_grids(args):
+    """(preset name, TableGrid, CandidateGrid) from the options; InputError if impossible."""
+    from pipeline.inversion.forward import GRIDS, parse_mechanisms
+    from pipeline.inversion.posterior import CandidateGrid
+    if args.quick and args.grid not in (None, "quick"):
+        raise InputError("--quick is --grid quick: give one of them")
+    preset = "quick" if args.quick else (args.grid or "full")
+    mechanisms = parse_mechanisms(args.mechanisms) if args.mechanisms else None
+    depths = _floats("depths")(args.depths) if args.depths else None
+    magnitudes = _floats("magnitudes")(args.magnitudes) if args.magnitudes else None
+    distances = _floats("distances")(args.distances) if args.distances else None
+    prior = _weights(args.mechanism_prior) if args.mechanism_prior else None
+    grid = GRIDS[preset].replace(
+        mechanisms=mechanisms, depths_km=depths, magnitudes=magnitudes,
+        distances_km=distances, azimuth_step_deg=args.azimuth_step,
+        members=args.members, seed=args.seed, fmax_hz=args.fmax, duration_s=args.duration)
+    values = dict(CANDIDATE_PRESETS[preset])
+    for key, option in (("radius_km", args.radius), ("step_km", args.step),
+                        ("strike_step_deg", args.strike_step)):
+        if option is not None:
+            values[key] = option
+    candidates = CandidateGrid(
+        **values, mechanisms=None if mechanisms is None else tuple(m[0] for m in mechanisms),
+        depths_km=depths, magnitudes=magnitudes, mechanism_prior=prior, gr_b=args.gr_b)
+    return preset, grid, candidates
+
+
+def _check_jobs(jobs):
+    if jobs is not None and jobs < 1:
+        raise InputError(f"--jobs must be at least 1, got {jobs}")
+    return jobs or os.cpu_count() or 1
+
+
+def forward_table(args, grid):
+    """(ForwardTable, info dict): the --table file, or the campaign's (run or reused)."""
+    from pipeline.inversion.forward import ForwardTable, run_forward
+    if args.table is not None:
+        table = ForwardTable.load(args.table)
+        info = {"table": str(args.table), "grid": table.info.get("grid"),
+                "grid_key": table.info.get("grid_key"),
+                "code_version": table.info.get("code_version"),
+                "yade_wall_s": table.info.get("yade_wall_s"), "runs": table.info.get("runs"),
+                "reused_file": True}
+        return table, info
+    table, cost = run_forward(grid, args.forward_dir, _check_jobs(args.jobs), args.scheduler)
+    return table, {**cost, "grid": grid.as_dict(), "grid_key": grid.key(),
+                   "code_version": table.info.get("code_version"), "reused_file": False}
+
+
+def run(args):
+    from pipeline.inversion import run_inversion
+    from pipeline.inversion.observations import load_observations
+    if args.demo == (args.observations is not None):
+        raise InputError("give an OBSERVATIONS.json file or --demo (not both)")
+    if args.trials is not None and not (args.demo and 1 <= args.trials <= 1000):
+        raise InputError("--trials (1-1000) goes with --demo")
+    _check_jobs(args.jobs)
+    preset, grid, candidates = build_grids(args)
+    if args.demo:
+        return _run_demo(args, preset, grid, candidates)
+    observations = load_observations(args.observations)
+    columns = set(observations.column_types()) - {"drums", "monolithic"}
+    if columns:
+        raise InputError(f"{args.observations.name}: column(s) {', '.join(sorted(columns))}: "
+                         "only drums and monolithic are modelled by the forward table yet "
+                         "(column files: issue 'Real columns')")
+    out = args.out or RESULTS_DIR / "inversion" / args.observations.stem
+    if out.exists() and not out.is_dir():
+        raise InputError(f"--out {out} is a file, not a directory")
+    started = time.monotonic()
+    table, info = forward_table(args, grid)
+    summary = run_inversion(observations, out, table, candidates, args.kernel_deg,
+                            args.floor, forward_info=info)
+    lo, hi = summary["back_azimuth_ci95_deg"]
+    mech = max(summary["mechanism_posterior"], key=summary["mechanism_posterior"].get)
+    print(f"{observations.n_fallen} fallen of {observations.n_columns} columns at "
+          f"{len(observations.sites)} site(s); {summary['candidates']} candidates")
+    print(f"back azimuth from {summary['first_site']}: MAP {summary['back_azimuth_map_deg']:.0f}"
+          f" deg, 95 % arc [{lo:.0f}, {hi:.0f}] ({summary['back_azimuth_ci95_width_deg']:.0f} "
+          f"deg); distance 95 % {summary['distance_ci95_km'][0]:.1f}-"
+          f"{summary['distance_ci95_km'][1]:.1f} km; 95 % area "
+          f"{summary['credible_area_95_km2']:.0f} km^2; most probable mechanism {mech} "
+          f"({summary['mechanism_posterior'][mech]:.2f})")
+    print(f"wrote {out} ({time.monotonic() - started:.0f} s)")
+    return 0
+
+
+def _run_demo(args, preset, grid, candidates):
+    from pipeline.inversion import EXAMPLES_DIR, run_inversion
+    from pipeline.inversion.demo import DEFAULT_TRIALS, paper_grid, paper_nodes, run_demo
+    from pipeline.inversion.forward import ForwardTable, run_forward, table_path
+    from pipeline.inversion.observations import load_observations
+    out = args.out or RESULTS_DIR / "inversion"
+    if out.exists() and not out.is_dir():
+        raise InputError(f"--out {out} is a file, not a directory")
+    started = time.monotonic()
+    table, info = forward_table(args, grid)
+    costs = {"main": info}
+    paper_tables = {}
+    for source in ("strike_slip", "thrust"):
+        if paper_nodes(table, source) is not None:
+            paper_tables[source] = table
+            continue
+        pgrid = paper_grid(grid, source, quick=preset == "quick")
+        if args.table is not None:      # a table file: its siblings, else nothing is run
+            sibling = Path(args.table).parent / table_path(".", pgrid).name
+            if sibling.is_file():
+                paper_tables[source] = ForwardTable.load(sibling)
+                costs[f"paper_{source}"] = {"table": str(sibling), "reused_file": True,
+                                            "yade_wall_s": paper_tables[source].info.get(
+                                                "yade_wall_s"),
+                                            "runs": paper_tables[source].info.get("runs")}
+            continue
+        paper_tables[source], cost = run_forward(pgrid, args.forward_dir,
+                                                 _check_jobs(args.jobs), args.scheduler)
+        costs[f"paper_{source}"] = {**cost, "grid": pgrid.as_dict()}
+    summary = run_demo(table, out, candidates, paper_tables, args.trials or DEFAULT_TRIALS,
+                       args.kernel_deg, args.floor, forward_info={**info, "costs": costs,
+                                                                  "preset": preset})
+    example = EXAMPLES_DIR / "two_sites.json"
+    observations = load_observations(example)
+    if set(observations.column_types()) <= set(table.columns):
+        ex = run_inversion(observations, out / "example_two_sites", table, candidates,
+                           args.kernel_deg, args.floor, forward_info=info)
+        summary["example"] = {"file": f"pipeline/inversion/examples/{example.name}",
+                              **{k: ex[k] for k in ("map_epicentre_km", "back_azimuth_map_deg",
+                                                    "back_azimuth_ci95_deg",
+                                                    "back_azimuth_ci68_deg",
+                                                    "distance_ci95_km", "mechanism_posterior",
+                                                    "credible_area_95_km2")}}
+    summary["elapsed_s"] = round(time.monotonic() - started, 1)
+    from pipeline.files import write_json
+    write_json(out / "demo_summary.json", summary)
+    cov = summary["coverage"]
+    print(f"truth tests: {cov['trials']} inversions; 95 % back-azimuth arc holds the truth in "
+          f"{cov['back_azimuth_95']:.0%}, the 95 % epicentre region in {cov['epicentre_95']:.0%}")
+    for row in summary["bound_30_deg"]:
+        k = row["fallen_per_site"]
+        print(f"  {row['mechanism']}, {row['sites']} site(s): " +
+              (f"+-30 deg from {k} fallen column(s) per site" if k else
+               f"not within +-30 deg (median {row['largest_tested_width_median_deg']:.0f} deg "
+               "at the most columns tried)"))
+    print(f"wrote {out / 'demo_summary.json'} ({summary['elapsed_s']:.0f} s)")
+    return 0

@@ -1,0 +1,197 @@
+"""Likelihood of observed columns for candidate sources, from a forward table.
+
+For one candidate (slice = mechanism, depth, magnitude; strike phi; epicentre E) and one
+site S: r = |S - E| and alpha = azimuth from E to S; the node coordinates are r and
+theta = alpha - phi (azimuth from the strike).  Per node and column type the table gives
+
+- P(toppled) = (k + 1/2) / (n + 1) for k falls among n members (the posterior mean under
+  Jeffreys' prior: never 0 or 1, so one surprising column cannot zero a candidate);
+- the circular density of downfall azimuths *relative to the direction from epicentre to
+  site* (a downfall azimuth psi, strike frame, at node azimuth theta_n becomes
+  psi - theta_n): a von Mises kernel mixture over the members' falls, the kernel width
+  ``kernel_deg`` and the observation's ``uncertainty_deg`` added in quadrature (von Mises
+  concentration with the wrapped normal's mean resultant length exp(-sigma^2/2)), floored
+  by mixing a fraction ``floor`` of the uniform density (1 / 2 pi per radian).
+
+A fallen column observed at geographic azimuth psi_obs contributes
+f(psi_obs - alpha) = sum_nodes w P_n d_n(psi_obs - alpha), a standing one
+sum_nodes w (1 - P_n): the sub-density of "fell toward psi" and the probability of
+standing are interpolated as mixtures of the four surrounding nodes, bilinearly in
+log distance (clamped at the first and last ring) and in node azimuth (periodic).
+Interpolating in the site frame moves a fall direction that is fixed relative to the
+source-to-site direction smoothly between nodes.  Log-likelihood = sum over columns.
+Densities are per radian.
+"""
+import math
+
+import numpy as np
+from scipy import optimize, special
+
+from pipeline.files import InputError
+
+DEFAULT_KERNEL_DEG = 20.0
+DEFAULT_FLOOR = 0.05
+PSI_STEP_DEG = 0.5
+OBS_CHUNK = 8                  # observations per vectorised block (memory)
+
+
+def mean_resultant_length(kappa):
+    """A(kappa) = I1(kappa) / I0(kappa) of a von Mises distribution."""
+    return special.i1e(kappa) / special.i0e(kappa)
+
+
+def concentration(sigma_deg):
+    """Von Mises concentration whose mean resultant length is the wrapped normal's,
+    exp(-sigma^2 / 2) (sigma in deg); inf for sigma 0."""
+    sigma = math.radians(float(sigma_deg))
+    if sigma <= 0:
+        return math.inf
+    target = math.exp(-sigma * sigma / 2.0)
+    if target < 1e-8:
+        return 0.0
+    return float(optimize.brentq(lambda k: mean_resultant_length(k) - target, 1e-10, 1e8,
+                                 xtol=1e-12, rtol=1e-12))
+
+
+def von_mises_pdf(x_rad, kappa):
+    """Von Mises density (per radian) at angles ``x_rad`` about 0, stable for large kappa."""
+    x = np.asarray(x_rad, float)
+    if kappa == 0:
+        return np.full(x.shape, 1.0 / (2 * math.pi))
+    return np.exp(kappa * (np.cos(x) - 1.0)) / (2 * math.pi * special.i0e(kappa))
+
+
+def p_toppled(k, n):
+    """(k + 1/2) / (n + 1)."""
+    return (np.asarray(k, float) + 0.5) / (np.asarray(n, float) + 1.0)
+
+
+class ForwardModel:
+    """Per-node toppling probabilities and direction densities of a forward table."""
+
+    def __init__(self, table, kernel_deg=DEFAULT_KERNEL_DEG, floor=DEFAULT_FLOOR):
+        if not (0 < kernel_deg <= 90):
+            raise InputError(f"--kernel-deg must lie in (0, 90], got {kernel_deg:g}")
+        if not (0 < floor < 1):
+            raise InputError(f"--floor must lie in (0, 1), got {floor:g}")
+        self.table, self.kernel_deg, self.floor = table, float(kernel_deg), float(floor)
+        self.k = table.toppled.sum(axis=-1)
+        self.n = table.valid.sum(axis=-1)
+        self.p = p_toppled(self.k, self.n)                       # (ns, nr, na, nc)
+        theta = table.azimuths_deg[None, None, :, None, None]
+        self.relative = np.where(table.toppled, np.mod(table.azimuth_deg - theta, 360.0),
+                                 np.nan)                         # site frame, deg
+        self.psi = np.arange(0.0, 360.0, PSI_STEP_DEG)
+        self._fallen = {}
+
+    # ------------------------------------------------------------------ node tables
+    def direction_density(self, sigma_deg):
+        """d_n(psi) per radian on ``self.psi`` (site frame), floored: (ns, nr, na, nc, npsi)."""
+        kappa = concentration(math.hypot(self.kernel_deg, sigma_deg))
+        fell = np.isfinite(self.relative)
+        count = fell.sum(axis=-1)
+        diff = np.radians(self.psi[None, :] - np.where(fell, self.relative, 0.0)[..., None])
+        kernel = von_mises_pdf(diff, kappa) * fell[..., None]
+        with np.errstate(invalid="ignore", divide="ignore"):
+            mixture = kernel.sum(axis=-2) / count[..., None]
+        mixture = np.where(count[..., None] > 0, mixture, 1.0 / (2 * math.pi))
+        return (1.0 - self.floor) * mixture + self.floor / (2 * math.pi)
+
+    def fallen_table(self, sigma_deg):
+        """P_n d_n(psi): (ns, nr, na, nc, npsi), cached per uncertainty."""
+        key = round(float(sigma_deg), 9)
+        if key not in self._fallen:
+            self._fallen[key] = self.p[..., None] * self.direction_density(sigma_deg)
+        return self._fallen[key]
+
+    def column_index(self, column):
+        try:
+            return self.table.columns.index(column)
+        except ValueError:
+            raise InputError(f"column {column!r}: the forward table models "
+                             f"{' and '.join(self.table.columns)} only (column files: issue "
+                             "'Real columns')") from None
+
+    # ------------------------------------------------------------------ weights
+    def distance_weights(self, r_km):
+        """(i0, i1, w1): rings around r, weight of i1, linear in log r, clamped."""
+        rings = np.log(self.table.distances_km)
+        x = np.log(np.maximum(np.asarray(r_km, float), 1e-6))
+        if len(rings) == 1:
+            zero = np.zeros(x.shape, int)
+            return zero, zero, np.zeros(x.shape)
+        i1 = np.clip(np.searchsorted(rings, x), 1, len(rings) - 1)
+        i0 = i1 - 1
+        w1 = np.clip((x - rings[i0]) / (rings[i1] - rings[i0]), 0.0, 1.0)
+        return i0, i1, w1
+
+    def azimuth_weights(self, theta_deg):
+        """(i0, i1, w1): node azimuths around theta (periodic), weight of i1."""
+        na = len(self.table.azimuths_deg)
+        x = np.mod(np.asarray(theta_deg, float), 360.0) / (360.0 / na)
+        i0 = np.floor(x).astype(int)
+        w1 = x - i0
+        return i0 % na, (i0 + 1) % na, w1
+
+    def _psi_weights(self, psi_deg):
+        x = np.mod(psi_deg, 360.0) / PSI_STEP_DEG
+        j0 = np.floor(x).astype(int)
+        return j0 % len(self.psi), (j0 + 1) % len(self.psi), x - j0
+
+    # ------------------------------------------------------------------ likelihood
+    def site_log_likelihood(self, site, east_km, north_km, strikes_deg):
+        """Log-likelihood of one site's columns: (ns, n_strikes, n_epicentres)."""
+        east, north = np.asarray(east_km, float), np.asarray(north_km, float)
+        strikes = np.asarray(strikes_deg, float)
+        dx, dy = site.east_km - east, site.north_km - north
+        r = np.hypot(dx, dy)
+        alpha = np.mod(np.degrees(np.arctan2(dx, dy)), 360.0)     # epicentre -> site
+        ri0, ri1, rw = self.distance_weights(r)
+        ai0, ai1, aw = self.azimuth_weights(alpha[None, :] - strikes[:, None])   # (nphi, ne)
+        ns, ne, nphi = self.p.shape[0], east.size, strikes.size
+        out = np.zeros((ns, nphi, ne))
+        by_type = {}
+        for obs in site.columns:
+            by_type.setdefault(self.column_index(obs.column), []).append(obs)
+        for c, group in by_type.items():
+            standing = sum(not o.fallen for o in group)
+            if standing:
+                q = 1.0 - self.p[..., c]                                  # (ns, nr, na)
+                qe = (1 - rw)[None, :, None] * q[:, ri0, :] + rw[None, :, None] * q[:, ri1, :]
+                for f in range(nphi):                                     # qe: (ns, ne, na)
+                    val = _pick(qe, ai0[f], ai1[f], aw[f])
+                    out[:, f, :] += standing * np.log(val)
+            fallen = [o for o in group if o.fallen]
+            for start in range(0, len(fallen), OBS_CHUNK):
+                chunk = fallen[start:start + OBS_CHUNK]
+                for sigma in sorted({o.uncertainty_deg for o in chunk}):
+                    obs = [o for o in chunk if o.uncertainty_deg == sigma]
+                    table = self.fallen_table(sigma)[..., c, :]           # (ns, nr, na, npsi)
+                    psi_obs = np.array([o.downfall_azimuth_deg for o in obs])
+                    j0, j1, pw = self._psi_weights(psi_obs[:, None] - alpha[None, :])
+                    g = 0.0
+                    for ring, wr in ((ri0, 1 - rw), (ri1, rw)):
+                        lo = table[:, ring[None, :], :, j0]               # (no, ne, ns, na)
+                        hi = table[:, ring[None, :], :, j1]
+                        g = g + wr[None, :, None, None] * (
+                            (1 - pw)[..., None, None] * lo + pw[..., None, None] * hi)
+                    g = g.transpose(2, 0, 1, 3)                           # (ns, no, ne, na)
+                    for f in range(nphi):
+                        val = _pick(g, ai0[f], ai1[f], aw[f])             # (ns, no, ne)
+                        out[:, f, :] += np.log(val).sum(axis=1)
+        return out
+
+    def log_likelihood(self, observations, east_km, north_km, strikes_deg):
+        """Sum over sites: (ns, n_strikes, n_epicentres)."""
+        total = 0.0
+        for site in observations.sites:
+            total = total + self.site_log_likelihood(site, east_km, north_km, strikes_deg)
+        return total
+
+
+def _pick(values, i0, i1, w1):
+    """Interpolate ``values[..., e, a]`` at node azimuth indices (i0, i1, weight w1) per e."""
+    shape = (1,) * (values.ndim - 2) + (values.shape[-2], 1)
+    lo = np.take_along_axis(values, i0.reshape(shape), axis=-1)[..., 0]
+    hi = np.take_along_axis(values, i1.reshape(shape), axis=-1)[..., 0]
+    return (1 - w1) * lo + w1 * hi

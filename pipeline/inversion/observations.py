@@ -1,0 +1,225 @@
+"""Observations of an inversion: sites with fallen and standing columns.
+
+Schema (keys are a contract)::
+
+    {"sites": [{"name": "A", "east_km": 0, "north_km": 0,
+                "columns": [{"column": "drums", "state": "fallen",
+                             "downfall_azimuth_deg": 240, "uncertainty_deg": 10},
+                            {"column": "monolithic", "state": "standing"}]}]}
+
+A site gives its position either as ``east_km``/``north_km`` (any local frame) or as
+``latitude``/``longitude`` (degrees), the same way for every site.  Positions are turned
+into km East/North of the first site: geographic ones on the local tangent plane about the
+first site (azimuthal equidistant: distance and azimuth from obspy.geodetics).
+``column`` is ``drums``, ``monolithic`` or a column file name (accepted and kept; the
+forward table models drums and monolithic only).  ``uncertainty_deg`` (optional, default
+10) is the 1-sigma uncertainty of the measured downfall azimuth.  Every problem is one
+line naming the site and column.
+"""
+import json
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from pipeline.files import InputError
+
+DEFAULT_UNCERTAINTY_DEG = 10.0
+MAX_UNCERTAINTY_DEG = 120.0
+STATES = ("fallen", "standing")
+SITE_KEYS = {"name", "east_km", "north_km", "latitude", "longitude", "columns"}
+COLUMN_KEYS = {"column", "state", "downfall_azimuth_deg", "uncertainty_deg", "note"}
+
+
+@dataclass(frozen=True)
+class ColumnObservation:
+    column: str
+    state: str
+    downfall_azimuth_deg: float = None
+    uncertainty_deg: float = DEFAULT_UNCERTAINTY_DEG
+
+    @property
+    def fallen(self):
+        return self.state == "fallen"
+
+
+@dataclass(frozen=True)
+class Site:
+    name: str
+    east_km: float          # East of the first site
+    north_km: float         # North of the first site
+    columns: tuple
+    latitude: float = None
+    longitude: float = None
+
+
+@dataclass(frozen=True)
+class Observations:
+    sites: tuple
+    source: str = "observations"
+    meta: dict = field(default_factory=dict)
+
+    @property
+    def n_columns(self):
+        return sum(len(s.columns) for s in self.sites)
+
+    @property
+    def n_fallen(self):
+        return sum(c.fallen for s in self.sites for c in s.columns)
+
+    def column_types(self):
+        return sorted({c.column for s in self.sites for c in s.columns})
+
+    def as_dict(self):
+        """The observations in the file's schema, positions in km from the first site."""
+        sites = []
+        for s in self.sites:
+            site = {"name": s.name, "east_km": s.east_km, "north_km": s.north_km}
+            if s.latitude is not None:
+                site.update(latitude=s.latitude, longitude=s.longitude)
+            site["columns"] = [{"column": c.column, "state": c.state,
+                                **({"downfall_azimuth_deg": c.downfall_azimuth_deg,
+                                    "uncertainty_deg": c.uncertainty_deg} if c.fallen else {})}
+                               for c in s.columns]
+            sites.append(site)
+        return {"sites": sites}
+
+    def turned(self, degrees):
+        """The observations turned clockwise by ``degrees`` about the first site: positions
+        and downfall azimuths (a check of the inversion's rotational symmetry)."""
+        a = math.radians(degrees)
+        sites = []
+        for s in self.sites:
+            east = s.east_km * math.cos(a) + s.north_km * math.sin(a)
+            north = -s.east_km * math.sin(a) + s.north_km * math.cos(a)
+            cols = tuple(ColumnObservation(c.column, c.state,
+                                           None if not c.fallen else
+                                           (c.downfall_azimuth_deg + degrees) % 360.0,
+                                           c.uncertainty_deg) for c in s.columns)
+            sites.append(Site(s.name, east, north, cols))
+        return Observations(tuple(sites), self.source, dict(self.meta))
+
+
+def _number(value, what, low=None, high=None):
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise InputError(f"{what} must be a number, got {value!r}")
+    value = float(value)
+    if not math.isfinite(value):
+        raise InputError(f"{what} must be finite, got {value!r}")
+    if (low is not None and value < low) or (high is not None and value > high):
+        raise InputError(f"{what} must lie in [{low:g}, {high:g}], got {value:g}")
+    return value
+
+
+def parse_column(item, where):
+    if not isinstance(item, dict):
+        raise InputError(f"{where}: a column must be an object, got {type(item).__name__}")
+    unknown = sorted(set(item) - COLUMN_KEYS)
+    if unknown:
+        raise InputError(f"{where}: unknown key(s) {', '.join(unknown)} (known: "
+                         f"{', '.join(sorted(COLUMN_KEYS))})")
+    column = item.get("column")
+    if not isinstance(column, str) or not column.strip():
+        raise InputError(f"{where}: 'column' must be drums, monolithic or a column file name")
+    state = item.get("state")
+    if state not in STATES:
+        raise InputError(f"{where}: 'state' must be 'fallen' or 'standing', got {state!r}")
+    if state == "standing":
+        if item.get("downfall_azimuth_deg") is not None:
+            raise InputError(f"{where}: a standing column has no downfall_azimuth_deg")
+        return ColumnObservation(column.strip(), state)
+    if item.get("downfall_azimuth_deg") is None:
+        raise InputError(f"{where}: a fallen column needs downfall_azimuth_deg")
+    azimuth = _number(item["downfall_azimuth_deg"], f"{where}: downfall_azimuth_deg", 0.0, 360.0)
+    sigma = item.get("uncertainty_deg", DEFAULT_UNCERTAINTY_DEG)
+    sigma = _number(sigma, f"{where}: uncertainty_deg", 0.0, MAX_UNCERTAINTY_DEG)
+    return ColumnObservation(column.strip(), state, azimuth % 360.0, sigma)
+
+
+def parse_observations(data, source="observations"):
+    """:class:`Observations` from the parsed JSON ``data``; InputError (one line) if bad."""
+    if not isinstance(data, dict) or "sites" not in data:
+        raise InputError(f"{source}: expected an object with a 'sites' list")
+    sites = data["sites"]
+    if not isinstance(sites, list) or not sites:
+        raise InputError(f"{source}: 'sites' must be a non-empty list")
+    raw, names = [], set()
+    for k, site in enumerate(sites):
+        where = f"{source}: site {k + 1}"
+        if not isinstance(site, dict):
+            raise InputError(f"{where}: must be an object, got {type(site).__name__}")
+        name = site.get("name", f"site{k + 1}")
+        if not isinstance(name, str) or not name.strip():
+            raise InputError(f"{where}: 'name' must be a non-empty string")
+        where = f"{source}: site {name!r}"
+        if name in names:
+            raise InputError(f"{where}: two sites have this name")
+        names.add(name)
+        unknown = sorted(set(site) - SITE_KEYS)
+        if unknown:
+            raise InputError(f"{where}: unknown key(s) {', '.join(unknown)} (known: "
+                             f"{', '.join(sorted(SITE_KEYS))})")
+        has_km = "east_km" in site or "north_km" in site
+        has_geo = "latitude" in site or "longitude" in site
+        if has_km == has_geo:
+            raise InputError(f"{where}: give either east_km and north_km or latitude and "
+                             "longitude")
+        if has_km:
+            if "east_km" not in site or "north_km" not in site:
+                raise InputError(f"{where}: needs both east_km and north_km")
+            position = ("km", _number(site["east_km"], f"{where}: east_km", -1e4, 1e4),
+                        _number(site["north_km"], f"{where}: north_km", -1e4, 1e4))
+        else:
+            if "latitude" not in site or "longitude" not in site:
+                raise InputError(f"{where}: needs both latitude and longitude")
+            position = ("geo", _number(site["latitude"], f"{where}: latitude", -90.0, 90.0),
+                        _number(site["longitude"], f"{where}: longitude", -180.0, 360.0))
+        columns = site.get("columns")
+        if not isinstance(columns, list) or not columns:
+            raise InputError(f"{where}: 'columns' must be a non-empty list")
+        parsed = tuple(parse_column(c, f"{where}, column {j + 1}")
+                       for j, c in enumerate(columns))
+        raw.append((name, position, parsed))
+    kinds = {p[0] for _, p, _ in raw}
+    if len(kinds) > 1:
+        raise InputError(f"{source}: mixes east_km/north_km and latitude/longitude between "
+                         "sites; use one for all")
+    out = []
+    if kinds == {"km"}:
+        _, e0, n0 = raw[0][1]
+        for name, (_, e, n), cols in raw:
+            out.append(Site(name, e - e0, n - n0, cols))
+    else:
+        from obspy.geodetics import gps2dist_azimuth
+        _, lat0, lon0 = raw[0][1]
+        for name, (_, lat, lon), cols in raw:
+            if (lat, lon) == (lat0, lon0):
+                east = north = 0.0
+            else:
+                dist_m, az, _ = gps2dist_azimuth(lat0, lon0, lat, lon)
+                east = dist_m / 1e3 * math.sin(math.radians(az))
+                north = dist_m / 1e3 * math.cos(math.radians(az))
+            if math.hypot(east, north) > 300.0:
+                raise InputError(f"{source}: site {name!r} lies {math.hypot(east, north):.0f} "
+                                 "km from the first site (more than 300 km: not one region)")
+            out.append(Site(name, east, north, cols, lat, lon))
+    for k, a in enumerate(out):
+        for b in out[:k]:
+            if math.hypot(a.east_km - b.east_km, a.north_km - b.north_km) < 1e-6:
+                raise InputError(f"{source}: sites {b.name!r} and {a.name!r} are at the same "
+                                 "place; list their columns under one site")
+    return Observations(tuple(out), source)
+
+
+def load_observations(path):
+    """Read and check an observations file; InputError (one line) for any problem."""
+    path = Path(path)
+    if not path.is_file():
+        raise InputError(f"observations file not found: {path}")
+    try:
+        data = json.loads(path.read_text())
+    except UnicodeDecodeError:
+        raise InputError(f"{path.name}: not a text (JSON) file") from None
+    except json.JSONDecodeError as exc:
+        raise InputError(f"{path.name}: not valid JSON (line {exc.lineno}, column "
+                         f"{exc.colno}: {exc.msg})") from None
+    return parse_observations(data, path.name)

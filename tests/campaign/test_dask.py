@@ -1,0 +1,225 @@
+"""The Dask executor: tasks carry their inputs, a campaign on an existing cluster gives the
+local run's ids and outcomes, a killed worker loses no finished result, Ctrl-C stops it."""
+import json
+import os
+import signal
+import socket
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import pandas as pd
+import pytest
+
+from pipeline import cli
+from pipeline.campaign.executor import TASK_PREFIX, run_task, worker_code_version
+from pipeline.motion import Motion
+from pipeline.motion.pulses import one_sine_pulse
+
+PROJECT = Path(__file__).resolve().parents[2]
+DASK = Path(sys.executable).parent / "dask"
+
+
+def pulse_npz(path, azimuth_deg, amplitude=5.0, duration=5.0):
+    """A processed one-sine pulse motion (strong enough to topple the twin model)."""
+    m = one_sine_pulse(azimuth_deg, amplitude, duration=duration)
+    return Motion(m.dt, m.acc, m.vel, m.disp, meta={"record_id": path.stem}).save(path)
+
+
+# ---------------------------------------------------------------- the task, without YADE
+def fake_worker(spec, run_dir):
+    """Stands in for run_column_spec: reads the motion, writes what a run writes."""
+    motion = Motion.load(spec["motion_file"])
+    (run_dir / "trajectory.npz").write_bytes(b"trajectory")
+    (run_dir / "yade.log").write_text(f"ran in {run_dir}\n")
+    if spec.get("fail"):
+        raise RuntimeError(f"boom; see {run_dir / 'yade.log'}")
+    (run_dir / "summary.json").write_text(json.dumps(
+        {"record": motion.record_id, "parameters": {"motion_file": spec["motion_file"]},
+         "log": str(run_dir / "yade.log")}))
+
+
+def test_task_carries_its_motion_and_returns_files_with_client_paths(tmp_path):
+    data = pulse_npz(tmp_path / "a.npz", 0.0).read_bytes()
+    spec = {"run_id": "r1", "record": "a", "motion_file": "/client/only/a.npz"}   # not here
+    code, client_dir = worker_code_version(), "/client/camp/runs/r1"
+    result = run_task(fake_worker, spec, data, client_dir, code, "t0")
+    assert result["error"] is None
+    assert sorted(result["files"]) == ["summary.json", "trajectory.npz", "yade.log"]
+    summary = json.loads(result["files"]["summary.json"])
+    assert summary["record"] == "a"
+    assert summary["parameters"]["motion_file"] == "/client/only/a.npz"
+    assert summary["log"] == client_dir + "/yade.log"
+    lean = run_task(fake_worker, dict(spec, keep_trajectory=False), data, client_dir, code, "t0")
+    assert sorted(lean["files"]) == ["summary.json"]
+    failed = run_task(fake_worker, dict(spec, fail=True), data, client_dir, code, "t0")
+    assert failed["message"] == f"boom; see {client_dir}/yade.log"
+    assert sorted(failed["files"]) == ["yade.log"]          # logs, no summary, no npz
+    assert not list(Path(tempfile.gettempdir()).glob(f"{TASK_PREFIX}-t0-*"))
+    with pytest.raises(Exception, match="other code"):
+        run_task(fake_worker, spec, data, client_dir, "0" * 16, "t0")
+
+
+# ---------------------------------------------------------------- a real cluster on 127.0.0.1
+def free_port():
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+class Cluster:
+    """`dask scheduler` and `dask worker --nthreads 1` processes on 127.0.0.1."""
+
+    def __init__(self, directory):
+        self.directory, self.port = directory, free_port()
+        self.address = f"tcp://127.0.0.1:{self.port}"
+        self.processes = []
+
+    def start(self, *args):
+        with open(self.directory / f"dask{len(self.processes)}.log", "w") as log:
+            proc = subprocess.Popen([str(DASK), *args], cwd=PROJECT, stdout=log,
+                                    stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL,
+                                    start_new_session=True)
+        self.processes.append(proc)
+        return proc
+
+    # Should the test process die before its finaliser: the scheduler ends after 2 idle
+    # minutes, its workers 30 s after losing it.
+    def scheduler(self):
+        return self.start("scheduler", "--host", "127.0.0.1", "--port", str(self.port),
+                          "--no-dashboard", "--dashboard-address", "127.0.0.1:0",
+                          "--idle-timeout", "120s")
+
+    def worker(self):
+        return self.start("worker", self.address, "--nthreads", "1", "--no-nanny",
+                          "--host", "127.0.0.1", "--no-dashboard",
+                          "--dashboard-address", "127.0.0.1:0", "--death-timeout", "30s",
+                          "--local-directory", str(self.directory))
+
+    def wait_for_workers(self, n, timeout_s=60):
+        from distributed import Client
+        with Client(self.address, timeout=timeout_s) as client:
+            client.wait_for_workers(n, timeout=timeout_s)
+
+    def stop(self):
+        """Kill every process started (a worker's YADE children die with it)."""
+        for proc in reversed(self.processes):
+            if proc.poll() is None:
+                proc.kill()
+            proc.wait()
+
+
+@pytest.fixture(scope="module")
+def cluster(tmp_path_factory):
+    cluster = Cluster(tmp_path_factory.mktemp("dask"))
+    try:
+        cluster.scheduler()
+        cluster.worker()
+        cluster.worker()
+        cluster.wait_for_workers(2)
+        yield cluster
+    finally:
+        cluster.stop()
+
+
+def task_yade_processes():
+    """{pid: parent pid} of scene processes running in a Dask task's temporary directory."""
+    found = {}
+    prefix = os.path.join(tempfile.gettempdir(), f"{TASK_PREFIX}-")
+    for pid in filter(str.isdigit, os.listdir("/proc")):
+        try:
+            cmd = Path(f"/proc/{pid}/cmdline").read_bytes()
+            cwd = os.readlink(f"/proc/{pid}/cwd")
+            parent = int(Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[1])
+        except (OSError, ValueError):
+            continue
+        if b"run_scene.py" in cmd and cwd.startswith(prefix):
+            found[int(pid)] = parent
+    return found
+
+
+def campaign_args(records, out, *extra):
+    return ["campaign", "records", "--records", ",".join(map(str, records)), "--out", str(out),
+            "--animations", "0", *extra]
+
+
+def cli_process(*args):
+    return subprocess.Popen([sys.executable, "-m", "pipeline", *args], cwd=PROJECT,
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+
+
+def run_ids(out):
+    return sorted(p.parent.name for p in out.glob("runs/*/summary.json"))
+
+
+@pytest.mark.yade
+def test_a_campaign_on_a_cluster_gives_the_local_run_ids_and_outcomes(tmp_path, cluster,
+                                                                        capsys):
+    records = [pulse_npz(tmp_path / "a.npz", 0.0), pulse_npz(tmp_path / "b.npz", 90.0)]
+    local, remote = tmp_path / "local", tmp_path / "remote"
+    assert cli.main(campaign_args(records, local, "--jobs", "2")) == 0
+    assert cli.main(campaign_args(records, remote, "--scheduler", cluster.address)) == 0
+    assert run_ids(remote) == run_ids(local) and len(run_ids(local)) == 2
+    a, b = pd.read_csv(local / "runs.csv"), pd.read_csv(remote / "runs.csv")
+    pd.testing.assert_frame_equal(a, b)              # same outcomes, paths and parameters
+    assert b["toppled"].all()
+    pd.testing.assert_frame_equal(pd.read_parquet(remote / "runs.parquet"), b,
+                                  check_dtype=False)
+    for run_id in run_ids(local):                    # the same files in each run directory
+        files = sorted(p.name for p in (local / "runs" / run_id).iterdir())
+        assert sorted(p.name for p in (remote / "runs" / run_id).iterdir()) == files
+        assert "trajectory.npz" in files
+    # resume by run id: nothing left to run
+    assert cli.main(campaign_args(records, remote, "--scheduler", cluster.address)) == 0
+    assert "2 already done, 0 to run" in capsys.readouterr().out
+
+
+@pytest.mark.yade
+def test_ctrl_c_on_a_cluster_stops_within_two_seconds_and_kills_its_runs(tmp_path, cluster):
+    records = [pulse_npz(tmp_path / f"p{k}.npz", 45.0 * k, duration=20.0) for k in range(2)]
+    out = tmp_path / "camp"
+    proc = cli_process(*campaign_args(records, out, "--scheduler", cluster.address))
+    deadline = time.monotonic() + 60
+    while not task_yade_processes() and time.monotonic() < deadline:
+        time.sleep(0.05)
+    assert task_yade_processes(), "no YADE run started on the workers"
+    sent = time.monotonic()
+    proc.send_signal(signal.SIGINT)
+    proc.communicate(timeout=30)
+    assert time.monotonic() - sent < 2.0
+    assert proc.returncode == 130
+    assert json.loads((out / "campaign.json").read_text())["interrupted"] is True
+    deadline = time.monotonic() + 5
+    while task_yade_processes() and time.monotonic() < deadline:
+        time.sleep(0.05)
+    assert not task_yade_processes(), "the workers kept running the interrupted campaign"
+
+
+@pytest.mark.yade
+def test_a_killed_worker_loses_no_finished_result(tmp_path, cluster):
+    victim = cluster.worker()                         # a third worker, killed mid-campaign
+    cluster.wait_for_workers(3)
+    records = [pulse_npz(tmp_path / f"p{k}.npz", 30.0 * k) for k in range(6)]
+    out = tmp_path / "camp"
+    proc = cli_process(*campaign_args(records, out, "--scheduler", cluster.address))
+
+    def ready():        # a result is in, and the third worker runs YADE
+        return (any(out.glob("runs/*/summary.json"))
+                and victim.pid in task_yade_processes().values())
+
+    deadline = time.monotonic() + 90
+    while not ready() and time.monotonic() < deadline:
+        time.sleep(0.05)
+    assert ready(), "no result, or the third worker runs nothing"
+    finished = {p.parent.name: p.read_bytes() for p in out.glob("runs/*/summary.json")}
+    victim.send_signal(signal.SIGKILL)
+    victim.wait()
+    _, err = proc.communicate(timeout=120)
+    assert proc.returncode == 0, err
+    assert len(run_ids(out)) == 6
+    for run_id, summary in finished.items():         # finished results kept as they were
+        assert (out / "runs" / run_id / "summary.json").read_bytes() == summary
+    assert len(pd.read_csv(out / "runs.csv")) == 12  # 6 runs x 2 columns
+    assert not task_yade_processes()

@@ -1,0 +1,131 @@
+"""The likelihood against numbers computed by hand on a tiny forward table."""
+import math
+
+import numpy as np
+import pytest
+from scipy import optimize, special
+
+from pipeline.inversion.forward import ForwardTable
+from pipeline.inversion.likelihood import ForwardModel, concentration
+from pipeline.inversion.observations import ColumnObservation, Site
+
+KERNEL, SIGMA, FLOOR = 20.0, 10.0, 0.05
+
+
+def kappa_by_hand(sigma_deg):
+    """Von Mises kappa with I1/I0 = exp(-sigma^2/2) (scipy.special.iv, brentq)."""
+    target = math.exp(-math.radians(sigma_deg) ** 2 / 2)
+    return optimize.brentq(lambda k: special.iv(1, k) / special.iv(0, k) - target, 1e-6, 500)
+
+
+def vm(x_deg, kappa):
+    return math.exp(kappa * math.cos(math.radians(x_deg))) / (2 * math.pi * special.iv(0, kappa))
+
+
+@pytest.fixture
+def tiny():
+    """1 slice; rings 5 and 10 km; node azimuths 0, 90, 180, 270; 4 members.
+    (5 km, 0):   drums fall toward 10 and 20 (strike frame), monolith stands (4x).
+    (5 km, 270): drums: one falls toward 285, monolith stands.
+    (10 km, *):  drums stand, monolith falls (4x) toward 0."""
+    n = 4
+    stand = [None] * n
+    falls = [[[None] * 4 for _ in range(2)]]
+    falls[0][0][0] = [[10.0, 20.0, None, None], stand]
+    falls[0][0][1] = [stand, stand]
+    falls[0][0][2] = [stand, stand]
+    falls[0][0][3] = [[285.0, None, None, None], stand]
+    for j in range(4):
+        falls[0][1][j] = [stand, [0.0] * n]
+    return ForwardTable.toy([("strike-slip", 90.0, 180.0, 10.0, 6.5)], (5.0, 10.0),
+                            (0.0, 90.0, 180.0, 270.0), falls)
+
+
+def site(*columns):
+    return Site("A", 0.0, 0.0, tuple(columns))
+
+
+DRUMS_15 = ColumnObservation("drums", "fallen", 15.0, SIGMA)
+MONO_STANDS = ColumnObservation("monolithic", "standing")
+
+
+def density_node0(psi):
+    kappa = kappa_by_hand(math.hypot(KERNEL, SIGMA))
+    return (1 - FLOOR) * 0.5 * (vm(psi - 10, kappa) + vm(psi - 20, kappa)) \
+        + FLOOR / (2 * math.pi)
+
+
+def test_concentration_matches_bessel_ratio():
+    for sigma in (5.0, 10.0, 22.36, 60.0):
+        assert concentration(sigma) == pytest.approx(kappa_by_hand(sigma), rel=1e-6)
+
+
+def test_at_a_node(tiny):
+    """Epicentre 5 km south of the site, strike 0: the site sits on node (5 km, 0)."""
+    model = ForwardModel(tiny, KERNEL, FLOOR)
+    ll = model.site_log_likelihood(site(DRUMS_15, MONO_STANDS), [0.0], [-5.0], [0.0])
+    p_drums = (2 + 0.5) / (4 + 1)               # 0.5
+    p_mono = (0 + 0.5) / (4 + 1)                # 0.1
+    expected = math.log(p_drums * density_node0(15.0)) + math.log(1 - p_mono)
+    assert ll.shape == (1, 1, 1)
+    assert ll[0, 0, 0] == pytest.approx(expected, rel=1e-9)
+
+
+def test_turned_strike_turns_the_observation_frame(tiny):
+    """Strike 90 with the epicentre 5 km west: the site is at azimuth 90 = strike + 0, the
+    same node; the observed fall turned by 90 deg gives the same likelihood."""
+    model = ForwardModel(tiny, KERNEL, FLOOR)
+    turned = ColumnObservation("drums", "fallen", 105.0, SIGMA)
+    a = model.site_log_likelihood(site(DRUMS_15, MONO_STANDS), [0.0], [-5.0], [0.0])
+    b = model.site_log_likelihood(site(turned, MONO_STANDS), [-5.0], [0.0], [90.0])
+    assert b[0, 0, 0] == pytest.approx(a[0, 0, 0], rel=1e-12)
+
+
+def test_between_rings_log_linear(tiny):
+    """r = sqrt(5 x 10): half of each ring; ring 10 km: drums P = 0.1 with a uniform
+    density, monolith P = 0.9."""
+    model = ForwardModel(tiny, KERNEL, FLOOR)
+    r = math.sqrt(50.0)
+    ll = model.site_log_likelihood(site(DRUMS_15, MONO_STANDS), [0.0], [-r], [0.0])
+    fallen = 0.5 * 0.5 * density_node0(15.0) + 0.5 * 0.1 / (2 * math.pi)
+    standing = 0.5 * (1 - 0.1) + 0.5 * (1 - 0.9)
+    assert ll[0, 0, 0] == pytest.approx(math.log(fallen) + math.log(standing), rel=1e-9)
+
+
+def test_between_node_azimuths_in_the_site_frame(tiny):
+    """Strike 45, site due north of the epicentre: node azimuth 315, half way between the
+    nodes 270 and 0.  Node 270's one fall (285) lies 15 deg clockwise of its site direction,
+    the observation too: both nodes are read at 15 deg in the site frame."""
+    model = ForwardModel(tiny, KERNEL, FLOOR)
+    ll = model.site_log_likelihood(site(DRUMS_15), [0.0], [-5.0], [45.0])
+    kappa = kappa_by_hand(math.hypot(KERNEL, SIGMA))
+    d270 = (1 - FLOOR) * vm(0.0, kappa) + FLOOR / (2 * math.pi)
+    value = 0.5 * 0.5 * density_node0(15.0) + 0.5 * (1.5 / 5) * d270
+    assert ll[0, 0, 0] == pytest.approx(math.log(value), rel=1e-9)
+
+
+def test_floor_keeps_an_odd_fall_finite(tiny):
+    """A fall opposite to every ensemble fall costs a bounded amount, never -inf."""
+    model = ForwardModel(tiny, KERNEL, FLOOR)
+    odd = ColumnObservation("drums", "fallen", 195.0, SIGMA)
+    ll = model.site_log_likelihood(site(odd), [0.0], [-5.0], [0.0])
+    assert np.isfinite(ll).all()
+    assert ll[0, 0, 0] >= math.log(0.5 * FLOOR / (2 * math.pi)) - 1e-12
+
+
+def test_distances_beyond_the_table_are_clamped(tiny):
+    model = ForwardModel(tiny, KERNEL, FLOOR)
+    near = model.site_log_likelihood(site(MONO_STANDS), [0.0], [-1.0], [0.0])
+    at5 = model.site_log_likelihood(site(MONO_STANDS), [0.0], [-5.0], [0.0])
+    far = model.site_log_likelihood(site(MONO_STANDS), [0.0], [-40.0], [0.0])
+    at10 = model.site_log_likelihood(site(MONO_STANDS), [0.0], [-10.0], [0.0])
+    assert near[0, 0, 0] == pytest.approx(at5[0, 0, 0])
+    assert far[0, 0, 0] == pytest.approx(at10[0, 0, 0])
+
+
+def test_unmodelled_column_is_one_line(tiny):
+    from pipeline.files import InputError
+    model = ForwardModel(tiny)
+    with pytest.raises(InputError, match="models drums and monolithic only"):
+        model.site_log_likelihood(site(ColumnObservation("ionic.json", "standing")),
+                                  [0.0], [-5.0], [0.0])

@@ -1,0 +1,112 @@
+"""Observation files: the schema, geographic positions, and one-line errors."""
+import json
+import math
+
+import pytest
+
+from pipeline import cli
+from pipeline.files import InputError
+from pipeline.inversion import EXAMPLES_DIR
+from pipeline.inversion.observations import load_observations, parse_observations
+
+GOOD_SITE = {"name": "A", "east_km": 0, "north_km": 0,
+             "columns": [{"column": "drums", "state": "fallen", "downfall_azimuth_deg": 240,
+                          "uncertainty_deg": 10}, {"column": "monolithic", "state": "standing"}]}
+
+
+def test_examples_parse():
+    obs = load_observations(EXAMPLES_DIR / "two_sites.json")
+    assert [s.name for s in obs.sites] == ["A", "B"]
+    assert obs.n_fallen == 3 and obs.n_columns == 5
+    geo = load_observations(EXAMPLES_DIR / "geographic.json")
+    assert (geo.sites[0].east_km, geo.sites[0].north_km) == (0.0, 0.0)
+
+
+def test_positions_are_relative_to_the_first_site():
+    obs = parse_observations({"sites": [dict(GOOD_SITE, east_km=3, north_km=4),
+                                        dict(GOOD_SITE, name="B", east_km=5, north_km=1)]})
+    assert (obs.sites[1].east_km, obs.sites[1].north_km) == (2.0, -3.0)
+    assert obs.sites[0].columns[1].downfall_azimuth_deg is None
+
+
+def test_latitude_longitude_on_the_local_tangent_plane():
+    a = {"name": "A", "latitude": 38.0, "longitude": 23.0, "columns": GOOD_SITE["columns"]}
+    b = dict(a, name="B", latitude=38.1)                 # 0.1 deg north: 11.1 km
+    c = dict(a, name="C", longitude=23.1)                # 0.1 deg east at 38 N: 8.8 km
+    obs = parse_observations({"sites": [a, b, c]})
+    assert obs.sites[1].north_km == pytest.approx(11.10, abs=0.02)
+    assert obs.sites[1].east_km == pytest.approx(0.0, abs=1e-6)
+    assert obs.sites[2].east_km == pytest.approx(111.0 * 0.1 * math.cos(math.radians(38)),
+                                                 rel=0.01)
+
+
+def test_column_file_names_pass_through():
+    obs = parse_observations({"sites": [dict(GOOD_SITE, columns=[
+        {"column": "columns/ionic.json", "state": "standing"}])]})
+    assert obs.column_types() == ["columns/ionic.json"]
+
+
+BAD = [
+    ("[1, 2", "not valid JSON"),
+    ({"site": []}, "expected an object with a 'sites' list"),
+    ({"sites": []}, "'sites' must be a non-empty list"),
+    ({"sites": [{"name": "A", "columns": GOOD_SITE["columns"]}]}, "give either east_km"),
+    ({"sites": [dict(GOOD_SITE, latitude=1.0, longitude=2.0)]}, "give either east_km"),
+    ({"sites": [GOOD_SITE, {"name": "B", "latitude": 1, "longitude": 2,
+                            "columns": GOOD_SITE["columns"]}]}, "mixes east_km"),
+    ({"sites": [dict(GOOD_SITE, east_km="3")]}, "east_km must be a number"),
+    ({"sites": [dict(GOOD_SITE, columns=[])]}, "'columns' must be a non-empty list"),
+    ({"sites": [dict(GOOD_SITE, columns=[{"column": "drums", "state": "fallen"}])]},
+     "needs downfall_azimuth_deg"),
+    ({"sites": [dict(GOOD_SITE, columns=[{"column": "drums", "state": "fallen",
+                                          "downfall_azimuth_deg": 400}])]},
+     r"must lie in \[0, 360\]"),
+    ({"sites": [dict(GOOD_SITE, columns=[{"column": "drums", "state": "toppled"}])]},
+     "'state' must be 'fallen' or 'standing'"),
+    ({"sites": [dict(GOOD_SITE, columns=[{"column": "drums", "state": "standing",
+                                          "downfall_azimuth_deg": 10}])]},
+     "a standing column has no downfall_azimuth_deg"),
+    ({"sites": [dict(GOOD_SITE, columns=[{"column": "drums", "state": "fallen",
+                                          "downfall_azimuth_deg": 10,
+                                          "uncertainty_deg": -1}])]}, "uncertainty_deg"),
+    ({"sites": [dict(GOOD_SITE, columns=[{"column": "drums", "state": "standing",
+                                          "azimuth": 3}])]}, "unknown key"),
+    ({"sites": [GOOD_SITE, GOOD_SITE]}, "two sites have this name"),
+    ({"sites": [GOOD_SITE, dict(GOOD_SITE, name="B")]}, "at the same place"),
+    ({"sites": [dict(GOOD_SITE, columns=[{"column": "ionic.json", "state": "standing"}])]},
+     "only drums and monolithic are modelled"),
+]
+
+
+@pytest.mark.parametrize("content, message", BAD)
+def test_bad_files_give_one_line_errors(tmp_path, capsys, content, message):
+    path = tmp_path / "obs.json"
+    path.write_text(content if isinstance(content, str) else json.dumps(content))
+    out = tmp_path / "out"
+    code = cli.main(["invert", str(path), "--out", str(out), "--table",
+                     str(tmp_path / "never-read.npz")])
+    err = capsys.readouterr().err
+    assert code == 2
+    assert err.count("\n") == 1 and err.startswith("error: ")
+    assert __import__("re").search(message, err), err
+    assert not out.exists()
+
+
+def test_missing_file_and_option_errors(tmp_path, capsys):
+    assert cli.main(["invert", str(tmp_path / "none.json")]) == 2
+    assert "observations file not found" in capsys.readouterr().err
+    good = tmp_path / "good.json"
+    good.write_text(json.dumps({"sites": [GOOD_SITE]}))
+    for argv, message in (([], "give an OBSERVATIONS.json file or --demo"),
+                          (["--radius", "-3"], "--radius must lie in"),
+                          (["--quick", "--grid", "full"], "--quick is --grid quick"),
+                          (["--azimuth-step", "7"], "--azimuth-step must divide 360"),
+                          (["--mechanisms", "oblique"], "unknown mechanism"),
+                          (["--depths", "5,x"], "--depths: not a comma-separated list"),
+                          (["--jobs", "0"], "--jobs must be at least 1")):
+        args = ["invert"] + ([str(good)] if argv else []) + argv
+        assert cli.main(args) == 2, argv
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and message in err, (argv, err)
+    with pytest.raises(InputError):
+        parse_observations({"sites": [dict(GOOD_SITE, name="")]})
