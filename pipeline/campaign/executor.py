@@ -357,7 +357,8 @@ def run_task(worker, spec, motion, client_run_dir, code, token):
         raise ToolError(f"the Dask worker on {host} runs other code than the client (hash "
                         f"{worker_code_version()} vs {code}): install the same version of "
                         "the project on the workers")
-    with tempfile.TemporaryDirectory(prefix=f"{TASK_PREFIX}-{token}-") as tmp:
+    with tempfile.TemporaryDirectory(prefix=f"{TASK_PREFIX}-{token}-",
+                                     dir=_scratch_directory()) as tmp:
         tmp = Path(tmp)
         spec = dict(spec)
         swaps = []
@@ -394,6 +395,16 @@ def run_task(worker, spec, motion, client_run_dir, code, token):
         return {"files": files, "error": error, "message": message, "host": host}
 
 
+def _scratch_directory():
+    """The Dask worker's local directory (its scratch space, which Dask purges when a
+    killed worker's successor starts), else the system's temporary directory."""
+    try:
+        from distributed import get_worker
+        return get_worker().local_directory
+    except (ImportError, ValueError, AttributeError):
+        return None
+
+
 def _swap(value, swaps):
     """``value`` (str, or JSON-like list/dict) with every (old, new) substring replaced."""
     if isinstance(value, str):
@@ -411,7 +422,7 @@ def kill_task_processes(token):
     """Kill this worker's YADE processes of campaign ``token`` (run with Client.run after
     Ctrl-C): children of this process whose working directory lies in a temporary
     directory of that campaign.  Returns their pids."""
-    prefix = os.path.join(tempfile.gettempdir(), f"{TASK_PREFIX}-{token}-")
+    mark = f"/{TASK_PREFIX}-{token}-"
     me, killed = os.getpid(), []
     for pid in filter(str.isdigit, os.listdir("/proc")):
         try:
@@ -420,7 +431,7 @@ def kill_task_processes(token):
             cwd = os.readlink(f"/proc/{pid}/cwd")
         except (OSError, ValueError, IndexError):
             continue
-        if parent == me and cwd.startswith(prefix):
+        if parent == me and mark in cwd:
             pid = int(pid)
             try:
                 if os.getpgid(pid) == pid:                # YADE leads its own group

@@ -125,9 +125,9 @@ def cluster(tmp_path_factory):
 
 
 def task_yade_processes():
-    """{pid: parent pid} of scene processes running in a Dask task's temporary directory."""
+    """{pid: parent pid} of scene processes running in a Dask task's temporary directory
+    (in the worker's local directory)."""
     found = {}
-    prefix = os.path.join(tempfile.gettempdir(), f"{TASK_PREFIX}-")
     for pid in filter(str.isdigit, os.listdir("/proc")):
         try:
             cmd = Path(f"/proc/{pid}/cmdline").read_bytes()
@@ -135,7 +135,7 @@ def task_yade_processes():
             parent = int(Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[1])
         except (OSError, ValueError):
             continue
-        if b"run_scene.py" in cmd and cwd.startswith(prefix):
+        if b"run_scene.py" in cmd and f"/{TASK_PREFIX}-" in cwd:
             found[int(pid)] = parent
     return found
 
