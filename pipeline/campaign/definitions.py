@@ -5,7 +5,7 @@ from pathlib import Path
 
 from pipeline import RESULTS_DIR, paper
 from pipeline.campaign import Campaign, register
-from pipeline.campaign.tables import collect
+from pipeline.campaign.tables import collect, write_tables
 from pipeline.files import InputError, code_hash, content_hash, write_csv
 from pipeline.motion import Motion
 from pipeline.records import catalog, catalog_row, processed_motion, resolve
@@ -92,16 +92,15 @@ def column_outputs(name, size_by=None):
     """Outputs of a column campaign: runs.csv, impacts.csv, direction statistics, figures."""
 
     def outputs(specs, campaign_dir, failures, animations, figures=True):
-        from pipeline import figures as figure_module
         from pipeline.stats.circular import direction_statistics
         campaign_dir = Path(campaign_dir)
         runs, impacts = collect(specs, name, campaign_dir)
-        write_csv(campaign_dir / "runs.csv", runs)
-        write_csv(campaign_dir / "impacts.csv", impacts)
+        write_tables(campaign_dir, runs, impacts)
         written = []
         if not runs.empty:
             write_csv(campaign_dir / "direction_statistics.csv", direction_statistics(runs))
             if figures:
+                from pipeline import figures as figure_module   # matplotlib: not after Ctrl-C
                 written = figure_module.campaign_figures(name, runs, impacts, campaign_dir,
                                                          size_by, animations)
         toppled = runs.groupby("column")["toppled"].agg(["sum", "count"]) if not runs.empty \
@@ -272,8 +271,7 @@ def columns_outputs(specs, campaign_dir, failures, animations, figures=True):
     if not runs.empty:
         names = {s["run_id"]: s["description"] for s in specs}
         runs.insert(1, "description", runs["run_id"].map(names))
-    write_csv(campaign_dir / "runs.csv", runs)
-    write_csv(campaign_dir / "impacts.csv", impacts)
+    write_tables(campaign_dir, runs, impacts)
     table = columns_table(specs, campaign_dir)
     write_csv(campaign_dir / "columns.csv", table)
     shown = table.drop(columns=["run_id", "back_azimuth_deg", "first_to_strike_index"])

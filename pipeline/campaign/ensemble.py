@@ -34,7 +34,7 @@ from scipy.stats import qmc
 from pipeline import paper
 from pipeline.campaign import Campaign, register
 from pipeline.campaign.definitions import column_specs, run_code_version, run_column_spec
-from pipeline.campaign.tables import collect
+from pipeline.campaign.tables import collect, write_parquet
 from pipeline.files import InputError, write_csv, write_json
 
 DEFAULT_MEMBERS = 16
@@ -117,6 +117,7 @@ def ensemble_outputs(specs, campaign_dir, failures, animations, figures=True):
         out = campaign_dir if len(records) == 1 else campaign_dir / record_id
         sub = runs[runs["record_id"] == record_id].sort_values(["member", "column"])
         write_csv(out / "members.csv", sub)
+        write_parquet(out / "members.parquet", sub)
         summary = summarise(sub, record_id, specs[0]["seed"])
         write_json(out / "ensemble_summary.json", summary)
         summaries.append(summary)

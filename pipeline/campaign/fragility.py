@@ -120,10 +120,7 @@ def fragility_specs(records, campaign_dir, levels=DEFAULT_LEVELS, members=DEFAUL
 # ---------------------------------------------------------------- tables
 def scaled_runs(specs, campaign_dir):
     """The 3D runs table with the record parameters of the scaled motions and the IMs."""
-    import inspect
-    # the collected record parameters are those of the unscaled records: no Parquet copy
-    quiet = {"parquet": False} if "parquet" in inspect.signature(collect).parameters else {}
-    runs, _ = collect(specs, "fragility", campaign_dir, **quiet)
+    runs, _ = collect(specs, "fragility", campaign_dir)
     if runs.empty:
         return runs
     by_id = {s["run_id"]: s for s in specs}

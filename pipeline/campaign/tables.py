@@ -17,15 +17,10 @@ IMPACT_COLUMNS = ["run_id", "column", "body_index", "impact_time_s", "x_m", "y_m
                   "mu_s", "record_id"]
 
 
-def collect(specs, campaign, campaign_dir, parquet=True):
-    """runs and impacts tables (DataFrames) from the summaries of finished runs;
-    ``parquet``: also write them as ``runs.parquet`` and ``impacts.parquet`` into
-    ``campaign_dir`` (the CSVs are the caller's)."""
-    runs, impacts = _tables(specs, campaign, campaign_dir)
-    if parquet:
-        write_parquet(Path(campaign_dir) / "runs.parquet", runs)
-        write_parquet(Path(campaign_dir) / "impacts.parquet", impacts)
-    return runs, impacts
+def collect(specs, campaign, campaign_dir):
+    """runs and impacts tables (DataFrames) from the summaries of finished runs
+    (written by the campaign with :func:`write_tables`)."""
+    return _tables(specs, campaign, campaign_dir)
 
 
 def write_tables(campaign_dir, runs, impacts):
