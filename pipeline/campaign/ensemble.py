@@ -38,6 +38,7 @@ from pipeline.campaign.tables import collect, write_parquet
 from pipeline.files import InputError, write_csv, write_json
 
 DEFAULT_MEMBERS = 16
+KEPT_TRAJECTORIES = 2          # the nominal run and the first members keep trajectory.npz
 DEFAULT_SEED = 20091001        # BSSA 99(5), October 2009
 ENSEMBLE_RANGES = {            # name: (low, high, "uniform" | "log")
     "mu_s": (0.55, 0.85, "uniform"),
@@ -100,6 +101,7 @@ def ensemble_specs(records, campaign_dir, record=None, column="both", members=DE
     for k, spec in enumerate(specs):
         spec["member"] = (k % per_record) - 1          # -1: the nominal run
         spec["seed"] = seed
+        spec["keep_trajectory"] = spec["member"] < KEPT_TRAJECTORIES   # summaries for all
     return specs
 
 
