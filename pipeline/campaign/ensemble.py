@@ -20,10 +20,14 @@ Ranges (``ENSEMBLE_RANGES``, all around the paper's values; override with
   (masonry tolerances of cut drums; real geometry: issue "Real columns");
 - ``rim_phase_deg`` 0 to one rim spacing: the rim discretisation moves a fall by
   up to ~12 deg (make bench); sampling its phase turns that bias into noise;
+- ``tilt_deg`` 0-0.5 deg toward ``tilt_azimuth_deg`` 0-360: a column already out
+  of plumb (every block leans alike; joints square to the inclined axis);
+- ``drum_offset_mm`` 0-3 mm: each drum above the first sits this far at most off
+  the centre of the drum below, in a random direction (seeded per member);
 - ``scale`` (off by default): an amplitude scaling of the motion.
 
-Not yet sampled: an initial out-of-plumb tilt and drum offsets (they need the
-column description of the "Real columns" issue).
+Tilt and offsets make each member a column description (``pipeline.scenario.geometry``);
+with ``--column both`` the monolith beside it has the same outline and tilt.
 """
 import math
 from pathlib import Path
@@ -47,7 +51,11 @@ ENSEMBLE_RANGES = {            # name: (low, high, "uniform" | "log")
     "height_tolerance": (-0.01, 0.01, "uniform"),
     "diameter_tolerance": (-0.01, 0.01, "uniform"),
     "rim_phase_deg": (0.0, 360.0 / 16, "uniform"),
+    "tilt_deg": (0.0, 0.5, "uniform"),
+    "tilt_azimuth_deg": (0.0, 360.0, "uniform"),
+    "drum_offset_mm": (0.0, 3.0, "uniform"),
 }
+GEOMETRY_KEYS = ("tilt_deg", "tilt_azimuth_deg", "drum_offset_mm")
 
 
 def sample_members(members, seed, ranges=None, column="both", mu_k_ratio=paper.MU_K_OVER_MU_S):
@@ -58,7 +66,7 @@ def sample_members(members, seed, ranges=None, column="both", mu_k_ratio=paper.M
     names = sorted(ranges)
     unit = qmc.LatinHypercube(d=len(names), seed=seed).random(members)
     rows = []
-    for u in unit:
+    for index, u in enumerate(unit):
         v = {}
         for name, x in zip(names, u):
             lo, hi, kind = ranges[name]
@@ -74,8 +82,33 @@ def sample_members(members, seed, ranges=None, column="both", mu_k_ratio=paper.M
                   "rim_phase_deg": round(v.get("rim_phase_deg", 0.0), 6)}
         if "scale" in v:
             params["scale"] = round(v["scale"], 6)
+        if any(v.get(k) for k in GEOMETRY_KEYS):
+            rng = np.random.default_rng([seed, index])
+            params["column_file"] = drum_description(
+                height, diameter, v.get("tilt_deg", 0.0), v.get("tilt_azimuth_deg", 0.0),
+                v.get("drum_offset_mm", 0.0) / 1000.0, rng)
+            for key in ("hd", "height"):
+                params.pop(key)
         rows.append(params)
     return rows
+
+
+def drum_description(height, diameter, tilt_deg, tilt_azimuth_deg, max_offset_m, rng,
+                     n_drums=paper.N_DRUMS, density=paper.MARBLE_DENSITY_KG_M3):
+    """Column description of the paper's drum column leaning ``tilt_deg`` toward
+    ``tilt_azimuth_deg`` with each drum above the first offset by up to ``max_offset_m``
+    in a random direction."""
+    blocks = []
+    for k in range(n_drums):
+        block = {"shape": "frustum", "height": round(height / n_drums, 9),
+                 "bottom_diameter": round(diameter, 9), "top_diameter": round(diameter, 9)}
+        if tilt_deg > 0:
+            block.update(tilt_deg=round(tilt_deg, 6), tilt_azimuth_deg=round(tilt_azimuth_deg, 6))
+        if k > 0 and max_offset_m > 0:
+            r, a = max_offset_m * rng.random(), 2 * math.pi * rng.random()
+            block["offset_m"] = [round(r * math.sin(a), 9), round(r * math.cos(a), 9)]
+        blocks.append(block)
+    return {"name": "drums (ensemble member)", "density": density, "blocks": blocks}
 
 
 def nominal(column="both"):
