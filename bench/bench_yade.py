@@ -461,8 +461,18 @@ def print_parallel(p):
           f"(start-up included; load average before {p['load_average_before']:.2f})")
     for jobs in (1, 2):
         r = p[f"jobs_{jobs}"]
-        print(f"   {jobs} process(es): {r['wall_s']:.1f} s wall, {r['runs_per_minute']:.1f} runs/min")
-    print(f"   scaling 2 vs 1: {p['scaling_2_vs_1']:.2f} (2.00 = perfect on 2 free cores)")
+        line = (f"   {jobs} Dask worker(s): {r['wall_s']:.1f} s wall, "
+                f"{r['runs_per_minute']:.1f} runs/min")
+        threads = p.get(f"threads_jobs_{jobs}")
+        if threads:
+            line += f"; threads: {threads['runs_per_minute']:.1f} runs/min"
+        print(line)
+    print(f"   scaling 2 vs 1 (Dask): {p['scaling_2_vs_1']:.2f} (2.00 = perfect on 2 free cores)")
+    for key, label in (("cluster_startup_s", "cluster start-up s"),
+                       ("cluster_close_s", "cluster close s"),
+                       ("task_overhead_ms", "overhead per task ms")):
+        if key in p:
+            print(f"   {label}: {p[key]:.2f}")
 
 
 def main(argv=None):
