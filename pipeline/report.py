@@ -466,8 +466,8 @@ def ensemble_section(results):
     seed = summaries[0]["seed"]
     lines = ["## Ensembles: probabilities instead of single runs\n",
              f"Members sample static friction, contact damping and stiffness, column "
-             f"height and diameter tolerances and the rim's angular phase (Latin hypercube, "
-             f"seed {seed}); P(toppled) with its Wilson 95 % interval, the mean downfall "
+             f"height and diameter tolerances, an out-of-plumb tilt, drum offsets and the "
+             f"rim's angular phase (Latin hypercube, seed {seed}); P(toppled) with its Wilson 95 % interval, the mean downfall "
              "azimuth of the toppled members with a bootstrap 95 % interval (clockwise from "
              "the first to the second value), its resultant length R (1: all members fall "
              "the same way) and the fractions toward / away from / across the epicentre. "
