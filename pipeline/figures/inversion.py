@@ -157,26 +157,36 @@ def plot_marginals(post, path, truth=None):
 
 def plot_interval_widths(table, path):
     """Median 95 % back-azimuth arc width (and its quartiles) against fallen columns per
-    site, one line per (mechanism, number of sites); ``table``: rows of the demo's
-    narrowing table (mechanism, sites, fallen_per_site, width_median_deg, width_q25_deg,
-    width_q75_deg)."""
-    fig, ax = new_figure(figsize=(7.5, 4.5))
-    for k, ((mech, sites), group) in enumerate(table.groupby(["mechanism", "sites"])):
-        group = group.sort_values("fallen_per_site")
-        ax.errorbar(group["fallen_per_site"], group["width_median_deg"],
-                    yerr=[group["width_median_deg"] - group["width_q25_deg"],
-                          group["width_q75_deg"] - group["width_median_deg"]],
-                    marker="os"[sites > 1], color=f"C{k}", capsize=3,
-                    ls="-" if sites > 1 else "--", label=f"{mech}, {sites} site(s)")
-    ax.axhline(60.0, color="k", lw=1, ls=":", label="±30°")
-    ax.set_xscale("log")
-    ax.set_xticks(sorted(table["fallen_per_site"].unique()))
-    ax.set_xticklabels([f"{v:g}" for v in sorted(table["fallen_per_site"].unique())])
-    ax.set_ylim(0, 370)
-    ax.set_xlabel("fallen columns per site")
-    ax.set_ylabel("95 % back-azimuth arc (deg)")
-    ax.set_title("How the back azimuth narrows with the evidence (synthetic truth tests)")
-    ax.grid(alpha=0.3)
-    ax.legend(fontsize=8)
+    site, one line per (mechanism, number of sites), one panel per likelihood; ``table``:
+    rows of the demo's narrowing table (likelihood, mechanism, sites, fallen_per_site,
+    width_median_deg, width_q25_deg, width_q75_deg, coverage_back_azimuth_95)."""
+    kinds = list(dict.fromkeys(table["likelihood"]))
+    fig, axes = new_figure(1, len(kinds), figsize=(6.5 * len(kinds), 4.8), squeeze=False)
+    ticks = sorted(table["fallen_per_site"].unique())
+    for ax, kind in zip(axes[0], kinds):
+        part = table[table["likelihood"] == kind]
+        for k, ((mech, sites), group) in enumerate(part.groupby(["mechanism", "sites"])):
+            group = group.sort_values("fallen_per_site")
+            ax.errorbar(group["fallen_per_site"], group["width_median_deg"],
+                        yerr=[group["width_median_deg"] - group["width_q25_deg"],
+                              group["width_q75_deg"] - group["width_median_deg"]],
+                        marker="os"[sites > 1], color=f"C{k}", capsize=3,
+                        ls="-" if sites > 1 else "--", label=f"{mech}, {sites} site(s)")
+            for x, y, c in zip(group["fallen_per_site"], group["width_median_deg"],
+                               group["coverage_back_azimuth_95"]):
+                ax.annotate(f"{100 * c:.0f}%", (x, y), xytext=(4, 4), fontsize=7,
+                            textcoords="offset points", color=f"C{k}")
+        ax.axhline(60.0, color="k", lw=1, ls=":", label="±30°")
+        ax.set_xscale("log")
+        ax.set_xticks(ticks)
+        ax.set_xticklabels([f"{v:g}" for v in ticks])
+        ax.set_ylim(0, 370)
+        ax.set_xlabel("fallen columns per site")
+        ax.set_ylabel("95 % back-azimuth arc (deg)")
+        ax.set_title(f"{kind} likelihood (labels: truth inside the arc)", fontsize=10)
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=8)
+    fig.suptitle("How the back azimuth narrows with the evidence (synthetic truth tests)")
+    fig.tight_layout()
     save_figure(fig, path, dpi=120, bbox_inches="tight")
     return path

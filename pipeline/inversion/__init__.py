@@ -35,7 +35,8 @@ def write_outputs(post, observations, out_dir, forward_info=None, truth=None, ti
                         "from North",
                "first_site": observations.sites[0].name,
                "prior": post.info.get("prior"),
-               "likelihood": {"kernel_deg": post.info.get("kernel_deg"),
+               "likelihood": {"kind": post.info.get("likelihood"),
+                              "kernel_deg": post.info.get("kernel_deg"),
                               "floor": post.info.get("floor"),
                               "p_toppled": "(k + 1/2) / (n + 1) per node"},
                "candidate_grid": post.info.get("grid"),
@@ -52,13 +53,14 @@ def write_outputs(post, observations, out_dir, forward_info=None, truth=None, ti
 
 
 def run_inversion(observations, out_dir, table, candidates, kernel_deg=None, floor=None,
-                  forward_info=None):
+                  forward_info=None, likelihood="independent"):
     """Invert ``observations`` with the forward ``table`` over ``candidates`` and write the
     outputs into ``out_dir`` (locked while writing); return the summary dict."""
     from pipeline.inversion.likelihood import DEFAULT_FLOOR, DEFAULT_KERNEL_DEG, ForwardModel
     from pipeline.inversion.posterior import invert
     started = time.monotonic()
-    model = ForwardModel(table, kernel_deg or DEFAULT_KERNEL_DEG, floor or DEFAULT_FLOOR)
+    model = ForwardModel(table, kernel_deg or DEFAULT_KERNEL_DEG, floor or DEFAULT_FLOOR,
+                         likelihood)
     post = invert(model, observations, candidates)
     with DirectoryLock(out_dir, wait=False):
         summary = write_outputs(post, observations, out_dir, forward_info)

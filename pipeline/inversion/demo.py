@@ -27,7 +27,8 @@ import numpy as np
 import pandas as pd
 
 from pipeline.files import write_csv, write_json
-from pipeline.inversion.likelihood import DEFAULT_FLOOR, DEFAULT_KERNEL_DEG, ForwardModel
+from pipeline.inversion.likelihood import (DEFAULT_FLOOR, DEFAULT_KERNEL_DEG, LIKELIHOODS,
+                                           ForwardModel)
 from pipeline.inversion.observations import ColumnObservation, Observations, Site
 from pipeline.inversion.posterior import in_arc, invert
 
@@ -144,7 +145,7 @@ def truth_tests(model, pool, candidates, trials=DEFAULT_TRIALS, seed=DEMO_SEED,
                                               candidates, rng)
                     if row is None:
                         break
-                    rows.append({**row, "trial": trial})
+                    rows.append({"likelihood": model.likelihood, **row, "trial": trial})
                     if examples is not None and trial == 0:
                         examples[(mechanism, n_sites, fallen)] = detail
     return pd.DataFrame(rows)
@@ -153,9 +154,11 @@ def truth_tests(model, pool, candidates, trials=DEFAULT_TRIALS, seed=DEMO_SEED,
 def narrowing(trials):
     """Per (mechanism, sites, fallen per site): coverage and back-azimuth widths."""
     rows = []
-    for (mech, sites, fallen), g in trials.groupby(["mechanism", "sites", "fallen_per_site"]):
+    for (kind, mech, sites, fallen), g in trials.groupby(["likelihood", "mechanism", "sites",
+                                                          "fallen_per_site"]):
         w = g["width95_deg"]
-        rows.append({"mechanism": mech, "sites": sites, "fallen_per_site": fallen,
+        rows.append({"likelihood": kind, "mechanism": mech, "sites": sites,
+                     "fallen_per_site": fallen,
                      "fallen_total": fallen * sites, "trials": len(g),
                      "width_median_deg": float(w.median()),
                      "width_q25_deg": float(w.quantile(0.25)),
@@ -176,11 +179,11 @@ def bound_answer(narrow):
     """The paper's question: per (mechanism, sites) the fewest fallen columns per site whose
     median 95 % back-azimuth arc is within +-30 deg (None: not reached)."""
     out = []
-    for (mech, sites), g in narrow.groupby(["mechanism", "sites"]):
+    for (kind, mech, sites), g in narrow.groupby(["likelihood", "mechanism", "sites"]):
         g = g.sort_values("fallen_per_site")
         ok = g[g["width_median_deg"] <= BOUND_DEG]
         first = None if ok.empty else ok.iloc[0]
-        out.append({"mechanism": mech, "sites": int(sites),
+        out.append({"likelihood": kind, "mechanism": mech, "sites": int(sites),
                     "fallen_per_site": None if first is None else int(first["fallen_per_site"]),
                     "fallen_total": None if first is None else int(first["fallen_total"]),
                     "coverage_back_azimuth_95": None if first is None else
@@ -283,10 +286,12 @@ def paper_scenario(model, obs_table, source_name, candidates):
 
 # ---------------------------------------------------------------- the whole demo
 def run_demo(table, out_dir, candidates, paper_tables=None, trials=DEFAULT_TRIALS,
-             kernel_deg=DEFAULT_KERNEL_DEG, floor=DEFAULT_FLOOR, forward_info=None):
-    """Truth tests and the paper scenario on ``table``; writes into ``out_dir``:
-    truth_tests.csv, narrowing.csv, paper_scenario_sites.csv, demo_summary.json and figures.
-    ``paper_tables``: {source name: table holding the nominal runs at the paper's sites}."""
+             kernel_deg=DEFAULT_KERNEL_DEG, floor=DEFAULT_FLOOR, forward_info=None,
+             likelihoods=LIKELIHOODS):
+    """Truth tests (with each likelihood of ``likelihoods``) and the paper scenario on
+    ``table``; writes into ``out_dir``: truth_tests.csv, narrowing.csv,
+    paper_scenario_sites.csv, demo_summary.json and figures.  ``paper_tables``: {source
+    name: table holding the nominal runs at the paper's sites}."""
     from pipeline.figures.inversion import plot_interval_widths
     from pipeline.inversion import write_outputs
     out_dir = Path(out_dir)
@@ -295,9 +300,13 @@ def run_demo(table, out_dir, candidates, paper_tables=None, trials=DEFAULT_TRIAL
     if len(likelihood_half.members) == 0 or len(pool.members) == 0:
         from pipeline.files import InputError
         raise InputError("the demo needs at least two ensemble members (--members 2)")
-    model = ForwardModel(likelihood_half, kernel_deg, floor)
-    examples = {}
-    trials_frame = truth_tests(model, pool, candidates, trials, examples=examples)
+    examples, frames = {}, []
+    for kind in likelihoods:
+        model = ForwardModel(likelihood_half, kernel_deg, floor, kind)
+        found = {}
+        frames.append(truth_tests(model, pool, candidates, trials, examples=found))
+        examples.update({(kind,) + key: value for key, value in found.items()})
+    trials_frame = pd.concat(frames, ignore_index=True)
     if trials_frame.empty:
         from pipeline.files import InputError
         raise InputError("no column of the table's observation half ever fell: nothing to "
@@ -306,24 +315,26 @@ def run_demo(table, out_dir, candidates, paper_tables=None, trials=DEFAULT_TRIAL
     narrow = narrowing(trials_frame)
     write_csv(out_dir / "narrowing.csv", narrow)
     figures = [plot_interval_widths(narrow, out_dir / "narrowing.png")]
-    for (mech, n_sites, fallen), (post, observations, truth) in examples.items():
+    for (kind, mech, n_sites, fallen), (post, observations, truth) in examples.items():
         if n_sites == max(SITE_COUNTS) and fallen == 10:
-            sub = out_dir / f"example_{mech}_{n_sites}sites_{fallen}fallen"
+            sub = out_dir / f"example_{kind}_{mech}_{n_sites}sites_{fallen}fallen"
             write_outputs(post, observations, sub, forward_info,
                           truth={"epicentre_km": list(truth), "mechanism": mech,
                                  "back_azimuth_deg": math.degrees(math.atan2(*truth)) % 360,
                                  "distance_km": math.hypot(*truth)},
-                          title=f"Synthetic truth test: {mech}, {n_sites} sites, "
-                                f"{fallen} fallen columns each")
+                          title=f"Synthetic truth test ({kind} likelihood): {mech}, "
+                                f"{n_sites} sites, {fallen} fallen columns each")
             figures += [sub / "posterior_map.png", sub / "marginals.png"]
-    coverage = {
-        "trials": int(len(trials_frame)),
-        "back_azimuth_95": float(trials_frame["back_azimuth_in_95"].mean()),
-        "back_azimuth_hpd95": float(trials_frame["back_azimuth_in_hpd95"].mean()),
-        "epicentre_95": float(trials_frame["epicentre_in_95"].mean()),
-        "back_azimuth_68": float(trials_frame["back_azimuth_in_68"].mean()),
-        "epicentre_68": float(trials_frame["epicentre_in_68"].mean()),
-        "distance_95": float(trials_frame["distance_in_95"].mean())}
+    coverage = {kind: {
+        "trials": int(len(g)),
+        "back_azimuth_95": float(g["back_azimuth_in_95"].mean()),
+        "back_azimuth_hpd95": float(g["back_azimuth_in_hpd95"].mean()),
+        "epicentre_95": float(g["epicentre_in_95"].mean()),
+        "back_azimuth_68": float(g["back_azimuth_in_68"].mean()),
+        "epicentre_68": float(g["epicentre_in_68"].mean()),
+        "distance_95": float(g["distance_in_95"].mean())}
+        for kind, g in trials_frame.groupby("likelihood", sort=False)}
+    # one column per type and site: both likelihoods give the same paper-scenario numbers
     full_model = ForwardModel(table, kernel_deg, floor)
     paper_rows, paper_joint = [], []
     for source_name, obs_table in (paper_tables or {}).items():
@@ -346,7 +357,7 @@ def run_demo(table, out_dir, candidates, paper_tables=None, trials=DEFAULT_TRIAL
         write_csv(out_dir / "paper_scenario_sites.csv", paper_sites)
     summary = {
         "forward_table": forward_info or {},
-        "likelihood": {"kernel_deg": kernel_deg, "floor": floor,
+        "likelihood": {"kinds": list(likelihoods), "kernel_deg": kernel_deg, "floor": floor,
                        "members_likelihood": likelihood_half.members.tolist(),
                        "members_observations": pool.members.tolist()},
         "candidate_grid": candidates.as_dict(), "prior": candidates.prior_statement(),

@@ -160,7 +160,7 @@ class TableGrid:
 GRIDS = {
     "quick": TableGrid(distances_km=(2.5, 6.0), azimuth_step_deg=90.0, members=2,
                        nominal=False, fmax_hz=5.0, duration_s=15.0, tail_s=3.0),
-    "demo": TableGrid(),
+    "demo": TableGrid(members=12),
     "full": TableGrid(mechanisms=("strike-slip", "thrust", "normal"), depths_km=(6.0, 12.0),
                       magnitudes=(6.5, 7.0), distances_km=(2.5, 5.0, 10.0, 20.0, 30.0),
                       members=8),
@@ -285,12 +285,18 @@ def _write_slice(grid, sl, key, directory, paths, total, num, r, a, seconds):
 
 
 # ---------------------------------------------------------------- runs (campaign)
+MEMBER_BATCH = 6    # members are drawn in Latin-hypercube batches of 6 (seeds seed, seed + 1,
+#                     ...): a grown ensemble keeps its first members, so their runs are reused
+
+
 def member_parameters(grid):
-    """[(member, params)]: member -1 is the nominal twin run, 0.. the ensemble members."""
+    """[(member, params)]: member -1 is the nominal twin run, 0.. the ensemble members
+    (batch b of MEMBER_BATCH members: Latin hypercube with seed ``grid.seed + b``)."""
     from pipeline.campaign.ensemble import nominal, sample_members
     runs = [(-1, nominal("both"))] if grid.nominal else []
-    if grid.members:
-        runs += list(enumerate(sample_members(grid.members, grid.seed, column="both")))
+    for b, first in enumerate(range(0, grid.members, MEMBER_BATCH)):
+        size = min(MEMBER_BATCH, grid.members - first)
+        runs += list(enumerate(sample_members(size, grid.seed + b, column="both"), first))
     return [(m, {**p, "tail_s": float(grid.tail_s)}) for m, p in runs]
 
 

@@ -19,8 +19,23 @@ sum_nodes w (1 - P_n): the sub-density of "fell toward psi" and the probability 
 standing are interpolated as mixtures of the four surrounding nodes, bilinearly in
 log distance (clamped at the first and last ring) and in node azimuth (periodic).
 Interpolating in the site frame moves a fall direction that is fixed relative to the
-source-to-site direction smoothly between nodes.  Log-likelihood = sum over columns.
-Densities are per radian.
+source-to-site direction smoothly between nodes.  Log-likelihood = sum over columns
+(``likelihood="independent"``, the default).  Densities are per radian.
+
+``likelihood="predictive"`` accounts for the ensemble's own sampling error, which the
+product above ignores: columns at one site share one ground motion, and the node's fall
+distribution is known only through its n members.  The columns of one type at one site
+are then exchangeable draws from an unknown distribution centred on the ensemble's, with
+the weight of n + 1 columns (a Polya urn / Dirichlet-process predictive): the j-th column,
+after f earlier falls and s earlier standing columns of its type at the site, contributes
+
+    fallen:   (A f(psi) + sum_i K(psi - psi_i)) / (A + j),   standing: (A q + s) / (A + j)
+
+with A = n + 1, f(psi) = P d(psi) and q = 1 - P as above, psi_i the earlier falls and K a
+von Mises kernel of width sqrt(kernel^2 + sigma^2 + sigma_i^2), floored like d.  The first
+column of a type contributes exactly what the independent product gives; later ones
+weigh less the more the site's own columns already say.  With many members (A >> j) the
+two agree.
 """
 import math
 
@@ -29,6 +44,7 @@ from scipy import optimize, special
 
 from pipeline.files import InputError
 
+LIKELIHOODS = ("independent", "predictive")
 DEFAULT_KERNEL_DEG = 20.0
 DEFAULT_FLOOR = 0.05
 PSI_STEP_DEG = 0.5
@@ -69,7 +85,12 @@ def p_toppled(k, n):
 class ForwardModel:
     """Per-node toppling probabilities and direction densities of a forward table."""
 
-    def __init__(self, table, kernel_deg=DEFAULT_KERNEL_DEG, floor=DEFAULT_FLOOR):
+    def __init__(self, table, kernel_deg=DEFAULT_KERNEL_DEG, floor=DEFAULT_FLOOR,
+                 likelihood="independent"):
+        if likelihood not in LIKELIHOODS:
+            raise InputError(f"--likelihood must be one of {', '.join(LIKELIHOODS)}, got "
+                             f"{likelihood!r}")
+        self.likelihood = likelihood
         if not (0 < kernel_deg <= 90):
             raise InputError(f"--kernel-deg must lie in (0, 90], got {kernel_deg:g}")
         if not (0 < floor < 1):
@@ -82,7 +103,7 @@ class ForwardModel:
         self.relative = np.where(table.toppled, np.mod(table.azimuth_deg - theta, 360.0),
                                  np.nan)                         # site frame, deg
         self.psi = np.arange(0.0, 360.0, PSI_STEP_DEG)
-        self._fallen = {}
+        self._fallen_cache = {}
 
     # ------------------------------------------------------------------ node tables
     def direction_density(self, sigma_deg):
@@ -100,9 +121,9 @@ class ForwardModel:
     def fallen_table(self, sigma_deg):
         """P_n d_n(psi): (ns, nr, na, nc, npsi), cached per uncertainty."""
         key = round(float(sigma_deg), 9)
-        if key not in self._fallen:
-            self._fallen[key] = self.p[..., None] * self.direction_density(sigma_deg)
-        return self._fallen[key]
+        if key not in self._fallen_cache:
+            self._fallen_cache[key] = self.p[..., None] * self.direction_density(sigma_deg)
+        return self._fallen_cache[key]
 
     def column_index(self, column):
         try:
@@ -146,7 +167,7 @@ class ForwardModel:
         dx, dy = site.east_km - east, site.north_km - north
         r = np.hypot(dx, dy)
         alpha = np.mod(np.degrees(np.arctan2(dx, dy)), 360.0)     # epicentre -> site
-        ri0, ri1, rw = self.distance_weights(r)
+        rings = self.distance_weights(r)
         ai0, ai1, aw = self.azimuth_weights(alpha[None, :] - strikes[:, None])   # (nphi, ne)
         ns, ne, nphi = self.p.shape[0], east.size, strikes.size
         out = np.zeros((ns, nphi, ne))
@@ -155,31 +176,71 @@ class ForwardModel:
             by_type.setdefault(self.column_index(obs.column), []).append(obs)
         for c, group in by_type.items():
             standing = sum(not o.fallen for o in group)
-            if standing:
-                q = 1.0 - self.p[..., c]                                  # (ns, nr, na)
-                qe = (1 - rw)[None, :, None] * q[:, ri0, :] + rw[None, :, None] * q[:, ri1, :]
-                for f in range(nphi):                                     # qe: (ns, ne, na)
-                    val = _pick(qe, ai0[f], ai1[f], aw[f])
-                    out[:, f, :] += standing * np.log(val)
-            fallen = [o for o in group if o.fallen]
+            q = self._standing(c, rings, ai0, ai1, aw) if standing else None  # (ns, nphi, ne)
+            fallen = [k for k, o in enumerate(group) if o.fallen]
+            if self.likelihood == "independent":
+                if standing:
+                    out += standing * np.log(q)
+                for start in range(0, len(fallen), OBS_CHUNK):
+                    chunk = [group[k] for k in fallen[start:start + OBS_CHUNK]]
+                    for value in self._fallen(c, chunk, alpha, rings, ai0, ai1, aw):
+                        out += np.log(value)
+                continue
+            # predictive: a Polya urn per site and column type, in the file's order
+            weight = float(np.mean(self.n[..., c])) + 1.0
+            values = {}
             for start in range(0, len(fallen), OBS_CHUNK):
-                chunk = fallen[start:start + OBS_CHUNK]
-                for sigma in sorted({o.uncertainty_deg for o in chunk}):
-                    obs = [o for o in chunk if o.uncertainty_deg == sigma]
-                    table = self.fallen_table(sigma)[..., c, :]           # (ns, nr, na, npsi)
-                    psi_obs = np.array([o.downfall_azimuth_deg for o in obs])
-                    j0, j1, pw = self._psi_weights(psi_obs[:, None] - alpha[None, :])
-                    g = 0.0
-                    for ring, wr in ((ri0, 1 - rw), (ri1, rw)):
-                        lo = table[:, ring[None, :], :, j0]               # (no, ne, ns, na)
-                        hi = table[:, ring[None, :], :, j1]
-                        g = g + wr[None, :, None, None] * (
-                            (1 - pw)[..., None, None] * lo + pw[..., None, None] * hi)
-                    g = g.transpose(2, 0, 1, 3)                           # (ns, no, ne, na)
-                    for f in range(nphi):
-                        val = _pick(g, ai0[f], ai1[f], aw[f])             # (ns, no, ne)
-                        out[:, f, :] += np.log(val).sum(axis=1)
+                ks = fallen[start:start + OBS_CHUNK]
+                values.update(zip(ks, self._fallen(c, [group[k] for k in ks], alpha, rings,
+                                                   ai0, ai1, aw)))
+            earlier, s_prev = [], 0
+            for j, obs in enumerate(group):
+                if not obs.fallen:
+                    out += np.log((weight * q + s_prev) / (weight + j))
+                    s_prev += 1
+                    continue
+                pair = sum(self._pair_kernel(obs, e) for e in earlier)
+                out += np.log((weight * values[j] + pair) / (weight + j))
+                earlier.append(obs)
         return out
+
+    def _standing(self, c, rings, ai0, ai1, aw):
+        """Interpolated 1 - P of column type c: (ns, nphi, ne)."""
+        ri0, ri1, rw = rings
+        q = 1.0 - self.p[..., c]                                          # (ns, nr, na)
+        qe = (1 - rw)[None, :, None] * q[:, ri0, :] + rw[None, :, None] * q[:, ri1, :]
+        return np.stack([_pick(qe, ai0[f], ai1[f], aw[f]) for f in range(len(ai0))], axis=1)
+
+    def _fallen(self, c, chunk, alpha, rings, ai0, ai1, aw):
+        """Interpolated P d(psi_obs - alpha) of each fallen observation in ``chunk``: list of
+        (ns, nphi, ne) arrays in the chunk's order."""
+        ri0, ri1, rw = rings
+        result = [None] * len(chunk)
+        for sigma in sorted({o.uncertainty_deg for o in chunk}):
+            index = [k for k, o in enumerate(chunk) if o.uncertainty_deg == sigma]
+            table = self.fallen_table(sigma)[..., c, :]                   # (ns, nr, na, npsi)
+            psi_obs = np.array([chunk[k].downfall_azimuth_deg for k in index])
+            j0, j1, pw = self._psi_weights(psi_obs[:, None] - alpha[None, :])
+            g = 0.0
+            for ring, wr in ((ri0, 1 - rw), (ri1, rw)):
+                lo = table[:, ring[None, :], :, j0]                       # (no, ne, ns, na)
+                hi = table[:, ring[None, :], :, j1]
+                g = g + wr[None, :, None, None] * (
+                    (1 - pw)[..., None, None] * lo + pw[..., None, None] * hi)
+            g = g.transpose(2, 0, 1, 3)                                   # (ns, no, ne, na)
+            val = np.stack([_pick(g, ai0[f], ai1[f], aw[f]) for f in range(len(ai0))],
+                           axis=1)                                        # (ns, nphi, no, ne)
+            for slot, k in enumerate(index):
+                result[k] = val[:, :, slot, :]
+        return result
+
+    def _pair_kernel(self, a, b):
+        """Floored von Mises density of column a's observed azimuth about column b's."""
+        width = math.sqrt(self.kernel_deg ** 2 + a.uncertainty_deg ** 2
+                          + b.uncertainty_deg ** 2)
+        d = math.radians(a.downfall_azimuth_deg - b.downfall_azimuth_deg)
+        return float((1 - self.floor) * von_mises_pdf(d, concentration(width))
+                     + self.floor / (2 * math.pi))
 
     def log_likelihood(self, observations, east_km, north_km, strikes_deg):
         """Sum over sites: (ns, n_strikes, n_epicentres)."""

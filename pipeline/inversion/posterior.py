@@ -331,7 +331,8 @@ def invert(model, observations, grid):
     from pipeline.inversion.likelihood import ForwardModel
     keep = grid.slice_mask(model.table)
     if not keep.all():
-        model = ForwardModel(model.table.select_slices(keep), model.kernel_deg, model.floor)
+        model = ForwardModel(model.table.select_slices(keep), model.kernel_deg, model.floor,
+                             model.likelihood)
     for column in observations.column_types():
         model.column_index(column)
     east, north = grid.lattice(observations)
@@ -342,7 +343,8 @@ def invert(model, observations, grid):
                  + np.zeros(loglike.shape))
     post = Posterior(model.table.slices, strikes, east, north, grid.step_km, log_prior,
                      loglike, info={"grid": grid.as_dict(), "prior": grid.prior_statement(),
-                                    "kernel_deg": model.kernel_deg, "floor": model.floor})
+                                    "kernel_deg": model.kernel_deg, "floor": model.floor,
+                                    "likelihood": model.likelihood})
     reach = max(np.hypot(s.east_km - east, s.north_km - north).max()
                 for s in observations.sites)
     post.info["beyond_table_fraction"] = float(np.mean(

@@ -98,7 +98,8 @@ def test_demo_outputs_feed_the_report(tmp_path, make_away_table):
     grid = CandidateGrid(radius_km=21, step_km=3, strike_step_deg=90)
     out = tmp_path / "results" / "inversion"
     summary = run_demo(table, out, grid, {"thrust": table}, trials=1)
-    assert summary["coverage"]["trials"] == 2 * 2 * 4
+    for kind in ("independent", "predictive"):
+        assert summary["coverage"][kind]["trials"] == 2 * 2 * 4
     assert {row["source"] for row in summary["paper_scenario"]["per_source"]} == {"thrust"}
     sites = pd.read_csv(out / "paper_scenario_sites.csv")
     assert len(sites) == 3 * 12                      # rings 5, 10, 20 km every 30 deg

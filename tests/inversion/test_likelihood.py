@@ -129,3 +129,36 @@ def test_unmodelled_column_is_one_line(tiny):
     with pytest.raises(InputError, match="models drums and monolithic only"):
         model.site_log_likelihood(site(ColumnObservation("ionic.json", "standing")),
                                   [0.0], [-5.0], [0.0])
+
+
+def test_predictive_polya_urn_by_hand(tiny):
+    """Two drums fell (15, then 25 deg) and one stands, at node (5 km, 0): n = 4 members,
+    A = 5.  First fall: as the independent product; second: the ensemble's weight A plus a
+    kernel about the first fall, over A + 1; the standing one: A (1 - P) over A + 2."""
+    model = ForwardModel(tiny, KERNEL, FLOOR, likelihood="predictive")
+    second = ColumnObservation("drums", "fallen", 25.0, SIGMA)
+    stands = ColumnObservation("drums", "standing")
+    ll = model.site_log_likelihood(site(DRUMS_15, second, stands), [0.0], [-5.0], [0.0])
+    a, p = 5.0, 0.5
+    pair = (1 - FLOOR) * vm(10.0, kappa_by_hand(math.sqrt(KERNEL ** 2 + 2 * SIGMA ** 2))) \
+        + FLOOR / (2 * math.pi)
+    terms = [p * density_node0(15.0),
+             (a * p * density_node0(25.0) + pair) / (a + 1),
+             a * (1 - p) / (a + 2)]
+    assert ll[0, 0, 0] == pytest.approx(sum(math.log(t) for t in terms), rel=1e-9)
+    # the site's first fall makes a second one nearby more probable than the ensemble
+    # alone says (P = 0.5 of a fall): the urn learns from the site's own columns
+    falls = site(DRUMS_15, second)
+    urn = model.site_log_likelihood(falls, [0.0], [-5.0], [0.0])
+    independent = ForwardModel(tiny, KERNEL, FLOOR).site_log_likelihood(falls, [0.0], [-5.0],
+                                                                         [0.0])
+    assert urn[0, 0, 0] > independent[0, 0, 0]
+
+
+def test_predictive_equals_independent_for_one_column_per_type(tiny):
+    obs = site(DRUMS_15, MONO_STANDS)
+    east, north, strikes = np.array([0.0, 3.0, -2.0]), np.array([-5.0, -1.0, 4.0]), [0, 45]
+    a = ForwardModel(tiny, likelihood="predictive").site_log_likelihood(obs, east, north,
+                                                                         strikes)
+    b = ForwardModel(tiny).site_log_likelihood(obs, east, north, strikes)
+    np.testing.assert_allclose(a, b, rtol=1e-12)
