@@ -97,7 +97,10 @@ def fragility_specs(records, campaign_dir, levels=DEFAULT_LEVELS, members=DEFAUL
     if not (isinstance(azimuths, int) and 1 <= azimuths <= 360):
         raise InputError(f"--azimuths must be an integer in [1, 360], got {azimuths!r}")
     seed = ensemble.DEFAULT_SEED if seed is None else seed
-    member_params = ensemble.sample_members(members, seed, column=column)
+    # the 2D block needs each member's height and h/d: no tilt or offset descriptions here
+    ranges = {k: v for k, v in ensemble.ENSEMBLE_RANGES.items()
+              if k not in ensemble.GEOMETRY_KEYS}
+    member_params = ensemble.sample_members(members, seed, ranges, column=column)
     cache = motion_cache(campaign_dir)
     runs, extra = [], []
     for record in records:
