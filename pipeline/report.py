@@ -664,7 +664,9 @@ def _inversion_findings(demo, narrow):
                      f"({', '.join(g['mechanism'])}) that hold the truth in "
                      f"{', '.join(_pct(c) for c in g['coverage_back_azimuth_95'])} of the trials")
     members = demo.get("likelihood", {}).get("members_likelihood", [])
-    return ("**Reading.** " + "; ".join(parts) + ".  The likelihood knows each node's fall "
+    reading = "; ".join(parts)
+    return ("**Reading.** " + reading[:1].upper() + reading[1:] + ".  The likelihood knows "
+            "each node's fall "
             f"distribution from {len(members)} members; the independent product treats the "
             "columns of a site as independent given that estimate, so it narrows with every "
             "column even where the estimate is wrong, while the predictive (Polya-urn) "

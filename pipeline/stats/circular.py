@@ -6,9 +6,11 @@ Differences are wrapped to (-180, 180]; axial statistics double the angles
 azimuth: toward (|downfall - back azimuth| <= 45 deg: falls toward the
 epicentre), away (>= 135 deg), transverse otherwise.
 """
+import math
+
 import numpy as np
 import pandas as pd
-from astropy.stats import circcorrcoef, circmean, circstd, circvar, rayleightest
+from astropy.stats import circcorrcoef, circmean, circvar, rayleightest
 
 from pipeline.files import InputError
 
@@ -57,7 +59,9 @@ def circular_summary(angles_deg, axial=False):
     length = min(max(length, 0.0), 1.0)  # rounding
     period = 360.0 / factor
     mean = np.rad2deg(float(circmean(radians))) / factor if length > 1e-12 else np.nan
-    std = np.rad2deg(float(circstd(radians, method="circular"))) / factor if length > 0 else np.inf
+    # Mardia's sqrt(-2 ln R) of the clipped R (astropy's circstd warns when rounding puts R
+    # a hair above 1 for identical angles)
+    std = np.rad2deg(math.sqrt(max(-2.0 * math.log(length), 0.0))) / factor if length > 0 else np.inf
     # astropy's small-sample series can dip below 0 for very concentrated data
     p_value = min(max(float(rayleightest(radians)), 0.0), 1.0)
     return dict(n=n, mean_deg=float(np.mod(mean, period)), resultant_length=length,
