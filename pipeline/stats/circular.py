@@ -61,7 +61,7 @@ def circular_summary(angles_deg, axial=False):
     mean = np.rad2deg(float(circmean(radians))) / factor if length > 1e-12 else np.nan
     # Mardia's sqrt(-2 ln R) of the clipped R (astropy's circstd warns when rounding puts R
     # a hair above 1 for identical angles)
-    std = np.rad2deg(math.sqrt(max(-2.0 * math.log(length), 0.0))) / factor if length > 0 else np.inf
+    std = np.rad2deg(math.sqrt(max(0.0, -2.0 * math.log(length)))) / factor if length > 0 else np.inf
     # astropy's small-sample series can dip below 0 for very concentrated data
     p_value = min(max(float(rayleightest(radians)), 0.0), 1.0)
     return dict(n=n, mean_deg=float(np.mod(mean, period)), resultant_length=length,
