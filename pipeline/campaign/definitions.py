@@ -5,6 +5,10 @@ from pathlib import Path
 
 from pipeline import RESULTS_DIR, paper
 from pipeline.campaign import Campaign, register
+from pipeline.campaign.column_file import (add_campaign_options, add_column_file_argument,
+                                           add_stiffness_argument, at_slenderness,
+                                           check_stiffness, column_kn, description, mark,
+                                           read_campaign_options, summary_entry)
 from pipeline.campaign.tables import collect, write_tables
 from pipeline.files import InputError, code_hash, content_hash, write_csv
 from pipeline.motion import Motion
@@ -95,6 +99,10 @@ def column_outputs(name, size_by=None):
         from pipeline.stats.circular import direction_statistics
         campaign_dir = Path(campaign_dir)
         runs, impacts = collect(specs, name, campaign_dir)
+        described = summary_entry(specs)
+        if described and not runs.empty:
+            names = {s["run_id"]: s["params"]["column_file"]["name"] for s in specs}
+            runs.insert(1, "description", runs["run_id"].map(names))
         write_tables(campaign_dir, runs, impacts)
         written = []
         if not runs.empty:
@@ -108,7 +116,7 @@ def column_outputs(name, size_by=None):
         print(f"wrote {campaign_dir / 'runs.csv'}" + (
             "" if toppled is None else "; toppled: " + ", ".join(
                 f"{c} {int(r['sum'])}/{int(r['count'])}" for c, r in toppled.iterrows())))
-        return {"code_version": run_code_version(),
+        return {"code_version": run_code_version(), **described,
                 "figures": [str(p.relative_to(campaign_dir)) for p in written]}
 
     return outputs
@@ -118,22 +126,54 @@ def _records_or(records, default):
     return list(records) if records else list(default)
 
 
+def described_twins(runs, column_file, stiffness):
+    """(record, twin parameters) pairs with the description ``column_file`` (a dict) and
+    its contact stiffness added; unchanged without one."""
+    if column_file is None:
+        return runs
+    kn = column_kn(column_file, stiffness)
+    return [(r, {**p, "column_file": column_file, "kn": kn}) for r, p in runs]
+
+
+def slenderness_specs(records, campaign_dir, column_file=None, stiffness="matched"):
+    """h/d sweep of the twin model; with a description, the described column's block
+    heights scaled to each h/d (:func:`pipeline.campaign.column_file.at_slenderness`)."""
+    data = description(column_file)
+    check_stiffness(stiffness)
+    recs = _records_or(records, [paper.SWEEP_RECORD, pulse_record()])
+    if data is None:
+        return column_specs([(r, twin(hd=hd)) for r in recs for hd in paper.SLENDERNESS_HD],
+                            campaign_dir)
+    sweep = []
+    for hd in paper.SLENDERNESS_HD:
+        scaled = at_slenderness(data, hd)
+        sweep.append(twin(hd=hd, column_file=scaled, kn=column_kn(scaled, stiffness)))
+    return mark(column_specs([(r, p) for r in recs for p in sweep], campaign_dir), data)
+
+
+def friction_specs(records, campaign_dir, column_file=None, stiffness="matched"):
+    data = description(column_file)
+    check_stiffness(stiffness)
+    runs = [(r, twin(mu_s=mu, mu_k=round(paper.MU_K_OVER_MU_S * mu, 4)))
+            for r in _records_or(records, [paper.SWEEP_RECORD, pulse_record()])
+            for mu in paper.FRICTION_MU_S]
+    return mark(column_specs(described_twins(runs, data, stiffness), campaign_dir), data)
+
+
 register(Campaign(
     "slenderness", f"h/d {paper.SLENDERNESS_HD[0]:g}-{paper.SLENDERNESS_HD[-1]:g} on the "
     "paper's sweep record and the pulse record",
-    lambda records, d: column_specs(
-        [(r, twin(hd=hd)) for r in _records_or(records, [paper.SWEEP_RECORD, pulse_record()])
-         for hd in paper.SLENDERNESS_HD], d),
-    run_column_spec, column_outputs("slenderness", "hd")))
+    slenderness_specs, run_column_spec, column_outputs("slenderness", "hd"),
+    options=lambda parser: add_campaign_options(
+        parser, "its block heights are scaled by one factor to each h/d of the sweep (overall "
+        "height over base width)"),
+    read_options=read_campaign_options))
 
 register(Campaign(
     "friction", f"mu_s {paper.FRICTION_MU_S[0]:g}-{paper.FRICTION_MU_S[-1]:g} "
     f"(mu_k = {paper.MU_K_OVER_MU_S:g} mu_s)",
-    lambda records, d: column_specs(
-        [(r, twin(mu_s=mu, mu_k=round(paper.MU_K_OVER_MU_S * mu, 4)))
-         for r in _records_or(records, [paper.SWEEP_RECORD, pulse_record()])
-         for mu in paper.FRICTION_MU_S], d),
-    run_column_spec, column_outputs("friction", "mu_s")))
+    friction_specs, run_column_spec, column_outputs("friction", "mu_s"),
+    options=add_campaign_options, read_options=read_campaign_options))
 
 
 def _nearsource_records():
@@ -141,19 +181,28 @@ def _nearsource_records():
     return sets.record_ids("nearsource")
 
 
+def records_specs(records, campaign_dir, column_file=None, stiffness="matched"):
+    data = description(column_file)
+    check_stiffness(stiffness)
+    runs = [(r, twin()) for r in (list(records) if records else _nearsource_records())]
+    return mark(column_specs(described_twins(runs, data, stiffness), campaign_dir), data)
+
+
 register(Campaign(
     "records", "the twin model under the paper's record selection (record set nearsource; "
     "--set all / fema for the others)",
-    lambda records, d: column_specs(
-        [(r, twin()) for r in (list(records) if records else _nearsource_records())], d),
-    run_column_spec, column_outputs("records")))
+    records_specs, run_column_spec, column_outputs("records"),
+    options=add_campaign_options, read_options=read_campaign_options))
 
 
-def synthetic_specs(records, campaign_dir):
+def synthetic_specs(records, campaign_dir, column_file=None, stiffness="matched"):
     from pipeline.motion import synthetics
+    data = description(column_file)
+    check_stiffness(stiffness)
     paths = list(records) if records else [p for source in synthetics.SOURCES
                                            for p in synthetics.generate(source)]
-    return column_specs([(str(p), twin()) for p in paths], campaign_dir)
+    runs = [(str(p), twin()) for p in paths]
+    return mark(column_specs(described_twins(runs, data, stiffness), campaign_dir), data)
 
 
 def synthetic_outputs(specs, campaign_dir, failures, animations, figures=True):
@@ -177,7 +226,8 @@ def synthetic_outputs(specs, campaign_dir, failures, animations, figures=True):
 
 
 register(Campaign("synthetic", "the twin model at synthetic sites around two sources",
-                  synthetic_specs, run_column_spec, synthetic_outputs))
+                  synthetic_specs, run_column_spec, synthetic_outputs,
+                  options=add_campaign_options, read_options=read_campaign_options))
 
 
 # ---------------------------------------------------------------- real columns
@@ -290,19 +340,11 @@ def columns_outputs(specs, campaign_dir, failures, animations, figures=True):
 
 
 def columns_options(parser):
-    from pipeline.scenario.geometry import example_names
-    parser.add_argument("--column-file", dest="column_files", default=None,
-                        metavar="NAME_OR_FILE,...",
-                        help="comma-separated column descriptions (shipped: "
-                        + ", ".join(example_names()) + "; default: all shipped)")
+    add_column_file_argument(parser, "default: all shipped", many=True, dest="column_files")
     parser.add_argument("--column", choices=("both", "monolithic", "drums"), default="both",
                         help="both (default): each description and a monolith of its "
                         "outline; drums: the description only; monolithic: the monolith only")
-    parser.add_argument("--stiffness", choices=("matched", "paper"), default="matched",
-                        help="contact stiffness per point: matched (default) raises the "
-                        "paper's kn for heavy columns so that each rocks on its contact "
-                        "springs no slower than the paper's column (13.5 Hz); paper: "
-                        f"{paper.COLUMN_KN_N_M:g} N/m for all")
+    add_stiffness_argument(parser)
 
 
 def columns_read_options(args):

@@ -28,6 +28,12 @@ Ranges (``ENSEMBLE_RANGES``, all around the paper's values; override with
 
 Tilt and offsets make each member a column description (``pipeline.scenario.geometry``);
 with ``--column both`` the monolith beside it has the same outline and tilt.
+
+With ``--column-file`` every member is the described column with the same sampled values
+applied to its blocks (:func:`pipeline.campaign.column_file.perturbed`: tolerances on
+every block, the tilt added to the described one, drum offsets on the blocks above the
+first that are not joined), and ``kn_factor`` multiplies the description's contact
+stiffness (``--stiffness``, as in ``campaign columns``).
 """
 import math
 from pathlib import Path
@@ -37,6 +43,10 @@ from scipy.stats import qmc
 
 from pipeline import paper
 from pipeline.campaign import Campaign, register
+from pipeline.campaign.column_file import (add_column_file_argument, add_stiffness_argument,
+                                           check_stiffness, column_kn, mark,
+                                           read_campaign_options, summary_entry)
+from pipeline.campaign.column_file import description as column_file_description
 from pipeline.campaign.definitions import column_specs, run_code_version, run_column_spec
 from pipeline.campaign.tables import collect, write_parquet
 from pipeline.files import InputError, write_csv, write_json
@@ -58,8 +68,14 @@ ENSEMBLE_RANGES = {            # name: (low, high, "uniform" | "log")
 GEOMETRY_KEYS = ("tilt_deg", "tilt_azimuth_deg", "drum_offset_mm")
 
 
-def sample_members(members, seed, ranges=None, column="both", mu_k_ratio=paper.MU_K_OVER_MU_S):
-    """Parameters of ``members`` runs (list of dicts for run_column_spec), Latin hypercube."""
+def sample_members(members, seed, ranges=None, column="both", mu_k_ratio=paper.MU_K_OVER_MU_S,
+                   description=None, kn=paper.COLUMN_KN_N_M):
+    """Parameters of ``members`` runs (list of dicts for run_column_spec), Latin hypercube.
+
+    ``description`` (a column description dict): every member is that column with the
+    sampled tolerances, tilt and offsets applied
+    (:func:`pipeline.campaign.column_file.perturbed`), validated; ``kn``: the contact
+    stiffness the sampled ``kn_factor`` multiplies."""
     ranges = dict(ENSEMBLE_RANGES if ranges is None else ranges)
     if not (isinstance(members, int) and 1 <= members <= 10000):
         raise InputError(f"--members must be an integer in [1, 10000], got {members!r}")
@@ -78,11 +94,15 @@ def sample_members(members, seed, ranges=None, column="both", mu_k_ratio=paper.M
         params = {"column": column, "hd": round(height / diameter, 6), "height": round(height, 6),
                   "mu_s": mu_s, "mu_k": round(mu_k_ratio * mu_s, 6),
                   "damping": round(v.get("damping", paper.DAMPING_RATIO), 6),
-                  "kn": round(paper.COLUMN_KN_N_M * v.get("kn_factor", 1.0), 1),
+                  "kn": round(kn * v.get("kn_factor", 1.0), 1),
                   "rim_phase_deg": round(v.get("rim_phase_deg", 0.0), 6)}
         if "scale" in v:
             params["scale"] = round(v["scale"], 6)
-        if any(v.get(k) for k in GEOMETRY_KEYS):
+        if description is not None:
+            params["column_file"] = described_member(description, v, seed, index)
+            for key in ("hd", "height"):
+                params.pop(key)
+        elif any(v.get(k) for k in GEOMETRY_KEYS):
             rng = np.random.default_rng([seed, index])
             params["column_file"] = drum_description(
                 height, diameter, v.get("tilt_deg", 0.0), v.get("tilt_azimuth_deg", 0.0),
@@ -91,6 +111,26 @@ def sample_members(members, seed, ranges=None, column="both", mu_k_ratio=paper.M
                 params.pop(key)
         rows.append(params)
     return rows
+
+
+def described_member(data, v, seed, index):
+    """Member ``index`` of a described column from its sampled values ``v``.  Validated
+    before anything runs without the sampled offsets (sizes, tilts, statics: milliseconds;
+    offset joints cost about a second each to outline), whose size is checked alone."""
+    from pipeline.campaign.column_file import perturbed
+    from pipeline.scenario.geometry import MAX_OFFSET_M, ColumnGeometry
+    args = (data, 1 + v.get("height_tolerance", 0.0), 1 + v.get("diameter_tolerance", 0.0),
+            v.get("tilt_deg", 0.0), v.get("tilt_azimuth_deg", 0.0))
+    member = perturbed(*args, v.get("drum_offset_mm", 0.0) / 1000.0,
+                       np.random.default_rng([seed, index]))
+    try:
+        ColumnGeometry.from_dict(perturbed(*args))
+        for k, block in enumerate(member["blocks"]):
+            if max(map(abs, block.get("offset_m", [0.0, 0.0]))) > MAX_OFFSET_M:
+                raise InputError(f"blocks[{k}]: offset_m above {MAX_OFFSET_M:g} m")
+    except InputError as exc:
+        raise InputError(f"ensemble member {index} of {data['name']}: {exc}") from None
+    return member
 
 
 def drum_description(height, diameter, tilt_deg, tilt_azimuth_deg, max_offset_m, rng,
@@ -111,25 +151,37 @@ def drum_description(height, diameter, tilt_deg, tilt_azimuth_deg, max_offset_m,
     return {"name": "drums (ensemble member)", "density": density, "blocks": blocks}
 
 
-def nominal(column="both"):
-    return {"column": column, "hd": paper.COLUMN_HD, "mu_s": paper.MU_STATIC,
-            "mu_k": paper.MU_KINETIC}
+def nominal(column="both", description=None, kn=None):
+    """The nominal run: the paper's values (and a description as described, with ``kn``)."""
+    params = {"column": column, "hd": paper.COLUMN_HD, "mu_s": paper.MU_STATIC,
+              "mu_k": paper.MU_KINETIC}
+    if description is not None:
+        params.update(column_file=description, kn=kn)
+    return params
 
 
 def ensemble_specs(records, campaign_dir, record=None, column="both", members=DEFAULT_MEMBERS,
-                   seed=DEFAULT_SEED, vary=None, **_):
+                   seed=DEFAULT_SEED, vary=None, column_file=None, stiffness="matched", **_):
+    data = column_file_description(column_file)
     records = list(records or []) + ([record] if record else [])
     if not records:
         raise InputError("campaign ensemble needs --record ID_OR_FILE (or --records/--set)")
     if column not in ("both", "monolithic", "drums"):
         raise InputError(f"--column must be both, monolithic or drums, got {column!r}")
+    check_stiffness(stiffness)
     ranges = dict(ENSEMBLE_RANGES, **(vary or {}))
-    member_params = sample_members(members, seed, ranges, column)
+    if data is None:
+        member_params = sample_members(members, seed, ranges, column)
+        nominal_params = nominal(column)
+    else:
+        kn = column_kn(data, stiffness)
+        member_params = sample_members(members, seed, ranges, column, description=data, kn=kn)
+        nominal_params = nominal(column, data, kn)
     runs = []
     for rec in records:
-        runs.append((rec, nominal(column)))
+        runs.append((rec, nominal_params))
         runs += [(rec, p) for p in member_params]
-    specs = column_specs(runs, campaign_dir)
+    specs = mark(column_specs(runs, campaign_dir), data)
     per_record = members + 1
     for k, spec in enumerate(specs):
         spec["member"] = (k % per_record) - 1          # -1: the nominal run
@@ -143,9 +195,12 @@ def ensemble_outputs(specs, campaign_dir, failures, animations, figures=True):
     campaign_dir = Path(campaign_dir)
     runs, _ = collect(specs, "ensemble", campaign_dir)
     if runs.empty:
-        return {"code_version": run_code_version(), "figures": []}
+        return {"code_version": run_code_version(), **summary_entry(specs), "figures": []}
     member_of = {s["run_id"]: s["member"] for s in specs}
     runs.insert(1, "member", runs["run_id"].map(member_of))
+    described = summary_entry(specs)
+    if described:
+        runs.insert(2, "description", described["column_file"]["name"])
     records = list(dict.fromkeys(runs["record_id"]))
     summaries, written = [], []
     for record_id in records:
@@ -154,6 +209,8 @@ def ensemble_outputs(specs, campaign_dir, failures, animations, figures=True):
         write_csv(out / "members.csv", sub)
         write_parquet(out / "members.parquet", sub)
         summary = summarise(sub, record_id, specs[0]["seed"])
+        if described:
+            summary["column_file"] = described["column_file"]["name"]
         write_json(out / "ensemble_summary.json", summary)
         summaries.append(summary)
         if figures:
@@ -166,7 +223,7 @@ def ensemble_outputs(specs, campaign_dir, failures, animations, figures=True):
                      f"(R {col['resultant_length']:.2f})"))
     if len(records) > 1:
         write_json(campaign_dir / "ensemble_summaries.json", summaries)
-    return {"code_version": run_code_version(),
+    return {"code_version": run_code_version(), **described,
             "figures": [str(Path(p).relative_to(campaign_dir)) for p in written]}
 
 
@@ -218,6 +275,12 @@ def ensemble_options(parser):
                         help="override a range: " + ", ".join(
                             f"{k} {v[0]:g}-{v[1]:g}" for k, v in ENSEMBLE_RANGES.items())
                         + "; scale=LO,HI samples an amplitude scaling")
+    add_column_file_argument(parser, "every member is the described column with the sampled "
+                             "height and diameter tolerances on every block, the tilt added "
+                             "to its own and the drum offsets on the blocks above the first "
+                             "(joined blocks keep theirs); with --column both a monolith of "
+                             "its outline stands beside it")
+    add_stiffness_argument(parser, "with --column-file, what kn_factor multiplies")
 
 
 def parse_vary(items):
@@ -242,7 +305,7 @@ def parse_vary(items):
 
 def read_options(args):
     return {"record": args.record, "column": args.column, "members": args.members,
-            "seed": args.seed, "vary": parse_vary(args.vary)}
+            "seed": args.seed, "vary": parse_vary(args.vary), **read_campaign_options(args)}
 
 
 register(Campaign("ensemble", "N members with sampled friction, damping, stiffness, "

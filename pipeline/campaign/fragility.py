@@ -27,6 +27,10 @@ keys in :func:`summarise`): ``fragility.json``, ``fragility_runs.csv`` (one row 
 run and column, 3D and 2D), ``fragility_levels.csv`` (fraction toppled per record
 and level, 3D columns beside the 2D block), figures ``fragility_curves.png``,
 ``fragility_2d_vs_3d.png`` and ``fragility_surface.png``.
+
+With ``--column-file`` the members are the described column with the sampled height and
+diameter tolerances (its tilt and offsets as described, none sampled), and the 2D block
+has each member's overall height and base width (:func:`block_size`).
 """
 import json
 import math
@@ -38,6 +42,10 @@ import pandas as pd
 
 from pipeline import paper
 from pipeline.campaign import Campaign, register
+from pipeline.campaign.column_file import (add_column_file_argument, add_stiffness_argument,
+                                           check_stiffness, column_kn, mark,
+                                           read_campaign_options, summary_entry)
+from pipeline.campaign.column_file import description as column_file_description
 from pipeline.campaign.definitions import (column_specs, motion_cache, pulse_record,
                                            run_code_version, run_column_spec)
 from pipeline.campaign import ensemble   # module: imported while ensemble may still load
@@ -88,8 +96,14 @@ def parse_levels(text):
 
 
 def fragility_specs(records, campaign_dir, levels=DEFAULT_LEVELS, members=DEFAULT_MEMBERS,
-                    column="both", seed=None, azimuths=DEFAULT_AZIMUTHS, **_):
-    """Run specs: every record x level x member; ``scale`` = level / PGA of the record."""
+                    column="both", seed=None, azimuths=DEFAULT_AZIMUTHS, column_file=None,
+                    stiffness="matched", **_):
+    """Run specs: every record x level x member; ``scale`` = level / PGA of the record.
+    With ``column_file`` every member is the described column with the sampled height
+    and diameter tolerances (its own tilt and offsets as described), and the 2D block
+    has each member's overall height and base width."""
+    data = column_file_description(column_file)
+    check_stiffness(stiffness)
     records = list(records) if records else default_records()
     levels = parse_levels(levels)
     if column not in ("both", "monolithic", "drums"):
@@ -100,7 +114,11 @@ def fragility_specs(records, campaign_dir, levels=DEFAULT_LEVELS, members=DEFAUL
     # the 2D block needs each member's height and h/d: no tilt or offset descriptions here
     ranges = {k: v for k, v in ensemble.ENSEMBLE_RANGES.items()
               if k not in ensemble.GEOMETRY_KEYS}
-    member_params = ensemble.sample_members(members, seed, ranges, column=column)
+    if data is None:
+        member_params = ensemble.sample_members(members, seed, ranges, column=column)
+    else:
+        member_params = ensemble.sample_members(members, seed, ranges, column=column,
+                                                description=data, kn=column_kn(data, stiffness))
     cache = motion_cache(campaign_dir)
     runs, extra = [], []
     for record in records:
@@ -114,10 +132,22 @@ def fragility_specs(records, campaign_dir, levels=DEFAULT_LEVELS, members=DEFAUL
                 runs.append((record, {**params, "scale": scale}))
                 extra.append({"level_m_s2": level, "level_index": li, "member": mi,
                               "scale": scale})
-    specs = column_specs(runs, campaign_dir)
+    specs = mark(column_specs(runs, campaign_dir), data)
     for spec, more in zip(specs, extra):
         spec.update(more, seed=seed, azimuths=azimuths, levels=list(levels))
     return specs
+
+
+def block_size(params):
+    """(height, width) in m of the 2D block of a run: the paper column's height and
+    diameter, or a description's overall height and base width."""
+    if "column_file" not in params:
+        return params["height"], params["height"] / params["hd"]
+    blocks = params["column_file"]["blocks"]     # as ColumnGeometry.height and .base_width
+    bottom = blocks[0]
+    width = (bottom["bottom_diameter"] if bottom["shape"] == "frustum"
+             else min(bottom["width"], bottom["depth"]))
+    return math.fsum(b["height"] for b in blocks), width
 
 
 # ---------------------------------------------------------------- tables
@@ -178,8 +208,8 @@ def _block_batch(group, motion_file, rp, along, directions, dt, max_step, t_afte
     from pipeline.rocking import rocking_response_sampled
     n_az = len(directions)
     rows = []
-    heights = np.array([s["params"]["height"] for s in group], float)
-    widths = heights / np.array([s["params"]["hd"] for s in group], float)
+    sizes = np.array([block_size(s["params"]) for s in group], float)
+    heights, widths = sizes[:, 0], sizes[:, 1]
     scales = np.array([s["scale"] for s in group], float)
     acc = (along[:, None, :] * scales[None, :, None]).reshape(len(along), -1)
     out = rocking_response_sampled(np.repeat(heights, n_az), np.repeat(widths, n_az), acc,
@@ -194,7 +224,8 @@ def _block_batch(group, motion_file, rp, along, directions, dt, max_step, t_afte
         base = {"campaign": "fragility", "run_id": spec["run_id"], "model": "2D",
                 "scale": s, "member": spec["member"], "level_index": spec["level_index"],
                 "level_m_s2": spec["level_m_s2"], "record_id": spec["record_id"],
-                "hd": spec["params"]["hd"], "height_m": spec["params"]["height"],
+                "hd": round(heights[i] / widths[i], 6) if "column_file" in spec["params"]
+                else spec["params"]["hd"], "height_m": float(heights[i]),
                 "pga_m_s2": rp["pga_h"] * s, "pgv_m_s": rp["pgv_h"] * s,
                 "pgv_pga_s": rp["pgv_pga_h"], "record_pga_h": rp["pga_h"],
                 "pga_h": rp["pga_h"] * s, "pgv_h": rp["pgv_h"] * s,
@@ -268,13 +299,19 @@ def summarise(table, specs, cost):
     alpha = float(blocks["alpha_rad"].median()) if len(blocks) else None
     p = float(blocks["p_per_s"].median()) if len(blocks) else None
     if alpha is None:
-        hd = float(np.median([s["params"]["hd"] for s in specs]))
-        height = float(np.median([s["params"]["height"] for s in specs]))
+        sizes = np.array([block_size(s["params"]) for s in specs], float)
+        hd = float(np.median(sizes[:, 0] / sizes[:, 1]))
+        height = float(np.median(sizes[:, 0]))
         from pipeline.rocking import block_constants
         c = block_constants(height, height / hd)
         alpha, p = c["alpha"], c["p"]
+    described = summary_entry(specs)
+    column_file = described["column_file"]["name"] if described else None
     descriptions = {
-        "monolithic": "3D YADE monolithic column", "drums": "3D YADE multi-drum column",
+        "monolithic": "3D YADE monolithic column" if column_file is None
+        else f"3D YADE monolith of the outline of {column_file}",
+        "drums": "3D YADE multi-drum column" if column_file is None
+        else f"3D YADE column as described in {column_file}",
         "block2d": "2D rigid block (Housner), shaken along the strongest azimuth",
         "block2d_worst": f"2D rigid block, worst of {first['azimuths']} azimuths over 180 deg"}
     columns = {}
@@ -316,6 +353,7 @@ def summarise(table, specs, cost):
         "records": list(dict.fromkeys(s["record_id"] for s in specs)),
         "levels_m_s2": first["levels"], "members": 1 + max(s["member"] for s in specs),
         "seed": first["seed"], "column": first["params"]["column"],
+        **({"column_file": column_file} if column_file else {}),
         "azimuths": first["azimuths"],
         "intensity_measures": {im: {"column": key, "unit": unit,
                                     "definition": _IM_DEFINITIONS[im]}
@@ -366,7 +404,7 @@ def fragility_outputs(specs, campaign_dir, failures, animations, figures=True):
     campaign_dir = Path(campaign_dir)
     runs = scaled_runs(specs, campaign_dir)
     if runs.empty:
-        return {"code_version": run_code_version(), "figures": []}
+        return {"code_version": run_code_version(), **summary_entry(specs), "figures": []}
     done = set(runs["run_id"])
     blocks, cost = block_runs([s for s in specs if s["run_id"] in done])
     wall = [json.loads((campaign_dir / "runs" / r / "summary.json").read_text()).get("wall_s")
@@ -397,7 +435,7 @@ def fragility_outputs(specs, campaign_dir, failures, animations, figures=True):
                  f"{fit['median_ci95'][1]:.2f}], beta {fit['beta']:.2f}"))
     print(f"2D block: {cost['block2d_cases']} cases in {cost['block2d_wall_s']:.1f} s; "
           f"YADE: {cost['yade_runs']} runs, {cost['yade_wall_s_total']:.0f} s")
-    return {"code_version": run_code_version(),
+    return {"code_version": run_code_version(), **summary_entry(specs),
             "figures": [str(Path(p).relative_to(campaign_dir)) for p in written]}
 
 
@@ -416,11 +454,16 @@ def fragility_options(parser):
     parser.add_argument("--azimuths", type=int, default=DEFAULT_AZIMUTHS,
                         help="2D block: shaking directions over 180 deg for its worst case "
                         f"(default {DEFAULT_AZIMUTHS})")
+    add_column_file_argument(parser, "every member is the described column with the sampled "
+                             "height and diameter tolerances (tilt and offsets as described); "
+                             "the 2D block has its overall height and base width")
+    add_stiffness_argument(parser, "with --column-file, what kn_factor multiplies")
 
 
 def read_options(args):
     return {"levels": parse_levels(args.levels), "members": args.members,
-            "column": args.column, "seed": args.seed, "azimuths": args.azimuths}
+            "column": args.column, "seed": args.seed, "azimuths": args.azimuths,
+            **read_campaign_options(args)}
 
 
 register(Campaign("fragility", "P(toppled | PGA, PGV, PGV/PGA) by incremental dynamic analysis: "

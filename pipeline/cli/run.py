@@ -6,10 +6,10 @@ import math
 from pathlib import Path
 
 from pipeline import RESULTS_DIR
+from pipeline.campaign.column_file import add_column_file_argument
 from pipeline.files import DirectoryLock, InputError
 from pipeline.records import processed_motion, resolve
 from pipeline.scenario import Column, Contact, Numerics
-from pipeline.scenario.geometry import example_names
 from pipeline.scenario.parameters import add_arguments, from_args
 from pipeline.simulate import back_azimuth_of, simulate
 
@@ -26,12 +26,8 @@ def setup(p):
     p.add_argument("--record", required=True, metavar="ID_OR_PATH",
                    help="catalogue id (records/catalog.csv), record file or processed .npz")
     add_arguments(p, Column)
-    p.add_argument("--column-file", default=None, metavar="NAME_OR_FILE",
-                   help="the column as found, from a description (JSON, or YAML with PyYAML; "
-                   "README 'Column files') or a shipped example by name ("
-                   + ", ".join(example_names()) + "); with --column both a monolith of "
-                   "the same outline stands beside it; excludes --hd, --height, --drums, "
-                   "--density")
+    add_column_file_argument(p, "with --column both a monolith of the same outline stands "
+                             "beside it; excludes --hd, --height, --drums, --density")
     add_arguments(p, Contact)
     add_arguments(p, Numerics)
     p.add_argument("--back-azimuth", type=float, default=None, metavar="DEG",

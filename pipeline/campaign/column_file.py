@@ -1,0 +1,176 @@
+"""``--column-file`` on ``run`` and on the campaigns: one definition of the option and its
+help text, and what the campaigns do with a column description.
+
+With a description, a campaign runs the described column in the drums' place and a
+monolith of its outline in the monolith's (``run_column_spec``, like ``run --column
+both``).  The description goes into each run's parameters as a dict, so the content-keyed
+run ids tell it apart, and into ``campaign.json`` (``column_file``) and the tables
+(``description``).  Without ``--column-file`` nothing of this touches a run's
+parameters: run ids and caches stay as they were.
+
+What a campaign varies and the description fixes:
+
+- slenderness: :func:`at_slenderness` scales every block height by one factor so that
+  the column's overall height over its base width (the bottom face's diameter or
+  smaller side) takes each h/d of the sweep; diameters, offsets and tilts stay;
+- ensemble: :func:`perturbed` applies the sampled height and diameter tolerances to
+  every block, adds the sampled out-of-plumb tilt (a vector sum with the described
+  tilt) to every block that is not joined, and moves every block above the first that
+  is not joined by the sampled drum offset (added to the described offset);
+- fragility: the 2D block has the described column's overall height and base width.
+"""
+import math
+
+from pipeline.files import InputError
+
+STIFFNESS_CHOICES = ("matched", "paper")
+
+
+def column_file_help(many=False):
+    """Help text of ``--column-file`` (without what a command adds)."""
+    from pipeline.scenario.geometry import example_names
+    what = ("comma-separated column descriptions" if many else
+            "the column as found, from a description")
+    return (f"{what} (JSON, or YAML with PyYAML; README 'Column files') or "
+            + ("shipped examples" if many else "a shipped example") + " by name ("
+            + ", ".join(example_names()) + ")")
+
+
+def add_column_file_argument(parser, note="", many=False, dest="column_file"):
+    """``--column-file NAME_OR_FILE`` (``many``: a comma-separated list) on ``parser``;
+    ``note``: what this command does with it."""
+    parser.add_argument("--column-file", dest=dest, default=None,
+                        metavar="NAME_OR_FILE,..." if many else "NAME_OR_FILE",
+                        help=column_file_help(many) + (f"; {note}" if note else ""))
+
+
+def add_stiffness_argument(parser, note=""):
+    """``--stiffness matched|paper``: the contact stiffness of described columns."""
+    from pipeline import paper
+    parser.add_argument("--stiffness", choices=STIFFNESS_CHOICES, default="matched",
+                        help=(f"{note}: " if note else "") + "contact stiffness per point: "
+                        "matched (default) raises the paper's kn for heavy columns so that "
+                        "each rocks on its contact springs no slower than the paper's column "
+                        f"(13.5 Hz); paper: {paper.COLUMN_KN_N_M:g} N/m for all")
+
+
+CAMPAIGN_NOTE = ("the described column stands in the drums' place and a monolith of its "
+                 "outline in the monolith's")
+
+
+def add_campaign_options(parser, note=""):
+    """``--column-file`` and ``--stiffness`` of a campaign that shakes one column model."""
+    add_column_file_argument(parser, CAMPAIGN_NOTE + (f"; {note}" if note else ""))
+    add_stiffness_argument(parser, "with --column-file")
+
+
+def read_campaign_options(args):
+    return {"column_file": args.column_file, "stiffness": args.stiffness}
+
+
+def description(column_file):
+    """The validated description dict of a shipped example's name, a file or a dict;
+    None for None.  InputError (one line) for an unknown name, a missing file or a
+    description that does not validate."""
+    from pipeline.scenario.geometry import ColumnGeometry
+    if column_file is None:
+        return None
+    if isinstance(column_file, dict):
+        return ColumnGeometry.from_dict(column_file).to_dict()
+    if not isinstance(column_file, str) or not column_file.strip():
+        raise InputError(f"--column-file needs a shipped example's name or a file, got "
+                         f"{column_file!r}")
+    return ColumnGeometry.load(column_file.strip()).to_dict()
+
+
+def check_stiffness(stiffness):
+    if stiffness not in STIFFNESS_CHOICES:
+        raise InputError(f"--stiffness must be matched or paper, got {stiffness!r}")
+
+
+def column_kn(data, stiffness="matched"):
+    """Contact stiffness per point (N/m) for a description: the campaign ``columns`` rule
+    (:func:`pipeline.campaign.definitions.matched_kn`) or the paper's kn."""
+    from pipeline import paper
+    from pipeline.campaign.definitions import matched_kn
+    from pipeline.scenario.geometry import ColumnGeometry
+    check_stiffness(stiffness)
+    if stiffness == "paper":
+        return paper.COLUMN_KN_N_M
+    return matched_kn(ColumnGeometry.from_dict(data))
+
+
+def slenderness_of(data):
+    """Overall height over base width of a description."""
+    from pipeline.scenario.geometry import ColumnGeometry
+    g = ColumnGeometry.from_dict(data)
+    return g.height / g.base_width
+
+
+def _name(data, suffix):
+    return f"{data['name'][:80 - len(suffix)]}{suffix}"
+
+
+def at_slenderness(data, hd):
+    """The description with every block height multiplied by hd / (its height / base
+    width), so that its overall h/d is ``hd``; validated (InputError when the scaled
+    column breaks a limit of the format, e.g. a block above 30 m)."""
+    from pipeline.scenario.geometry import ColumnGeometry
+    factor = hd / slenderness_of(data)
+    blocks = [{**b, "height": round(b["height"] * factor, 9)} for b in data["blocks"]]
+    scaled = {**data, "name": _name(data, f" at h/d {hd:g}"), "blocks": blocks}
+    try:
+        return ColumnGeometry.from_dict(scaled).to_dict()
+    except InputError as exc:
+        raise InputError(f"--column-file {data['name']} scaled to h/d {hd:g}: {exc}") from None
+
+
+HORIZONTAL_SIZES = ("bottom_diameter", "top_diameter", "width", "depth")
+
+
+def perturbed(data, height_factor=1.0, diameter_factor=1.0, tilt_deg=0.0,
+              tilt_azimuth_deg=0.0, max_offset_m=0.0, rng=None):
+    """An ensemble member of a description: block heights x ``height_factor``, diameters,
+    widths and depths x ``diameter_factor``, the tilt vector (tilt_deg toward
+    tilt_azimuth_deg) added to every block's that is not joined, and every block above
+    the first that is not joined moved by up to ``max_offset_m`` in a random direction
+    (``rng``), added to its described offset.  Not validated (the caller does)."""
+    tx = tilt_deg * math.sin(math.radians(tilt_azimuth_deg))
+    ty = tilt_deg * math.cos(math.radians(tilt_azimuth_deg))
+    blocks = []
+    for k, raw in enumerate(data["blocks"]):
+        b = dict(raw)
+        b["height"] = round(b["height"] * height_factor, 9)
+        for key in HORIZONTAL_SIZES:
+            if key in b:
+                b[key] = round(b[key] * diameter_factor, 9)
+        if not b.get("joined"):
+            if tilt_deg > 0:
+                t0, a0 = b.get("tilt_deg", 0.0), math.radians(b.get("tilt_azimuth_deg", 0.0))
+                x, y = t0 * math.sin(a0) + tx, t0 * math.cos(a0) + ty
+                b["tilt_deg"] = round(math.hypot(x, y), 6)
+                b["tilt_azimuth_deg"] = round(math.degrees(math.atan2(x, y)) % 360.0, 6)
+            if k > 0 and max_offset_m > 0:
+                r, a = max_offset_m * rng.random(), 2 * math.pi * rng.random()
+                east, north = b.get("offset_m", [0.0, 0.0])
+                b["offset_m"] = [round(east + r * math.sin(a), 9),
+                                 round(north + r * math.cos(a), 9)]
+        blocks.append(b)
+    return {**data, "name": _name(data, " (ensemble member)"), "blocks": blocks}
+
+
+def mark(specs, data):
+    """Name the description in each spec (``description``; outputs and tables show it)."""
+    if data is not None:
+        for spec in specs:
+            spec["description"] = data["name"]
+            spec["column_description"] = data
+    return specs
+
+
+def summary_entry(specs):
+    """``{"column_file": description}`` for campaign.json when the specs carry one."""
+    for spec in specs:
+        if spec.get("column_description") is not None:
+            return {"column_file": spec["column_description"]}
+    return {}
