@@ -175,12 +175,39 @@ def _check_jobs(jobs):
     return jobs or os.cpu_count() or 1
 
 
-def forward_table(args, grid):
-    """(ForwardTable, info dict): the --table file, or the campaign's (run or reused)."""
-    from pipeline.inversion.forward import ForwardTable, run_forward
-    if args.table is not None:
-        table = ForwardTable.load(args.table)
-        info = {"table": str(args.table), "grid": table.info.get("grid"),
+def described_grids(observations, grid, base_dir="."):
+    """{column name in the observations: the forward grid of that described column} for
+    every column that is a column file (a shipped example's name, or a file, relative to
+    ``base_dir`` (the observations file's folder) when it is there); one-line errors
+    before anything runs."""
+    from pipeline.campaign.column_file import description
+    from pipeline.scenario.geometry import example_names
+    out = {}
+    for name in observations.column_types():
+        if name in ("drums", "monolithic"):
+            continue
+        beside = Path(base_dir) / name
+        source = str(beside) if name not in example_names() and beside.is_file() else name
+        try:
+            out[name] = grid.replace(column_file=description(source))
+        except InputError as exc:
+            message = str(exc).removeprefix(f"--column-file {source}: ")
+            raise InputError(f"column {name!r}: {message}") from None
+    return out
+
+
+def forward_table(args, grid, sibling_of=None):
+    """(ForwardTable, info dict): the --table file (``sibling_of``: the table of ``grid``
+    beside that file), or the campaign's (run or reused)."""
+    from pipeline.inversion.forward import ForwardTable, run_forward, table_path
+    path = args.table if sibling_of is None else \
+        Path(sibling_of).parent / table_path(".", grid).name
+    if sibling_of is not None and not path.is_file():
+        raise InputError(f"--table: no forward table of the described column "
+                         f"{grid.column_file['name']!r} ({path.name}) beside {sibling_of}")
+    if path is not None:
+        table = ForwardTable.load(path)
+        info = {"table": str(path), "grid": table.info.get("grid"),
                 "grid_key": table.info.get("grid_key"),
                 "code_version": table.info.get("code_version"),
                 "yade_wall_s": table.info.get("yade_wall_s"), "runs": table.info.get("runs"),
@@ -203,16 +230,21 @@ def run(args):
     if args.demo:
         return _run_demo(args, preset, grid, candidates)
     observations = load_observations(args.observations)
-    columns = set(observations.column_types()) - {"drums", "monolithic"}
-    if columns:
-        raise InputError(f"{args.observations.name}: column(s) {', '.join(sorted(columns))}: "
-                         "only drums and monolithic are modelled by the forward table yet "
-                         "(column files: issue 'Real columns')")
+    described = described_grids(observations, grid, args.observations.parent)
     out = args.out or RESULTS_DIR / "inversion" / args.observations.stem
     if out.exists() and not out.is_dir():
         raise InputError(f"--out {out} is a file, not a directory")
     started = time.monotonic()
     table, info = forward_table(args, grid)
+    if args.table is not None and described and table.info.get("grid"):
+        from pipeline.inversion.forward import TableGrid       # the --table file's grid
+        grid = TableGrid(**table.info["grid"])
+        described = {name: grid.replace(column_file=g.column_file)
+                     for name, g in described.items()}
+    for name, column_grid in described.items():
+        column_table, column_info = forward_table(args, column_grid, sibling_of=args.table)
+        table = table.with_column(name, column_table)
+        info.setdefault("described_columns", {})[name] = column_info
     summary = run_inversion(observations, out, table, candidates, args.kernel_deg,
                             args.floor, forward_info=info, likelihood=args.likelihood)
     lo, hi = summary["back_azimuth_ci95_deg"]

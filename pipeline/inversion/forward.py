@@ -104,9 +104,13 @@ class TableGrid:
     fmax_hz: float = 10.0
     duration_s: float = 20.0
     tail_s: float = 5.0
+    column_file: dict = None    # a column description: the table of that column alone
 
     def __post_init__(self):
         object.__setattr__(self, "mechanisms", parse_mechanisms(self.mechanisms))
+        if self.column_file is not None:
+            from pipeline.campaign.column_file import description
+            object.__setattr__(self, "column_file", description(self.column_file))
         for name in ("depths_km", "magnitudes", "distances_km"):
             values = tuple(sorted(float(v) for v in getattr(self, name)))
             if not values or len(set(values)) != len(values) or \
@@ -145,8 +149,17 @@ class TableGrid:
         return (len(self.slices()) * len(self.distances_km) * len(self.azimuths_deg)
                 * (self.members + int(self.nominal)))
 
+    @property
+    def columns(self):
+        """Column roles of the table: the twin model's, or the described column alone
+        (in the drums' role of its runs)."""
+        return COLUMNS if self.column_file is None else COLUMNS[:1]
+
     def as_dict(self):
-        return {**dataclasses.asdict(self), "mechanisms": [list(m) for m in self.mechanisms]}
+        out = {**dataclasses.asdict(self), "mechanisms": [list(m) for m in self.mechanisms]}
+        if self.column_file is None:
+            out.pop("column_file")      # the twin grids' keys stay as they were
+        return out
 
     def key(self):
         return content_hash(self.as_dict())
@@ -292,11 +305,19 @@ MEMBER_BATCH = 6    # members are drawn in Latin-hypercube batches of 6 (seeds s
 def member_parameters(grid):
     """[(member, params)]: member -1 is the nominal twin run, 0.. the ensemble members
     (batch b of MEMBER_BATCH members: Latin hypercube with seed ``grid.seed + b``)."""
+    from pipeline.campaign.column_file import column_kn
     from pipeline.campaign.ensemble import nominal, sample_members
-    runs = [(-1, nominal("both"))] if grid.nominal else []
+    if grid.column_file is None:
+        column, described = "both", {}
+    else:                   # the described column alone, stiffness as in `campaign columns`
+        column = "drums"
+        described = {"description": grid.column_file,
+                     "kn": column_kn(grid.column_file, "matched")}
+    runs = [(-1, nominal(column, **described))] if grid.nominal else []
     for b, first in enumerate(range(0, grid.members, MEMBER_BATCH)):
         size = min(MEMBER_BATCH, grid.members - first)
-        runs += list(enumerate(sample_members(size, grid.seed + b, column="both"), first))
+        runs += list(enumerate(sample_members(size, grid.seed + b, column=column,
+                                              **described), first))
     return [(m, {**p, "tail_s": float(grid.tail_s)}) for m, p in runs]
 
 
@@ -423,7 +444,8 @@ class ForwardTable:
         runs_dir = Path(campaign_dir) / "runs"
         sl = grid.slices()
         members = np.arange(grid.members)
-        shape = (len(sl), len(grid.distances_km), len(grid.azimuths_deg), len(COLUMNS))
+        columns = grid.columns
+        shape = (len(sl), len(grid.distances_km), len(grid.azimuths_deg), len(columns))
         top = np.zeros(shape + (len(members),), bool)
         az = np.full(shape + (len(members),), np.nan)
         valid = np.zeros(shape + (len(members),), bool)
@@ -439,7 +461,7 @@ class ForwardTable:
             simulated += bool(summary.get("simulated", True))
             i, j = divmod(spec["node"], na)
             for col in summary["columns"]:
-                c = COLUMNS.index(col["column"])
+                c = columns.index(col["column"])
                 fell = bool(col["toppled"]) and col["downfall_azimuth_deg"] is not None
                 value = col["downfall_azimuth_deg"] if fell else np.nan
                 index = (spec["slice"], i, j, c)
@@ -452,7 +474,7 @@ class ForwardTable:
         slices = [{"mechanism": s[0], "dip_deg": s[1], "rake_deg": s[2], "depth_km": s[3],
                    "mw": s[4]} for s in sl]
         return cls(slices, grid.distances_km, grid.azimuths_deg, members, top, az, valid,
-                   COLUMNS, ntop if grid.nominal else None, naz if grid.nominal else None,
+                   columns, ntop if grid.nominal else None, naz if grid.nominal else None,
                    nval if grid.nominal else None,
                    info={"grid": grid.as_dict(), "grid_key": grid.key(),
                          "yade_wall_s": round(wall, 1), "runs": len(specs),
@@ -477,6 +499,39 @@ class ForwardTable:
                    "mw": s[4]} for s in slices]
         return cls(slices, distances_km, azimuths_deg, np.arange(n_members), top, az, valid,
                    tuple(columns), info=dict(info or {"toy": True}))
+
+    def with_column(self, name, other):
+        """This table and the first column of ``other`` (same slices, nodes and members,
+        e.g. a described column's table) as column ``name``."""
+        same = (self.slices == other.slices
+                and np.array_equal(self.distances_km, other.distances_km)
+                and np.array_equal(self.azimuths_deg, other.azimuths_deg)
+                and np.array_equal(self.members, other.members)
+                and (self.nominal_toppled is None) == (other.nominal_toppled is None))
+        if not same:
+            raise InputError(f"forward table of {name}: its grid differs from the main "
+                             "table's (slices, rings, azimuths, members, nominal run)")
+        if name in self.columns:
+            raise InputError(f"forward table: column {name!r} is there already")
+
+        def join(a, b):
+            return None if a is None else np.concatenate([a, b[..., :1]], axis=3)
+
+        def join_members(a, b):
+            return np.concatenate([a, b[:, :, :, :1, :]], axis=3)
+
+        return dataclasses.replace(
+            self, columns=tuple(self.columns) + (name,),
+            toppled=join_members(self.toppled, other.toppled),
+            azimuth_deg=join_members(self.azimuth_deg, other.azimuth_deg),
+            valid=join_members(self.valid, other.valid),
+            nominal_toppled=join(self.nominal_toppled, other.nominal_toppled),
+            nominal_azimuth_deg=join(self.nominal_azimuth_deg, other.nominal_azimuth_deg),
+            nominal_valid=join(self.nominal_valid, other.nominal_valid),
+            info={**self.info, "described_columns": {
+                **self.info.get("described_columns", {}),
+                name: {k: other.info.get(k) for k in ("grid_key", "yade_wall_s", "runs",
+                                                      "code_version")}}})
 
     def select_members(self, mask):
         """A table with the members where ``mask`` (bool over ``members``) holds."""

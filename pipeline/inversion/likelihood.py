@@ -130,8 +130,8 @@ class ForwardModel:
             return self.table.columns.index(column)
         except ValueError:
             raise InputError(f"column {column!r}: the forward table models "
-                             f"{' and '.join(self.table.columns)} only (column files: issue "
-                             "'Real columns')") from None
+                             f"{', '.join(self.table.columns)} only (`invert` adds the table "
+                             "of each column file its observations name)") from None
 
     # ------------------------------------------------------------------ weights
     def distance_weights(self, r_km):

@@ -11,8 +11,9 @@ A site gives its position either as ``east_km``/``north_km`` (any local frame) o
 ``latitude``/``longitude`` (degrees), the same way for every site.  Positions are turned
 into km East/North of the first site: geographic ones on the local tangent plane about the
 first site (azimuthal equidistant: distance and azimuth from obspy.geodetics).
-``column`` is ``drums``, ``monolithic`` or a column file name (accepted and kept; the
-forward table models drums and monolithic only).  ``uncertainty_deg`` (optional, default
+``column`` is ``drums``, ``monolithic`` or a column file: a shipped example's name or a
+JSON/YAML file (relative to the observations file's folder); ``invert`` computes a forward
+table for each described column.  ``uncertainty_deg`` (optional, default
 10) is the 1-sigma uncertainty of the measured downfall azimuth.  Every problem is one
 line naming the site and column.
 """

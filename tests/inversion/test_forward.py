@@ -23,7 +23,7 @@ def test_mw65_layout_is_the_paper_scenarios():
 
 def test_grid_checks_and_sizes():
     assert GRIDS["quick"].n_runs() == 2 * 2 * 4 * 2
-    assert GRIDS["demo"].n_runs() == 2 * 4 * 12 * 13
+    assert GRIDS["demo"].n_runs() == 2 * 4 * 12 * 7
     with pytest.raises(InputError, match="azimuth-step"):
         TableGrid(azimuth_step_deg=25)
     with pytest.raises(InputError, match="distances"):
@@ -39,7 +39,7 @@ def test_member_parameters_nominal_first_and_grown_ensembles_keep_their_members(
     params = member_parameters(TableGrid(members=3))
     assert [m for m, _ in params] == [-1, 0, 1, 2]
     assert all(p["column"] == "both" and p["tail_s"] == 5.0 for _, p in params)
-    six, twelve = member_parameters(TableGrid(members=6)), member_parameters(GRIDS["demo"])
+    six, twelve = member_parameters(TableGrid(members=6)), member_parameters(TableGrid(members=12))
     assert len(twelve) == 13 and twelve[:7] == six       # the first batch: the same runs
     assert twelve[7][1] != six[1][1]                     # the second batch: a new seed
 

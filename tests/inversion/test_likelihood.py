@@ -126,7 +126,7 @@ def test_distances_beyond_the_table_are_clamped(tiny):
 def test_unmodelled_column_is_one_line(tiny):
     from pipeline.files import InputError
     model = ForwardModel(tiny)
-    with pytest.raises(InputError, match="models drums and monolithic only"):
+    with pytest.raises(InputError, match="models drums, monolithic only"):
         model.site_log_likelihood(site(ColumnObservation("ionic.json", "standing")),
                                   [0.0], [-5.0], [0.0])
 

@@ -74,7 +74,9 @@ BAD = [
     ({"sites": [GOOD_SITE, GOOD_SITE]}, "two sites have this name"),
     ({"sites": [GOOD_SITE, dict(GOOD_SITE, name="B")]}, "at the same place"),
     ({"sites": [dict(GOOD_SITE, columns=[{"column": "ionic.json", "state": "standing"}])]},
-     "only drums and monolithic are modelled"),
+     "column 'ionic.json': no such file or shipped example"),
+    ({"sites": [dict(GOOD_SITE, columns=[{"column": "corinthian", "state": "standing"}])]},
+     "column 'corinthian': no such file or shipped example"),
 ]
 
 
