@@ -217,35 +217,40 @@ def _edge_distances(poly, point):
 
 
 def _inside(edge, a, p):
-    """True when point p lies left of (or on) the directed edge from a."""
-    return edge[0] * (p[1] - a[1]) - edge[1] * (p[0] - a[0]) >= -1e-15
+    """True where points p (n x 2) lie left of (or on) the directed edge from a."""
+    return edge[0] * (p[:, 1] - a[1]) - edge[1] * (p[:, 0] - a[0]) >= -1e-15
 
 
 def _crossing(edge, a, p, q):
-    """Where segment p-q crosses the line of the edge from a."""
-    p, q = np.asarray(p), np.asarray(q)
+    """Where segments p-q (n x 2 each) cross the line of the edge from a."""
     d = q - p
-    t = (edge[1] * (p[0] - a[0]) - edge[0] * (p[1] - a[1])) / (edge[0] * d[1] - edge[1] * d[0])
-    return tuple(p + t * d)
+    t = (edge[1] * (p[:, 0] - a[0]) - edge[0] * (p[:, 1] - a[1])) / \
+        (edge[0] * d[:, 1] - edge[1] * d[:, 0])
+    return p + t[:, None] * d
 
 
 def clip_convex(subject, clipper):
-    """Intersection of two convex CCW polygons (Sutherland-Hodgman), n x 2 (may be empty)."""
-    out = [tuple(p) for p in subject]
+    """Intersection of two convex CCW polygons (Sutherland-Hodgman), n x 2 (may be empty).
+    Each clipper edge keeps, for every subject edge p-q in order, the crossing where the
+    edge leaves or enters the half-plane, then q when q is inside."""
+    out = np.asarray(subject, float).reshape(-1, 2)
     clipper = np.asarray(clipper, float)
     for a, b in zip(clipper, np.roll(clipper, -1, axis=0)):
-        if not out:
+        if not len(out):
             break
         edge = b - a
-        points, out = out, []
-        for p, q in zip(points, points[1:] + points[:1]):
-            if _inside(edge, a, q):
-                if not _inside(edge, a, p):
-                    out.append(_crossing(edge, a, p, q))
-                out.append(q)
-            elif _inside(edge, a, p):
-                out.append(_crossing(edge, a, p, q))
-    return np.array(out, float).reshape(-1, 2)
+        p_in = _inside(edge, a, out)
+        if p_in.all():              # nothing cut: the points, starting one further on
+            out = np.roll(out, -1, axis=0)
+            continue
+        q = np.roll(out, -1, axis=0)
+        q_in = np.roll(p_in, -1)
+        cross = p_in != q_in
+        points = np.stack([np.zeros_like(out), q], axis=1)
+        if cross.any():
+            points[cross, 0] = _crossing(edge, a, out[cross], q[cross])
+        out = points[np.column_stack([cross, q_in])]
+    return out.reshape(-1, 2)
 
 
 def contact_outline(below, above):
