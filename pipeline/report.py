@@ -422,6 +422,17 @@ def verification_section(results):
     return "\n".join(lines)
 
 
+def columns_section(results):
+    """Real columns on the same records (campaign columns), when it has run."""
+    path = results / "columns" / "columns.md"
+    if not path.exists():
+        return ("## Real columns\n\nNot run yet (`python -m pipeline campaign columns`: the "
+                "shipped column descriptions, each with a monolith of its outline, on the "
+                "same records).\n")
+    text = path.read_text().split("\n", 1)[1]          # below the file's own title
+    return "## Real columns on the same records (campaign columns)\n" + text
+
+
 def speed_section(results):
     path = results / "bench" / "bench.json"
     if not path.exists():
@@ -502,7 +513,7 @@ def build_report(results=RESULTS_DIR):
         sweep_section(results, "friction", "mu_s",
                       "friction had a minor influence on downfall directions; with mu_s = 0.1 "
                       "neither column toppled (they slid instead)."),
-        ensemble_section(results), inversion_section(results),
+        ensemble_section(results), columns_section(results), inversion_section(results),
         records_section(results), synthetic_section(results), speed_section(results)]
     text = "\n".join(head + body)
     write_text(results / "REPORT.md", text)
