@@ -38,6 +38,7 @@ from pipeline.motion.pulses import one_sine_pulse  # noqa: E402
 from pipeline.outcome.columns import column_outcomes, total_energy  # noqa: E402
 from pipeline.scenario import (Column, Contact, Numerics, run_yade, scene_params,  # noqa: E402
                                write_scenario)
+from pipeline.scenario.runner import reuse_processes  # noqa: E402
 from pipeline.simulate import can_move  # noqa: E402
 
 STARTUP_T_MAX_S = 1e-3          # a run this short measures YADE's start-up (s)
@@ -314,7 +315,8 @@ def parallel(work, n_runs, t_max, n_noop=40):
     a LocalCluster of 1 and 2 single-threaded worker processes on 127.0.0.1
     (``jobs_1``, ``jobs_2``; each task carries its motion and returns the run's files,
     trajectory included), the same runs with the thread executor for comparison
-    (``threads_jobs_N``), and Dask's overheads: the cluster's start-up until its workers
+    (``threads_jobs_N``: a fresh YADE process per run; ``threads_reused_jobs_N``: one per
+    thread, as the campaign executor runs them), and Dask's overheads: the cluster's start-up until its workers
     have imported what a campaign's worker imports (``cluster_startup_s``, not in the
     runs per minute), its closing (``cluster_close_s``) and the wall time per task of
     ``n_noop`` tasks that run no YADE on one worker (``task_overhead_ms``)."""
@@ -366,6 +368,12 @@ def parallel(work, n_runs, t_max, n_noop=40):
             list(pool.map(run_yade, dirs))
         wall = time.perf_counter() - start
         out[f"threads_jobs_{jobs}"] = {"wall_s": wall, "runs_per_minute": 60.0 * n_runs / wall}
+        start = time.perf_counter()
+        with reuse_processes(), ThreadPoolExecutor(max_workers=jobs) as pool:
+            list(pool.map(run_yade, dirs))       # as a campaign runs them: one YADE per thread
+        wall = time.perf_counter() - start
+        out[f"threads_reused_jobs_{jobs}"] = {"wall_s": wall,
+                                              "runs_per_minute": 60.0 * n_runs / wall}
     out["scaling_2_vs_1"] = out["jobs_2"]["runs_per_minute"] / out["jobs_1"]["runs_per_minute"]
     out["threads_scaling_2_vs_1"] = (out["threads_jobs_2"]["runs_per_minute"]
                                      / out["threads_jobs_1"]["runs_per_minute"])
@@ -466,6 +474,11 @@ def print_parallel(p):
         threads = p.get(f"threads_jobs_{jobs}")
         if threads:
             line += f"; threads: {threads['runs_per_minute']:.1f} runs/min"
+        reused = p.get(f"threads_reused_jobs_{jobs}")
+        if reused:
+            line += (f"; threads reusing one YADE process each (campaigns): "
+                     f"{reused['runs_per_minute']:.1f} runs/min "
+                     f"(x{reused['runs_per_minute'] / threads['runs_per_minute']:.2f})")
         print(line)
     print(f"   scaling 2 vs 1 (Dask): {p['scaling_2_vs_1']:.2f} (2.00 = perfect on 2 free cores)")
     for key, label in (("cluster_startup_s", "cluster start-up s"),

@@ -1,20 +1,67 @@
 # Run a generated YADE scene with YADE imported as a Python module.
 #
 #     /usr/bin/python3 run_scene.py DIR/scene.py
+#     /usr/bin/python3 run_scene.py --serve FD      (campaigns: one process, many scenes)
 #
 # Unlike the `yade` launcher this opens no network port (the launcher serves a
 # Python prompt on 0.0.0.0:9000 and an info server on 0.0.0.0:21000) and saves
 # the launcher's start-up.  YADE's compiled module is built for Debian's python3
 # and its numpy, so this runs under /usr/bin/python3, not the project's venv.
 # `yade -n -x scene.py` still runs the same scene on its own.
+#
+# --serve: read scene directories from stdin, one per line; for each, reset YADE,
+# run DIR/scene.py with stdout and stderr in DIR/yade.log, and answer its exit code
+# as one line on file descriptor FD (a pipe from the parent).  YADE's start-up (about
+# 1 s) is paid once per process instead of once per scene.
 import os
 import runpy
 import sys
+import traceback
 
 YADE_PY = os.environ.get("YADE_PY_PATH", "/usr/lib/x86_64-linux-gnu/yade-double/py")
 sys.path.insert(1, YADE_PY)
-import yade  # noqa: E402,F401  (boots YADE: plugins, O)
 
-scene = os.path.abspath(sys.argv[1])
-sys.argv = [scene]
-runpy.run_path(scene, run_name="__main__")
+
+def run(scene):
+    """Run one scene file as __main__ (it reads and writes next to itself)."""
+    scene = os.path.abspath(scene)
+    sys.argv = [scene]
+    runpy.run_path(scene, run_name="__main__")
+
+
+def serve(control_fd):
+    from yade import O
+    control = os.fdopen(control_fd, "w", buffering=1)
+    quiet = os.open(os.devnull, os.O_WRONLY)
+    for line in sys.stdin:
+        run_dir = line.rstrip("\n")
+        sys.stdout.flush()
+        sys.stderr.flush()
+        log = os.open(os.path.join(run_dir, "yade.log"), os.O_WRONLY | os.O_CREAT | os.O_TRUNC,
+                      0o666)
+        os.dup2(log, 1)
+        os.dup2(log, 2)
+        os.close(log)
+        code = 0
+        try:
+            os.chdir(run_dir)
+            O.reset()
+            run(os.path.join(run_dir, "scene.py"))
+        except SystemExit as exc:
+            code = exc.code if isinstance(exc.code, int) else (0 if exc.code is None else 1)
+        except BaseException:
+            traceback.print_exc()
+            code = 1
+        sys.stdout.flush()
+        sys.stderr.flush()
+        os.dup2(quiet, 1)
+        os.dup2(quiet, 2)
+        control.write(f"{code}\n")
+
+
+if __name__ == "__main__":
+    import yade  # noqa: E402,F401  (boots YADE: plugins, O)
+    if sys.argv[1] == "--serve":
+        serve(int(sys.argv[2]))
+    else:
+        run(sys.argv[1])

@@ -48,7 +48,7 @@ from pipeline.files import (
     code_hash,
     write_text,
 )
-from pipeline.scenario.runner import kill_running
+from pipeline.scenario.runner import kill_running, reuse_processes
 
 EXECUTORS = ("threads", "dask")
 DEFAULT_EXECUTOR = "threads"    # why: README "On a cluster: Dask" (start-up, ports)
@@ -93,7 +93,8 @@ def execute(specs, campaign_dir, jobs, worker, label="runs", executor=None, sche
     bar = tqdm(total=len(specs), initial=done, unit="run", dynamic_ncols=True)
     try:
         if executor == "threads":
-            return _execute_threads(todo, runs_dir, jobs, worker, bar)
+            with reuse_processes():        # one YADE process per thread, not per run
+                return _execute_threads(todo, runs_dir, jobs, worker, bar)
         return _execute_dask(todo, runs_dir, jobs, worker, bar, scheduler)
     finally:
         bar.close()

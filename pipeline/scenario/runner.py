@@ -4,10 +4,19 @@ The scene runs in a child process of Debian's python3 (YADE's compiled module
 needs it), single-threaded, in its own process group, with a wall-clock limit;
 the child is killed when its parent dies (Linux ``PR_SET_PDEATHSIG``), so a
 killed campaign leaves no YADE behind.
+
+Within :func:`reuse_processes` (the campaign executor's threads) each thread keeps one
+YADE process that runs its scenes one after the other (``run_scene.py --serve``,
+``O.reset()`` between scenes): YADE's start-up, about 1 s, is paid once per thread
+instead of once per run.  That process dies with its thread (``PR_SET_PDEATHSIG`` is
+per thread), when the block ends, on a timeout and on Ctrl-C.
 """
+import contextlib
 import ctypes
 import functools
+import json
 import os
+import select
 import signal
 import subprocess
 import threading
@@ -26,6 +35,9 @@ MIN_SIM_S_PER_WALL_S = 0.05        # slower than this and the run is declared hu
 _PR_SET_PDEATHSIG = 1
 _RUNNING = set()                   # YADE processes of this process, for kill_running()
 _RUNNING_LOCK = threading.Lock()
+SCENES_PER_PROCESS = 200           # a served process is replaced after this many scenes
+_SERVED = threading.local()        # this thread's serving process (reuse_processes)
+_REUSE = {"depth": 0}
 
 
 class YadeError(ToolError):
@@ -67,24 +79,44 @@ def run_yade(run_dir, timeout_s=None):
     The log goes to ``run_dir/yade.log``.  Failure or timeout raises YadeError.
     """
     check_yade()
-    run_dir = Path(run_dir)
+    run_dir = Path(run_dir).resolve()
     out = run_dir / "trajectory.npz"
     out.unlink(missing_ok=True)
     if timeout_s is None:
-        import json
         timeout_s = wall_limit_s(json.loads((run_dir / "params.json").read_text())["t_max"])
+    start = time.perf_counter()
+    if _REUSE["depth"] and "\n" not in str(run_dir):
+        code = _run_served(run_dir, timeout_s)
+    else:
+        code = _run_once(run_dir, timeout_s)
+    wall = time.perf_counter() - start
+    if code < 0:
+        raise YadeError(f"YADE was stopped by signal {-code}; see {run_dir / 'yade.log'}")
+    if code != 0 or not out.exists():
+        tail = (run_dir / "yade.log").read_text(errors="replace").strip().splitlines()[-1:]
+        raise YadeError(f"YADE failed (exit {code}): {' '.join(tail)[:200]}; "
+                        f"see {run_dir / 'yade.log'}")
+    return Trajectory.load(out, wall_s=wall)
+
+
+def _environment():
     env = dict(os.environ, OMP_NUM_THREADS="1", YADE_PY_PATH=YADE_PY_PATH)
     env.pop("PYTHONPATH", None)
     env.pop("VIRTUAL_ENV", None)
-    start = time.perf_counter()
+    return env
+
+
+def _run_once(run_dir, timeout_s):
+    """One scene in a fresh process; its exit code (negative: killed by a signal)."""
     with open(run_dir / "yade.log", "w") as log:
         proc = subprocess.Popen([DEBIAN_PYTHON, str(WRAPPER), "scene.py"], cwd=run_dir,
                                 stdout=log, stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL,
-                                env=env, start_new_session=True, preexec_fn=_die_with_parent)
+                                env=_environment(), start_new_session=True,
+                                preexec_fn=_die_with_parent)
         with _RUNNING_LOCK:
             _RUNNING.add(proc)
         try:
-            code = proc.wait(timeout=timeout_s)
+            return proc.wait(timeout=timeout_s)
         except subprocess.TimeoutExpired:
             _kill(proc)
             raise YadeError(f"YADE exceeded its wall-clock limit of {timeout_s:.0f} s; "
@@ -95,14 +127,73 @@ def run_yade(run_dir, timeout_s=None):
         finally:
             with _RUNNING_LOCK:
                 _RUNNING.discard(proc)
-    wall = time.perf_counter() - start
-    if code < 0:
-        raise YadeError(f"YADE was stopped by signal {-code}; see {run_dir / 'yade.log'}")
-    if code != 0 or not out.exists():
-        tail = (run_dir / "yade.log").read_text(errors="replace").strip().splitlines()[-1:]
-        raise YadeError(f"YADE failed (exit {code}): {' '.join(tail)[:200]}; "
-                        f"see {run_dir / 'yade.log'}")
-    return Trajectory.load(out, wall_s=wall)
+
+
+@contextlib.contextmanager
+def reuse_processes():
+    """Within this block, every thread runs its scenes in one YADE process of its own."""
+    with _RUNNING_LOCK:
+        _REUSE["depth"] += 1
+    try:
+        yield
+    finally:
+        with _RUNNING_LOCK:
+            _REUSE["depth"] -= 1
+            last = _REUSE["depth"] == 0
+        if last:                      # served processes idle between scenes: end them
+            with _RUNNING_LOCK:
+                served = [p for p in _RUNNING if hasattr(p, "control")]
+            for proc in served:
+                _kill(proc)
+
+
+def _server():
+    """This thread's serving process (started, or replaced when dead or old)."""
+    proc = getattr(_SERVED, "proc", None)
+    if proc is not None and proc.poll() is None and proc.scenes < SCENES_PER_PROCESS:
+        return proc
+    if proc is not None:
+        _kill(proc)
+    read_fd, write_fd = os.pipe()
+    try:
+        proc = subprocess.Popen([DEBIAN_PYTHON, str(WRAPPER), "--serve", str(write_fd)],
+                                stdin=subprocess.PIPE, stdout=subprocess.DEVNULL,
+                                stderr=subprocess.DEVNULL, pass_fds=(write_fd,),
+                                env=_environment(), start_new_session=True,
+                                preexec_fn=_die_with_parent)
+    finally:
+        os.close(write_fd)
+    proc.control = os.fdopen(read_fd, "rb")
+    proc.scenes = 0
+    _SERVED.proc = proc
+    with _RUNNING_LOCK:
+        _RUNNING.add(proc)
+    return proc
+
+
+def _run_served(run_dir, timeout_s):
+    """One scene in this thread's serving process; its exit code."""
+    proc = _server()
+    proc.scenes += 1
+    try:
+        proc.stdin.write(f"{run_dir}\n".encode())
+        proc.stdin.flush()
+        ready, _, _ = select.select([proc.control], [], [], timeout_s)
+        if not ready:
+            _kill(proc)
+            raise YadeError(f"YADE exceeded its wall-clock limit of {timeout_s:.0f} s; "
+                            f"see {run_dir / 'yade.log'}")
+        answer = proc.control.readline()
+    except BrokenPipeError:
+        answer = b""
+    except BaseException:
+        _kill(proc)
+        raise
+    if not answer:                     # the process died (a crash, or killed)
+        code = proc.wait()
+        _kill(proc)
+        return code if code != 0 else 1
+    return int(answer)
 
 
 def kill_running():
@@ -117,9 +208,16 @@ def kill_running():
 
 
 def _kill(proc):
-    """Kill the child's whole process group and reap it."""
+    """Kill the child's whole process group and reap it (and close a served process's
+    pipes)."""
     try:
         os.killpg(proc.pid, signal.SIGKILL)
     except ProcessLookupError:
         pass
     proc.wait()
+    with _RUNNING_LOCK:
+        _RUNNING.discard(proc)
+    for pipe in (proc.stdin, getattr(proc, "control", None)):
+        if pipe is not None:
+            with contextlib.suppress(OSError):
+                pipe.close()

@@ -1,0 +1,95 @@
+"""The runner's reused YADE processes (campaign threads): the same trajectory to the last
+bit as a fresh process, failures and timeouts that leave the next scene unharmed, and no
+process left behind."""
+import os
+import threading
+import time
+
+import numpy as np
+import pytest
+
+from pipeline.motion.pulses import one_sine_pulse
+from pipeline.scenario import Column, YadeError, run_yade, scene_params, write_scenario
+from pipeline.scenario import runner
+
+pytestmark = pytest.mark.yade
+
+
+def scene(path, amplitude=6.0):
+    """A monolith under a short one-sine pulse: a scene directory."""
+    motion = one_sine_pulse(30.0, amplitude, 0.8, 2.0)
+    params = scene_params(columns=Column("monolithic").specs(),
+                          motion_duration=motion.duration)
+    write_scenario(path, params, motion)
+    return path
+
+
+def same(a, b):
+    return all(np.array_equal(getattr(a, k), getattr(b, k)) for k in ("t", "pos", "quat"))
+
+
+def gone(pid, within_s=5.0):
+    """True when process ``pid`` has exited (and been reaped) within ``within_s``."""
+    end = time.monotonic() + within_s
+    while time.monotonic() < end:
+        try:
+            os.kill(pid, 0)
+        except ProcessLookupError:
+            return True
+        try:
+            with open(f"/proc/{pid}/stat") as f:    # a zombie waits for its parent's wait()
+                if f.read().split()[2] == "Z":
+                    return True
+        except FileNotFoundError:
+            return True
+        time.sleep(0.05)
+    return False
+
+
+def test_served_scenes_match_a_fresh_process_and_end_with_the_block(tmp_path):
+    fresh = run_yade(scene(tmp_path / "fresh"))
+    with runner.reuse_processes():
+        served = [run_yade(scene(tmp_path / f"s{k}")) for k in range(3)]
+        pid = runner._SERVED.proc.pid
+    assert all(same(fresh, s) for s in served)
+    assert gone(pid) and not runner._RUNNING
+
+
+def test_a_failing_scene_leaves_the_next_one_unharmed(tmp_path):
+    bad = scene(tmp_path / "bad")
+    (bad / "scene.py").write_text("raise RuntimeError('a broken scene')\n")
+    with runner.reuse_processes():
+        with pytest.raises(YadeError, match="a broken scene"):
+            run_yade(bad)
+        pid = runner._SERVED.proc.pid
+        ok = run_yade(scene(tmp_path / "ok"))
+        assert runner._SERVED.proc.pid == pid          # the same process ran both
+    assert same(ok, run_yade(scene(tmp_path / "fresh")))
+
+
+def test_a_hung_scene_is_killed_and_the_next_gets_a_new_process(tmp_path):
+    hung = scene(tmp_path / "hung")
+    (hung / "scene.py").write_text("import time\ntime.sleep(60)\n")
+    with runner.reuse_processes():
+        run_yade(scene(tmp_path / "first"))
+        pid = runner._SERVED.proc.pid
+        started = time.monotonic()
+        with pytest.raises(YadeError, match="wall-clock limit of 2 s"):
+            run_yade(hung, timeout_s=2.0)
+        assert time.monotonic() - started < 10 and gone(pid)
+        run_yade(scene(tmp_path / "next"))
+        assert runner._SERVED.proc.pid != pid
+
+
+def test_a_threads_process_dies_with_its_thread(tmp_path):
+    pids = []
+
+    def work():
+        run_yade(scene(tmp_path / "in_thread"))
+        pids.append(runner._SERVED.proc.pid)
+
+    with runner.reuse_processes():
+        thread = threading.Thread(target=work)
+        thread.start()
+        thread.join()
+        assert pids and gone(pids[0])                  # PR_SET_PDEATHSIG of its thread
