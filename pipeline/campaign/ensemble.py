@@ -116,7 +116,7 @@ def sample_members(members, seed, ranges=None, column="both", mu_k_ratio=paper.M
 def described_member(data, v, seed, index):
     """Member ``index`` of a described column from its sampled values ``v``.  Validated
     before anything runs without the sampled offsets (sizes, tilts, statics: milliseconds;
-    offset joints cost about a second each to outline), whose size is checked alone."""
+    a member with offset joints takes about a second), whose size is checked alone."""
     from pipeline.campaign.column_file import perturbed
     from pipeline.scenario.geometry import MAX_OFFSET_M, ColumnGeometry
     args = (data, 1 + v.get("height_tolerance", 0.0), 1 + v.get("diameter_tolerance", 0.0),
