@@ -433,6 +433,38 @@ def columns_section(results):
     return "## Real columns on the same records (campaign columns)\n" + text
 
 
+def fragility_section(results):
+    """Lognormal fragility medians per column model and intensity measure (campaign
+    fragility), when it has run."""
+    path = results / "fragility" / "fragility.json"
+    if not path.exists():
+        return ("## Fragility\n\nNot run yet (`python -m pipeline campaign fragility`: "
+                "P(toppled) against PGA, PGV and PGV/PGA from scaled records, beside a 2D "
+                "rigid block).\n")
+    summary = json.loads(path.read_text())
+    rows = []
+    for name, entry in summary.get("columns", {}).items():
+        row = {"model": entry.get("description", name),
+               "runs (toppled)": f"{entry.get('runs')} ({entry.get('toppled')})"}
+        for im, fit in entry.items():
+            if not isinstance(fit, dict) or "median" not in fit:
+                continue
+            lo_hi = fit.get("median_ci95") or [None, None]
+            row[f"{im} median [95 %] {fit.get('unit', '')}".strip()] = (
+                "-" if fit["median"] is None else
+                f"{fit['median']:.3g} [{_fmt(lo_hi[0], 2)}, {_fmt(lo_hi[1], 2)}], "
+                f"beta {_fmt(fit.get('beta'), 2)}")
+        rows.append(row)
+    lines = ["## Fragility (campaign fragility)\n",
+             f"Records {', '.join(map(str, summary.get('records', [])))}; "
+             f"{summary.get('members')} members per record and level; lognormal "
+             "maximum-likelihood fits P(toppled | IM) = Phi(ln(IM / median) / beta).\n",
+             _table(pd.DataFrame(rows)) + "\n"]
+    for fig in ("fragility_curves.png", "fragility_2d_vs_3d.png", "fragility_surface.png"):
+        lines.append(_figure(results, results / "fragility" / fig, fig[:-4].replace("_", " ")))
+    return "\n".join(lines)
+
+
 def speed_section(results):
     path = results / "bench" / "bench.json"
     if not path.exists():
@@ -513,7 +545,8 @@ def build_report(results=RESULTS_DIR):
         sweep_section(results, "friction", "mu_s",
                       "friction had a minor influence on downfall directions; with mu_s = 0.1 "
                       "neither column toppled (they slid instead)."),
-        ensemble_section(results), columns_section(results), inversion_section(results),
+        ensemble_section(results), fragility_section(results), columns_section(results),
+        inversion_section(results),
         records_section(results), synthetic_section(results), speed_section(results)]
     text = "\n".join(head + body)
     write_text(results / "REPORT.md", text)
