@@ -9,7 +9,7 @@
 # The geometry comes ready-made in params.json (pipeline/scenario/geometry.py): each
 # column is a list of bodies, each body with its world placement (centre of mass,
 # rotation), mass, inertia tensor about the centre of mass, rims and top plate.
-# Bodies are clumps (see ../shared/notes/yade-modeling.md): small spheres on their
+# Bodies are clumps (README, "The YADE model"): small spheres on their
 # rims (the base rim on the contact area with what is below, the other rims on the
 # outer edges: they let a falling body strike the pedestal), a Box plate as the top
 # face a body above stands on, and a tiny dense core sphere at the centre of mass;
