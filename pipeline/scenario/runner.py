@@ -119,8 +119,7 @@ def _run_once(run_dir, timeout_s):
             return proc.wait(timeout=timeout_s)
         except subprocess.TimeoutExpired:
             _kill(proc)
-            raise YadeError(f"YADE exceeded its wall-clock limit of {timeout_s:.0f} s; "
-                            f"see {run_dir / 'yade.log'}") from None
+            raise _timed_out(run_dir, timeout_s) from None
         except BaseException:
             _kill(proc)
             raise
@@ -179,21 +178,24 @@ def _run_served(run_dir, timeout_s):
         proc.stdin.write(f"{run_dir}\n".encode())
         proc.stdin.flush()
         ready, _, _ = select.select([proc.control], [], [], timeout_s)
-        if not ready:
-            _kill(proc)
-            raise YadeError(f"YADE exceeded its wall-clock limit of {timeout_s:.0f} s; "
-                            f"see {run_dir / 'yade.log'}")
-        answer = proc.control.readline()
+        answer = proc.control.readline() if ready else None
     except BrokenPipeError:
         answer = b""
     except BaseException:
         _kill(proc)
         raise
-    if not answer:                     # the process died (a crash, or killed)
-        code = proc.wait()
+    if answer is None:
         _kill(proc)
-        return code if code != 0 else 1
+        raise _timed_out(run_dir, timeout_s)
+    if not answer:                     # the process died (a crash, or killed)
+        _kill(proc)
+        return proc.returncode if proc.returncode != 0 else 1
     return int(answer)
+
+
+def _timed_out(run_dir, timeout_s):
+    return YadeError(f"YADE exceeded its wall-clock limit of {timeout_s:.0f} s; "
+                     f"see {run_dir / 'yade.log'}")
 
 
 def kill_running():
@@ -201,6 +203,8 @@ def kill_running():
     with _RUNNING_LOCK:
         procs = list(_RUNNING)
     for proc in procs:
+        if proc.returncode is not None:          # reaped: its pid is no longer its own
+            continue
         try:
             os.killpg(proc.pid, signal.SIGKILL)
         except ProcessLookupError:
@@ -209,12 +213,14 @@ def kill_running():
 
 def _kill(proc):
     """Kill the child's whole process group and reap it (and close a served process's
-    pipes)."""
-    try:
-        os.killpg(proc.pid, signal.SIGKILL)
-    except ProcessLookupError:
-        pass
-    proc.wait()
+    pipes).  A child already reaped is not signalled: its pid may belong to another
+    process by now (unreaped, even when it has exited, its pid is still its own)."""
+    if proc.returncode is None:
+        try:
+            os.killpg(proc.pid, signal.SIGKILL)
+        except ProcessLookupError:
+            pass
+        proc.wait()
     with _RUNNING_LOCK:
         _RUNNING.discard(proc)
     for pipe in (proc.stdin, getattr(proc, "control", None)):
