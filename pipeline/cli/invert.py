@@ -175,11 +175,10 @@ def _check_jobs(jobs):
     return jobs or os.cpu_count() or 1
 
 
-def described_grids(observations, grid, base_dir="."):
-    """{column name in the observations: the forward grid of that described column} for
-    every column that is a column file (a shipped example's name, or a file, relative to
-    ``base_dir`` (the observations file's folder) when it is there); one-line errors
-    before anything runs."""
+def described_columns(observations, base_dir="."):
+    """{column name in the observations: its description dict} for every column that is a
+    column file (a shipped example's name, or a file, relative to ``base_dir`` (the
+    observations file's folder) when it is there); one-line errors before anything runs."""
     from pipeline.campaign.column_file import description
     from pipeline.scenario.geometry import example_names
     out = {}
@@ -189,7 +188,7 @@ def described_grids(observations, grid, base_dir="."):
         beside = Path(base_dir) / name
         source = str(beside) if name not in example_names() and beside.is_file() else name
         try:
-            out[name] = grid.replace(column_file=description(source))
+            out[name] = description(source)
         except InputError as exc:
             message = str(exc).removeprefix(f"--column-file {source}: ")
             raise InputError(f"column {name!r}: {message}") from None
@@ -230,7 +229,7 @@ def run(args):
     if args.demo:
         return _run_demo(args, preset, grid, candidates)
     observations = load_observations(args.observations)
-    described = described_grids(observations, grid, args.observations.parent)
+    described = described_columns(observations, args.observations.parent)
     out = args.out or RESULTS_DIR / "inversion" / args.observations.stem
     if out.exists() and not out.is_dir():
         raise InputError(f"--out {out} is a file, not a directory")
@@ -239,10 +238,9 @@ def run(args):
     if args.table is not None and described and table.info.get("grid"):
         from pipeline.inversion.forward import TableGrid       # the --table file's grid
         grid = TableGrid(**table.info["grid"])
-        described = {name: grid.replace(column_file=g.column_file)
-                     for name, g in described.items()}
-    for name, column_grid in described.items():
-        column_table, column_info = forward_table(args, column_grid, sibling_of=args.table)
+    for name, data in described.items():
+        column_table, column_info = forward_table(args, grid.replace(column_file=data),
+                                                  sibling_of=args.table)
         table = table.with_column(name, column_table)
         info.setdefault("described_columns", {})[name] = column_info
     summary = run_inversion(observations, out, table, candidates, args.kernel_deg,

@@ -112,10 +112,10 @@ def test_unknown_column_file_is_one_line_before_anything(tmp_path, capsys):
 
 
 def test_a_column_file_beside_the_observations(tmp_path):
-    from pipeline.cli.invert import described_grids
+    from pipeline.cli.invert import described_columns
     from pipeline.inversion.observations import load_observations
     data = description("roman-granite")
     write_json(tmp_path / "my_column.json", data)
-    grids = described_grids(load_observations(_observations(tmp_path, "my_column.json")),
-                            TableGrid(), tmp_path)
-    assert grids["my_column.json"].column_file == data
+    found = described_columns(load_observations(_observations(tmp_path, "my_column.json")),
+                              tmp_path)
+    assert found == {"my_column.json": data}
