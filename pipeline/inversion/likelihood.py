@@ -116,7 +116,11 @@ class ForwardModel:
         with np.errstate(invalid="ignore", divide="ignore"):
             mixture = kernel.sum(axis=-2) / count[..., None]
         mixture = np.where(count[..., None] > 0, mixture, 1.0 / (2 * math.pi))
-        return (1.0 - self.floor) * mixture + self.floor / (2 * math.pi)
+        return self._floored(mixture)
+
+    def _floored(self, density):
+        """A direction density (per radian) mixed with the fraction ``floor`` of uniform."""
+        return (1.0 - self.floor) * density + self.floor / (2 * math.pi)
 
     def fallen_table(self, sigma_deg):
         """P_n d_n(psi): (ns, nr, na, nc, npsi), cached per uncertainty."""
@@ -239,8 +243,7 @@ class ForwardModel:
         width = math.sqrt(self.kernel_deg ** 2 + a.uncertainty_deg ** 2
                           + b.uncertainty_deg ** 2)
         d = math.radians(a.downfall_azimuth_deg - b.downfall_azimuth_deg)
-        return float((1 - self.floor) * von_mises_pdf(d, concentration(width))
-                     + self.floor / (2 * math.pi))
+        return float(self._floored(von_mises_pdf(d, concentration(width))))
 
     def log_likelihood(self, observations, east_km, north_km, strikes_deg):
         """Sum over sites: (ns, n_strikes, n_epicentres)."""
