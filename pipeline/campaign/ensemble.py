@@ -44,7 +44,7 @@ from scipy.stats import qmc
 from pipeline import paper
 from pipeline.campaign import Campaign, register
 from pipeline.campaign.column_file import (add_column_file_argument, add_stiffness_argument,
-                                           check_stiffness, column_kn, mark,
+                                           check_stiffness, column_kn, mark, perturbed,
                                            read_campaign_options, summary_entry)
 from pipeline.campaign.column_file import description as column_file_description
 from pipeline.campaign.definitions import column_specs, run_code_version, run_column_spec
@@ -100,15 +100,14 @@ def sample_members(members, seed, ranges=None, column="both", mu_k_ratio=paper.M
             params["scale"] = round(v["scale"], 6)
         if description is not None:
             params["column_file"] = described_member(description, v, seed, index)
-            for key in ("hd", "height"):
-                params.pop(key)
         elif any(v.get(k) for k in GEOMETRY_KEYS):
-            rng = np.random.default_rng([seed, index])
-            params["column_file"] = drum_description(
-                height, diameter, v.get("tilt_deg", 0.0), v.get("tilt_azimuth_deg", 0.0),
-                v.get("drum_offset_mm", 0.0) / 1000.0, rng)
-            for key in ("hd", "height"):
-                params.pop(key)
+            params["column_file"] = perturbed(
+                paper_drums(height, diameter), tilt_deg=v.get("tilt_deg", 0.0),
+                tilt_azimuth_deg=v.get("tilt_azimuth_deg", 0.0),
+                max_offset_m=v.get("drum_offset_mm", 0.0) / 1000.0,
+                rng=np.random.default_rng([seed, index]))
+        if "column_file" in params:             # the description fixes the sizes
+            del params["hd"], params["height"]
         rows.append(params)
     return rows
 
@@ -117,7 +116,6 @@ def described_member(data, v, seed, index):
     """Member ``index`` of a described column from its sampled values ``v``.  Validated
     before anything runs without the sampled offsets (sizes, tilts, statics: milliseconds;
     a member with offset joints takes about a second), whose size is checked alone."""
-    from pipeline.campaign.column_file import perturbed
     from pipeline.scenario.geometry import MAX_OFFSET_M, ColumnGeometry
     args = (data, 1 + v.get("height_tolerance", 0.0), 1 + v.get("diameter_tolerance", 0.0),
             v.get("tilt_deg", 0.0), v.get("tilt_azimuth_deg", 0.0))
@@ -133,22 +131,12 @@ def described_member(data, v, seed, index):
     return member
 
 
-def drum_description(height, diameter, tilt_deg, tilt_azimuth_deg, max_offset_m, rng,
-                     n_drums=paper.N_DRUMS, density=paper.MARBLE_DENSITY_KG_M3):
-    """Column description of the paper's drum column leaning ``tilt_deg`` toward
-    ``tilt_azimuth_deg`` with each drum above the first offset by up to ``max_offset_m``
-    in a random direction."""
-    blocks = []
-    for k in range(n_drums):
-        block = {"shape": "frustum", "height": round(height / n_drums, 9),
-                 "bottom_diameter": round(diameter, 9), "top_diameter": round(diameter, 9)}
-        if tilt_deg > 0:
-            block.update(tilt_deg=round(tilt_deg, 6), tilt_azimuth_deg=round(tilt_azimuth_deg, 6))
-        if k > 0 and max_offset_m > 0:
-            r, a = max_offset_m * rng.random(), 2 * math.pi * rng.random()
-            block["offset_m"] = [round(r * math.sin(a), 9), round(r * math.cos(a), 9)]
-        blocks.append(block)
-    return {"name": "drums (ensemble member)", "density": density, "blocks": blocks}
+def paper_drums(height, diameter):
+    """Description of the paper's drum column (equal cylindrical drums) of this size."""
+    drum = {"shape": "frustum", "height": round(height / paper.N_DRUMS, 9),
+            "bottom_diameter": round(diameter, 9), "top_diameter": round(diameter, 9)}
+    return {"name": "drums", "density": paper.MARBLE_DENSITY_KG_M3,
+            "blocks": [dict(drum) for _ in range(paper.N_DRUMS)]}
 
 
 def nominal(column="both", description=None, kn=None):
