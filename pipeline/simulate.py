@@ -36,9 +36,10 @@ def back_azimuth_of(motion, override=None):
 PRECHECK_MARGIN = 0.9   # skip YADE only below 90 % of the rigid-block thresholds
 
 
-def can_move(drive, columns, contact):
-    """False when no body can rock or slide at any sample (rigid-body statics): the
-    horizontal acceleration stays below (g + a_up) min(uplift ratio, mu_s) x margin.
+def movable_samples(drive, columns, contact):
+    """Per sample of ``drive``: True where a body at rest could start to rock or slide
+    (rigid-body statics): the horizontal acceleration reaches (g + a_up) min(uplift
+    ratio, mu_s) x margin, or the vertical cancels gravity.
 
     A column's uplift ratio (``params.json`` columns[].uplift_ratio, from
     :mod:`pipeline.scenario.geometry`) is the smallest, over its joints, of the
@@ -48,7 +49,25 @@ def can_move(drive, columns, contact):
     effective_g = MODEL_GRAVITY + drive.acc[:, 2]
     horizontal = np.hypot(drive.acc[:, 0], drive.acc[:, 1])
     limit = PRECHECK_MARGIN * effective_g * min(tan_alpha, contact.mu_s)
-    return bool(np.any(effective_g <= 0) or np.any(horizontal >= limit))
+    return (effective_g <= 0) | (horizontal >= limit)
+
+
+def can_move(drive, columns, contact):
+    """False when no body can rock or slide at any sample (see :func:`movable_samples`)."""
+    return bool(movable_samples(drive, columns, contact).any())
+
+
+def quiet_window(drive, columns, contact, lead_s):
+    """Times (s, on the motion's clock) between which the scene must simulate:
+    ``start_s``, ``lead_s`` before the first sample that can move a body at rest (on the
+    sample grid, not before 0), and ``quiet_after_s``, one sample after the last such
+    sample (after it no sample can set a resting body moving).  None when no sample can."""
+    movable = np.flatnonzero(movable_samples(drive, columns, contact))
+    if not len(movable):
+        return None
+    first = max(0, movable[0] - int(math.floor(lead_s / drive.dt + 1e-9)))
+    last = min(movable[-1] + 1, drive.npts - 1)
+    return first * drive.dt, last * drive.dt
 
 
 def geometry_parameters(column):
@@ -90,17 +109,20 @@ def simulate(motion, out_dir, column=None, contact=None, numerics=None, window=N
                           motion_duration=drive.duration)
     out_dir = Path(out_dir)
     (out_dir / "summary.json").unlink(missing_ok=True)
-    write_scenario(out_dir, params, drive)
     started = time.perf_counter()
-    moves = can_move(drive, params["columns"], contact)
-    trajectory = run_yade(out_dir, timeout_s=timeout_s) if moves else None
+    window_s = quiet_window(drive, params["columns"], contact, numerics.quiet_lead_s)
+    if window_s is not None and numerics.quiet_motion == "skip":
+        params.update(start_s=window_s[0], quiet_after_s=window_s[1])
+    write_scenario(out_dir, params, drive)
+    trajectory = run_yade(out_dir, timeout_s=timeout_s) if window_s is not None else None
     parameters = {"column": column.kind, "hd": column.hd, "height_m": column.height,
                   "n_drums": column.n_drums, "density_kg_m3": column.density,
                   **geometry_parameters(column),
                   **dataclasses.asdict(contact), "window_s": list(window) if window else None,
                   "rotate_deg": rotate_deg, "scale": scale,
                   "motion_file": None if motion_file is None else str(motion_file),
-                  "dt_factor": numerics.dt_factor, "rim_points": numerics.rim_points}
+                  "dt_factor": numerics.dt_factor, "rim_points": numerics.rim_points,
+                  "quiet_motion": numerics.quiet_motion}
     provenance = {"software": software_versions(), "motion": motion.meta.get("processing"),
                   "code": {"scenario": code_hash("scenario", "outcome", "yade_scripts")}}
     if trajectory is None:
@@ -109,12 +131,15 @@ def simulate(motion, out_dir, column=None, contact=None, numerics=None, window=N
                    "simulated": False,
                    "note": "not simulated: the horizontal acceleration stays below the uplift "
                    "and sliding thresholds at every sample, so no body can move",
-                   "simulated_s": 0.0, "motion_end_s": drive.duration, "stopped_early": False,
+                   "simulated_s": 0.0, "simulated_window_s": None,
+                   "motion_end_s": drive.duration, "stopped_early": False,
                    "time_step_s": None, "wall_s": time.perf_counter() - started,
                    "provenance": provenance}
     else:
         summary = summarise(trajectory, record=record or motion.record_id,
                             back_azimuth_deg=drive.back_azimuth, parameters=parameters,
                             provenance=provenance)
+        if "quiet_after_s" in params:
+            summary["quiet_after_s"] = params["quiet_after_s"]
     write_json(out_dir / "summary.json", summary)
     return summary

@@ -63,6 +63,11 @@ REST_DURATION_S = P["rest_duration_s"]
 T_MAX = P["t_max"]                    # s, simulated time at most
 VERLET_DISTANCE = P["verlet_distance"]  # m
 MOTION_FILE = P.get("motion_file")    # processed-motion npz (dt, acc, disp; East, North, Up)
+# the motion's quiet parts (pipeline/simulate.py, quiet_window): the scene starts at START_S
+# on the motion's clock (no body can move before START_S + quiet_lead_s) and may stop once
+# every body rests seated after QUIET_AFTER_S (no later sample can set it moving)
+START_S = P.get("start_s", 0.0)       # s
+QUIET_AFTER_S = P.get("quiet_after_s")  # s, None: the motion's end
 OUTPUT = P["output"]                  # trajectory file name
 PLATE_HALF_THICKNESS = 0.005          # m, the top plate (a Box clump member)
 CORE_MASK = 1 << 29          # collides with nothing
@@ -246,6 +251,12 @@ if MOTION_FILE:
                   "disp": np.array(mf["disp"], float)}
     motion["t"] = motion["dt"] * np.arange(len(motion["acc"]))
     motion_end = float(motion["t"][-1])
+quiet_after = motion_end if QUIET_AFTER_S is None else QUIET_AFTER_S
+
+
+def now():
+    """Time (s) on the motion's clock."""
+    return O.time + START_S
 
 
 def motion_at(key, times):
@@ -264,8 +275,8 @@ drive_steps = max(1, int(round(DRIVE_INTERVAL_S / O.dt)))
 newton = NewtonIntegrator(damping=0.0, gravity=(0, 0, -G))
 # inertial drive: gravity in the pedestal frame, -a(t) averaged over each drive interval
 # (sampled at its midpoint), precomputed so that each update is a table look-up
-n_drive = int((motion_end + DRIVE_INTERVAL_S) / (drive_steps * O.dt)) + 2
-drive_acc = motion_at("acc", (np.arange(n_drive) + 0.5) * drive_steps * O.dt)
+n_drive = int((motion_end - START_S + DRIVE_INTERVAL_S) / (drive_steps * O.dt)) + 2
+drive_acc = motion_at("acc", START_S + (np.arange(n_drive) + 0.5) * drive_steps * O.dt)
 GRAVITY_TABLE = [Vector3(-a[0], -a[1], -G - a[2]) for a in drive_acc] + [Vector3(0, 0, -G)]
 
 
@@ -275,7 +286,7 @@ def drive_inertial():
 
 def drive_kinematic():
     """Pedestal velocity (d(t + dt) - d(t)) / dt for the coming step."""
-    d = motion_at("disp", [O.time, O.time + O.dt])
+    d = motion_at("disp", [now(), now() + O.dt])
     v = Vector3(*((d[1] - d[0]) / O.dt))
     for pid in pedestal_ids:
         O.bodies[pid].state.vel = v
@@ -310,10 +321,10 @@ pedestal_origin = Vector3(pedestal_state.pos)
 
 
 def record_state():
-    samples.append((O.time, [(Vector3(s.pos), Quaternion(s.ori), Vector3(s.vel), Vector3(s.angVel))
+    samples.append((now(), [(Vector3(s.pos), Quaternion(s.ori), Vector3(s.vel), Vector3(s.angVel))
                              for s in states],
                     pedestal_state.pos - pedestal_origin, Vector3(pedestal_state.vel)))
-    if O.time >= T_MAX:
+    if now() >= T_MAX:
         O.pause()    # the main thread writes the output once the loop has stopped
 
 
@@ -340,28 +351,62 @@ def settled(rel):
     return all(energy[k] < SETTLED_FRACTION * BARRIERS[k] for k in BARRIERS)
 
 
+# a standing body is seated when, against the column's bottom body, it has shifted and
+# tilted (times the column's height) by at most this fraction of the column's smallest
+# rocking lever: its rocking threshold is then within 2 % of the pre-check's
+SEATED_FRACTION = 0.02
+SEATED = []      # per body: (index of its column's bottom body, shift tolerance m, tilt tol rad)
+for col in COLUMNS:
+    bottom = len(SEATED)
+    tol = SEATED_FRACTION * col.get("rocking_lever_m", 0.0)
+    SEATED += [(bottom, tol, tol / col["height"])] * len(col["bodies"])
+INITIAL_AXES = [Vector3(*np.asarray(b["initial_rotation"], float)[:, 2]) for b in bodies]
+
+
+def seated(axes):
+    """True when every standing body (``axes``: its z axis, None when lying) is seated
+    (SEATED_FRACTION) on its column's bottom body as at the start."""
+    for k, (axis, s, b) in enumerate(zip(axes, states, bodies)):
+        if axis is None:
+            continue
+        bottom, shift_tol, tilt_tol = SEATED[k]
+        if shift_tol <= 0 or axes[bottom] is None:
+            return False
+        shift = (s.pos - states[bottom].pos) - (Vector3(*b["initial_pos"])
+                                               - Vector3(*bodies[bottom]["initial_pos"]))
+        if math.hypot(shift[0], shift[1]) > shift_tol:
+            return False
+        if 1.0 - axis.dot(INITIAL_AXES[k]) > 0.5 * tilt_tol ** 2:
+            return False
+    return True
+
+
 def check_stop():
-    """Stop once the standing bodies rest and either the motion is over or every column
-    has fallen, or once the motion is over and no column can topple any more (energy).
-    Bodies lying on the pedestal (tilt > 60 deg) may roll on: their impact is recorded
-    already and a rolling cylinder takes long to stop."""
+    """Stop once the standing bodies rest and either the motion is over, or every column
+    has fallen, or no later sample can set them moving again (after quiet_after, every
+    standing body seated); or once the motion is over and no column can topple any more
+    (energy).  Bodies lying on the pedestal (tilt > 60 deg) may roll on: their impact is
+    recorded already and a rolling cylinder takes long to stop."""
     v_rest, length = REST_VELOCITY, REST_LENGTH
     rel = pedestal_state.vel
-    if BARRIERS and O.time > motion_end and settled(rel):
+    t = now()
+    if BARRIERS and t > motion_end and settled(rel):
         state["stopped_early"] = True
         record_state()
         O.pause()
         return
-    at_rest, fallen = True, {}
+    at_rest, fallen, axes = True, {}, []
     for b, s, c in zip(bodies, states, clumps):
-        lying = (s.ori * body_offset[c] * Vector3(0, 0, 1))[2] < 0.5
+        axis = s.ori * body_offset[c] * Vector3(0, 0, 1)
+        lying = axis[2] < 0.5
+        axes.append(None if lying else axis)
         fallen[b["column"]] = fallen.get(b["column"], False) or lying
         if not lying and ((s.vel - rel).norm() >= v_rest or s.angVel.norm() * length >= v_rest):
             at_rest = False
-    if at_rest and (O.time > motion_end or all(fallen.values())):
+    if at_rest and (t > motion_end or all(fallen.values()) or (t > quiet_after and seated(axes))):
         if state["rest_since"] is None:
-            state["rest_since"] = O.time
-        elif O.time - state["rest_since"] >= REST_DURATION_S:
+            state["rest_since"] = t
+        elif t - state["rest_since"] >= REST_DURATION_S:
             state["stopped_early"] = True
             record_state()
             O.pause()
@@ -390,7 +435,7 @@ def finish():
     offsets = np.array([[body_offset[c][3], body_offset[c][0], body_offset[c][1], body_offset[c][2]]
                         for c in clumps])
     if DRIVE == "kinematic":
-        disp = shift[:, 0, :]
+        disp = shift[:, 0, :] + (motion_at("disp", [START_S])[0] if START_S else 0.0)
     else:
         disp = motion_at("disp", t)
     out = os.path.join(HERE, OUTPUT)
@@ -399,7 +444,7 @@ def finish():
         tmp, t=t, pedestal_disp=disp, pos=pos - shift,
         quat=quat_multiply(ori.reshape(len(t), len(clumps), 4), offsets[None]), vel=vel - ped_vel,
         angvel=angvel, bodies=json.dumps(bodies), dt=O.dt,
-        stopped_early=state["stopped_early"], motion_end=motion_end)
+        stopped_early=state["stopped_early"], motion_end=motion_end, start_s=START_S)
     os.replace(tmp, out)
 
 

@@ -13,6 +13,7 @@ from pipeline.campaign.tables import collect, write_tables
 from pipeline.files import InputError, code_hash, content_hash, write_csv
 from pipeline.motion import Motion
 from pipeline.records import catalog, catalog_row, processed_motion, resolve
+from pipeline.records.processing import signal_end_s
 from pipeline.scenario import Column, Contact, Numerics
 from pipeline.simulate import simulate
 
@@ -195,13 +196,28 @@ register(Campaign(
     options=add_campaign_options, read_options=read_campaign_options))
 
 
+def signal_window(record):
+    """[0, end] (s): a motion given ready-made (a synthetic npz) up to the end of its
+    signal, as the processing cuts records (:func:`~pipeline.records.processing.
+    signal_end_s`): its quiet tail would only keep a rocking column simulated.  None
+    for a record that the processing cuts anyway."""
+    source = resolve(record)
+    if not source.processed:
+        return None
+    motion = Motion.load(source.path)
+    return [0.0, round(float(signal_end_s(motion.acc, motion.dt)), 6)]
+
+
 def synthetic_specs(records, campaign_dir, column_file=None, stiffness="matched"):
     from pipeline.motion import synthetics
     data = description(column_file)
     check_stiffness(stiffness)
     paths = list(records) if records else [p for source in synthetics.SOURCES
                                            for p in synthetics.generate(source)]
-    runs = [(str(p), twin()) for p in paths]
+    runs = []
+    for path in paths:
+        window = signal_window(path)
+        runs.append((str(path), twin(window=window) if window else twin()))
     return mark(column_specs(described_twins(runs, data, stiffness), campaign_dir), data)
 
 

@@ -78,6 +78,8 @@ def _tables(specs, campaign, campaign_dir):
                 "impact_time_s": _nan(col["impact_time_s"]), "impact_x_m": point[0],
                 "impact_y_m": point[1], "max_tilt_deg": col["max_tilt_deg"],
                 "base_slip_m": col.get("base_slip_m"), "simulated": summary.get("simulated", True),
+                "simulated_from_s": _nan((summary.get("simulated_window_s") or [None])[0]),
+                "simulated_s": summary.get("simulated_s"),
                 **{k: v if isinstance(v, str) else _nan(v) for k, v in rp.items()},
                 "back_azimuth_deg": _nan(summary["back_azimuth_deg"]),
                 "motion_file": spec["motion_file"],

@@ -13,7 +13,9 @@ class Trajectory:
     t (n,) s; pedestal_disp (n, 3) m; pos, vel (n, nb, 3) m, m/s; angvel (n, nb, 3)
     rad/s; quat (n, nb, 4) ordered (w, x, y, z); bodies: one dict per body (shape,
     column, index, height, radius or width/depth, mass, initial_pos); dt: time step
-    (s); motion_end: end of the ground motion (s); wall_s: wall-clock time of the run.
+    (s); motion_end: end of the ground motion (s); start_s: time on the motion's clock at
+    which the simulation started (after a skipped quiet lead-in; t is on that clock);
+    wall_s: wall-clock time of the run.
     """
     t: np.ndarray
     pos: np.ndarray
@@ -25,6 +27,7 @@ class Trajectory:
     dt: float = 0.0
     motion_end: float = 0.0
     stopped_early: bool = False
+    start_s: float = 0.0
     wall_s: float = None
     extra: dict = field(default_factory=dict)
 
@@ -45,8 +48,9 @@ class Trajectory:
                    bodies=json.loads(str(raw["bodies"])), vel=raw["vel"], angvel=raw["angvel"],
                    pedestal_disp=raw["pedestal_disp"], dt=float(raw["dt"]),
                    motion_end=float(raw["motion_end"]), stopped_early=bool(raw["stopped_early"]),
-                   wall_s=wall_s)
+                   start_s=float(raw.get("start_s", 0.0)), wall_s=wall_s)
 
     @property
     def simulated_s(self):
-        return float(self.t[-1]) if len(self.t) else 0.0
+        """Simulated time (s): from the start to the last sample."""
+        return float(self.t[-1]) - self.start_s if len(self.t) else 0.0

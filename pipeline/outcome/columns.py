@@ -152,6 +152,8 @@ def summarise(trajectory, record=None, back_azimuth_deg=None, parameters=None,
     return {"record": record, "back_azimuth_deg": back, "parameters": parameters or {},
             "columns": column_outcomes(trajectory), "simulated": True,
             "simulated_s": trajectory.simulated_s,
+            "simulated_window_s": [trajectory.start_s, float(trajectory.t[-1])
+                                   if len(trajectory.t) else trajectory.start_s],
             "motion_end_s": trajectory.motion_end, "stopped_early": trajectory.stopped_early,
             "time_step_s": trajectory.dt, "wall_s": trajectory.wall_s,
             "provenance": provenance or {}}

@@ -95,6 +95,15 @@ def trim_to_signal(work, arias_fractions=(0.001, 0.995), margin_s=5.0, highpass_
             "margin_s": margin_s, "data_s": [max(i0, first) * work.dt, (min(i1, last) - 1) * work.dt]}
 
 
+def signal_end_s(acc, dt):
+    """End (s) of the signal window a record is cut to (``trim_to_signal`` with the
+    default steps' Arias fraction and margin), at most the last sample: for motions that
+    do not pass through the processing, e.g. synthetics."""
+    work = Work(acc, dt)
+    window = trim_to_signal(work, **dict(DEFAULT_STEPS)["trim_to_signal"])["window_s"]
+    return min(window[1], dt * (len(acc) - 1))
+
+
 @step
 def pad_to_window(work):
     """Zeros before and after the data up to the signal window of ``trim_to_signal``."""

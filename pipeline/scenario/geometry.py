@@ -495,8 +495,9 @@ class ColumnGeometry:
 
     def statics(self, g=9.81):
         """Per joint (body k on what is below it): ``ratio`` = rocking threshold / g
-        (horizontal distance from the rocking edge to the centre of mass of bodies k..,
-        over its height above that edge; 0 for a block released on its edge) and
+        (``lever_m``, the horizontal distance from the rocking edge to the centre of mass
+        of bodies k.., over its height above that edge; 0 for a block released on its
+        edge) and
         ``barrier_j``, the smallest energy that tips that stack over its edge."""
         return _statics(self.bodies(), g)
 
@@ -755,7 +756,8 @@ def _statics(bodies, g):
         com = np.array([math.fsum(b.mass * b.centre[i] for b in stack) for i in range(3)]) / mass
         if body.edge_mode:
             joints.append({"body": k, "from_block": body.parts[0].index, "ratio": 0.0,
-                           "barrier_j": 0.0, "mass_kg": mass, "com_m": com.tolist()})
+                           "lever_m": 0.0, "barrier_j": 0.0, "mass_kg": mass,
+                           "com_m": com.tolist()})
             continue
         plane_rot = body.support_rotation
         tilted = not np.array_equal(plane_rot, np.eye(3))
@@ -774,7 +776,8 @@ def _statics(bodies, g):
         ratio = d / h
         barrier = mass * g * (np.hypot(d, h) - h)
         joints.append({"body": k, "from_block": body.parts[0].index,
-                       "ratio": float(ratio.min()), "barrier_j": float(barrier.min()),
+                       "ratio": float(ratio.min()), "lever_m": float(d.min()),
+                       "barrier_j": float(barrier.min()),
                        "mass_kg": mass, "com_m": com.tolist()})
     return joints
 
@@ -793,7 +796,9 @@ class ColumnSpec:
     def scene(self, rim_points):
         """The ``params.json`` entry of this column: bodies with placement, mass
         properties, rims and plates (body frames centred on the centre of mass), its
-        rocking threshold (``uplift_ratio``) and overturning energy barrier."""
+        rocking threshold (``uplift_ratio``), the smallest horizontal distance from a
+        rocking edge to the centre of mass of the stack above it (``rocking_lever_m``) and
+        the overturning energy barrier."""
         bodies = self.geometry.bodies(self.x, self.y)
         statics = _statics(bodies, 9.81)
         n = len(bodies)
@@ -803,6 +808,7 @@ class ColumnSpec:
                 "description": self.geometry.name,
                 "height": self.geometry.height, "n_bodies": n,
                 "uplift_ratio": min(j["ratio"] for j in statics),
+                "rocking_lever_m": min(j["lever_m"] for j in statics),
                 "overturning_barrier_j": (min(j["barrier_j"] for j in statics)
                                           if settles else None),
                 "settles": settles,

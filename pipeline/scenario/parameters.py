@@ -106,6 +106,14 @@ class Numerics:
     rest_duration_s: float = param(0.5, "s", "rest this long to stop early", 0.0, 1e9,
                                    low_open=True)
     tail_s: float = param(10.0, "s", "simulated time allowed after the motion ends", 0.0, 600.0)
+    quiet_motion: str = param("skip", "", "the motion's quiet parts, where no body at rest can "
+                              "start to move (the pre-check's thresholds): skip = start "
+                              "quiet_lead_s before the first sample that can move a body and "
+                              "stop once every body rests seated after the last; simulate = "
+                              "the whole motion", flag="--quiet-motion",
+                              choices=("skip", "simulate"))
+    quiet_lead_s: float = param(1.0, "s", "simulated time before the first sample that can "
+                                "move a body (quiet_motion skip)", 0.0, 600.0)
 
     def __post_init__(self):
         check_fields(self)

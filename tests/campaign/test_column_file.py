@@ -25,7 +25,8 @@ CAMPAIGN_OPTIONS = {               # small but complete: every kind of run of ea
     "slenderness": {}, "friction": {}, "records": {}, "synthetic": {},
     "ensemble": {"members": 3}, "fragility": {"members": 2, "levels": (1.0, 4.0)}}
 # sha256 (first 16 hex) of the run parameters without --column-file on the pulse record,
-# computed before the option existed ("scale" dropped: it depends on the motion's PGA)
+# computed before the option existed ("scale" dropped: it depends on the motion's PGA;
+# "window" too: synthetic runs have since been cut at their signal's end)
 # (commit 5b7b9e3; the run ids were equal too, at an unchanged model code hash)
 DEFAULT_PARAMS_SHA = {"slenderness": "e42a62714eaad8d6", "friction": "915100ca0ef786ec",
                       "records": "43eb8fb2261ce585", "synthetic": "43eb8fb2261ce585",
@@ -47,7 +48,8 @@ def _specs(name, record, campaign_dir, **options):
 
 
 def _params_sha(specs):
-    params = [{k: v for k, v in s["params"].items() if k != "scale"} for s in specs]
+    params = [{k: v for k, v in s["params"].items() if k not in ("scale", "window")}
+              for s in specs]
     return hashlib.sha256(json.dumps(params, sort_keys=True).encode()).hexdigest()[:16]
 
 
