@@ -12,7 +12,9 @@ One run prints, and writes to results/bench/bench.json (+ convergence.png):
 4. peer: the twin model under the same one-sine pulse in MuJoCo (bench/mujoco_twin.py):
    both engines' s/s, their ratio and the downfall azimuths per column;
 5. convergence: outcome against the time-step factor and the rim points (strong pulse);
-6. parallel: runs per minute with 1 and 2 YADE processes at once, and their ratio.
+6. parallel: runs per minute with 1 and 2 YADE processes at once, and their ratio;
+7. quiet_motion: real records with the motion's quiet parts skipped and simulated,
+   simulated and wall seconds and outcomes side by side.
 
 Units: seconds (s), metres, m/s^2; azimuths in degrees clockwise from North.
 ``--quick`` shortens every run and skips the convergence table (for development).
@@ -380,6 +382,44 @@ def parallel(work, n_runs, t_max, n_noop=40):
     return out
 
 
+# ---------------------------------------------------------------- 7. quiet motion
+QUIET_RECORDS = ("GM20", "NF04", "RC-CCC", "RSN126-GAZLI")   # run-all's ensemble records
+
+
+def quiet_motion(work, records=QUIET_RECORDS):
+    """The twin model under real records, each run twice side by side in 2 threads (one
+    YADE process each, as campaigns): skipping the motion's quiet parts (default) and
+    simulating the whole motion.  Per record: simulated s, YADE wall s and both
+    outcomes per column (toppled, downfall azimuth deg)."""
+    from pipeline.records import processed_motion
+    from pipeline.simulate import simulate
+
+    def one(task):
+        record, mode = task
+        motion, _ = processed_motion(record)
+        return simulate(motion, work / "quiet" / f"{record}_{mode}",
+                        numerics=Numerics(quiet_motion=mode), record=record)
+
+    tasks = [(r, m) for r in records for m in ("skip", "simulate")]
+    with reuse_processes(), ThreadPoolExecutor(2) as pool:
+        summaries = dict(zip(tasks, pool.map(one, tasks)))
+    rows = []
+    for record in records:
+        row = {"record": record}
+        for mode in ("skip", "simulate"):
+            s = summaries[(record, mode)]
+            row[mode] = {"simulated_s": s["simulated_s"], "wall_s": s["wall_s"],
+                         "window_s": s["simulated_window_s"], "motion_end_s": s["motion_end_s"],
+                         "columns": {c["column"]: (c["toppled"], c["downfall_azimuth_deg"])
+                                     for c in s["columns"]}}
+        rows.append(row)
+    total = {mode: sum(r[mode]["simulated_s"] for r in rows) for mode in ("skip", "simulate")}
+    wall = {mode: sum(r[mode]["wall_s"] for r in rows) for mode in ("skip", "simulate")}
+    return {"records": rows, "simulated_s": total, "wall_s": wall,
+            "simulated_ratio": total["simulate"] / total["skip"],
+            "wall_ratio": wall["simulate"] / wall["skip"]}
+
+
 # ---------------------------------------------------------------- printing
 def fmt(value, spec=".1f"):
     return "-" if value is None else format(value, spec)
@@ -488,6 +528,23 @@ def print_parallel(p):
             print(f"   {label}: {p[key]:.2f}")
 
 
+def print_quiet(q):
+    def outcome(cols):
+        return ", ".join(f"{c} {az:.0f}" if top else f"{c} stood"
+                         for c, (top, az) in cols.items())
+    print("\n7. Quiet motion: the twin model under real records, the motion's quiet parts "
+          "skipped (default) and simulated, side by side")
+    print(f"   {'record':<14}{'skip: window s':>18}{'sim s':>7}{'wall s':>8}   "
+          f"{'full: sim s':>11}{'wall s':>8}   outcomes skip | full")
+    for r in q["records"]:
+        s, f = r["skip"], r["simulate"]
+        print(f"   {r['record']:<14}{s['window_s'][0]:8.1f}-{s['window_s'][1]:<8.1f}"
+              f"{s['simulated_s']:7.1f}{s['wall_s']:8.1f}   {f['simulated_s']:11.1f}"
+              f"{f['wall_s']:8.1f}   {outcome(s['columns'])} | {outcome(f['columns'])}")
+    print(f"   simulated s full / skip: {q['simulated_ratio']:.2f}; YADE wall s full / skip: "
+          f"{q['wall_ratio']:.2f}")
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true",
@@ -529,6 +586,9 @@ def main(argv=None):
             plot_convergence(result["convergence"], args.out / "convergence.png")
         result["parallel"] = parallel(work, 4, 1.0 if args.quick else 3.0)
         print_parallel(result["parallel"])
+        result["quiet_motion"] = quiet_motion(work, QUIET_RECORDS[:1] if args.quick
+                                              else QUIET_RECORDS)
+        print_quiet(result["quiet_motion"])
     result["bench_wall_s"] = time.perf_counter() - started
     write_json(args.out / "bench.json", result)
     print(f"\nbench: {result['bench_wall_s']:.0f} s wall; wrote {args.out / 'bench.json'}")

@@ -334,21 +334,26 @@ SETTLED_FRACTION = 0.9   # after the motion, energy below the barrier cannot tip
 
 
 def settled(rel):
-    """True when, after the motion, every body still stands (tilt < 30 deg) and no column
-    holds more than 90 % of the energy it needs to tip any stack over: energy only
-    decreases then, so no column can fall.  Scenes with a test block (verification) or a
-    column that has begun to fall never count as settled."""
+    """True when, after the motion, every column is decided: all its bodies lie on the
+    pedestal (tilt > 60 deg: their impacts are recorded, they may roll on), or all still
+    stand (tilt < 30 deg) and it holds less than 90 % of the energy it needs to tip any
+    stack over (energy only decreases then, so it cannot fall).  Scenes with a test
+    block (verification) and columns partly fallen are never decided this way."""
     energy = dict.fromkeys(BARRIERS, 0.0)
+    tilt = {}          # column -> set of "stands" / "lies" / "between"
     for b, s, c in zip(bodies, states, clumps):
         if b["column"] not in BARRIERS:
             return False
-        if (s.ori * body_offset[c] * Vector3(0, 0, 1))[2] < 0.866:     # tilted > 30 deg
-            return False
+        up = (s.ori * body_offset[c] * Vector3(0, 0, 1))[2]
+        tilt.setdefault(b["column"], set()).add(
+            "stands" if up >= 0.866 else "lies" if up < 0.5 else "between")
         w = s.ori.conjugate() * s.angVel                               # clump frame
         energy[b["column"]] += (0.5 * b["mass"] * (s.vel - rel).squaredNorm()
                                 + 0.5 * sum(s.inertia[i] * w[i] ** 2 for i in range(3))
                                 + b["mass"] * G * (s.pos[2] - b["initial_pos"][2]))
-    return all(energy[k] < SETTLED_FRACTION * BARRIERS[k] for k in BARRIERS)
+    return all(tilt[k] == {"lies"} or (tilt[k] == {"stands"}
+                                       and energy[k] < SETTLED_FRACTION * BARRIERS[k])
+               for k in BARRIERS)
 
 
 # a standing body is seated when, against the column's bottom body, it has shifted and

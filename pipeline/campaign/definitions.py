@@ -212,8 +212,9 @@ def synthetic_specs(records, campaign_dir, column_file=None, stiffness="matched"
     from pipeline.motion import synthetics
     data = description(column_file)
     check_stiffness(stiffness)
-    paths = list(records) if records else [p for source in synthetics.SOURCES
-                                           for p in synthetics.generate(source)]
+    paths = list(records) if records else [
+        p for source_paths in synthetics.generate_sources(synthetics.SOURCES).values()
+        for p in source_paths]
     runs = []
     for path in paths:
         window = signal_window(path)

@@ -4,7 +4,8 @@ import time
 
 from pipeline.files import InputError
 from pipeline.motion.synthetics import (GMM_VS30_M_S, QUICK_DURATION_S, QUICK_FMAX_HZ, SOURCES,
-                                        generate, source_parameters, write_gmm_summary)
+                                        generate_sources, source_parameters,
+                                        write_gmm_summary)
 
 NAME = "synthetics"
 ORDER = 50
@@ -40,11 +41,12 @@ def run(args):
     for name in names:
         source_parameters(name)
     rings = _float_list(args.rings)
-    for name in names:
-        started = time.monotonic()
-        paths = generate(name, rings, args.step, quick=args.quick, jobs=max(1, args.jobs))
-        print(f"{name}: {len(paths)} sites in {paths[0].parent} "
-              f"({time.monotonic() - started:.0f} s, cached when ~0)")
+    started = time.monotonic()
+    generated = generate_sources(names, rings, args.step, quick=args.quick,
+                                 jobs=max(1, args.jobs))
+    for name, paths in generated.items():
+        print(f"{name}: {len(paths)} sites in {paths[0].parent}")
+    print(f"{time.monotonic() - started:.0f} s (cached when ~0)")
     base = paths[0].parent.parent
     summary = write_gmm_summary(base)
     shown = summary[summary["source"].isin(names)]

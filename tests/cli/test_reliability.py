@@ -267,7 +267,7 @@ def test_two_runs_into_one_directory(tmp_path):
     record = write_motion_npz(tmp_path / "rocking.npz", amplitude=1.7, duration=40.0)
     out = tmp_path / "run"
     first = cli_process("run", "--record", str(record), "--column", "monolithic", "--out",
-                        str(out))
+                        str(out), "--quiet-motion", "simulate")     # rocks on to 40 s
     deadline = time.monotonic() + 30
     while not yade_processes(out) and time.monotonic() < deadline:
         time.sleep(0.05)

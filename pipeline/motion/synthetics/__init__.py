@@ -23,7 +23,8 @@ every generator parameter.
 """
 from pipeline.motion.synthetics.compute import (DEFAULT_OUT_DIR, QUICK_DURATION_S,
                                                  QUICK_FMAX_HZ, QUICK_OUT_DIR, band_limited_motion,
-                                                 generate, moment_tensor_xyz, numerics,
+                                                 generate, generate_sources, moment_tensor_xyz,
+                                                 numerics,
                                                  point_source_displacement, site_table)
 from pipeline.motion.synthetics.gmm import (GMM_VS30_M_S, gmm_check, gmm_summary, rotd50,
                                             rupture_distances, write_gmm_summary)

@@ -173,62 +173,81 @@ def generate(source_name, rings_km=(5, 10, 20), azimuth_step_deg=30, duration_s=
     (``<source>/gmm_check_sites.csv``) and refreshes the summary of all
     sources, ``gmm_check.csv``, in the output directory.
     """
-    src = source_parameters(source_name)
+    return generate_sources([source_name], rings_km, azimuth_step_deg, duration_s, sampling_hz,
+                            fmax_hz, out_dir, quick, jobs)[source_name]
+
+
+def generate_sources(source_names, rings_km=(5, 10, 20), azimuth_step_deg=30, duration_s=30.0,
+                     sampling_hz=100.0, fmax_hz=10.0, out_dir=None, quick=False, jobs=None):
+    """:func:`generate` for several sources at once: {source name: npz paths}.  The
+    sub-events of every source to compute share one pool of ``jobs`` processes (two
+    sources of five sub-events on 2 cores: five rounds of pyprop8 calls instead of six);
+    each source's motions are the same as computed alone."""
+    from pipeline.motion.synthetics.gmm import write_gmm_summary
     cfg = _settings(rings_km, azimuth_step_deg, duration_s, sampling_hz, fmax_hz, out_dir, quick)
     num = numerics(cfg["duration_s"], cfg["sampling_hz"], cfg["fmax_hz"])
-    sites = site_table(source_name, cfg["rings_km"], cfg["azimuth_step_deg"], cfg["base"])
-    paths = [Path(p) for p in sites["npz"]]
-    source_dir = cfg["base"] / source_name
-    manifest_path = source_dir / "manifest.json"
-    key = _cache_key(source_name, cfg, num)
-    from pipeline.motion.synthetics.gmm import write_gmm_summary
-    if (manifest_path.is_file() and all(p.is_file() for p in paths)
-            and json.loads(manifest_path.read_text()).get("cache_key") == key):
-        if not (source_dir / "gmm_check_sites.csv").is_file():
-            _write_gmm_check(source_name, cfg)
-        write_gmm_summary(cfg["base"])
-        return paths
-    jobs = jobs or os.cpu_count() or 1
-
-    subs = subevents(source_name)
-    mechanism = (src["strike_deg"], src["dip_deg"], src["rake_deg"])
-    tasks = []
-    for _, sub in subs.iterrows():
-        sub = dict(sub, rise_s=src["subevent_rise_s"], duration_s=src["subevent_duration_s"])
-        tasks.append((sites["x_km"].to_numpy(), sites["y_km"].to_numpy(), mechanism, sub, num,
-                      cfg["fmax_hz"]))
-    started = time.monotonic()
-    total = 0.0
-    progress = tqdm(total=len(tasks), desc=f"pyprop8 {source_name}", unit="sub-event")
-    if jobs > 1 and len(tasks) > 1:
-        with Pool(min(jobs, len(tasks))) as pool:
-            for disp in pool.imap(_point_source_task, tasks):  # in order: reproducible sum
-                total = total + disp
+    plans, tasks = {}, []
+    for name in source_names:
+        src = source_parameters(name)
+        sites = site_table(name, cfg["rings_km"], cfg["azimuth_step_deg"], cfg["base"])
+        paths = [Path(p) for p in sites["npz"]]
+        manifest_path = cfg["base"] / name / "manifest.json"
+        key = _cache_key(name, cfg, num)
+        plans[name] = {"src": src, "sites": sites, "paths": paths, "key": key}
+        if (manifest_path.is_file() and all(p.is_file() for p in paths)
+                and json.loads(manifest_path.read_text()).get("cache_key") == key):
+            if not (cfg["base"] / name / "gmm_check_sites.csv").is_file():
+                _write_gmm_check(name, cfg)
+            continue
+        mechanism = (src["strike_deg"], src["dip_deg"], src["rake_deg"])
+        for _, sub in subevents(name).iterrows():
+            sub = dict(sub, rise_s=src["subevent_rise_s"], duration_s=src["subevent_duration_s"])
+            tasks.append((name, (sites["x_km"].to_numpy(), sites["y_km"].to_numpy(), mechanism,
+                                 sub, num, cfg["fmax_hz"])))
+    if tasks:
+        jobs = jobs or os.cpu_count() or 1
+        started = time.monotonic()
+        totals = dict.fromkeys((name for name, _ in tasks), 0.0)
+        progress = tqdm(total=len(tasks), desc="pyprop8 " + ", ".join(totals),
+                        unit="sub-event")
+        calls = [task for _, task in tasks]
+        if jobs > 1 and len(tasks) > 1:
+            with Pool(min(jobs, len(tasks))) as pool:
+                results = pool.imap(_point_source_task, calls)   # in order: reproducible sums
+                for (name, _), disp in zip(tasks, results):
+                    totals[name] = totals[name] + disp
+                    progress.update(1)
+        else:
+            for name, task in tasks:
+                totals[name] = totals[name] + _point_source_task(task)
                 progress.update(1)
-    else:
-        for task in tasks:
-            total = total + _point_source_task(task)
-            progress.update(1)
-    progress.close()
-    elapsed = time.monotonic() - started
+        progress.close()
+        elapsed = time.monotonic() - started
+        for name, total in totals.items():
+            _write_source(name, plans[name], total, cfg, num, elapsed, jobs)
+    write_gmm_summary(cfg["base"])
+    return {name: plans[name]["paths"] for name in source_names}
 
+
+def _write_source(name, plan, total, cfg, num, elapsed, jobs):
+    """Write one source's site motions, its GMM check and its manifest (last)."""
+    source_dir = cfg["base"] / name
+    manifest_path = source_dir / "manifest.json"
     manifest_path.unlink(missing_ok=True)
-    for stale in set(source_dir.glob("*.npz")) - set(paths):
+    for stale in set(source_dir.glob("*.npz")) - set(plan["paths"]):
         stale.unlink()
-    for (_, site), path in zip(sites.iterrows(), paths):
+    for (_, site), path in zip(plan["sites"].iterrows(), plan["paths"]):
         acc, vel, disp = band_limited_motion(total[site.name].T, num["dt_calc"], num["upsample"])
-        meta = _site_meta(source_name, src, site, cfg, num, key)
+        meta = _site_meta(name, plan["src"], site, cfg, num, plan["key"])
         Motion(1.0 / cfg["sampling_hz"], acc, vel, disp, meta=meta).save(path)
-    _write_gmm_check(source_name, cfg)
+    _write_gmm_check(name, cfg)
     files.write_json(manifest_path, {
-        "cache_key": key, "source": source_name, "source_parameters": src,
+        "cache_key": plan["key"], "source": name, "source_parameters": plan["src"],
         "crust_layers_thickness_vp_vs_rho": [  # thickness null: the half-space
             [None if math.isinf(layer[0]) else layer[0], *layer[1:]] for layer in CRUST_LAYERS],
         "settings": {k: v for k, v in cfg.items() if k != "base"}, "numerics": num,
         "compute_seconds": round(elapsed, 1), "jobs": jobs,
-        "sites": [p.name for p in paths]})
-    write_gmm_summary(cfg["base"])
-    return paths
+        "sites": [p.name for p in plan["paths"]]})
 
 
 def _write_gmm_check(source_name, cfg):
