@@ -116,37 +116,49 @@ def animate_run(run, path, fps=20, max_seconds=None, max_frames=600):
     ax.set_box_aspect((2 * reach, 2 * reach, max(height, 1.0)))
     square = np.array([[-1, -1], [1, -1], [1, 1], [-1, 1], [-1, -1]]) * PEDESTAL_HALF
     pedestal_line, = ax.plot([], [], [], color="grey")
-    body_lines = []  # per body, per part: two rim lines, then the side lines
-    for body in bodies:
-        colour = COLUMN_COLOURS.get(body["column"], "k")
-        parts = []
-        for rings in body_surfaces(body, np.zeros(3), [1, 0, 0, 0]):
-            rims = [ax.plot([], [], [], color=colour, lw=1)[0] for _ in range(2)]
-            sides = [ax.plot([], [], [], color=colour, lw=0.6)[0]
-                     for _ in range(len(rings[0][::3]))]
-            parts.append(rims + sides)
-        body_lines.append(parts)
+    # one line per body part: bottom and top outline and every third side edge, apart
+    # by NaN (one artist instead of ~10: a frame draws about 3x faster)
+    body_lines = [[ax.plot([], [], [], color=COLUMN_COLOURS.get(body["column"], "k"), lw=0.8)[0]
+                   for _ in body_parts(body)] for body in bodies]
     title = ax.set_title("")
+    gap = np.full((1, 3), np.nan)
+
+    def outline(rims):
+        """Vertices (n x 3) of a part's line: closed bottom and top rims, side edges."""
+        pieces = [np.vstack([rims[0], rims[0][:1]]), gap, np.vstack([rims[1], rims[1][:1]])]
+        for a, b in zip(rims[0][::3], rims[1][::3]):
+            pieces += [gap, a[None], b[None]]
+        return np.vstack(pieces)
 
     def draw(k):
         disp = traj.pedestal_disp[k]
         pedestal_line.set_data_3d(square[:, 0] + disp[0], square[:, 1] + disp[1],
                                   np.full(5, disp[2]))
         for j, body in enumerate(bodies):
-            for rims, lines in zip(body_surfaces(body, traj.pos[k, j] + disp, traj.quat[k, j]),
-                                   body_lines[j]):
-                for line, rim in zip(lines[:2], rims):
-                    closed = np.vstack([rim, rim[:1]])
-                    line.set_data_3d(closed[:, 0], closed[:, 1], closed[:, 2])
-                for line, a, b in zip(lines[2:], rims[0][::3], rims[1][::3]):
-                    line.set_data_3d(*np.column_stack([a, b]))
+            for rims, line in zip(body_surfaces(body, traj.pos[k, j] + disp, traj.quat[k, j]),
+                                  body_lines[j]):
+                xyz = outline(rims)
+                line.set_data_3d(xyz[:, 0], xyz[:, 1], xyz[:, 2])
         title.set_text(f"t = {t[k]:5.2f} s")
 
+    if path.suffix == ".gif":
+        # frames drawn here and quantised with Pillow's fast octree (its default
+        # median cut took a third of the time of matplotlib's PillowWriter)
+        from PIL import Image
+        images = []
+        for k in frames:
+            draw(k)
+            fig.canvas.draw()
+            rgba = Image.frombuffer("RGBA", fig.canvas.get_width_height(),
+                                    fig.canvas.buffer_rgba(), "raw", "RGBA", 0, 1)
+            images.append(rgba.convert("RGB").quantize(method=Image.Quantize.FASTOCTREE))
+        with atomic_path(path) as tmp:
+            images[0].save(tmp, format="GIF", save_all=True, append_images=images[1:],
+                           duration=round(1000 / fps), loop=0)
+        return path
     anim = animation.FuncAnimation(fig, draw, frames=frames, interval=1000 / fps)
-    writer = (animation.PillowWriter(fps=fps) if path.suffix == ".gif"
-              else animation.FFMpegWriter(fps=fps))
     with atomic_path(path) as tmp:
-        anim.save(tmp.with_suffix(path.suffix), writer=writer)
+        anim.save(tmp.with_suffix(path.suffix), writer=animation.FFMpegWriter(fps=fps))
         tmp.with_suffix(path.suffix).replace(tmp)
     return path
 

@@ -67,7 +67,12 @@ def test_vtk_export_is_valid_xml_with_all_frames(tmp_path):
 
 
 def test_animation_gif(tmp_path):
-    out = animation.animate_run(lying_east_trajectory(), tmp_path / "a.gif", fps=2)
+    from PIL import Image
+    traj = lying_east_trajectory()
+    out = animation.animate_run(traj, tmp_path / "a.gif", fps=2)
     assert out.read_bytes()[:6] in (b"GIF89a", b"GIF87a")
+    with Image.open(out) as gif:    # frames every 0.5 s: both samples (t 0 and 1 s), 500 ms
+        assert gif.n_frames == len(traj.t) == 2
+        assert gif.info["duration"] == 500
     with pytest.raises(InputError):
         animation.animate_run(lying_east_trajectory(), tmp_path / "a.avi")
