@@ -38,6 +38,7 @@ import uuid
 from concurrent.futures import FIRST_COMPLETED, ThreadPoolExecutor, wait
 from pathlib import Path
 
+import numpy as np
 from tqdm import tqdm
 
 from pipeline.files import (
@@ -82,6 +83,8 @@ def execute(specs, campaign_dir, jobs, worker, label="runs", executor=None, sche
         jobs = os.cpu_count() or 1
     runs_dir = Path(campaign_dir) / "runs"
     todo = [s for s in specs if not (runs_dir / s["run_id"] / "summary.json").exists()]
+    durations = {}
+    todo.sort(key=lambda spec: motion_seconds(spec, durations), reverse=True)
     done = len(specs) - len(todo)
     where = (f"{jobs} parallel YADE process(es)" if executor == "threads" else
              f"{jobs} local Dask worker process(es)" if not scheduler else
@@ -98,6 +101,25 @@ def execute(specs, campaign_dir, jobs, worker, label="runs", executor=None, sche
         return _execute_dask(todo, runs_dir, jobs, worker, bar, scheduler)
     finally:
         bar.close()
+
+
+def motion_seconds(spec, durations):
+    """Seconds of motion a run shakes (its window, else its motion file's length; 0 if
+    unknown): campaigns start the longest first, so that no core idles at the end while
+    one long run finishes.  ``durations`` caches file lengths by path."""
+    window = spec.get("params", {}).get("window")
+    if window:
+        return float(window[1]) - float(window[0])
+    path = spec.get("motion_file")
+    if not path:
+        return 0.0
+    if path not in durations:
+        try:
+            with np.load(path) as motion:
+                durations[path] = float(motion["dt"]) * (len(motion["acc"]) - 1)
+        except (OSError, KeyError, ValueError):
+            durations[path] = 0.0          # the run itself reports the bad file
+    return durations[path]
 
 
 def _finished(spec, exc, runs_dir, failures, bar):

@@ -3,6 +3,7 @@ import json
 import math
 import subprocess
 import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -68,3 +69,25 @@ def test_run_bad_input_one_line_and_nothing_written(tmp_path, args, message):
     assert proc.returncode == 2
     assert proc.stderr.count("\n") == 1 and message in proc.stderr
     assert not (out / "summary.json").exists()
+
+
+def test_campaign_runs_start_longest_motion_first(tmp_path):
+    """One worker thread: runs start in order of decreasing motion length (a window's
+    length when the run has one), equal lengths in the campaign's order."""
+    from pipeline.files import write_json
+    from pipeline.motion.pulses import one_sine_pulse
+    specs = []
+    for name, seconds, window in (("a", 4.0, None), ("b", 9.0, None), ("c", 9.0, [0.0, 2.0]),
+                                  ("d", 6.0, None), ("e", 9.0, None)):
+        path = tmp_path / f"{name}.npz"
+        one_sine_pulse(duration=seconds).save(path)
+        specs.append({"run_id": name, "motion_file": str(path),
+                      "params": {"window": window} if window else {}})
+    started = []
+
+    def worker(spec, run_dir):
+        started.append(spec["run_id"])
+        write_json(Path(run_dir) / "summary.json", {})
+
+    assert execute(specs, tmp_path, 1, worker) == ([], False)
+    assert started == ["b", "e", "d", "a", "c"]
