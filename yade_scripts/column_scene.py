@@ -358,7 +358,8 @@ def settled(rel):
 
 # a standing body is seated when, against the column's bottom body, it has shifted and
 # tilted (times the column's height) by at most this fraction of the column's smallest
-# rocking lever: its rocking threshold is then within 2 % of the pre-check's
+# rocking lever: the levers then differ from the start's by a few per cent, inside the
+# pre-check's 10 % margin
 SEATED_FRACTION = 0.02
 SEATED = []      # per body: (index of its column's bottom body, shift tolerance m, tilt tol rad)
 for col in COLUMNS:
