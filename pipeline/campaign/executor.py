@@ -38,7 +38,6 @@ import uuid
 from concurrent.futures import FIRST_COMPLETED, ThreadPoolExecutor, wait
 from pathlib import Path
 
-import numpy as np
 from tqdm import tqdm
 
 from pipeline.files import (
@@ -49,6 +48,7 @@ from pipeline.files import (
     code_hash,
     write_text,
 )
+from pipeline.motion import Motion
 from pipeline.scenario.runner import kill_running, reuse_processes
 
 EXECUTORS = ("threads", "dask")
@@ -115,9 +115,8 @@ def motion_seconds(spec, durations):
         return 0.0
     if path not in durations:
         try:
-            with np.load(path) as motion:
-                durations[path] = float(motion["dt"]) * (len(motion["acc"]) - 1)
-        except (OSError, KeyError, ValueError):
+            durations[path] = Motion.load(path).duration
+        except (OSError, InputError):
             durations[path] = 0.0          # the run itself reports the bad file
     return durations[path]
 
