@@ -1,7 +1,7 @@
 # Run a generated YADE scene with YADE imported as a Python module.
 #
 #     /usr/bin/python3 run_scene.py DIR/scene.py
-#     /usr/bin/python3 run_scene.py --serve FD      (campaigns: one process, many scenes)
+#     /usr/bin/python3 run_scene.py --serve FD IDLE_S   (campaigns: one process, many scenes)
 #
 # Unlike the `yade` launcher this opens no network port (the launcher serves a
 # Python prompt on 0.0.0.0:9000 and an info server on 0.0.0.0:21000) and saves
@@ -12,9 +12,12 @@
 # --serve: read scene directories from stdin, one per line; for each, reset YADE,
 # run DIR/scene.py with stdout and stderr in DIR/yade.log, and answer its exit code
 # as one line on file descriptor FD (a pipe from the parent).  YADE's start-up (about
-# 1 s) is paid once per process instead of once per scene.
+# 1 s) is paid once per process instead of once per scene.  The process ends by itself
+# after IDLE_S seconds without a scene (a Dask worker keeps it between tasks; should its
+# campaign's client vanish, nothing stays behind for long) or when stdin closes.
 import os
 import runpy
+import select
 import sys
 import traceback
 
@@ -29,12 +32,26 @@ def run(scene):
     runpy.run_path(scene, run_name="__main__")
 
 
-def serve(control_fd):
+def lines(fd, idle_s):
+    """Lines read from ``fd`` (decoded, without newline) until it closes or stays silent
+    for ``idle_s`` seconds."""
+    buffer = b""
+    while True:
+        while b"\n" not in buffer:
+            ready, _, _ = select.select([fd], [], [], idle_s)
+            chunk = os.read(fd, 65536) if ready else b""
+            if not chunk:
+                return
+            buffer += chunk
+        line, buffer = buffer.split(b"\n", 1)
+        yield line.decode()
+
+
+def serve(control_fd, idle_s):
     from yade import O
     control = os.fdopen(control_fd, "w", buffering=1)
     quiet = os.open(os.devnull, os.O_WRONLY)
-    for line in sys.stdin:
-        run_dir = line.rstrip("\n")
+    for scene_number, run_dir in enumerate(lines(sys.stdin.fileno(), idle_s), 1):
         sys.stdout.flush()
         sys.stderr.flush()
         log = os.open(os.path.join(run_dir, "yade.log"), os.O_WRONLY | os.O_CREAT | os.O_TRUNC,
@@ -42,6 +59,7 @@ def serve(control_fd):
         os.dup2(log, 1)
         os.dup2(log, 2)
         os.close(log)
+        print(f"run_scene.py --serve: process {os.getpid()}, scene {scene_number}", flush=True)
         code = 0
         try:
             os.chdir(run_dir)
@@ -56,12 +74,13 @@ def serve(control_fd):
         sys.stderr.flush()
         os.dup2(quiet, 1)
         os.dup2(quiet, 2)
+        os.chdir("/")                 # hold no run directory (it may be a temporary one)
         control.write(f"{code}\n")
 
 
 if __name__ == "__main__":
     import yade  # noqa: E402,F401  (boots YADE: plugins, O)
     if sys.argv[1] == "--serve":
-        serve(int(sys.argv[2]))
+        serve(int(sys.argv[2]), float(sys.argv[3]))
     else:
         run(sys.argv[1])

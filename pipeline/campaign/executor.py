@@ -49,7 +49,7 @@ from pipeline.files import (
     write_text,
 )
 from pipeline.motion import Motion
-from pipeline.scenario.runner import kill_running, reuse_processes
+from pipeline.scenario.runner import end_served_processes, kill_running, reuse_processes
 
 EXECUTORS = ("threads", "dask")
 DEFAULT_EXECUTOR = "threads"    # why: README "On a cluster: Dask" (start-up, ports)
@@ -321,19 +321,24 @@ def write_run_files(run_dir, files, clear=True):
 
 def close_dask(client, cluster, token=None, interrupted=False, futures=()):
     """Cancel what is left; after Ctrl-C kill the campaign's YADE processes on the
-    workers of a cluster we don't own.  Kill a local cluster's worker processes (their
-    YADE processes die with them; a graceful close takes seconds) and close it and the
-    client.  Best effort: nothing here may keep Ctrl-C from returning."""
-    if client is not None and interrupted:
+    workers of a cluster we don't own, and end the idle YADE processes its workers kept
+    for the next task (they would end by themselves after SERVE_IDLE_S).  Kill a local
+    cluster's worker processes (their YADE processes die with them; a graceful close
+    takes seconds) and close it and the client.  Best effort: nothing here may keep
+    Ctrl-C from returning."""
+    if client is not None and (interrupted or cluster is None):
         def stop():
-            with contextlib.suppress(Exception):
-                client.cancel(futures)
+            if interrupted:
+                with contextlib.suppress(Exception):
+                    client.cancel(futures)
             if cluster is None:
                 with contextlib.suppress(Exception):
-                    client.run(kill_task_processes, token, on_error="ignore")
+                    if interrupted:
+                        client.run(kill_task_processes, token, on_error="ignore")
+                    client.run(end_served_processes, on_error="ignore")
         stopping = threading.Thread(target=stop, daemon=True)     # an unreachable worker
         stopping.start()                                          # must not hold Ctrl-C up
-        stopping.join(CLOSE_TIMEOUT_S)
+        stopping.join(CLOSE_TIMEOUT_S if interrupted else CONNECT_TIMEOUT_S)
     if cluster is not None:             # results in, or Ctrl-C: nothing to wait for
         _kill_local_workers(cluster)
     for closing in (client, cluster):
@@ -395,7 +400,8 @@ def run_task(worker, spec, motion, client_run_dir, code, token):
         swaps.append((str(run_dir), client_run_dir))
         error = message = None
         try:
-            worker(spec, run_dir)
+            with reuse_processes(end=False):          # the worker's YADE process serves on
+                worker(spec, run_dir)
         except Exception as exc:                      # noqa: BLE001 (sent back to the client)
             error = _swap("".join(traceback.format_exception(exc)), swaps)
             message = _swap(str(exc), swaps)

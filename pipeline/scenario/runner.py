@@ -5,11 +5,13 @@ needs it), single-threaded, in its own process group, with a wall-clock limit;
 the child is killed when its parent dies (Linux ``PR_SET_PDEATHSIG``), so a
 killed campaign leaves no YADE behind.
 
-Within :func:`reuse_processes` (the campaign executor's threads) each thread keeps one
-YADE process that runs its scenes one after the other (``run_scene.py --serve``,
-``O.reset()`` between scenes): YADE's start-up, about 1 s, is paid once per thread
-instead of once per run.  That process dies with its thread (``PR_SET_PDEATHSIG`` is
-per thread), when the block ends, on a timeout and on Ctrl-C.
+Within :func:`reuse_processes` (the campaign executor's threads, a Dask worker's tasks)
+each thread keeps one YADE process that runs its scenes one after the other
+(``run_scene.py --serve``, ``O.reset()`` between scenes): YADE's start-up, about 1 s, is
+paid once per thread instead of once per run.  That process dies with its thread
+(``PR_SET_PDEATHSIG`` is per thread), when the block ends (or, for a Dask worker, with
+:func:`end_served_processes` at the campaign's end), on a timeout, on Ctrl-C, and by
+itself after ``SERVE_IDLE_S`` without a scene.
 """
 import contextlib
 import ctypes
@@ -36,6 +38,7 @@ _PR_SET_PDEATHSIG = 1
 _RUNNING = set()                   # YADE processes of this process, for kill_running()
 _RUNNING_LOCK = threading.Lock()
 SCENES_PER_PROCESS = 200           # a served process is replaced after this many scenes
+SERVE_IDLE_S = 120.0               # a served process ends itself after this long without a scene
 _SERVED = threading.local()        # this thread's serving process (reuse_processes)
 _REUSE = {"depth": 0}
 
@@ -129,8 +132,12 @@ def _run_once(run_dir, timeout_s):
 
 
 @contextlib.contextmanager
-def reuse_processes():
-    """Within this block, every thread runs its scenes in one YADE process of its own."""
+def reuse_processes(end=True):
+    """Within this block, every thread runs its scenes in one YADE process of its own.
+
+    ``end``: end the idle served processes when the last such block ends; False (a Dask
+    task) leaves them to the next task, to :func:`end_served_processes` and to their
+    own idle limit."""
     with _RUNNING_LOCK:
         _REUSE["depth"] += 1
     try:
@@ -139,23 +146,38 @@ def reuse_processes():
         with _RUNNING_LOCK:
             _REUSE["depth"] -= 1
             last = _REUSE["depth"] == 0
-        if last:                      # served processes idle between scenes: end them
-            with _RUNNING_LOCK:
-                served = [p for p in _RUNNING if hasattr(p, "control")]
-            for proc in served:
-                _kill(proc)
+        if last and end:
+            end_served_processes()
+
+
+def end_served_processes():
+    """Kill this process's served YADE processes that run no scene now; their number."""
+    with _RUNNING_LOCK:
+        idle = [p for p in _RUNNING if hasattr(p, "control") and not p.busy]
+        for proc in idle:
+            proc.retired = True           # no thread takes it up again
+    for proc in idle:
+        _kill(proc)
+    return len(idle)
 
 
 def _server():
-    """This thread's serving process (started, or replaced when dead or old)."""
+    """This thread's serving process, marked busy (started, or replaced when dead, old,
+    retired or near its idle limit)."""
     proc = getattr(_SERVED, "proc", None)
-    if proc is not None and proc.poll() is None and proc.scenes < SCENES_PER_PROCESS:
-        return proc
+    with _RUNNING_LOCK:
+        usable = (proc is not None and not proc.retired and proc.poll() is None
+                  and proc.scenes < SCENES_PER_PROCESS
+                  and time.monotonic() - proc.last_used < SERVE_IDLE_S / 2)
+        if usable:
+            proc.busy = True
+            return proc
     if proc is not None:
         _kill(proc)
     read_fd, write_fd = os.pipe()
     try:
-        proc = subprocess.Popen([DEBIAN_PYTHON, str(WRAPPER), "--serve", str(write_fd)],
+        proc = subprocess.Popen([DEBIAN_PYTHON, str(WRAPPER), "--serve", str(write_fd),
+                                 str(SERVE_IDLE_S)],
                                 stdin=subprocess.PIPE, stdout=subprocess.DEVNULL,
                                 stderr=subprocess.DEVNULL, pass_fds=(write_fd,),
                                 env=_environment(), start_new_session=True,
@@ -163,7 +185,7 @@ def _server():
     finally:
         os.close(write_fd)
     proc.control = os.fdopen(read_fd, "rb")
-    proc.scenes = 0
+    proc.scenes, proc.busy, proc.retired, proc.last_used = 0, True, False, time.monotonic()
     _SERVED.proc = proc
     with _RUNNING_LOCK:
         _RUNNING.add(proc)
@@ -174,6 +196,14 @@ def _run_served(run_dir, timeout_s):
     """One scene in this thread's serving process; its exit code."""
     proc = _server()
     proc.scenes += 1
+    try:
+        return _answer(proc, run_dir, timeout_s)
+    finally:
+        proc.last_used, proc.busy = time.monotonic(), False
+
+
+def _answer(proc, run_dir, timeout_s):
+    """Send ``run_dir`` to the serving process ``proc``; the scene's exit code."""
     try:
         proc.stdin.write(f"{run_dir}\n".encode())
         proc.stdin.flush()

@@ -140,6 +140,22 @@ def task_yade_processes():
     return found
 
 
+def worker_yade_processes(cluster):
+    """pids of scene processes (run_scene.py) whose parent is one of the cluster's
+    processes, running or idle."""
+    workers = {proc.pid for proc in cluster.processes if proc.poll() is None}
+    found = []
+    for pid in filter(str.isdigit, os.listdir("/proc")):
+        try:
+            cmd = Path(f"/proc/{pid}/cmdline").read_bytes()
+            parent = int(Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[1])
+        except (OSError, ValueError):
+            continue
+        if b"run_scene.py" in cmd and parent in workers:
+            found.append(int(pid))
+    return found
+
+
 def campaign_args(records, out, *extra):
     return ["campaign", "records", "--records", ",".join(map(str, records)), "--out", str(out),
             "--animations", "0", *extra]
@@ -174,6 +190,23 @@ def test_a_campaign_on_a_cluster_gives_the_local_run_ids_and_outcomes(tmp_path, 
     # resume by run id: nothing left to run
     assert cli.main(campaign_args(records, remote, "--scheduler", cluster.address)) == 0
     assert "2 already done, 0 to run" in capsys.readouterr().out
+
+
+@pytest.mark.yade
+def test_a_worker_runs_its_tasks_in_one_yade_process_and_keeps_none_after(tmp_path, cluster):
+    records = [pulse_npz(tmp_path / f"p{k}.npz", 20.0 * k, duration=2.0) for k in range(6)]
+    out = tmp_path / "camp"
+    assert cli.main(campaign_args(records, out, "--scheduler", cluster.address)) == 0
+    served = [int(line.split("process ")[1].split(",")[0])
+              for log in out.glob("runs/*/yade.log")
+              for line in log.read_text().splitlines()[:1]
+              if line.startswith("run_scene.py --serve: process ")]
+    assert len(served) == 6
+    assert len(set(served)) <= 2                     # two workers: one YADE process each
+    deadline = time.monotonic() + 5
+    while worker_yade_processes(cluster) and time.monotonic() < deadline:
+        time.sleep(0.05)
+    assert not worker_yade_processes(cluster), "idle YADE processes outlived the campaign"
 
 
 @pytest.mark.yade

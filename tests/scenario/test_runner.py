@@ -93,3 +93,29 @@ def test_a_threads_process_dies_with_its_thread(tmp_path):
         thread.start()
         thread.join()
         assert pids and gone(pids[0])                  # PR_SET_PDEATHSIG of its thread
+
+
+def test_a_kept_process_serves_the_next_block_and_ends_when_told_or_idle(tmp_path, monkeypatch):
+    """Dask tasks keep their thread's process (end=False); end_served_processes ends it,
+    and a process left alone ends itself after SERVE_IDLE_S without a scene."""
+    with runner.reuse_processes(end=False):
+        run_yade(scene(tmp_path / "a"))
+    first = runner._SERVED.proc.pid
+    with runner.reuse_processes(end=False):
+        run_yade(scene(tmp_path / "b"))
+    assert runner._SERVED.proc.pid == first and not gone(first, within_s=0.2)
+    log = (tmp_path / "b" / "yade.log").read_text()
+    assert f"process {first}, scene 2" in log                   # its second scene
+    assert os.readlink(f"/proc/{first}/cwd") == "/"             # holds no run directory
+    assert runner.end_served_processes() == 1 and gone(first)
+    assert not runner._RUNNING
+
+    monkeypatch.setattr(runner, "SERVE_IDLE_S", 2.0)
+    with runner.reuse_processes(end=False):
+        run_yade(scene(tmp_path / "c"))
+    idle = runner._SERVED.proc.pid
+    assert gone(idle, within_s=8.0)                             # no one told it: idle limit
+    with runner.reuse_processes(end=False):                     # the next scene: a new one
+        run_yade(scene(tmp_path / "d"))
+    assert runner._SERVED.proc.pid != idle
+    runner.end_served_processes()
