@@ -143,7 +143,7 @@ def _execute_threads(todo, runs_dir, jobs, worker, bar):
             finished, pending = wait(pending, timeout=0.5, return_when=FIRST_COMPLETED)
             for future in finished:
                 _finished(futures[future], future.exception(), runs_dir, failures, bar)
-    except KeyboardInterrupt:
+    except BaseException as exc:                   # Ctrl-C, or no room for error.txt
         for future in pending:
             future.cancel()
         pool.shutdown(wait=False, cancel_futures=True)
@@ -151,7 +151,9 @@ def _execute_threads(todo, runs_dir, jobs, worker, bar):
             kill_running()                         # starts YADE after the first kill
             wait(pending, timeout=0.05)
         pool.shutdown(wait=True)
-        return failures, True
+        if isinstance(exc, KeyboardInterrupt):
+            return failures, True
+        raise
     pool.shutdown(wait=True)
     return failures, False
 

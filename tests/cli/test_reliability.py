@@ -371,3 +371,38 @@ def test_sub_threshold_motion_is_not_simulated_and_says_so(tmp_path, capsys):
     summary = json.loads((tmp_path / "r" / "summary.json").read_text())
     assert summary["simulated"] is False
     assert not any(c["toppled"] for c in summary["columns"])
+
+
+@pytest.mark.parametrize("full", [("runs.csv",), ("summary.json",), ("summary.json", "error.txt")])
+def test_a_full_disk_gives_one_line_nothing_partial_and_resume_finishes(tmp_path, monkeypatch,
+                                                                        capsys, full):
+    """ENOSPC while writing the campaign's table, the runs' summaries, or those and their
+    error.txt: exit 1 with one line, no partial file, finished runs kept; once there is room,
+    the same command finishes the campaign."""
+    import errno
+    records = ",".join(str(write_motion_npz(tmp_path / f"weak{k}.npz", 30.0 * k, amplitude=0.2))
+                       for k in range(2))                   # sub-threshold: no YADE needed
+    args = ["campaign", "records", "--records", records, "--out", str(tmp_path / "camp"),
+            "--animations", "0"]
+    replace = os.replace
+
+    def disk_full(src, dst, *rest, **kwargs):
+        if Path(dst).name in full:
+            raise OSError(errno.ENOSPC, "No space left on device", str(dst))
+        return replace(src, dst, *rest, **kwargs)
+
+    monkeypatch.setattr(os, "replace", disk_full)
+    assert cli.main(args) == 1
+    err = [line for line in capsys.readouterr().err.splitlines()
+           if line.strip() and "run/s]" not in line and "failed:" not in line]   # bar, runs
+    assert len(err) == 1 and err[0].startswith("error: ")
+    assert ("disk full" in err[0]) != (full == ("summary.json",))   # else: runs failed
+    out = tmp_path / "camp"
+    assert not list(out.rglob("*.tmp")) and not list(out.rglob(".*.tmp"))
+    assert (out / "runs.csv").exists() == (full == ("summary.json",))
+    assert len(list(out.glob("runs/*/summary.json"))) == (2 if full == ("runs.csv",) else 0)
+    monkeypatch.setattr(os, "replace", replace)
+    assert cli.main(args) == 0
+    if full == ("runs.csv",):
+        assert "2 already done, 0 to run" in capsys.readouterr().out   # kept, not redone
+    assert len(list(out.glob("runs/*/summary.json"))) == 2 and (out / "runs.csv").exists()
