@@ -13,7 +13,6 @@ import pytest
 from obspy import Stream, Trace
 
 from pipeline import cli
-from pipeline.files import InputError
 from pipeline.motion import Motion
 from pipeline.motion.pulses import one_sine_pulse
 
