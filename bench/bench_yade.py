@@ -316,7 +316,7 @@ def parallel(work, n_runs, t_max, n_noop=40):
     ``t_max`` s each, YADE start-up included) through the campaign executor's Dask path,
     a LocalCluster of 1 and 2 single-threaded worker processes on 127.0.0.1
     (``jobs_1``, ``jobs_2``; each task carries its motion and returns the run's files,
-    trajectory included), the same runs with the thread executor for comparison
+    trajectory included; each worker runs its tasks in one YADE process), the same runs with the thread executor for comparison
     (``threads_jobs_N``: a fresh YADE process per run; ``threads_reused_jobs_N``: one per
     thread, as the campaign executor runs them), and Dask's overheads: the cluster's start-up until its workers
     have imported what a campaign's worker imports (``cluster_startup_s``, not in the
