@@ -44,7 +44,7 @@ def lines(fd, idle_s):
                 return
             buffer += chunk
         line, buffer = buffer.split(b"\n", 1)
-        yield line.decode()
+        yield os.fsdecode(line)
 
 
 def serve(control_fd, idle_s):

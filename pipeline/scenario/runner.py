@@ -205,7 +205,7 @@ def _run_served(run_dir, timeout_s):
 def _answer(proc, run_dir, timeout_s):
     """Send ``run_dir`` to the serving process ``proc``; the scene's exit code."""
     try:
-        proc.stdin.write(f"{run_dir}\n".encode())
+        proc.stdin.write(os.fsencode(run_dir) + b"\n")     # any bytes a path may hold
         proc.stdin.flush()
         ready, _, _ = select.select([proc.control], [], [], timeout_s)
         answer = proc.control.readline() if ready else None

@@ -55,6 +55,13 @@ def test_served_scenes_match_a_fresh_process_and_end_with_the_block(tmp_path):
     assert gone(pid) and not runner._RUNNING
 
 
+def test_a_served_scene_may_live_in_a_directory_of_any_name(tmp_path):
+    odd = tmp_path / "it's \"odd\" ; $(x) \u00f6 \udcff"     # quotes, shell, UTF-8, raw 0xff
+    with runner.reuse_processes():
+        served = run_yade(scene(odd))
+    assert same(served, run_yade(scene(tmp_path / "plain")))
+
+
 def test_a_failing_scene_leaves_the_next_one_unharmed(tmp_path):
     bad = scene(tmp_path / "bad")
     (bad / "scene.py").write_text("raise RuntimeError('a broken scene')\n")
