@@ -316,10 +316,10 @@ def parallel(work, n_runs, t_max, n_noop=40):
     ``t_max`` s each, YADE start-up included) through the campaign executor's Dask path,
     a LocalCluster of 1 and 2 single-threaded worker processes on 127.0.0.1
     (``jobs_1``, ``jobs_2``; each task carries its motion and returns the run's files,
-    trajectory included; each worker runs its tasks in one YADE process), the same runs with the thread executor for comparison
-    (``threads_jobs_N``: a fresh YADE process per run; ``threads_reused_jobs_N``: one per
-    thread, as the campaign executor runs them), and Dask's overheads: the cluster's start-up until its workers
-    have imported what a campaign's worker imports (``cluster_startup_s``, not in the
+    trajectory included; each worker runs its tasks in one YADE process), the same runs
+    with the thread executor for comparison (``threads_jobs_N``: a fresh YADE process per
+    run; ``threads_reused_jobs_N``: one per thread, as the campaign executor runs them),
+    and Dask's overheads: the cluster's start-up until its workers have imported what a campaign's worker imports (``cluster_startup_s``, not in the
     runs per minute), its closing (``cluster_close_s``) and the wall time per task of
     ``n_noop`` tasks that run no YADE on one worker (``task_overhead_ms``)."""
     import importlib

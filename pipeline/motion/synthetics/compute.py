@@ -1,4 +1,5 @@
 """pyprop8 synthetics at sites on rings around a source, written as processed motions."""
+import contextlib
 import importlib.metadata
 import json
 import math
@@ -211,15 +212,12 @@ def generate_sources(source_names, rings_km=(5, 10, 20), azimuth_step_deg=30, du
         progress = tqdm(total=len(tasks), desc="pyprop8 " + ", ".join(totals),
                         unit="sub-event")
         calls = [task for _, task in tasks]
-        if jobs > 1 and len(tasks) > 1:
-            with Pool(min(jobs, len(tasks))) as pool:
-                results = pool.imap(_point_source_task, calls)   # in order: reproducible sums
-                for (name, _), disp in zip(tasks, results):
-                    totals[name] = totals[name] + disp
-                    progress.update(1)
-        else:
-            for name, task in tasks:
-                totals[name] = totals[name] + _point_source_task(task)
+        parallel = jobs > 1 and len(tasks) > 1
+        with Pool(min(jobs, len(tasks))) if parallel else contextlib.nullcontext() as pool:
+            results = (pool.imap(_point_source_task, calls) if parallel    # in order:
+                       else map(_point_source_task, calls))                # reproducible sums
+            for (name, _), disp in zip(tasks, results):
+                totals[name] = totals[name] + disp
                 progress.update(1)
         progress.close()
         elapsed = time.monotonic() - started
