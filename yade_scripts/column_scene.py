@@ -333,6 +333,14 @@ BARRIERS = {col["name"]: col["overturning_barrier_j"] for col in COLUMNS if col[
 SETTLED_FRACTION = 0.9   # after the motion, energy below the barrier cannot tip a stack (10 % margin)
 
 
+STANDS_UP, LIES_UP = 0.866, 0.5   # z of a body's axis: stands (tilt < 30 deg), lies (> 60 deg)
+
+
+def up_axis(s, c):
+    """World direction (Vector3) of the axis of the body of clump ``c`` (state ``s``)."""
+    return s.ori * body_offset[c] * Vector3(0, 0, 1)
+
+
 def settled(rel):
     """True when, after the motion, every column is decided: all its bodies lie on the
     pedestal (tilt > 60 deg: their impacts are recorded, they may roll on), or all still
@@ -344,9 +352,9 @@ def settled(rel):
     for b, s, c in zip(bodies, states, clumps):
         if b["column"] not in BARRIERS:
             return False
-        up = (s.ori * body_offset[c] * Vector3(0, 0, 1))[2]
+        up = up_axis(s, c)[2]
         tilt.setdefault(b["column"], set()).add(
-            "stands" if up >= 0.866 else "lies" if up < 0.5 else "between")
+            "stands" if up >= STANDS_UP else "lies" if up < LIES_UP else "between")
         w = s.ori.conjugate() * s.angVel                               # clump frame
         energy[b["column"]] += (0.5 * b["mass"] * (s.vel - rel).squaredNorm()
                                 + 0.5 * sum(s.inertia[i] * w[i] ** 2 for i in range(3))
@@ -403,8 +411,8 @@ def check_stop():
         return
     at_rest, fallen, axes = True, {}, []
     for b, s, c in zip(bodies, states, clumps):
-        axis = s.ori * body_offset[c] * Vector3(0, 0, 1)
-        lying = axis[2] < 0.5
+        axis = up_axis(s, c)
+        lying = axis[2] < LIES_UP
         axes.append(None if lying else axis)
         fallen[b["column"]] = fallen.get(b["column"], False) or lying
         if not lying and ((s.vel - rel).norm() >= v_rest or s.angVel.norm() * length >= v_rest):
