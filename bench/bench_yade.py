@@ -14,13 +14,19 @@ One run prints, and writes to results/bench/bench.json (+ convergence.png):
 5. convergence: outcome against the time-step factor and the rim points (strong pulse);
 6. parallel: runs per minute with 1 and 2 YADE processes at once, and their ratio;
 7. quiet_motion: real records with the motion's quiet parts skipped and simulated,
-   simulated and wall seconds and outcomes side by side.
+   simulated and wall seconds and outcomes side by side;
+8. two_x: what the speed issue's 2x per simulated second would take, measured: the
+   shaking twin scene with the Python friction switch off (the C++ engines alone: the
+   most a C++ static/kinetic friction law could give), with the largest allowed
+   time-step factor, and both, side by side; and Housner's free-rocking check at both
+   time-step factors against its tolerance.
 
 Units: seconds (s), metres, m/s^2; azimuths in degrees clockwise from North.
 ``--quick`` shortens every run and skips the convergence table (for development).
 """
 import argparse
 import contextlib
+import dataclasses
 import json
 import os
 import sys
@@ -31,13 +37,14 @@ from pathlib import Path
 
 import numpy as np
 from scipy.integrate import cumulative_trapezoid
+from scipy.spatial.transform import Rotation
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))       # bench/mujoco_twin.py
 from pipeline import RESULTS_DIR  # noqa: E402
 from pipeline.files import save_figure, write_json  # noqa: E402
 from pipeline.motion import Motion  # noqa: E402
 from pipeline.motion.pulses import one_sine_pulse  # noqa: E402
-from pipeline.outcome.columns import column_outcomes, total_energy  # noqa: E402
+from pipeline.outcome.columns import column_outcomes, rotations, total_energy  # noqa: E402
 from pipeline.scenario import (Column, Contact, Numerics, run_yade, scene_params,  # noqa: E402
                                write_scenario)
 from pipeline.scenario.runner import reuse_processes  # noqa: E402
@@ -421,6 +428,66 @@ def quiet_motion(work, records=QUIET_RECORDS):
 
 
 # ---------------------------------------------------------------- printing
+# ---------------------------------------------------------------- 8. what 2x needs
+def largest_dt_factor():
+    """The largest time-step factor Numerics allows (its field's upper bound)."""
+    field = next(f for f in dataclasses.fields(Numerics) if f.name == "dt_factor")
+    return field.metadata["high"]
+
+
+TWO_X_DT_FACTOR = largest_dt_factor()
+STILL_COLUMN, STILL_S = "doric-peristyle", 0.5      # column file, simulated s
+STILL_ROTATION_DEG = 0.01   # tests/scenario/test_column_files.py: a still column stays put
+
+
+def two_x(work, shaking_s):
+    """The shaking twin scene of section 2 (``shaking_s`` simulated s, no early stop) with
+    the default numerics, without the friction switch (mu_s only: YADE's C++ engines
+    alone), at time-step factor TWO_X_DT_FACTOR, and both; speeds (simulated s per wall s
+    of the loop) and their ratio to the default.  Then, at the default factor and at
+    TWO_X_DT_FACTOR, the accuracy the tests ask for: Housner's free rocking (the
+    verification's marble block), largest relative errors of impact times and peaks against
+    the test's tolerance; and STILL_COLUMN (out of plumb on wedge joints) on a still pedestal
+    for STILL_S, the largest rotation of a body from where it was put (deg) against the
+    still-column test's STILL_ROTATION_DEG (as the test runs it: default early stop, from
+    the body's placement)."""
+    from pipeline.verification.checks import verify_housner
+    default_dt = Numerics().dt_factor
+    shaking = shaking_motion(shaking_s)
+    cases = {"default": {},
+             "no friction switch": {"friction": "static"},
+             f"dt factor {TWO_X_DT_FACTOR:g}": {"dt_factor": TWO_X_DT_FACTOR},
+             "both": {"friction": "static", "dt_factor": TWO_X_DT_FACTOR}}
+    rows = {}
+    for label, numerics in cases.items():
+        traj = run_timed(prepare(work / f"two_x_{len(rows)}", "both", shaking, shaking_s,
+                                 **numerics))
+        rows[label] = {"numerics": numerics, **rates(traj, 0.0)}
+    base = rows["default"]["sim_s_per_wall_s"]
+    for row in rows.values():
+        row["x_default"] = row["sim_s_per_wall_s"] / base
+    accuracy = []
+    for dt_factor in (default_dt, TWO_X_DT_FACTOR):
+        h = verify_housner(run_dir=work / f"two_x_housner_{dt_factor:g}", dt_factor=dt_factor)
+        run_dir = work / f"two_x_still_{dt_factor:g}"
+        params = scene_params(columns=Column("both", column_file=STILL_COLUMN).specs(),
+                              numerics=Numerics(dt_factor=dt_factor), motion_duration=0.0,
+                              t_max=STILL_S)
+        write_scenario(run_dir, params, None)
+        traj = run_yade(run_dir)
+        rotation = max(np.degrees((Rotation.from_matrix(body["initial_rotation"]).inv()
+                                   * rotations(traj.quat[:, j])).magnitude()).max()
+                       for j, body in enumerate(traj.bodies))
+        accuracy.append({"dt_factor": dt_factor, "housner_passed": h["passed"],
+                         "housner_tolerance": h["tolerance"],
+                         "max_rel_error_impact_times": h["max_rel_error_impact_times"],
+                         "max_rel_error_peaks": h["max_rel_error_peaks"],
+                         "still_rotation_deg": float(rotation)})
+    return {"shaking_s": shaking_s, "scenes": rows, "accuracy": accuracy,
+            "still_column": STILL_COLUMN, "still_s": STILL_S,
+            "still_rotation_limit_deg": STILL_ROTATION_DEG}
+
+
 def fmt(value, spec=".1f"):
     return "-" if value is None else format(value, spec)
 
@@ -545,6 +612,27 @@ def print_quiet(q):
           f"{q['wall_ratio']:.2f}")
 
 
+def print_two_x(t):
+    print(f"\n8. What 2x per simulated second takes: the shaking twin scene of section 2 "
+          f"({t['shaking_s']:g} s), side by side")
+    print(f"   {'numerics':<22}{'dt us':>7}{'us/step':>9}{'sim s/wall s':>13}{'x default':>10}"
+          f"{'CPU %':>7}")
+    for label, r in t["scenes"].items():
+        print(f"   {label:<22}{r['time_step_s'] * 1e6:7.0f}{r['us_per_step']:9.1f}"
+              f"{r['sim_s_per_wall_s']:13.2f}{r['x_default']:10.2f}{r['cpu_pct']:7.0f}")
+    print("   no friction switch: mu_s only, YADE's C++ engines alone (the most a C++ "
+          "static/kinetic friction law could give)")
+    for a in t["accuracy"]:
+        still_ok = a["still_rotation_deg"] < t["still_rotation_limit_deg"]
+        print(f"   dt factor {a['dt_factor']:g}: Housner free rocking, impact times within "
+              f"{100 * a['max_rel_error_impact_times']:.2f} %, peaks within "
+              f"{100 * a['max_rel_error_peaks']:.2f} % (tolerance "
+              f"{100 * a['housner_tolerance']:g} %): {'passed' if a['housner_passed'] else 'FAILED'}"
+              f"; {t['still_column']} on a still pedestal for {t['still_s']:g} s turns "
+              f"{a['still_rotation_deg']:.4f} deg (test: < {t['still_rotation_limit_deg']:g}): "
+              f"{'passed' if still_ok else 'FAILED'}")
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true",
@@ -589,6 +677,8 @@ def main(argv=None):
         result["quiet_motion"] = quiet_motion(work, QUIET_RECORDS[:1] if args.quick
                                               else QUIET_RECORDS)
         print_quiet(result["quiet_motion"])
+        result["two_x"] = two_x(work, shaking_s)
+        print_two_x(result["two_x"])
     result["bench_wall_s"] = time.perf_counter() - started
     write_json(args.out / "bench.json", result)
     print(f"\nbench: {result['bench_wall_s']:.0f} s wall; wrote {args.out / 'bench.json'}")
