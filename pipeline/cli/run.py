@@ -10,7 +10,7 @@ from pipeline.campaign.column_file import add_column_file_argument
 from pipeline.files import DirectoryLock, InputError
 from pipeline.records import processed_motion, resolve
 from pipeline.scenario import Column, Contact, Numerics
-from pipeline.scenario.parameters import add_arguments, from_args
+from pipeline.scenario.parameters import add_arguments, check_time_step, from_args
 from pipeline.simulate import back_azimuth_of, simulate
 
 NAME = "run"
@@ -68,6 +68,7 @@ def run(args):
     check_run_options(args)
     column = from_args(Column, args, centred=True if args.centred else None)
     contact, numerics = from_args(Contact, args), from_args(Numerics, args)
+    check_time_step(contact, numerics)
     out = args.out
     if out is None:
         out = RESULTS_DIR / "runs" / resolve(args.record).id

@@ -16,6 +16,14 @@ from pipeline.scenario.geometry import ColumnGeometry, ColumnSpec
 COLUMN_KINDS = ("both", "monolithic", "drums")
 RIM_SPHERE_RADIUS_M = 0.005   # rim contact spheres of the columns
 MIN_BODY_SIZE_M = 10 * RIM_SPHERE_RADIUS_M   # a drum must hold its two rims of spheres
+# An explicit step of a spring-dashpot of damping ratio zeta is stable for
+# dt omega <= 2 (sqrt(1 + zeta^2) - zeta); the scene's stiffest modes (drums rocking on
+# each other) are faster than sqrt(kn x rim points / m), so the allowed time-step factor
+# is a fraction of that bound.  Measured on the still twin model over 0.5 s: with
+# dt_factor / (sqrt(1 + zeta^2) - zeta) up to 0.72 no body turns by more than 0.05 deg;
+# from 0.81 on, at (dt_factor, zeta) = (0.5, 0.5) bodies turn 0.2 deg, (0.4, 0.8) 0.27 deg,
+# (0.4, 1.0) 9 deg, (0.5, 0.8) 10 deg, and at (0.5, 1.0) the column falls.
+STABLE_DT_FRACTION = 0.75
 
 
 def param(default, unit, help, low=None, high=None, flag=None, low_open=False, choices=None):
@@ -88,7 +96,8 @@ class Numerics:
                                  -360.0, 360.0)
     verlet_distance: float = param(0.02, "m", "collider bound enlargement", 0.0, 1.0)
     dt_factor: float = param(0.3, "", "time step as a fraction of sqrt(m_min / (kn x rim "
-                             "points)); converged up to 0.3 (make bench)", 0.0, 0.5,
+                             "points)); converged up to 0.3 (make bench); at most "
+                             f"{STABLE_DT_FRACTION:g} (sqrt(1 + damping^2) - damping)", 0.0, 0.5,
                              "--dt-factor", low_open=True)
     drive: str = param("inertial", "", "pedestal drive: gravity table (inertial) or per-step "
                        "velocity (kinematic, slow)", choices=("inertial", "kinematic"))
@@ -203,6 +212,20 @@ PEDESTAL = {"size": paper.PEDESTAL_SIZE_M, "thickness": paper.PEDESTAL_THICKNESS
             "contact_half_size": 12.0}
 
 
+def largest_stable_dt_factor(damping):
+    """Largest time-step factor that keeps contacts of this damping ratio stable."""
+    return STABLE_DT_FRACTION * (math.sqrt(1 + damping ** 2) - damping)
+
+
+def check_time_step(contact, numerics):
+    """InputError when the time-step factor is too coarse for the contact damping."""
+    limit = largest_stable_dt_factor(contact.damping)
+    if numerics.dt_factor > limit:
+        raise InputError(f"--dt-factor {numerics.dt_factor:g} with --damping "
+                         f"{contact.damping:g} is unstable (a still column rocks or falls): "
+                         f"at this damping use --dt-factor <= {math.floor(limit * 1e3) / 1e3:g}")
+
+
 def scene_params(columns=(), block=None, contact=None, numerics=None, motion_duration=0.0,
                  t_max=None):
     """The ``params.json`` content of a scene (JSON-serialisable dict).
@@ -214,6 +237,7 @@ def scene_params(columns=(), block=None, contact=None, numerics=None, motion_dur
     """
     contact = contact or Contact()
     numerics = numerics or Numerics()
+    check_time_step(contact, numerics)
     if not columns and block is None:
         raise InputError("a scene needs at least one column or a block")
     if t_max is None:

@@ -137,6 +137,8 @@ PARAMETER_CASES = {
     "rotate NaN": (["--rotate", "nan"], "--rotate"),
     "back azimuth 400": (["--back-azimuth", "400"], "--back-azimuth"),
     "back azimuth NaN": (["--back-azimuth", "nan"], "--back-azimuth"),
+    "time step too coarse for the damping": (["--dt-factor", "0.4", "--damping", "1"],
+                                             "--dt-factor"),
 }
 
 

@@ -8,6 +8,7 @@ import pytest
 from pipeline.files import InputError
 from pipeline.motion import Motion
 from pipeline.scenario import Column, Contact, Numerics, scene_params, write_scenario
+from pipeline.scenario.parameters import largest_stable_dt_factor
 from pipeline.scenario.writer import SCENE_TEMPLATE
 
 
@@ -32,6 +33,22 @@ def test_impossible_scene_parameters(cls, bad):
     message = str(info.value)
     assert "\n" not in message
     assert any(key in message or key.replace("_", "-") in message for key in bad)
+
+
+def test_time_step_factor_limited_by_the_contact_damping():
+    # 0.75 (sqrt(1 + zeta^2) - zeta): 0.75 undamped, 0.75 (sqrt(2) - 1) = 0.3107 critical,
+    # 0.75 (sqrt(1.1296) - 0.36) = 0.5271 at the paper's 0.36
+    assert largest_stable_dt_factor(0.0) == pytest.approx(0.75)
+    assert largest_stable_dt_factor(1.0) == pytest.approx(0.31066, abs=1e-5)
+    assert largest_stable_dt_factor(0.36) == pytest.approx(0.52711, abs=1e-5)
+    scene_params(columns=Column().specs(), contact=Contact(damping=1.0))     # default 0.3
+    scene_params(columns=Column().specs(), numerics=Numerics(dt_factor=0.5))  # damping 0.36
+    with pytest.raises(InputError) as info:
+        scene_params(columns=Column().specs(), contact=Contact(damping=1.0),
+                     numerics=Numerics(dt_factor=0.4))
+    message = str(info.value)
+    assert "\n" not in message and "--dt-factor 0.4" in message and "--damping 1" in message
+    assert "<= 0.31" in message
 
 
 def test_mu_k_follows_mu_s_unless_given():
