@@ -37,14 +37,14 @@ from pathlib import Path
 
 import numpy as np
 from scipy.integrate import cumulative_trapezoid
-from scipy.spatial.transform import Rotation
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))       # bench/mujoco_twin.py
 from pipeline import RESULTS_DIR  # noqa: E402
 from pipeline.files import InputError, save_figure, write_json  # noqa: E402
 from pipeline.motion import Motion  # noqa: E402
 from pipeline.motion.pulses import one_sine_pulse  # noqa: E402
-from pipeline.outcome.columns import column_outcomes, rotations, total_energy  # noqa: E402
+from pipeline.outcome.columns import (column_outcomes, rotation_from_start_deg,  # noqa: E402
+                                      total_energy)
 from pipeline.scenario import (Column, Contact, Numerics, run_yade, scene_params,  # noqa: E402
                                write_scenario)
 from pipeline.scenario.runner import reuse_processes  # noqa: E402
@@ -479,16 +479,13 @@ def two_x(work, shaking_s):
                               numerics=Numerics(dt_factor=dt_factor), motion_duration=0.0,
                               t_max=STILL_S)
         write_scenario(run_dir, params, None)
-        traj = run_yade(run_dir)
-        rotation = max(np.degrees((Rotation.from_matrix(body["initial_rotation"]).inv()
-                                   * rotations(traj.quat[:, j])).magnitude()).max()
-                       for j, body in enumerate(traj.bodies))
+        rotation = rotation_from_start_deg(run_yade(run_dir))
         accuracy.append({"dt_factor": dt_factor, "housner_passed": h["passed"],
                          "housner_refused": h.get("refused"),
                          "housner_tolerance": h["tolerance"],
                          "max_rel_error_impact_times": h["max_rel_error_impact_times"],
                          "max_rel_error_peaks": h["max_rel_error_peaks"],
-                         "still_rotation_deg": float(rotation)})
+                         "still_rotation_deg": rotation})
     return {"shaking_s": shaking_s, "scenes": rows, "accuracy": accuracy,
             "still_column": STILL_COLUMN, "still_s": STILL_S,
             "still_rotation_limit_deg": STILL_ROTATION_DEG}

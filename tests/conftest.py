@@ -58,6 +58,11 @@ def still_motion(n=101, dt=0.01):
     return Motion(dt, zeros, zeros, zeros, meta={"record_id": "still"})
 
 
+@pytest.fixture
+def make_still_motion():
+    return still_motion
+
+
 def make_runs_table(n=8):
     """A hand-made runs table: falls scattered around 60 deg, back azimuth 240 deg."""
     rng = np.random.default_rng(0)

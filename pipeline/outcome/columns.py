@@ -33,6 +33,14 @@ def rotations(quat):
     return Rotation.from_quat(np.asarray(quat, float).reshape(-1, 4)[:, [1, 2, 3, 0]])
 
 
+def rotation_from_start_deg(trajectory):
+    """Largest rotation (deg) of any body away from where it was placed (its
+    ``initial_rotation``) over the whole trajectory."""
+    return float(max(np.degrees((Rotation.from_matrix(body["initial_rotation"]).inv()
+                                 * rotations(trajectory.quat[:, j])).magnitude()).max()
+                     for j, body in enumerate(trajectory.bodies)))
+
+
 def body_rims(body):
     """Rims of a trajectory body in its frame about the centre of mass: dicts with role
     ("base" or "edge"), z, and kind "circle" (radius, centre) or "polygon" (vertices).

@@ -7,13 +7,12 @@ import math
 
 import numpy as np
 import pytest
-from scipy.spatial.transform import Rotation
 
 from pipeline import cli, paper, rocking
 from pipeline.constants import MODEL_GRAVITY as G
 from pipeline.motion import Motion
 from pipeline.motion.pulses import one_sine_pulse
-from pipeline.outcome.columns import body_axes, column_outcomes
+from pipeline.outcome.columns import body_axes, column_outcomes, rotation_from_start_deg
 from pipeline.scenario import (
     Column,
     ColumnGeometry,
@@ -104,16 +103,6 @@ def test_wide_capital_stack_rocks_at_its_statics_threshold_and_not_below(tmp_pat
     print(f"uplift ratio {ratio:.4f} (d/h {0.5 / 3.35:.4f}); max tilt {tilts} deg")
     assert tilts[0.8] < 0.05              # elastic contact compression only
     assert tilts[1.5] > 0.5
-
-
-def rotation_from_start_deg(traj):
-    """Largest rotation (deg) of any body away from its initial orientation."""
-    worst = 0.0
-    for j, body in enumerate(traj.bodies):
-        start = Rotation.from_matrix(np.array(body["initial_rotation"]))
-        now = Rotation.from_quat(traj.quat[:, j][:, [1, 2, 3, 0]])
-        worst = max(worst, np.degrees((start.inv() * now).magnitude()).max())
-    return worst
 
 
 @pytest.mark.parametrize("name", ["doric-peristyle", "roman-granite"])

@@ -11,7 +11,7 @@ import pytest
 from pipeline.constants import MODEL_GRAVITY as G
 from pipeline.motion import Motion
 from pipeline.motion.pulses import one_sine_pulse as pulse
-from pipeline.outcome.columns import column_outcomes, total_energy
+from pipeline.outcome.columns import column_outcomes, rotation_from_start_deg, total_energy
 from pipeline.scenario import Block, Column, Contact, Numerics, run_yade, scene_params, \
     write_scenario
 
@@ -129,25 +129,18 @@ def test_run_ends_when_one_column_lies_and_the_other_cannot_fall(tmp_path):
     assert energy[-1] - energy[0] < 0.9 * barrier
 
 
-def largest_turn_deg(trajectory):
-    """Largest rotation (deg) of any body away from its first sample."""
-    q = trajectory.quat                    # (samples, bodies, 4) w, x, y, z
-    dot = np.abs(np.einsum("tbi,bi->tb", q, q[0]))
-    return float(np.degrees(2 * np.arccos(np.clip(dot, 0.0, 1.0))).max())
-
-
-def test_time_step_limit_separates_a_still_column_from_an_unstable_one(tmp_path):
+def test_time_step_limit_separates_a_still_column_from_an_unstable_one(tmp_path,
+                                                                       make_still_motion):
     """At critical damping the largest allowed factor (0.3, limit 0.31) keeps the still
     twin model still; 0.4, refused by the parameters, is what the limit guards against:
     written by hand, it rocks the still column by degrees within 0.5 s."""
-    still = np.zeros((501, 3))                   # 0.5 s of a still pedestal: no early stop
-    motion = Motion(0.001, still, still, still, meta={"record_id": "still"})
+    motion = make_still_motion(501, 0.001)       # 0.5 s of a still pedestal: no early stop
     turns = {}
     for dt_factor in (0.3, 0.4):
         params = scene_params(columns=Column("both").specs(), contact=Contact(damping=1.0),
                               motion_duration=motion.duration, t_max=motion.duration)
         params["dt_factor"] = dt_factor          # past scene_params' check
         write_scenario(tmp_path / str(dt_factor), params, motion)
-        turns[dt_factor] = largest_turn_deg(run_yade(tmp_path / str(dt_factor)))
+        turns[dt_factor] = rotation_from_start_deg(run_yade(tmp_path / str(dt_factor)))
     assert turns[0.3] < 0.1, turns
     assert turns[0.4] > 1.0, turns
