@@ -16,6 +16,18 @@ from pipeline.motion.pulses import one_sine_pulse  # noqa: E402
 from pipeline.outcome import Trajectory  # noqa: E402
 
 
+def pytest_addoption(parser):
+    parser.addoption("--second-libm", action="store_true",
+                     help="YADE processes use glibc's other libm routines "
+                     "(pipeline.scenario.runner.SECOND_LIBM_TUNABLES): a second CPU's last bits")
+
+
+def pytest_configure(config):
+    if config.getoption("--second-libm"):
+        from pipeline.scenario.runner import SECOND_LIBM_TUNABLES
+        os.environ["GLIBC_TUNABLES"] = SECOND_LIBM_TUNABLES
+
+
 def lying_trajectory(azimuth_deg, n_drums=1, radius=0.29, height=3.5, fall_at=1.0):
     """Hand-built trajectory: a column standing at (1.5, 0) that lies flat toward
     azimuth_deg from fall_at on (bodies along the fall line, centres at height r)."""

@@ -16,6 +16,7 @@ from pipeline.records import catalog, catalog_row, processed_motion, resolve
 from pipeline.records.processing import signal_end_s
 from pipeline.scenario import Column, Contact, Numerics
 from pipeline.simulate import simulate
+from pipeline.stats.circular import direction_statistics
 
 
 NUMERICS_FIELDS = {f.name for f in dataclasses.fields(Numerics)}
@@ -97,7 +98,6 @@ def column_outputs(name, size_by=None):
     """Outputs of a column campaign: runs.csv, impacts.csv, direction statistics, figures."""
 
     def outputs(specs, campaign_dir, failures, animations, figures=True):
-        from pipeline.stats.circular import direction_statistics
         campaign_dir = Path(campaign_dir)
         runs, impacts = collect(specs, name, campaign_dir)
         described = summary_entry(specs)

@@ -7,8 +7,10 @@ import os
 from pathlib import Path
 
 import pandas as pd
+import pyarrow as pa
+import pyarrow.parquet  # noqa: F401  (pandas' to_parquet engine, loaded before any run)
 
-from pipeline.files import atomic_path
+from pipeline.files import atomic_path, write_csv
 from pipeline.motion import Motion
 from pipeline.motion.measures import record_parameters
 
@@ -25,7 +27,6 @@ def collect(specs, campaign, campaign_dir):
 
 def write_tables(campaign_dir, runs, impacts):
     """runs.csv, impacts.csv and their Parquet twins in ``campaign_dir``."""
-    from pipeline.files import write_csv
     campaign_dir = Path(campaign_dir)
     for name, frame in (("runs", runs), ("impacts", impacts)):
         write_csv(campaign_dir / f"{name}.csv", frame)
@@ -35,7 +36,6 @@ def write_tables(campaign_dir, runs, impacts):
 def write_parquet(path, frame):
     """Write a DataFrame atomically as Parquet (pyarrow, no index).  Object columns
     mixing types (a text value in one run, a number in another) are written as text."""
-    import pyarrow as pa
     frame = frame.copy()
     for column in frame.columns[frame.dtypes == object]:
         try:

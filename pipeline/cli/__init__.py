@@ -48,7 +48,8 @@ def main(argv=None):
         print(f"error: {exc}", file=sys.stderr)
         return 1
     except KeyboardInterrupt:
-        print("interrupted: finished results are kept", file=sys.stderr)
+        from pipeline.__main__ import INTERRUPTED
+        print(INTERRUPTED, file=sys.stderr)
         return 130
     except OSError as exc:
         what = "disk full" if exc.errno == errno.ENOSPC else exc.strerror or str(exc)

@@ -40,6 +40,11 @@ def setup(p):
     p.add_argument("--scale", type=float, default=1.0, help="scale the motion (default 1; 0-20)")
     p.add_argument("--centred", action="store_true",
                    help="put a single column at the pedestal centre (default for one column)")
+    p.add_argument("--processing", choices=("default", "none"), default="default",
+                   help="default: cut, offset, taper, 0.1-25 Hz band-pass, baseline "
+                   "(pipeline/records/processing.py); none: the file's acceleration as given "
+                   "(an already processed motion: synthetic, shake table, analytic pulse); "
+                   "recorded in summary.json")
     p.add_argument("--out", type=Path, default=None, metavar="DIR",
                    help="output directory (default results/runs/<record id>)")
 
@@ -74,7 +79,8 @@ def run(args):
         out = RESULTS_DIR / "runs" / resolve(args.record).id
     if out.exists() and not out.is_dir():
         raise InputError(f"--out {out} exists and is not a directory")
-    motion, _ = processed_motion(args.record, back_azimuth=args.back_azimuth, cache_dir=None)
+    motion, _ = processed_motion(args.record, back_azimuth=args.back_azimuth, cache_dir=None,
+                                 mode=args.processing)
     length = (args.window[1] - args.window[0]) if args.window else motion.duration
     if length > MAX_DURATION_S:
         raise InputError(f"the record lasts {motion.duration:.0f} s: give --window START END "

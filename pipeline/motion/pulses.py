@@ -37,3 +37,20 @@ def phased_sine_pulse(amplitude, omega, psi, dt=0.001, tail_s=4.0):
     return Motion(dt, np.column_stack([acc_e, zeros, zeros]), np.column_stack([vel_e, zeros, zeros]),
                   np.column_stack([disp_e, zeros, zeros]),
                   meta={"record_id": "sine_pulse", "has_vertical": False})
+
+
+def raw_pulse(kind="sine", amplitude=6.0, frequency=0.75, azimuth_deg=0.0, start_s=8.0,
+              duration=30.0, dt=0.01):
+    """Unprocessed 3-component acceleration (n, 3) m/s^2 East/North/Up of one cycle of a
+    one-sine (``kind`` "sine": Makris & Roussos 2000 type A, a forward fling leaving the
+    displacement amplitude / (2 pi frequency^2)) or one-cosine ("cosine": type B, ends at
+    rest) acceleration pulse along ``azimuth_deg``, starting ``start_s`` into a file of
+    ``duration`` s of zeros: what a file from a user holds, for the processing."""
+    if kind not in ("sine", "cosine"):
+        raise ValueError(f"kind must be 'sine' or 'cosine', got {kind!r}")
+    tau = np.arange(0.0, duration, dt) - start_s
+    on = (tau >= 0) & (tau <= 1.0 / frequency)
+    shape = np.sin if kind == "sine" else np.cos
+    acc = np.where(on, amplitude * shape(2 * math.pi * frequency * tau), 0.0)
+    u = np.array([math.sin(math.radians(azimuth_deg)), math.cos(math.radians(azimuth_deg)), 0.0])
+    return acc[:, None] * u

@@ -95,16 +95,20 @@ def _sanitise(stem):
     return text
 
 
-def processed_motion(record, back_azimuth=None, cache_dir=CACHE_DIR):
+def processed_motion(record, back_azimuth=None, cache_dir=CACHE_DIR, mode="default"):
     """The processed :class:`Motion` of ``record`` and the path of its cached npz.
 
     Cached in ``cache_dir/<key>.npz`` (``cache_dir`` None: not cached, path None).
     ``back_azimuth`` (deg) is used only when neither file nor catalogue gives one.
+    ``mode``: "default" (:data:`processing.DEFAULT_STEPS`) or "none" (the acceleration
+    as given, integrated: a motion that is already processed).  A processed npz is
+    always taken as it is.
     """
+    steps = processing.steps_for(mode)
     source = resolve(record)
     if source.processed:
         return Motion.load(source.path), source.path
-    key = source.key(back_azimuth)
+    key = source.key(back_azimuth, steps)
     path = None if cache_dir is None else Path(cache_dir) / f"{key}.npz"
     if path is not None and path.is_file():
         try:
@@ -113,7 +117,7 @@ def processed_motion(record, back_azimuth=None, cache_dir=CACHE_DIR):
                 return motion, path
         except InputError:
             pass
-    motion = build_motion(source, back_azimuth, key)
+    motion = build_motion(source, back_azimuth, key, mode)
     if path is not None:
         motion.save(path)
     return motion, path
@@ -133,15 +137,17 @@ def read_east_north_up(source):
     return enz, dt, info, needs_vertical
 
 
-def build_motion(source, back_azimuth=None, key=None):
-    """Read and process one :class:`Source`; return its :class:`Motion` (not written)."""
+def build_motion(source, back_azimuth=None, key=None, mode="default"):
+    """Read and process one :class:`Source` (``mode`` as in :func:`processed_motion`);
+    return its :class:`Motion` (not written)."""
     row = source.row or {}
     enz, dt, info, needs_vertical = read_east_north_up(source)
     band = (info.get("lowest_usable_hz"), info.get("highest_usable_hz"))
-    acc, vel, disp, steps = processing.process(enz, dt, band, name=source.path.name)
+    acc, vel, disp, steps = processing.process(enz, dt, band, processing.steps_for(mode),
+                                               name=source.path.name)
     meta = _motion_meta(source, row, info, back_azimuth, needs_vertical)
-    meta["processing"] = {"steps": steps, "input_hash": key, "reader": info.get("format"),
-                          "software": software_versions()}
+    meta["processing"] = {"mode": mode, "steps": steps, "input_hash": key,
+                          "reader": info.get("format"), "software": software_versions()}
     trims = [s["window_s"][0] for s in steps if s["step"] == "trim_to_signal"]
     meta["start_in_file_s"] = float(trims[0]) if trims else 0.0
     return Motion(dt, acc, vel, disp, meta=meta)

@@ -5,17 +5,25 @@ Like gmprocess, the processing is configuration: ``DEFAULT_STEPS`` lists
 :func:`step`.  Every step returns what it actually did (e.g. the band used),
 which becomes the motion's ``meta["processing"]["steps"]`` provenance.
 
-Default: cut the record to its signal window (0.1-99.5 % of the Arias
-intensity of a high-passed copy, plus 5 s each side; exact zeros at the file's
-ends count as no data), demean, linear detrend, zeros where the window reaches
-beyond the data, Hann taper of at most 2 s per end (inside the 5 s margins, so
-it never touches the strong motion), zero-phase
-4-pole Butterworth band-pass from max(0.1 Hz, the record's lowest usable
-frequency) to min(25 Hz, its highest usable frequency, 0.8 x Nyquist) on a
-zero-padded copy (1.5 x corners / freqmin seconds each side, Boore & Bommer
-2005), double integration and removal of a displacement baseline t^2..t^6
-(ending at rest) through its second derivative in the acceleration, so
-acceleration, velocity and displacement are trapezoidal integrals of each other.
+Default (the order of gmprocess and PEER: offsets out, taper, band-pass, then a
+baseline on the filtered record): cut the record to its signal window (0.1-99.5 % of
+the Arias intensity of a high-passed copy, plus a margin as long as the band-pass
+filter's transient, 1.5 x corners / freqmin: 60 s at 0.1 Hz; exact zeros at the file's
+ends count as no data); remove an offset and linear trend fitted to the quiet samples
+outside the Arias window (the pre-event mean of PEER, gmprocess's ``pre`` detrending;
+with less than 1 s of quiet data, the mean of all samples): a pulse's own nonzero
+mean is never taken for an offset; zeros where the window reaches beyond the data;
+Hann taper of at most 2 s per end (inside the margins, so it never touches the strong
+motion); zero-phase 4-pole Butterworth band-pass from max(0.1 Hz, the record's lowest
+usable frequency) to min(25 Hz, its highest usable frequency, 0.8 x Nyquist) on a
+zero-padded copy (1.5 x corners / freqmin seconds each side, Boore & Bommer 2005);
+double integration and removal of a displacement baseline t^2..t^6 (ending at rest)
+through its second derivative in the acceleration, so acceleration, velocity and
+displacement are trapezoidal integrals of each other.  Because the window holds the
+filter's whole transient, the band-passed displacement already returns to rest and
+the baseline is a small correction over minutes: a pulse keeps its band-passed
+acceleration and velocity, and a permanent displacement (fling) is removed only as
+far as the band-pass removes it (tests/records/test_pulses.py).
 
 No step's extent scales with the file's length: the same strong motion gives
 the same processed motion however much quiet time surrounds it in the file
@@ -29,17 +37,48 @@ from pipeline.files import InputError
 
 STEPS = {}
 
+BAND = {"freqmin_hz": 0.1, "freqmax_hz": 25.0, "nyquist_fraction": 0.8, "corners": 4}
+
+
+def filter_transient_s(freqmin_hz, corners):
+    """Length (s) of a Butterworth filter's transient (Boore & Bommer 2005): the zero pad
+    of the band-pass and the signal window's margin."""
+    return 1.5 * corners / freqmin_hz
+
+
 DEFAULT_STEPS = (
-    ("trim_to_signal", {"arias_fractions": (0.001, 0.995), "margin_s": 5.0,
+    ("trim_to_signal", {"arias_fractions": (0.001, 0.995),
+                        "margin_s": filter_transient_s(BAND["freqmin_hz"], BAND["corners"]),
                         "highpass_hz": 0.1}),
-    ("demean", {}),
-    ("detrend", {"type": "linear"}),
+    ("remove_offset", {"trend": "linear", "min_quiet_s": 1.0}),
     ("pad_to_window", {}),
     ("taper", {"max_percentage": 0.05, "max_length_s": 2.0, "type": "hann"}),
-    ("bandpass", {"freqmin_hz": 0.1, "freqmax_hz": 25.0, "nyquist_fraction": 0.8,
-                  "corners": 4, "pad": True}),
+    ("bandpass", {**BAND, "pad": True}),
     ("integrate_baseline", {"max_power": 6}),
 )
+
+
+# A motion that is already processed (a synthetic, a shake-table record, an analytic
+# pulse) runs as given: its acceleration untouched, velocity and displacement its
+# trapezoidal integrals.
+AS_GIVEN_STEPS = (("integrate", {}),)
+MODES = {"default": DEFAULT_STEPS, "none": AS_GIVEN_STEPS}   # --processing choices
+
+
+def steps_for(mode):
+    """The processing steps of a ``--processing`` mode ("default" or "none")."""
+    try:
+        return MODES[mode]
+    except KeyError:
+        raise InputError(f"--processing must be one of {', '.join(MODES)}, got {mode!r}") \
+            from None
+
+
+def processing_mode(meta):
+    """How a motion was processed, from its meta: "default", "none" (run as given), or
+    "none" too for a motion made processed (a synthetic, an analytic pulse)."""
+    recorded = meta.get("processing") or {}
+    return recorded.get("mode", "default" if recorded.get("steps") else "none")
 
 
 def step(func):
@@ -58,6 +97,7 @@ class Work:
         self.vel = self.disp = None
         self.start_s = 0.0          # time of the first sample in the original record
         self.pad = (0, 0)           # zero samples to add before and after (pad_to_window)
+        self.signal = (0, len(self.acc))   # samples of acc inside the Arias window
 
     def stream(self):
         return Stream([Trace(np.array(self.acc[:, i]), header={"delta": self.dt})
@@ -90,6 +130,7 @@ def trim_to_signal(work, arias_fractions=(0.001, 0.995), margin_s=5.0, highpass_
     i0, i1 = lo - margin, hi + margin + 1                  # may reach beyond the data
     work.pad = (max(0, first - i0), max(0, i1 - last))
     work.acc = work.acc[max(i0, first):min(i1, last)]
+    work.signal = (lo - max(i0, first), hi + 1 - max(i0, first))
     work.start_s = i0 * work.dt
     return {"window_s": [i0 * work.dt, (i1 - 1) * work.dt], "arias_fractions": list(arias_fractions),
             "margin_s": margin_s, "data_s": [max(i0, first) * work.dt, (min(i1, last) - 1) * work.dt]}
@@ -110,6 +151,27 @@ def pad_to_window(work):
     before, after = getattr(work, "pad", (0, 0))
     work.acc = np.pad(work.acc, ((before, after), (0, 0)))
     return {"zeros_before_s": before * work.dt, "zeros_after_s": after * work.dt}
+
+
+@step
+def remove_offset(work, trend="linear", min_quiet_s=1.0):
+    """Subtract an offset (``trend`` "mean") or offset and slope ("linear") fitted to the
+    quiet samples outside the Arias window of ``trim_to_signal``; with less than
+    ``min_quiet_s`` of them, the mean of all samples (zero for a whole pulse)."""
+    if trend not in ("mean", "linear"):
+        raise InputError(f"remove_offset: trend must be 'mean' or 'linear', got {trend!r}")
+    n = len(work.acc)
+    lo, hi = work.signal
+    quiet = np.r_[0:max(0, min(lo, n)), max(0, hi):n]
+    t = np.arange(n) * work.dt
+    if len(quiet) * work.dt < min_quiet_s:
+        work.acc = work.acc - work.acc.mean(axis=0)
+        return {"trend": "mean", "fitted_to": "all samples", "quiet_s": len(quiet) * work.dt}
+    design = np.column_stack([np.ones(len(quiet))] + ([t[quiet]] if trend == "linear" else []))
+    coeffs = np.linalg.lstsq(design, work.acc[quiet], rcond=None)[0]
+    full = np.column_stack([np.ones(n)] + ([t] if trend == "linear" else []))
+    work.acc = work.acc - full @ coeffs
+    return {"trend": trend, "fitted_to": "quiet samples", "quiet_s": len(quiet) * work.dt}
 
 
 @step
@@ -176,6 +238,14 @@ def integrate_baseline(work, max_power=6):
     work.vel = cumulative_trapezoid(work.acc, dx=dt, axis=0, initial=0.0)
     work.disp = cumulative_trapezoid(work.vel, dx=dt, axis=0, initial=0.0)
     return {"max_power": max_power, "fit_window_s": [0.0, dt * (len(work.acc) - 1)]}
+
+
+@step
+def integrate(work):
+    """Velocity and displacement as trapezoidal integrals of the acceleration as given."""
+    work.vel = cumulative_trapezoid(work.acc, dx=work.dt, axis=0, initial=0.0)
+    work.disp = cumulative_trapezoid(work.vel, dx=work.dt, axis=0, initial=0.0)
+    return {}
 
 
 def baseline_acceleration(disp, vel, dt, max_power=6):

@@ -17,13 +17,18 @@ COLUMN_KINDS = ("both", "monolithic", "drums")
 RIM_SPHERE_RADIUS_M = 0.005   # rim contact spheres of the columns
 MIN_BODY_SIZE_M = 10 * RIM_SPHERE_RADIUS_M   # a drum must hold its two rims of spheres
 # An explicit step of a spring-dashpot of damping ratio zeta is stable for
-# dt omega <= 2 (sqrt(1 + zeta^2) - zeta); the scene's stiffest modes (drums rocking on
-# each other) are faster than sqrt(kn x rim points / m), so the allowed time-step factor
-# is a fraction of that bound.  Measured on the still twin model over 0.5 s: with
-# dt_factor / (sqrt(1 + zeta^2) - zeta) up to 0.72 no body turns by more than 0.05 deg;
-# from 0.81 on, at (dt_factor, zeta) = (0.5, 0.5) bodies turn 0.2 deg, (0.4, 0.8) 0.27 deg,
-# (0.4, 1.0) 9 deg, (0.5, 0.8) 10 deg, and at (0.5, 1.0) the column falls.
+# dt omega <= 2 (sqrt(1 + zeta^2) - zeta).  The scene's fastest mode is not one body on
+# its rim springs (omega_n = sqrt(kn x rim points / m), the time step's unit) but the
+# drums of a stack rocking on each other: measured on the still twin model over 5 s
+# (make bench, section 9), the first factors that turn a body by degrees fit a mode of
+# MODE_FREQUENCY_RATIO omega_n with MODE_DAMPING_RATIO times the contact's damping ratio
+# (failures at zeta 0.2, 0.36, 0.5, 0.7, 1.0 from factors 0.45, 0.306, 0.24, 0.208, 0.166).
+# The allowed factor is STABLE_DT_FRACTION of that mode's bound: at least 1.28x below
+# every failure measured.
+MODE_FREQUENCY_RATIO = 3.0
+MODE_DAMPING_RATIO = 2.3
 STABLE_DT_FRACTION = 0.75
+CONVERGED_DT_FACTOR = 0.3     # outcomes converged up to this factor (make bench, section 5)
 
 
 def param(default, unit, help, low=None, high=None, flag=None, low_open=False, choices=None):
@@ -45,6 +50,8 @@ def check_fields(obj):
                                  f"got {value!r}")
             continue
         if meta.get("low") is None and meta.get("high") is None:
+            continue
+        if value is None and f.default is None:      # unset: decided where it is used
             continue
         if isinstance(value, bool) or not isinstance(value, (int, float)) or \
                 not math.isfinite(value):
@@ -95,10 +102,10 @@ class Numerics:
                                  "(ensembles sample it: discretisation becomes noise)",
                                  -360.0, 360.0)
     verlet_distance: float = param(0.02, "m", "collider bound enlargement", 0.0, 1.0)
-    dt_factor: float = param(0.3, "", "time step as a fraction of sqrt(m_min / (kn x rim "
-                             "points)); converged up to 0.3 (make bench); at most "
-                             f"{STABLE_DT_FRACTION:g} (sqrt(1 + damping^2) - damping)", 0.0, 0.5,
-                             "--dt-factor", low_open=True)
+    dt_factor: float = param(None, "", "time step as a fraction of sqrt(m_min / (kn x rim "
+                             "points)); default: the largest stable at the contact damping "
+                             f"(0.235 at the paper's 0.36), at most {CONVERGED_DT_FACTOR:g} "
+                             "(converged, make bench)", 0.0, 0.5, "--dt-factor", low_open=True)
     drive: str = param("inertial", "", "pedestal drive: gravity table (inertial) or per-step "
                        "velocity (kinematic, slow)", choices=("inertial", "kinematic"))
     drive_interval_s: float = param(0.002, "s", "gravity update interval", 0.0, 0.1,
@@ -214,13 +221,22 @@ PEDESTAL = {"size": paper.PEDESTAL_SIZE_M, "thickness": paper.PEDESTAL_THICKNESS
 
 def largest_stable_dt_factor(damping):
     """Largest time-step factor that keeps contacts of this damping ratio stable."""
-    return STABLE_DT_FRACTION * (math.sqrt(1 + damping ** 2) - damping)
+    zeta = MODE_DAMPING_RATIO * damping
+    return STABLE_DT_FRACTION * 2.0 * (math.sqrt(1 + zeta ** 2) - zeta) / MODE_FREQUENCY_RATIO
+
+
+def dt_factor_for(contact, numerics):
+    """The time-step factor a scene uses: the given one, else the largest stable at the
+    contact damping, at most CONVERGED_DT_FACTOR."""
+    if numerics.dt_factor is not None:
+        return numerics.dt_factor
+    return min(CONVERGED_DT_FACTOR, largest_stable_dt_factor(contact.damping))
 
 
 def check_time_step(contact, numerics):
     """InputError when the time-step factor is too coarse for the contact damping."""
     limit = largest_stable_dt_factor(contact.damping)
-    if numerics.dt_factor > limit:
+    if numerics.dt_factor is not None and numerics.dt_factor > limit:
         raise InputError(f"--dt-factor {numerics.dt_factor:g} with --damping "
                          f"{contact.damping:g} is unstable (a still column rocks or falls): "
                          f"at this damping use --dt-factor <= {math.floor(limit * 1e3) / 1e3:g}")
@@ -258,7 +274,8 @@ def scene_params(columns=(), block=None, contact=None, numerics=None, motion_dur
     return {"columns": [spec.scene(numerics.rim_points) for spec in specs],
             "block": None if block is None else dataclasses.asdict(block),
             "contact": dataclasses.asdict(contact), "pedestal": pedestal,
-            **dataclasses.asdict(numerics), "t_max": float(t_max),
+            **dataclasses.asdict(numerics), "dt_factor": dt_factor_for(contact, numerics),
+            "t_max": float(t_max),
             "motion_file": None, "output": "trajectory.npz"}
 
 

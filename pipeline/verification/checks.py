@@ -13,9 +13,11 @@ import numpy as np
 
 from pipeline import RESULTS_DIR, paper, rocking
 from pipeline.files import InputError
+from pipeline.motion import Motion
 from pipeline.motion.pulses import phased_sine_pulse
-from pipeline.outcome.columns import body_axes
-from pipeline.scenario import Block, Contact, Numerics, run_yade, scene_params, write_scenario
+from pipeline.outcome.columns import body_axes, rotation_from_start_deg
+from pipeline.scenario import (Block, Column, Contact, Numerics, run_yade, scene_params,
+                               write_scenario)
 from pipeline.scenario.parameters import split_options
 
 MARBLE_BLOCK = paper.MARBLE_BLOCK_M
@@ -196,3 +198,24 @@ def verify_sliding(mu_values=SLIDING_MU,
         and not any(r["pure_rocking"] for r in rows if r["mu_s"] <= 0.9 * mu_min)
         and any(r["mu_s"] <= 0.9 * mu_min for r in rows))
     return result
+
+
+STILL_MODELS = ("twin", "doric-peristyle")   # the paper's twin model; a column file on wedges
+
+
+def still_rotation_deg(run_dir, model, damping, dt_factor, seconds=5.0):
+    """Largest rotation (deg) of any body of ``model`` (one of STILL_MODELS) from where it
+    was placed, standing ``seconds`` on a still pedestal with contact ``damping`` and
+    time-step factor ``dt_factor`` (written past scene_params' stability check, so that
+    refused pairs can be measured too).  An unstable pair rocks the column by degrees."""
+    if model not in STILL_MODELS:
+        raise InputError(f"unknown still model {model!r} (known: {', '.join(STILL_MODELS)})")
+    column = Column("both") if model == "twin" else Column("both", column_file=model)
+    n = int(round(seconds / 0.01)) + 1
+    zeros = np.zeros((n, 3))
+    still = Motion(0.01, zeros, zeros, zeros, meta={"record_id": "still"})
+    params = scene_params(columns=column.specs(), contact=Contact(damping=damping),
+                          motion_duration=still.duration, t_max=still.duration)
+    params["dt_factor"] = dt_factor
+    write_scenario(run_dir, params, still)
+    return rotation_from_start_deg(run_yade(run_dir))

@@ -114,7 +114,9 @@ def test_miniseed_round_trip(tmp_path):
     out = tmp_path / "out"
     motion, motion_path = records.processed_motion(path, cache_dir=out)
     assert motion.acc.shape[1] == 3 and motion.dt == pytest.approx(0.01)
-    assert motion.duration < 30.0        # trimmed to the signal window (Gaussian envelope)
+    transient = records.processing.filter_transient_s(records.processing.BAND["freqmin_hz"],
+                                                      records.processing.BAND["corners"])
+    assert motion.duration < 30.0 + 2 * transient   # signal window and the filter's transient
     assert motion.meta["back_azimuth_deg"] is None
     assert motion.meta["has_vertical"] is True
     # cached: a second call does not rewrite; a given back azimuth is a new input

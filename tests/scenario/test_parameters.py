@@ -36,19 +36,23 @@ def test_impossible_scene_parameters(cls, bad):
 
 
 def test_time_step_factor_limited_by_the_contact_damping():
-    # 0.75 (sqrt(1 + zeta^2) - zeta): 0.75 undamped, 0.75 (sqrt(2) - 1) = 0.3107 critical,
-    # 0.75 (sqrt(1.1296) - 0.36) = 0.5271 at the paper's 0.36
-    assert largest_stable_dt_factor(0.0) == pytest.approx(0.75)
-    assert largest_stable_dt_factor(1.0) == pytest.approx(0.31066, abs=1e-5)
-    assert largest_stable_dt_factor(0.36) == pytest.approx(0.52711, abs=1e-5)
-    scene_params(columns=Column().specs(), contact=Contact(damping=1.0))     # default 0.3
-    scene_params(columns=Column().specs(), numerics=Numerics(dt_factor=0.5))  # damping 0.36
+    # 0.75 x 2 (sqrt(1 + (2.3 zeta)^2) - 2.3 zeta) / 3, by hand: 0.5 undamped,
+    # 0.5 (sqrt(6.29) - 2.3) = 0.10399 critical, 0.5 (sqrt(1.685584) - 0.828) = 0.23515
+    # at the paper's 0.36
+    assert largest_stable_dt_factor(0.0) == pytest.approx(0.5)
+    assert largest_stable_dt_factor(1.0) == pytest.approx(0.10399, abs=1e-5)
+    assert largest_stable_dt_factor(0.36) == pytest.approx(0.23515, abs=1e-5)
+    default = scene_params(columns=Column().specs(), contact=Contact(damping=1.0))
+    assert default["dt_factor"] == pytest.approx(0.10399, abs=1e-5)   # unset: the limit
+    assert scene_params(columns=Column().specs(),
+                        contact=Contact(damping=0.1))["dt_factor"] == 0.3   # converged cap
+    scene_params(columns=Column().specs(), numerics=Numerics(dt_factor=0.2))  # damping 0.36
     with pytest.raises(InputError) as info:
         scene_params(columns=Column().specs(), contact=Contact(damping=1.0),
-                     numerics=Numerics(dt_factor=0.4))
+                     numerics=Numerics(dt_factor=0.3))
     message = str(info.value)
-    assert "\n" not in message and "--dt-factor 0.4" in message and "--damping 1" in message
-    assert "<= 0.31" in message
+    assert "\n" not in message and "--dt-factor 0.3" in message and "--damping 1" in message
+    assert "<= 0.103" in message
 
 
 def test_mu_k_follows_mu_s_unless_given():

@@ -10,6 +10,7 @@ from pipeline import verification as verify
 pytestmark = pytest.mark.yade
 
 
+@pytest.mark.libm
 def test_free_rocking_matches_housner_within_two_percent(tmp_path):
     result = verify.verify_housner(theta0_ratio=0.5, run_dir=tmp_path / "h")
     assert len(result["yade"]["impact_times_s"]) == 5
@@ -27,6 +28,7 @@ def test_paper_damping_keeps_impact_times_and_restitution_close(tmp_path):
         1.01 * result["housner_restitution"]
 
 
+@pytest.mark.libm
 def test_sine_pulse_gives_the_three_modes_in_order(tmp_path):
     """Zhang & Makris (2000) at omega = 5p: overturning after one impact (away from the
     first push, East), a safe band, then overturning without impact (West)."""
