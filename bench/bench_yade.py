@@ -15,11 +15,14 @@ One run prints, and writes to results/bench/bench.json (+ convergence.png):
 6. parallel: runs per minute with 1 and 2 YADE processes at once, and their ratio;
 7. quiet_motion: real records with the motion's quiet parts skipped and simulated,
    simulated and wall seconds and outcomes side by side;
-8. two_x: what the speed issue's 2x per simulated second would take, measured: the
-   shaking twin scene with the Python friction switch off (the C++ engines alone: the
-   most a C++ static/kinetic friction law could give), with the largest allowed
-   time-step factor, and both, side by side; and Housner's free-rocking check at both
-   time-step factors against its tolerance.
+8. two_x: the shaking twin scene with the Python friction switch off (the C++ engines
+   alone: the most a C++ static/kinetic friction law could give) beside the default;
+   Housner's free-rocking check and a still column at the default numerics;
+9. time_step_limit: the table the time-step limit rests on: still twin model and still
+   Doric column for 5 s at the largest allowed factor and 1.3x it, several dampings,
+   on this machine's libm and on the second libm path;
+10. ctrl_c: seconds from Ctrl-C to the exit of a running campaign and of a command
+   interrupted during its start-up.
 
 Units: seconds (s), metres, m/s^2; azimuths in degrees clockwise from North.
 ``--quick`` shortens every run and skips the convergence table (for development).
@@ -39,7 +42,7 @@ import numpy as np
 from scipy.integrate import cumulative_trapezoid
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))       # bench/mujoco_twin.py
-from pipeline import RESULTS_DIR  # noqa: E402
+from pipeline import PROJECT_ROOT as PROJECT, RESULTS_DIR  # noqa: E402
 from pipeline.files import InputError, save_figure, write_json  # noqa: E402
 from pipeline.motion import Motion  # noqa: E402
 from pipeline.motion.pulses import one_sine_pulse  # noqa: E402
@@ -429,35 +432,23 @@ def quiet_motion(work, records=QUIET_RECORDS):
 
 # ---------------------------------------------------------------- printing
 # ---------------------------------------------------------------- 8. what 2x needs
-def largest_dt_factor():
-    """The largest time-step factor Numerics allows (its field's upper bound)."""
-    field = next(f for f in dataclasses.fields(Numerics) if f.name == "dt_factor")
-    return field.metadata["high"]
-
-
-TWO_X_DT_FACTOR = largest_dt_factor()
 STILL_COLUMN, STILL_S = "doric-peristyle", 0.5      # column file, simulated s
 STILL_ROTATION_DEG = 0.01   # tests/scenario/test_column_files.py: a still column stays put
 
 
 def two_x(work, shaking_s):
     """The shaking twin scene of section 2 (``shaking_s`` simulated s, no early stop) with
-    the default numerics, without the friction switch (mu_s only: YADE's C++ engines
-    alone), at time-step factor TWO_X_DT_FACTOR, and both; speeds (simulated s per wall s
-    of the loop) and their ratio to the default.  Then, at the default factor and at
-    TWO_X_DT_FACTOR, the accuracy the tests ask for: Housner's free rocking (the
-    verification's marble block), largest relative errors of impact times and peaks against
-    the test's tolerance; and STILL_COLUMN (out of plumb on wedge joints) on a still pedestal
-    for STILL_S, the largest rotation of a body from where it was put (deg) against the
-    still-column test's STILL_ROTATION_DEG (as the test runs it: default early stop, from
-    the body's placement)."""
+    the default numerics and without the friction switch (mu_s only: YADE's C++ engines
+    alone), speeds (simulated s per wall s of the loop) and their ratio.  A larger time
+    step is not a way to 2x: section 9 shows the stability limit of the time step.
+    Then, at the default numerics, the accuracy the tests ask for: Housner's free
+    rocking (the verification's marble block, critically damped contacts: the default
+    factor at that damping), and STILL_COLUMN on a still pedestal for STILL_S, the
+    largest rotation of a body from where it was put (deg) against the still-column
+    test's STILL_ROTATION_DEG."""
     from pipeline.verification.checks import verify_housner
-    default_dt = Numerics().dt_factor
     shaking = shaking_motion(shaking_s)
-    cases = {"default": {},
-             "no friction switch": {"friction": "static"},
-             f"dt factor {TWO_X_DT_FACTOR:g}": {"dt_factor": TWO_X_DT_FACTOR},
-             "both": {"friction": "static", "dt_factor": TWO_X_DT_FACTOR}}
+    cases = {"default": {}, "no friction switch": {"friction": "static"}}
     rows = {}
     for label, numerics in cases.items():
         traj = run_timed(prepare(work / f"two_x_{len(rows)}", "both", shaking, shaking_s,
@@ -466,29 +457,128 @@ def two_x(work, shaking_s):
     base = rows["default"]["sim_s_per_wall_s"]
     for row in rows.values():
         row["x_default"] = row["sim_s_per_wall_s"] / base
-    accuracy = []
-    for dt_factor in (default_dt, TWO_X_DT_FACTOR):
-        try:                          # Housner's impacts use critically damped contacts
-            h = verify_housner(run_dir=work / f"two_x_housner_{dt_factor:g}",
-                               dt_factor=dt_factor)
-        except InputError as exc:
-            h = {"passed": False, "refused": str(exc), "tolerance": None,
-                 "max_rel_error_impact_times": None, "max_rel_error_peaks": None}
-        run_dir = work / f"two_x_still_{dt_factor:g}"
-        params = scene_params(columns=Column("both", column_file=STILL_COLUMN).specs(),
-                              numerics=Numerics(dt_factor=dt_factor), motion_duration=0.0,
-                              t_max=STILL_S)
-        write_scenario(run_dir, params, None)
-        rotation = rotation_from_start_deg(run_yade(run_dir))
-        accuracy.append({"dt_factor": dt_factor, "housner_passed": h["passed"],
-                         "housner_refused": h.get("refused"),
-                         "housner_tolerance": h["tolerance"],
-                         "max_rel_error_impact_times": h["max_rel_error_impact_times"],
-                         "max_rel_error_peaks": h["max_rel_error_peaks"],
-                         "still_rotation_deg": rotation})
+    h = verify_housner(run_dir=work / "two_x_housner")
+    run_dir = work / "two_x_still"
+    params = scene_params(columns=Column("both", column_file=STILL_COLUMN).specs(),
+                          motion_duration=0.0, t_max=STILL_S)
+    write_scenario(run_dir, params, None)
+    accuracy = [{"dt_factor": params["dt_factor"], "housner_passed": h["passed"],
+                 "housner_refused": None, "housner_tolerance": h["tolerance"],
+                 "max_rel_error_impact_times": h["max_rel_error_impact_times"],
+                 "max_rel_error_peaks": h["max_rel_error_peaks"],
+                 "still_rotation_deg": rotation_from_start_deg(run_yade(run_dir))}]
     return {"shaking_s": shaking_s, "scenes": rows, "accuracy": accuracy,
             "still_column": STILL_COLUMN, "still_s": STILL_S,
             "still_rotation_limit_deg": STILL_ROTATION_DEG}
+
+
+# ---------------------------------------------------------------- 9. time-step limit
+STABILITY_DAMPINGS = (0.0, 0.2, 0.36, 0.5, 0.7, 1.0)
+STABILITY_RATIOS = (1.0, 1.3)       # factor / the allowed limit at that damping
+STABILITY_S = 5.0                   # simulated s on a still pedestal
+
+
+def time_step_limit(work, seconds):
+    """The table the time-step limit rests on: the still twin model and the still Doric
+    column (STILL_MODELS) held ``seconds`` on a still pedestal at each damping of
+    STABILITY_DAMPINGS, at the largest allowed factor and 1.3x it, on this machine's
+    libm and on the second libm path (SECOND_LIBM_TUNABLES); the largest rotation of a
+    body from where it was placed (deg).  Two runs at once (no speed is measured)."""
+    from pipeline.scenario.parameters import largest_stable_dt_factor
+    from pipeline.scenario.runner import SECOND_LIBM_TUNABLES
+    from pipeline.verification.checks import STILL_MODELS, still_rotation_deg
+    cases = [(z, r, m) for z in STABILITY_DAMPINGS for r in STABILITY_RATIOS
+             for m in STILL_MODELS]
+    rows = []
+    for path in ("native", "second"):
+        if path == "second":
+            os.environ["GLIBC_TUNABLES"] = SECOND_LIBM_TUNABLES
+        try:
+            def one(case):
+                zeta, ratio, model = case
+                factor = ratio * largest_stable_dt_factor(zeta)
+                rotation = still_rotation_deg(work / f"limit_{path}_{model}_{zeta}_{ratio}",
+                                              model, zeta, factor, seconds)
+                return {"libm": path, "damping": zeta, "ratio_to_limit": ratio,
+                        "dt_factor": factor, "model": model, "rotation_deg": rotation}
+            with ThreadPoolExecutor(max_workers=2) as pool:
+                rows += list(pool.map(one, cases))
+        finally:
+            os.environ.pop("GLIBC_TUNABLES", None)
+    return {"seconds": seconds, "rows": rows}
+
+
+def print_time_step_limit(t):
+    print(f"\n9. Time-step limit: largest body rotation (deg) over {t['seconds']:g} s on a still "
+          "pedestal, at the allowed factor (x1.0) and 1.3x it; native / second libm path")
+    models = sorted({r["model"] for r in t["rows"]})
+    head = "".join(f"{m + ' x' + format(k, 'g'):>30}" for m in models for k in STABILITY_RATIOS)
+    print(f"   {'damping':>8}{'factor':>8}{head}")
+    table = {(r["libm"], r["damping"], r["ratio_to_limit"], r["model"]): r for r in t["rows"]}
+    for zeta in sorted({r["damping"] for r in t["rows"]}):
+        factor = table[("native", zeta, 1.0, models[0])]["dt_factor"]
+        cells = "".join(
+            f"{table[('native', zeta, k, m)]['rotation_deg']:>15.4f}"
+            f"{table[('second', zeta, k, m)]['rotation_deg']:>15.4f}"
+            for m in models for k in STABILITY_RATIOS)
+        print(f"   {zeta:>8g}{factor:>8.3f}{cells}")
+
+
+# ---------------------------------------------------------------- 10. Ctrl-C
+def ctrl_c(work, trials=3):
+    """Seconds from Ctrl-C (SIGINT) to the exit of a 4-run records campaign (two YADE runs
+    going), and of a command interrupted 0.3 s into its start-up; exit status and the
+    last line it printed."""
+    import signal
+    import subprocess
+    from pipeline.motion.pulses import one_sine_pulse as pulse
+
+    def yade_running(under):
+        for pid in filter(str.isdigit, os.listdir("/proc")):
+            with contextlib.suppress(OSError):
+                if b"run_scene.py" in Path(f"/proc/{pid}/cmdline").read_bytes() and \
+                        os.readlink(f"/proc/{pid}/cwd").startswith(str(under)):
+                    return True
+        return False
+
+    def interrupt(out, args, when):
+        proc = subprocess.Popen([sys.executable, "-m", "pipeline", *args], cwd=PROJECT,
+                                stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        deadline = time.monotonic() + 60
+        while not when() and time.monotonic() < deadline:
+            time.sleep(0.02)
+        sent = time.monotonic()
+        proc.send_signal(signal.SIGINT)
+        _, err = proc.communicate(timeout=120)
+        lines = err.strip().splitlines()
+        return {"stop_s": time.monotonic() - sent, "exit": proc.returncode,
+                "last_line": lines[-1] if lines else ""}
+
+    records = []
+    for k in range(4):
+        m = pulse(45.0 * k, 5.0, duration=20.0)
+        path = work / f"ctrl_c_{k}.npz"
+        Motion(m.dt, m.acc, m.vel, m.disp, meta={"record_id": path.stem}).save(path)
+        records.append(str(path))
+    running = []
+    for trial in range(trials):
+        out = work / f"ctrl_c_campaign_{trial}"
+        running.append(interrupt(out, ["campaign", "records", "--records", ",".join(records),
+                                        "--out", str(out), "--jobs", "2", "--animations", "0"],
+                                 lambda out=out: yade_running(out)))
+    started = time.monotonic()
+    startup = interrupt(work / "ctrl_c_startup", ["campaign", "records", "--records", "GM20",
+                                                  "--out", str(work / "ctrl_c_startup")],
+                        lambda: time.monotonic() - started > 0.3)
+    return {"running": running, "startup": startup}
+
+
+def print_ctrl_c(c):
+    times = ", ".join(f"{r['stop_s']:.2f}" for r in c["running"])
+    print(f"\n10. Ctrl-C: a running 4-run campaign stops in {times} s (exit "
+          f"{sorted({r['exit'] for r in c['running']})}); 0.3 s into start-up: "
+          f"{c['startup']['stop_s']:.2f} s, exit {c['startup']['exit']}, "
+          f"last line {c['startup']['last_line']!r}")
 
 
 def fmt(value, spec=".1f"):
@@ -684,6 +774,10 @@ def main(argv=None):
         print_quiet(result["quiet_motion"])
         result["two_x"] = two_x(work, shaking_s)
         print_two_x(result["two_x"])
+        result["time_step_limit"] = time_step_limit(work, 1.0 if args.quick else STABILITY_S)
+        print_time_step_limit(result["time_step_limit"])
+        result["ctrl_c"] = ctrl_c(work, 1 if args.quick else 3)
+        print_ctrl_c(result["ctrl_c"])
     result["bench_wall_s"] = time.perf_counter() - started
     write_json(args.out / "bench.json", result)
     print(f"\nbench: {result['bench_wall_s']:.0f} s wall; wrote {args.out / 'bench.json'}")

@@ -7,7 +7,7 @@ from pipeline import RESULTS_DIR, files
 from pipeline.files import InputError
 from pipeline.motion import Motion
 from pipeline.motion.measures import record_parameters
-from pipeline.records import CACHE_DIR, build_motion, processed_motion, resolve, sets
+from pipeline.records import CACHE_DIR, build_motion, peer_check, processed_motion, resolve, sets
 
 NAME = "records"
 ORDER = 10
@@ -91,8 +91,25 @@ def run(args):
             plot_motion(motion, figure)
     table = parameters_table([(rid, motion) for rid, motion, _, _ in motions])
     _update_table(Path(out_dir) / "records.csv", table)
+    sources = {rid: spec for spec, (rid, _, _, _) in zip(specs, motions)}
+    peer = peer_check.peer_table([(rid, motion) for rid, motion, _, _ in motions],
+                                 lambda rid: processed_motion(sources[rid], cache_dir=None,
+                                                              mode="none")[0])
+    if not peer.empty:
+        _update_table(Path(out_dir) / "peer_check.csv", peer)
+        report_peer_check(pd.read_csv(Path(out_dir) / "peer_check.csv", dtype={"id": str}))
     print(f"wrote {len(motions)} records to {out_dir}", flush=True)
     return 0
+
+
+def report_peer_check(table):
+    """Print the PEER check's medians and worst cases (ours / PEER's, RotD50)."""
+    for label, stats in peer_check.summary(table).items():
+        for key, s in stats.items():
+            if key != "records":
+                print(f"PEER check, {label.replace('_', '-')} records, {key}: median "
+                      f"{s['median']:.3f}, worst {s['worst']:.3f} ({s['worst_id']}; "
+                      f"{s['records']} records)")
 
 
 def _motion(spec, source, back_azimuth, key, out_dir):

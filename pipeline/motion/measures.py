@@ -25,7 +25,8 @@ def record_parameters(motion):
     the displacement: ``disp_perp_ratio`` = peak displacement along
     ``az_max_disp_deg`` / peak perpendicular to it, and ``disp_pulses`` = number of
     half cycles along that azimuth exceeding half the peak.  Also
-    ``back_azimuth_deg``, ``epicentral_distance_km`` (None when unknown),
+    ``back_azimuth_deg``, ``epicentral_distance_km``, ``station_latitude``,
+    ``station_longitude``, ``event_latitude``, ``event_longitude`` (None when unknown),
     ``duration_s`` and ``dt_s``.
     """
     dt = motion.dt
@@ -50,6 +51,9 @@ def record_parameters(motion):
     meta = motion.meta
     params["back_azimuth_deg"] = meta.get("back_azimuth_deg")
     params["epicentral_distance_km"] = meta.get("epicentral_distance_km")
+    for column, key in (("station_latitude", "station_lat"), ("station_longitude", "station_lon"),
+                        ("event_latitude", "event_lat"), ("event_longitude", "event_lon")):
+        params[column] = meta.get(key)           # degrees, as records/catalog.csv names them
     params["duration_s"] = motion.duration
     params["dt_s"] = dt
     return params

@@ -146,6 +146,8 @@ def build_motion(source, back_azimuth=None, key=None, mode="default"):
     acc, vel, disp, steps = processing.process(enz, dt, band, processing.steps_for(mode),
                                                name=source.path.name)
     meta = _motion_meta(source, row, info, back_azimuth, needs_vertical)
+    if info.get("peer"):
+        meta["peer_reference"] = info["peer"]       # PEER's own peaks of this record
     meta["processing"] = {"mode": mode, "steps": steps, "input_hash": key,
                           "reader": info.get("format"), "software": software_versions()}
     trims = [s["window_s"][0] for s in steps if s["step"] == "trim_to_signal"]

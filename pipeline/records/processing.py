@@ -136,12 +136,16 @@ def trim_to_signal(work, arias_fractions=(0.001, 0.995), margin_s=5.0, highpass_
             "margin_s": margin_s, "data_s": [max(i0, first) * work.dt, (min(i1, last) - 1) * work.dt]}
 
 
+SIGNAL_END_MARGIN_S = 5.0   # quiet simulated after a ready-made motion's signal (s)
+
+
 def signal_end_s(acc, dt):
-    """End (s) of the signal window a record is cut to (``trim_to_signal`` with the
-    default steps' Arias fraction and margin), at most the last sample: for motions that
-    do not pass through the processing, e.g. synthetics."""
+    """End (s) of the signal window of a motion that does not pass through the
+    processing (a synthetic): ``trim_to_signal`` with the default steps' Arias fractions
+    and SIGNAL_END_MARGIN_S (no filter transient to hold), at most the last sample."""
     work = Work(acc, dt)
-    window = trim_to_signal(work, **dict(DEFAULT_STEPS)["trim_to_signal"])["window_s"]
+    trim = dict(DEFAULT_STEPS)["trim_to_signal"]
+    window = trim_to_signal(work, **{**trim, "margin_s": SIGNAL_END_MARGIN_S})["window_s"]
     return min(window[1], dt * (len(acc) - 1))
 
 

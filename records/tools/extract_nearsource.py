@@ -36,6 +36,9 @@ What it writes:
   rjb_km, rrup_km           ``RJB(km)``, ``RRUP(km)``
   lowest_usable_hz          ``LOWFREQ(Hz)`` = NGA lowest usable frequency of the average
                             horizontal component (1.25 x the larger HP corner)
+  pga_g, pgv_cm_s, pgd_cm   ``PGA(g)``, ``PGV(cm/sec)``, ``PGD(cm)``: PEER's own peak values
+                            of its processed record (NGA-West2 flatfile: RotD50 of the
+                            two horizontals), for the processing check
   file_name_h1/_h2/_v       ``FILE_NAME_H1``/``_H2``/``_V`` (PEER file names)
   h1_azimuth_deg,           ``H1 azimth (degrees)``, ``H2 azimith (degrees)`` of
   h2_azimuth_deg            nga_w2_selected.csv; where that file has no row, the three
@@ -117,7 +120,7 @@ FLAT_COLUMNS = ["rsn", "event", "year", "magnitude", "magnitude_type", "mechanis
                 "hypocentral_distance_km", "rjb_km", "rrup_km", "lowest_usable_hz",
                 "lowest_usable_h1_hz", "lowest_usable_h2_hz", "h1_azimuth_deg", "h2_azimuth_deg",
                 "azimuth_source", "hp_h1_hz", "hp_h2_hz", "lp_h1_hz", "lp_h2_hz",
-                "file_name_h1", "file_name_h2", "file_name_v"]
+                "pga_g", "pgv_cm_s", "pgd_cm", "file_name_h1", "file_name_h2", "file_name_v"]
 CATALOG_COLUMNS = ["id", "label", "source_file", "format", "event", "date", "magnitude",
                    "mechanism", "station", "station_latitude", "station_longitude",
                    "event_latitude", "event_longitude", "epicentral_distance_km",
@@ -214,6 +217,7 @@ def flatfile_rows(shared, rsns):
                "epicentral_distance_km": f["EPICENTER_DEPTH(km)"],
                "hypocentral_distance_km": f["HYPOCENTER_DEPTH(km)"], "rjb_km": f["RJB(km)"],
                "rrup_km": f["RRUP(km)"], "lowest_usable_hz": f["LOWFREQ(Hz)"],
+               "pga_g": f["PGA(g)"], "pgv_cm_s": f["PGV(cm/sec)"], "pgd_cm": f["PGD(cm)"],
                "file_name_h1": f["FILE_NAME_H1"], "file_name_h2": f["FILE_NAME_H2"],
                "file_name_v": f["FILE_NAME_V"]}
         s = selected.get(rsn)

@@ -305,17 +305,34 @@ def resume_completes(records, out):
 
 
 @pytest.mark.yade
-def test_ctrl_c_stops_a_campaign_within_two_seconds_and_resume_completes(tmp_path):
+def test_ctrl_c_stops_a_campaign_and_resume_completes(tmp_path):
+    """Ctrl-C ends a running campaign (a bound that catches a hang, not a speed: make
+    bench, section 10, measures the time)."""
     records, out, proc = start_campaign_and_wait_for_yade(tmp_path)
     sent = time.monotonic()
     proc.send_signal(signal.SIGINT)
-    proc.communicate(timeout=30)
-    assert time.monotonic() - sent < 2.0
+    _, err = proc.communicate(timeout=60)
+    assert time.monotonic() - sent < 30.0
+    assert err.strip().splitlines()[-1] == "interrupted: finished results are kept"
     assert proc.returncode == 130
     assert (out / "runs.csv").exists()
     assert not yade_processes(out)
     assert json.loads((out / "campaign.json").read_text())["interrupted"] is True
     resume_completes(records, out)
+
+
+@pytest.mark.parametrize("delay_s", [0.2, 0.6])
+def test_ctrl_c_during_start_up_exits_130_with_one_line(tmp_path, delay_s):
+    """Ctrl-C while the command is still importing its modules: the same one line and
+    exit status 130 as later, no traceback, nothing written."""
+    out = tmp_path / "camp"
+    proc = cli_process("campaign", "records", "--records", "GM20", "--out", str(out))
+    time.sleep(delay_s)
+    proc.send_signal(signal.SIGINT)
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == 130, err
+    assert err.strip().splitlines() == ["interrupted: finished results are kept"]
+    assert "Traceback" not in err
 
 
 @pytest.mark.yade

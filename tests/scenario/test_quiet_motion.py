@@ -140,7 +140,7 @@ def test_a_rocking_column_is_not_stopped_by_the_quiet_tail(tmp_path):
 
 
 def test_ready_made_motion_is_cut_at_its_signal_end_like_a_record(tmp_path):
-    """A 2 s burst at 5 s in 30 s of quiet: the window ends 5 s (the processing's margin)
+    """A 2 s burst at 5 s in 30 s of quiet: the window ends 5 s (SIGNAL_END_MARGIN_S)
     after the burst's 99.5 % Arias point, whatever quiet follows; records are cut by
     their processing instead."""
     from pipeline.campaign.definitions import signal_window

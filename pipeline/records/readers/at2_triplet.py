@@ -309,6 +309,11 @@ def _row_info(row):
         info["event"] = row["event"]
     if row.get("mechanism"):
         info["mechanism"] = row["mechanism"]
+    if value("pga_g") is not None and value("pgv_cm_s") is not None:
+        info["peer"] = {"measure": "RotD50", "source": "NGA-West2 flatfile",
+                        "rsn": int(value("rsn")) if value("rsn") else None,
+                        "pga_ms2": value("pga_g") * STANDARD_GRAVITY,
+                        "pgv_ms": value("pgv_cm_s") / 100.0, "pulse_like": None}
     return info
 
 

