@@ -17,6 +17,16 @@ from pipeline.records.processing import processing_mode
 from pipeline.scenario import Column, Contact, Numerics, run_yade, scene_params, write_scenario
 
 
+MAX_SCALE = 20.0        # the largest motion scale factor (run --scale, ensemble --vary scale)
+
+
+def check_scale(value, flag="--scale"):
+    """InputError unless 0 <= value <= MAX_SCALE (finite)."""
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or \
+            not (math.isfinite(value) and 0.0 <= value <= MAX_SCALE):
+        raise InputError(f"{flag} {value!r} outside the allowed range [0, {MAX_SCALE:g}]")
+
+
 def drive_motion(motion, window=None, rotate_deg=0.0, scale=1.0):
     """The pedestal's motion: ``motion`` cut to ``window`` = (start_s, end_s), turned
     clockwise by ``rotate_deg`` and scaled by ``scale``."""

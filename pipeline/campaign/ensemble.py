@@ -50,6 +50,9 @@ from pipeline.campaign.column_file import description as column_file_description
 from pipeline.campaign.definitions import column_specs, run_code_version, run_column_spec
 from pipeline.campaign.tables import collect, write_parquet
 from pipeline.files import InputError, write_csv, write_json
+from pipeline.scenario import Contact, Numerics
+from pipeline.scenario.parameters import check_time_step
+from pipeline.simulate import check_scale
 
 DEFAULT_MEMBERS = 16
 KEPT_TRAJECTORIES = 2          # the nominal run and the first members keep trajectory.npz
@@ -66,6 +69,41 @@ ENSEMBLE_RANGES = {            # name: (low, high, "uniform" | "log")
     "drum_offset_mm": (0.0, 3.0, "uniform"),
 }
 GEOMETRY_KEYS = ("tilt_deg", "tilt_azimuth_deg", "drum_offset_mm")
+# what --vary may ask of the parameters without a home of their own (the others are
+# checked by their dataclass: Contact, Numerics; scale by simulate.check_scale)
+VARY_LIMITS = {"kn_factor": (0.01, 100.0), "height_tolerance": (-0.2, 0.2),
+               "diameter_tolerance": (-0.2, 0.2), "tilt_deg": (0.0, 10.0),
+               "tilt_azimuth_deg": (0.0, 360.0), "drum_offset_mm": (0.0, 50.0)}
+
+
+def check_seed(seed):
+    """InputError unless the Latin-hypercube seed is a non-negative integer (--seed)."""
+    if seed is not None and (isinstance(seed, bool) or not isinstance(seed, int)
+                             or not 0 <= seed < 2 ** 63):
+        raise InputError(f"--seed must be an integer in [0, 2^63), got {seed!r}")
+    return seed
+
+
+def check_vary_value(name, value):
+    """InputError when ``value`` of --vary parameter ``name`` is outside what a run of
+    that parameter allows (the same check as its flag)."""
+    flag = f"--vary {name}="
+    if name == "scale":
+        check_scale(value, flag.rstrip("="))
+    elif name in ("mu_s", "damping"):
+        try:
+            check_time_step(Contact(**{name: value}), Numerics())
+        except InputError as exc:
+            raise InputError(f"{flag}: {exc}") from None
+    elif name == "rim_phase_deg":
+        try:
+            Numerics(rim_phase_deg=value)
+        except InputError as exc:
+            raise InputError(f"{flag}: {exc}") from None
+    else:
+        lo, hi = VARY_LIMITS[name]
+        if not lo <= value <= hi:
+            raise InputError(f"{flag}{value:g} outside the allowed range [{lo:g}, {hi:g}]")
 
 
 def sample_members(members, seed, ranges=None, column="both", mu_k_ratio=paper.MU_K_OVER_MU_S,
@@ -284,6 +322,10 @@ def parse_vary(items):
                              f"{', '.join(ENSEMBLE_RANGES)}, scale)")
         if not (math.isfinite(lo) and math.isfinite(hi) and lo <= hi):
             raise InputError(f"--vary {item!r}: need finite LO <= HI")
+        if name in ranges:
+            raise InputError(f"--vary {name} given twice")
+        check_vary_value(name, lo)
+        check_vary_value(name, hi)
         kind = ENSEMBLE_RANGES.get(name, (0, 0, "uniform"))[2]
         if kind == "log" and lo <= 0:
             raise InputError(f"--vary {item!r}: {name} is sampled log-uniformly: LO > 0")
@@ -293,7 +335,8 @@ def parse_vary(items):
 
 def read_options(args):
     return {"record": args.record, "column": args.column, "members": args.members,
-            "seed": args.seed, "vary": parse_vary(args.vary), **read_campaign_options(args)}
+            "seed": check_seed(args.seed), "vary": parse_vary(args.vary),
+            **read_campaign_options(args)}
 
 
 register(Campaign("ensemble", "N members with sampled friction, damping, stiffness, "

@@ -462,7 +462,8 @@ def fragility_options(parser):
 
 def read_options(args):
     return {"levels": parse_levels(args.levels), "members": args.members,
-            "column": args.column, "seed": args.seed, "azimuths": args.azimuths,
+            "column": args.column, "seed": ensemble.check_seed(args.seed),
+            "azimuths": args.azimuths,
             **read_campaign_options(args)}
 
 

@@ -36,8 +36,25 @@ def build_parser():
     return parser
 
 
+def empty_path_option(argv):
+    """The first option given an empty value (``--out ''``), or None: an empty path would
+    mean the current directory."""
+    argv = list(sys.argv[1:] if argv is None else argv)
+    for k, arg in enumerate(argv):
+        if arg.startswith("--") and "=" in arg and arg.split("=", 1)[1] == "":
+            return arg.split("=", 1)[0]
+        if arg.startswith("--") and k + 1 < len(argv) and argv[k + 1] == "":
+            return arg
+    return None
+
+
 def main(argv=None):
     parser = build_parser()
+    empty = empty_path_option(argv)
+    if empty:
+        print(f"error: {empty} is empty (give a path; '.' for the current directory)",
+              file=sys.stderr)
+        return 2
     args = parser.parse_args(argv)
     try:
         return int(args.func(args) or 0)

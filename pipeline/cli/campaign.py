@@ -46,6 +46,10 @@ def setup(p):
 
 def run(args):
     records = [r for r in args.records.split(",") if r] if args.records else None
+    repeated = sorted({r for r in records or [] if records.count(r) > 1})
+    if repeated:
+        raise InputError(f"--records names {', '.join(repeated)} more than once: a record is "
+                         "run and counted once")
     record_set = getattr(args, "record_set", None)
     if record_set:
         if records:

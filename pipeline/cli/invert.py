@@ -145,6 +145,7 @@ CANDIDATE_PRESETS = {"quick": {"radius_km": 12.0, "step_km": 1.0, "strike_step_d
 def build_grids(args):
     """(preset name, TableGrid, CandidateGrid) from the options; InputError if impossible."""
     from pipeline.inversion.forward import GRIDS, parse_mechanisms
+    from pipeline.campaign.ensemble import check_seed
     from pipeline.inversion.posterior import CandidateGrid
     if args.quick and args.grid not in (None, "quick"):
         raise InputError("--quick is --grid quick: give one of them")
@@ -157,7 +158,8 @@ def build_grids(args):
     grid = GRIDS[preset].replace(
         mechanisms=mechanisms, depths_km=depths, magnitudes=magnitudes,
         distances_km=distances, azimuth_step_deg=args.azimuth_step,
-        members=args.members, seed=args.seed, fmax_hz=args.fmax, duration_s=args.duration)
+        members=args.members, seed=check_seed(args.seed), fmax_hz=args.fmax,
+        duration_s=args.duration)
     values = dict(CANDIDATE_PRESETS[preset])
     for key, option in (("radius_km", args.radius), ("step_km", args.step),
                         ("strike_step_deg", args.strike_step)):
@@ -224,6 +226,8 @@ def run(args):
         raise InputError("give an OBSERVATIONS.json file or --demo (not both)")
     if args.trials is not None and not (args.demo and 1 <= args.trials <= 1000):
         raise InputError("--trials (1-1000) goes with --demo")
+    from pipeline.inversion.likelihood import check_model_options
+    check_model_options(args.kernel_deg, args.floor, getattr(args, "likelihood", "independent"))
     _check_jobs(args.jobs)
     preset, grid, candidates = build_grids(args)
     if args.demo:
@@ -290,7 +294,7 @@ def _run_demo(args, preset, grid, candidates):
         paper_tables[source], cost = run_forward(pgrid, args.forward_dir,
                                                  _check_jobs(args.jobs), args.scheduler)
         costs[f"paper_{source}"] = {**cost, "grid": pgrid.as_dict()}
-    summary = run_demo(table, out, candidates, paper_tables, args.trials or DEFAULT_TRIALS,
+    summary = run_demo(table, out, candidates, paper_tables, DEFAULT_TRIALS if args.trials is None else args.trials,
                        args.kernel_deg, args.floor, forward_info={**info, "costs": costs,
                                                                   "preset": preset})
     example = EXAMPLES_DIR / "two_sites.json"

@@ -11,7 +11,7 @@ from pipeline.files import DirectoryLock, InputError
 from pipeline.records import processed_motion, resolve
 from pipeline.scenario import Column, Contact, Numerics
 from pipeline.scenario.parameters import add_arguments, check_time_step, from_args
-from pipeline.simulate import back_azimuth_of, simulate
+from pipeline.simulate import MAX_SCALE, back_azimuth_of, check_scale, simulate
 
 NAME = "run"
 ORDER = 20
@@ -37,7 +37,8 @@ def setup(p):
                    f"{MAX_DURATION_S:g} s")
     p.add_argument("--rotate", type=float, default=0.0, metavar="DEG",
                    help="turn the horizontal motion clockwise by DEG")
-    p.add_argument("--scale", type=float, default=1.0, help="scale the motion (default 1; 0-20)")
+    p.add_argument("--scale", type=float, default=1.0,
+                   help=f"scale the motion (default 1; 0-{MAX_SCALE:g})")
     p.add_argument("--centred", action="store_true",
                    help="put a single column at the pedestal centre (default for one column)")
     p.add_argument("--processing", choices=("default", "none"), default="default",
@@ -55,8 +56,7 @@ def check_run_options(args):
         back_azimuth_of(None, args.back_azimuth)
     if not math.isfinite(args.rotate):
         raise InputError(f"--rotate must be a finite angle, got {args.rotate}")
-    if not (math.isfinite(args.scale) and 0.0 <= args.scale <= 20.0):
-        raise InputError(f"--scale {args.scale:g} outside the allowed range [0, 20]")
+    check_scale(args.scale)
     if getattr(args, "column_file", None) is not None:
         given = [flag for flag, name in (("--hd", "hd"), ("--height", "height"),
                                          ("--drums", "n_drums"), ("--density", "density"))

@@ -59,7 +59,8 @@ def run_inversion(observations, out_dir, table, candidates, kernel_deg=None, flo
     from pipeline.inversion.likelihood import DEFAULT_FLOOR, DEFAULT_KERNEL_DEG, ForwardModel
     from pipeline.inversion.posterior import invert
     started = time.monotonic()
-    model = ForwardModel(table, kernel_deg or DEFAULT_KERNEL_DEG, floor or DEFAULT_FLOOR,
+    model = ForwardModel(table, DEFAULT_KERNEL_DEG if kernel_deg is None else kernel_deg,
+                         DEFAULT_FLOOR if floor is None else floor,
                          likelihood)
     post = invert(model, observations, candidates)
     with DirectoryLock(out_dir, wait=False):

@@ -82,19 +82,24 @@ def p_toppled(k, n):
     return (np.asarray(k, float) + 0.5) / (np.asarray(n, float) + 1.0)
 
 
+def check_model_options(kernel_deg, floor, likelihood):
+    """InputError unless the likelihood's options are in range (called before any work)."""
+    if likelihood not in LIKELIHOODS:
+        raise InputError(f"--likelihood must be one of {', '.join(LIKELIHOODS)}, got "
+                         f"{likelihood!r}")
+    if not (math.isfinite(kernel_deg) and 0 < kernel_deg <= 90):
+        raise InputError(f"--kernel-deg must lie in (0, 90], got {kernel_deg:g}")
+    if not (math.isfinite(floor) and 0 < floor < 1):
+        raise InputError(f"--floor must lie in (0, 1), got {floor:g}")
+
+
 class ForwardModel:
     """Per-node toppling probabilities and direction densities of a forward table."""
 
     def __init__(self, table, kernel_deg=DEFAULT_KERNEL_DEG, floor=DEFAULT_FLOOR,
                  likelihood="independent"):
-        if likelihood not in LIKELIHOODS:
-            raise InputError(f"--likelihood must be one of {', '.join(LIKELIHOODS)}, got "
-                             f"{likelihood!r}")
+        check_model_options(kernel_deg, floor, likelihood)
         self.likelihood = likelihood
-        if not (0 < kernel_deg <= 90):
-            raise InputError(f"--kernel-deg must lie in (0, 90], got {kernel_deg:g}")
-        if not (0 < floor < 1):
-            raise InputError(f"--floor must lie in (0, 1), got {floor:g}")
         self.table, self.kernel_deg, self.floor = table, float(kernel_deg), float(floor)
         self.k = table.toppled.sum(axis=-1)
         self.n = table.valid.sum(axis=-1)

@@ -5,7 +5,10 @@ All positions are in the pedestal frame (pedestal top face z = 0, metres).
 A column has toppled when one of its bodies struck the pedestal other than
 by its base: any rim of a body above the bottom one, or any rim of the bottom
 body but its base (the top rim of a drum or monolith; a capital's abacus
-edge on a monolith of that outline).  Rims are the outlines a body carries
+edge on a monolith of that outline).  A body tilted past 90 deg that struck
+nothing (upside down, or thrown off the pedestal) has toppled too: a column is
+never "standing" then, whatever the input; its azimuth is that of the body's
+axis when it passed 90 deg (``toppled_by`` says which rule decided).  Rims are the outlines a body carries
 contact spheres on (``bodies[].rims`` of the trajectory, body frame about the
 centre of mass: circles and polygons).  The downfall azimuth points from the
 column's initial axis to the mass-weighted mean of the centres of mass of
@@ -99,12 +102,17 @@ def column_outcomes(trajectory):
             struck = np.min([rim_lowest(pos[:, j], trajectory.quat[:, j], r, axes[:, j])
                              for r in rims], axis=0)
             hits = np.flatnonzero(struck <= CONTACT_TOLERANCE_M)
+            tilt = tilt_deg(axes[:, j])
+            over = np.flatnonzero(tilt > 90.0)
             entry = {"index": b["index"], **({"name": b["block_name"]} if b.get("block_name")
                                              else {}),
                      "mass_kg": b["mass"], "struck": bool(hits.size),
                      "impact_time_s": None, "impact_point_m": None, "azimuth_deg": None,
-                     "max_tilt_deg": float(tilt_deg(axes[:, j]).max()),
-                     "final_position_m": (pos[-1, j, :2] - origin).round(4).tolist()}
+                     "max_tilt_deg": float(tilt.max()),
+                     "final_position_m": (pos[-1, j, :2] - origin).round(4).tolist(),
+                     "past_90_s": float(t[over[0]]) if over.size else None,
+                     "past_90_azimuth_deg": azimuth_deg(*axes[over[0], j, :2])
+                     if over.size else None}
             if hits.size:
                 k = hits[0]
                 point = pos[k, j, :2] - origin
@@ -114,7 +122,10 @@ def column_outcomes(trajectory):
         if not bodies:
             continue
         struck = [b for b in bodies if b["struck"]]
-        result = {"column": name, "toppled": bool(struck), "downfall_azimuth_deg": None,
+        upset = [b for b in bodies if b["past_90_s"] is not None]
+        result = {"column": name, "toppled": bool(struck or upset),
+                  "toppled_by": "impact" if struck else "tilt past 90 deg" if upset else None,
+                  "downfall_azimuth_deg": None,
                   "impact_time_s": None, "impact_point_m": None,
                   "max_tilt_deg": max(b["max_tilt_deg"] for b in bodies),
                   "base_slip_m": float(np.hypot(*(pos[:, members[0], :2]
@@ -127,6 +138,10 @@ def column_outcomes(trajectory):
             result.update(downfall_azimuth_deg=azimuth_deg(*centre),
                           impact_time_s=min(b["impact_time_s"] for b in struck),
                           impact_point_m=centre.tolist())
+        elif upset:          # thrown over without striking the pedestal: never "standing"
+            first_over = min(upset, key=lambda b: b["past_90_s"])
+            result.update(downfall_azimuth_deg=first_over["past_90_azimuth_deg"],
+                          impact_time_s=first_over["past_90_s"])
         results.append(result)
     return results
 

@@ -29,6 +29,9 @@ MARBLE_CONTACT = {"kn": paper.MARBLE_BLOCK_KN_N_M, "damping": paper.DAMPING_RATI
 # restitution within 0.2 %; the paper's 0.36 gives a 0.4 % higher one (see README)
 HOUSNER_DAMPING = 1.0
 TOLERANCE = 0.02            # relative, impact times and peak amplitudes
+MAX_IMPACTS = 20            # Housner's free rocking: impacts compared (decay below ~1e-3)
+MAX_AMPLITUDE_RATIO = 50.0  # one-sine pulse: amplitude / (alpha g)
+MAX_OMEGA_RATIO = 50.0      # one-sine pulse: omega / p (a pulse of ~20 time steps at most)
 
 
 def run_block(run_dir, height, width, depth, theta0=0.0, motion=None, duration=5.0,
@@ -74,6 +77,9 @@ def verify_housner(height=MARBLE_BLOCK["height"], width=MARBLE_BLOCK["width"],
     (integrated) and his closed form (eq 6), first n_impacts impacts."""
     if not 0 < theta0_ratio < 1:
         raise InputError(f"theta0 ratio must be between 0 and 1, got {theta0_ratio}")
+    if isinstance(n_impacts, bool) or not isinstance(n_impacts, int) or \
+            not 1 <= n_impacts <= MAX_IMPACTS:
+        raise InputError(f"--impacts must be an integer in [1, {MAX_IMPACTS}], got {n_impacts!r}")
     contact = {**MARBLE_CONTACT, "damping": HOUSNER_DAMPING, **contact}
     const = rocking.block_constants(height, width)
     alpha = const["alpha"]
@@ -132,8 +138,10 @@ def verify_sine_pulse(height=PULSE_BLOCK["height"], width=PULSE_BLOCK["width"],
                       run_dir=None, **contact):
     """One-sine pulse of amplitude K alpha g and circular frequency W p: YADE against
     the integration (overturned or not, impacts before overturning, direction)."""
-    if amplitude_ratio <= 0 or omega_ratio <= 0:
-        raise InputError("amplitude and omega ratios must be positive")
+    if not (0 < amplitude_ratio <= MAX_AMPLITUDE_RATIO and 0 < omega_ratio <= MAX_OMEGA_RATIO):
+        raise InputError(f"--amplitude-ratio must be in (0, {MAX_AMPLITUDE_RATIO:g}] and "
+                         f"--omega-ratio in (0, {MAX_OMEGA_RATIO:g}] (the pulse must last "
+                         f"steps of the model), got {amplitude_ratio:g} and {omega_ratio:g}")
     contact = {**dataclasses.asdict(Contact()), **contact}
     const = rocking.block_constants(height, width)
     ref = rocking.sine_pulse_response(height, width, amplitude_ratio, omega_ratio)

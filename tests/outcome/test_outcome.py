@@ -64,3 +64,20 @@ def test_drive_window_cuts_and_rezeroes_displacement():
     assert cut.disp[0, 0] == 0.0 and cut.disp[-1, 0] == pytest.approx(0.2)
     with pytest.raises(InputError):
         drive_motion(motion, window=(2.0, 3.0))
+
+
+def test_a_body_upside_down_is_never_standing(make_lying_trajectory):
+    """A monolith turned upside down in the air (tilt 180 deg, no rim near the pedestal):
+    toppled, by its tilt, toward the azimuth its axis had when it passed 90 deg."""
+    from scipy.spatial.transform import Rotation
+    from pipeline.outcome.columns import column_outcomes
+    traj = make_lying_trajectory(0.0)
+    n = len(traj.t)
+    angle = np.radians(np.linspace(0.0, 180.0, n))                # tips over toward East
+    q = Rotation.from_rotvec(np.column_stack([0 * angle, angle, 0 * angle])).as_quat()
+    traj.quat[:, 0] = q[:, [3, 0, 1, 2]]
+    traj.pos[:, 0] = traj.bodies[0]["initial_pos"] + np.array([0.0, 0.0, 50.0])  # in the air
+    (col,) = column_outcomes(traj)
+    assert col["toppled"] and col["toppled_by"] == "tilt past 90 deg"
+    assert col["downfall_azimuth_deg"] == pytest.approx(90.0, abs=1.0)
+    assert col["max_tilt_deg"] == pytest.approx(180.0, abs=0.5)

@@ -17,6 +17,7 @@ tell.  Bad input raises :class:`~pipeline.files.InputError` with one line.
 import functools
 import glob
 import gzip
+import zlib
 import importlib
 import pkgutil
 from pathlib import Path
@@ -72,7 +73,7 @@ def read_bytes(path):
     if raw[:2] == b"\x1f\x8b":
         try:
             raw = gzip.decompress(raw)
-        except (OSError, EOFError) as exc:
+        except (OSError, EOFError, zlib.error) as exc:
             raise InputError(f"{path.name}: broken gzip file ({str(exc).splitlines()[0]})") \
                 from None
     return raw

@@ -1,0 +1,54 @@
+"""The contract of the old surfaces on the new ones: ensemble, fragility, invert, verify
+and campaign options are range-checked before any work, zero is a value, duplicates
+are refused; each refusal is one `error:` line, exit 2, and writes nothing."""
+import gzip
+
+import pytest
+
+from pipeline import cli
+from pipeline.inversion import EXAMPLES_DIR
+
+
+def one_line_error(capsys, code):
+    err = capsys.readouterr().err
+    assert code == 2, err
+    assert err.count("\n") == 1 and err.startswith("error: "), err
+    return err
+
+
+@pytest.mark.parametrize("args, words", [
+    (["campaign", "ensemble", "--records", "GM20", "--vary", "scale=1000,2000"], "--vary scale"),
+    (["campaign", "ensemble", "--records", "GM20", "--vary", "damping=0.2,5"], "damping"),
+    (["campaign", "ensemble", "--records", "GM20", "--vary", "mu_s=0.5,0.6",
+      "--vary", "mu_s=0.6,0.7"], "twice"),
+    (["campaign", "ensemble", "--records", "GM20", "--vary", "tilt_deg=0,90"], "tilt_deg"),
+    (["campaign", "ensemble", "--records", "GM20", "--seed", "-1"], "--seed"),
+    (["campaign", "fragility", "--records", "GM20", "--seed", "-1"], "--seed"),
+    (["campaign", "records", "--records", "GM20,NF04,GM20"], "GM20 more than once"),
+    (["verify", "housner", "--impacts", "-3"], "--impacts"),
+    (["verify", "sine-pulse", "--amplitude-ratio", "6", "--omega-ratio", "1e9"],
+     "--omega-ratio"),
+    (["invert", str(EXAMPLES_DIR / "two_sites.json"), "--kernel-deg", "0"], "--kernel-deg"),
+    (["invert", str(EXAMPLES_DIR / "two_sites.json"), "--floor", "0"], "--floor"),
+    (["invert", str(EXAMPLES_DIR / "two_sites.json"), "--seed", "-5"], "--seed"),
+    (["run", "--record", "GM20", "--out", ""], "--out is empty"),
+])
+def test_new_options_are_refused_before_any_work(tmp_path, monkeypatch, capsys, args, words):
+    monkeypatch.chdir(tmp_path)
+    if "--out" not in args:
+        args = args + ["--out", str(tmp_path / "out")]
+    err = one_line_error(capsys, cli.main(args))
+    assert words in err
+    assert not (tmp_path / "out").exists()
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_a_gz_record_with_a_broken_deflate_stream_is_one_line(tmp_path, capsys):
+    good = gzip.compress(b"PEER NGA STRONG MOTION DATABASE RECORD\n" * 200)
+    broken = good[:20] + bytes(b ^ 0xFF for b in good[20:60]) + good[60:]
+    path = tmp_path / "rec.AT2.gz"
+    path.write_bytes(broken)
+    err = one_line_error(capsys, cli.main(["records", str(path), "--out",
+                                           str(tmp_path / "out")]))
+    assert "rec.AT2.gz" in err
+    assert not (tmp_path / "out").exists()
