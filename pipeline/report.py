@@ -226,8 +226,10 @@ def records_statements(fractions, directions, correlations):
     for column in sorted(set(fractions["column"]) if not fractions.empty else []):
         f = fractions[fractions["column"] == column].iloc[0]
         text = (f"**{COLUMN_NAMES.get(column, column)}.** {f['toppled']} of {f['records']} records "
-                f"toppled it ({_percent(f['fraction'])}, 95 % interval "
-                f"{_percent(f['ci_low'])}-{_percent(f['ci_high'])})")
+                f"toppled it in one run each ({_percent(f['fraction'])}, 95 % interval "
+                f"{_percent(f['ci_low'])}-{_percent(f['ci_high'])}; each run is a sample: a "
+                f"record near its threshold can flip with a CPU's last bits, so the count is "
+                f"known to its interval, not exactly)")
         if "paper_toppled" in f and math.isfinite(_float(f.get("paper_fraction"))):
             inside = f["ci_low"] <= f["paper_fraction"] <= f["ci_high"]
             text += (f"; the paper: {int(f['paper_toppled'])} of {int(f['paper_records'])} "
@@ -290,9 +292,19 @@ def records_statements(fractions, directions, correlations):
                 text += (" Circular correlations need at least 3 falls and varying reference "
                          "directions: not defined here")
             if not finite.empty:
-                best = finite.loc[finite["circcorr"].astype(float).abs().idxmax()]
-                text += (f"; strongest with the {REFERENCE_NAMES.get(best['reference'])} "
-                         f"(|r| = {abs(float(best['circcorr'])):.2f})")
+                strength = finite["circcorr"].astype(float).abs().sort_values(ascending=False)
+                best = finite.loc[strength.index[0]]
+                error = 1.0 / math.sqrt(n)         # standard error of a correlation of n falls
+                if len(strength) > 1 and strength.iloc[0] - strength.iloc[1] < error:
+                    text += (f"; no reference stands out: the largest |r| "
+                             f"({abs(float(best['circcorr'])):.2f}, "
+                             f"{REFERENCE_NAMES.get(best['reference'])}) exceeds the next by "
+                             f"less than the standard error 1/sqrt({n}) = {error:.2f}, so "
+                             "another CPU's single runs may rank them otherwise")
+                else:
+                    text += (f"; strongest with the {REFERENCE_NAMES.get(best['reference'])} "
+                             f"(|r| = {abs(float(best['circcorr'])):.2f}, standard error "
+                             f"{error:.2f})")
             text += "."
         out.append(text)
     question = ("**Answer to the paper's question** (do toppled columns point to the "

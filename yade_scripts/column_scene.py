@@ -251,7 +251,12 @@ if MOTION_FILE:
                   "disp": np.array(mf["disp"], float)}
     motion["t"] = motion["dt"] * np.arange(len(motion["acc"]))
     motion_end = float(motion["t"][-1])
-quiet_after = motion_end if QUIET_AFTER_S is None else QUIET_AFTER_S
+# the stop checks' end of the motion: the end of its signal when the processing gives one
+# (after it, the band-pass filter's transient only, far below anything that moves a body;
+# the pedestal is still driven by it while the run goes on)
+signal_end = motion_end if P.get("signal_end_s") is None else \
+    min(motion_end, float(P["signal_end_s"]))
+quiet_after = signal_end if QUIET_AFTER_S is None else QUIET_AFTER_S
 
 
 def now():
@@ -404,7 +409,7 @@ def check_stop():
     v_rest, length = REST_VELOCITY, REST_LENGTH
     rel = pedestal_state.vel
     t = now()
-    if BARRIERS and t > motion_end and settled(rel):
+    if BARRIERS and t > signal_end and settled(rel):
         state["stopped_early"] = True
         record_state()
         O.pause()
@@ -417,7 +422,7 @@ def check_stop():
         fallen[b["column"]] = fallen.get(b["column"], False) or lying
         if not lying and ((s.vel - rel).norm() >= v_rest or s.angVel.norm() * length >= v_rest):
             at_rest = False
-    if at_rest and (t > motion_end or all(fallen.values()) or (t > quiet_after and seated(axes))):
+    if at_rest and (t > signal_end or all(fallen.values()) or (t > quiet_after and seated(axes))):
         if state["rest_since"] is None:
             state["rest_since"] = t
         elif t - state["rest_since"] >= REST_DURATION_S:

@@ -152,6 +152,7 @@ def build_motion(source, back_azimuth=None, key=None, mode="default"):
                           "reader": info.get("format"), "software": software_versions()}
     trims = [s["window_s"][0] for s in steps if s["step"] == "trim_to_signal"]
     meta["start_in_file_s"] = float(trims[0]) if trims else 0.0
+    meta["signal_end_s"] = processing.signal_end_in_motion_s(steps)
     return Motion(dt, acc, vel, disp, meta=meta)
 
 

@@ -132,11 +132,23 @@ def trim_to_signal(work, arias_fractions=(0.001, 0.995), margin_s=5.0, highpass_
     work.acc = work.acc[max(i0, first):min(i1, last)]
     work.signal = (lo - max(i0, first), hi + 1 - max(i0, first))
     work.start_s = i0 * work.dt
-    return {"window_s": [i0 * work.dt, (i1 - 1) * work.dt], "arias_fractions": list(arias_fractions),
+    return {"window_s": [i0 * work.dt, (i1 - 1) * work.dt], "signal_s": [lo * work.dt, hi * work.dt],
+            "arias_fractions": list(arias_fractions),
             "margin_s": margin_s, "data_s": [max(i0, first) * work.dt, (min(i1, last) - 1) * work.dt]}
 
 
-SIGNAL_END_MARGIN_S = 5.0   # quiet simulated after a ready-made motion's signal (s)
+SIGNAL_END_MARGIN_S = 5.0   # quiet simulated after a motion's signal (s)
+
+
+def signal_end_in_motion_s(steps):
+    """End (s, on the processed motion's clock) of the signal, SIGNAL_END_MARGIN_S after
+    its 99.5 % Arias point, from the provenance of ``process``; None without a cut.  A
+    run treats the motion as over there: what follows is the band-pass filter's
+    transient, far below anything that moves a column."""
+    trim = next((s for s in steps if s["step"] == "trim_to_signal"), None)
+    if trim is None or "signal_s" not in trim:
+        return None
+    return float(trim["signal_s"][1] - trim["window_s"][0] + SIGNAL_END_MARGIN_S)
 
 
 def signal_end_s(acc, dt):

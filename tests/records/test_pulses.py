@@ -5,6 +5,7 @@ processed motion as on the pulse band-passed alone.
 The reference is independent of the processing code: a zero-phase 4-pole Butterworth
 0.1-25 Hz band-pass (scipy's sosfiltfilt) of the pulse padded with 5 minutes of zeros
 each side, integrated by the trapezoid rule."""
+import json
 import math
 
 import numpy as np
@@ -121,3 +122,24 @@ def test_processing_option_is_checked(tmp_path, capsys):
         cli.main(["run", "--record", str(path), "--processing", "raw", "--out",
                   str(tmp_path / "o")])
     assert not (tmp_path / "o").exists()
+
+
+@pytest.mark.yade
+def test_run_on_a_processed_pulse_stops_after_its_signal_and_says_how_it_was_processed(
+        tmp_path, capsys):
+    """A pulse that rocks the monolith without toppling it: the run stops once the column
+    rests after the signal's end, not after the filter's minute-long transient that the
+    processed motion carries; summary.json records the processing mode."""
+    enz = raw_pulse("cosine", 2.5, 1.0, 30.0, 8.0, 30.0, DT)
+    path = write_pulse_mseed(tmp_path / "rock.mseed", enz)
+    for mode in ("default", "none"):
+        out = tmp_path / mode
+        assert cli.main(["run", "--record", str(path), "--column", "monolithic",
+                         "--processing", mode, "--out", str(out)]) == 0
+        summary = json.loads((out / "summary.json").read_text())
+        assert summary["parameters"]["processing"] == mode
+        (column,) = summary["columns"]
+        assert not column["toppled"] and column["max_tilt_deg"] > 0.1      # it rocked
+        if mode == "default":
+            assert summary["motion_end_s"] > 100.0          # signal + the filter transient
+            assert summary["simulated_window_s"][1] < summary["motion_end_s"] - 40.0
