@@ -42,7 +42,7 @@ bench: setup
 	$(PY) bench/bench_yade.py
 
 invert-demo: setup
-	$(PY) -m pipeline invert --demo --grid $(or $(INVERT_GRID),demo) --jobs $(JOBS) $(INVERT_ARGS)
+	$(PY) -m pipeline invert --demo --grid $(or $(INVERT_GRID),demo) --jobs $(JOBS) --allow-long $(INVERT_ARGS)
 	$(PY) -m pipeline report
 
 clean:

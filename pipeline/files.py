@@ -4,10 +4,12 @@ and the software versions recorded as provenance.
 Every result file is written to a temporary file in the same directory and
 renamed into place, so an interrupted run never leaves a partial result.
 """
+import ctypes
 import hashlib
 import io
 import json
 import os
+import signal
 import tempfile
 from contextlib import contextmanager
 from pathlib import Path
@@ -167,3 +169,10 @@ class DirectoryLock:
         os.close(self.fd)
         self.fd = None
         return False
+
+
+def die_with_parent():
+    """In a child process (``preexec_fn``, a Pool's ``initializer``): be killed when the
+    parent dies, even by kill -9 (Linux PR_SET_PDEATHSIG), and leave Ctrl-C to the parent."""
+    ctypes.CDLL("libc.so.6", use_errno=True).prctl(1, signal.SIGKILL)   # 1: PR_SET_PDEATHSIG
+    signal.signal(signal.SIGINT, signal.SIG_IGN)

@@ -116,18 +116,21 @@ def simulate(motion, out_dir, column=None, contact=None, numerics=None, window=N
                                                        back_azimuth_deg=back_azimuth_of(
                                                            motion, back_azimuth)))
     drive = drive_motion(motion, window, rotate_deg, scale)
+    signal_end = motion.meta.get("signal_end_s")
+    if signal_end is not None:          # the stop checks treat the motion as over there
+        signal_end = float(min(max(signal_end - (window[0] if window else 0.0), 0.0),
+                               drive.duration))
     params = scene_params(columns=column.specs(), contact=contact, numerics=numerics,
-                          motion_duration=drive.duration)
+                          motion_duration=drive.duration,
+                          t_max=None if signal_end is None else signal_end + numerics.tail_s)
+    if signal_end is not None:
+        params["signal_end_s"] = signal_end
     out_dir = Path(out_dir)
     (out_dir / "summary.json").unlink(missing_ok=True)
     started = time.perf_counter()
     window_s = quiet_window(drive, params["columns"], contact, numerics.quiet_lead_s)
     if window_s is not None and numerics.quiet_motion == "skip":
         params.update(start_s=window_s[0], quiet_after_s=window_s[1])
-    signal_end = motion.meta.get("signal_end_s")
-    if signal_end is not None:          # the stop checks treat the motion as over there
-        signal_end -= window[0] if window else 0.0
-        params["signal_end_s"] = float(min(max(signal_end, 0.0), drive.duration))
     write_scenario(out_dir, params, drive)
     trajectory = run_yade(out_dir, timeout_s=timeout_s) if window_s is not None else None
     parameters = {"column": column.kind, "hd": column.hd, "height_m": column.height,

@@ -78,8 +78,20 @@ def serve(control_fd, idle_s):
         control.write(f"{code}\n")
 
 
+def note_tmp_dir():
+    """YADE makes /tmp/yade-XXXXXX per process (a fixed path, not TMPDIR) and removes it
+    only at a normal exit: tell the parent where it is (a file in the directory named by
+    TOPPLING_YADE_NOTE_DIR), so that it removes it after a kill too."""
+    note_dir = os.environ.get("TOPPLING_YADE_NOTE_DIR")
+    if note_dir:
+        from yade import O
+        with open(os.path.join(note_dir, "yade_tmp_dir"), "w") as note:
+            note.write(os.path.dirname(O.tmpFilename()))
+
+
 if __name__ == "__main__":
     import yade  # noqa: E402,F401  (boots YADE: plugins, O)
+    note_tmp_dir()
     if sys.argv[1] == "--serve":
         serve(int(sys.argv[2]), float(sys.argv[3]))
     else:

@@ -77,6 +77,10 @@ def setup(p):
                    help="run the forward campaign on an existing Dask cluster")
     p.add_argument("--jobs", type=int, default=None,
                    help="parallel YADE runs / pyprop8 processes (default: all cores)")
+    p.add_argument("--allow-long", action="store_true",
+                   help=f"start a forward table estimated to take over "
+                   f"{LONG_RUN_S / 3600:g} h on this machine (refused otherwise; the "
+                   "estimate is printed before any run)")
     p.add_argument("--table", type=Path, default=None, metavar="FILE",
                    help="use this forward table file (tables/forward_table_<key>.npz) as it "
                    "is: no pyprop8, no YADE (its code version is reported, not checked)")
@@ -197,6 +201,31 @@ def described_columns(observations, base_dir="."):
     return out
 
 
+LONG_RUN_S = 3600.0     # a forward table estimated to take longer needs --allow-long
+FORWARD_RUN_CORE_S = 9.0   # wall s of one forward run on one core (make invert-demo:
+#                            672 + 2 x 72 runs in 48.6 min on 2 cores with the time-step
+#                            factor 0.3, x 1.28 for the default 0.235 at damping 0.36)
+
+
+def preflight(grid, forward_dir, jobs, allow_long):
+    """Say how many runs the forward table needs, how many may be cached and roughly how
+    long the rest takes on ``jobs`` cores; InputError past LONG_RUN_S without
+    ``allow_long``.  Returns the estimate (s)."""
+    from pipeline.inversion.forward import DEFAULT_FORWARD_DIR
+    runs_dir = Path(forward_dir or DEFAULT_FORWARD_DIR) / "runs"
+    done = sum(1 for _ in runs_dir.glob("*/summary.json")) if runs_dir.is_dir() else 0
+    needed = grid.n_runs()
+    estimate = max(0, needed - done) * FORWARD_RUN_CORE_S / jobs
+    print(f"forward table: {needed} YADE runs, up to {min(done, needed)} of them cached in "
+          f"{runs_dir.parent}; the rest takes about {estimate / 60:.0f} min on {jobs} "
+          f"core(s) ({FORWARD_RUN_CORE_S:g} s a run)", flush=True)
+    if estimate > LONG_RUN_S and not allow_long:
+        raise InputError(f"this forward table ({needed} runs) would take about "
+                         f"{estimate / 3600:.1f} h here: add --allow-long to start it, or "
+                         "choose --grid demo or quick, or give a computed --table")
+    return estimate
+
+
 def forward_table(args, grid, sibling_of=None):
     """(ForwardTable, info dict): the --table file (``sibling_of``: the table of ``grid``
     beside that file), or the campaign's (run or reused)."""
@@ -214,6 +243,8 @@ def forward_table(args, grid, sibling_of=None):
                 "yade_wall_s": table.info.get("yade_wall_s"), "runs": table.info.get("runs"),
                 "reused_file": True}
         return table, info
+    if not args.scheduler:
+        preflight(grid, args.forward_dir, _check_jobs(args.jobs), args.allow_long)
     table, cost = run_forward(grid, args.forward_dir, _check_jobs(args.jobs), args.scheduler)
     return table, {**cost, "grid": grid.as_dict(), "grid_key": grid.key(),
                    "code_version": table.info.get("code_version"), "reused_file": False}

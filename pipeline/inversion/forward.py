@@ -40,7 +40,7 @@ import pandas as pd
 from pipeline import RESULTS_DIR, files
 from pipeline.campaign import Campaign, register
 from pipeline.campaign.definitions import column_specs, run_code_version, run_column_spec
-from pipeline.files import InputError, content_hash, write_csv, write_json
+from pipeline.files import InputError, content_hash, die_with_parent, write_csv, write_json
 from pipeline.motion import Motion
 
 GENERATOR_VERSION = 1          # bump when the written motions change
@@ -250,7 +250,7 @@ def slice_motions(grid, motion_dir, jobs=None):
     print(f"inversion-forward: pyprop8 for {len(todo)} source slice(s), {len(r)} receivers, "
           f"{len(tasks)} sub-events on {jobs} process(es)", flush=True)
     if jobs > 1:
-        with Pool(jobs) as pool:
+        with Pool(jobs, initializer=die_with_parent) as pool:
             results = pool.map(_point_source_task, tasks)      # in order: reproducible sums
     else:
         results = [_point_source_task(t) for t in tasks]

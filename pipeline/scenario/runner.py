@@ -14,23 +14,25 @@ paid once per thread instead of once per run.  That process dies with its thread
 itself after ``SERVE_IDLE_S`` without a scene.
 """
 import contextlib
-import ctypes
 import functools
 import json
 import os
 import select
+import shutil
 import signal
 import subprocess
+import tempfile
 import threading
 import time
 from pathlib import Path
 
 from pipeline import YADE_SCRIPTS_DIR
-from pipeline.files import ToolError
+from pipeline.files import ToolError, die_with_parent
 from pipeline.outcome import Trajectory
 
 DEBIAN_PYTHON = "/usr/bin/python3"
 YADE_PY_PATH = "/usr/lib/x86_64-linux-gnu/yade-double/py"
+TMP_PREFIX = "toppling-yade-"     # a YADE process's note of its temporary directory
 # glibc picks its libm routines (exp, sin, pow...) by CPU feature: with these tunables a
 # YADE process takes the non-FMA/AVX2 ones, as an older or another vendor's CPU would, so
 # that one machine can show which results depend on a CPU's last bits (make test runs the
@@ -39,7 +41,6 @@ SECOND_LIBM_TUNABLES = "glibc.cpu.hwcaps=-AVX2_Usable,-FMA_Usable,-AVX2,-FMA"
 WRAPPER = YADE_SCRIPTS_DIR / "run_scene.py"
 STARTUP_ALLOWANCE_S = 120.0        # wall-clock seconds granted on top of the simulation
 MIN_SIM_S_PER_WALL_S = 0.05        # slower than this and the run is declared hung
-_PR_SET_PDEATHSIG = 1
 _RUNNING = set()                   # YADE processes of this process, for kill_running()
 _RUNNING_LOCK = threading.Lock()
 SCENES_PER_PROCESS = 200           # a served process is replaced after this many scenes
@@ -75,12 +76,6 @@ def wall_limit_s(t_max):
     return STARTUP_ALLOWANCE_S + t_max / MIN_SIM_S_PER_WALL_S
 
 
-def _die_with_parent():
-    libc = ctypes.CDLL("libc.so.6", use_errno=True)
-    libc.prctl(_PR_SET_PDEATHSIG, signal.SIGKILL)
-    signal.signal(signal.SIGINT, signal.SIG_IGN)   # the parent decides about Ctrl-C
-
-
 def run_yade(run_dir, timeout_s=None):
     """Run ``run_dir/scene.py``; return its :class:`~pipeline.outcome.Trajectory`.
 
@@ -107,8 +102,11 @@ def run_yade(run_dir, timeout_s=None):
     return Trajectory.load(out, wall_s=wall)
 
 
-def _environment():
-    env = dict(os.environ, OMP_NUM_THREADS="1", YADE_PY_PATH=YADE_PY_PATH)
+def _environment(note_dir):
+    """The YADE process's environment; it notes the temporary directory YADE makes for it
+    in ``note_dir`` (run_scene.py), which :func:`_remove_tmp` removes with that note."""
+    env = dict(os.environ, OMP_NUM_THREADS="1", YADE_PY_PATH=YADE_PY_PATH,
+               TOPPLING_YADE_NOTE_DIR=note_dir)
     env.pop("PYTHONPATH", None)
     env.pop("VIRTUAL_ENV", None)
     return env
@@ -117,10 +115,12 @@ def _environment():
 def _run_once(run_dir, timeout_s):
     """One scene in a fresh process; its exit code (negative: killed by a signal)."""
     with open(run_dir / "yade.log", "w") as log:
+        tmpdir = tempfile.mkdtemp(prefix=TMP_PREFIX)
         proc = subprocess.Popen([DEBIAN_PYTHON, str(WRAPPER), "scene.py"], cwd=run_dir,
                                 stdout=log, stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL,
-                                env=_environment(), start_new_session=True,
-                                preexec_fn=_die_with_parent)
+                                env=_environment(tmpdir), start_new_session=True,
+                                preexec_fn=die_with_parent)
+        proc.tmpdir = tmpdir
         with _RUNNING_LOCK:
             _RUNNING.add(proc)
         try:
@@ -134,6 +134,7 @@ def _run_once(run_dir, timeout_s):
         finally:
             with _RUNNING_LOCK:
                 _RUNNING.discard(proc)
+            _remove_tmp(tmpdir)
 
 
 @contextlib.contextmanager
@@ -180,15 +181,20 @@ def _server():
     if proc is not None:
         _kill(proc)
     read_fd, write_fd = os.pipe()
+    tmpdir = tempfile.mkdtemp(prefix=TMP_PREFIX)
     try:
         proc = subprocess.Popen([DEBIAN_PYTHON, str(WRAPPER), "--serve", str(write_fd),
                                  str(SERVE_IDLE_S)],
                                 stdin=subprocess.PIPE, stdout=subprocess.DEVNULL,
                                 stderr=subprocess.DEVNULL, pass_fds=(write_fd,),
-                                env=_environment(), start_new_session=True,
-                                preexec_fn=_die_with_parent)
+                                env=_environment(tmpdir), start_new_session=True,
+                                preexec_fn=die_with_parent)
+    except BaseException:
+        _remove_tmp(tmpdir)
+        raise
     finally:
         os.close(write_fd)
+    proc.tmpdir = tmpdir
     proc.control = os.fdopen(read_fd, "rb")
     proc.scenes, proc.busy, proc.retired, proc.last_used = 0, True, False, time.monotonic()
     _SERVED.proc = proc
@@ -262,3 +268,15 @@ def _kill(proc):
         if pipe is not None:
             with contextlib.suppress(OSError):
                 pipe.close()
+    if getattr(proc, "tmpdir", None):
+        _remove_tmp(proc.tmpdir)
+
+
+def _remove_tmp(note_dir):
+    """Remove the temporary directory YADE made for a process that has ended (named in
+    ``note_dir``, by run_scene.py) and ``note_dir`` itself."""
+    with contextlib.suppress(OSError):
+        made = (Path(note_dir) / "yade_tmp_dir").read_text().strip()
+        if Path(made).name.startswith("yade-"):
+            shutil.rmtree(made, ignore_errors=True)
+    shutil.rmtree(note_dir, ignore_errors=True)

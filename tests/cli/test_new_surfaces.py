@@ -52,3 +52,39 @@ def test_a_gz_record_with_a_broken_deflate_stream_is_one_line(tmp_path, capsys):
                                            str(tmp_path / "out")]))
     assert "rec.AT2.gz" in err
     assert not (tmp_path / "out").exists()
+
+
+def test_invert_says_what_the_default_grid_costs_and_refuses_hours_of_work(tmp_path, capsys):
+    code = cli.main(["invert", str(EXAMPLES_DIR / "two_sites.json"), "--out",
+                     str(tmp_path / "out"), "--forward-dir", str(tmp_path / "forward")])
+    captured = capsys.readouterr()
+    assert "forward table: 6480 YADE runs" in captured.out
+    assert code == 2 and captured.err.count("\n") == 1 and "--allow-long" in captured.err
+    assert not (tmp_path / "out").exists() and not (tmp_path / "forward").exists()
+
+
+def test_pool_workers_die_with_their_parent(tmp_path):
+    """kill -9 of a command leaves no pool worker (pyprop8's) running: the initializer
+    the pools use ties each worker to its parent."""
+    import os
+    import signal
+    import subprocess
+    import sys
+    import time
+    script = ("import time\nfrom multiprocessing import Pool\n"
+              "from pipeline.files import die_with_parent\n"
+              "pool = Pool(2, initializer=die_with_parent)\n"
+              "print(' '.join(str(p.pid) for p in pool._pool), flush=True)\n"
+              "pool.map(time.sleep, [60, 60])\n")
+    proc = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE, text=True)
+    workers = [int(p) for p in proc.stdout.readline().split()]
+    assert len(workers) == 2
+    proc.send_signal(signal.SIGKILL)
+    proc.wait(timeout=10)
+    deadline = time.monotonic() + 10
+    alive = workers
+    while alive and time.monotonic() < deadline:
+        alive = [p for p in workers if os.path.exists(f"/proc/{p}")
+                 and "Z" not in open(f"/proc/{p}/stat").read().split()[2]]
+        time.sleep(0.05)
+    assert not alive

@@ -126,3 +126,29 @@ def test_a_kept_process_serves_the_next_block_and_ends_when_told_or_idle(tmp_pat
         run_yade(scene(tmp_path / "d"))
     assert runner._SERVED.proc.pid != idle
     runner.end_served_processes()
+
+
+def test_yade_processes_leave_no_temporary_directory(tmp_path, monkeypatch):
+    """YADE makes /tmp/yade-XXXXXX per process and keeps it when killed: the runner
+    removes it when the process ends, fresh or served (ended by a kill)."""
+    import glob
+    import tempfile
+    scratch = tmp_path / "notes"
+    scratch.mkdir()
+    monkeypatch.setattr(tempfile, "tempdir", str(scratch))
+    made = []
+    real = runner._remove_tmp
+
+    def spy(note_dir):
+        note = os.path.join(note_dir, "yade_tmp_dir")
+        made.append(open(note).read().strip() if os.path.exists(note) else None)
+        real(note_dir)
+
+    monkeypatch.setattr(runner, "_remove_tmp", spy)
+    run_yade(scene(tmp_path / "fresh"))
+    with runner.reuse_processes():
+        run_yade(scene(tmp_path / "served"))
+    noted = [m for m in made if m]
+    assert len(noted) >= 2 and all(m.startswith("/tmp/yade-") for m in noted), made
+    assert not any(glob.glob(m) for m in noted)
+    assert list(scratch.iterdir()) == []

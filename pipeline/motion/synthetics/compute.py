@@ -16,7 +16,7 @@ from threadpoolctl import threadpool_limits
 from tqdm import tqdm
 
 from pipeline import RESULTS_DIR, files
-from pipeline.files import InputError
+from pipeline.files import InputError, die_with_parent
 from pipeline.motion import Motion
 from pipeline.motion.synthetics.sources import (CRUST_LAYERS, LEAD_TIME_S, source_parameters,
                                                 subevents)
@@ -213,7 +213,9 @@ def generate_sources(source_names, rings_km=(5, 10, 20), azimuth_step_deg=30, du
                         unit="sub-event")
         calls = [task for _, task in tasks]
         parallel = jobs > 1 and len(tasks) > 1
-        with Pool(min(jobs, len(tasks))) if parallel else contextlib.nullcontext() as pool:
+        pool_or_none = Pool(min(jobs, len(tasks)), initializer=die_with_parent) if parallel \
+            else contextlib.nullcontext()
+        with pool_or_none as pool:
             results = (pool.imap(_point_source_task, calls) if parallel    # in order:
                        else map(_point_source_task, calls))                # reproducible sums
             for (name, _), disp in zip(tasks, results):
