@@ -14,6 +14,7 @@ import pandas as pd
 
 from pipeline import RESULTS_DIR, __version__
 from pipeline.files import write_text
+from pipeline.stats.ensemble import wilson_interval
 
 
 def _read_csv(path):
@@ -76,15 +77,6 @@ ALPHA = 0.05                     # significance level of the plain-language stat
 COLUMN_NAMES = {"drums": "Drum column", "monolithic": "Monolithic column"}
 MIN_FALLS = 5                    # fewer falls with a back azimuth: no statement on concentration
 FEMA_SOURCE_FILE = "fema_p695.npz"
-
-
-def wilson_interval(k, n, confidence=0.95):
-    """Wilson score interval (low, high) of a binomial proportion k/n (scipy binomtest)."""
-    from scipy.stats import binomtest
-    if n <= 0:
-        return math.nan, math.nan
-    ci = binomtest(int(k), int(n)).proportion_ci(confidence_level=confidence, method="wilson")
-    return float(ci.low), float(ci.high)
 
 
 def toppled_fractions(runs):

@@ -38,6 +38,7 @@ import math
 import numpy as np
 from scipy.integrate import solve_ivp
 
+from pipeline.constants import MODEL_GRAVITY
 from pipeline.files import InputError
 
 MODE_NO_OVERTURN = 0
@@ -54,7 +55,7 @@ _MAX_EVENTS = 5000
 _FREE_ROCKING_T_MAX = 1e4     # s, bound only: free rocking stops at its last peak
 
 
-def block_constants(height, width, g=9.81):
+def block_constants(height, width, g=MODEL_GRAVITY):
     """Geometry and Housner constants of a rectangular block (h, b in m).
 
     Returns dict: alpha (rad), R (m, half-diagonal), p (1/s), I0_per_mass
@@ -81,7 +82,7 @@ def housner_closed_form(theta0_ratio, r, n):
     return 1.0 - np.sqrt(1.0 - r ** k * (1.0 - (1.0 - theta0_ratio) ** 2))
 
 
-def housner_half_periods(height, width, theta0_ratio, n, r=None, g=9.81):
+def housner_half_periods(height, width, theta0_ratio, n, r=None, g=MODEL_GRAVITY):
     """Paper eq 7 (linearised block): duration (s) of half-cycles k = 0..n.
 
     T_k / 2 = (2 / p) artanh( sqrt(r^k (1 - (1 - theta0/alpha)^2)) ), the time
@@ -95,7 +96,7 @@ def housner_half_periods(height, width, theta0_ratio, n, r=None, g=9.81):
     return 2.0 / c["p"] * np.arctanh(np.sqrt(r ** k * (1.0 - (1.0 - theta0_ratio) ** 2)))
 
 
-def housner_free_rocking(height, width, theta0, n_impacts=10, restitution=None, g=9.81,
+def housner_free_rocking(height, width, theta0, n_impacts=10, restitution=None, g=MODEL_GRAVITY,
                          linearised=False, dt_out=0.001):
     """Free rocking released from rest at theta0 (rad, != 0), Housner's equation.
 
@@ -124,7 +125,7 @@ def housner_free_rocking(height, width, theta0, n_impacts=10, restitution=None, 
                 restitution=out["restitution"], overturned=out["overturned"])
 
 
-def rocking_response(height, width, acc_func, t_end, restitution=None, g=9.81, theta0=0.0,
+def rocking_response(height, width, acc_func, t_end, restitution=None, g=MODEL_GRAVITY, theta0=0.0,
                      omega0=0.0, still_after=None, dt_out=0.005, rest_max_step=1e-3):
     """Rocking of the rigid block under a horizontal ground acceleration.
 
@@ -162,7 +163,7 @@ def sine_pulse(amplitude, omega, psi):
 
 
 def sine_pulse_response(height, width, amplitude_ratio, omega_ratio, psi=None,
-                        restitution=None, g=9.81, t_after=30.0, dt_out=0.005):
+                        restitution=None, g=MODEL_GRAVITY, t_after=30.0, dt_out=0.005):
     """Block under a one-sine pulse a_g = A sin(omega t + psi) (Zhang & Makris 2000).
 
     A = amplitude_ratio * alpha * g (m/s^2, > 0: the first half-cycle pushes the
@@ -199,7 +200,7 @@ def sine_pulse_response(height, width, amplitude_ratio, omega_ratio, psi=None,
     return out
 
 
-def overturning_map(height, width, amplitude_ratios, omega_ratios, restitution=None, g=9.81):
+def overturning_map(height, width, amplitude_ratios, omega_ratios, restitution=None, g=MODEL_GRAVITY):
     """Outcome of one-sine pulses over a grid (like Zhang & Makris 2000, Fig. 6).
 
     Returns dict: mode (int array, shape (len(omega_ratios), len(amplitude_ratios)),
@@ -224,7 +225,7 @@ def overturning_map(height, width, amplitude_ratios, omega_ratios, restitution=N
                 amplitude_ratios=amps, omega_ratios=omegas, mode_names=dict(MODE_NAMES))
 
 
-def mode_edges(height, width, omega_ratio, amplitude_ratios, restitution=None, g=9.81,
+def mode_edges(height, width, omega_ratio, amplitude_ratios, restitution=None, g=MODEL_GRAVITY,
                tol=1e-3):
     """Amplitude ratios (A / (alpha g)) where the one-sine-pulse mode changes.
 
@@ -459,7 +460,7 @@ def _append_state(samples_t, samples_y, dt_out, t, theta, omega):
 _BATCH_REST_OMEGA_FRACTION = 1e-5   # rest when |omega| after an impact < this * p * alpha
 
 
-def rocking_response_sampled(height, width, acc, dt, t_after=30.0, restitution=None, g=9.81,
+def rocking_response_sampled(height, width, acc, dt, t_after=30.0, restitution=None, g=MODEL_GRAVITY,
                              max_step=1e-3):
     """Rocking of N rigid blocks under sampled ground accelerations, all at once.
 

@@ -17,6 +17,16 @@ from pipeline.records.processing import processing_mode
 from pipeline.scenario import Column, Contact, Numerics, run_yade, scene_params, write_scenario
 
 
+# the code that turns a motion and parameters into an outcome: one list for the run ids,
+# summary.json's code hash and the Dask workers' check
+RUN_CODE = ("scenario", "outcome", "motion", "simulate", "yade_scripts")
+
+
+def run_code_version():
+    """Hash of the code that turns a motion and parameters into an outcome (RUN_CODE)."""
+    return code_hash(*RUN_CODE)
+
+
 MAX_SCALE = 20.0        # the largest motion scale factor (run --scale, ensemble --vary scale)
 
 
@@ -143,7 +153,7 @@ def simulate(motion, out_dir, column=None, contact=None, numerics=None, window=N
                   "dt_factor": params["dt_factor"], "rim_points": numerics.rim_points,
                   "quiet_motion": numerics.quiet_motion}
     provenance = {"software": software_versions(), "motion": motion.meta.get("processing"),
-                  "code": {"scenario": code_hash("scenario", "outcome", "yade_scripts")}}
+                  "code": {"scenario": run_code_version(), "packages": list(RUN_CODE)}}
     if trajectory is None:
         summary = {"record": record or motion.record_id, "back_azimuth_deg": drive.back_azimuth,
                    "parameters": parameters, "columns": still_outcome(params["columns"]),

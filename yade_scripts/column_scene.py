@@ -240,7 +240,9 @@ for c, col in enumerate(COLUMNS):
 # ---------------------------------------------------------------- time step
 # a body resting on its whole base rim: stiffness kn x its base points (at least
 # RIM_POINTS: a box on its four corners steps as finely as a drum on its rim)
-O.dt = DT_FACTOR * math.sqrt(min(m / k for m, k in face_stiffness))
+# (computed by pipeline.scenario.parameters.time_step_s: the same operations on the same
+# bodies; the scene keeps the formula for scenes written without it)
+O.dt = P.get("time_step_s") or DT_FACTOR * math.sqrt(min(m / k for m, k in face_stiffness))
 
 # ---------------------------------------------------------------- motion
 motion = None

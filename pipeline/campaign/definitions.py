@@ -15,18 +15,13 @@ from pipeline.motion import Motion
 from pipeline.records import catalog, catalog_row, processed_motion, resolve
 from pipeline.records.processing import signal_end_s
 from pipeline.scenario import Column, Contact, Numerics
-from pipeline.simulate import simulate
+from pipeline.simulate import run_code_version, simulate
 from pipeline.stats.circular import direction_statistics
 
 
 NUMERICS_FIELDS = {f.name for f in dataclasses.fields(Numerics)}
 
 # ---------------------------------------------------------------- column runs
-def run_code_version():
-    """Hash of the code that turns a motion and parameters into an outcome."""
-    return code_hash("scenario", "outcome", "motion", "simulate", "yade_scripts")
-
-
 def motion_cache(campaign_dir):
     """Where a campaign caches processed motions: results/cache/motions, or inside the
     campaign directory when it lies outside results/."""

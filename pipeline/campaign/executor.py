@@ -50,6 +50,7 @@ from pipeline.files import (
 )
 from pipeline.motion import Motion
 from pipeline.scenario.runner import end_served_processes, kill_running, reuse_processes
+from pipeline.simulate import RUN_CODE
 
 EXECUTORS = ("threads", "dask")
 DEFAULT_EXECUTOR = "threads"    # why: README "On a cluster: Dask" (start-up, ports)
@@ -58,7 +59,7 @@ CLOSE_TIMEOUT_S = 1.0           # closing the local cluster after Ctrl-C
 TASK_PREFIX = "toppling"        # Dask keys and worker temporary directories
 # The model code (what turns a motion and parameters into an outcome, as in the run ids):
 # a worker whose imported copy differs from the client's files refuses the task.
-WORKER_CODE = ("scenario", "outcome", "motion", "simulate", "yade_scripts")
+WORKER_CODE = RUN_CODE
 
 
 class RunError(ToolError):

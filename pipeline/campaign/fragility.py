@@ -50,6 +50,7 @@ from pipeline.campaign.definitions import (column_specs, motion_cache, pulse_rec
                                            run_code_version, run_column_spec)
 from pipeline.campaign import ensemble   # module: imported while ensemble may still load
 from pipeline.campaign.tables import collect
+from pipeline.constants import MODEL_GRAVITY
 from pipeline.files import InputError, write_csv, write_json
 from pipeline.motion import Motion
 from pipeline.motion.measures import horizontal_peak, record_parameters
@@ -360,7 +361,8 @@ def summarise(table, specs, cost):
                                for im, (key, unit, _) in INTENSITY_MEASURES.items()},
         "columns": columns, "comparison": comparison,
         "levels": levels.to_dict(orient="records"),
-        "block2d": {"alpha_rad": alpha, "p_per_s": p, "uplift_acc_m_s2": 9.81 * math.tan(alpha),
+        "block2d": {"alpha_rad": alpha, "p_per_s": p,
+                    "uplift_acc_m_s2": MODEL_GRAVITY * math.tan(alpha),
                     "restitution": "Housner, 1 - 1.5 sin^2 alpha",
                     "excitation": "horizontal acceleration projected on an azimuth; no "
                                   "vertical motion, no sliding",

@@ -10,7 +10,9 @@ from pipeline.campaign.column_file import add_column_file_argument
 from pipeline.files import DirectoryLock, InputError
 from pipeline.records import processed_motion, resolve
 from pipeline.scenario import Column, Contact, Numerics
-from pipeline.scenario.parameters import add_arguments, check_time_step, from_args
+from pipeline.scenario.parameters import (add_arguments, check_cost, check_time_step,
+                                          from_args, scene_params)
+from pipeline.scenario.runner import wall_limit_s
 from pipeline.simulate import MAX_SCALE, back_azimuth_of, check_scale, simulate
 
 NAME = "run"
@@ -85,6 +87,8 @@ def run(args):
     if length > MAX_DURATION_S:
         raise InputError(f"the record lasts {motion.duration:.0f} s: give --window START END "
                          f"(at most {MAX_DURATION_S:g} s simulated)")
+    check_cost(scene_params(columns=column.specs(), contact=contact, numerics=numerics,
+                            motion_duration=length), wall_limit_s(length + numerics.tail_s))
     with DirectoryLock(out, wait=False):
         summary = simulate(motion, out, column=column, contact=contact, numerics=numerics,
                            window=args.window, rotate_deg=args.rotate, scale=args.scale,

@@ -233,6 +233,47 @@ def dt_factor_for(contact, numerics):
     return min(CONVERGED_DT_FACTOR, largest_stable_dt_factor(contact.damping))
 
 
+US_PER_BODY_STEP = 8.0   # wall us per body and time step: twin model 4.5 (8 bodies, ~36 us
+#                          a step), a stack of 60 thin drums over 6.7 (it hit its wall limit)
+
+
+def time_step_s(columns, contact, rim_points, dt_factor):
+    """The scene's time step (s): ``dt_factor`` sqrt(m / (kn x base points)) of its
+    lightest body on its base rim (at least ``rim_points`` points), as
+    yade_scripts/column_scene.py computes it (same operations, same value)."""
+    stiffness = []
+    for column in columns:
+        for body in column["bodies"]:
+            base = next(r for r in body["rims"] if r["role"] == "base")
+            n_base = rim_points if base["kind"] == "circle" else len(base["points"])
+            stiffness.append((body["mass"], contact.kn * max(n_base, rim_points)))
+    return dt_factor * math.sqrt(min(m / k for m, k in stiffness))
+
+
+def estimated_wall_s(params, simulated_s):
+    """Rough wall time (s) of simulating ``simulated_s`` seconds of the scene ``params``
+    (US_PER_BODY_STEP per body and step), for a warning before long runs."""
+    bodies = sum(len(c["bodies"]) for c in params["columns"])
+    return simulated_s / params["time_step_s"] * bodies * US_PER_BODY_STEP * 1e-6
+
+
+def check_cost(params, wall_limit_s):
+    """InputError when the scene ``params`` would need more wall time for its t_max than
+    ``wall_limit_s`` (the run's wall-clock limit would end it): say so before starting;
+    a note on stdout when it takes over 5 minutes.  Returns the estimate (s)."""
+    estimate = estimated_wall_s(params, params["t_max"])
+    bodies = sum(len(c["bodies"]) for c in params["columns"])
+    what = (f"{bodies} bodies stepping {params['time_step_s']:.2g} s for "
+            f"{params['t_max']:.0f} s simulated: about {estimate / 60:.0f} min")
+    if estimate > wall_limit_s:
+        raise InputError(f"{what}, beyond the run's wall-clock limit ({wall_limit_s / 60:.0f} "
+                         "min): use fewer or heavier blocks, a stiffer contact or a shorter "
+                         "--window")
+    if estimate > 300.0:
+        print(f"note: {what} at most (quiet parts are skipped)", flush=True)
+    return estimate
+
+
 def check_time_step(contact, numerics):
     """InputError when the time-step factor is too coarse for the contact damping."""
     limit = largest_stable_dt_factor(contact.damping)
@@ -271,10 +312,13 @@ def scene_params(columns=(), block=None, contact=None, numerics=None, motion_dur
         reach = math.hypot(spec.x, spec.y) + 1.1 * spec.geometry.height + 2.0
         if reach > pedestal["contact_half_size"]:
             pedestal["contact_half_size"] = float(math.ceil(reach))
-    return {"columns": [spec.scene(numerics.rim_points) for spec in specs],
+    scene_columns = [spec.scene(numerics.rim_points) for spec in specs]
+    dt_factor = dt_factor_for(contact, numerics)
+    return {"columns": scene_columns,
             "block": None if block is None else dataclasses.asdict(block),
             "contact": dataclasses.asdict(contact), "pedestal": pedestal,
-            **dataclasses.asdict(numerics), "dt_factor": dt_factor_for(contact, numerics),
+            **dataclasses.asdict(numerics), "dt_factor": dt_factor,
+            "time_step_s": time_step_s(scene_columns, contact, numerics.rim_points, dt_factor),
             "t_max": float(t_max),
             "motion_file": None, "output": "trajectory.npz"}
 

@@ -6,6 +6,7 @@ import math
 import numpy as np
 from scipy import optimize, stats
 
+from pipeline.constants import MODEL_GRAVITY
 from pipeline.stats.circular import angle_difference_deg, circular_summary, direction_class
 
 
@@ -223,7 +224,7 @@ def binary_regression(X, y, link="logit", firth=False):
 LOGISTIC_SURFACE_FORM = "logit P = b0 + b1 ln(PGA / 1 m/s^2) + b2 ln(PGV/PGA / 1 s)"
 
 
-def logistic_surface(pga, pgv_pga, toppled, alpha=None, p=None, g=9.81):
+def logistic_surface(pga, pgv_pga, toppled, alpha=None, p=None, g=MODEL_GRAVITY):
     """Two-parameter logistic fragility surface after Purvance et al. (2008):
     logit P(toppled) = b0 + b1 ln PGA + b2 ln(PGV/PGA) (PGA in m/s^2, PGV/PGA in s),
     fitted by maximum likelihood (statsmodels when installed, else scipy.optimize;

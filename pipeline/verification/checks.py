@@ -18,7 +18,7 @@ from pipeline.motion.pulses import phased_sine_pulse
 from pipeline.outcome.columns import body_axes, rotation_from_start_deg
 from pipeline.scenario import (Block, Column, Contact, Numerics, run_yade, scene_params,
                                write_scenario)
-from pipeline.scenario.parameters import split_options
+from pipeline.scenario.parameters import split_options, time_step_s
 
 MARBLE_BLOCK = paper.MARBLE_BLOCK_M
 PULSE_BLOCK = paper.PULSE_BLOCK_M
@@ -222,8 +222,11 @@ def still_rotation_deg(run_dir, model, damping, dt_factor, seconds=5.0):
     n = int(round(seconds / 0.01)) + 1
     zeros = np.zeros((n, 3))
     still = Motion(0.01, zeros, zeros, zeros, meta={"record_id": "still"})
-    params = scene_params(columns=column.specs(), contact=Contact(damping=damping),
+    contact = Contact(damping=damping)
+    params = scene_params(columns=column.specs(), contact=contact,
                           motion_duration=still.duration, t_max=still.duration)
     params["dt_factor"] = dt_factor
+    params["time_step_s"] = time_step_s(params["columns"], contact, params["rim_points"],
+                                        dt_factor)
     write_scenario(run_dir, params, still)
     return rotation_from_start_deg(run_yade(run_dir))

@@ -88,3 +88,33 @@ def test_pool_workers_die_with_their_parent(tmp_path):
                  and "Z" not in open(f"/proc/{p}/stat").read().split()[2]]
         time.sleep(0.05)
     assert not alive
+
+
+def test_a_run_that_cannot_finish_in_its_wall_clock_limit_is_refused_before_it_starts(
+        tmp_path, capsys):
+    """60 drums of 2 cm (column files allow 2 cm): a time step 4x finer and 8x the
+    bodies of the paper's column; on a 290 s record the estimate says before anything
+    runs that it cannot finish; on 120 s it notes the time it may take."""
+    import json
+    column = {"name": "thin drums", "density": 2700.0,
+              "blocks": [{"shape": "frustum", "height": 0.02, "bottom_diameter": 0.58,
+                          "top_diameter": 0.58}] * 60}
+    path = tmp_path / "thin.json"
+    path.write_text(json.dumps(column))
+    record = tmp_path / "pulse.npz"
+    from pipeline.motion.pulses import one_sine_pulse
+    from pipeline.motion import Motion
+    m = one_sine_pulse(0.0, 5.0, duration=290.0, dt=0.01)
+    Motion(m.dt, m.acc, m.vel, m.disp, meta={"record_id": "p"}).save(record)
+    err = one_line_error(capsys, cli.main(["run", "--record", str(record), "--column",
+                                           "drums", "--column-file", str(path),
+                                           "--out", str(tmp_path / "out")]))
+    assert "60 bodies" in err and "wall-clock limit" in err
+    assert not (tmp_path / "out").exists()
+    from pipeline.scenario import ColumnGeometry, ColumnSpec, scene_params
+    from pipeline.scenario.parameters import check_cost
+    sixty = ColumnGeometry.from_dict(column)
+    params = scene_params(columns=[ColumnSpec("drums", "drums", 0.0, 0.0, sixty)],
+                          motion_duration=120.0)
+    assert check_cost(params, 1e9) > 600.0
+    assert "note: 60 bodies" in capsys.readouterr().out

@@ -149,3 +149,15 @@ def test_time_step_limit_keeps_a_still_column_still(tmp_path, damping):
         with pytest.raises(InputError, match="--dt-factor 0.3 with --damping 1"):
             check_time_step(Contact(damping=1.0), Numerics(dt_factor=0.3))
         assert still_rotation_deg(tmp_path / "old", "twin", 1.0, 0.4, seconds=1.0) > 1.0
+
+
+@pytest.mark.parametrize("column", [Column("both"), Column("both", column_file="doric-peristyle")])
+def test_time_step_is_the_one_the_parameters_compute(tmp_path, column):
+    """scene_params' time_step_s (used by the cost estimate) is the step the scene takes,
+    and the scene's own formula (for scenes written without it) gives the same bits."""
+    params = scene_params(columns=column.specs(), t_max=1e-3)
+    write_scenario(tmp_path / "given", params, None)
+    without = {k: v for k, v in params.items() if k != "time_step_s"}
+    write_scenario(tmp_path / "formula", without, None)
+    assert run_yade(tmp_path / "given").dt == params["time_step_s"]
+    assert run_yade(tmp_path / "formula").dt == params["time_step_s"]
