@@ -10,12 +10,13 @@ A run spec is a dict with ``run_id`` (content hash of its inputs and of the code
 that turns them into an outcome), ``record``/``record_id`` and the parameters.
 """
 import os
+import shutil
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable
 
 from pipeline import RESULTS_DIR
-from pipeline.files import DirectoryLock, InputError, write_json
+from pipeline.files import DirectoryLock, InputError, ToolError, write_json
 
 CAMPAIGNS = {}
 
@@ -64,7 +65,7 @@ def run_campaign(name, jobs=None, records=None, campaign_dir=None, animations=1,
     Ctrl-C stops within seconds: no new run starts, running YADE processes end,
     the tables of the finished runs are written, then KeyboardInterrupt propagates.
     """
-    from pipeline.campaign.executor import EXECUTORS, execute
+    from pipeline.campaign.executor import EXECUTORS
     campaign = get(name)
     if executor is not None and executor not in EXECUTORS:
         raise InputError(f"--executor must be one of {', '.join(EXECUTORS)}, got {executor!r}")
@@ -77,7 +78,21 @@ def run_campaign(name, jobs=None, records=None, campaign_dir=None, animations=1,
     campaign_dir = Path(campaign_dir or RESULTS_DIR / name)
     if campaign_dir.exists() and not campaign_dir.is_dir():
         raise InputError(f"--out {campaign_dir} is a file, not a directory")
-    specs = campaign.specs(records, campaign_dir, **(options or {}))
+    existed = campaign_dir.exists()
+    try:
+        specs = campaign.specs(records, campaign_dir, **(options or {}))
+        return _run_specs(campaign, name, specs, campaign_dir, jobs, animations, executor,
+                          scheduler)
+    except (InputError, ToolError, OSError):
+        if not existed and not (campaign_dir / "campaign.json").exists() and \
+                not any(campaign_dir.glob("runs/*/summary.json")):
+            shutil.rmtree(campaign_dir, ignore_errors=True)   # a refusal leaves nothing
+        raise
+
+
+def _run_specs(campaign, name, specs, campaign_dir, jobs, animations, executor, scheduler):
+    """Execute the specs and write the campaign's outputs (see :func:`run_campaign`)."""
+    from pipeline.campaign.executor import execute
     with DirectoryLock(campaign_dir, wait=False):
         failures, interrupted = execute(specs, campaign_dir, jobs, campaign.worker,
                                         campaign.label, executor=executor,
@@ -91,7 +106,6 @@ def run_campaign(name, jobs=None, records=None, campaign_dir=None, animations=1,
     if interrupted:
         raise KeyboardInterrupt
     if failures:
-        from pipeline.files import ToolError
         raise ToolError(f"{len(failures)} run(s) failed; see error.txt in their run "
                         "directories; rerun the campaign to retry them")
     return result

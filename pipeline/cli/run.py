@@ -83,10 +83,19 @@ def run(args):
         raise InputError(f"--out {out} exists and is not a directory")
     motion, _ = processed_motion(args.record, back_azimuth=args.back_azimuth, cache_dir=None,
                                  mode=args.processing)
-    length = (args.window[1] - args.window[0]) if args.window else motion.duration
-    if length > MAX_DURATION_S:
-        raise InputError(f"the record lasts {motion.duration:.0f} s: give --window START END "
-                         f"(at most {MAX_DURATION_S:g} s simulated)")
+    if args.window:
+        if args.window[0] >= motion.duration:
+            raise InputError(f"--window starts at {args.window[0]:g} s, after the motion ends "
+                             f"({motion.duration:.1f} s)")
+        length = min(args.window[1], motion.duration) - args.window[0]
+        if length > MAX_DURATION_S:
+            raise InputError(f"--window spans {length:.0f} s: at most {MAX_DURATION_S:g} s "
+                             "are simulated")
+    else:
+        length = motion.duration
+        if length > MAX_DURATION_S:
+            raise InputError(f"the record lasts {motion.duration:.0f} s: give --window START "
+                             f"END (at most {MAX_DURATION_S:g} s simulated)")
     check_cost(scene_params(columns=column.specs(), contact=contact, numerics=numerics,
                             motion_duration=length), wall_limit_s(length + numerics.tail_s))
     with DirectoryLock(out, wait=False):

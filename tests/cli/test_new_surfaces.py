@@ -118,3 +118,23 @@ def test_a_run_that_cannot_finish_in_its_wall_clock_limit_is_refused_before_it_s
                           motion_duration=120.0)
     assert check_cost(params, 1e9) > 600.0
     assert "note: 60 bodies" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("window, words", [(("0", "400"), "--window spans"),
+                                           (("500", "600"), "after the motion ends")])
+def test_run_window_errors_say_what_is_wrong(tmp_path, capsys, window, words):
+    from pipeline.motion import Motion
+    from pipeline.motion.pulses import one_sine_pulse
+    m = one_sine_pulse(0.0, 5.0, duration=400.0, dt=0.05)
+    record = Motion(m.dt, m.acc, m.vel, m.disp, meta={"record_id": "p"}).save(tmp_path / "p.npz")
+    err = one_line_error(capsys, cli.main(["run", "--record", str(record), "--window", *window,
+                                           "--out", str(tmp_path / "out")]))
+    assert words in err and not (tmp_path / "out").exists()
+
+
+def test_a_refused_campaign_leaves_nothing(tmp_path, capsys):
+    """An unknown record after a good one: the good one was processed into the campaign's
+    motion cache before the refusal; nothing of it stays."""
+    err = one_line_error(capsys, cli.main(["campaign", "records", "--records", "GM20,NOPE",
+                                           "--out", str(tmp_path / "camp")]))
+    assert "NOPE" in err and not (tmp_path / "camp").exists()
