@@ -32,7 +32,7 @@ campaigns: records
 	$(PY) -m pipeline campaign friction --jobs $(JOBS)
 	$(PY) -m pipeline campaign records --jobs $(JOBS)
 	$(PY) -m pipeline campaign synthetic --jobs $(JOBS)
-	$(PY) -m pipeline campaign ensemble --records GM20,NF04,RC-CCC,RSN126-GAZLI --members 6 --jobs $(JOBS)
+	$(PY) -m pipeline campaign ensemble --records GM20,NF04,RC-CCC,RSN126-GAZLI --members 6 --max-members 6 --jobs $(JOBS)
 
 run-all: campaigns
 	$(PY) -m pipeline report

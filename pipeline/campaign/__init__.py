@@ -35,6 +35,8 @@ class Campaign:
     label: str = "runs"
     options: Callable = None       # options(parser): campaign-specific command-line options
     read_options: Callable = None  # read_options(args) -> dict of keyword options for specs
+    driver: Callable = None        # driver(run, records, campaign_dir, options): runs it
+    #                                (several times: ensembles sized by their error)
 
 
 def register(campaign):

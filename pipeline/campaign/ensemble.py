@@ -106,9 +106,23 @@ def check_vary_value(name, value):
             raise InputError(f"{flag}{value:g} outside the allowed range [{lo:g}, {hi:g}]")
 
 
+def sample_batches(members, batch, seed, ranges=None, column="both", description=None,
+                   kn=paper.COLUMN_KN_N_M):
+    """Parameters of ``members`` runs in Latin-hypercube batches of ``batch``: batch 0 is
+    :func:`sample_members` of ``seed`` (a fixed ensemble of ``batch`` members), batch b
+    a hypercube of its own (seed [seed, b]), so that adding a batch reuses every member
+    that ran."""
+    rows = []
+    for b in range(-(-members // batch)):
+        rows += sample_members(batch, seed if b == 0 else [seed, b], ranges, column,
+                               description=description, kn=kn, first_index=b * batch)
+    return rows[:members]
+
+
 def sample_members(members, seed, ranges=None, column="both", mu_k_ratio=paper.MU_K_OVER_MU_S,
-                   description=None, kn=paper.COLUMN_KN_N_M):
-    """Parameters of ``members`` runs (list of dicts for run_column_spec), Latin hypercube.
+                   description=None, kn=paper.COLUMN_KN_N_M, first_index=0):
+    """Parameters of ``members`` runs (list of dicts for run_column_spec), Latin hypercube
+    (``seed``: an integer, or a list for a batch; members numbered from ``first_index``).
 
     ``description`` (a column description dict): every member is that column with the
     sampled tolerances, tilt and offsets applied
@@ -118,9 +132,10 @@ def sample_members(members, seed, ranges=None, column="both", mu_k_ratio=paper.M
     if not (isinstance(members, int) and 1 <= members <= 10000):
         raise InputError(f"--members must be an integer in [1, 10000], got {members!r}")
     names = sorted(ranges)
-    unit = qmc.LatinHypercube(d=len(names), seed=seed).random(members)
+    rng = seed if isinstance(seed, int) else np.random.default_rng(seed)
+    unit = qmc.LatinHypercube(d=len(names), seed=rng).random(members)
     rows = []
-    for index, u in enumerate(unit):
+    for index, u in enumerate(unit, start=first_index):
         v = {}
         for name, x in zip(names, u):
             lo, hi, kind = ranges[name]
@@ -137,17 +152,22 @@ def sample_members(members, seed, ranges=None, column="both", mu_k_ratio=paper.M
         if "scale" in v:
             params["scale"] = round(v["scale"], 6)
         if description is not None:
-            params["column_file"] = described_member(description, v, seed, index)
+            params["column_file"] = described_member(description, v, _first(seed), index)
         elif any(v.get(k) for k in GEOMETRY_KEYS):
             params["column_file"] = perturbed(
                 paper_drums(height, diameter), tilt_deg=v.get("tilt_deg", 0.0),
                 tilt_azimuth_deg=v.get("tilt_azimuth_deg", 0.0),
                 max_offset_m=v.get("drum_offset_mm", 0.0) / 1000.0,
-                rng=np.random.default_rng([seed, index]))
+                rng=np.random.default_rng([_first(seed), index]))
         if "column_file" in params:             # the description fixes the sizes
             del params["hd"], params["height"]
         rows.append(params)
     return rows
+
+
+def _first(seed):
+    """The campaign's seed of an integer seed or a batch's [seed, b]."""
+    return seed if isinstance(seed, int) else int(seed[0])
 
 
 def described_member(data, v, seed, index):
@@ -187,7 +207,10 @@ def nominal(column="both", description=None, kn=None):
 
 
 def ensemble_specs(records, campaign_dir, record=None, column="both", members=DEFAULT_MEMBERS,
-                   seed=DEFAULT_SEED, vary=None, column_file=None, stiffness="matched", **_):
+                   seed=DEFAULT_SEED, vary=None, column_file=None, stiffness="matched",
+                   batch=None, record_members=None, **_):
+    """Specs of the nominal run and ``members`` members per record (``record_members``:
+    {record: members} overrides it per record), sampled in batches of ``batch``."""
     data = column_file_description(column_file)
     records = list(records or []) + ([record] if record else [])
     if not records:
@@ -196,21 +219,25 @@ def ensemble_specs(records, campaign_dir, record=None, column="both", members=DE
         raise InputError(f"--column must be both, monolithic or drums, got {column!r}")
     check_stiffness(stiffness)
     ranges = dict(ENSEMBLE_RANGES, **(vary or {}))
+    batch = batch or members
+    counts = {rec: (record_members or {}).get(rec, members) for rec in records}
+    most = max(counts.values())
     if data is None:
-        member_params = sample_members(members, seed, ranges, column)
+        member_params = sample_batches(most, batch, seed, ranges, column)
         nominal_params = nominal(column)
     else:
         kn = column_kn(data, stiffness)
-        member_params = sample_members(members, seed, ranges, column, description=data, kn=kn)
+        member_params = sample_batches(most, batch, seed, ranges, column, description=data,
+                                       kn=kn)
         nominal_params = nominal(column, data, kn)
-    runs = []
+    runs, member_numbers = [], []
     for rec in records:
         runs.append((rec, nominal_params))
-        runs += [(rec, p) for p in member_params]
+        runs += [(rec, p) for p in member_params[:counts[rec]]]
+        member_numbers += range(-1, counts[rec])        # -1: the nominal run
     specs = mark(column_specs(runs, campaign_dir), data)
-    per_record = members + 1
-    for k, spec in enumerate(specs):
-        spec["member"] = (k % per_record) - 1          # -1: the nominal run
+    for spec, member in zip(specs, member_numbers):
+        spec["member"] = member
         spec["seed"] = seed
         spec["keep_trajectory"] = spec["member"] < KEPT_TRAJECTORIES   # summaries for all
     return specs
@@ -235,6 +262,8 @@ def ensemble_outputs(specs, campaign_dir, failures, animations, figures=True):
         write_csv(out / "members.csv", sub)
         write_parquet(out / "members.parquet", sub)
         summary = summarise(sub, record_id, specs[0]["seed"])
+        summary["record_input"] = next(sp["record"] for sp in specs
+                                       if sp["record_id"] == record_id)
         if described:
             summary["column_file"] = described["column_file"]["name"]
         write_json(out / "ensemble_summary.json", summary)
@@ -251,6 +280,22 @@ def ensemble_outputs(specs, campaign_dir, failures, animations, figures=True):
         write_json(campaign_dir / "ensemble_summaries.json", summaries)
     return {"code_version": run_code_version(), **described,
             "figures": [str(Path(p).relative_to(campaign_dir)) for p in written]}
+
+
+def mean_direction_error_deg(azimuths_deg):
+    """Standard error (deg) of the circular mean of ``azimuths_deg`` (Fisher 1993, eq.
+    4.21: sqrt((1 - R2) / (2 n R^2)), R2 the mean resultant of the doubled deviations);
+    None for fewer than 2 or a mean that is not defined."""
+    a = np.radians(np.asarray(azimuths_deg, float))
+    a = a[np.isfinite(a)]
+    if a.size < 2:
+        return None
+    c, s = np.cos(a).mean(), np.sin(a).mean()
+    r = math.hypot(c, s)
+    if r < 1e-9:
+        return None
+    r2 = float(np.cos(2 * (a - math.atan2(s, c))).mean())
+    return float(math.degrees(math.sqrt(max(0.0, 1 - r2) / (2 * a.size * r * r))))
 
 
 def summarise(runs, record_id, seed):
@@ -274,6 +319,9 @@ def summarise(runs, record_id, seed):
             "column": column, "members": int(len(group)), "toppled": int(len(fell)),
             "p_toppled": float(len(fell) / len(group)),
             "p_toppled_ci95": wilson_interval(len(fell), len(group)),
+            "p_toppled_mc_error": float(math.sqrt(len(fell) * (len(group) - len(fell))
+                                                  / len(group) ** 3)),
+            "mean_azimuth_mc_error_deg": mean_direction_error_deg(az),
             "mean_downfall_azimuth_deg": None if not len(fell) or not np.isfinite(
                 stats["mean_deg"]) else stats["mean_deg"],
             "resultant_length": None if not len(fell) else stats["resultant_length"],
@@ -288,13 +336,81 @@ def summarise(runs, record_id, seed):
             "back_azimuth_deg": back, "columns": columns}
 
 
+DEFAULT_PRECISION = 0.1       # half-width of P(toppled)'s 95 % interval
+DEFAULT_ARC_DEG = 60.0        # width of the mean direction's 95 % interval, where falls gather
+DEFAULT_MAX_MEMBERS = 256
+CONCENTRATED = {"falls": 5, "resultant_length": 0.5}   # "falls concentrate"
+
+
+def converged(summary, precision, arc_deg):
+    """(bool, why) for one record's summary: every column's P(toppled) interval within
+    +-``precision`` and, where falls concentrate, its mean-direction interval under
+    ``arc_deg``."""
+    for col in summary["columns"]:
+        lo, hi = col["p_toppled_ci95"]
+        if (hi - lo) / 2 > precision:
+            return False, f"{col['column']}: P(toppled) +-{(hi - lo) / 2:.2f}"
+        ci = col.get("mean_azimuth_ci95_deg")
+        if (col["toppled"] >= CONCENTRATED["falls"] and ci is not None
+                and (col["resultant_length"] or 0) >= CONCENTRATED["resultant_length"]):
+            width = (ci[1] - ci[0]) % 360.0
+            if width > arc_deg:
+                return False, f"{col['column']}: mean direction arc {width:.0f} deg"
+    return True, "precision reached"
+
+
+def run_sized(run, records, campaign_dir, options):
+    """Add members in Latin-hypercube batches of ``options["members"]`` to the records not
+    yet converged (:func:`converged`) until all are or ``max_members`` is reached; each
+    record's ensemble_summary.json gets ``sizing`` (target, members, why it stopped).
+    ``run(options)`` runs the campaign once and returns its outputs dict."""
+    batch, cap = options["members"], options["max_members"]
+    precision, arc = options["precision"], options["arc_deg"]
+    counts = {rec: min(batch, cap) for rec in records}
+    while True:
+        result = run({**options, "batch": batch, "record_members": dict(counts)})
+        pending = {}
+        for summary in result.get("summaries", []):
+            rec = summary["record_input"]
+            ok, why = converged(summary, precision, arc)
+            if not ok and counts[rec] < cap:
+                pending[rec] = why
+            summary["sizing"] = {"precision": precision, "arc_deg": arc, "batch": batch,
+                                 "max_members": cap, "members": counts[rec],
+                                 "stopped_by": "precision" if ok else "member cap",
+                                 "open": None if ok else why}
+        if not pending:
+            break
+        for rec, why in pending.items():
+            print(f"{rec}: {why} after {counts[rec]} members: adding {batch}", flush=True)
+            counts[rec] = min(cap, counts[rec] + batch)
+    for summary in result.get("summaries", []):
+        out = Path(campaign_dir)
+        if len(result["summaries"]) > 1:
+            out = out / summary["record"]
+        write_json(out / "ensemble_summary.json", summary)
+    if len(result.get("summaries", [])) > 1:
+        write_json(Path(campaign_dir) / "ensemble_summaries.json", result["summaries"])
+    return result
+
+
 def ensemble_options(parser):
     parser.add_argument("--record", metavar="ID_OR_FILE", default=None,
                         help="catalogue id, record file or processed .npz")
     parser.add_argument("--column", choices=("both", "monolithic", "drums"), default="both",
                         help="column model (default both: the twin model)")
     parser.add_argument("--members", type=int, default=DEFAULT_MEMBERS,
-                        help=f"ensemble members per record (default {DEFAULT_MEMBERS})")
+                        help=f"members of the first Latin-hypercube batch, and of each batch "
+                        f"added (default {DEFAULT_MEMBERS})")
+    parser.add_argument("--precision", type=float, default=DEFAULT_PRECISION,
+                        help="members are added until P(toppled)'s 95 %% interval is within "
+                        f"+- this (default {DEFAULT_PRECISION:g}; 0-0.5)")
+    parser.add_argument("--arc-deg", type=float, default=DEFAULT_ARC_DEG,
+                        help="... and, where falls gather, the mean direction's 95 %% "
+                        f"interval narrower than this (deg, default {DEFAULT_ARC_DEG:g})")
+    parser.add_argument("--max-members", type=int, default=DEFAULT_MAX_MEMBERS,
+                        help="the most members per record (default "
+                        f"{DEFAULT_MAX_MEMBERS}; equal to --members: a fixed ensemble)")
     parser.add_argument("--seed", type=int, default=DEFAULT_SEED,
                         help=f"seed of the Latin hypercube (default {DEFAULT_SEED})")
     parser.add_argument("--vary", action="append", default=[], metavar="NAME=LO,HI",
@@ -334,12 +450,21 @@ def parse_vary(items):
 
 
 def read_options(args):
+    if not (isinstance(args.members, int) and 1 <= args.members <= 10000):
+        raise InputError(f"--members must be an integer in [1, 10000], got {args.members!r}")
+    if not args.members <= args.max_members <= 10000:
+        raise InputError(f"--max-members must lie in [--members, 10000], got {args.max_members}")
+    if not (math.isfinite(args.precision) and 0.0 <= args.precision <= 0.5):
+        raise InputError(f"--precision must lie in [0, 0.5], got {args.precision:g}")
+    if not (math.isfinite(args.arc_deg) and 0.0 <= args.arc_deg <= 360.0):
+        raise InputError(f"--arc-deg must lie in [0, 360], got {args.arc_deg:g}")
     return {"record": args.record, "column": args.column, "members": args.members,
-            "seed": check_seed(args.seed), "vary": parse_vary(args.vary),
-            **read_campaign_options(args)}
+            "max_members": args.max_members, "precision": args.precision,
+            "arc_deg": args.arc_deg, "seed": check_seed(args.seed),
+            "vary": parse_vary(args.vary), **read_campaign_options(args)}
 
 
 register(Campaign("ensemble", "N members with sampled friction, damping, stiffness, "
                   "geometry tolerances and rim phase: probabilities of toppling and direction",
                   ensemble_specs, run_column_spec, ensemble_outputs, label="members",
-                  options=ensemble_options, read_options=read_options))
+                  options=ensemble_options, read_options=read_options, driver=run_sized))

@@ -57,7 +57,16 @@ def run(args):
         records = sets.record_ids(record_set)
     definition = campaign.get(args.name)
     options = definition.read_options(args) if definition.read_options else {}
-    campaign.run_campaign(args.name, jobs=args.jobs, records=records, campaign_dir=args.out,
-                          animations=args.animations, options=options,
-                          executor=args.executor, scheduler=args.scheduler)
+    def run_once(opts):
+        return campaign.run_campaign(args.name, jobs=args.jobs, records=records,
+                                     campaign_dir=args.out, animations=args.animations,
+                                     options=opts, executor=args.executor,
+                                     scheduler=args.scheduler)
+
+    if definition.driver is None:
+        run_once(options)
+    else:
+        given = list(records or []) + ([options["record"]] if options.get("record") else [])
+        definition.driver(run_once, given, args.out or campaign.RESULTS_DIR / args.name,
+                          options)
     return 0

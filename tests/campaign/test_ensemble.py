@@ -69,3 +69,64 @@ def test_sub_threshold_motion_never_topples(tmp_path):
     for col in summary["columns"]:
         assert col["p_toppled"] == 0.0 and col["mean_downfall_azimuth_deg"] is None
         assert col["p_toppled_ci95"][0] == 0.0
+
+
+def fake_campaign(p_true, tmp_path):
+    """A stand-in for run_campaign: per record, k = round(p n) of n members toppled."""
+    from pipeline.campaign import ensemble
+    from pipeline.stats.ensemble import wilson_interval
+    calls = []
+
+    def run(options):
+        calls.append(dict(options["record_members"]))
+        summaries = []
+        for rec, n in options["record_members"].items():
+            k = int(round(p_true[rec] * n))
+            summaries.append({"record": rec, "record_input": rec, "columns": [
+                {"column": "drums", "members": n, "toppled": k, "p_toppled": k / n,
+                 "p_toppled_ci95": wilson_interval(k, n), "mean_azimuth_ci95_deg": None,
+                 "resultant_length": None}]})
+        return {"summaries": summaries}
+    return ensemble, run, calls
+
+
+def test_members_are_added_until_the_interval_is_narrow_enough(tmp_path):
+    """P = 0.5 needs about (1.96 / 0.1)^2 / 4 = 96 members for +-0.1; P = 0 is decided
+    within two batches of 16; each record stops by itself and says why."""
+    ensemble, run, calls = fake_campaign({"A": 0.5, "B": 0.0}, tmp_path)
+    options = {"members": 16, "max_members": 256, "precision": 0.1, "arc_deg": 60.0}
+    result = ensemble.run_sized(run, ["A", "B"], tmp_path, options)
+    sizing = {s["record"]: s["sizing"] for s in result["summaries"]}
+    assert sizing["A"]["stopped_by"] == "precision" and 96 <= sizing["A"]["members"] <= 112
+    assert sizing["B"]["stopped_by"] == "precision" and sizing["B"]["members"] <= 32
+    assert calls[0] == {"A": 16, "B": 16}
+    assert all(c["A"] - p["A"] in (0, 16) for p, c in zip(calls, calls[1:]))
+    written = json.loads((tmp_path / "A" / "ensemble_summary.json").read_text())
+    assert written["sizing"]["stopped_by"] == "precision"
+
+
+def test_the_member_cap_ends_the_sizing_and_says_so(tmp_path):
+    ensemble, run, _ = fake_campaign({"A": 0.5}, tmp_path)
+    options = {"members": 8, "max_members": 24, "precision": 0.0, "arc_deg": 60.0}
+    (summary,) = ensemble.run_sized(run, ["A"], tmp_path, options)["summaries"]
+    assert summary["sizing"]["members"] == 24 and summary["sizing"]["stopped_by"] == "member cap"
+    assert "P(toppled)" in summary["sizing"]["open"]
+
+
+def test_batches_keep_the_members_that_ran():
+    from pipeline.campaign import ensemble
+    first = ensemble.sample_members(6, ensemble.DEFAULT_SEED)
+    grown = ensemble.sample_batches(18, 6, ensemble.DEFAULT_SEED)
+    assert grown[:6] == first                      # a fixed 6-member ensemble, unchanged
+    assert grown[6:12] != first and grown[12:] != grown[6:12]
+    assert grown == ensemble.sample_batches(18, 6, ensemble.DEFAULT_SEED)   # reproducible
+
+
+def test_mean_direction_error_is_the_circular_standard_error():
+    from pipeline.campaign.ensemble import mean_direction_error_deg
+    rng = np.random.default_rng(3)
+    samples = rng.vonmises(0.0, 8.0, size=(400, 50))         # kappa 8: sigma ~ 20.7 deg
+    means = np.degrees(np.angle(np.exp(1j * samples).mean(axis=1)))
+    spread = means.std()                                       # the real Monte Carlo error
+    predicted = np.median([mean_direction_error_deg(np.degrees(s)) for s in samples])
+    assert predicted == pytest.approx(spread, rel=0.15)
