@@ -15,7 +15,8 @@ first site (azimuthal equidistant: distance and azimuth from obspy.geodetics).
 JSON/YAML file (relative to the observations file's folder); ``invert`` computes a forward
 table for each described column.  ``uncertainty_deg`` (optional, default
 10) is the 1-sigma uncertainty of the measured downfall azimuth.  Every problem is one
-line naming the site and column.
+line naming the site and column; so is every problem with the file itself (too large,
+not UTF-8, not JSON, nested too deeply, an integer of absurd length).
 """
 import json
 import math
@@ -23,12 +24,20 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from pipeline.files import InputError
+from pipeline.userfiles import MAX_FILE_BYTES, MAX_NESTING
+from pipeline.userfiles import Unreadable as _Unreadable
+from pipeline.userfiles import json_int as _json_int
+from pipeline.userfiles import keys_text as _keys
+from pipeline.userfiles import nesting as _nesting
+from pipeline.userfiles import show as _show
 
 DEFAULT_UNCERTAINTY_DEG = 10.0
 MAX_UNCERTAINTY_DEG = 120.0
 STATES = ("fallen", "standing")
 SITE_KEYS = {"name", "east_km", "north_km", "latitude", "longitude", "columns"}
 COLUMN_KEYS = {"column", "state", "downfall_azimuth_deg", "uncertainty_deg", "note"}
+MAX_SITES = 1000
+MAX_COLUMNS_PER_SITE = 1000
 
 
 @dataclass(frozen=True)
@@ -102,8 +111,12 @@ class Observations:
 
 def _number(value, what, low=None, high=None):
     if isinstance(value, bool) or not isinstance(value, (int, float)):
-        raise InputError(f"{what} must be a number, got {value!r}")
-    value = float(value)
+        raise InputError(f"{what} must be a number, got {_show(value)}")
+    try:
+        value = float(value)
+    except OverflowError:                     # an int beyond any float
+        raise InputError(f"{what} must lie in [{low:g}, {high:g}], got {_show(value)}") \
+            from None
     if not math.isfinite(value):
         raise InputError(f"{what} must be finite, got {value!r}")
     if (low is not None and value < low) or (high is not None and value > high):
@@ -111,19 +124,27 @@ def _number(value, what, low=None, high=None):
     return value
 
 
+def _file_name(text):
+    """Whether ``text`` can name a column file (printable, no part longer than a file
+    system allows)."""
+    return text.isprintable() and len(text) <= 1024 and \
+        all(len(part.encode()) <= 255 for part in text.split("/"))
+
+
 def parse_column(item, where):
     if not isinstance(item, dict):
         raise InputError(f"{where}: a column must be an object, got {type(item).__name__}")
-    unknown = sorted(set(item) - COLUMN_KEYS)
+    unknown = set(item) - COLUMN_KEYS
     if unknown:
-        raise InputError(f"{where}: unknown key(s) {', '.join(unknown)} (known: "
+        raise InputError(f"{where}: unknown key(s) {_keys(unknown)} (known: "
                          f"{', '.join(sorted(COLUMN_KEYS))})")
     column = item.get("column")
-    if not isinstance(column, str) or not column.strip():
+    if not isinstance(column, str) or not column.strip() or not _file_name(column.strip()):
         raise InputError(f"{where}: 'column' must be drums, monolithic or a column file name")
     state = item.get("state")
     if state not in STATES:
-        raise InputError(f"{where}: 'state' must be 'fallen' or 'standing', got {state!r}")
+        raise InputError(f"{where}: 'state' must be 'fallen' or 'standing', got "
+                         f"{_show(state)}")
     if state == "standing":
         if item.get("downfall_azimuth_deg") is not None:
             raise InputError(f"{where}: a standing column has no downfall_azimuth_deg")
@@ -143,6 +164,8 @@ def parse_observations(data, source="observations"):
     sites = data["sites"]
     if not isinstance(sites, list) or not sites:
         raise InputError(f"{source}: 'sites' must be a non-empty list")
+    if len(sites) > MAX_SITES:
+        raise InputError(f"{source}: {len(sites)} sites, at most {MAX_SITES}")
     raw, names = [], set()
     for k, site in enumerate(sites):
         where = f"{source}: site {k + 1}"
@@ -151,13 +174,13 @@ def parse_observations(data, source="observations"):
         name = site.get("name", f"site{k + 1}")
         if not isinstance(name, str) or not name.strip():
             raise InputError(f"{where}: 'name' must be a non-empty string")
-        where = f"{source}: site {name!r}"
+        where = f"{source}: site {_show(name)}"
         if name in names:
             raise InputError(f"{where}: two sites have this name")
         names.add(name)
-        unknown = sorted(set(site) - SITE_KEYS)
+        unknown = set(site) - SITE_KEYS
         if unknown:
-            raise InputError(f"{where}: unknown key(s) {', '.join(unknown)} (known: "
+            raise InputError(f"{where}: unknown key(s) {_keys(unknown)} (known: "
                              f"{', '.join(sorted(SITE_KEYS))})")
         has_km = "east_km" in site or "north_km" in site
         has_geo = "latitude" in site or "longitude" in site
@@ -177,6 +200,9 @@ def parse_observations(data, source="observations"):
         columns = site.get("columns")
         if not isinstance(columns, list) or not columns:
             raise InputError(f"{where}: 'columns' must be a non-empty list")
+        if len(columns) > MAX_COLUMNS_PER_SITE:
+            raise InputError(f"{where}: {len(columns)} columns, at most "
+                             f"{MAX_COLUMNS_PER_SITE}")
         parsed = tuple(parse_column(c, f"{where}, column {j + 1}")
                        for j, c in enumerate(columns))
         raw.append((name, position, parsed))
@@ -200,27 +226,57 @@ def parse_observations(data, source="observations"):
                 east = dist_m / 1e3 * math.sin(math.radians(az))
                 north = dist_m / 1e3 * math.cos(math.radians(az))
             if math.hypot(east, north) > 300.0:
-                raise InputError(f"{source}: site {name!r} lies {math.hypot(east, north):.0f} "
+                raise InputError(f"{source}: site {_show(name)} lies "
+                                 f"{math.hypot(east, north):.0f} "
                                  "km from the first site (more than 300 km: not one region)")
             out.append(Site(name, east, north, cols, lat, lon))
     for k, a in enumerate(out):
         for b in out[:k]:
             if math.hypot(a.east_km - b.east_km, a.north_km - b.north_km) < 1e-6:
-                raise InputError(f"{source}: sites {b.name!r} and {a.name!r} are at the same "
-                                 "place; list their columns under one site")
+                raise InputError(f"{source}: sites {_show(b.name)} and {_show(a.name)} are "
+                                 "at the same place; list their columns under one site")
     return Observations(tuple(out), source)
 
 
 def load_observations(path):
-    """Read and check an observations file; InputError (one line) for any problem."""
+    """Read and check an observations file; InputError (one line) for any problem, whatever
+    the file holds: its size is checked before reading, its nesting right after parsing."""
     path = Path(path)
-    if not path.is_file():
+    try:
+        found = path.is_file()
+    except (OSError, ValueError):               # a name too long, a NUL byte
+        found = False
+    if not found:
         raise InputError(f"observations file not found: {path}")
     try:
-        data = json.loads(path.read_text())
-    except UnicodeDecodeError:
-        raise InputError(f"{path.name}: not a text (JSON) file") from None
+        with open(path, "rb") as f:
+            content = f.read(MAX_FILE_BYTES + 1)
+    except OSError as exc:
+        raise InputError(f"{path.name}: cannot be read ({exc.strerror or exc})") from None
+    if len(content) > MAX_FILE_BYTES:
+        raise InputError(f"{path.name}: larger than {MAX_FILE_BYTES // 1_000_000} MB; not an "
+                         "observations file")
+    bom = 3 if content.startswith(b"\xef\xbb\xbf") else 0     # a UTF-8 BOM is allowed
+    try:
+        text = content[bom:].decode("utf-8")
+    except UnicodeDecodeError as exc:
+        at = bom + exc.start
+        raise InputError(f"{path.name}: not a text (JSON) file (byte {at + 1} is "
+                         f"0x{content[at]:02x}, not UTF-8)") from None
+    try:
+        data = json.loads(text, parse_int=_json_int)
     except json.JSONDecodeError as exc:
         raise InputError(f"{path.name}: not valid JSON (line {exc.lineno}, column "
                          f"{exc.colno}: {exc.msg})") from None
+    except _Unreadable as exc:
+        raise InputError(f"{path.name}: {exc}; not an observations file") from None
+    except RecursionError:                          # deeper than the parser goes
+        deep = True
+    else:
+        deep = _nesting(data, MAX_NESTING) > MAX_NESTING
+    if deep:
+        raise InputError(f"{path.name}: nested more than {MAX_NESTING} levels deep; not an "
+                         "observations file")
     return parse_observations(data, path.name)
+
+

@@ -43,7 +43,14 @@ from pathlib import Path
 
 import numpy as np
 
+from pipeline.constants import MODEL_GRAVITY
 from pipeline.files import InputError
+from pipeline.userfiles import MAX_FILE_BYTES, MAX_INT_DIGITS, MAX_NESTING
+from pipeline.userfiles import Unreadable as _Unreadable
+from pipeline.userfiles import json_int as _json_int
+from pipeline.userfiles import keys_text as _keys
+from pipeline.userfiles import nesting as _nesting
+from pipeline.userfiles import show as _show
 
 SHAPES = ("frustum", "box")
 TILT_MODES = ("wedge", "edge")
@@ -394,30 +401,54 @@ class ColumnGeometry:
     @classmethod
     def load(cls, name_or_path):
         """A description from a shipped example's name (``doric-peristyle``) or a file
-        (.json; .yaml/.yml with PyYAML)."""
+        (.json; .yaml/.yml with PyYAML).  Whatever the file holds, a problem is one
+        InputError naming the file (and the line and column where the parser knows them):
+        files over MAX_FILE_BYTES are refused unread, and nesting beyond MAX_NESTING,
+        integers over MAX_INT_DIGITS digits and YAML tags other than the standard ones
+        are refused while parsing."""
         text = str(name_or_path)
         path = Path(text)
         shipped = EXAMPLES_DIR / f"{text}.json"
-        if path.suffix == "" and "/" not in text and shipped.is_file():
-            path = shipped
-        if not path.is_file():
-            known = ", ".join(example_names())
-            raise InputError(f"--column-file {text}: no such file or shipped example "
-                             f"(shipped: {known})")
         try:
-            raw = path.read_text()
-            if path.suffix.lower() in (".yaml", ".yml"):
-                try:
-                    import yaml
-                except ImportError:
-                    raise InputError(f"{path}: reading YAML needs PyYAML (pip install pyyaml); "
-                                     "or give the description as JSON") from None
-                data = yaml.safe_load(raw)
-            else:
-                data = json.loads(raw)
-        except (OSError, UnicodeDecodeError, ValueError) as exc:
+            if path.suffix == "" and "/" not in text and shipped.is_file():
+                path = shipped
+            found = path.is_file()
+        except (OSError, ValueError):              # a name too long, a NUL byte
+            found = False
+        if not found:
+            known = ", ".join(example_names())
+            shown = text if text.isprintable() and len(text) <= 300 else _show(text)
+            raise InputError(f"--column-file {shown}: no such file or shipped example "
+                             f"(shipped: {known})")
+        yaml_file = path.suffix.lower() in (".yaml", ".yml")
+        if yaml_file:
+            try:
+                import yaml  # noqa: F401
+            except ImportError:
+                raise InputError(f"{path}: reading YAML needs PyYAML (pip install pyyaml); "
+                                 "or give the description as JSON") from None
+        try:
+            with open(path, "rb") as f:
+                content = f.read(MAX_FILE_BYTES + 1)
+            if len(content) > MAX_FILE_BYTES:
+                raise _Unreadable(f"larger than {MAX_FILE_BYTES // 1_000_000} MB; a column "
+                                  "description is a few kB")
+            bom = 3 if content.startswith(b"\xef\xbb\xbf") else 0   # a UTF-8 BOM is allowed
+            try:
+                raw = content[bom:].decode("utf-8")
+            except UnicodeDecodeError as exc:
+                at = bom + exc.start
+                raise _Unreadable(f"not UTF-8 text: byte {at + 1} is "
+                                  f"0x{content[at]:02x}") from None
+            data = _parse_yaml(raw) if yaml_file else _parse_json(raw)
+            if _nesting(data, MAX_NESTING) > MAX_NESTING:
+                raise _Unreadable(f"nested more than {MAX_NESTING} levels deep (or refers "
+                                  "to itself)")
+        except OSError as exc:
             raise InputError(f"{path}: not a readable column description ("
-                             f"{str(exc).splitlines()[0]})") from None
+                             f"{_one_line(exc.strerror or exc)})") from None
+        except _Unreadable as exc:
+            raise InputError(f"{path}: not a readable column description ({exc})") from None
         return cls.from_dict(data, where=str(path.name))
 
     @classmethod
@@ -425,9 +456,10 @@ class ColumnGeometry:
         """Validate a description dict; InputError with one line naming the problem."""
         if not isinstance(data, dict):
             raise InputError(f"{where}: expected a JSON object with name, density, blocks")
+        _check_keys(data, where)
         unknown = set(data) - TOP_KEYS
         if unknown:
-            raise InputError(f"{where}: unknown key(s) {', '.join(sorted(unknown))} "
+            raise InputError(f"{where}: unknown key(s) {_keys(unknown)} "
                              f"(allowed: {', '.join(sorted(TOP_KEYS))})")
         for key in ("name", "density", "blocks"):
             if key not in data:
@@ -493,7 +525,7 @@ class ColumnGeometry:
                                  "cannot stand")
         return statics
 
-    def statics(self, g=9.81):
+    def statics(self, g=MODEL_GRAVITY):
         """Per joint (body k on what is below it): ``ratio`` = rocking threshold / g
         (``lever_m``, the horizontal distance from the rocking edge to the centre of mass
         of bodies k.., over its height above that edge; 0 for a block released on its
@@ -505,7 +537,7 @@ class ColumnGeometry:
         """Smallest rocking threshold of any stack / g (tan alpha of a single block)."""
         return min(j["ratio"] for j in self.statics())
 
-    def overturning_barrier(self, g=9.81):
+    def overturning_barrier(self, g=MODEL_GRAVITY):
         """Smallest energy (J) that tips any stack of bodies over its edge."""
         return min(j["barrier_j"] for j in self.statics(g))
 
@@ -531,35 +563,118 @@ class ColumnGeometry:
 
 
 def _number(value, what, low, high, unit, low_open=False):
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-        raise InputError(f"{what} must be a finite number, got {value!r}")
-    if (value <= low if low_open else value < low) or value > high:
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or \
+            (isinstance(value, float) and not math.isfinite(value)):
+        raise InputError(f"{what} must be a finite number, got {_show(value)}")
+    if (value <= low if low_open else value < low) or value > high:   # exact for any int
         bracket = "(" if low_open else "["
-        raise InputError(f"{what} {value:g} outside the plausible range {bracket}{low:g}, "
+        raise InputError(f"{what} {_g(value)} outside the plausible range {bracket}{low:g}, "
                          f"{high:g}] {unit}".rstrip())
     return float(value)
+
+
+def _g(number):
+    """A number from a file as ``{:g}`` formats it (a short repr beyond a float's range)."""
+    try:
+        return f"{float(number):g}"
+    except OverflowError:
+        return _show(number)
+
+
+def _one_line(text, most=200):
+    """``text`` as one line of at most ``most`` characters."""
+    text = " ".join(str(text).split())
+    return text if len(text) <= most else text[:most - 3] + "..."
+
+
+def _check_keys(mapping, where):
+    for key in mapping:
+        if not isinstance(key, str):
+            raise InputError(f"{where}: keys must be strings, got {_show(key)}")
+
+
+def _parse_json(text):
+    try:
+        return json.loads(text, parse_int=_json_int)
+    except json.JSONDecodeError as exc:
+        raise _Unreadable(f"line {exc.lineno}, column {exc.colno}: {exc.msg}") from None
+    except RecursionError:
+        raise _Unreadable(f"nested more than {MAX_NESTING} levels deep") from None
+    except ValueError as exc:
+        raise _Unreadable(_one_line(exc)) from None
+
+
+_YAML_LOADER = None
+
+
+def _yaml_loader():
+    """PyYAML's SafeLoader (standard tags only) that refuses long integers and reports a
+    standard tag's bad value (``!!bool maybe``, a 13th month) at its line and column."""
+    global _YAML_LOADER
+    if _YAML_LOADER is None:
+        import yaml
+        from yaml.constructor import ConstructorError
+
+        class Loader(yaml.SafeLoader):
+            def construct_object(self, node, deep=False):
+                try:
+                    return super().construct_object(node, deep)
+                except (yaml.YAMLError, RecursionError):
+                    raise
+                except Exception as exc:         # the standard tags' own constructors
+                    value = f"{node.value!r:.40} " if isinstance(node, yaml.ScalarNode) else ""
+                    raise ConstructorError(None, None, f"cannot read {value}as "
+                                           f"{node.tag.rpartition(':')[2]} ({exc})",
+                                           node.start_mark) from None
+
+            def construct_yaml_int(self, node):
+                digits = len(str(node.value).lstrip("+-"))
+                if digits > MAX_INT_DIGITS:
+                    raise ConstructorError(None, None, f"an integer of {digits} digits (at "
+                                           f"most {MAX_INT_DIGITS})", node.start_mark)
+                return super().construct_yaml_int(node)
+
+        Loader.add_constructor("tag:yaml.org,2002:int", Loader.construct_yaml_int)
+        _YAML_LOADER = Loader
+    return _YAML_LOADER
+
+
+def _parse_yaml(text):
+    import yaml
+    try:
+        return yaml.load(text, Loader=_yaml_loader())
+    except yaml.MarkedYAMLError as exc:
+        mark = exc.problem_mark or exc.context_mark
+        at = f"line {mark.line + 1}, column {mark.column + 1}: " if mark else ""
+        problem = ", ".join(p for p in (exc.context, exc.problem) if p)
+        raise _Unreadable(_one_line(at + (problem or "not YAML"))) from None
+    except yaml.YAMLError as exc:                # e.g. a control character
+        raise _Unreadable(_one_line(exc)) from None
+    except RecursionError:
+        raise _Unreadable(f"nested more than {MAX_NESTING} levels deep") from None
 
 
 def _parse_block(raw, where, index):
     if not isinstance(raw, dict):
         raise InputError(f"{where}: expected an object with shape and sizes")
+    _check_keys(raw, where)
     shape = raw.get("shape")
     if shape is None:
         raise InputError(f"{where}: missing key 'shape' (one of {', '.join(SHAPES)})")
     if shape not in SHAPES:
-        raise InputError(f"{where}: unknown shape {shape!r} (known: {', '.join(SHAPES)})")
+        raise InputError(f"{where}: unknown shape {_show(shape)} (known: {', '.join(SHAPES)})")
     missing = sorted(BLOCK_KEYS[shape] - set(raw))
     if missing:
         raise InputError(f"{where}: missing key(s) {', '.join(missing)} for a {shape}")
     unknown = set(raw) - BLOCK_KEYS[shape] - OPTIONAL_BLOCK_KEYS
     if unknown:
-        raise InputError(f"{where}: unknown key(s) {', '.join(sorted(unknown))} for a {shape}")
+        raise InputError(f"{where}: unknown key(s) {_keys(unknown)} for a {shape}")
     sizes = {}
     for key in sorted(BLOCK_KEYS[shape]):
         value = raw[key]
         if isinstance(value, (int, float)) and not isinstance(value, bool) and \
-                math.isfinite(value) and value <= 0:
-            raise InputError(f"{where}: {key} must be positive, got {value:g}")
+                (isinstance(value, int) or math.isfinite(value)) and value <= 0:
+            raise InputError(f"{where}: {key} must be positive, got {_g(value)}")
         high = MAX_BLOCK_HEIGHT_M if key == "height" else MAX_WIDTH_M
         sizes[key] = _number(value, f"{where}: {key}", MIN_SIZE_M, high, "m")
     solid = Frustum(**sizes) if shape == "frustum" else Box(**sizes)
@@ -576,7 +691,7 @@ def _parse_block(raw, where, index):
     mode = raw.get("tilt_mode", "wedge")
     if mode not in TILT_MODES:
         raise InputError(f"{where}: tilt_mode must be one of {', '.join(TILT_MODES)}, "
-                         f"got {mode!r}")
+                         f"got {_show(mode)}")
     joined = raw.get("joined", False)
     if not isinstance(joined, bool):
         raise InputError(f"{where}: joined must be true or false")
@@ -800,7 +915,7 @@ class ColumnSpec:
         rocking edge to the centre of mass of the stack above it (``rocking_lever_m``) and
         the overturning energy barrier."""
         bodies = self.geometry.bodies(self.x, self.y)
-        statics = _statics(bodies, 9.81)
+        statics = _statics(bodies, MODEL_GRAVITY)
         n = len(bodies)
         # a body released on its edge is not at rest at the start: no energy criterion
         settles = self.geometry.settles and not any(b.edge_mode for b in bodies)

@@ -1,0 +1,66 @@
+"""What the loaders of user-written files (column descriptions, observations) share:
+bounds checked before and right after parsing, and short one-line renderings of
+whatever a file holds, for the one-line errors."""
+import reprlib
+
+MAX_FILE_BYTES = 1_000_000   # a column description or an observations file is a few kB
+MAX_NESTING = 16             # they nest 4-5 deep
+MAX_INT_DIGITS = 100         # longer integers are refused while parsing
+
+
+class Unreadable(ValueError):
+    """A file that cannot be parsed; the message says where and why (one line)."""
+
+
+_REPR = reprlib.Repr()
+_REPR.maxlevel, _REPR.maxlist, _REPR.maxdict, _REPR.maxset = 2, 4, 4, 4
+_REPR.maxstring, _REPR.maxother, _REPR.maxlong = 60, 60, 40
+
+
+def show(value, most=80):
+    """A short one-line repr of a value read from a file, for messages."""
+    try:
+        text = _REPR.repr(value)
+    except ValueError:                    # an int beyond Python's str conversion limit
+        return f"<{type(value).__name__}>"
+    return text if len(text) <= most else text[:most - 3] + "..."
+
+
+def keys_text(keys, most=8):
+    """Keys read from a file, for messages: sorted, odd ones quoted, at most ``most``."""
+    names = sorted(k if isinstance(k, str) and k.isprintable() and len(k) <= 40 else show(k)
+                   for k in keys)
+    more = f" and {len(names) - most} more" if len(names) > most else ""
+    return ", ".join(names[:most]) + more
+
+
+def json_int(digits):
+    """``parse_int`` of json.loads: Unreadable past MAX_INT_DIGITS digits."""
+    n = len(digits.lstrip("-"))
+    if n > MAX_INT_DIGITS:
+        raise Unreadable(f"an integer of {n} digits (at most {MAX_INT_DIGITS})")
+    return int(digits)
+
+
+def nesting(value, limit=MAX_NESTING):
+    """Nesting depth of parsed data (0: a scalar; lists and dicts count), or limit + 1 once
+    it exceeds ``limit`` or refers to itself (YAML anchors can build cycles).  Iterative;
+    each container is visited once, so shared ones (YAML aliases) cost nothing more."""
+    depth, path = {}, set()            # depths of finished containers; ids on the path
+    stack = [(value, False)]
+    while stack:
+        node, finished = stack.pop()
+        key = id(node)
+        items = node.values() if isinstance(node, dict) else node
+        if finished:
+            path.discard(key)
+            depth[key] = 1 + max((depth.get(id(c), 0) for c in items), default=0)
+            if depth[key] > limit:
+                return limit + 1
+        elif key in path:
+            return limit + 1
+        elif key not in depth and isinstance(node, (list, dict)):
+            path.add(key)
+            stack.append((node, True))
+            stack.extend((c, False) for c in items if isinstance(c, (list, dict)))
+    return depth.get(id(value), 0)
