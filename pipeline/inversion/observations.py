@@ -31,6 +31,9 @@ from pipeline.userfiles import keys_text as _keys
 from pipeline.userfiles import nesting as _nesting
 from pipeline.userfiles import show as _show
 
+MAX_REGION_KM = 300.0   # sites further from the first are not one region (the forward
+#                         table reaches 30 km; candidates are gridded over the region)
+
 DEFAULT_UNCERTAINTY_DEG = 10.0
 MAX_UNCERTAINTY_DEG = 120.0
 STATES = ("fallen", "standing")
@@ -225,11 +228,12 @@ def parse_observations(data, source="observations"):
                 dist_m, az, _ = gps2dist_azimuth(lat0, lon0, lat, lon)
                 east = dist_m / 1e3 * math.sin(math.radians(az))
                 north = dist_m / 1e3 * math.cos(math.radians(az))
-            if math.hypot(east, north) > 300.0:
-                raise InputError(f"{source}: site {_show(name)} lies "
-                                 f"{math.hypot(east, north):.0f} "
-                                 "km from the first site (more than 300 km: not one region)")
             out.append(Site(name, east, north, cols, lat, lon))
+    for site in out:                  # one rule, whether sites come in km or in degrees
+        if math.hypot(site.east_km, site.north_km) > MAX_REGION_KM:
+            raise InputError(f"{source}: site {_show(site.name)} lies "
+                             f"{math.hypot(site.east_km, site.north_km):.0f} km from the "
+                             f"first site (more than {MAX_REGION_KM:g} km: not one region)")
     for k, a in enumerate(out):
         for b in out[:k]:
             if math.hypot(a.east_km - b.east_km, a.north_km - b.north_km) < 1e-6:

@@ -112,3 +112,14 @@ def test_missing_file_and_option_errors(tmp_path, capsys):
         assert err.count("\n") == 1 and message in err, (argv, err)
     with pytest.raises(InputError):
         parse_observations({"sites": [dict(GOOD_SITE, name="")]})
+
+
+def test_sites_in_km_far_apart_are_refused_like_sites_in_degrees(tmp_path):
+    """1,000 km between two sites given in km: refused by the same rule as latitudes and
+    longitudes over 300 km apart (it used to be accepted and tried to allocate GiB)."""
+    from pipeline.inversion.observations import MAX_REGION_KM, parse_observations
+    column = {"column": "drums", "state": "standing"}
+    data = {"sites": [{"name": "A", "east_km": 0.0, "north_km": 0.0, "columns": [column]},
+                      {"name": "B", "east_km": 1000.0, "north_km": 0.0, "columns": [column]}]}
+    with pytest.raises(InputError, match=f"more than {MAX_REGION_KM:g} km"):
+        parse_observations(data, "far.json")
