@@ -191,8 +191,15 @@ def described_columns(observations, base_dir="."):
     for name in observations.column_types():
         if name in ("drums", "monolithic"):
             continue
-        beside = Path(base_dir) / name
-        source = str(beside) if name not in example_names() and beside.is_file() else name
+        beside = Path(base_dir) / name          # an absolute name stays itself
+        if name in example_names():
+            source = name
+        elif beside.is_file():
+            source = str(beside)
+        else:                                   # never the current directory's file
+            raise InputError(f"column {name!r}: no such file or shipped example (looked for "
+                             f"{beside} beside the observations; shipped: "
+                             f"{', '.join(example_names())})")
         try:
             out[name] = description(source)
         except InputError as exc:

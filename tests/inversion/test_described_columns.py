@@ -119,3 +119,18 @@ def test_a_column_file_beside_the_observations(tmp_path):
     found = described_columns(load_observations(_observations(tmp_path, "my_column.json")),
                               tmp_path)
     assert found == {"my_column.json": data}
+
+
+def test_a_column_file_in_the_current_directory_is_not_taken(tmp_path, monkeypatch, capsys):
+    """A column named in the observations is looked for beside the observations file (or
+    among the shipped examples), never in the directory the command runs from."""
+    import json as _json
+    elsewhere = tmp_path / "cwd"
+    elsewhere.mkdir()
+    (elsewhere / "ionic.json").write_text(_json.dumps(
+        {"name": "ionic", "density": 2700.0, "blocks": [
+            {"shape": "frustum", "height": 3.0, "bottom_diameter": 0.6, "top_diameter": 0.5}]}))
+    monkeypatch.chdir(elsewhere)
+    obs = _observations(tmp_path, "ionic.json")
+    assert cli.main(["invert", str(obs), "--out", str(tmp_path / "out")]) == 2
+    assert "column 'ionic.json': no such file" in capsys.readouterr().err
