@@ -138,3 +138,11 @@ def test_a_refused_campaign_leaves_nothing(tmp_path, capsys):
     err = one_line_error(capsys, cli.main(["campaign", "records", "--records", "GM20,NOPE",
                                            "--out", str(tmp_path / "camp")]))
     assert "NOPE" in err and not (tmp_path / "camp").exists()
+
+
+def test_an_unreachable_scheduler_leaves_nothing(tmp_path, capsys):
+    code = cli.main(["campaign", "records", "--records", "GM20", "--scheduler",
+                     "tcp://127.0.0.1:9", "--out", str(tmp_path / "camp")])
+    err = capsys.readouterr().err
+    assert code == 1 and err.strip().splitlines()[-1].startswith("error: cannot reach")
+    assert not (tmp_path / "camp").exists()
