@@ -187,3 +187,18 @@ def test_records_section_from_runs_csv(tmp_path):
     assert "Answer to the paper's question" in section
     empty = report.records_section(tmp_path / "nothing")
     assert "Not run yet" in empty
+
+
+def test_processing_section_quotes_the_peer_check(tmp_path):
+    rows = [{"id": "A", "pulse_like": True, "pga_ratio_given": 1.0, "pgv_ratio_given": 0.95,
+             "pga_ratio_flatfile": None, "pgv_ratio_flatfile": None},
+            {"id": "B", "pulse_like": True, "pga_ratio_given": 0.99, "pgv_ratio_given": 0.8,
+             "pga_ratio_flatfile": None, "pgv_ratio_flatfile": None},
+            {"id": "C", "pulse_like": None, "pga_ratio_given": 0.98, "pgv_ratio_given": 1.0,
+             "pga_ratio_flatfile": 0.97, "pgv_ratio_flatfile": 0.9}]
+    (tmp_path / "records").mkdir()
+    pd.DataFrame(rows).to_csv(tmp_path / "records" / "peer_check.csv", index=False)
+    text = report.processing_section(tmp_path)
+    assert "| pulse-like | PGV / PEER's record |   2 |    0.875 | 0.800 (B)" in text
+    assert "1 of 2 keep their PGV within 10 %" in text
+    assert "Not run yet" in report.processing_section(tmp_path / "nothing")
