@@ -9,7 +9,29 @@ MAX_INT_DIGITS = 100         # longer integers are refused while parsing
 
 
 class Unreadable(ValueError):
-    """A file that cannot be parsed; the message says where and why (one line)."""
+    """A file that cannot be parsed; the message says where and why (one line).
+    ``kind``: "size" (over MAX_FILE_BYTES), "utf8" (``offset``, ``byte``: the first
+    bad byte, 0-based) or None."""
+
+    def __init__(self, message, kind=None, offset=None, byte=None):
+        super().__init__(message)
+        self.kind, self.offset, self.byte = kind, offset, byte
+
+
+def read_text(path):
+    """The text of a user's file: at most MAX_FILE_BYTES read, strict UTF-8 (a BOM
+    allowed).  Unreadable ("size" or "utf8"); OSError as open raises it."""
+    with open(path, "rb") as f:
+        content = f.read(MAX_FILE_BYTES + 1)
+    if len(content) > MAX_FILE_BYTES:
+        raise Unreadable(f"larger than {MAX_FILE_BYTES // 1_000_000} MB", "size")
+    bom = 3 if content.startswith(b"\xef\xbb\xbf") else 0     # a UTF-8 BOM is allowed
+    try:
+        return content[bom:].decode("utf-8")
+    except UnicodeDecodeError as exc:
+        at = bom + exc.start
+        raise Unreadable(f"byte {at + 1} is 0x{content[at]:02x}, not UTF-8", "utf8", at,
+                         content[at]) from None
 
 
 _REPR = reprlib.Repr()

@@ -24,7 +24,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from pipeline.files import InputError
-from pipeline.userfiles import MAX_FILE_BYTES, MAX_NESTING
+from pipeline.userfiles import MAX_NESTING, read_text
 from pipeline.userfiles import Unreadable as _Unreadable
 from pipeline.userfiles import json_int as _json_int
 from pipeline.userfiles import keys_text as _keys
@@ -253,20 +253,13 @@ def load_observations(path):
     if not found:
         raise InputError(f"observations file not found: {path}")
     try:
-        with open(path, "rb") as f:
-            content = f.read(MAX_FILE_BYTES + 1)
+        text = read_text(path)
     except OSError as exc:
         raise InputError(f"{path.name}: cannot be read ({exc.strerror or exc})") from None
-    if len(content) > MAX_FILE_BYTES:
-        raise InputError(f"{path.name}: larger than {MAX_FILE_BYTES // 1_000_000} MB; not an "
-                         "observations file")
-    bom = 3 if content.startswith(b"\xef\xbb\xbf") else 0     # a UTF-8 BOM is allowed
-    try:
-        text = content[bom:].decode("utf-8")
-    except UnicodeDecodeError as exc:
-        at = bom + exc.start
-        raise InputError(f"{path.name}: not a text (JSON) file (byte {at + 1} is "
-                         f"0x{content[at]:02x}, not UTF-8)") from None
+    except _Unreadable as exc:
+        if exc.kind == "size":
+            raise InputError(f"{path.name}: {exc}; not an observations file") from None
+        raise InputError(f"{path.name}: not a text (JSON) file ({exc})") from None
     try:
         data = json.loads(text, parse_int=_json_int)
     except json.JSONDecodeError as exc:

@@ -45,7 +45,7 @@ import numpy as np
 
 from pipeline.constants import MODEL_GRAVITY
 from pipeline.files import InputError
-from pipeline.userfiles import MAX_FILE_BYTES, MAX_INT_DIGITS, MAX_NESTING
+from pipeline.userfiles import MAX_INT_DIGITS, MAX_NESTING, read_text
 from pipeline.userfiles import Unreadable as _Unreadable
 from pipeline.userfiles import json_int as _json_int
 from pipeline.userfiles import keys_text as _keys
@@ -428,18 +428,11 @@ class ColumnGeometry:
                 raise InputError(f"{path}: reading YAML needs PyYAML (pip install pyyaml); "
                                  "or give the description as JSON") from None
         try:
-            with open(path, "rb") as f:
-                content = f.read(MAX_FILE_BYTES + 1)
-            if len(content) > MAX_FILE_BYTES:
-                raise _Unreadable(f"larger than {MAX_FILE_BYTES // 1_000_000} MB; a column "
-                                  "description is a few kB")
-            bom = 3 if content.startswith(b"\xef\xbb\xbf") else 0   # a UTF-8 BOM is allowed
             try:
-                raw = content[bom:].decode("utf-8")
-            except UnicodeDecodeError as exc:
-                at = bom + exc.start
-                raise _Unreadable(f"not UTF-8 text: byte {at + 1} is "
-                                  f"0x{content[at]:02x}") from None
+                raw = read_text(path)
+            except _Unreadable as exc:
+                raise _Unreadable(f"{exc}; a column description is a few kB"
+                                  if exc.kind == "size" else f"not UTF-8 text: {exc}") from None
             data = _parse_yaml(raw) if yaml_file else _parse_json(raw)
             if _nesting(data, MAX_NESTING) > MAX_NESTING:
                 raise _Unreadable(f"nested more than {MAX_NESTING} levels deep (or refers "

@@ -30,10 +30,10 @@ from pipeline.inversion.observations import (  # noqa: E402
     load_observations,
     parse_observations,
 )
+from pipeline.userfiles import MAX_FILE_BYTES  # noqa: E402
 from pipeline.scenario.geometry import (  # noqa: E402
     BLOCK_KEYS,
     EXAMPLES_DIR,
-    MAX_FILE_BYTES,
     OPTIONAL_BLOCK_KEYS,
     TOP_KEYS,
     ColumnGeometry,
