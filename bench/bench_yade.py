@@ -271,8 +271,8 @@ def convergence(work):
     at the paper's damping, its half and its quarter) and the number of rim contact
     points (default early stop)."""
     from pipeline.scenario.parameters import dt_factor_for
-    default = round(dt_factor_for(Contact(), Numerics()), 4)
-    factors = (round(default / 4, 4), round(default / 2, 4), default)
+    default = dt_factor_for(Contact(), Numerics())
+    factors = (default / 4, default / 2, default)
     rows = []
     for key, values in (("dt_factor", factors), ("rim_points", (8, 16, 32))):
         for value in values:
