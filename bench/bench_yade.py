@@ -64,7 +64,7 @@ WEAK_PEAK = (1.5, 1.5, 0.75)    # m/s^2: rocks the drum column without toppling 
 # written to bench_loop.json); for runs of a fixed duration, the scene's stop checks see
 # the motion last until t_max (HOLD; RELEASE restores motion_end for the output); for
 # the timing run, O.timingEnabled and timing.stats().
-HOLD = "_bench_motion_end, motion_end = motion_end, T_MAX\nquiet_after = T_MAX\n"
+HOLD = "_bench_motion_end, motion_end = motion_end, T_MAX\nsignal_end = quiet_after = T_MAX\n"
 RELEASE = "motion_end = _bench_motion_end\n"
 LOOP_START = "_bench_t0 = (time.perf_counter(), time.process_time())\nO.run()\n"
 LOOP_END = ("_bench_t1 = (time.perf_counter(), time.process_time())\n"
