@@ -18,10 +18,10 @@ setup: .venv/.installed
 	$(PY) -m pip install -q -e '.[test]'
 	touch $@
 
-# the YADE physics tests once more on glibc's second libm path (another CPU's last bits)
+# the YADE physics tests on glibc's second libm path (another CPU's last bits), then all
 test: setup
-	$(PY) -m pytest -q tests
 	$(PY) -m pytest -q -m libm --second-libm tests
+	$(PY) -m pytest -q tests
 
 records: setup
 	$(PY) -m pipeline records --all
