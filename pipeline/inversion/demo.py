@@ -31,6 +31,7 @@ from pipeline.inversion.likelihood import (DEFAULT_FLOOR, DEFAULT_KERNEL_DEG, LI
                                            ForwardModel)
 from pipeline.inversion.observations import ColumnObservation, Observations, Site
 from pipeline.inversion.posterior import in_arc, invert
+from pipeline.stats.circular import angle_difference_deg
 
 FALLEN_PER_SITE = (1, 3, 10, 30)
 SITE_COUNTS = (1, 3)
@@ -106,7 +107,7 @@ def truth_trial(model, pool, mechanism, n_sites, fallen, candidates, rng):
     post = invert(model, observations, candidates)
     summary = post.summary()
     true_baz = math.degrees(math.atan2(truth[0], truth[1])) % 360.0
-    map_error = (summary["back_azimuth_map_deg"] - true_baz + 180.0) % 360.0 - 180.0
+    map_error = angle_difference_deg(summary["back_azimuth_map_deg"], true_baz)
     d = math.hypot(*truth)
     lo, hi = summary["distance_ci95_km"]
     return {"mechanism": mechanism, "sites": len(sites), "fallen_per_site": fallen,
@@ -262,8 +263,8 @@ def paper_scenario(model, obs_table, source_name, candidates):
                          "width95_deg": summary["back_azimuth_ci95_width_deg"],
                          "back_azimuth_in_95": in_arc(true_baz, summary["back_azimuth_ci95_deg"]),
                          "map_back_azimuth_deg": summary["back_azimuth_map_deg"],
-                         "map_error_deg": (summary["back_azimuth_map_deg"] - true_baz + 180.0)
-                         % 360.0 - 180.0,
+                         "map_error_deg": angle_difference_deg(summary["back_azimuth_map_deg"],
+                                                               true_baz),
                          "epicentre_in_95": post.contains(*truth, level=0.95),
                          "credible_area_95_km2": summary["credible_area_95_km2"],
                          "p_true_mechanism": summary["mechanism_posterior"].get(
