@@ -31,7 +31,7 @@ def column_file_help(many=False):
     from pipeline.scenario.geometry import example_names
     what = ("comma-separated column descriptions" if many else
             "the column as found, from a description")
-    return (f"{what} (JSON, or YAML with PyYAML; README 'Column files') or "
+    return (f"{what} (JSON, or YAML with PyYAML; docs/columns-and-model.md) or "
             + ("shipped examples" if many else "a shipped example") + " by name ("
             + ", ".join(example_names()) + ")")
 

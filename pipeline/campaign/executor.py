@@ -53,7 +53,7 @@ from pipeline.scenario.runner import end_served_processes, kill_running, reuse_p
 from pipeline.simulate import RUN_CODE
 
 EXECUTORS = ("threads", "dask")
-DEFAULT_EXECUTOR = "threads"    # why: README "On a cluster: Dask" (start-up, ports)
+DEFAULT_EXECUTOR = "threads"    # why: docs/campaigns.md, "On a cluster: Dask" (start-up, ports)
 CONNECT_TIMEOUT_S = 10          # reaching an existing Dask scheduler (s)
 CLOSE_TIMEOUT_S = 1.0           # closing the local cluster after Ctrl-C
 TASK_PREFIX = "toppling"        # Dask keys and worker temporary directories

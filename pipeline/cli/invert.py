@@ -22,7 +22,7 @@ DESCRIPTION = (
     "toward an azimuth, or standing) from a forward table of twin-model ensembles shaken by "
     "pyprop8 synthetics (campaign inversion-forward, cached by content: a second inversion "
     "reuses every run). Writes posterior.csv, inversion_summary.json, posterior_map.png and "
-    "marginals.png. Observations schema: README 'Inverting fallen columns for the source'.")
+    "marginals.png. Observations schema: docs/inversion.md.")
 
 
 def _floats(name):
@@ -58,7 +58,7 @@ def setup(p):
     from pipeline.inversion.likelihood import DEFAULT_FLOOR, DEFAULT_KERNEL_DEG
     full, quick = GRIDS["full"], GRIDS["quick"]
     p.add_argument("observations", nargs="?", type=Path, metavar="OBSERVATIONS.json",
-                   help="sites with their fallen and standing columns (README schema)")
+                   help="sites with their fallen and standing columns (schema: docs/inversion.md)")
     p.add_argument("--out", type=Path, default=None, metavar="DIR",
                    help="output directory (default results/inversion/<file stem>; "
                    "--demo: results/inversion)")

@@ -9,7 +9,7 @@ Modules: :mod:`~pipeline.inversion.observations` (the file's schema and checks),
 :mod:`~pipeline.inversion.forward` (symmetries, node motions, the campaign, the table),
 :mod:`~pipeline.inversion.likelihood`, :mod:`~pipeline.inversion.posterior` (candidates,
 prior, credible regions), :mod:`~pipeline.inversion.demo` (synthetic truth tests and the
-paper's scenario).  README: "Inverting fallen columns for the source".
+paper's scenario).  docs/inversion.md.
 """
 import time
 from pathlib import Path

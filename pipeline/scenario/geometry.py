@@ -1,6 +1,6 @@
 """Column geometry: a column as the stack of blocks that was found, from the bottom.
 
-A column description (JSON, YAML optional; schema in README, "Column files") is
+A column description (JSON, YAML optional; schema in docs/columns-and-model.md) is
 
     {"name": str, "density": kg/m^3, "blocks": [block, ... from the bottom]}
 
@@ -10,7 +10,7 @@ North), optional ``density``, ``name``, ``offset_m: [east, north]``, ``tilt_deg`
 ``tilt_azimuth_deg``, ``tilt_mode`` ("wedge" or "edge") and ``joined`` (true: carved
 from one stone with the block below, e.g. echinus and abacus of one capital).
 
-Rules (README, "Column files"):
+Rules (docs/columns-and-model.md):
 
 - Placement: a block's bottom face is centred ``offset_m`` from the top-face centre of
   the block below (from the column's position for the bottom block), along that face.
@@ -280,7 +280,7 @@ def perimeter_points(vertices, n):
     points: every corner (a vertex turning by more than CORNER_TURN_DEG), and along each
     curved stretch between corners (an arc of a circle cut by another face) as many
     points, evenly spaced, as a circle has on that angle; straight edges carry their two
-    corners only (a box rocks on an edge as Housner's block does: see README, "Column
+    corners only (a box rocks on an edge as Housner's block does: see docs/columns-and-model.md, "Column
     files").  A polygon without corners gets n points evenly spaced."""
     v = np.asarray(vertices, float)
     prev, nxt = np.roll(v, 1, axis=0), np.roll(v, -1, axis=0)

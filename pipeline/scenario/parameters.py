@@ -2,7 +2,7 @@
 unit, allowed range and help text; the command line and ``params.json`` derive from it.
 
 Defaults are the paper's (:mod:`pipeline.paper`).  Ranges are what the model can
-represent and keep stable (see README, "Parameters"); a value outside raises an
+represent and keep stable (docs/command-line.md); a value outside raises an
 :class:`~pipeline.files.InputError` naming the option and its range.
 """
 import dataclasses

@@ -26,7 +26,7 @@ MARBLE_CONTACT = {"kn": paper.MARBLE_BLOCK_KN_N_M, "damping": paper.DAMPING_RATI
                   "mu_s": paper.MU_STATIC, "mu_k": paper.MU_KINETIC,
                   "rim_sphere_radius": 0.001}   # b / 80: rounded edges shift alpha by < 1 %
 # Housner's impact is perfectly inelastic: critically damped contacts reproduce his
-# restitution within 0.2 %; the paper's 0.36 gives a 0.4 % higher one (see README)
+# restitution within 0.2 %; the paper's 0.36 gives a 0.4 % higher one (docs/campaigns.md, Verification)
 HOUSNER_DAMPING = 1.0
 TOLERANCE = 0.02            # relative, impact times and peak amplitudes
 MAX_IMPACTS = 20            # Housner's free rocking: impacts compared (decay below ~1e-3)

@@ -20,7 +20,7 @@ from pipeline.motion.pulses import one_sine_pulse
 from pipeline.scenario.geometry import ColumnGeometry
 
 DORIC = "doric-peristyle"          # 10.43 m high, base diameter 1.905 m, 13 blocks
-DORIC_KN = 2.3e9                   # matched_kn (README "Contact stiffness of heavy columns")
+DORIC_KN = 2.3e9                   # matched_kn (docs/columns-and-model.md, "Contact stiffness of heavy columns")
 CAMPAIGN_OPTIONS = {               # small but complete: every kind of run of each campaign
     "slenderness": {}, "friction": {}, "records": {}, "synthetic": {},
     "ensemble": {"members": 3}, "fragility": {"members": 2, "levels": (1.0, 4.0)}}

@@ -16,7 +16,7 @@ built by ``make_moment_tensor`` (r, theta, phi; strike clockwise from North,
 fault dipping to the right of the strike direction, rake 0 = left-lateral)
 and turned into East/North/Up by ``rtf2xyz``.
 
-Sites are written like processed records (README: npz with dt, acc, vel,
+Sites are written like processed records (docs/records.md: npz with dt, acc, vel,
 disp in m/s^2, m/s, m, columns East, North, Up, and a JSON meta) under
 ``results/synthetics/<source>/<site_id>.npz``, cached by a content hash of
 every generator parameter.
