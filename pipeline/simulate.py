@@ -13,7 +13,6 @@ import numpy as np
 from pipeline.constants import MODEL_GRAVITY
 from pipeline.files import InputError, code_hash, software_versions, write_json
 from pipeline.outcome.columns import summarise
-from pipeline.records.processing import processing_mode
 from pipeline.scenario import Column, Contact, Numerics, run_yade, scene_params, write_scenario
 
 
@@ -149,7 +148,7 @@ def simulate(motion, out_dir, column=None, contact=None, numerics=None, window=N
                   **dataclasses.asdict(contact), "window_s": list(window) if window else None,
                   "rotate_deg": rotate_deg, "scale": scale,
                   "motion_file": None if motion_file is None else str(motion_file),
-                  "processing": processing_mode(motion.meta),
+                  "processing": motion.processing_mode,
                   "dt_factor": params["dt_factor"], "rim_points": numerics.rim_points,
                   "quiet_motion": numerics.quiet_motion}
     provenance = {"software": software_versions(), "motion": motion.meta.get("processing"),

@@ -67,6 +67,13 @@ class Motion:
         value = self.meta.get("back_azimuth_deg")
         return None if value is None or not math.isfinite(value) else float(value)
 
+    @property
+    def processing_mode(self):
+        """How the motion was processed: "default", or "none" (run as given, or made
+        processed: a synthetic, an analytic pulse), from ``meta["processing"]``."""
+        recorded = self.meta.get("processing") or {}
+        return recorded.get("mode", "default" if recorded.get("steps") else "none")
+
     # ------------------------------------------------------------ file format
     @classmethod
     def load(cls, path):

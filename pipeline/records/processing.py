@@ -74,13 +74,6 @@ def steps_for(mode):
             from None
 
 
-def processing_mode(meta):
-    """How a motion was processed, from its meta: "default", "none" (run as given), or
-    "none" too for a motion made processed (a synthetic, an analytic pulse)."""
-    recorded = meta.get("processing") or {}
-    return recorded.get("mode", "default" if recorded.get("steps") else "none")
-
-
 def step(func):
     """Register a processing step under its function name."""
     STEPS[func.__name__] = func

@@ -112,8 +112,8 @@ def test_processing_none_runs_the_acceleration_as_given(tmp_path):
     assert motion.meta["processing"]["mode"] == "none"
     assert np.allclose(motion.acc, enz, atol=1e-6)             # MiniSEED float32... as given
     assert horizontal_peak(motion.vel) == pytest.approx(2.546, rel=0.01)   # 2 A / (2 pi f)
-    assert processing.processing_mode(motion.meta) == "none"
-    assert processing.processing_mode(Motion(DT, enz, enz, enz, meta={}).meta) == "none"
+    assert motion.processing_mode == "none"
+    assert Motion(DT, enz, enz, enz, meta={}).processing_mode == "none"
 
 
 def test_processing_option_is_checked(tmp_path, capsys):
