@@ -250,19 +250,13 @@ def time_step_s(columns, contact, rim_points, dt_factor):
     return dt_factor * math.sqrt(min(m / k for m, k in stiffness))
 
 
-def estimated_wall_s(params, simulated_s):
-    """Rough wall time (s) of simulating ``simulated_s`` seconds of the scene ``params``
-    (US_PER_BODY_STEP per body and step), for a warning before long runs."""
-    bodies = sum(len(c["bodies"]) for c in params["columns"])
-    return simulated_s / params["time_step_s"] * bodies * US_PER_BODY_STEP * 1e-6
-
-
 def check_cost(params, wall_limit_s):
     """InputError when the scene ``params`` would need more wall time for its t_max than
     ``wall_limit_s`` (the run's wall-clock limit would end it): say so before starting;
-    a note on stdout when it takes over 5 minutes.  Returns the estimate (s)."""
-    estimate = estimated_wall_s(params, params["t_max"])
+    a note on stdout when it takes over 5 minutes.  Returns the estimate (s): t_max /
+    time step x bodies x US_PER_BODY_STEP."""
     bodies = sum(len(c["bodies"]) for c in params["columns"])
+    estimate = params["t_max"] / params["time_step_s"] * bodies * US_PER_BODY_STEP * 1e-6
     what = (f"{bodies} bodies stepping {params['time_step_s']:.2g} s for "
             f"{params['t_max']:.0f} s simulated: about {estimate / 60:.0f} min")
     if estimate > wall_limit_s:
