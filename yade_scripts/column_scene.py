@@ -112,9 +112,12 @@ def contact_material(mass, n_points):
 
 def rim_spheres(rim):
     """Centres (n x 3, body frame) of a rim's contact spheres: circles get RIM_POINTS
-    points from the phase on, polygons their given points; each point lies in the rim's
+    points from the phase on, polygons their given points, point sets (a mesh specimen's
+    footprint and hull) theirs one radius along their inward normals; each point lies in the rim's
     face (the plane through z with the rim's normal, e.g. a wedge joint) and its sphere
     one radius inside the body along that normal."""
+    if rim["kind"] == "points":              # a mesh specimen: surface points, inward normals
+        return np.asarray(rim["points"], float) + RIM_R * np.asarray(rim["normals"], float)
     if rim["kind"] == "circle":
         ang = 2 * math.pi * np.arange(RIM_POINTS) / RIM_POINTS + math.radians(RIM_PHASE_DEG)
         xy = np.column_stack([rim["radius"] * np.cos(ang), rim["radius"] * np.sin(ang)])

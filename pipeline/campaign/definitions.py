@@ -415,3 +415,4 @@ register(Campaign("verification", "Housner, one-sine pulse and sliding checks ov
 
 from pipeline.campaign import ensemble  # noqa: E402,F401  (registers the ensemble campaign)
 from pipeline.campaign import fragility  # noqa: E402,F401  (registers the fragility campaign)
+from pipeline.campaign import shake_table  # noqa: E402,F401  (registers the shake-table campaign)

@@ -6,9 +6,15 @@ A column has toppled when one of its bodies struck the pedestal other than
 by its base: any rim of a body above the bottom one, or any rim of the bottom
 body but its base (the top rim of a drum or monolith; a capital's abacus
 edge on a monolith of that outline).  A body tilted past 90 deg that struck
-nothing (upside down, or thrown off the pedestal) has toppled too: a column is
+nothing (upside down, or thrown off the pedestal), or still tilted past 60 deg when the
+scene stopped (the scene takes it as lying and stops without waiting for its strike),
+has toppled too: a column is
 never "standing" then, whatever the input; its azimuth is that of the body's
-axis when it passed 90 deg (``toppled_by`` says which rule decided).  Rims are the outlines a body carries
+axis when it passed 90 deg (``toppled_by`` says which rule decided).  A mesh specimen
+(a scanned rock, whose hull points near its footprint touch the table while it rocks)
+has overturned when it ends tilted past its critical angle (``overturn_tilt_deg``: it no
+longer stands on its footprint); its "impact" is the time from which it stayed past
+that angle and its azimuth that of its centre of mass's displacement.  Rims are the outlines a body carries
 contact spheres on (``bodies[].rims`` of the trajectory, body frame about the
 centre of mass: circles and polygons).  The downfall azimuth points from the
 column's initial axis to the mass-weighted mean of the centres of mass of
@@ -23,6 +29,7 @@ from pipeline.constants import MODEL_GRAVITY
 from pipeline.motion import azimuth_deg
 
 CONTACT_TOLERANCE_M = 0.02   # a rim this close to the pedestal top has struck it
+LIES_DEG = 60.0              # tilt past which the scene takes a body as lying (fallen)
 
 
 def body_axes(quat):
@@ -97,13 +104,25 @@ def column_outcomes(trajectory):
         for j in members:
             b = trajectory.bodies[j]
             rims = [r for r in body_rims(b) if b["index"] > 0 or r["role"] != "base"]
-            if not rims:
+            critical = b.get("overturn_tilt_deg")      # a mesh specimen (see module doc)
+            if not rims and critical is None:
                 continue
-            struck = np.min([rim_lowest(pos[:, j], trajectory.quat[:, j], r, axes[:, j])
-                             for r in rims], axis=0)
-            hits = np.flatnonzero(struck <= CONTACT_TOLERANCE_M)
             tilt = tilt_deg(axes[:, j])
+            if critical is None:
+                struck = np.min([rim_lowest(pos[:, j], trajectory.quat[:, j], r, axes[:, j])
+                                 for r in rims], axis=0)
+                hits = np.flatnonzero(struck <= CONTACT_TOLERANCE_M)
+            else:
+                hits = np.flatnonzero(tilt > critical)[-1:] if tilt[-1] > critical \
+                    else np.array([], int)
+                if hits.size:                            # since when it stays past it
+                    below = np.flatnonzero(tilt <= critical)
+                    hits = np.array([below[-1] + 1 if below.size else 0])
             over = np.flatnonzero(tilt > 90.0)
+            lying = not over.size and tilt[-1] > LIES_DEG    # the scene stopped it lying
+            if lying:
+                below = np.flatnonzero(tilt <= LIES_DEG)
+                over = np.array([below[-1] + 1 if below.size else 0])
             entry = {"index": b["index"], **({"name": b["block_name"]} if b.get("block_name")
                                              else {}),
                      "mass_kg": b["mass"], "struck": bool(hits.size),
@@ -111,11 +130,14 @@ def column_outcomes(trajectory):
                      "max_tilt_deg": float(tilt.max()),
                      "final_position_m": (pos[-1, j, :2] - origin).round(4).tolist(),
                      "past_90_s": float(t[over[0]]) if over.size else None,
+                     "lying_at_end": bool(lying),
                      "past_90_azimuth_deg": azimuth_deg(*axes[over[0], j, :2])
                      if over.size else None}
             if hits.size:
                 k = hits[0]
                 point = pos[k, j, :2] - origin
+                if critical is not None:              # where its centre of mass went
+                    point = pos[-1, j, :2] - np.asarray(b["initial_pos"][:2], float)
                 entry.update(impact_time_s=float(t[k]), impact_point_m=point.tolist(),
                              azimuth_deg=azimuth_deg(*point))
             bodies.append(entry)
@@ -124,13 +146,19 @@ def column_outcomes(trajectory):
         struck = [b for b in bodies if b["struck"]]
         upset = [b for b in bodies if b["past_90_s"] is not None]
         result = {"column": name, "toppled": bool(struck or upset),
-                  "toppled_by": "impact" if struck else "tilt past 90 deg" if upset else None,
+                  "toppled_by": ("rests past its critical angle" if struck and
+                                 first.get("overturn_tilt_deg") is not None else
+                                 "impact" if struck else None),
                   "downfall_azimuth_deg": None,
                   "impact_time_s": None, "impact_point_m": None,
                   "max_tilt_deg": max(b["max_tilt_deg"] for b in bodies),
                   "base_slip_m": float(np.hypot(*(pos[:, members[0], :2]
                                                    - first["initial_pos"][:2]).T).max()),
                   "position_m": origin.tolist(), "bodies": bodies}
+        if upset and not struck:
+            result["toppled_by"] = ("tilt past 90 deg" if any(not b["lying_at_end"]
+                                                             for b in upset)
+                                    else "lying past 60 deg when the run stopped")
         if struck:
             weights = np.array([b["mass_kg"] for b in struck])
             points = np.array([b["impact_point_m"] for b in struck])

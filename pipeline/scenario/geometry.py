@@ -52,6 +52,7 @@ from pipeline.userfiles import keys_text as _keys
 from pipeline.userfiles import nesting as _nesting
 from pipeline.userfiles import show as _show
 
+MESH_SUFFIXES = (".obj", ".ply", ".stl")   # pipeline.scenario.mesh reads these
 SHAPES = ("frustum", "box")
 TILT_MODES = ("wedge", "edge")
 EXAMPLES_DIR = Path(__file__).with_name("columns")
@@ -415,6 +416,9 @@ class ColumnGeometry:
             found = path.is_file()
         except (OSError, ValueError):              # a name too long, a NUL byte
             found = False
+        if found and (path.suffix.lower() in MESH_SUFFIXES or _names_mesh(path)):
+            from pipeline.scenario.mesh import MeshSpecimen
+            return MeshSpecimen.load(path)
         if not found:
             known = ", ".join(example_names())
             shown = text if text.isprintable() and len(text) <= 300 else _show(text)
@@ -446,7 +450,11 @@ class ColumnGeometry:
 
     @classmethod
     def from_dict(cls, data, where="column description"):
-        """Validate a description dict; InputError with one line naming the problem."""
+        """Validate a description dict; InputError with one line naming the problem.
+        A dict with a "mesh" key describes a mesh specimen (:mod:`pipeline.scenario.mesh`)."""
+        if isinstance(data, dict) and "mesh" in data:
+            from pipeline.scenario.mesh import MeshSpecimen
+            return MeshSpecimen.from_dict(data, where=where)
         if not isinstance(data, dict):
             raise InputError(f"{where}: expected a JSON object with name, density, blocks")
         _check_keys(data, where)
@@ -699,6 +707,17 @@ def _parse_block(raw, where, index):
     return ColumnBlock(solid, density, name, offset, tilt, azimuth, mode, joined)
 
 
+def _names_mesh(path):
+    """True when a .json file is a mesh specimen's description (it has a "mesh" key)."""
+    if path.suffix.lower() != ".json":
+        return False
+    try:
+        data = json.loads(read_text(path))
+    except (OSError, _Unreadable, ValueError):
+        return False
+    return isinstance(data, dict) and "mesh" in data
+
+
 def example_names():
     """Names of the shipped column descriptions."""
     return sorted(p.stem for p in EXAMPLES_DIR.glob("*.json"))
@@ -907,6 +926,8 @@ class ColumnSpec:
         rocking threshold (``uplift_ratio``), the smallest horizontal distance from a
         rocking edge to the centre of mass of the stack above it (``rocking_lever_m``) and
         the overturning energy barrier."""
+        if hasattr(self.geometry, "scene_column"):          # a mesh specimen
+            return self.geometry.scene_column(self, rim_points)
         bodies = self.geometry.bodies(self.x, self.y)
         statics = _statics(bodies, MODEL_GRAVITY)
         n = len(bodies)

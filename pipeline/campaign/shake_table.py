@@ -1,0 +1,303 @@
+"""The ``shake-table`` campaign: a specimen against laboratory experiments.
+
+An experiment set is a CSV (records/shake_table/tests.csv, read by
+:func:`load_experiments`) with one row per test: ``test``, ``date`` (yyyy-mm-dd),
+``pga_g``, ``pgv_pga_s``, the observed outcome (column ``--outcome``, 1 = overturned)
+and ``motion_file`` (a lab table, :mod:`pipeline.records.readers.lab_table`, relative to
+the CSV; empty when the motion is missing: the row then counts in the observed rates
+only).  Each test with a motion is one YADE run of the specimen (``--column-file``: a
+column description or a mesh specimen) standing alone on the table.
+
+Calibration keeps the validation tests out: the tests dated before ``--validate-from``
+choose among the parameter sets of ``--grid`` (the best accuracy; ties: the first), and
+only the chosen set runs on the validation tests.  Scores (accuracy, precision, recall,
+F1, confusion) are reported per split beside the trivial baselines ("never overturns";
+"overturns when PGA >= g tan(critical angle)").  Outputs in the campaign directory:
+``experiments.csv`` (per test and parameter set), ``shake_table.json`` (scores), the
+figure ``shake_table_rates.png`` (observed and predicted rate per PGA x PGV/PGA bin).
+"""
+import itertools
+import json
+import math
+from datetime import date
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from pipeline import RESULTS_DIR
+from pipeline.campaign import Campaign, register
+from pipeline.campaign.column_file import add_column_file_argument
+from pipeline.files import InputError, write_csv, write_json
+from pipeline.records import RECORDS_DIR
+from pipeline.stats.classification import binned_rates, scores
+
+EXPERIMENTS = RECORDS_DIR / "shake_table" / "tests.csv"
+SPECIMEN = RECORDS_DIR / "shake_table" / "sp1.json"
+OUTCOME = "sp1_overturned"
+VALIDATE_FROM = "2021-08-01"     # the issue's split: calibrate on June-July, validate August
+COLUMNS = ("test", "date", "pga_g", "pgv_pga_s", "motion_file")
+# what --grid may vary: contact parameters, and the specimen's footprint tolerance
+GRID_CONTACT = {"kn": (1e5, 1e11), "damping": (0.0, 1.0), "mu_s": (0.01, 2.0),
+                "mu_k": (0.01, 2.0)}
+GRID_SPECIMEN = {"footprint_tolerance_m": (0.0, 0.05)}
+DEFAULT_GRID = "damping=0.1,0.36"
+DEFAULT_CONTACT = {"kn": 1.2e8, "damping": 0.36, "mu_s": 0.7, "mu_k": 0.6}
+PGA_EDGES_G = np.array([0.0, 0.1, 0.2, 0.3, 0.4, 0.5, 0.7, 1.0, 2.0])
+PGV_PGA_EDGES_S = np.array([0.0, 0.05, 0.1, 0.2, 0.3, 0.5, 1.0])
+
+def load_experiments(path=EXPERIMENTS, outcome=OUTCOME):
+    """The experiment table (pandas DataFrame; ``observed`` bool, ``motion_path`` Path or
+    None).  One-line InputError for a missing column, a bad date, an outcome not 0/1, a
+    duplicated test or a motion file that is named but absent."""
+    path = Path(path)
+    try:
+        frame = pd.read_csv(path, dtype={"test": str, "motion_file": str},
+                            keep_default_na=False)
+    except (OSError, ValueError, pd.errors.ParserError) as exc:
+        raise InputError(f"{path.name}: not a readable experiment table "
+                         f"({str(exc).splitlines()[0][:120]})") from None
+    missing = [c for c in COLUMNS + (outcome,) if c not in frame.columns]
+    if missing:
+        raise InputError(f"{path.name}: missing column(s) {', '.join(missing)}")
+    if frame["test"].duplicated().any():
+        raise InputError(f"{path.name}: test {frame['test'][frame['test'].duplicated()].iloc[0]}"
+                         " appears twice")
+    for column in ("pga_g", "pgv_pga_s"):
+        values = pd.to_numeric(frame[column], errors="coerce")
+        if not (np.isfinite(values) & (values >= 0)).all():
+            raise InputError(f"{path.name}: column {column} must hold numbers >= 0")
+        frame[column] = values
+    try:
+        frame["day"] = [date.fromisoformat(d) for d in frame["date"]]
+    except ValueError as exc:
+        raise InputError(f"{path.name}: bad date ({exc}); expected yyyy-mm-dd") from None
+    observed = pd.to_numeric(frame[outcome], errors="coerce")
+    if not observed.isin([0, 1]).all():
+        raise InputError(f"{path.name}: column {outcome} must be 0 or 1")
+    frame["observed"] = observed.astype(bool)
+    paths = []
+    for name in frame["motion_file"]:
+        motion = path.parent / name if name else None
+        if motion is not None and not motion.is_file():
+            raise InputError(f"{path.name}: motion file {name} not found")
+        paths.append(motion)
+    frame["motion_path"] = paths
+    return frame
+
+def parse_grid(text):
+    """``name=v1,v2;name=v1`` -> list of parameter dicts (the Cartesian product)."""
+    axes = {}
+    for item in (text or "").split(";"):
+        if not item.strip():
+            continue
+        name, _, values = item.partition("=")
+        name = name.strip()
+        bounds = GRID_CONTACT.get(name) or GRID_SPECIMEN.get(name)
+        if bounds is None:
+            raise InputError(f"--grid: unknown parameter {name!r} (known: "
+                             f"{', '.join([*GRID_CONTACT, *GRID_SPECIMEN])})")
+        try:
+            numbers = [float(v) for v in values.split(",") if v.strip()]
+        except ValueError:
+            raise InputError(f"--grid {name}: values must be numbers, got {values!r}") from None
+        if not numbers or not all(math.isfinite(v) and bounds[0] <= v <= bounds[1]
+                                  for v in numbers):
+            raise InputError(f"--grid {name}: values in [{bounds[0]:g}, {bounds[1]:g}] needed, "
+                             f"got {values!r}")
+        if name in axes:
+            raise InputError(f"--grid names {name} twice")
+        axes[name] = numbers
+    names = list(axes)
+    return [dict(zip(names, combo)) for combo in itertools.product(*axes.values())] or [{}]
+
+def _label(point):
+    return ", ".join(f"{k}={v:g}" for k, v in point.items()) or "defaults"
+
+def _run_params(specimen, point):
+    """Run parameters of one grid point: the specimen alone at the table's centre."""
+    from pipeline.scenario.geometry import ColumnGeometry
+    description = dict(specimen)
+    for key in GRID_SPECIMEN:
+        if key in point:
+            description[key] = point[key]
+    ColumnGeometry.from_dict(description)          # refuse a bad point before any run
+    contact = {**DEFAULT_CONTACT, **{k: v for k, v in point.items() if k in GRID_CONTACT}}
+    return {"column": "monolithic", "column_file": description, **contact}
+
+def specs(records, campaign_dir, experiments=EXPERIMENTS, specimen=SPECIMEN, outcome=OUTCOME,
+          validate_from=VALIDATE_FROM, grid=DEFAULT_GRID, stage="calibration", chosen=None,
+          tests=None):
+    """Run specs of one stage: every grid point on the calibration tests, or the chosen
+    point on the validation tests."""
+    from pipeline.campaign.definitions import column_specs
+    from pipeline.scenario.geometry import ColumnGeometry
+    if records:
+        raise InputError("the shake-table campaign takes its motions from --experiments, "
+                         "not --records")
+    frame = load_experiments(experiments, outcome)
+    frame = frame[[p is not None for p in frame["motion_path"]]]
+    if tests:
+        frame = frame[frame["test"].isin(tests)]
+    split = date.fromisoformat(validate_from)
+    frame = frame[(frame["day"] < split) if stage == "calibration" else (frame["day"] >= split)]
+    description = ColumnGeometry.load(specimen).to_dict()
+    points = parse_grid(grid) if stage == "calibration" else [chosen or {}]
+    runs, meta = [], []
+    for point in points:
+        params = _run_params(description, point)
+        for row in frame.itertuples():
+            runs.append((str(row.motion_path), params))
+            meta.append({"test": row.test, "observed": bool(row.observed), "stage": stage,
+                         "grid_point": _label(point), "point": point})
+    out = column_specs(runs, campaign_dir)
+    for spec, extra in zip(out, meta):
+        spec.update(extra)
+    return out
+
+def outputs(specs_, campaign_dir, failures, animations, figures=True):
+    """Per-run table of this stage and its scores per grid point."""
+    campaign_dir = Path(campaign_dir)
+    rows = []
+    for spec in specs_:
+        path = campaign_dir / "runs" / spec["run_id"] / "summary.json"
+        if not path.exists():
+            continue
+        summary = json.loads(path.read_text())
+        column = summary["columns"][0]
+        rows.append({"test": spec["test"], "stage": spec["stage"],
+                     "grid_point": spec["grid_point"], "observed": spec["observed"],
+                     "predicted": bool(column["toppled"]),
+                     "max_tilt_deg": column["max_tilt_deg"],
+                     "run_id": spec["run_id"]})
+    table = pd.DataFrame(rows)
+    per_point = {}
+    if len(table):
+        stage = specs_[0]["stage"]
+        write_csv(campaign_dir / f"{stage}.csv", table)
+        for label, group in table.groupby("grid_point", sort=False):
+            per_point[label] = scores(group["observed"], group["predicted"])
+    points = {spec["grid_point"]: spec["point"] for spec in specs_}
+    return {"scores": per_point, "points": points, "runs_done": len(rows)}
+
+def best_point(result):
+    """The grid point of the best calibration accuracy (ties: the first)."""
+    ranked = [(s["accuracy"] if s["accuracy"] is not None else -1, -k, label)
+              for k, (label, s) in enumerate(result["scores"].items())]
+    if not ranked:
+        raise InputError("no calibration run finished")
+    _, _, label = max(ranked)
+    return label, result["points"][label]
+
+def drive(run, records, campaign_dir, options):
+    """Calibrate on the tests before ``validate_from``, validate the chosen parameters on
+    the others, write experiments.csv, shake_table.json and the rates figure."""
+    from pipeline.scenario.geometry import ColumnGeometry
+    campaign_dir = Path(campaign_dir)
+    calibration = run({**options, "stage": "calibration"})
+    label, point = best_point(calibration)
+    print(f"calibration: best {label} (accuracy {calibration['scores'][label]['accuracy']:.3f} "
+          f"on {calibration['scores'][label]['n']} tests)", flush=True)
+    validation = run({**options, "stage": "validation", "chosen": point})
+    frame = load_experiments(options["experiments"], options["outcome"])
+    specimen = ColumnGeometry.load(options["specimen"])
+    table = _experiment_table(frame, campaign_dir, label, options["validate_from"])
+    write_csv(campaign_dir / "experiments.csv", table.drop(columns=["day", "motion_path"]))
+    result = summarise(table, specimen, calibration, label, point, options)
+    write_json(campaign_dir / "shake_table.json", result)
+    from pipeline.figures.shake_table import plot_rates
+    plot_rates(table, campaign_dir / "shake_table_rates.png", result)
+    for line in result["lines"]:
+        print(line)
+    return {**validation, "summary": result}
+
+def _experiment_table(frame, campaign_dir, label, validate_from):
+    """The experiment table with split and the chosen parameters' prediction (None where
+    not simulated)."""
+    predicted = {}
+    for stage in ("calibration", "validation"):
+        path = Path(campaign_dir) / f"{stage}.csv"
+        if path.exists():
+            runs = pd.read_csv(path)
+            runs = runs[runs["grid_point"] == label]
+            predicted.update(dict(zip(runs["test"].astype(str), runs["predicted"])))
+    out = frame.copy()
+    out["split"] = np.where(out["day"] < date.fromisoformat(validate_from), "calibration",
+                            "validation")
+    out["predicted"] = [predicted.get(t) for t in out["test"]]
+    return out
+
+def summarise(table, specimen, calibration, label, point, options):
+    """Scores per split for the model and the baselines, the calibration table, lines."""
+    critical = specimen.critical_angle_deg()
+    threshold_g = math.tan(math.radians(critical))
+    splits = {}
+    for split in ("calibration", "validation", "all"):
+        rows = table if split == "all" else table[table["split"] == split]
+        run = rows[[p is not None for p in rows["predicted"]]]
+        obs = run["observed"].to_numpy(bool)
+        splits[split] = {
+            "model": scores(obs, run["predicted"].astype(bool)),
+            "never_overturns": scores(obs, np.zeros(len(run), bool)),
+            "pga_threshold": scores(obs, run["pga_g"].to_numpy() >= threshold_g),
+            "tests_with_motion": len(run), "tests": len(rows)}
+    lines = [f"specimen {specimen.name}: critical angle {critical:.1f} deg "
+             f"(PGA threshold baseline {threshold_g:.3f} g); parameters {label}"]
+    for split, s in splits.items():
+        m = s["model"]
+        if not m["n"]:
+            continue
+        lines.append(f"{split:>11} ({m['n']} tests): accuracy {m['accuracy']:.3f} "
+                     f"[{m['accuracy_95'][0]:.2f}, {m['accuracy_95'][1]:.2f}], precision "
+                     f"{_f(m['precision'])}, recall {_f(m['recall'])}, F1 {_f(m['f1'])}; "
+                     f"baselines: never {s['never_overturns']['accuracy']:.3f}, PGA >= "
+                     f"{threshold_g:.2f} g {s['pga_threshold']['accuracy']:.3f}")
+    return {"specimen": specimen.to_dict(), "critical_angle_deg": critical,
+            "pga_threshold_g": threshold_g, "validate_from": options["validate_from"],
+            "grid": options["grid"], "chosen": {"label": label, "parameters": point},
+            "calibration_scores": calibration["scores"], "splits": splits, "lines": lines}
+
+def _f(value):
+    return "n/a" if value is None else f"{value:.3f}"
+
+def add_options(parser):
+    parser.add_argument("--experiments", type=Path, default=EXPERIMENTS, metavar="CSV",
+                        help="experiment table (default: the SP1 granite tests shipped in "
+                        "records/shake_table/tests.csv)")
+    parser.add_argument("--outcome", default=OUTCOME, metavar="COLUMN",
+                        help=f"column of the observed outcome, 1 = overturned (default {OUTCOME})")
+    add_column_file_argument(parser, "the specimen: a mesh specimen or column description "
+                             "(default records/shake_table/sp1.json, the scanned rock SP1)")
+    parser.add_argument("--validate-from", default=VALIDATE_FROM, metavar="YYYY-MM-DD",
+                        help="tests from this date on are held out for validation; the "
+                        f"earlier ones calibrate (default {VALIDATE_FROM})")
+    parser.add_argument("--grid", default=DEFAULT_GRID, metavar="NAME=V,V;NAME=V",
+                        help="parameter sets the calibration chooses from (Cartesian product; "
+                        f"default '{DEFAULT_GRID}'; names: "
+                        f"{', '.join([*GRID_CONTACT, *GRID_SPECIMEN])})")
+    parser.add_argument("--tests", default=None, metavar="TEST,TEST",
+                        help="only these tests (a quick look; default all)")
+
+def read_options(args):
+    try:
+        date.fromisoformat(args.validate_from)
+    except ValueError:
+        raise InputError(f"--validate-from {args.validate_from!r}: expected yyyy-mm-dd") from None
+    parse_grid(args.grid)
+    load_experiments(args.experiments, args.outcome)
+    tests = [t for t in (args.tests or "").split(",") if t] or None
+    return {"experiments": args.experiments, "outcome": args.outcome,
+            "specimen": args.column_file or SPECIMEN, "validate_from": args.validate_from,
+            "grid": args.grid, "tests": tests}
+
+def _worker(spec, run_dir):
+    from pipeline.campaign.definitions import run_column_spec
+    run_column_spec(spec, run_dir)
+
+register(Campaign(
+    "shake-table", "a specimen (default the scanned granite rock SP1) against shake-table "
+    "experiments: calibrate on the early tests, validate on the held-out later ones",
+    specs, _worker, outputs, label="experiments", options=add_options,
+    read_options=read_options, driver=drive))
+
+RESULTS = RESULTS_DIR / "shake-table"

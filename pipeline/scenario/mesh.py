@@ -1,0 +1,356 @@
+"""A specimen from a triangle mesh (a scanned rock): exact mass properties from the
+mesh, its rest pose on the table, and contact points that follow its footprint and the
+faces it can land on.
+
+A mesh specimen is given as a mesh file (``.obj``, ``.ply``, ``.stl``, read by trimesh)
+or as a JSON file that names one (schema in docs/columns-and-model.md, "Mesh specimens")::
+
+    {"name": "SP1", "mesh": "SP1.obj", "mass_kg": 353.8,
+     "units": "m", "rotation_wxyz": [1, 0, 0, 0], "rest_pose": "nearest",
+     "heading_deg": 0, "footprint_tolerance_m": 0.003}
+
+- ``mass_kg`` or ``density`` (kg/m^3; a bare mesh file gets DEFAULT_DENSITY, granite);
+  the inertia is the mesh's, scaled to that mass.
+- ``rotation_wxyz`` turns the mesh into the table frame (x East, y North, z up; default:
+  the mesh's own axes, as a scan of a rock standing on the table has them).
+- ``rest_pose``: "nearest" (default) lets the specimen settle onto the table: the stable
+  pose of its convex hull (trimesh) nearest to the given orientation, reached by the
+  smallest rotation; "given" keeps the orientation, which must then stand by itself.
+- ``heading_deg`` turns the specimen clockwise (seen from above) about the vertical.
+- ``footprint_tolerance_m``: the specimen stands on the hull's points within this height
+  of the table (a rough base seats on its asperities); the outline of those points is
+  the footprint, whose edges it rocks about.
+
+In the scene the specimen is one clump: contact spheres along the footprint's outline
+(the base rim, ``rim_points`` per full turn of its corners as a column's rim) and on up to
+LANDING_POINTS_PER_RIM_POINT x ``rim_points`` hull vertices elsewhere (the faces it can
+land on), each sphere one radius inside the surface.
+"""
+import functools
+import hashlib
+import json
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from pipeline.constants import MODEL_GRAVITY
+from pipeline.files import InputError
+from pipeline.scenario.geometry import MESH_SUFFIXES, perimeter_points
+from pipeline.userfiles import Unreadable, keys_text, read_text, show
+
+MAX_MESH_BYTES = 200_000_000
+DEFAULT_DENSITY = 2650.0          # kg/m^3, granite
+DENSITY_RANGE = (100.0, 25000.0)  # kg/m^3
+MASS_RANGE = (1e-3, 1e7)          # kg
+SIZE_RANGE_M = (0.02, 30.0)       # largest extent of a specimen
+UNITS = {"m": 1.0, "cm": 0.01, "mm": 0.001}
+REST_POSES = ("nearest", "given")
+DEFAULT_FOOTPRINT_TOLERANCE_M = 0.003
+FOOTPRINT_TOLERANCE_RANGE_M = (0.0, 0.05)
+LANDING_POINTS_PER_RIM_POINT = 8
+KEYS = {"name", "mesh", "mass_kg", "density", "units", "rotation_wxyz", "rest_pose",
+        "heading_deg", "footprint_tolerance_m", "source", "notes", "mesh_sha256"}
+
+
+@dataclass(frozen=True)
+class MeshSpecimen:
+    """A rigid specimen from a mesh, in its rest pose on the table (x East, y North, z
+    up; the table at z = 0, the centre of mass above the origin).  Lengths m, mass kg."""
+    name: str
+    mesh_path: str
+    mesh_sha256: str
+    options: dict                   # the description's other keys, as given (to_dict)
+    mass: float
+    volume_m3: float
+    com: np.ndarray = field(repr=False)            # (3,) table frame
+    inertia: np.ndarray = field(repr=False)        # 3 x 3 about the centre of mass
+    footprint: np.ndarray = field(repr=False)      # (k, 2) CCW outline it stands on
+    hull_points: np.ndarray = field(repr=False)    # (n, 3) hull vertices above it
+    extent_m: tuple = ()                           # (x, y, z) size of the posed specimen
+    settled_by_deg: float = 0.0     # rotation from the given orientation to the rest pose
+    source: str = None
+    notes: str = None
+    settles = True
+    blocks = ()
+    edge_rims = True
+
+    # ------------------------------------------------------------ loading
+    @classmethod
+    def load(cls, path):
+        """A specimen from a mesh file, or from a JSON description naming one."""
+        path = Path(path)
+        if path.suffix.lower() in MESH_SUFFIXES:
+            return cls.from_dict({"name": path.stem, "mesh": str(path.resolve())},
+                                 where=path.name)
+        try:
+            data = json.loads(read_text(path))
+        except (OSError, Unreadable, ValueError) as exc:
+            raise InputError(f"{path.name}: not a readable specimen description "
+                             f"({str(exc).splitlines()[0][:120]})") from None
+        return cls.from_dict(data, where=path.name, base=path.resolve().parent)
+
+    @classmethod
+    def from_dict(cls, data, where="specimen description", base=None):
+        """Validate a description dict (``mesh`` relative to ``base``); one-line InputError."""
+        if not isinstance(data, dict) or "mesh" not in data:
+            raise InputError(f"{where}: a mesh specimen needs a 'mesh' file")
+        unknown = set(data) - KEYS
+        if unknown:
+            raise InputError(f"{where}: unknown key(s) {keys_text(unknown)} "
+                             f"(allowed: {', '.join(sorted(KEYS))})")
+        name = data.get("name", "specimen")
+        if not isinstance(name, str) or not name.strip() or len(name) > 80:
+            raise InputError(f"{where}: 'name' must be a non-empty string (at most 80 "
+                             "characters)")
+        if not isinstance(data["mesh"], str):
+            raise InputError(f"{where}: 'mesh' must be a file name, got {show(data['mesh'])}")
+        mesh = Path(data["mesh"])
+        if not mesh.is_absolute() and base is not None:
+            mesh = Path(base) / mesh
+        if mesh.suffix.lower() not in MESH_SUFFIXES:
+            raise InputError(f"{where}: mesh {mesh.name}: not a mesh file "
+                             f"({', '.join(MESH_SUFFIXES)})")
+        if "mass_kg" in data and "density" in data:
+            raise InputError(f"{where}: give 'mass_kg' or 'density', not both")
+        mass = _number(data, "mass_kg", None, *MASS_RANGE, where)
+        density = _number(data, "density", None, *DENSITY_RANGE, where)
+        units = data.get("units", "m")
+        if units not in UNITS:
+            raise InputError(f"{where}: 'units' must be one of {', '.join(UNITS)}, got "
+                             f"{show(units)}")
+        rotation = data.get("rotation_wxyz", [1.0, 0.0, 0.0, 0.0])
+        if (not isinstance(rotation, list) or len(rotation) != 4
+                or not all(isinstance(q, (int, float)) and not isinstance(q, bool)
+                           and math.isfinite(q) for q in rotation)
+                or math.fsum(q * q for q in rotation) < 1e-12):
+            raise InputError(f"{where}: 'rotation_wxyz' must be 4 finite numbers, not all "
+                             f"zero (a quaternion w, x, y, z), got {show(rotation)}")
+        rest_pose = data.get("rest_pose", "nearest")
+        if rest_pose not in REST_POSES:
+            raise InputError(f"{where}: 'rest_pose' must be one of {', '.join(REST_POSES)}, "
+                             f"got {show(rest_pose)}")
+        heading = _number(data, "heading_deg", 0.0, -360.0, 360.0, where)
+        tolerance = _number(data, "footprint_tolerance_m", DEFAULT_FOOTPRINT_TOLERANCE_M,
+                            *FOOTPRINT_TOLERANCE_RANGE_M, where)
+        for key in ("source", "notes"):
+            if data.get(key) is not None and not isinstance(data[key], str):
+                raise InputError(f"{where}: '{key}' must be a string")
+        if not mesh.is_file():
+            raise InputError(f"{where}: mesh file not found: {mesh}")
+        if mesh.stat().st_size > MAX_MESH_BYTES:
+            raise InputError(f"{where}: mesh {mesh.name} is larger than "
+                             f"{MAX_MESH_BYTES // 1_000_000} MB")
+        digest = hashlib.sha256(mesh.read_bytes()).hexdigest()
+        if data.get("mesh_sha256") not in (None, digest):
+            raise InputError(f"{where}: mesh {mesh.name} is not the file described "
+                             "(its SHA-256 differs from 'mesh_sha256')")
+        options = {k: data[k] for k in ("mass_kg", "density", "units", "rotation_wxyz",
+                                         "rest_pose", "heading_deg", "footprint_tolerance_m")
+                   if k in data}
+        posed = _posed(str(mesh), digest, UNITS[units], tuple(float(q) for q in rotation),
+                       rest_pose, heading, tolerance, where)
+        volume = posed["volume"]
+        if mass is None:
+            mass = (DEFAULT_DENSITY if density is None else density) * volume
+        return cls(name.strip(), str(mesh), digest, options, float(mass), volume,
+                   posed["com"], posed["inertia_per_kg"] * mass, posed["footprint"],
+                   posed["hull_points"], posed["extent"], posed["settled_by_deg"],
+                   data.get("source"), data.get("notes"))
+
+    def to_dict(self):
+        """The description (absolute mesh path and its SHA-256: run ids follow the file)."""
+        out = {"name": self.name, "mesh": self.mesh_path, "mesh_sha256": self.mesh_sha256,
+               **self.options}
+        for key in ("source", "notes"):
+            if getattr(self, key):
+                out[key] = getattr(self, key)
+        return out
+
+    # ------------------------------------------------------------ what campaigns ask
+    @property
+    def height(self):
+        """Height (m) of the specimen standing on the table."""
+        return float(self.extent_m[2])
+
+    @property
+    def base_width(self):
+        """Smallest width (m) of the footprint."""
+        return float(2 * min(self._edge_levers()))
+
+    @property
+    def density(self):
+        """Mean density (kg/m^3): mass over the mesh's volume."""
+        return self.mass / self.volume_m3
+
+    def monolithic(self):
+        """The specimen itself: it is one stone."""
+        return self
+
+    def bodies(self, x=0.0, y=0.0):
+        """Its rigid bodies: itself (one stone)."""
+        return [self]
+
+    def _edge_levers(self):
+        """Horizontal distance (m) from the centre of mass to each footprint edge."""
+        a = self.footprint
+        b = np.roll(a, -1, axis=0)
+        e = b - a
+        normal = np.column_stack([e[:, 1], -e[:, 0]]) / np.hypot(*e.T)[:, None]
+        return np.abs(((self.com[:2] - a) * normal).sum(axis=1))
+
+    def statics(self, g=MODEL_GRAVITY):
+        """One joint (the specimen on the table): rocking threshold / g about its weakest
+        footprint edge (``ratio`` = tan of the critical angle), its lever (m) and the
+        smallest energy (J) that tips it over an edge."""
+        d = self._edge_levers()
+        h = float(self.com[2])
+        return [{"body": 0, "from_block": 0, "ratio": float(d.min() / h),
+                 "lever_m": float(d.min()), "barrier_j":
+                 float((self.mass * g * (np.hypot(d, h) - h)).min()),
+                 "mass_kg": self.mass, "com_m": self.com.tolist()}]
+
+    def uplift_ratio(self):
+        return self.statics()[0]["ratio"]
+
+    def critical_angle_deg(self):
+        """Smallest angle (deg) it must be tilted about a footprint edge to fall."""
+        return math.degrees(math.atan(self.uplift_ratio()))
+
+    def overturning_barrier(self, g=MODEL_GRAVITY):
+        return self.statics(g)[0]["barrier_j"]
+
+    def check(self):
+        return self.statics()
+
+    def contact_rocking_hz(self, kn, rim_points=16):
+        """Frequency (Hz) of the specimen rocking on the contact springs of its footprint
+        outline (kn N/m per point), the smaller about the two horizontal axes."""
+        pts = perimeter_points(self.footprint, rim_points) - self.com[:2]
+        out = []
+        for axis, other in ((0, 1), (1, 0)):
+            inertia = self.inertia[other, other] + self.mass * self.com[2] ** 2
+            out.append(math.sqrt(kn * (pts[:, axis] ** 2).sum() / inertia) / (2 * math.pi))
+        return min(out)
+
+    def scene_column(self, spec, rim_points):
+        """The ``params.json`` column entry of this specimen placed as ``spec``
+        (:class:`~pipeline.scenario.geometry.ColumnSpec`): one body whose rims are
+        explicit points (body frame about the centre of mass) with inward normals."""
+        com = self.com
+        base = perimeter_points(self.footprint, rim_points) - com[:2]
+        base3 = np.column_stack([base, np.full(len(base), -com[2])])
+        landing = _spread(self.hull_points, LANDING_POINTS_PER_RIM_POINT * rim_points) - com
+        inward = -landing / np.linalg.norm(landing, axis=1)[:, None]
+        up = np.tile([0.0, 0.0, 1.0], (len(base3), 1))
+        joint = self.statics()[0]
+        critical = math.degrees(math.atan(joint["ratio"]))
+        _, axes = np.linalg.eigh(self.inertia)
+        body = {"name": f"{spec.name}[0]", "column": spec.name, "index": 0,
+                "block_name": self.name, "blocks": [0], "shape": "mesh",
+                "height": self.height, "mass": self.mass, "inertia": self.inertia.tolist(),
+                "principal_axes": axes.tolist(),
+                "centre": [spec.x + com[0], spec.y + com[1], float(com[2])],
+                "rotation": np.eye(3).tolist(), "column_position": [spec.x, spec.y],
+                "parts": [{"shape": "mesh", "block": 0, "name": self.name,
+                           "mesh_sha256": self.mesh_sha256}],
+                "rims": [{"role": "base", "kind": "points", "points": base3.tolist(),
+                          "normals": up.tolist(), "vertices": base.tolist(),
+                          "z": float(-com[2])},
+                         {"role": "edge", "kind": "points", "points": landing.tolist(),
+                          "normals": inward.tolist()}],
+                "plate": None, "overturn_tilt_deg": critical}
+        return {"name": spec.name, "kind": spec.kind, "x": spec.x, "y": spec.y,
+                "description": self.name, "height": self.height, "n_bodies": 1,
+                "uplift_ratio": joint["ratio"], "rocking_lever_m": joint["lever_m"],
+                "overturning_barrier_j": joint["barrier_j"], "settles": True,
+                "bodies": [body]}
+
+
+def _number(data, key, default, low, high, where):
+    if key not in data:
+        return default
+    value = data[key]
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or \
+            not math.isfinite(value) or not low <= value <= high:
+        raise InputError(f"{where}: '{key}' must be a number in [{low:g}, {high:g}], got "
+                         f"{show(value)}")
+    return float(value)
+
+
+def _spread(points, n):
+    """At most ``n`` of ``points`` (k, 3), spread over them: farthest-point sampling from
+    the lowest point (deterministic)."""
+    points = np.asarray(points, float)
+    if len(points) <= n:
+        return points
+    chosen = [int(np.argmin(points[:, 2]))]
+    dist = np.linalg.norm(points - points[chosen[0]], axis=1)
+    for _ in range(n - 1):
+        k = int(np.argmax(dist))
+        chosen.append(k)
+        dist = np.minimum(dist, np.linalg.norm(points - points[k], axis=1))
+    return points[sorted(chosen)]
+
+
+@functools.lru_cache(maxsize=8)
+def _posed(path, digest, scale, rotation_wxyz, rest_pose, heading_deg, tolerance, where):
+    """Mass properties (per kg), footprint and hull of the mesh in its rest pose."""
+    import trimesh
+    from scipy.spatial import ConvexHull
+    from scipy.spatial.transform import Rotation
+
+    try:
+        mesh = trimesh.load(path, force="mesh", process=True)
+    except Exception as exc:  # trimesh raises many kinds on a broken file
+        raise InputError(f"{where}: mesh {Path(path).name} unreadable "
+                         f"({str(exc).splitlines()[0][:120] if str(exc) else type(exc).__name__})") \
+            from None
+    if not isinstance(mesh, trimesh.Trimesh) or len(mesh.faces) < 4:
+        raise InputError(f"{where}: mesh {Path(path).name} holds no closed surface")
+    if not mesh.is_watertight:
+        raise InputError(f"{where}: mesh {Path(path).name} is not watertight (holes or open "
+                         "edges): its volume and mass are undefined; close it first")
+    mesh.apply_scale(scale)
+    if mesh.volume < 0:
+        mesh.invert()                      # inward-facing normals (a common scan export)
+    size = float(np.ptp(mesh.vertices, axis=0).max())
+    if not SIZE_RANGE_M[0] <= size <= SIZE_RANGE_M[1]:
+        raise InputError(f"{where}: mesh {Path(path).name} is {size:g} m across with units "
+                         f"{'m' if scale == 1 else 'cm' if scale == 0.01 else 'mm'}: expected "
+                         f"{SIZE_RANGE_M[0]:g}-{SIZE_RANGE_M[1]:g} m (check 'units')")
+    w, x, y, z = rotation_wxyz
+    given = Rotation.from_quat([x, y, z, w])
+    settle = Rotation.identity()
+    if rest_pose == "nearest":
+        transforms, _ = mesh.compute_stable_poses()
+        ups = [given.apply(np.linalg.inv(T[:3, :3]) @ [0.0, 0.0, 1.0]) for T in transforms]
+        # the stable pose whose up direction is nearest the given orientation's
+        up = max(ups, key=lambda u: u[2])
+        settle, _ = Rotation.align_vectors([[0.0, 0.0, 1.0]], [up])
+    turn = Rotation.from_euler("z", -heading_deg, degrees=True)
+    total = turn * settle * given
+    matrix = np.eye(4)
+    matrix[:3, :3] = total.as_matrix()
+    mesh.apply_transform(matrix)
+    lowest = mesh.vertices[:, 2].min()
+    com = mesh.center_mass
+    mesh.apply_translation([-com[0], -com[1], -lowest])
+    hull = mesh.convex_hull.vertices
+    near = hull[hull[:, 2] <= tolerance + 1e-9]
+    com = np.array(mesh.center_mass, float)
+    if len(near) < 3 or ConvexHull(near[:, :2], qhull_options="QJ").volume <= 0:
+        raise InputError(f"{where}: fewer than 3 hull points within footprint_tolerance_m "
+                         f"{tolerance:g} m of the table: it cannot stand (raise the tolerance)")
+    outline = near[ConvexHull(near[:, :2]).vertices][:, :2]
+    from matplotlib.path import Path as Polygon
+    if not Polygon(outline).contains_point(com[:2]):
+        raise InputError(f"{where}: the centre of mass lies outside the footprint in this "
+                         "pose: the specimen cannot stand (use rest_pose \"nearest\")")
+    landing = hull[hull[:, 2] > tolerance + 1e-9]
+    return {"volume": float(mesh.volume), "com": com,
+            "inertia_per_kg": np.array(mesh.moment_inertia, float) / mesh.volume,
+            "footprint": outline, "hull_points": landing,
+            "extent": tuple(float(e) for e in np.ptp(mesh.vertices, axis=0)),
+            "settled_by_deg": float(np.degrees((settle).magnitude()))}
