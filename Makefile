@@ -5,7 +5,7 @@ PY := .venv/bin/python
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 JOBS ?= $(shell nproc)
 
-.PHONY: setup test run-all records campaigns bench clean invert-demo
+.PHONY: setup test run-all records campaigns bench clean invert-demo shake-table
 
 setup: .venv/.installed
 	@command -v yade >/dev/null || { echo "installing YADE (apt-get install yade)"; \
@@ -40,6 +40,12 @@ run-all: campaigns
 bench: setup
 	@$(PY) -c "import mujoco" 2>/dev/null || $(PY) -m pip install -q -e '.[bench]'
 	$(PY) bench/bench_yade.py
+
+# the scanned granite rock SP1 against 490 shake-table tests (calibrate June-July 2021,
+# validate August): about 25 min on 2 cores
+shake-table: setup
+	$(PY) -m pipeline campaign shake-table --grid "$(or $(SHAKE_GRID),footprint_tolerance_m=0.001,0.003;damping=0.1,0.36)" --jobs $(JOBS)
+	$(PY) -m pipeline report
 
 invert-demo: setup
 	$(PY) -m pipeline invert --demo --grid $(or $(INVERT_GRID),demo) --jobs $(JOBS) --allow-long $(INVERT_ARGS)

@@ -35,6 +35,7 @@ from pipeline.stats.classification import binned_rates, scores
 EXPERIMENTS = RECORDS_DIR / "shake_table" / "tests.csv"
 SPECIMEN = RECORDS_DIR / "shake_table" / "sp1.json"
 OUTCOME = "sp1_overturned"
+AXIS_DEG = 90.0                  # the shipped tests shake along East-West
 VALIDATE_FROM = "2021-08-01"     # the issue's split: calibrate on June-July, validate August
 COLUMNS = ("test", "date", "pga_g", "pgv_pga_s", "motion_file")
 # what --grid may vary: contact parameters, and the specimen's footprint tolerance
@@ -127,7 +128,7 @@ def _run_params(specimen, point):
 
 def specs(records, campaign_dir, experiments=EXPERIMENTS, specimen=SPECIMEN, outcome=OUTCOME,
           validate_from=VALIDATE_FROM, grid=DEFAULT_GRID, stage="calibration", chosen=None,
-          tests=None):
+          tests=None, axis_deg=AXIS_DEG):
     """Run specs of one stage: every grid point on the calibration tests, or the chosen
     point on the validation tests."""
     from pipeline.campaign.definitions import column_specs
@@ -229,7 +230,10 @@ def _experiment_table(frame, campaign_dir, label, validate_from):
 
 def summarise(table, specimen, calibration, label, point, options):
     """Scores per split for the model and the baselines, the calibration table, lines."""
-    critical = specimen.critical_angle_deg()
+    axis = options.get("axis_deg", AXIS_DEG)
+    critical = (specimen.critical_angle_along_deg(axis)
+                if hasattr(specimen, "critical_angle_along_deg")
+                else math.degrees(math.atan(specimen.uplift_ratio())))
     threshold_g = math.tan(math.radians(critical))
     splits = {}
     for split in ("calibration", "validation", "all"):
@@ -241,7 +245,8 @@ def summarise(table, specimen, calibration, label, point, options):
             "never_overturns": scores(obs, np.zeros(len(run), bool)),
             "pga_threshold": scores(obs, run["pga_g"].to_numpy() >= threshold_g),
             "tests_with_motion": len(run), "tests": len(rows)}
-    lines = [f"specimen {specimen.name}: critical angle {critical:.1f} deg "
+    lines = [f"specimen {specimen.name}: critical angle {critical:.1f} deg along the "
+             f"table's axis ({axis:g} deg) "
              f"(PGA threshold baseline {threshold_g:.3f} g); parameters {label}"]
     for split, s in splits.items():
         m = s["model"]
@@ -252,7 +257,7 @@ def summarise(table, specimen, calibration, label, point, options):
                      f"{_f(m['precision'])}, recall {_f(m['recall'])}, F1 {_f(m['f1'])}; "
                      f"baselines: never {s['never_overturns']['accuracy']:.3f}, PGA >= "
                      f"{threshold_g:.2f} g {s['pga_threshold']['accuracy']:.3f}")
-    return {"specimen": specimen.to_dict(), "critical_angle_deg": critical,
+    return {"specimen": specimen.to_dict(), "critical_angle_deg": critical, "axis_deg": axis,
             "pga_threshold_g": threshold_g, "validate_from": options["validate_from"],
             "grid": options["grid"], "chosen": {"label": label, "parameters": point},
             "calibration_scores": calibration["scores"], "splits": splits, "lines": lines}
@@ -275,6 +280,9 @@ def add_options(parser):
                         help="parameter sets the calibration chooses from (Cartesian product; "
                         f"default '{DEFAULT_GRID}'; names: "
                         f"{', '.join([*GRID_CONTACT, *GRID_SPECIMEN])})")
+    parser.add_argument("--axis-deg", type=float, default=AXIS_DEG, metavar="DEG",
+                        help="azimuth of the table's shaking line, for the PGA-threshold "
+                        f"baseline's critical angle (default {AXIS_DEG:g}: East-West)")
     parser.add_argument("--tests", default=None, metavar="TEST,TEST",
                         help="only these tests (a quick look; default all)")
 
@@ -285,10 +293,12 @@ def read_options(args):
         raise InputError(f"--validate-from {args.validate_from!r}: expected yyyy-mm-dd") from None
     parse_grid(args.grid)
     load_experiments(args.experiments, args.outcome)
+    if not (math.isfinite(args.axis_deg) and 0.0 <= args.axis_deg < 360.0):
+        raise InputError(f"--axis-deg must be in [0, 360), got {args.axis_deg:g}")
     tests = [t for t in (args.tests or "").split(",") if t] or None
     return {"experiments": args.experiments, "outcome": args.outcome,
             "specimen": args.column_file or SPECIMEN, "validate_from": args.validate_from,
-            "grid": args.grid, "tests": tests}
+            "grid": args.grid, "tests": tests, "axis_deg": args.axis_deg}
 
 def _worker(spec, run_dir):
     from pipeline.campaign.definitions import run_column_spec

@@ -2,7 +2,7 @@
 PGA and PGV/PGA."""
 import numpy as np
 
-from pipeline.figures.style import new_figure
+from pipeline.figures.style import figure
 from pipeline.files import save_figure
 from pipeline.stats.classification import binned_rates
 
@@ -15,7 +15,8 @@ def plot_rates(table, path, result):
     panels = [("observed, all tests", table, table["observed"]),
               ("observed, simulated tests", simulated, simulated["observed"]),
               ("predicted (YADE)", simulated, simulated["predicted"].astype(float))]
-    fig, axes = new_figure(1, 3, figsize=(15, 4.8), sharey=True, layout="constrained")
+    fig = figure(figsize=(15, 4.8), layout="constrained")
+    axes = fig.subplots(1, 3, sharey=True)
     for ax, (title, rows, outcome) in zip(axes, panels):
         rate, count = binned_rates(rows["pga_g"], rows["pgv_pga_s"],
                                    np.asarray(outcome, float), PGA_EDGES_G, PGV_PGA_EDGES_S)

@@ -218,6 +218,16 @@ class MeshSpecimen:
         """Smallest angle (deg) it must be tilted about a footprint edge to fall."""
         return math.degrees(math.atan(self.uplift_ratio()))
 
+    def critical_angle_along_deg(self, azimuth_deg):
+        """Critical angle (deg) for tipping along a horizontal line (azimuth, deg clockwise
+        from North): the smaller of tipping toward it and away from it, about the
+        footprint's extreme support lines across it."""
+        a = math.radians(azimuth_deg)
+        u = np.array([math.sin(a), math.cos(a)])
+        along = (self.footprint - self.com[:2]) @ u
+        lever = min(along.max(), -along.min())
+        return math.degrees(math.atan(lever / self.com[2]))
+
     def overturning_barrier(self, g=MODEL_GRAVITY):
         return self.statics(g)[0]["barrier_j"]
 
