@@ -18,8 +18,10 @@ setup: .venv/.installed
 	$(PY) -m pip install -q -e '.[test]'
 	touch $@
 
-# the YADE physics tests on glibc's second libm path (another CPU's last bits), then all
+# the layers of the stages (import-linter contract in pyproject.toml), the YADE physics
+# tests on glibc's second libm path (another CPU's last bits), then all
 test: setup
+	.venv/bin/lint-imports
 	$(PY) -m pytest -q -m libm --second-libm tests
 	$(PY) -m pytest -q tests
 

@@ -109,21 +109,6 @@ def code_hash(*packages):
     return h.hexdigest()[:16]
 
 
-def software_versions():
-    """Versions (dict) of the package, obspy, numpy, scipy and YADE, for provenance."""
-    import importlib.metadata
-    from pipeline import __version__
-    versions = {"toppling-columns": __version__}
-    for dist in ("obspy", "numpy", "scipy"):
-        try:
-            versions[dist] = importlib.metadata.version(dist)
-        except importlib.metadata.PackageNotFoundError:
-            versions[dist] = None
-    from pipeline.scenario.runner import yade_version
-    versions["yade"] = yade_version()
-    return versions
-
-
 def _json_default(obj):
     if isinstance(obj, np.generic):
         return obj.item()

@@ -11,7 +11,8 @@ from pathlib import Path
 import numpy as np
 
 from pipeline.constants import MODEL_GRAVITY
-from pipeline.files import InputError, code_hash, software_versions, write_json
+from pipeline.files import InputError, code_hash, write_json
+from pipeline.provenance import software_versions
 from pipeline.outcome.columns import summarise
 from pipeline.scenario import Column, Contact, Numerics, run_yade, scene_params, write_scenario
 

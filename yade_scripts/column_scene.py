@@ -344,6 +344,10 @@ SETTLED_FRACTION = 0.9   # after the motion, energy below the barrier cannot tip
 
 
 STANDS_UP, LIES_UP = 0.866, 0.5   # z of a body's axis: stands (tilt < 30 deg), lies (> 60 deg)
+# a mesh specimen (a rock) lies once tilted 30 deg past its critical angle (at most 60):
+# it has overturned, and may chatter on its landing points for long before it rests
+LIES_AT = [math.cos(math.radians(min(60.0, b["overturn_tilt_deg"] + 30.0)))
+           if b.get("overturn_tilt_deg") is not None else LIES_UP for b in bodies]
 
 
 def up_axis(s, c):
@@ -359,12 +363,12 @@ def settled(rel):
     block (verification) and columns partly fallen are never decided this way."""
     energy = dict.fromkeys(BARRIERS, 0.0)
     tilt = {}          # column -> set of "stands" / "lies" / "between"
-    for b, s, c in zip(bodies, states, clumps):
+    for b, s, c, lies_up in zip(bodies, states, clumps, LIES_AT):
         if b["column"] not in BARRIERS:
             return False
         up = up_axis(s, c)[2]
         tilt.setdefault(b["column"], set()).add(
-            "stands" if up >= STANDS_UP else "lies" if up < LIES_UP else "between")
+            "stands" if up >= STANDS_UP else "lies" if up < lies_up else "between")
         w = s.ori.conjugate() * s.angVel                               # clump frame
         energy[b["column"]] += (0.5 * b["mass"] * (s.vel - rel).squaredNorm()
                                 + 0.5 * sum(s.inertia[i] * w[i] ** 2 for i in range(3))
@@ -420,9 +424,9 @@ def check_stop():
         O.pause()
         return
     at_rest, fallen, axes = True, {}, []
-    for b, s, c in zip(bodies, states, clumps):
+    for b, s, c, lies_up in zip(bodies, states, clumps, LIES_AT):
         axis = up_axis(s, c)
-        lying = axis[2] < LIES_UP
+        lying = axis[2] < lies_up
         axes.append(None if lying else axis)
         fallen[b["column"]] = fallen.get(b["column"], False) or lying
         if not lying and ((s.vel - rel).norm() >= v_rest or s.angVel.norm() * length >= v_rest):

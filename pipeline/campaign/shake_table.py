@@ -207,7 +207,8 @@ def drive(run, records, campaign_dir, options):
     result = summarise(table, specimen, calibration, label, point, options)
     write_json(campaign_dir / "shake_table.json", result)
     from pipeline.figures.shake_table import plot_rates
-    plot_rates(table, campaign_dir / "shake_table_rates.png", result)
+    plot_rates(table, campaign_dir / "shake_table_rates.png", result, PGA_EDGES_G,
+               PGV_PGA_EDGES_S)
     for line in result["lines"]:
         print(line)
     return {**validation, "summary": result}

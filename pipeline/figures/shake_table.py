@@ -7,10 +7,10 @@ from pipeline.files import save_figure
 from pipeline.stats.classification import binned_rates
 
 
-def plot_rates(table, path, result):
-    """Three panels: observed rate (every test, with or without a motion), predicted rate
+def plot_rates(table, path, result, pga_edges_g, pgv_pga_edges_s):
+    """Three panels (bins: PGA edges g, PGV/PGA edges s): observed rate (every test, with or without a motion), predicted rate
     and observed rate on the simulated tests; counts in each cell.  Returns the path."""
-    from pipeline.campaign.shake_table import PGA_EDGES_G, PGV_PGA_EDGES_S
+    PGA_EDGES_G, PGV_PGA_EDGES_S = np.asarray(pga_edges_g), np.asarray(pgv_pga_edges_s)
     simulated = table[[p is not None for p in table["predicted"]]]
     panels = [("observed, all tests", table, table["observed"]),
               ("observed, simulated tests", simulated, simulated["observed"]),

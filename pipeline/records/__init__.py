@@ -18,7 +18,8 @@ from obspy.geodetics import gps2dist_azimuth
 from obspy.signal.rotate import rotate2zne
 
 from pipeline import PROJECT_ROOT, RECORDS_DIR, RESULTS_DIR
-from pipeline.files import InputError, code_hash, content_hash, software_versions
+from pipeline.files import InputError, code_hash, content_hash
+from pipeline.provenance import software_versions
 from pipeline.motion import Motion
 from pipeline.records import processing
 from pipeline.records.catalog import catalog, catalog_row

@@ -49,7 +49,7 @@ UNITS = {"m": 1.0, "cm": 0.01, "mm": 0.001}
 REST_POSES = ("nearest", "given")
 DEFAULT_FOOTPRINT_TOLERANCE_M = 0.003
 FOOTPRINT_TOLERANCE_RANGE_M = (0.0, 0.05)
-LANDING_POINTS_PER_RIM_POINT = 8
+LANDING_POINTS_PER_RIM_POINT = 4
 KEYS = {"name", "mesh", "mass_kg", "density", "units", "rotation_wxyz", "rest_pose",
         "heading_deg", "footprint_tolerance_m", "source", "notes", "mesh_sha256"}
 

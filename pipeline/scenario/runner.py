@@ -29,9 +29,9 @@ from pathlib import Path
 from pipeline import YADE_SCRIPTS_DIR
 from pipeline.files import ToolError, die_with_parent
 from pipeline.outcome import Trajectory
+from pipeline.provenance import YADE_PY_PATH, yade_version  # noqa: F401  (re-exported)
 
 DEBIAN_PYTHON = "/usr/bin/python3"
-YADE_PY_PATH = "/usr/lib/x86_64-linux-gnu/yade-double/py"
 TMP_PREFIX = "toppling-yade-"     # a YADE process's note of its temporary directory
 # glibc picks its libm routines (exp, sin, pow...) by CPU feature: with these tunables a
 # YADE process takes the non-FMA/AVX2 ones, as an older or another vendor's CPU would, so
@@ -51,18 +51,6 @@ _REUSE = {"depth": 0}
 
 class YadeError(ToolError):
     """YADE failed or exceeded its wall-clock limit; the message points at yade.log."""
-
-
-@functools.lru_cache(maxsize=1)
-def yade_version():
-    """YADE's version string (from its config module), or None when not installed."""
-    config = Path(YADE_PY_PATH) / "yade" / "config.py"
-    if not config.is_file():
-        return None
-    for line in config.read_text(errors="replace").splitlines():
-        if line.startswith("version="):
-            return line.split("=", 1)[1].strip().strip("'\"")
-    return None
 
 
 def check_yade():
