@@ -45,8 +45,17 @@ def register(campaign):
     return campaign
 
 
+def discover():
+    """Import every module of this package (found with pkgutil, as readers and commands
+    are): each campaign module registers its definitions when imported."""
+    import importlib
+    import pkgutil
+    for info in pkgutil.iter_modules(__path__):
+        importlib.import_module(f"{__name__}.{info.name}")
+
+
 def get(name):
-    from pipeline.campaign import definitions  # noqa: F401  (fills the registry)
+    discover()
     try:
         return CAMPAIGNS[name]
     except KeyError:
@@ -54,7 +63,7 @@ def get(name):
 
 
 def names():
-    from pipeline.campaign import definitions  # noqa: F401
+    discover()
     return list(CAMPAIGNS)
 
 

@@ -21,6 +21,7 @@ What a campaign varies and the description fixes:
 """
 import math
 
+from pipeline import paper
 from pipeline.files import InputError
 
 STIFFNESS_CHOICES = ("matched", "paper")
@@ -46,7 +47,6 @@ def add_column_file_argument(parser, note="", many=False, dest="column_file"):
 
 def add_stiffness_argument(parser, note=""):
     """``--stiffness matched|paper``: the contact stiffness of described columns."""
-    from pipeline import paper
     parser.add_argument("--stiffness", choices=STIFFNESS_CHOICES, default="matched",
                         help=(f"{note}: " if note else "") + "contact stiffness per point: "
                         "matched (default) raises the paper's kn for heavy columns so that "
@@ -90,9 +90,7 @@ def check_stiffness(stiffness):
 
 def column_kn(data, stiffness="matched"):
     """Contact stiffness per point (N/m) for a description: the campaign ``columns`` rule
-    (:func:`pipeline.campaign.definitions.matched_kn`) or the paper's kn."""
-    from pipeline import paper
-    from pipeline.campaign.definitions import matched_kn
+    (:func:`matched_kn`) or the paper's kn."""
     from pipeline.scenario.geometry import ColumnGeometry
     check_stiffness(stiffness)
     if stiffness == "paper":
@@ -174,3 +172,18 @@ def summary_entry(specs):
         if spec.get("column_description") is not None:
             return {"column_file": spec["column_description"]}
     return {}
+
+
+def matched_kn(geometry):
+    """Contact stiffness per point (N/m) that lets a column rock on its contact springs no
+    slower than the paper's column does with the paper's kn (13.5 Hz): the paper's kn for
+    columns of its size, more for heavier ones (kn scales with the square of the
+    frequency), rounded to two significant digits."""
+    from pipeline.scenario.geometry import ColumnGeometry
+    reference = ColumnGeometry.monolith(paper.COLUMN_HEIGHT_M,
+                                        paper.COLUMN_HEIGHT_M / paper.COLUMN_HD,
+                                        paper.MARBLE_DENSITY_KG_M3)
+    ratio = (reference.contact_rocking_hz(paper.COLUMN_KN_N_M)
+             / geometry.contact_rocking_hz(paper.COLUMN_KN_N_M)) ** 2
+    kn = paper.COLUMN_KN_N_M * max(1.0, ratio)
+    return float(f"{kn:.2g}")

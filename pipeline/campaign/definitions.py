@@ -6,6 +6,7 @@ from pathlib import Path
 from pipeline import RESULTS_DIR, paper
 from pipeline.campaign import Campaign, register
 from pipeline.campaign.column_file import (add_campaign_options, add_column_file_argument,
+                                           matched_kn,
                                            add_stiffness_argument, at_slenderness,
                                            check_stiffness, column_kn, description, mark,
                                            read_campaign_options, summary_entry)
@@ -243,21 +244,6 @@ register(Campaign("synthetic", "the twin model at synthetic sites around two sou
 
 
 # ---------------------------------------------------------------- real columns
-def matched_kn(geometry):
-    """Contact stiffness per point (N/m) that lets a column rock on its contact springs no
-    slower than the paper's column does with the paper's kn (13.5 Hz): the paper's kn for
-    columns of its size, more for heavier ones (kn scales with the square of the
-    frequency), rounded to two significant digits."""
-    from pipeline.scenario.geometry import ColumnGeometry
-    reference = ColumnGeometry.monolith(paper.COLUMN_HEIGHT_M,
-                                        paper.COLUMN_HEIGHT_M / paper.COLUMN_HD,
-                                        paper.MARBLE_DENSITY_KG_M3)
-    ratio = (reference.contact_rocking_hz(paper.COLUMN_KN_N_M)
-             / geometry.contact_rocking_hz(paper.COLUMN_KN_N_M)) ** 2
-    kn = paper.COLUMN_KN_N_M * max(1.0, ratio)
-    return float(f"{kn:.2g}")
-
-
 def columns_specs(records, campaign_dir, column_files=None, column="both",
                   stiffness="matched"):
     """Every column description (default: the shipped examples) on the same records
@@ -411,8 +397,3 @@ def _verification_worker(spec, run_dir):
 register(Campaign("verification", "Housner, one-sine pulse and sliding checks over ranges",
                   verification_specs, _verification_worker, verification_outputs,
                   label="verification runs"))
-
-
-from pipeline.campaign import ensemble  # noqa: E402,F401  (registers the ensemble campaign)
-from pipeline.campaign import fragility  # noqa: E402,F401  (registers the fragility campaign)
-from pipeline.campaign import shake_table  # noqa: E402,F401  (registers the shake-table campaign)

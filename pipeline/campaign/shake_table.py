@@ -30,7 +30,7 @@ from pipeline.campaign import Campaign, register
 from pipeline.campaign.column_file import add_column_file_argument
 from pipeline.files import InputError, write_csv, write_json
 from pipeline.records import RECORDS_DIR
-from pipeline.stats.classification import binned_rates, scores
+from pipeline.stats.classification import scores
 
 EXPERIMENTS = RECORDS_DIR / "shake_table" / "tests.csv"
 SPECIMEN = RECORDS_DIR / "shake_table" / "sp1.json"

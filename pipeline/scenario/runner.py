@@ -14,7 +14,6 @@ paid once per thread instead of once per run.  That process dies with its thread
 itself after ``SERVE_IDLE_S`` without a scene.
 """
 import contextlib
-import functools
 import json
 import os
 import select

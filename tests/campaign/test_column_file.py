@@ -13,7 +13,7 @@ import pytest
 from pipeline import campaign, cli, paper
 from pipeline.campaign import fragility
 from pipeline.campaign.column_file import at_slenderness, column_file_help, perturbed
-from pipeline.campaign.definitions import matched_kn
+from pipeline.campaign.column_file import matched_kn
 from pipeline.files import InputError
 from pipeline.motion import Motion
 from pipeline.motion.pulses import one_sine_pulse
