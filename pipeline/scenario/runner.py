@@ -28,7 +28,7 @@ from pathlib import Path
 from pipeline import YADE_SCRIPTS_DIR
 from pipeline.files import ToolError, die_with_parent
 from pipeline.outcome import Trajectory
-from pipeline.provenance import YADE_PY_PATH, yade_version  # noqa: F401  (re-exported)
+from pipeline.provenance import YADE_PY_PATH
 
 DEBIAN_PYTHON = "/usr/bin/python3"
 TMP_PREFIX = "toppling-yade-"     # a YADE process's note of its temporary directory
