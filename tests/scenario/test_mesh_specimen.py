@@ -147,3 +147,13 @@ def test_a_box_mesh_rocks_as_the_same_box_from_a_column_file(tmp_path):
             east = [math.sin(math.radians(o["downfall_azimuth_deg"])) for o in outcome.values()]
             assert east[0] * east[1] > 0 and min(abs(e) for e in east) > 0.9
     print(f"max tilt (deg) per factor of the uplift threshold: {tilts}")
+
+
+@pytest.mark.parametrize("suffix", [".stl", ".ply"])
+def test_stl_and_ply_give_the_same_specimen_as_obj(tmp_path, suffix):
+    obj = MeshSpecimen.load(box_mesh(tmp_path))
+    other = MeshSpecimen.load(box_mesh(tmp_path, name=f"box{suffix}"))
+    # STL and PLY store float32 vertices (the box sits 40 m up): 1e-5 is their precision
+    assert other.mass == pytest.approx(obj.mass, rel=1e-5)       # bare mesh: granite
+    assert obj.density == pytest.approx(2650.0)
+    assert other.uplift_ratio() == pytest.approx(obj.uplift_ratio(), rel=1e-5)
