@@ -68,19 +68,27 @@ def read_campaign_options(args):
     return {"column_file": args.column_file, "stiffness": args.stiffness}
 
 
-def description(column_file):
+def description(column_file, meshes=False):
     """The validated description dict of a shipped example's name, a file or a dict;
     None for None.  InputError (one line) for an unknown name, a missing file or a
-    description that does not validate."""
+    description that does not validate, and for a mesh specimen unless ``meshes`` (a
+    campaign that scales or perturbs blocks cannot take one)."""
     from pipeline.scenario.geometry import ColumnGeometry
     if column_file is None:
         return None
     if isinstance(column_file, dict):
-        return ColumnGeometry.from_dict(column_file).to_dict()
-    if not isinstance(column_file, str) or not column_file.strip():
+        data = ColumnGeometry.from_dict(column_file).to_dict()
+    elif not isinstance(column_file, str) or not column_file.strip():
         raise InputError(f"--column-file needs a shipped example's name or a file, got "
                          f"{column_file!r}")
-    return ColumnGeometry.load(column_file.strip()).to_dict()
+    else:
+        data = ColumnGeometry.load(column_file.strip()).to_dict()
+    if "mesh" in data and not meshes:
+        raise InputError(f"--column-file {data['name']}: a mesh specimen; this command scales "
+                         "or perturbs the blocks of a column description (mesh specimens run "
+                         "with run, campaign records, friction, synthetic, columns and "
+                         "shake-table)")
+    return data
 
 
 def check_stiffness(stiffness):

@@ -149,7 +149,7 @@ def slenderness_specs(records, campaign_dir, column_file=None, stiffness="matche
 
 
 def friction_specs(records, campaign_dir, column_file=None, stiffness="matched"):
-    data = description(column_file)
+    data = description(column_file, meshes=True)
     check_stiffness(stiffness)
     runs = [(r, twin(mu_s=mu, mu_k=round(paper.MU_K_OVER_MU_S * mu, 4)))
             for r in _records_or(records, [paper.SWEEP_RECORD, pulse_record()])
@@ -179,7 +179,7 @@ def _nearsource_records():
 
 
 def records_specs(records, campaign_dir, column_file=None, stiffness="matched"):
-    data = description(column_file)
+    data = description(column_file, meshes=True)
     check_stiffness(stiffness)
     runs = [(r, twin()) for r in (list(records) if records else _nearsource_records())]
     return mark(column_specs(described_twins(runs, data, stiffness), campaign_dir), data)
@@ -206,7 +206,7 @@ def signal_window(record):
 
 def synthetic_specs(records, campaign_dir, column_file=None, stiffness="matched"):
     from pipeline.motion import synthetics
-    data = description(column_file)
+    data = description(column_file, meshes=True)
     check_stiffness(stiffness)
     paths = list(records) if records else [
         p for source_paths in synthetics.generate_sources(synthetics.SOURCES).values()

@@ -157,3 +157,12 @@ def test_stl_and_ply_give_the_same_specimen_as_obj(tmp_path, suffix):
     assert other.mass == pytest.approx(obj.mass, rel=1e-5)       # bare mesh: granite
     assert obj.density == pytest.approx(2650.0)
     assert other.uplift_ratio() == pytest.approx(obj.uplift_ratio(), rel=1e-5)
+
+
+def test_campaigns_that_scale_blocks_refuse_a_mesh_in_one_line(tmp_path):
+    from pipeline.campaign.column_file import description
+    data = {"name": "box", "mesh": str(box_mesh(tmp_path)), "density": DENSITY}
+    assert description(data, meshes=True)["mesh_sha256"]
+    with pytest.raises(InputError, match="a mesh specimen") as info:
+        description(data)
+    assert "\n" not in str(info.value)
