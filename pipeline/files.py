@@ -161,3 +161,16 @@ def die_with_parent():
     parent dies, even by kill -9 (Linux PR_SET_PDEATHSIG), and leave Ctrl-C to the parent."""
     ctypes.CDLL("libc.so.6", use_errno=True).prctl(1, signal.SIGKILL)   # 1: PR_SET_PDEATHSIG
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
+def csv_true(value):
+    """True for a boolean read back from a CSV cell or a JSON value: True, numpy's True
+    or the text "true" in any case; False for anything else (False, "", NaN, None)."""
+    if isinstance(value, (bool, np.bool_)):
+        return bool(value)
+    return isinstance(value, str) and value.strip().lower() == "true"
+
+
+def csv_true_column(series):
+    """:func:`csv_true` of every cell of a pandas Series (a bool Series)."""
+    return series.map(csv_true).astype(bool)

@@ -13,7 +13,7 @@ import numpy as np
 import pandas as pd
 
 from pipeline import RESULTS_DIR, __version__
-from pipeline.files import write_text
+from pipeline.files import csv_true, csv_true_column, write_text
 from pipeline.stats.ensemble import wilson_interval
 
 
@@ -106,13 +106,13 @@ def record_orientation(record_id, motion_file=None):
     from pipeline.records.catalog import catalog_row
     row = catalog_row(str(record_id))
     if row is not None:
-        compass = str(row.get("horizontals_compass")).strip().lower() == "true"
+        compass = csv_true(str(row.get("horizontals_compass")))
         return compass, row.get("source_file") == FEMA_SOURCE_FILE
     if isinstance(motion_file, str) and Path(motion_file).is_file():
         from pipeline.motion import Motion
         meta = Motion.load(motion_file).meta
         compass = meta.get("horizontals_compass", True)
-        return compass is True or str(compass).lower() == "true", \
+        return csv_true(compass if isinstance(compass, bool) else str(compass)), \
             str(meta.get("source_file", "")).endswith(FEMA_SOURCE_FILE)
     return True, False
 
@@ -121,7 +121,7 @@ def with_back_azimuth(runs):
     """The runs whose downfall azimuth can be compared with a back azimuth: known back
     azimuth, compass horizontals, never a FEMA pair.  Adds ``compass`` and ``fema``."""
     runs = runs.copy()
-    runs["toppled"] = runs["toppled"].astype(str).str.lower() == "true"
+    runs["toppled"] = csv_true_column(runs["toppled"].astype(str))
     files = runs["motion_file"] if "motion_file" in runs.columns else [None] * len(runs)
     cache = {}
     flags = [cache.setdefault(r, record_orientation(r, f)) for r, f in zip(runs["record_id"], files)]
@@ -170,7 +170,7 @@ def per_record_table(runs):
     azimuth (or "stands") and its class relative to the back azimuth."""
     from pipeline.stats.circular import direction_differences
     runs = runs.copy()
-    runs["toppled"] = runs["toppled"].astype(str).str.lower() == "true"
+    runs["toppled"] = csv_true_column(runs["toppled"].astype(str))
     comparable = set(with_back_azimuth(runs).index)
     classes = direction_differences(runs)["direction_class"]
     rows = {}
@@ -334,7 +334,7 @@ def records_section(results):
     if runs is None:
         return "## Measured records\n\nNot run yet (`python -m pipeline campaign records`).\n"
     runs = runs.copy()
-    runs["toppled"] = runs["toppled"].astype(str).str.lower() == "true"
+    runs["toppled"] = csv_true_column(runs["toppled"].astype(str))
     n_records = runs["record_id"].nunique()
     comparable = with_back_azimuth(runs)
     fractions = toppled_fractions(runs)
@@ -414,7 +414,7 @@ def processing_section(results):
                              "n": st["records"], "median": f"{st['median']:.3f}",
                              "worst": f"{st['worst']:.3f} ({st['worst_id']})"})
     lines.append(_table(pd.DataFrame(rows)))
-    pulses = table[table["pulse_like"].astype(str) == "True"]
+    pulses = table[csv_true_column(table["pulse_like"])]
     if not pulses.empty:
         inside = int((abs(pulses["pgv_ratio_given"] - 1.0) <= 0.10).sum())
         lines.append(f"\nFEMA P695's pulse-like records: {inside} of {len(pulses)} keep their "

@@ -11,7 +11,8 @@ from pipeline.campaign.column_file import (add_campaign_options, add_column_file
                                            check_stiffness, column_kn, description, mark,
                                            read_campaign_options, summary_entry)
 from pipeline.campaign.tables import collect, write_tables
-from pipeline.files import InputError, code_hash, content_hash, write_csv
+from pipeline.files import (InputError, code_hash, content_hash, csv_true_column,
+                            write_csv)
 from pipeline.motion import Motion
 from pipeline.records import catalog, catalog_row, processed_motion, resolve
 from pipeline.records.processing import signal_end_s
@@ -84,7 +85,7 @@ def twin(**params):
 def pulse_record():
     """Catalogue id of the pulse-like record that stands in for the paper's GM23."""
     table = catalog()
-    chosen = table[table["replaces_gm23"].astype(str).str.lower() == "true"]
+    chosen = table[csv_true_column(table["replaces_gm23"].astype(str))]
     if chosen.empty:
         raise InputError("records/catalog.csv nominates no record with replaces_gm23 = True")
     return str(chosen["id"].iloc[0])

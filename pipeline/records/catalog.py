@@ -12,6 +12,7 @@ import functools
 import numpy as np
 import pandas as pd
 
+from pipeline.files import csv_true
 from pipeline import RECORDS_DIR
 
 CATALOG_PATH = RECORDS_DIR / "catalog.csv"
@@ -29,8 +30,7 @@ def _read():
     for column in _BOOL_COLUMNS:
         if column in frame.columns and frame[column].dtype != bool:
             frame[column] = frame[column].map(
-                lambda v: str(v).strip().lower() == "true" if isinstance(v, (str, bool, np.bool_))
-                else v)
+                lambda v: csv_true(v) if isinstance(v, (str, bool, np.bool_)) else v)
     if "usable" not in frame.columns:
         frame["usable"] = True
     for full, short in COORDINATE_ALIASES.items():

@@ -10,6 +10,8 @@ as ``peer_check.csv``; the report quotes its median and worst ratios.
 import numpy as np
 import pandas as pd
 
+from pipeline.files import csv_true_column
+
 ROTATIONS_DEG = np.arange(0.0, 180.0, 1.0)
 
 
@@ -72,5 +74,5 @@ def summary(table):
                         "worst": float(worst[key]),
                         "worst_id": str(worst["id"])}
         return out
-    pulses = table[table["pulse_like"].astype(str) == "True"] if not table.empty else table
+    pulses = table[csv_true_column(table["pulse_like"])] if not table.empty else table
     return {"all": stats(table), "pulse_like": stats(pulses)}

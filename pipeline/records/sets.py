@@ -25,7 +25,7 @@ from pathlib import Path
 import pandas as pd
 
 from pipeline import paper
-from pipeline.files import InputError, write_json
+from pipeline.files import InputError, csv_true, write_json
 from pipeline.records.catalog import catalog
 
 SETS = {
@@ -145,4 +145,4 @@ def _number(value):
 
 
 def _true(value):
-    return value is True or str(value).strip().lower() == "true"
+    return csv_true(value)
