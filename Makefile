@@ -5,7 +5,7 @@ PY := .venv/bin/python
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 JOBS ?= $(shell nproc)
 
-.PHONY: setup test run-all records campaigns bench clean invert-demo shake-table
+.PHONY: setup test run-all records campaigns bench clean invert-demo shake-table docs
 
 setup: .venv/.installed
 	@command -v yade >/dev/null || { echo "installing YADE (apt-get install yade)"; \
@@ -48,6 +48,11 @@ bench: setup
 shake-table: setup
 	$(PY) -m pipeline campaign shake-table --grid "$(or $(SHAKE_GRID),footprint_tolerance_m=0.001,0.003;damping=0.1,0.36)" --jobs $(JOBS)
 	$(PY) -m pipeline report
+
+# the docs/ tree as a website (results/site; mkdocs --strict fails on a broken link)
+docs: setup
+	@$(PY) -c "import mkdocs" 2>/dev/null || $(PY) -m pip install -q -e '.[docs]'
+	$(PY) -m mkdocs build --quiet
 
 invert-demo: setup
 	$(PY) -m pipeline invert --demo --grid $(or $(INVERT_GRID),demo) --jobs $(JOBS) --allow-long $(INVERT_ARGS)
