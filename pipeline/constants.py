@@ -1,4 +1,4 @@
-"""Physical constants with one home each.
+"""Physical constants and the names of the column models, with one home each.
 
 Two gravities on purpose: ``STANDARD_GRAVITY`` converts accelerations given in
 units of g (record files) to m/s^2; ``MODEL_GRAVITY`` is the gravity the YADE
@@ -8,3 +8,8 @@ import scipy.constants
 
 STANDARD_GRAVITY = scipy.constants.g   # m/s^2, 9.80665: unit conversion "g" -> m/s^2
 MODEL_GRAVITY = 9.81                   # m/s^2: gravity of the simulated world
+
+# the column models of a scene: the twin model ("both": drums at x = -1.5 m, monolith at
+# +1.5 m) or one of its two columns (also the names of the columns in every output)
+COLUMN_TYPES = ("drums", "monolithic")
+COLUMN_KINDS = ("both", "monolithic", "drums")

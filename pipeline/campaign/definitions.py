@@ -3,6 +3,7 @@ import dataclasses
 import json
 from pathlib import Path
 
+from pipeline.constants import COLUMN_KINDS
 from pipeline import RESULTS_DIR, paper
 from pipeline.campaign import Campaign, register
 from pipeline.campaign.column_file import (add_campaign_options, add_column_file_argument,
@@ -254,7 +255,7 @@ def columns_specs(records, campaign_dir, column_files=None, column="both",
     from pipeline.scenario.geometry import ColumnGeometry, example_names
     names = list(column_files) if column_files else example_names()
     geometries = [ColumnGeometry.load(name) for name in names]
-    if column not in ("both", "monolithic", "drums"):
+    if column not in COLUMN_KINDS:
         raise InputError(f"--column must be both, monolithic or drums, got {column!r}")
     if stiffness not in ("matched", "paper"):
         raise InputError(f"--stiffness must be matched or paper, got {stiffness!r}")
@@ -340,7 +341,7 @@ def columns_outputs(specs, campaign_dir, failures, animations, figures=True):
 
 def columns_options(parser):
     add_column_file_argument(parser, "default: all shipped", many=True, dest="column_files")
-    parser.add_argument("--column", choices=("both", "monolithic", "drums"), default="both",
+    parser.add_argument("--column", choices=COLUMN_KINDS, default="both",
                         help="both (default): each description and a monolith of its "
                         "outline; drums: the description only; monolithic: the monolith only")
     add_stiffness_argument(parser)

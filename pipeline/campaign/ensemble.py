@@ -41,6 +41,7 @@ from pathlib import Path
 import numpy as np
 from scipy.stats import qmc
 
+from pipeline.constants import COLUMN_KINDS
 from pipeline import paper
 from pipeline.campaign import Campaign, register
 from pipeline.campaign.column_file import (add_column_file_argument, add_stiffness_argument,
@@ -215,7 +216,7 @@ def ensemble_specs(records, campaign_dir, record=None, column="both", members=DE
     records = list(records or []) + ([record] if record else [])
     if not records:
         raise InputError("campaign ensemble needs --record ID_OR_FILE (or --records/--set)")
-    if column not in ("both", "monolithic", "drums"):
+    if column not in COLUMN_KINDS:
         raise InputError(f"--column must be both, monolithic or drums, got {column!r}")
     check_stiffness(stiffness)
     ranges = dict(ENSEMBLE_RANGES, **(vary or {}))
@@ -397,7 +398,7 @@ def run_sized(run, records, campaign_dir, options):
 def ensemble_options(parser):
     parser.add_argument("--record", metavar="ID_OR_FILE", default=None,
                         help="catalogue id, record file or processed .npz")
-    parser.add_argument("--column", choices=("both", "monolithic", "drums"), default="both",
+    parser.add_argument("--column", choices=COLUMN_KINDS, default="both",
                         help="column model (default both: the twin model)")
     parser.add_argument("--members", type=int, default=DEFAULT_MEMBERS,
                         help=f"members of the first Latin-hypercube batch, and of each batch "

@@ -50,7 +50,7 @@ from pipeline.campaign.definitions import (column_specs, motion_cache, pulse_rec
                                            run_code_version, run_column_spec)
 from pipeline.campaign import ensemble   # module: imported while ensemble may still load
 from pipeline.campaign.tables import collect
-from pipeline.constants import MODEL_GRAVITY
+from pipeline.constants import COLUMN_KINDS, MODEL_GRAVITY
 from pipeline.files import InputError, write_csv, write_json
 from pipeline.motion import Motion
 from pipeline.motion.measures import horizontal_peak, record_parameters
@@ -107,7 +107,7 @@ def fragility_specs(records, campaign_dir, levels=DEFAULT_LEVELS, members=DEFAUL
     check_stiffness(stiffness)
     records = list(records) if records else default_records()
     levels = parse_levels(levels)
-    if column not in ("both", "monolithic", "drums"):
+    if column not in COLUMN_KINDS:
         raise InputError(f"--column must be both, monolithic or drums, got {column!r}")
     if not (isinstance(azimuths, int) and 1 <= azimuths <= 360):
         raise InputError(f"--azimuths must be an integer in [1, 360], got {azimuths!r}")
@@ -449,7 +449,7 @@ def fragility_options(parser):
     parser.add_argument("--members", type=int, default=DEFAULT_MEMBERS,
                         help=f"ensemble members per record and level (default {DEFAULT_MEMBERS}; "
                         "sampled like campaign ensemble, the same at every level)")
-    parser.add_argument("--column", choices=("both", "monolithic", "drums"), default="both",
+    parser.add_argument("--column", choices=COLUMN_KINDS, default="both",
                         help="column model (default both: the twin model)")
     parser.add_argument("--seed", type=int, default=ensemble.DEFAULT_SEED,
                         help=f"seed of the Latin hypercube (default {ensemble.DEFAULT_SEED})")

@@ -8,6 +8,7 @@ import os
 import time
 from pathlib import Path
 
+from pipeline.constants import COLUMN_TYPES
 from pipeline import RESULTS_DIR
 from pipeline.files import InputError
 from pipeline.inversion import forward as _forward  # noqa: F401  (registers the campaign
@@ -189,7 +190,7 @@ def described_columns(observations, base_dir="."):
     from pipeline.scenario.geometry import example_names
     out = {}
     for name in observations.column_types():
-        if name in ("drums", "monolithic"):
+        if name in COLUMN_TYPES:
             continue
         beside = Path(base_dir) / name          # an absolute name stays itself
         if name in example_names():

@@ -5,6 +5,7 @@
 import math
 from pathlib import Path
 
+from pipeline.constants import COLUMN_TYPES
 from pipeline import RESULTS_DIR
 from pipeline.campaign.column_file import add_column_file_argument
 from pipeline.files import DirectoryLock, InputError
@@ -109,7 +110,7 @@ def run(args):
     if column.geometry is not None:
         roles = {"drums": "'drums' = as described",
                  "monolithic": "'monolithic' = one stone of its outline"}
-        shown = ["drums", "monolithic"] if column.kind == "both" else [column.kind]
+        shown = list(COLUMN_TYPES) if column.kind == "both" else [column.kind]
         print(f"column {column.geometry.name!r}: " + ", ".join(roles[k] for k in shown))
         hz = column.geometry.contact_rocking_hz(contact.kn, numerics.rim_points)
         if hz < SOFT_CONTACT_HZ:

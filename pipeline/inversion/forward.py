@@ -37,6 +37,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from pipeline.constants import COLUMN_TYPES
 from pipeline import RESULTS_DIR, files
 from pipeline.campaign import Campaign, register
 from pipeline.campaign.definitions import column_specs, run_code_version, run_column_spec
@@ -45,7 +46,7 @@ from pipeline.motion import Motion
 
 GENERATOR_VERSION = 1          # bump when the written motions change
 DEFAULT_FORWARD_DIR = RESULTS_DIR / "inversion-forward"
-COLUMNS = ("drums", "monolithic")
+COLUMNS = COLUMN_TYPES
 REFERENCE_MW = 6.5             # the paper scenario's magnitude: the sub-event template's
 TEMPLATE_SOURCE = "strike_slip"  # sub-event layout, rupture velocity, rise and duration
 SAMPLING_HZ = 100.0

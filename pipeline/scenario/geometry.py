@@ -712,9 +712,9 @@ def _names_mesh(path):
     if path.suffix.lower() != ".json":
         return False
     try:
-        data = json.loads(read_text(path))
-    except (OSError, _Unreadable, ValueError):
-        return False
+        data = _parse_json(read_text(path))
+    except (OSError, _Unreadable):
+        return False                      # the column loader says what is wrong
     return isinstance(data, dict) and "mesh" in data
 
 

@@ -28,7 +28,6 @@ land on), each sphere one radius inside the surface.
 """
 import functools
 import hashlib
-import json
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -37,7 +36,7 @@ import numpy as np
 
 from pipeline.constants import MODEL_GRAVITY
 from pipeline.files import InputError
-from pipeline.scenario.geometry import MESH_SUFFIXES, perimeter_points
+from pipeline.scenario.geometry import MESH_SUFFIXES, _parse_json, perimeter_points
 from pipeline.userfiles import Unreadable, keys_text, read_text, show
 
 MAX_MESH_BYTES = 200_000_000
@@ -85,8 +84,8 @@ class MeshSpecimen:
             return cls.from_dict({"name": path.stem, "mesh": str(path.resolve())},
                                  where=path.name)
         try:
-            data = json.loads(read_text(path))
-        except (OSError, Unreadable, ValueError) as exc:
+            data = _parse_json(read_text(path))
+        except (OSError, Unreadable) as exc:
             raise InputError(f"{path.name}: not a readable specimen description "
                              f"({str(exc).splitlines()[0][:120]})") from None
         return cls.from_dict(data, where=path.name, base=path.resolve().parent)

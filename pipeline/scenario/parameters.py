@@ -9,11 +9,11 @@ import dataclasses
 import math
 from dataclasses import dataclass, field
 
+from pipeline.constants import COLUMN_KINDS, COLUMN_TYPES
 from pipeline import paper
 from pipeline.files import InputError
 from pipeline.scenario.geometry import ColumnGeometry, ColumnSpec
 
-COLUMN_KINDS = ("both", "monolithic", "drums")
 RIM_SPHERE_RADIUS_M = 0.005   # rim contact spheres of the columns
 MIN_BODY_SIZE_M = 10 * RIM_SPHERE_RADIUS_M   # a drum must hold its two rims of spheres
 # An explicit step of a spring-dashpot of damping ratio zeta is stable for
@@ -188,7 +188,7 @@ class Column:
         """The columns of the scene (:class:`~pipeline.scenario.geometry.ColumnSpec`):
         'both' puts the drums (or the described column) at x = -1.5 m and the monolith at
         +1.5 m; one column stands at the centre unless centred=False."""
-        kinds = ["drums", "monolithic"] if self.kind == "both" else [self.kind]
+        kinds = list(COLUMN_TYPES) if self.kind == "both" else [self.kind]
         centred = self.kind != "both" if self.centred is None else self.centred
         drums, monolith = self.geometries()
         out = []

@@ -12,9 +12,9 @@ import numpy as np
 import pandas as pd
 from astropy.stats import circcorrcoef, circmean, circvar, rayleightest
 
+from pipeline.constants import COLUMN_TYPES
 from pipeline.files import InputError
 
-COLUMN_TYPES = ("drums", "monolithic")
 TOWARD_MAX_DEG = 45.0
 AWAY_MIN_DEG = 135.0
 # reference direction name -> runs column holding its azimuth (deg)
