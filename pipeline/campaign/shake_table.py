@@ -42,7 +42,10 @@ COLUMNS = ("test", "date", "pga_g", "pgv_pga_s", "motion_file")
 GRID_CONTACT = {"kn": (1e5, 1e11), "damping": (0.0, 1.0), "mu_s": (0.01, 2.0),
                 "mu_k": (0.01, 2.0)}
 GRID_SPECIMEN = {"footprint_tolerance_m": (0.0, 0.05)}
-DEFAULT_GRID = "damping=0.1,0.36"
+# and the motion: rotate_deg turns the table motion clockwise (180: the other sign of an
+# axis whose sign the laboratory does not state)
+GRID_MOTION = {"rotate_deg": (0.0, 360.0)}
+DEFAULT_GRID = "footprint_tolerance_m=0.001,0.003;damping=0.05,0.1;rotate_deg=0,180"
 DEFAULT_CONTACT = {"kn": 1.2e8, "damping": 0.36, "mu_s": 0.7, "mu_k": 0.6}
 PGA_EDGES_G = np.array([0.0, 0.1, 0.2, 0.3, 0.4, 0.5, 0.7, 1.0, 2.0])
 PGV_PGA_EDGES_S = np.array([0.0, 0.05, 0.1, 0.2, 0.3, 0.5, 1.0])
@@ -94,10 +97,10 @@ def parse_grid(text):
             continue
         name, _, values = item.partition("=")
         name = name.strip()
-        bounds = GRID_CONTACT.get(name) or GRID_SPECIMEN.get(name)
+        bounds = GRID_CONTACT.get(name) or GRID_SPECIMEN.get(name) or GRID_MOTION.get(name)
         if bounds is None:
             raise InputError(f"--grid: unknown parameter {name!r} (known: "
-                             f"{', '.join([*GRID_CONTACT, *GRID_SPECIMEN])})")
+                             f"{', '.join([*GRID_CONTACT, *GRID_SPECIMEN, *GRID_MOTION])})")
         try:
             numbers = [float(v) for v in values.split(",") if v.strip()]
         except ValueError:
@@ -124,7 +127,8 @@ def _run_params(specimen, point):
             description[key] = point[key]
     ColumnGeometry.from_dict(description)          # refuse a bad point before any run
     contact = {**DEFAULT_CONTACT, **{k: v for k, v in point.items() if k in GRID_CONTACT}}
-    return {"column": "monolithic", "column_file": description, **contact}
+    motion = {k: v for k, v in point.items() if k in GRID_MOTION and v}
+    return {"column": "monolithic", "column_file": description, **contact, **motion}
 
 def specs(records, campaign_dir, experiments=EXPERIMENTS, specimen=SPECIMEN, outcome=OUTCOME,
           validate_from=VALIDATE_FROM, grid=DEFAULT_GRID, stage="calibration", chosen=None,
@@ -280,7 +284,7 @@ def add_options(parser):
     parser.add_argument("--grid", default=DEFAULT_GRID, metavar="NAME=V,V;NAME=V",
                         help="parameter sets the calibration chooses from (Cartesian product; "
                         f"default '{DEFAULT_GRID}'; names: "
-                        f"{', '.join([*GRID_CONTACT, *GRID_SPECIMEN])})")
+                        f"{', '.join([*GRID_CONTACT, *GRID_SPECIMEN, *GRID_MOTION])})")
     parser.add_argument("--axis-deg", type=float, default=AXIS_DEG, metavar="DEG",
                         help="azimuth of the table's shaking line, for the PGA-threshold "
                         f"baseline's critical angle (default {AXIS_DEG:g}: East-West)")
