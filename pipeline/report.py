@@ -491,7 +491,7 @@ def shake_table_section(results):
                          "accuracy": _fmt(sc["accuracy"], 3),
                          "precision": _fmt(sc["precision"], 3),
                          "recall": _fmt(sc["recall"], 3), "F1": _fmt(sc["f1"], 3)})
-    lines.append(_table(pd.DataFrame(rows)) + "\n")
+    lines.append(pd.DataFrame(rows).to_markdown(index=False, disable_numparse=True) + "\n")
     lines += [f"- {x}" for x in summary["lines"]]
     lines.append("")
     lines.append(_figure(results, results / "shake-table" / "shake_table_rates.png",

@@ -102,3 +102,36 @@ def test_shipped_motions_give_the_pga_their_summary_states(k):
     motion = build_motion(resolve(str(row["motion_path"])))
     pga_g = np.abs(motion.acc[:, :2]).max() / 9.80665
     assert pga_g == pytest.approx(row["pga_g"], rel=0.05)
+
+
+def test_summary_and_report_state_the_scores_of_the_table(tmp_path):
+    """summarise() scores each split from the experiment table; the report prints them."""
+    import json
+    from datetime import date
+
+    import pandas as pd
+
+    from pipeline.campaign.shake_table import summarise
+    from pipeline.report import shake_table_section
+    box = ColumnGeometry.from_dict({"name": "box", "density": 2700.0, "blocks": [
+        {"shape": "box", "height": 1.0, "width": 0.25, "depth": 0.5}]})
+    table = pd.DataFrame({
+        "test": [f"T{k}" for k in range(6)],
+        "day": [date(2021, 6, 1)] * 3 + [date(2021, 8, 2)] * 3,
+        "split": ["calibration"] * 3 + ["validation"] * 3,
+        "pga_g": [0.1, 0.3, 0.5, 0.1, 0.3, 0.5],
+        "observed": [False, True, True, False, False, True],
+        "predicted": [False, True, False, True, False, True]})
+    result = summarise(table, box, {"scores": {}}, "defaults", {},
+                       {"validate_from": "2021-08-01", "grid": "", "axis_deg": 90.0})
+    assert result["pga_threshold_g"] == pytest.approx(0.25)        # tan alpha = b / h
+    assert result["splits"]["calibration"]["model"]["accuracy"] == pytest.approx(2 / 3)
+    assert result["splits"]["validation"]["model"]["precision"] == pytest.approx(0.5)
+    assert result["splits"]["all"]["pga_threshold"]["accuracy"] == pytest.approx(5 / 6)
+    (tmp_path / "shake-table").mkdir()
+    (tmp_path / "shake-table" / "shake_table.json").write_text(json.dumps(result))
+    text = shake_table_section(tmp_path)
+    row = [c.strip() for c in next(line for line in text.splitlines()
+                                    if "| validation" in line and "YADE" in line).split("|")]
+    assert row[1:8] == ["validation", "YADE model", "3", "0.667", "0.500", "1.000", "0.667"]
+    assert "Not run yet" in shake_table_section(tmp_path / "nothing")
