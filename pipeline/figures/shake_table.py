@@ -8,9 +8,12 @@ from pipeline.stats.classification import binned_rates
 
 
 def plot_rates(table, path, result, pga_edges_g, pgv_pga_edges_s):
-    """Three panels (bins: PGA edges g, PGV/PGA edges s): observed rate (every test, with or without a motion), predicted rate
+    """Three panels (bins: PGA edges g, PGV/PGA edges s; tests whose PGA is nominal,
+    ``pga_nominal``, left out): observed rate (every test, with or without a motion), predicted rate
     and observed rate on the simulated tests; counts in each cell.  Returns the path."""
     PGA_EDGES_G, PGV_PGA_EDGES_S = np.asarray(pga_edges_g), np.asarray(pgv_pga_edges_s)
+    if "pga_nominal" in table.columns:          # placeholder PGA values: no bin for them
+        table = table[table["pga_nominal"].astype(int) == 0]
     simulated = table[[p is not None for p in table["predicted"]]]
     panels = [("observed, all tests", table, table["observed"]),
               ("observed, simulated tests", simulated, simulated["observed"]),
