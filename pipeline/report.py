@@ -347,7 +347,11 @@ def records_section(results):
               "horizontals; FEMA P695 pairs, records without coordinates and records whose "
               "horizontals are not compass azimuths are never compared with a back azimuth. "
               "Classes: toward = within 45 deg of the back azimuth, away = within 45 deg of "
-              "its opposite, transverse otherwise.\n")]
+              "its opposite, transverse otherwise.\n"),
+             ("**One run per record: a sample.** Each record here is one trajectory of a "
+              "chaotic system; another CPU's last bits move single falls and can turn a "
+              "marginal column. The fractions below count records, not probabilities per "
+              "record: those, with their Monte Carlo error, are in the Ensembles section.\n")]
     lines += [t + "\n" for t in records_statements(fractions, directions, correlations)]
     shown = fractions.copy()
     if not shown.empty:
