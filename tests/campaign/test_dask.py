@@ -14,7 +14,8 @@ import pandas as pd
 import pytest
 
 from pipeline import cli
-from pipeline.campaign.executor import TASK_PREFIX, run_task, worker_code_version
+from pipeline.campaign.dask_worker import run_task, worker_code_version
+from pipeline.campaign.executor import TASK_PREFIX
 from pipeline.motion import Motion
 from pipeline.motion.pulses import one_sine_pulse
 
