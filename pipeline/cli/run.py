@@ -107,11 +107,19 @@ def run(args):
         print(f"note: {summary['note']}")
     elif not any(c["max_tilt_deg"] > 0.1 for c in summary["columns"]):
         print("note: the motion did not make any column rock (max tilt below 0.1 deg)")
-    if column.geometry is not None:
+    if getattr(column.geometry, "mesh_path", None):
+        rock = column.geometry
+        print(f"specimen {rock.name!r} from {Path(rock.mesh_path).name}: {rock.mass:.1f} kg, "
+              f"centre of mass {rock.com[2]:.3f} m up, critical angle "
+              f"{rock.critical_angle_deg():.1f} deg"
+              + (f", settled {rock.settled_by_deg:.2f} deg onto its base"
+                 if rock.settled_by_deg > 0.01 else ""))
+    elif column.geometry is not None:
         roles = {"drums": "'drums' = as described",
                  "monolithic": "'monolithic' = one stone of its outline"}
         shown = list(COLUMN_TYPES) if column.kind == "both" else [column.kind]
         print(f"column {column.geometry.name!r}: " + ", ".join(roles[k] for k in shown))
+    if column.geometry is not None:
         hz = column.geometry.contact_rocking_hz(contact.kn, numerics.rim_points)
         if hz < SOFT_CONTACT_HZ:
             print(f"note: with --kn {contact.kn:g} this column rocks on its contact springs "
@@ -123,6 +131,11 @@ def run(args):
                         key=lambda b: b["impact_time_s"])
             label = first.get("name") or f"body {first['index']}"
             more = f" (first to strike: {label})" if column.geometry is not None else ""
+            if col.get("toppled_by") == "rests past its critical angle":
+                print(f"{col['column']:>10}: overturned toward "
+                      f"{col['downfall_azimuth_deg']:.0f} deg (past its critical angle from "
+                      f"{col['impact_time_s']:.2f} s on)")
+                continue
             print(f"{col['column']:>10}: toppled toward {col['downfall_azimuth_deg']:.0f} deg "
                   f"at {col['impact_time_s']:.2f} s{more}")
         else:

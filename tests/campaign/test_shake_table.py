@@ -1,6 +1,7 @@
 """The shake-table campaign's pieces: scores against a confusion table counted by hand,
 the experiment table's loader, the grid, and the shipped SP1 data against what its
 sources state about it (mass, critical angle, PGA)."""
+import json
 import math
 
 import numpy as np
@@ -135,3 +136,33 @@ def test_summary_and_report_state_the_scores_of_the_table(tmp_path):
                                     if "| validation" in line and "YADE" in line).split("|")]
     assert row[1:8] == ["validation", "YADE model", "3", "0.667", "0.500", "1.000", "0.667"]
     assert "Not run yet" in shake_table_section(tmp_path / "nothing")
+
+
+@pytest.mark.yade
+def test_run_a_lab_table_on_the_sp1_specimen(tmp_path, capsys):
+    """The user's path: a lab table and the shipped mesh specimen through `run`. A gentle
+    2 Hz shaking at half SP1's weakest uplift threshold leaves it standing; two cycles
+    at 0.5 g along East-West, between the thresholds toward its weak side (East, tan
+    14.7 deg = 0.26 g) and its strong side (West, tan 38 deg = 0.78 g), overturn it
+    toward East."""
+    from pipeline import cli
+    rock = ColumnGeometry.load(SPECIMEN)
+    t = np.arange(0.0, 6.0, 0.005)
+    on = (t > 1.0) & (t < 3.0)
+    for name, accel_g, standing in (
+            ("gentle", 0.5 * rock.uplift_ratio() * np.sin(2 * np.pi * 2.0 * t), True),
+            ("cycles", np.where(on, 0.5 * np.sin(2 * np.pi * (t - 1.0)), 0.0), False)):
+        table = tmp_path / f"{name}.txt"
+        table.write_text("# lab-table: test\n# units: g\n# axes: 90\n" + "\n".join(
+            f"{a:.4f} {b:.6f}" for a, b in zip(t, accel_g)) + "\n")
+        code = cli.main(["run", "--record", str(table), "--column", "monolithic",
+                         "--column-file", str(SPECIMEN), "--out", str(tmp_path / name)])
+        assert code == 0
+        out = capsys.readouterr().out
+        assert "specimen 'SP1' from SP1.obj: 353.8 kg" in out
+        summary = json.loads((tmp_path / name / "summary.json").read_text())
+        (column,) = summary["columns"]
+        assert column["toppled"] is (not standing)
+        if not standing:                 # toward its weak side
+            assert column["toppled_by"] == "rests past its critical angle"
+            assert abs((column["downfall_azimuth_deg"] - 90.0 + 180.0) % 360.0 - 180.0) < 45.0
