@@ -86,6 +86,14 @@ def shake_table_section(results):
                          "recall": _fmt(sc["recall"], 3), "F1": _fmt(sc["f1"], 3)})
     lines.append(pd.DataFrame(rows).to_markdown(index=False, disable_numparse=True) + "\n")
     lines += [f"- {x}" for x in summary["lines"]]
+    calibration = [{"parameters": label, "n": sc["n"], "accuracy": _fmt(sc["accuracy"], 3),
+                    "precision": _fmt(sc["precision"], 3), "recall": _fmt(sc["recall"], 3)}
+                   for label, sc in summary.get("calibration_scores", {}).items()]
+    if calibration:
+        lines.append("\nEvery parameter set on the calibration tests (the validation tests "
+                     "ran the chosen one only):\n")
+        lines.append(pd.DataFrame(calibration).to_markdown(index=False,
+                                                          disable_numparse=True) + "\n")
     lines.append("")
     lines.append(_figure(results, results / "shake-table" / "shake_table_rates.png",
                          "Observed and predicted overturning rate per PGA x PGV/PGA bin"))
