@@ -36,6 +36,7 @@ EXPERIMENTS = RECORDS_DIR / "shake_table" / "tests.csv"
 SPECIMEN = RECORDS_DIR / "shake_table" / "sp1.json"
 OUTCOME = "sp1_overturned"
 AXIS_DEG = 90.0                  # the shipped tests shake along East-West
+RUN_CPU_S = 1.6                  # CPU-s per run: 2,303 runs of SP1 took 62 CPU-min (2026-11-24)
 VALIDATE_FROM = "2021-08-01"     # the issue's split: calibrate on June-July, validate August
 COLUMNS = ("test", "date", "pga_g", "pgv_pga_s", "motion_file")
 # what --grid may vary: contact parameters, and the specimen's footprint tolerance
@@ -199,12 +200,24 @@ def drive(run, records, campaign_dir, options):
     the others, write experiments.csv, shake_table.json and the rates figure."""
     from pipeline.scenario.geometry import ColumnGeometry
     campaign_dir = Path(campaign_dir)
+    frame = load_experiments(options["experiments"], options["outcome"])
+    frame = frame[[p is not None for p in frame["motion_path"]]]
+    if options.get("tests"):
+        frame = frame[frame["test"].isin(options["tests"])]
+    early = int((frame["day"] < date.fromisoformat(options["validate_from"])).sum())
+    runs = len(parse_grid(options["grid"])) * early + len(frame) - early
+    print(f"shake-table: {len(parse_grid(options['grid']))} parameter set(s) x {early} "
+          f"calibration tests, then the chosen set on {len(frame) - early} validation tests: "
+          f"at most {runs} YADE runs, about {runs * RUN_CPU_S / 60:.0f} CPU-min (finished "
+          "runs are kept and not run again)", flush=True)
     calibration = run({**options, "stage": "calibration"})
     label, point = best_point(calibration)
     print(f"calibration: best {label} (accuracy {calibration['scores'][label]['accuracy']:.3f} "
           f"on {calibration['scores'][label]['n']} tests)", flush=True)
     validation = run({**options, "stage": "validation", "chosen": point})
     frame = load_experiments(options["experiments"], options["outcome"])
+    if options.get("tests"):
+        frame = frame[frame["test"].isin(options["tests"])]
     specimen = ColumnGeometry.load(options["specimen"])
     table = _experiment_table(frame, campaign_dir, label, options["validate_from"])
     write_csv(campaign_dir / "experiments.csv", table.drop(columns=["day", "motion_path"]))

@@ -166,3 +166,29 @@ def test_run_a_lab_table_on_the_sp1_specimen(tmp_path, capsys):
         if not standing:                 # toward its weak side
             assert column["toppled_by"] == "rests past its critical angle"
             assert abs((column["downfall_azimuth_deg"] - 90.0 + 180.0) % 360.0 - 180.0) < 45.0
+
+
+@pytest.mark.yade
+def test_campaign_calibrates_on_early_tests_and_validates_the_chosen_set_only(tmp_path):
+    """Two parameter sets on two June tests, the chosen one alone on two August tests;
+    the outputs say so and score what ran."""
+    import pandas as pd
+
+    from pipeline import cli
+    tests = "Test011,Test048,Test412,Test595"
+    code = cli.main(["campaign", "shake-table", "--tests", tests, "--grid",
+                     "footprint_tolerance_m=0.001;damping=0.05,0.1", "--out",
+                     str(tmp_path / "st"), "--jobs", "2"])
+    assert code == 0
+    calibration = pd.read_csv(tmp_path / "st" / "calibration.csv")
+    validation = pd.read_csv(tmp_path / "st" / "validation.csv")
+    assert sorted(set(calibration["test"])) == ["Test011", "Test048"]
+    observed = dict(zip(calibration["test"], calibration["observed"]))
+    assert observed == {"Test011": False, "Test048": True}          # tests.csv says so
+    assert calibration["grid_point"].nunique() == 2
+    assert sorted(validation["test"]) == sorted(["Test412", "Test595"])
+    summary = json.loads((tmp_path / "st" / "shake_table.json").read_text())
+    assert validation["grid_point"].unique().tolist() == [summary["chosen"]["label"]]
+    assert summary["splits"]["validation"]["model"]["n"] == 2
+    assert summary["splits"]["all"]["tests"] == 4
+    assert (tmp_path / "st" / "shake_table_rates.png").stat().st_size > 10_000
