@@ -116,7 +116,6 @@ def sine(factor, ratio, freq=2.0, seconds=3.0, dt=0.005):
 
 
 @pytest.mark.yade
-@pytest.mark.libm
 def test_a_box_mesh_rocks_as_the_same_box_from_a_column_file(tmp_path):
     """Below the uplift threshold neither rocks; above it both rock alike (the mesh's
     footprint points are the box's corners: same mass, inertia and base), and a strong
