@@ -201,13 +201,14 @@ def drive(run, records, campaign_dir, options):
     from pipeline.scenario.geometry import ColumnGeometry
     campaign_dir = Path(campaign_dir)
     frame = load_experiments(options["experiments"], options["outcome"])
-    frame = frame[[p is not None for p in frame["motion_path"]]]
     if options.get("tests"):
         frame = frame[frame["test"].isin(options["tests"])]
-    early = int((frame["day"] < date.fromisoformat(options["validate_from"])).sum())
-    runs = len(parse_grid(options["grid"])) * early + len(frame) - early
-    print(f"shake-table: {len(parse_grid(options['grid']))} parameter set(s) x {early} "
-          f"calibration tests, then the chosen set on {len(frame) - early} validation tests: "
+    simulated = frame[[p is not None for p in frame["motion_path"]]]
+    early = int((simulated["day"] < date.fromisoformat(options["validate_from"])).sum())
+    points = len(parse_grid(options["grid"]))
+    runs = points * early + len(simulated) - early
+    print(f"shake-table: {points} parameter set(s) x {early} calibration tests, then the "
+          f"chosen set on {len(simulated) - early} validation tests: "
           f"at most {runs} YADE runs, about {runs * RUN_CPU_S / 60:.0f} CPU-min (finished "
           "runs are kept and not run again)", flush=True)
     calibration = run({**options, "stage": "calibration"})
@@ -215,9 +216,6 @@ def drive(run, records, campaign_dir, options):
     print(f"calibration: best {label} (accuracy {calibration['scores'][label]['accuracy']:.3f} "
           f"on {calibration['scores'][label]['n']} tests)", flush=True)
     validation = run({**options, "stage": "validation", "chosen": point})
-    frame = load_experiments(options["experiments"], options["outcome"])
-    if options.get("tests"):
-        frame = frame[frame["test"].isin(options["tests"])]
     specimen = ColumnGeometry.load(options["specimen"])
     table = _experiment_table(frame, campaign_dir, label, options["validate_from"])
     write_csv(campaign_dir / "experiments.csv", table.drop(columns=["day", "motion_path"]))
@@ -229,6 +227,7 @@ def drive(run, records, campaign_dir, options):
     for line in result["lines"]:
         print(line)
     return {**validation, "summary": result}
+
 
 def _experiment_table(frame, campaign_dir, label, validate_from):
     """The experiment table with split and the chosen parameters' prediction (None where

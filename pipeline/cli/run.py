@@ -5,9 +5,9 @@
 import math
 from pathlib import Path
 
-from pipeline.constants import COLUMN_TYPES
 from pipeline import RESULTS_DIR
 from pipeline.campaign.column_file import add_column_file_argument
+from pipeline.constants import COLUMN_TYPES
 from pipeline.files import DirectoryLock, InputError
 from pipeline.records import processed_motion, resolve
 from pipeline.scenario import Column, Contact, Numerics

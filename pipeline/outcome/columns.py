@@ -84,6 +84,15 @@ def rim_lowest(pos, quat, rim, axis=None):
     return pos[..., 2] + heights.min(axis=1)
 
 
+def stays_past(tilt, limit_deg):
+    """[index of the first sample of the final stretch of ``tilt`` (deg) above
+    ``limit_deg``], or an empty array when the last sample is not above it."""
+    if tilt[-1] <= limit_deg:
+        return np.array([], int)
+    below = np.flatnonzero(tilt <= limit_deg)
+    return np.array([below[-1] + 1 if below.size else 0])
+
+
 def tilt_deg(axis):
     return np.degrees(np.arccos(np.clip(axis[..., 2], -1.0, 1.0)))
 
@@ -113,16 +122,11 @@ def column_outcomes(trajectory):
                                  for r in rims], axis=0)
                 hits = np.flatnonzero(struck <= CONTACT_TOLERANCE_M)
             else:
-                hits = np.flatnonzero(tilt > critical)[-1:] if tilt[-1] > critical \
-                    else np.array([], int)
-                if hits.size:                            # since when it stays past it
-                    below = np.flatnonzero(tilt <= critical)
-                    hits = np.array([below[-1] + 1 if below.size else 0])
+                hits = stays_past(tilt, critical)
             over = np.flatnonzero(tilt > 90.0)
             lying = not over.size and tilt[-1] > LIES_DEG    # the scene stopped it lying
             if lying:
-                below = np.flatnonzero(tilt <= LIES_DEG)
-                over = np.array([below[-1] + 1 if below.size else 0])
+                over = stays_past(tilt, LIES_DEG)
             entry = {"index": b["index"], **({"name": b["block_name"]} if b.get("block_name")
                                              else {}),
                      "mass_kg": b["mass"], "struck": bool(hits.size),

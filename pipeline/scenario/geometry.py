@@ -230,7 +230,8 @@ class ColumnGeometry:
     @classmethod
     def load(cls, name_or_path):
         """A description from a shipped example's name (``doric-peristyle``) or a file
-        (.json; .yaml/.yml with PyYAML).  Whatever the file holds, a problem is one
+        (.json; .yaml/.yml with PyYAML), a column's or a mesh specimen's (a "mesh" key;
+        a bare mesh file too: :mod:`pipeline.scenario.mesh`).  Whatever the file holds, a problem is one
         InputError naming the file (and the line and column where the parser knows them):
         files over MAX_FILE_BYTES are refused unread, and nesting beyond MAX_NESTING,
         integers over MAX_INT_DIGITS digits and YAML tags other than the standard ones
@@ -244,7 +245,7 @@ class ColumnGeometry:
             found = path.is_file()
         except (OSError, ValueError):              # a name too long, a NUL byte
             found = False
-        if found and (path.suffix.lower() in MESH_SUFFIXES or _names_mesh(path)):
+        if found and path.suffix.lower() in MESH_SUFFIXES:
             from pipeline.scenario.mesh import MeshSpecimen
             return MeshSpecimen.load(path)
         if not found:
@@ -274,6 +275,9 @@ class ColumnGeometry:
                              f"{_one_line(exc.strerror or exc)})") from None
         except _Unreadable as exc:
             raise InputError(f"{path}: not a readable column description ({exc})") from None
+        if isinstance(data, dict) and "mesh" in data:     # a mesh specimen's description
+            from pipeline.scenario.mesh import MeshSpecimen
+            return MeshSpecimen.from_dict(data, where=path.name, base=path.resolve().parent)
         return cls.from_dict(data, where=str(path.name))
 
     @classmethod
@@ -533,17 +537,6 @@ def _parse_block(raw, where, index):
     if name is not None and not isinstance(name, str):
         raise InputError(f"{where}: name must be a string")
     return ColumnBlock(solid, density, name, offset, tilt, azimuth, mode, joined)
-
-
-def _names_mesh(path):
-    """True when a .json file is a mesh specimen's description (it has a "mesh" key)."""
-    if path.suffix.lower() != ".json":
-        return False
-    try:
-        data = _parse_json(read_text(path))
-    except (OSError, _Unreadable):
-        return False                      # the column loader says what is wrong
-    return isinstance(data, dict) and "mesh" in data
 
 
 def example_names():

@@ -36,8 +36,8 @@ import numpy as np
 
 from pipeline.constants import MODEL_GRAVITY
 from pipeline.files import InputError
-from pipeline.scenario.geometry import MESH_SUFFIXES, _parse_json, perimeter_points
-from pipeline.userfiles import Unreadable, keys_text, read_text, show
+from pipeline.scenario.geometry import MESH_SUFFIXES, perimeter_points
+from pipeline.userfiles import keys_text, show
 
 MAX_MESH_BYTES = 200_000_000
 DEFAULT_DENSITY = 2650.0          # kg/m^3, granite
@@ -78,17 +78,11 @@ class MeshSpecimen:
     # ------------------------------------------------------------ loading
     @classmethod
     def load(cls, path):
-        """A specimen from a mesh file, or from a JSON description naming one."""
+        """A specimen from a bare mesh file (a JSON description naming one is read by
+        :meth:`pipeline.scenario.geometry.ColumnGeometry.load`, as column files are)."""
         path = Path(path)
-        if path.suffix.lower() in MESH_SUFFIXES:
-            return cls.from_dict({"name": path.stem, "mesh": str(path.resolve())},
-                                 where=path.name)
-        try:
-            data = _parse_json(read_text(path))
-        except (OSError, Unreadable) as exc:
-            raise InputError(f"{path.name}: not a readable specimen description "
-                             f"({str(exc).splitlines()[0][:120]})") from None
-        return cls.from_dict(data, where=path.name, base=path.resolve().parent)
+        return cls.from_dict({"name": path.stem, "mesh": str(path.resolve())},
+                             where=path.name)
 
     @classmethod
     def from_dict(cls, data, where="specimen description", base=None):
