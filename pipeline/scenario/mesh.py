@@ -259,8 +259,7 @@ class MeshSpecimen:
                 "parts": [{"shape": "mesh", "block": 0, "name": self.name,
                            "mesh_sha256": self.mesh_sha256}],
                 "rims": [{"role": "base", "kind": "points", "points": base3.tolist(),
-                          "normals": up.tolist(), "vertices": base.tolist(),
-                          "z": float(-com[2])},
+                          "normals": up.tolist()},
                          {"role": "edge", "kind": "points", "points": landing.tolist(),
                           "normals": inward.tolist()}],
                 "plate": None, "overturn_tilt_deg": critical}
