@@ -279,8 +279,78 @@ def ensemble_outputs(specs, campaign_dir, failures, animations, figures=True):
                      f"(R {col['resultant_length']:.2f})"))
     if len(records) > 1:
         write_json(campaign_dir / "ensemble_summaries.json", summaries)
+        pooled = pooled_summary(runs)
+        if pooled is not None:
+            write_json(campaign_dir / POOLED_FILE, pooled)
+            if figures:
+                from pipeline.figures.ensemble import plot_pooled
+                written.append(plot_pooled(runs, pooled, campaign_dir))
+            for col in pooled["columns"]:
+                print(f"over {pooled['records']} records, {col['column']}: {col['answer']}")
     return {"code_version": run_code_version(), **described,
             "figures": [str(Path(p).relative_to(campaign_dir)) for p in written]}
+
+
+POOLED_FILE = "pooled_summary.json"
+QUESTION = ("Do the columns fall toward (or away from) the epicentre?  Hinzen (2009) asked it "
+            "of single runs; here every record's ensemble answers, pooled over the records.")
+
+
+def pooled_summary(runs, resamples=2000):
+    """The paper's question over the records of an ensemble campaign that have a back
+    azimuth (:func:`pipeline.stats.ensemble.pooled_answer` per column: every record
+    weighs alike; intervals hold the choice of records and the members' Monte Carlo
+    error); None for fewer than two such records."""
+    from pipeline.stats.circular import angle_difference_deg
+    from pipeline.stats.ensemble import pooled_answer
+    members = runs[(runs["member"] >= 0) & runs["back_azimuth_deg"].notna()]
+    records = list(dict.fromkeys(members["record_id"]))
+    if len(records) < 2:
+        return None
+    columns = []
+    for column, group in members.groupby("column", sort=True):
+        toppled, relative = [], []
+        for record_id in records:
+            sub = group[group["record_id"] == record_id].sort_values("member")
+            t = sub["toppled"].astype(bool).to_numpy()
+            toppled.append(t)
+            relative.append(np.where(t, angle_difference_deg(
+                sub["downfall_azimuth_deg"].to_numpy(float),
+                sub["back_azimuth_deg"].to_numpy(float)), np.nan))
+        answer = pooled_answer(toppled, relative, resamples=resamples)
+        columns.append({"column": column, **answer, "answer": pooled_sentence(answer)})
+    return {"question": QUESTION, "records": len(records), "record_ids": records,
+            "members_per_record": {r: int((members["record_id"] == r).sum()
+                                          / members["column"].nunique()) for r in records},
+            "columns": columns}
+
+
+def pooled_sentence(answer):
+    """One sentence: what the pooled fall directions say of the epicentre's direction."""
+    st = answer["statistics"]
+
+    def value(name, digits=2):
+        s = st[name]
+        return (f"{s['estimate']:.{digits}f} [{s['ci95'][0]:.{digits}f}, "
+                f"{s['ci95'][1]:.{digits}f}]")
+
+    p = f"P(toppled) {value('p_toppled')} per record"
+    if answer["falls"] < 2 or st["polarity"]["ci95"] is None:
+        return f"{p}; too few falls to say where they point"
+    polar, radial = st["polarity"], st["radial_alignment"]
+    if polar["differs"]:
+        side = "toward" if polar["estimate"] > 0 else "away from"
+        finding = f"falls lean {side} the epicentre (polarity {value('polarity')}, 0: no relation)"
+    elif radial["differs"]:
+        side = "along" if radial["estimate"] > 0 else "across"
+        finding = (f"falls gather {side} the epicentre line, as often toward as away "
+                   f"(radial alignment {value('radial_alignment')}, 0: no relation)")
+    else:
+        finding = (f"the fall directions show no relation to the epicentre's direction "
+                   f"(polarity {value('polarity')}, radial alignment "
+                   f"{value('radial_alignment')}; 0: no relation)")
+    return (f"{p}; {finding}; toward {value('fraction_toward')}, away "
+            f"{value('fraction_away')} of the falls (0.25 each without a relation)")
 
 
 def mean_direction_error_deg(azimuths_deg):

@@ -7,7 +7,8 @@ import numpy as np
 from scipy import optimize, stats
 
 from pipeline.constants import MODEL_GRAVITY
-from pipeline.stats.circular import angle_difference_deg, circular_summary, direction_class
+from pipeline.stats.circular import (AWAY_MIN_DEG as AWAY, TOWARD_MAX_DEG as TOWARD,
+                                     angle_difference_deg, circular_summary, direction_class)
 
 
 def wilson_interval(successes, trials, confidence=0.95):
@@ -336,3 +337,111 @@ def fragility_fit(im, toppled, min_distinct=3):
             "method": "Firth-penalised probit (scipy.optimize)", "separated": True,
             "note": "the outcomes are separated in IM: the maximum-likelihood beta is 0; "
                     "Firth-penalised estimate"}
+
+
+# ---------------------------------------------------------------- ensembles compared
+def compare_ensembles(toppled_a, azimuths_a, toppled_b, azimuths_b, min_falls=5):
+    """Do two ensembles of one record and column (e.g. two numerical settings) sample one
+    distribution?  P(toppled) by Fisher's exact test on the 2 x 2 counts, the fall
+    directions (deg; NaN for standing members) by Kuiper's two-sample test (astropy;
+    invariant to where the circle is cut), with at least ``min_falls`` falls in each.
+    Returns p-values (None where a test does not apply) and the difference of P(toppled)
+    with its Monte Carlo error (binomial, the two ensembles independent)."""
+    from astropy.stats import kuiper_two
+    ta, tb = np.asarray(toppled_a, bool), np.asarray(toppled_b, bool)
+    ka, kb, na, nb = int(ta.sum()), int(tb.sum()), ta.size, tb.size
+    p_fisher = float(stats.fisher_exact([[ka, na - ka], [kb, nb - kb]])[1]) if na and nb else None
+    fa = np.asarray(azimuths_a, float)
+    fb = np.asarray(azimuths_b, float)
+    fa, fb = fa[np.isfinite(fa)], fb[np.isfinite(fb)]
+    p_kuiper = None
+    if fa.size >= min_falls and fb.size >= min_falls:
+        p_kuiper = float(kuiper_two(np.mod(fa, 360.0) / 360.0, np.mod(fb, 360.0) / 360.0)[1])
+    pa, pb = (ka / na if na else math.nan), (kb / nb if nb else math.nan)
+    error = math.sqrt(pa * (1 - pa) / na + pb * (1 - pb) / nb) if na and nb else math.nan
+    return {"p_toppled_difference": pb - pa, "p_toppled_difference_mc_error": error,
+            "fisher_p": p_fisher, "kuiper_p": p_kuiper, "falls": [int(fa.size), int(fb.size)]}
+
+
+def holm_reject(p_values, alpha=0.05):
+    """Holm's step-down rejections (list of bool, None for a None p-value) of a family of
+    tests at family-wise level ``alpha``."""
+    given = [(p, i) for i, p in enumerate(p_values) if p is not None]
+    reject = [None if p is None else False for p in p_values]
+    for rank, (p, i) in enumerate(sorted(given)):
+        if p > alpha / (len(given) - rank):
+            break
+        reject[i] = True
+    return reject
+
+
+# ---------------------------------------------------------------- pooled over records
+NO_RELATION = {"fraction_toward": 0.25, "fraction_away": 0.25, "fraction_transverse": 0.5,
+               "radial_alignment": 0.0, "polarity": 0.0}   # falls that ignore the epicentre
+
+
+def _pooled(toppled, relative):
+    """Record-weighted statistics of one (re)sample: lists per record of toppled flags
+    (bool arrays) and fall-minus-back-azimuth angles of the falls (deg)."""
+    p = float(np.mean([t.mean() for t in toppled]))
+    with_falls = [r for r in relative if r.size]
+    if not with_falls:
+        return {"p_toppled": p, **dict.fromkeys(NO_RELATION)}
+    size = [np.abs(angle_difference_deg(r, 0.0)) for r in with_falls]
+    rad = [np.radians(r) for r in with_falls]
+    return {"p_toppled": p,
+            "fraction_toward": float(np.mean([(s <= TOWARD).mean() for s in size])),
+            "fraction_away": float(np.mean([(s >= AWAY).mean() for s in size])),
+            "fraction_transverse": float(np.mean([((s > TOWARD) & (s < AWAY)).mean()
+                                                  for s in size])),
+            "radial_alignment": float(np.mean([np.cos(2 * r).mean() for r in rad])),
+            "polarity": float(np.mean([np.cos(r).mean() for r in rad]))}
+
+
+def pooled_answer(toppled, relative_deg, resamples=2000, seed=0, confidence=0.95):
+    """The paper's question over records: does a column fall toward (or away from) the
+    epicentre?  ``toppled``: per record, the members' toppled flags; ``relative_deg``:
+    per record, the members' downfall minus back azimuth (deg; NaN when standing).
+
+    Every record weighs alike (a record's falls share its weight): P(toppled); the
+    fractions of falls toward (|diff| <= 45 deg), away (>= 135) and transverse; the
+    radial alignment, mean cos(2 diff) (+1 along the epicentre line, -1 across it, 0 no
+    relation); the polarity, mean cos(diff) (+1 toward, -1 away).  Intervals: a two-stage
+    percentile bootstrap, records drawn with replacement and then each drawn record's
+    members, so that they hold both the choice of records and the ensembles' Monte Carlo
+    error; ``mc_error``: the bootstrap standard deviation.  ``no_relation``: the values
+    of falls that ignore the epicentre; ``differs``: the interval excludes it."""
+    toppled = [np.asarray(t, bool) for t in toppled]
+    relative = [np.asarray(r, float) for r in relative_deg]
+    if not toppled or len(toppled) != len(relative) or any(
+            t.size == 0 or t.size != r.size for t, r in zip(toppled, relative)):
+        raise ValueError("pooled_answer needs, per record, as many members as directions")
+    falls = [r[t & np.isfinite(r)] for t, r in zip(toppled, relative)]
+    estimate = _pooled(toppled, falls)
+    rng = np.random.default_rng(seed)
+    draws = []
+    for _ in range(resamples):
+        picked = rng.integers(0, len(toppled), len(toppled))
+        t_draw, f_draw = [], []
+        for k in picked:
+            members = rng.integers(0, toppled[k].size, toppled[k].size)
+            t, r = toppled[k][members], relative[k][members]
+            t_draw.append(t)
+            f_draw.append(r[t & np.isfinite(r)])
+        draws.append(_pooled(t_draw, f_draw))
+    tail = 50.0 * (1.0 - confidence)
+    out = {"records": len(toppled), "members": int(sum(t.size for t in toppled)),
+           "records_with_falls": int(sum(f.size > 0 for f in falls)),
+           "falls": int(sum(f.size for f in falls)), "resamples": resamples, "seed": seed,
+           "confidence": confidence, "statistics": {}}
+    for name, value in estimate.items():
+        values = np.array([d[name] for d in draws if d[name] is not None], float)
+        ok = value is not None and values.size >= 0.5 * resamples
+        ci = [float(v) for v in np.percentile(values, [tail, 100 - tail])] if ok else None
+        reference = NO_RELATION.get(name)
+        out["statistics"][name] = {
+            "estimate": value, "ci95": ci, "mc_error": float(values.std(ddof=1)) if ok else None,
+            "no_relation": reference,
+            "differs": None if reference is None or ci is None
+            else bool(not ci[0] <= reference <= ci[1])}
+    return out
