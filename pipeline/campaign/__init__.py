@@ -101,10 +101,61 @@ def run_campaign(name, jobs=None, records=None, campaign_dir=None, animations=1,
         raise
 
 
+def reuse_finished(specs, campaign_dir, worker):
+    """Copy into ``campaign_dir/runs`` the unfinished specs' runs that a campaign beside it
+    (a directory of the same parent with a campaign.json of a campaign with the same
+    worker) has finished: the run id hashes the motion, the parameters and the model code,
+    so a run computed once is not computed again.  A spec that keeps its trajectory takes
+    only a run that kept one.  Returns how many runs were copied."""
+    import json
+    here = Path(campaign_dir).resolve()
+    sources = []
+    for meta in sorted(here.parent.glob("*/campaign.json")):
+        if meta.parent == here:
+            continue
+        try:
+            name = json.loads(meta.read_text())["campaign"]
+        except (OSError, ValueError, KeyError, TypeError):
+            continue
+        discover()
+        if name in CAMPAIGNS and CAMPAIGNS[name].worker is worker:
+            sources.append(meta.parent / "runs")
+    copied = 0
+    for spec in specs:
+        target = here / "runs" / spec["run_id"]
+        if not sources or (target / "summary.json").exists():
+            continue
+        keep = spec.get("keep_trajectory", True)
+        for runs in sources:
+            source = runs / spec["run_id"]
+            if not (source / "summary.json").exists() or (
+                    keep and not (source / "trajectory.npz").exists()):
+                continue
+            staging = target.with_name(target.name + ".copying")
+            try:
+                shutil.rmtree(staging, ignore_errors=True)
+                if keep:
+                    shutil.copytree(source, staging, ignore=shutil.ignore_patterns(".lock"))
+                else:
+                    staging.mkdir(parents=True)
+                    shutil.copy2(source / "summary.json", staging / "summary.json")
+                shutil.rmtree(target, ignore_errors=True)      # an unfinished attempt
+                os.replace(staging, target)
+                copied += 1
+                break
+            except OSError:                   # the other campaign is changing it: run it
+                shutil.rmtree(staging, ignore_errors=True)
+    return copied
+
+
 def _run_specs(campaign, name, specs, campaign_dir, jobs, animations, executor, scheduler):
     """Execute the specs and write the campaign's outputs (see :func:`run_campaign`)."""
     from pipeline.campaign.executor import execute
     with DirectoryLock(campaign_dir, wait=False):
+        reused = reuse_finished(specs, campaign_dir, campaign.worker)
+        if reused:
+            print(f"{Path(campaign_dir).name}: {reused} run(s) copied from campaigns beside it "
+                  "(same run id: same motion, parameters and model code)", flush=True)
         failures, interrupted = execute(specs, campaign_dir, jobs, campaign.worker,
                                         campaign.label, executor=executor,
                                         scheduler=scheduler)

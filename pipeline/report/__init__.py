@@ -12,7 +12,8 @@ from pathlib import Path
 
 from pipeline import RESULTS_DIR, __version__
 from pipeline.files import write_text
-from pipeline.report.campaigns import (columns_section, ensemble_section, fragility_section,
+from pipeline.report.campaigns import (columns_section, convergence_section, ensemble_section,
+                                       fragility_section, paper_question_section,
                                        shake_table_section, speed_section, sweep_section,
                                        verification_section)
 from pipeline.report.inversion import inversion_section
@@ -22,7 +23,8 @@ from pipeline.report.records import (back_azimuth_table, correlation_table, per_
                                      with_back_azimuth)
 from pipeline.stats.ensemble import wilson_interval
 
-__all__ = ["build_report", "back_azimuth_table", "columns_section", "correlation_table",
+__all__ = ["build_report", "back_azimuth_table", "columns_section", "convergence_section",
+           "correlation_table", "paper_question_section",
            "ensemble_section", "fragility_section", "inversion_section", "per_record_table",
            "processing_section", "record_orientation", "records_section", "records_statements",
            "shake_table_section", "speed_section", "sweep_section", "synthetic_section",
@@ -32,7 +34,8 @@ __all__ = ["build_report", "back_azimuth_table", "columns_section", "correlation
 def build_report(results=RESULTS_DIR):
     results = Path(results)
     campaigns = {}
-    for name in ("verification", "slenderness", "friction", "records", "synthetic", "ensemble"):
+    for name in ("verification", "slenderness", "friction", "records", "synthetic", "ensemble",
+                 "paper-question", "convergence", "fragility", "columns"):
         meta = results / name / "campaign.json"
         if meta.exists():
             campaigns[name] = json.loads(meta.read_text())
@@ -53,7 +56,8 @@ def build_report(results=RESULTS_DIR):
                       "friction had a minor influence on downfall directions; with mu_s = 0.1 "
                       "neither column toppled (they slid instead)."),
         shake_table_section(results),
-        ensemble_section(results), fragility_section(results), columns_section(results),
+        paper_question_section(results), ensemble_section(results),
+        convergence_section(results), fragility_section(results), columns_section(results),
         inversion_section(results),
         records_section(results), processing_section(results), synthetic_section(results),
         speed_section(results)]

@@ -1,10 +1,11 @@
 """Report sections of the campaigns: verification, sweeps, ensembles, fragility, real
 columns, the shake-table check, speed."""
 import json
+from pathlib import Path
 
 import pandas as pd
 
-from pipeline.report.common import _figure, _fmt, _read_csv, _spread, _table
+from pipeline.report.common import _figure, _fmt, _p, _read_csv, _spread, _table
 
 
 def sweep_section(results, name, parameter, paper_notes):
@@ -186,4 +187,88 @@ def ensemble_section(results):
     for summary in summaries:
         sub = base if len(summaries) == 1 else base / summary["record"]
         lines.append(_figure(results, sub / "rose.png", f"ensemble {summary['record']}"))
+    return "\n".join(lines)
+
+
+PAPER_QUESTION_DIR = "paper-question"     # make paper-question / run-all's reduced size
+POOLED_NAMES = {"p_toppled": "P(toppled) per record", "fraction_toward": "toward (0.25)",
+                "fraction_away": "away (0.25)", "fraction_transverse": "transverse (0.5)",
+                "polarity": "polarity (0)", "radial_alignment": "radial alignment (0)"}
+
+
+def paper_question_section(results):
+    """The paper's question from ensembles over the near-source records (the ensemble
+    campaign in results/paper-question): pooled numbers with intervals over records and
+    members, the Monte Carlo error of each, the answer per column and the figure."""
+    base = Path(results) / PAPER_QUESTION_DIR
+    title = "## The paper's question from ensembles\n"
+    path = base / "pooled_summary.json"
+    if not path.exists():
+        return (title + "\nNot run yet (`make run-all` at a reduced size, `make paper-question` "
+                "at full precision).\n")
+    pooled = json.loads(path.read_text())
+    sizes = sorted(set(pooled["members_per_record"].values()))
+    summaries = base / "ensemble_summaries.json"
+    sizing = [s.get("sizing") for s in json.loads(summaries.read_text())] \
+        if summaries.exists() else []
+    capped = sum(1 for s in sizing if s and s.get("stopped_by") == "member cap")
+    precision = next((s["precision"] for s in sizing if s), None)
+    size = (f"{sizes[0]}" if len(sizes) == 1 else f"{sizes[0]}-{sizes[-1]}")
+    lines = [title, f"{pooled['question']}  {pooled['records']} near-source records with a back "
+             f"azimuth, {size} members per record (plus the nominal run, left out)"
+             + ("" if precision is None else
+                f"; members were added until P(toppled)'s 95 % interval was within "
+                f"+-{precision:g} ({capped} of {len(sizing)} records stopped by the member "
+                "cap instead)") + ".  Every record weighs alike; the 95 % intervals are a "
+             "two-stage bootstrap (records drawn again, then their members), so they hold both "
+             "the choice of records and the ensembles' Monte Carlo error (MC error: the "
+             "bootstrap's standard deviation).  In brackets: the value of falls that ignore "
+             "the epicentre.\n"]
+    rows = []
+    for col in pooled["columns"]:
+        row = {"column": col["column"], "falls (records)": f"{col['falls']} "
+               f"({col['records_with_falls']})"}
+        for name, label in POOLED_NAMES.items():
+            st = col["statistics"][name]
+            row[label] = "-" if st["ci95"] is None else (
+                f"{st['estimate']:.2f} [{st['ci95'][0]:.2f}, {st['ci95'][1]:.2f}] "
+                f"+-{st['mc_error']:.2f}")
+        rows.append(row)
+    lines.append(_table(pd.DataFrame(rows)) + "\n")
+    for col in pooled["columns"]:
+        lines.append(f"- **{col['column']}**: {col['answer']}.")
+    lines.append("\nSingle runs per record (campaign records, below) are samples of these "
+                 "distributions.\n")
+    lines.append(_figure(results, base / "pooled.png", "the paper's question from ensembles"))
+    return "\n".join(lines)
+
+
+def convergence_section(results):
+    """The model's convergence judged on distributions (make convergence)."""
+    path = Path(results) / "convergence" / "convergence.json"
+    title = "## Convergence on distributions\n"
+    if not path.exists():
+        return title + "\nNot run yet (`make convergence`).\n"
+    conv = json.loads(path.read_text())
+    rows = []
+    for r in conv["rows"]:
+        ci = r["p_toppled_ci95"]
+        rows.append({"record": r["record"], "column": r["column"], "setting": r["variant"],
+                     "members": r["members"],
+                     "P(toppled) [95 %]": f"{r['p_toppled']:.2f} [{ci[0]:.2f}, {ci[1]:.2f}]",
+                     "mean downfall (deg), R": "-" if r["mean_downfall_azimuth_deg"] is None
+                     else f"{r['mean_downfall_azimuth_deg']:.0f}, {r['resultant_length']:.2f}",
+                     "Fisher p": _p(r.get("fisher_p")), "Kuiper p": _p(r.get("kuiper_p"))})
+    cost = conv.get("cost_vs_default") or {}
+    lines = [title, "The twin model's ensembles (independent Latin-hypercube samples per "
+             "setting) at the default numerics (16 rim points, time step factor 0.3 or the "
+             "stability limit at the member's damping) and at 32 and 64 rim points and time "
+             "step factor 0.15; each setting against the defaults: Fisher's exact test on "
+             "P(toppled), Kuiper's two-sample test on the fall directions, Holm's correction "
+             f"over all {conv['comparisons']} comparisons at {conv['alpha']:g}.\n",
+             f"**{conv['verdict']}.**  Cost per member relative to the defaults: "
+             + ", ".join(f"{k} {v:.2f}x" for k, v in cost.items()) + ".\n",
+             _table(pd.DataFrame(rows)) + "\n",
+             _figure(results, Path(results) / "convergence" / "convergence.png",
+                     "convergence on distributions")]
     return "\n".join(lines)
