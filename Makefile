@@ -5,7 +5,8 @@ PY := .venv/bin/python
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 JOBS ?= $(shell nproc)
 
-.PHONY: setup test run-all records campaigns bench clean invert-demo shake-table docs
+.PHONY: setup test run-all records campaigns bench clean invert-demo shake-table docs \
+	convergence paper-question
 
 setup: .venv/.installed
 	@command -v yade >/dev/null || { echo "installing YADE (apt-get install yade)"; \
@@ -28,13 +29,22 @@ test: setup
 records: setup
 	$(PY) -m pipeline records --all
 
+# run-all: the paper's campaigns at full size, then every REPORT.md section; the
+# paper's question, fragility and the inversion at a reduced size (the REPORT says what
+# was reduced; make paper-question, make invert-demo and campaign fragility give them
+# in full).  The ensembles' nominal runs are the records campaign's (copied, not rerun).
+PAPER_BATCH ?= 1
 campaigns: records
 	$(PY) -m pipeline campaign verification --jobs $(JOBS)
 	$(PY) -m pipeline campaign slenderness --jobs $(JOBS)
 	$(PY) -m pipeline campaign friction --jobs $(JOBS)
 	$(PY) -m pipeline campaign records --jobs $(JOBS)
 	$(PY) -m pipeline campaign synthetic --jobs $(JOBS)
-	$(PY) -m pipeline campaign ensemble --records GM20,NF04,RC-CCC,RSN126-GAZLI --members 6 --max-members 6 --jobs $(JOBS)
+	$(PY) -m pipeline campaign ensemble --set nearsource --out results/paper-question \
+	  --members $(PAPER_BATCH) --max-members $(PAPER_BATCH) --animations 0 --jobs $(JOBS)
+	$(PY) -m pipeline campaign columns --jobs $(JOBS)
+	$(PY) -m pipeline campaign fragility --levels 1,2,4,8 --members 1 --jobs $(JOBS)
+	$(PY) -m pipeline invert --demo --quick --jobs $(JOBS)
 
 run-all: campaigns
 	$(PY) -m pipeline report
@@ -47,6 +57,20 @@ bench: setup
 # validate August; 8 parameter sets): about 45 min on 2 cores
 shake-table: setup
 	$(PY) -m pipeline campaign shake-table $(if $(SHAKE_GRID),--grid "$(SHAKE_GRID)") --jobs $(JOBS)
+	$(PY) -m pipeline report
+
+# the model's convergence judged on distributions: the twin model's ensembles of 3 records
+# at 16 (default), 32 and 64 rim points and time step factor 0.15, 32 members each
+convergence: records
+	$(PY) -m pipeline campaign convergence --jobs $(JOBS)
+	$(PY) -m pipeline report
+
+# the paper's question at full precision: every near-source record's ensemble sized by its
+# error (P(toppled) within +-0.1, falls' mean direction within 60 deg), pooled over records;
+# it takes over the reduced ensembles of run-all (the same first members) and adds batches
+paper-question: records
+	$(PY) -m pipeline campaign ensemble --set nearsource --out results/paper-question \
+	  --members $(PAPER_BATCH) --jobs $(JOBS)
 	$(PY) -m pipeline report
 
 # the docs/ tree as a website (results/site; mkdocs --strict fails on a broken link)

@@ -430,6 +430,36 @@ def converged(summary, precision, arc_deg):
     return True, "precision reached"
 
 
+def members_needed(summary, precision, batch, cap, arc_deg=None):
+    """Members (whole batches beyond the record's current ones, at most ``cap``, at least
+    one batch more) whose P(toppled) Wilson interval would be within +-``precision`` at the
+    fractions toppled so far: a record far from its precision gets several batches in one
+    round instead of a round per batch; likewise for a mean direction's interval wider
+    than ``arc_deg`` where falls gather (its width shrinks as 1 / sqrt(falls))."""
+    from pipeline.stats.ensemble import wilson_interval
+    current = summary["columns"][0]["members"] if summary["columns"] else 0
+    need = min(cap, current + batch)
+    for col in summary["columns"]:
+        p = col["toppled"] / max(col["members"], 1)
+        n = current + batch
+        while n < cap:
+            lo, hi = wilson_interval(round(p * n), n)
+            if (hi - lo) / 2 <= precision:
+                break
+            n += batch
+        need = max(need, min(cap, n))
+        ci = col.get("mean_azimuth_ci95_deg")
+        if (arc_deg is not None and ci is not None and col["toppled"] >= CONCENTRATED["falls"]
+                and (col["resultant_length"] or 0) >= CONCENTRATED["resultant_length"]):
+            width = (ci[1] - ci[0]) % 360.0     # shrinks as 1 / sqrt(falls)
+            if width > arc_deg:
+                falls = col["toppled"] * (width / arc_deg) ** 2
+                n = current + batch * math.ceil(
+                    max(falls / max(p, 1e-9) - current, 1) / batch)
+                need = max(need, min(cap, n))
+    return need
+
+
 def run_sized(run, records, campaign_dir, options):
     """Add members in Latin-hypercube batches of ``options["members"]`` to the records not
     yet converged (:func:`converged`) until all are or ``max_members`` is reached; each
@@ -453,8 +483,10 @@ def run_sized(run, records, campaign_dir, options):
         if not pending:
             break
         for rec, why in pending.items():
-            print(f"{rec}: {why} after {counts[rec]} members: adding {batch}", flush=True)
-            counts[rec] = min(cap, counts[rec] + batch)
+            summary = next(x for x in result["summaries"] if x["record_input"] == rec)
+            more = members_needed(summary, precision, batch, cap, arc) - counts[rec]
+            print(f"{rec}: {why} after {counts[rec]} members: adding {more}", flush=True)
+            counts[rec] += more
     for summary in result.get("summaries", []):
         out = Path(campaign_dir)
         if len(result["summaries"]) > 1:
