@@ -55,7 +55,7 @@ def _weights(text):
 
 
 def setup(p):
-    from pipeline.inversion.forward import GRIDS, MECHANISMS
+    from pipeline.inversion.grid import GRIDS, MECHANISMS
     from pipeline.inversion.likelihood import DEFAULT_FLOOR, DEFAULT_KERNEL_DEG
     full, quick = GRIDS["full"], GRIDS["quick"]
     p.add_argument("observations", nargs="?", type=Path, metavar="OBSERVATIONS.json",
@@ -149,7 +149,7 @@ CANDIDATE_PRESETS = {"quick": {"radius_km": 12.0, "step_km": 1.0, "strike_step_d
 
 def build_grids(args):
     """(preset name, TableGrid, CandidateGrid) from the options; InputError if impossible."""
-    from pipeline.inversion.forward import GRIDS, parse_mechanisms
+    from pipeline.inversion.grid import GRIDS, parse_mechanisms
     from pipeline.campaign.ensemble import check_seed
     from pipeline.inversion.posterior import CandidateGrid
     if args.quick and args.grid not in (None, "quick"):
@@ -237,7 +237,8 @@ def preflight(grid, forward_dir, jobs, allow_long):
 def forward_table(args, grid, sibling_of=None):
     """(ForwardTable, info dict): the --table file (``sibling_of``: the table of ``grid``
     beside that file), or the campaign's (run or reused)."""
-    from pipeline.inversion.forward import ForwardTable, run_forward, table_path
+    from pipeline.inversion.forward import run_forward, table_path
+    from pipeline.inversion.table import ForwardTable
     path = args.table if sibling_of is None else \
         Path(sibling_of).parent / table_path(".", grid).name
     if sibling_of is not None and not path.is_file():
@@ -279,7 +280,7 @@ def run(args):
     started = time.monotonic()
     table, info = forward_table(args, grid)
     if args.table is not None and described and table.info.get("grid"):
-        from pipeline.inversion.forward import TableGrid       # the --table file's grid
+        from pipeline.inversion.grid import TableGrid          # the --table file's grid
         grid = TableGrid(**table.info["grid"])
     for name, data in described.items():
         column_table, column_info = forward_table(args, grid.replace(column_file=data),
@@ -305,7 +306,8 @@ def run(args):
 def _run_demo(args, preset, grid, candidates):
     from pipeline.inversion import EXAMPLES_DIR, run_inversion
     from pipeline.inversion.demo import DEFAULT_TRIALS, paper_grid, paper_nodes, run_demo
-    from pipeline.inversion.forward import ForwardTable, run_forward, table_path
+    from pipeline.inversion.forward import run_forward, table_path
+    from pipeline.inversion.table import ForwardTable
     from pipeline.inversion.observations import load_observations
     out = args.out or RESULTS_DIR / "inversion"
     if out.exists() and not out.is_dir():

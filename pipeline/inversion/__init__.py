@@ -6,7 +6,9 @@
         inversion_summary.json, posterior_map.png, marginals.png
 
 Modules: :mod:`~pipeline.inversion.observations` (the file's schema and checks),
-:mod:`~pipeline.inversion.forward` (symmetries, node motions, the campaign, the table),
+:mod:`~pipeline.inversion.grid` (the grid and its pyprop8 motions),
+:mod:`~pipeline.inversion.forward` (the symmetries, the campaign),
+:mod:`~pipeline.inversion.table` (the forward table),
 :mod:`~pipeline.inversion.likelihood`, :mod:`~pipeline.inversion.posterior` (candidates,
 prior, credible regions), :mod:`~pipeline.inversion.demo` (synthetic truth tests and the
 paper's scenario).  docs/inversion.md.

@@ -38,7 +38,7 @@ def inversion_section(results):
            f"{forward.get('code_version')}) and read with `--table`."
            if forward.get("reused_file") else ".") + "\n")
     if runs:
-        from pipeline.inversion.forward import GRIDS
+        from pipeline.inversion.grid import GRIDS
         full = GRIDS["full"]
         lines.append(f"The default (`full`) grid, {len(full.mechanisms)} mechanisms x "
                      f"{len(full.depths_km)} depths x {len(full.magnitudes)} magnitudes x "

@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-from pipeline.inversion.forward import ForwardTable
+from pipeline.inversion.table import ForwardTable
 
 DISTANCES = (2.5, 5.0, 10.0, 20.0)
 AZIMUTHS = tuple(np.arange(0.0, 360.0, 30.0))

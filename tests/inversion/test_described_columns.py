@@ -8,8 +8,9 @@ import pytest
 from pipeline import cli
 from pipeline.campaign.column_file import column_kn, description
 from pipeline.files import InputError, write_json
-from pipeline.inversion.forward import (GRIDS, ForwardTable, TableGrid, member_parameters,
-                                        node_positions, table_path)
+from pipeline.inversion.forward import member_parameters, table_path
+from pipeline.inversion.grid import GRIDS, TableGrid, node_positions
+from pipeline.inversion.table import ForwardTable
 
 
 def test_twin_grids_keep_their_keys_and_a_description_makes_another():

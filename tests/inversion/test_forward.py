@@ -5,8 +5,9 @@ import numpy as np
 import pytest
 
 from pipeline.files import InputError, write_json
-from pipeline.inversion.forward import (GRIDS, ForwardTable, TableGrid, member_parameters,
-                                        node_positions, subevent_layout)
+from pipeline.inversion.forward import member_parameters
+from pipeline.inversion.grid import GRIDS, TableGrid, node_positions, subevent_layout
+from pipeline.inversion.table import ForwardTable
 from pipeline.motion.synthetics import SOURCES, subevents
 
 

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 from scipy import optimize, special
 
-from pipeline.inversion.forward import ForwardTable
+from pipeline.inversion.table import ForwardTable
 from pipeline.inversion.likelihood import ForwardModel, concentration
 from pipeline.inversion.observations import ColumnObservation, Site
 

@@ -1,0 +1,254 @@
+"""The forward table (:class:`ForwardTable`): the ensemble's outcomes at every node of a
+grid (:mod:`pipeline.inversion.grid`), from the finished runs of the campaign
+``inversion-forward`` (:mod:`pipeline.inversion.forward`), saved and loaded as one npz."""
+import dataclasses
+import json
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from pipeline import files
+from pipeline.campaign.definitions import run_code_version
+from pipeline.constants import COLUMN_TYPES as COLUMNS
+from pipeline.files import InputError
+
+@dataclass
+class ForwardTable:
+    """Outcomes at the nodes, all azimuths in the strike frame (strike = North).
+
+    Arrays are indexed [slice, distance, azimuth, column, member]; ``toppled`` and
+    ``valid`` (the run finished) are bool, ``azimuth_deg`` the downfall azimuth (NaN when
+    standing).  ``nominal_*`` hold the nominal twin run ([slice, distance, azimuth,
+    column]; None without).  ``slices``: dicts mechanism, dip_deg, rake_deg, depth_km, mw.
+    """
+    slices: list
+    distances_km: np.ndarray
+    azimuths_deg: np.ndarray
+    members: np.ndarray
+    toppled: np.ndarray
+    azimuth_deg: np.ndarray
+    valid: np.ndarray
+    columns: tuple = COLUMNS
+    nominal_toppled: np.ndarray = None
+    nominal_azimuth_deg: np.ndarray = None
+    nominal_valid: np.ndarray = None
+    info: dict = field(default_factory=dict)
+
+    def __post_init__(self):
+        self.distances_km = np.asarray(self.distances_km, float)
+        self.azimuths_deg = np.asarray(self.azimuths_deg, float)
+        self.members = np.asarray(self.members, int)
+        shape = (len(self.slices), len(self.distances_km), len(self.azimuths_deg),
+                 len(self.columns), len(self.members))
+        for name in ("toppled", "azimuth_deg", "valid"):
+            value = np.asarray(getattr(self, name))
+            if value.shape != shape:
+                raise InputError(f"forward table: {name} has shape {value.shape}, "
+                                 f"expected {shape}")
+            setattr(self, name, value)
+        self.toppled = self.toppled.astype(bool) & self.valid.astype(bool)
+        self.valid = self.valid.astype(bool)
+        self.azimuth_deg = np.where(self.toppled, np.mod(self.azimuth_deg.astype(float), 360.0),
+                                    np.nan)
+        steps = np.diff(np.r_[self.azimuths_deg, self.azimuths_deg[0] + 360.0])
+        if len(self.azimuths_deg) < 2 or not np.allclose(steps, steps[0]) or \
+                abs(self.azimuths_deg[0]) > 1e-9:
+            raise InputError("forward table: node azimuths must be evenly spaced from 0 "
+                             "(at least two)")
+        if np.any(np.diff(self.distances_km) <= 0):
+            raise InputError("forward table: distances must increase")
+
+    # -------------------------------------------------------------- construction
+    @classmethod
+    def from_runs(cls, specs, campaign_dir, grid):
+        runs_dir = Path(campaign_dir) / "runs"
+        sl = grid.slices()
+        members = np.arange(grid.members)
+        columns = grid.columns
+        shape = (len(sl), len(grid.distances_km), len(grid.azimuths_deg), len(columns))
+        top = np.zeros(shape + (len(members),), bool)
+        az = np.full(shape + (len(members),), np.nan)
+        valid = np.zeros(shape + (len(members),), bool)
+        ntop, naz, nval = np.zeros(shape, bool), np.full(shape, np.nan), np.zeros(shape, bool)
+        wall, simulated = 0.0, 0
+        na = len(grid.azimuths_deg)
+        for spec in specs:
+            path = runs_dir / spec["run_id"] / "summary.json"
+            if not path.exists():
+                continue
+            summary = json.loads(path.read_text())
+            wall += float(summary.get("wall_s") or 0.0)
+            simulated += bool(summary.get("simulated", True))
+            i, j = divmod(spec["node"], na)
+            for col in summary["columns"]:
+                c = columns.index(col["column"])
+                fell = bool(col["toppled"]) and col["downfall_azimuth_deg"] is not None
+                value = col["downfall_azimuth_deg"] if fell else np.nan
+                index = (spec["slice"], i, j, c)
+                if spec["member"] < 0:
+                    ntop[index], naz[index], nval[index] = fell, value, True
+                else:
+                    top[index + (spec["member"],)] = fell
+                    az[index + (spec["member"],)] = value
+                    valid[index + (spec["member"],)] = True
+        slices = [{"mechanism": s[0], "dip_deg": s[1], "rake_deg": s[2], "depth_km": s[3],
+                   "mw": s[4]} for s in sl]
+        return cls(slices, grid.distances_km, grid.azimuths_deg, members, top, az, valid,
+                   columns, ntop if grid.nominal else None, naz if grid.nominal else None,
+                   nval if grid.nominal else None,
+                   info={"grid": grid.as_dict(), "grid_key": grid.key(),
+                         "yade_wall_s": round(wall, 1), "runs": len(specs),
+                         "simulated_runs": simulated,
+                         "code_version": _code_version()})
+
+    @classmethod
+    def toy(cls, slices, distances_km, azimuths_deg, falls, columns=COLUMNS, info=None):
+        """A table from ``falls[s][i][j][c]`` = list of downfall azimuths (strike frame) or
+        None for standing members (tests and examples)."""
+        n_members = max(len(m) for a in falls for b in a for c in b for m in c)
+        shape = (len(slices), len(distances_km), len(azimuths_deg), len(columns), n_members)
+        top, az, valid = np.zeros(shape, bool), np.full(shape, np.nan), np.zeros(shape, bool)
+        for index in np.ndindex(shape[:4]):
+            outcomes = falls[index[0]][index[1]][index[2]][index[3]]
+            for k, value in enumerate(outcomes):
+                valid[index + (k,)] = True
+                if value is not None:
+                    top[index + (k,)], az[index + (k,)] = True, value
+        slices = [dict(s) if isinstance(s, dict) else
+                  {"mechanism": s[0], "dip_deg": s[1], "rake_deg": s[2], "depth_km": s[3],
+                   "mw": s[4]} for s in slices]
+        return cls(slices, distances_km, azimuths_deg, np.arange(n_members), top, az, valid,
+                   tuple(columns), info=dict(info or {"toy": True}))
+
+    def with_column(self, name, other):
+        """This table and the first column of ``other`` (same slices, nodes and members,
+        e.g. a described column's table) as column ``name``."""
+        same = (self.slices == other.slices
+                and np.array_equal(self.distances_km, other.distances_km)
+                and np.array_equal(self.azimuths_deg, other.azimuths_deg)
+                and np.array_equal(self.members, other.members)
+                and (self.nominal_toppled is None) == (other.nominal_toppled is None))
+        if not same:
+            raise InputError(f"forward table of {name}: its grid differs from the main "
+                             "table's (slices, rings, azimuths, members, nominal run)")
+        if name in self.columns:
+            raise InputError(f"forward table: column {name!r} is there already")
+
+        def join(a, b):
+            return None if a is None else np.concatenate([a, b[..., :1]], axis=3)
+
+        def join_members(a, b):
+            return np.concatenate([a, b[:, :, :, :1, :]], axis=3)
+
+        return dataclasses.replace(
+            self, columns=tuple(self.columns) + (name,),
+            toppled=join_members(self.toppled, other.toppled),
+            azimuth_deg=join_members(self.azimuth_deg, other.azimuth_deg),
+            valid=join_members(self.valid, other.valid),
+            nominal_toppled=join(self.nominal_toppled, other.nominal_toppled),
+            nominal_azimuth_deg=join(self.nominal_azimuth_deg, other.nominal_azimuth_deg),
+            nominal_valid=join(self.nominal_valid, other.nominal_valid),
+            info={**self.info, "described_columns": {
+                **self.info.get("described_columns", {}),
+                name: {k: other.info.get(k) for k in ("grid_key", "yade_wall_s", "runs",
+                                                      "code_version")}}})
+
+    def select_members(self, mask):
+        """A table with the members where ``mask`` (bool over ``members``) holds."""
+        mask = np.asarray(mask, bool)
+        return dataclasses.replace(self, members=self.members[mask],
+                                   toppled=self.toppled[..., mask],
+                                   azimuth_deg=self.azimuth_deg[..., mask],
+                                   valid=self.valid[..., mask], info=dict(self.info))
+
+    def select_slices(self, keep):
+        """A table with the slices where ``keep`` (bool over ``slices``) holds."""
+        keep = np.asarray(keep, bool)
+        if not keep.any():
+            raise InputError("no forward-table slice matches the chosen mechanisms, depths "
+                             "and magnitudes")
+
+        def pick(values):
+            return None if values is None else values[keep]
+
+        return dataclasses.replace(
+            self, slices=[s for s, k in zip(self.slices, keep) if k],
+            toppled=self.toppled[keep], azimuth_deg=self.azimuth_deg[keep],
+            valid=self.valid[keep], nominal_toppled=pick(self.nominal_toppled),
+            nominal_azimuth_deg=pick(self.nominal_azimuth_deg),
+            nominal_valid=pick(self.nominal_valid), info=dict(self.info))
+
+    # -------------------------------------------------------------- file
+    def save(self, path):
+        arrays = {"distances_km": self.distances_km, "azimuths_deg": self.azimuths_deg,
+                  "members": self.members, "toppled": self.toppled,
+                  "azimuth_deg": self.azimuth_deg, "valid": self.valid}
+        if self.nominal_toppled is not None:
+            arrays.update(nominal_toppled=self.nominal_toppled,
+                          nominal_azimuth_deg=self.nominal_azimuth_deg,
+                          nominal_valid=self.nominal_valid)
+        meta = {"slices": self.slices, "columns": list(self.columns), "info": self.info,
+                "frame": "downfall azimuths in the strike frame (strike = North); node "
+                         "azimuth = site azimuth from the epicentre minus the strike"}
+        files.write_npz(path, meta=np.array(json.dumps(meta)), **arrays)
+        return Path(path)
+
+    @classmethod
+    def load(cls, path):
+        path = Path(path)
+        if not path.is_file():
+            raise InputError(f"forward table not found: {path}")
+        try:
+            with np.load(path, allow_pickle=False) as archive:
+                data = {k: archive[k] for k in archive.files}
+            meta = json.loads(str(data.pop("meta")))
+        except (ValueError, OSError, EOFError, KeyError):
+            raise InputError(f"{path.name}: not a forward table (npz with meta)") from None
+        try:
+            return cls(meta["slices"], data["distances_km"], data["azimuths_deg"],
+                       data["members"], data["toppled"], data["azimuth_deg"], data["valid"],
+                       tuple(meta["columns"]), data.get("nominal_toppled"),
+                       data.get("nominal_azimuth_deg"), data.get("nominal_valid"),
+                       info=meta.get("info", {}))
+        except KeyError as exc:
+            raise InputError(f"{path.name}: forward table lacks {exc}") from None
+
+    # -------------------------------------------------------------- views
+    def slice_index(self, mechanism, depth_km=None, mw=None):
+        for k, s in enumerate(self.slices):
+            if s["mechanism"] == mechanism and (depth_km is None or s["depth_km"] == depth_km) \
+                    and (mw is None or s["mw"] == mw):
+                return k
+        raise KeyError((mechanism, depth_km, mw))
+
+    def cells(self):
+        """One row per node and column: members, toppled, P (k/n), mean downfall azimuth
+        in the strike frame and relative to the direction from epicentre to site."""
+        from pipeline.stats.circular import circular_summary
+        rows = []
+        for index in np.ndindex(self.toppled.shape[:4]):
+            s, i, j, c = index
+            valid, fell = self.valid[index], self.toppled[index]
+            az = self.azimuth_deg[index][fell]
+            stats = circular_summary(az)
+            rel = circular_summary((az - self.azimuths_deg[j]) % 360.0)
+            row = {**self.slices[s], "distance_km": self.distances_km[i],
+                   "azimuth_from_strike_deg": self.azimuths_deg[j],
+                   "column": self.columns[c], "members": int(valid.sum()),
+                   "toppled": int(fell.sum()),
+                   "p_toppled": float(fell.sum() / valid.sum()) if valid.any() else np.nan,
+                   "mean_downfall_strike_frame_deg": stats["mean_deg"],
+                   "mean_downfall_from_site_direction_deg": rel["mean_deg"],
+                   "resultant_length": stats["resultant_length"]}
+            if self.nominal_toppled is not None:
+                row["nominal_toppled"] = bool(self.nominal_toppled[index]) \
+                    if self.nominal_valid[index] else None
+                row["nominal_downfall_strike_frame_deg"] = self.nominal_azimuth_deg[index]
+            rows.append(row)
+        return pd.DataFrame(rows)
+
+
+def _code_version():
+    return run_code_version()
