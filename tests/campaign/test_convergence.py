@@ -1,0 +1,50 @@
+"""The convergence campaign's comparison: a setting that samples the defaults'
+distribution agrees, a setting whose falls turn is called different; specs are
+independent samples per setting with the rim phase over one rim spacing."""
+import numpy as np
+import pandas as pd
+
+from pipeline.campaign.convergence import VARIANTS, compare_variants, variant_ranges
+
+
+def _members(rng, variant, n, p, centre_deg, spread_deg=25.0):
+    rows = []
+    for m in range(n):
+        fell = bool(rng.random() < p)
+        rows.append({"record_id": "R", "column": "drums", "variant": variant, "member": m,
+                     "toppled": fell, "downfall_azimuth_deg":
+                     (rng.normal(centre_deg, spread_deg)) % 360 if fell else np.nan})
+    return rows
+
+
+def test_a_turned_distribution_is_called_and_a_resampled_one_is_not():
+    rng = np.random.default_rng(11)
+    rows = (_members(rng, "default", 60, 0.8, 350.0) + _members(rng, "rim 32", 60, 0.8, 355.0)
+            + _members(rng, "rim 64", 60, 0.8, 80.0) + _members(rng, "dt 0.15", 60, 0.1, 350.0))
+    result = compare_variants(pd.DataFrame(rows), {"default": 10.0, "rim 64": 30.0})
+    by = {r["variant"]: r for r in result["rows"]}
+    assert not by["rim 32"]["fisher_differs"] and not by["rim 32"]["kuiper_differs"]
+    assert by["rim 64"]["kuiper_differs"] and not by["rim 64"]["fisher_differs"]
+    assert by["dt 0.15"]["fisher_differs"]
+    assert set(result["differing"]) == {"R drums rim 64", "R drums dt 0.15"}
+    assert result["cost_vs_default"] == {"default": 1.0, "rim 64": 3.0}
+    assert "fisher_p" not in by["default"]          # the reference is not tested against itself
+
+
+def test_the_rim_phase_spans_one_spacing_of_each_setting():
+    for numerics in VARIANTS.values():
+        lo, hi, _ = variant_ranges(numerics)["rim_phase_deg"]
+        assert lo == 0.0 and hi * numerics.get("rim_points", 16) == 360.0
+
+
+def test_specs_sample_each_setting_independently(tmp_path):
+    from pipeline.campaign.convergence import convergence_specs
+    specs = convergence_specs(["RSN126-GAZLI"], tmp_path, members=3)
+    assert len(specs) == 3 * len(VARIANTS) and len({s["run_id"] for s in specs}) == len(specs)
+    by = {}
+    for s in specs:
+        by.setdefault(s["variant"], []).append(s["params"])
+    assert [p["rim_points"] for p in by["rim 64"]] == [64] * 3
+    assert [p["dt_factor"] for p in by["dt 0.15"]] == [0.15] * 3
+    assert all("rim_points" not in p and "dt_factor" not in p for p in by["default"])
+    assert [p["mu_s"] for p in by["default"]] != [p["mu_s"] for p in by["rim 32"]]
