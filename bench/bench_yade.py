@@ -342,7 +342,7 @@ def parallel(work, n_runs, t_max, n_noop=40):
 
     from pipeline.campaign.dask_client import close_dask, local_cluster
     from pipeline.campaign.dask_worker import run_task
-    from pipeline.campaign.executor import WORKER_CODE
+    from pipeline.campaign.dask_worker import WORKER_CODE
     from pipeline.files import code_hash
     out = {"runs": n_runs, "t_max_s": t_max, "executor": "dask",
            "load_average_before": os.getloadavg()[0]}

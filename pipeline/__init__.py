@@ -11,3 +11,5 @@ PROJECT_ROOT = Path(__file__).resolve().parent.parent
 RECORDS_DIR = PROJECT_ROOT / "records"
 RESULTS_DIR = PROJECT_ROOT / "results"
 YADE_SCRIPTS_DIR = PROJECT_ROOT / "yade_scripts"
+# the last line after Ctrl-C (exit status 130), whenever it comes
+INTERRUPTED = "interrupted: finished results are kept"

@@ -5,7 +5,7 @@ status 130 (after finished results are written)."""
 import os
 import sys
 
-INTERRUPTED = "interrupted: finished results are kept"
+from pipeline import INTERRUPTED
 
 
 def console():

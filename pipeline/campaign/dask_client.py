@@ -9,11 +9,13 @@ import threading
 import uuid
 from pathlib import Path
 
-from pipeline.campaign.dask_worker import kill_task_processes, run_task
-from pipeline.campaign.executor import (CLOSE_TIMEOUT_S, CONNECT_TIMEOUT_S, TASK_PREFIX,
-                                        WORKER_CODE, RunError, _finished, _write_error)
+from pipeline.campaign.dask_worker import TASK_PREFIX, WORKER_CODE, kill_task_processes, run_task
+from pipeline.campaign.run_dirs import RunError, book_finished, write_error
 from pipeline.files import DirectoryLock, ToolError, atomic_path, code_hash
 from pipeline.scenario.runner import end_served_processes
+
+CONNECT_TIMEOUT_S = 10          # reaching an existing Dask scheduler (s)
+CLOSE_TIMEOUT_S = 1.0           # closing the local cluster after Ctrl-C
 
 
 def execute_dask(todo, runs_dir, jobs, worker, bar, scheduler):
@@ -46,7 +48,7 @@ def execute_dask(todo, runs_dir, jobs, worker, bar, scheduler):
                 try:
                     motion = _motion_future(client, motions, spec["motion_file"], token)
                 except OSError as exc:
-                    _finished(spec, exc, runs_dir, failures, bar)
+                    book_finished(spec, exc, runs_dir, failures, bar)
                     return
             future = client.submit(run_task, worker, spec, motion,
                                    str(runs_dir / spec["run_id"]), code, token,
@@ -117,18 +119,18 @@ def _store_result(spec, future, result, runs_dir, failures, bar):
             exc = result
         else:
             exc = RunError(f"the Dask task ended as {future.status}")
-        _finished(spec, exc, runs_dir, failures, bar)
+        book_finished(spec, exc, runs_dir, failures, bar)
         return
     try:
         write_run_files(run_dir, result["files"], clear=result["error"] is None)
         if result["error"] is not None:
-            _write_error(run_dir, None, result["error"])
+            write_error(run_dir, None, result["error"])
     except (OSError, ToolError) as exc:
-        _finished(spec, exc, runs_dir, failures, bar)
+        book_finished(spec, exc, runs_dir, failures, bar)
         return
     exc = None if result["error"] is None else RunError(
         f"{result['message']} (on {result['host']})")
-    _finished(spec, exc, runs_dir, failures, bar)
+    book_finished(spec, exc, runs_dir, failures, bar)
 
 
 def write_run_files(run_dir, files, clear=True):

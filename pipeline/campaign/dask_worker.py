@@ -9,9 +9,14 @@ import tempfile
 import traceback
 from pathlib import Path
 
-from pipeline.campaign.executor import TASK_PREFIX, WORKER_CODE
 from pipeline.files import ToolError, code_hash
 from pipeline.scenario.runner import reuse_processes
+from pipeline.simulate import RUN_CODE
+
+TASK_PREFIX = "toppling"        # Dask keys and worker temporary directories
+# The model code (what turns a motion and parameters into an outcome, as in the run ids):
+# a worker whose imported copy differs from the client's files refuses the task.
+WORKER_CODE = RUN_CODE
 
 
 @functools.lru_cache(maxsize=1)

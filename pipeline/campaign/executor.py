@@ -24,31 +24,19 @@ local cluster and returns what finished; the caller writes its tables and
 exits 130.
 """
 import os
-import shutil
-import traceback
 from concurrent.futures import FIRST_COMPLETED, ThreadPoolExecutor, wait
 from pathlib import Path
 
 from tqdm import tqdm
 
-from pipeline.files import DirectoryLock, InputError, ToolError, write_text
+from pipeline.campaign.dask_client import execute_dask
+from pipeline.campaign.run_dirs import book_finished, keep_only_summary
+from pipeline.files import DirectoryLock, InputError
 from pipeline.motion import Motion
 from pipeline.scenario.runner import kill_running, reuse_processes
-from pipeline.simulate import RUN_CODE
 
 EXECUTORS = ("threads", "dask")
 DEFAULT_EXECUTOR = "threads"    # why: docs/campaigns.md, "On a cluster: Dask" (start-up, ports)
-CONNECT_TIMEOUT_S = 10          # reaching an existing Dask scheduler (s)
-CLOSE_TIMEOUT_S = 1.0           # closing the local cluster after Ctrl-C
-TASK_PREFIX = "toppling"        # Dask keys and worker temporary directories
-# The model code (what turns a motion and parameters into an outcome, as in the run ids):
-# a worker whose imported copy differs from the client's files refuses the task.
-WORKER_CODE = RUN_CODE
-
-
-class RunError(ToolError):
-    """A run failed on a Dask worker; the message is the worker's, with this
-    machine's run directory in place of the worker's temporary one."""
 
 
 def execute(specs, campaign_dir, jobs, worker, label="runs", executor=None, scheduler=None):
@@ -83,7 +71,6 @@ def execute(specs, campaign_dir, jobs, worker, label="runs", executor=None, sche
         if executor == "threads":
             with reuse_processes():        # one YADE process per thread, not per run
                 return _execute_threads(todo, runs_dir, jobs, worker, bar)
-        from pipeline.campaign.dask_client import execute_dask
         return execute_dask(todo, runs_dir, jobs, worker, bar, scheduler)
     finally:
         bar.close()
@@ -107,16 +94,6 @@ def motion_seconds(spec, durations):
     return durations[path]
 
 
-def _finished(spec, exc, runs_dir, failures, bar):
-    """Book one finished run: a failure gets error.txt and a line above the bar."""
-    if exc is not None:
-        failures.append((spec, exc))
-        if not isinstance(exc, RunError):          # a RunError's error.txt is written
-            _write_error(runs_dir / spec["run_id"], exc)
-        tqdm.write(f"run {spec['run_id']} ({spec.get('record')}) failed: {exc}")
-    bar.update()
-
-
 # ---------------------------------------------------------------- threads
 def _execute_threads(todo, runs_dir, jobs, worker, bar):
     failures = []
@@ -128,7 +105,7 @@ def _execute_threads(todo, runs_dir, jobs, worker, bar):
         while pending:
             finished, pending = wait(pending, timeout=0.5, return_when=FIRST_COMPLETED)
             for future in finished:
-                _finished(futures[future], future.exception(), runs_dir, failures, bar)
+                book_finished(futures[future], future.exception(), runs_dir, failures, bar)
     except BaseException as exc:                   # Ctrl-C, or no room for error.txt
         for future in pending:
             future.cancel()
@@ -151,19 +128,4 @@ def _guarded(worker, spec, run_dir):
         (run_dir / "error.txt").unlink(missing_ok=True)
         worker(spec, run_dir)
         if not spec.get("keep_trajectory", True):
-            _keep_only_summary(run_dir)
-
-
-def _keep_only_summary(run_dir):
-    for path in Path(run_dir).iterdir():
-        if path.name in ("summary.json", ".lock"):
-            continue
-        if path.is_dir() and not path.is_symlink():
-            shutil.rmtree(path)
-        else:
-            path.unlink()
-
-
-def _write_error(run_dir, exc, text=None):
-    run_dir.mkdir(parents=True, exist_ok=True)
-    write_text(run_dir / "error.txt", text or "".join(traceback.format_exception(exc)))
+            keep_only_summary(run_dir)

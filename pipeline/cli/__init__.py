@@ -12,6 +12,7 @@ import importlib
 import pkgutil
 import sys
 
+from pipeline import INTERRUPTED
 from pipeline.files import InputError, ToolError
 
 
@@ -65,7 +66,6 @@ def main(argv=None):
         print(f"error: {exc}", file=sys.stderr)
         return 1
     except KeyboardInterrupt:
-        from pipeline.__main__ import INTERRUPTED
         print(INTERRUPTED, file=sys.stderr)
         return 130
     except OSError as exc:

@@ -100,8 +100,9 @@ def plot_pooled(members, pooled, out_dir):
             d = angle_difference_deg(sub.loc[t, "downfall_azimuth_deg"].to_numpy(float),
                                      sub.loc[t, "back_azimuth_deg"].to_numpy(float))
             d = np.atleast_1d(d)
-            diffs += list(d)
-            weights += [1.0 / d.size] * d.size
+            if d.size:                                  # a record's falls share its weight
+                diffs += list(d)
+                weights += [1.0 / d.size] * d.size
         p = np.asarray(p)
         left.errorbar(p, y + 0.2 * (k - 0.5), xerr=[p - np.asarray(lo), np.asarray(hi) - p],
                       fmt=COLUMN_MARKERS.get(name, "o"), color=colour, ms=4, lw=0.8,

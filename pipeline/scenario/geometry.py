@@ -45,6 +45,7 @@ import numpy as np
 
 from pipeline.constants import MODEL_GRAVITY
 from pipeline.files import InputError
+from pipeline.scenario.mesh import MESH_SUFFIXES, MeshSpecimen
 from pipeline.scenario.outline import Outline, _edge_distances, contact_outline, perimeter_points
 from pipeline.userfiles import MAX_INT_DIGITS, MAX_NESTING, read_text
 from pipeline.userfiles import Unreadable as _Unreadable
@@ -53,7 +54,6 @@ from pipeline.userfiles import keys_text as _keys
 from pipeline.userfiles import nesting as _nesting
 from pipeline.userfiles import show as _show
 
-MESH_SUFFIXES = (".obj", ".ply", ".stl")   # pipeline.scenario.mesh reads these
 SHAPES = ("frustum", "box")
 TILT_MODES = ("wedge", "edge")
 EXAMPLES_DIR = Path(__file__).with_name("columns")
@@ -246,7 +246,6 @@ class ColumnGeometry:
         except (OSError, ValueError):              # a name too long, a NUL byte
             found = False
         if found and path.suffix.lower() in MESH_SUFFIXES:
-            from pipeline.scenario.mesh import MeshSpecimen
             return MeshSpecimen.load(path)
         if not found:
             known = ", ".join(example_names())
@@ -276,7 +275,6 @@ class ColumnGeometry:
         except _Unreadable as exc:
             raise InputError(f"{path}: not a readable column description ({exc})") from None
         if isinstance(data, dict) and "mesh" in data:     # a mesh specimen's description
-            from pipeline.scenario.mesh import MeshSpecimen
             return MeshSpecimen.from_dict(data, where=path.name, base=path.resolve().parent)
         return cls.from_dict(data, where=str(path.name))
 
@@ -285,7 +283,6 @@ class ColumnGeometry:
         """Validate a description dict; InputError with one line naming the problem.
         A dict with a "mesh" key describes a mesh specimen (:mod:`pipeline.scenario.mesh`)."""
         if isinstance(data, dict) and "mesh" in data:
-            from pipeline.scenario.mesh import MeshSpecimen
             return MeshSpecimen.from_dict(data, where=where)
         if not isinstance(data, dict):
             raise InputError(f"{where}: expected a JSON object with name, density, blocks")

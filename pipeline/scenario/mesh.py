@@ -36,8 +36,10 @@ import numpy as np
 
 from pipeline.constants import MODEL_GRAVITY
 from pipeline.files import InputError
-from pipeline.scenario.geometry import MESH_SUFFIXES, perimeter_points
+from pipeline.scenario.outline import perimeter_points
 from pipeline.userfiles import keys_text, show
+
+MESH_SUFFIXES = (".obj", ".ply", ".stl")   # the mesh files trimesh reads here
 
 MAX_MESH_BYTES = 200_000_000
 DEFAULT_DENSITY = 2650.0          # kg/m^3, granite

@@ -15,7 +15,7 @@ import pytest
 
 from pipeline import cli
 from pipeline.campaign.dask_worker import run_task, worker_code_version
-from pipeline.campaign.executor import TASK_PREFIX
+from pipeline.campaign.dask_worker import TASK_PREFIX
 from pipeline.motion import Motion
 from pipeline.motion.pulses import one_sine_pulse
 

@@ -90,3 +90,15 @@ def test_holm_by_hand():
     # sorted 0.005 <= 0.05/4, 0.01 <= 0.05/3, then 0.03 > 0.05/2: stop
     assert holm_reject([0.01, 0.04, 0.03, None, 0.005]) == [True, False, False, None, True]
     assert holm_reject([None]) == [None]
+
+
+def test_the_pooled_figure_takes_records_where_nothing_fell(tmp_path):
+    from pipeline.figures.ensemble import plot_pooled
+    rows = [{"record_id": r, "member": m, "column": c, "toppled": r == "A" and m == 0,
+             "back_azimuth_deg": 10.0, "downfall_azimuth_deg": 40.0 if r == "A" and m == 0
+             else np.nan} for r in ("A", "B", "C") for m in (-1, 0, 1)
+            for c in ("drums", "monolithic")]
+    runs = pd.DataFrame(rows)
+    pooled = pooled_summary(runs, resamples=50)
+    assert pooled["columns"][0]["records_with_falls"] == 1
+    assert plot_pooled(runs, pooled, tmp_path).exists()

@@ -21,13 +21,13 @@ disp in m/s^2, m/s, m, columns East, North, Up, and a JSON meta) under
 ``results/synthetics/<source>/<site_id>.npz``, cached by a content hash of
 every generator parameter.
 """
-from pipeline.motion.synthetics.compute import (DEFAULT_OUT_DIR, QUICK_DURATION_S,
-                                                 QUICK_FMAX_HZ, QUICK_OUT_DIR, band_limited_motion,
-                                                 generate, generate_sources, moment_tensor_xyz,
-                                                 numerics,
-                                                 point_source_displacement, site_table)
+from pipeline.motion.synthetics.compute import (band_limited_motion, generate, generate_sources,
+                                                 moment_tensor_xyz, numerics,
+                                                 point_source_displacement)
 from pipeline.motion.synthetics.gmm import (GMM_VS30_M_S, gmm_check, gmm_summary, rotd50,
                                             rupture_distances, write_gmm_summary)
+from pipeline.motion.synthetics.sites import (DEFAULT_OUT_DIR, QUICK_DURATION_S, QUICK_FMAX_HZ,
+                                               QUICK_OUT_DIR, site_table)
 from pipeline.motion.synthetics.sources import (CRUST_LAYERS, LEAD_TIME_S, SOURCES,
                                                 moment_from_mw, rupture_centre,
                                                 source_parameters, subevents)

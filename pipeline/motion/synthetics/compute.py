@@ -9,24 +9,21 @@ from multiprocessing import Pool
 from pathlib import Path
 
 import numpy as np
-import pandas as pd
 import pyprop8
 from pyprop8.utils import clp_filter, make_moment_tensor, rtf2xyz, stf_trapezoidal
 from threadpoolctl import threadpool_limits
 from tqdm import tqdm
 
-from pipeline import RESULTS_DIR, files
+from pipeline import files
 from pipeline.files import InputError, die_with_parent
 from pipeline.motion import Motion
+from pipeline.motion.synthetics.gmm import gmm_check, write_gmm_summary
+from pipeline.motion.synthetics.sites import settings, site_table
 from pipeline.motion.synthetics.sources import (CRUST_LAYERS, LEAD_TIME_S, source_parameters,
                                                 subevents)
 
 GENERATOR_VERSION = 2  # bump when the written motions change
 PYPROP8_VERSION = importlib.metadata.version("pyprop8")
-DEFAULT_OUT_DIR = RESULTS_DIR / "synthetics"
-QUICK_OUT_DIR = RESULTS_DIR / "synthetics-quick"
-QUICK_FMAX_HZ = 2.5
-QUICK_DURATION_S = 20.0
 
 
 def numerics(duration_s, sampling_hz, fmax_hz, layers=CRUST_LAYERS):
@@ -118,43 +115,6 @@ def band_limited_motion(disp, dt, upsample):
     return out_acc, out_vel, out_disp
 
 
-def _settings(rings_km, azimuth_step_deg, duration_s, sampling_hz, fmax_hz, out_dir, quick):
-    if quick:
-        fmax_hz = min(fmax_hz, QUICK_FMAX_HZ)
-        duration_s = min(duration_s, QUICK_DURATION_S)
-    rings = tuple(float(r) for r in rings_km)
-    if not rings or min(rings) <= 0 or not 0 < azimuth_step_deg <= 360:
-        raise InputError(f"impossible site rings {rings_km} km / azimuth step {azimuth_step_deg}")
-    base = Path(out_dir) if out_dir is not None else (QUICK_OUT_DIR if quick else DEFAULT_OUT_DIR)
-    return {"rings_km": rings, "azimuth_step_deg": float(azimuth_step_deg),
-            "duration_s": float(duration_s), "sampling_hz": float(sampling_hz),
-            "fmax_hz": float(fmax_hz), "base": base}
-
-
-def site_table(source_name, rings_km=(5, 10, 20), azimuth_step_deg=30, out_dir=None,
-               quick=False):
-    """Sites on rings around the epicentre of ``source_name``.
-
-    Columns: site_id, x_km, y_km (East, North of the epicentre), ring_km,
-    site_azimuth_deg (epicentre to site), back_azimuth_deg (site to
-    epicentre), distance_km (epicentral), npz (path of the motion file).
-    """
-    source_parameters(source_name)
-    cfg = _settings(rings_km, azimuth_step_deg, 1.0, 100.0, 1.0, out_dir, quick)
-    azimuths = np.arange(0.0, 360.0 - 1e-9, cfg["azimuth_step_deg"])
-    rows = []
-    for ring in cfg["rings_km"]:
-        for az in azimuths:
-            x, y = ring * math.sin(math.radians(az)), ring * math.cos(math.radians(az))
-            site_id = f"r{ring:02g}_az{az:03g}"
-            rows.append({"site_id": site_id, "x_km": x, "y_km": y, "ring_km": ring,
-                         "site_azimuth_deg": float(az),
-                         "back_azimuth_deg": (float(az) + 180.0) % 360.0,
-                         "distance_km": math.hypot(x, y),
-                         "npz": cfg["base"] / source_name / f"{site_id}.npz"})
-    return pd.DataFrame(rows)
-
-
 def _cache_key(source_name, cfg, num):
     params = {k: v for k, v in cfg.items() if k != "base"}
     return files.content_hash(GENERATOR_VERSION, source_name, source_parameters(source_name),
@@ -184,8 +144,7 @@ def generate_sources(source_names, rings_km=(5, 10, 20), azimuth_step_deg=30, du
     sub-events of every source to compute share one pool of ``jobs`` processes (two
     sources of five sub-events on 2 cores: five rounds of pyprop8 calls instead of six);
     each source's motions are the same as computed alone."""
-    from pipeline.motion.synthetics.gmm import write_gmm_summary
-    cfg = _settings(rings_km, azimuth_step_deg, duration_s, sampling_hz, fmax_hz, out_dir, quick)
+    cfg = settings(rings_km, azimuth_step_deg, duration_s, sampling_hz, fmax_hz, out_dir, quick)
     num = numerics(cfg["duration_s"], cfg["sampling_hz"], cfg["fmax_hz"])
     plans, tasks = {}, []
     for name in source_names:
@@ -251,7 +210,6 @@ def _write_source(name, plan, total, cfg, num, elapsed, jobs):
 
 
 def _write_gmm_check(source_name, cfg):
-    from pipeline.motion.synthetics.gmm import gmm_check
     files.write_csv(cfg["base"] / source_name / "gmm_check_sites.csv",
                     gmm_check([source_name], cfg["rings_km"], cfg["azimuth_step_deg"], cfg["base"]))
 

@@ -8,7 +8,7 @@ import pandas as pd
 from pipeline import files
 from pipeline.constants import STANDARD_GRAVITY
 from pipeline.motion import Motion
-from pipeline.motion.synthetics.compute import site_table
+from pipeline.motion.synthetics.sites import site_table
 from pipeline.motion.synthetics.sources import SOURCES, source_parameters, subevents
 
 GMM_VS30_M_S = 760.0  # reference rock for the ground-motion-model check

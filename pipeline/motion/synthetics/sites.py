@@ -1,0 +1,53 @@
+"""Sites on rings around a synthetic source's epicentre, and the generator's settings
+(rings, azimuth step, duration, sampling, band, where the motions are written)."""
+import math
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from pipeline import RESULTS_DIR
+from pipeline.files import InputError
+from pipeline.motion.synthetics.sources import source_parameters
+
+DEFAULT_OUT_DIR = RESULTS_DIR / "synthetics"
+QUICK_OUT_DIR = RESULTS_DIR / "synthetics-quick"
+QUICK_FMAX_HZ = 2.5
+QUICK_DURATION_S = 20.0
+
+
+def settings(rings_km, azimuth_step_deg, duration_s, sampling_hz, fmax_hz, out_dir, quick):
+    if quick:
+        fmax_hz = min(fmax_hz, QUICK_FMAX_HZ)
+        duration_s = min(duration_s, QUICK_DURATION_S)
+    rings = tuple(float(r) for r in rings_km)
+    if not rings or min(rings) <= 0 or not 0 < azimuth_step_deg <= 360:
+        raise InputError(f"impossible site rings {rings_km} km / azimuth step {azimuth_step_deg}")
+    base = Path(out_dir) if out_dir is not None else (QUICK_OUT_DIR if quick else DEFAULT_OUT_DIR)
+    return {"rings_km": rings, "azimuth_step_deg": float(azimuth_step_deg),
+            "duration_s": float(duration_s), "sampling_hz": float(sampling_hz),
+            "fmax_hz": float(fmax_hz), "base": base}
+
+
+def site_table(source_name, rings_km=(5, 10, 20), azimuth_step_deg=30, out_dir=None,
+               quick=False):
+    """Sites on rings around the epicentre of ``source_name``.
+
+    Columns: site_id, x_km, y_km (East, North of the epicentre), ring_km,
+    site_azimuth_deg (epicentre to site), back_azimuth_deg (site to
+    epicentre), distance_km (epicentral), npz (path of the motion file).
+    """
+    source_parameters(source_name)
+    cfg = settings(rings_km, azimuth_step_deg, 1.0, 100.0, 1.0, out_dir, quick)
+    azimuths = np.arange(0.0, 360.0 - 1e-9, cfg["azimuth_step_deg"])
+    rows = []
+    for ring in cfg["rings_km"]:
+        for az in azimuths:
+            x, y = ring * math.sin(math.radians(az)), ring * math.cos(math.radians(az))
+            site_id = f"r{ring:02g}_az{az:03g}"
+            rows.append({"site_id": site_id, "x_km": x, "y_km": y, "ring_km": ring,
+                         "site_azimuth_deg": float(az),
+                         "back_azimuth_deg": (float(az) + 180.0) % 360.0,
+                         "distance_km": math.hypot(x, y),
+                         "npz": cfg["base"] / source_name / f"{site_id}.npz"})
+    return pd.DataFrame(rows)
