@@ -286,7 +286,12 @@ def ensemble_outputs(specs, campaign_dir, failures, animations, figures=True):
                 from pipeline.figures.ensemble import plot_pooled
                 written.append(plot_pooled(runs, pooled, campaign_dir))
             for col in pooled["columns"]:
-                print(f"over {pooled['records']} records, {col['column']}: {col['answer']}")
+                st = col["statistics"]
+                errors = ", ".join(f"{name} +-{st[name]['mc_error']:.2f}" for name in
+                                   ("p_toppled", "polarity", "radial_alignment")
+                                   if st[name]["mc_error"] is not None)
+                print(f"over {pooled['records']} records, {col['column']}: {col['answer']} "
+                      f"(Monte Carlo error: {errors})")
     return {"code_version": run_code_version(), **described,
             "figures": [str(Path(p).relative_to(campaign_dir)) for p in written]}
 

@@ -74,6 +74,11 @@ def setup(p):
                    "machine ran 'demo'); the options below override it")
     p.add_argument("--demo", action="store_true",
                    help="synthetic truth tests and the paper's scenario (make invert-demo)")
+    p.add_argument("--member-study", action="store_true",
+                   help="truth tests at 3, 6, 12, 24 and 48 likelihood members per node "
+                   "(observed columns from 16 members no likelihood uses): how many fallen "
+                   "columns bound the back azimuth, the epicentre and the magnitude (default "
+                   "--grid study: 2,304 runs; make invert-study)")
     p.add_argument("--scheduler", default=None, metavar="ADDRESS",
                    help="run the forward campaign on an existing Dask cluster")
     p.add_argument("--jobs", type=int, default=None,
@@ -143,6 +148,7 @@ def setup(p):
 
 
 CANDIDATE_PRESETS = {"quick": {"radius_km": 12.0, "step_km": 1.0, "strike_step_deg": 90.0},
+                     "study": {"radius_km": 15.0, "step_km": 1.0, "strike_step_deg": 30.0},
                      "demo": {"radius_km": 25.0, "step_km": 1.0, "strike_step_deg": 30.0},
                      "full": {"radius_km": 30.0, "step_km": 1.0, "strike_step_deg": 30.0}}
 
@@ -154,7 +160,8 @@ def build_grids(args):
     from pipeline.inversion.posterior import CandidateGrid
     if args.quick and args.grid not in (None, "quick"):
         raise InputError("--quick is --grid quick: give one of them")
-    preset = "quick" if args.quick else (args.grid or "full")
+    preset = "quick" if args.quick else (
+        args.grid or ("study" if getattr(args, "member_study", False) else "full"))
     mechanisms = parse_mechanisms(args.mechanisms) if args.mechanisms else None
     depths = _floats("depths")(args.depths) if args.depths else None
     magnitudes = _floats("magnitudes")(args.magnitudes) if args.magnitudes else None
@@ -262,16 +269,19 @@ def forward_table(args, grid, sibling_of=None):
 def run(args):
     from pipeline.inversion import run_inversion
     from pipeline.inversion.observations import load_observations
-    if args.demo == (args.observations is not None):
-        raise InputError("give an OBSERVATIONS.json file or --demo (not both)")
-    if args.trials is not None and not (args.demo and 1 <= args.trials <= 1000):
-        raise InputError("--trials (1-1000) goes with --demo")
+    if args.demo + args.member_study + (args.observations is not None) != 1:
+        raise InputError("give one of an OBSERVATIONS.json file, --demo or --member-study")
+    if args.trials is not None and not ((args.demo or args.member_study)
+                                        and 1 <= args.trials <= 1000):
+        raise InputError("--trials (1-1000) goes with --demo or --member-study")
     from pipeline.inversion.likelihood import check_model_options
     check_model_options(args.kernel_deg, args.floor, getattr(args, "likelihood", "independent"))
     _check_jobs(args.jobs)
     preset, grid, candidates = build_grids(args)
     if args.demo:
         return _run_demo(args, preset, grid, candidates)
+    if args.member_study:
+        return _run_member_study(args, grid, candidates)
     observations = load_observations(args.observations)
     described = described_columns(observations, args.observations.parent)
     out = args.out or RESULTS_DIR / "inversion" / args.observations.stem
@@ -365,3 +375,47 @@ def _run_demo(args, preset, grid, candidates):
                "at the most columns tried)"))
     print(f"wrote {out / 'demo_summary.json'} ({summary['elapsed_s']:.0f} s)")
     return 0
+
+
+def _run_member_study(args, grid, candidates):
+    """invert --member-study: the forward table (run, reused or --table), then the study's
+    truth tests; writes member_study.csv (one row per trial), member_study_summary.csv,
+    member_study.json (the answer per likelihood) and member_study.png."""
+    from pipeline.files import write_csv, write_json
+    from pipeline.figures.inversion import plot_member_study
+    from pipeline.inversion.study import (LIKELIHOOD_MEMBERS, OBSERVATION_MEMBERS,
+                                          STUDY_TRIALS, member_study, study_answer,
+                                          study_summary)
+    out = args.out or RESULTS_DIR / "inversion" / "member-study"
+    if out.exists() and not out.is_dir():
+        raise InputError(f"--out {out} is a file, not a directory")
+    started = time.monotonic()
+    table, info = forward_table(args, grid)
+    trials = STUDY_TRIALS if args.trials is None else args.trials
+
+    def progress(kind, size, n_sites, fallen):
+        print(f"  {kind}, {size} members, {n_sites} site(s) x {fallen} fallen: done",
+              flush=True)
+
+    rows = member_study(table, candidates, trials=trials, kernel_deg=args.kernel_deg,
+                        floor=args.floor, progress=progress)
+    if rows.empty:
+        raise InputError("no column of the observed members ever fell: nothing to test "
+                         "(a grid with stronger shaking: closer rings, higher Mw)")
+    summary = study_summary(rows)
+    answer = study_answer(summary)
+    write_csv(out / "member_study.csv", rows)
+    write_csv(out / "member_study_summary.csv", summary)
+    figure = plot_member_study(summary, out / "member_study.png")
+    write_json(out / "member_study.json", {
+        "answer": answer, "likelihood_members": sorted(summary["likelihood_members"].unique()
+                                                       .tolist()),
+        "requested_likelihood_members": list(LIKELIHOOD_MEMBERS),
+        "observation_members": OBSERVATION_MEMBERS, "trials": trials,
+        "forward_table": info, "figure": figure.name,
+        "elapsed_s": round(time.monotonic() - started, 1)})
+    for text in answer.values():
+        print(text)
+    print(f"wrote {out} ({time.monotonic() - started:.0f} s)")
+    return 0
+

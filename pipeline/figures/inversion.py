@@ -190,3 +190,46 @@ def plot_interval_widths(table, path):
     fig.tight_layout()
     save_figure(fig, path, dpi=120, bbox_inches="tight")
     return path
+
+
+def plot_member_study(summary, path):
+    """The member study: per likelihood (rows) the median 95 % back-azimuth arc and its
+    coverage (with Wilson intervals) against the likelihood members per node; colour: fallen
+    columns per site, line style: sites."""
+    kinds = sorted(summary["likelihood"].unique())
+    fig, axes = new_figure(len(kinds), 2, figsize=(12, 4.2 * len(kinds)), squeeze=False)
+    fallen = sorted(summary["fallen_per_site"].unique())
+    styles = {1: "-", 3: "--"}
+    for row, kind in zip(axes, kinds):
+        width_ax, cover_ax = row
+        g = summary[summary["likelihood"] == kind]
+        for (sites, k), h in g.groupby(["sites", "fallen_per_site"]):
+            h = h.sort_values("likelihood_members")
+            style = dict(color=f"C{fallen.index(k)}", ls=styles.get(sites, ":"),
+                         marker="o", ms=4, label=f"{sites} site(s) x {k} fallen")
+            width_ax.plot(h["likelihood_members"], h["width_median_deg"], **style)
+            lo = [c[0] for c in h["coverage_ci95"]]
+            hi = [c[1] for c in h["coverage_ci95"]]
+            cover_ax.plot(h["likelihood_members"], h["coverage_back_azimuth_95"], **style)
+            cover_ax.fill_between(h["likelihood_members"], lo, hi, color=style["color"],
+                                  alpha=0.08)
+        width_ax.axhline(60.0, color="k", lw=1, ls=":", label="+-30 deg")
+        cover_ax.axhline(0.95, color="k", lw=1, ls=":", label="95 %")
+        for ax in row:
+            ax.set_xscale("log", base=2)
+            ax.set_xticks(sorted(g["likelihood_members"].unique()),
+                          [str(v) for v in sorted(g["likelihood_members"].unique())])
+            ax.set_xlabel("likelihood members per node")
+            ax.grid(alpha=0.3)
+        width_ax.set_ylabel("median width of the 95 % back-azimuth arc (deg)")
+        width_ax.set_ylim(0, 365)
+        cover_ax.set_ylabel("coverage of the 95 % arc (Wilson 95 %)")
+        cover_ax.set_ylim(0, 1.02)
+        width_ax.set_title(f"{kind} likelihood: arc width", fontsize=10)
+        cover_ax.set_title(f"{kind} likelihood: coverage", fontsize=10)
+        width_ax.legend(fontsize=7, ncol=2)
+    fig.suptitle("How many fallen columns bound the back azimuth? (truth tests, observed "
+                 "columns from members no likelihood uses)", fontsize=11)
+    fig.tight_layout()
+    save_figure(fig, path, dpi=110)
+    return path

@@ -16,7 +16,7 @@ from pipeline.report.campaigns import (columns_section, convergence_section, ens
                                        fragility_section, paper_question_section,
                                        shake_table_section, speed_section, sweep_section,
                                        verification_section)
-from pipeline.report.inversion import inversion_section
+from pipeline.report.inversion import inversion_section, member_study_section
 from pipeline.report.records import (back_azimuth_table, correlation_table, per_record_table,
                                      processing_section, record_orientation, records_section,
                                      records_statements, synthetic_section, toppled_fractions,
@@ -25,7 +25,8 @@ from pipeline.stats.ensemble import wilson_interval
 
 __all__ = ["build_report", "back_azimuth_table", "columns_section", "convergence_section",
            "correlation_table", "paper_question_section",
-           "ensemble_section", "fragility_section", "inversion_section", "per_record_table",
+           "ensemble_section", "fragility_section", "inversion_section",
+           "member_study_section", "per_record_table",
            "processing_section", "record_orientation", "records_section", "records_statements",
            "shake_table_section", "speed_section", "sweep_section", "synthetic_section",
            "toppled_fractions", "verification_section", "wilson_interval", "with_back_azimuth"]
@@ -58,7 +59,7 @@ def build_report(results=RESULTS_DIR):
         shake_table_section(results),
         paper_question_section(results), ensemble_section(results),
         convergence_section(results), fragility_section(results), columns_section(results),
-        inversion_section(results),
+        inversion_section(results), member_study_section(results),
         records_section(results), processing_section(results), synthetic_section(results),
         speed_section(results)]
     text = "\n".join(head + body)

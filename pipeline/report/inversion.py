@@ -166,3 +166,40 @@ def _inversion_findings(demo, narrow):
             "likelihood lets a site's columns inform each other and stays calibrated.  Where "
             "the two disagree, the ensemble, not the number of columns, limits what the falls "
             "can tell.")
+
+
+def member_study_section(results):
+    """How many fallen columns bound the source (invert --member-study, make invert-study):
+    the answer per likelihood, the table at the largest likelihood size and the figure."""
+    base = Path(results) / "inversion" / "member-study"
+    title = "## How many fallen columns bound the earthquake's direction?\n"
+    path = base / "member_study.json"
+    if not path.exists():
+        return title + ("\nNot run yet (`make invert-study`: truth tests at 3-48 likelihood "
+                        "members per node, 2,304 YADE runs).\n")
+    study = json.loads(path.read_text())
+    summary = pd.read_csv(base / "member_study_summary.csv")
+    grid = (study.get("forward_table") or {}).get("grid") or {}
+    lines = [title, f"Truth tests on a forward table of {grid.get('members', '?')} members per "
+             f"node ({', '.join(m[0] for m in grid.get('mechanisms', []))}; Mw "
+             f"{', '.join(f'{v:g}' for v in grid.get('magnitudes', []))}; rings "
+             f"{', '.join(f'{v:g}' for v in grid.get('distances_km', []))} km every "
+             f"{_fmt(grid.get('azimuth_step_deg'))} deg): the observed columns come from the "
+             f"last {study['observation_members']} members, which no likelihood uses; the "
+             f"likelihood from the first {', '.join(map(str, study['likelihood_members']))}; "
+             f"{study['trials']} trials per configuration, the same draws for every size.\n"]
+    lines += [f"- {text}." for text in study["answer"].values()]
+    largest = summary[summary["likelihood_members"] == summary["likelihood_members"].max()]
+    table = largest[["likelihood", "sites", "fallen_per_site", "trials",
+                     "coverage_back_azimuth_95", "width_median_deg", "coverage_epicentre_95",
+                     "credible_area_95_km2_median", "coverage_mw_95"]].rename(columns={
+                         "fallen_per_site": "fallen per site",
+                         "coverage_back_azimuth_95": "back-azimuth coverage",
+                         "width_median_deg": "median 95 % arc (deg)",
+                         "coverage_epicentre_95": "epicentre coverage",
+                         "credible_area_95_km2_median": "median 95 % area (km^2)",
+                         "coverage_mw_95": "Mw coverage"})
+    lines += ["", f"At {int(summary['likelihood_members'].max())} likelihood members per node:",
+              "", _table(table.round(2)) + "\n",
+              _figure(results, base / "member_study.png", "member study")]
+    return "\n".join(lines)

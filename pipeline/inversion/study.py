@@ -1,0 +1,184 @@
+"""How many fallen columns bound the earthquake's direction?  The member study.
+
+The demo's truth tests (:mod:`pipeline.inversion.demo`) use half of a few members per node
+for the likelihood, so they cannot tell whether the physics or the forward table keeps the
+direction unknown.  Here the table's members are split once: the last
+``observation_members`` are the "observed" columns, never used by a likelihood; the
+likelihood takes the first L members, for every L of ``likelihood_members`` that fits.
+A trial draws a table slice (mechanism, depth, magnitude) and a strike at random, S sites
+at nodes where the observation members fall, and K fallen columns per site (the standing
+ones drawn on the way are observed too), as the demo does; each (likelihood, L, S, K) is
+inverted ``trials`` times with the same draws (seeded by S, K and the trial, not by L), so
+that a change with L is the likelihood's alone.
+
+Per configuration: coverage of the 95 % back-azimuth arc (with its Wilson interval: a
+coverage is calibrated when the interval holds 0.95), its median width, the share of arcs
+within +-30 deg, the coverage and median size of the epicentre's 95 % credible area, and
+the magnitude's: whether the true Mw lies in the smallest set of table magnitudes holding
+95 % of the posterior, and the posterior probability of the true Mw.
+"""
+import math
+
+import numpy as np
+import pandas as pd
+
+from pipeline.inversion.demo import BOUND_DEG, FALLEN_PER_SITE, SITE_COUNTS, _frame, \
+    _site_position, draw_site_columns
+from pipeline.inversion.likelihood import DEFAULT_FLOOR, DEFAULT_KERNEL_DEG, LIKELIHOODS, \
+    ForwardModel
+from pipeline.inversion.posterior import in_arc, invert
+from pipeline.stats.ensemble import wilson_interval
+
+LIKELIHOOD_MEMBERS = (3, 6, 12, 24, 48)
+OBSERVATION_MEMBERS = 16
+STUDY_TRIALS = 20
+STUDY_SEED = 2027
+
+
+def split_for_study(table, observation_members=OBSERVATION_MEMBERS):
+    """(members the likelihoods may use: all but the last ``observation_members``, the
+    observation pool: those last members)."""
+    order = np.sort(table.members)
+    if not 1 <= observation_members < order.size:
+        from pipeline.files import InputError
+        raise InputError(f"the member study needs more than {observation_members} members "
+                         f"per node (the table has {order.size})")
+    pool = np.isin(table.members, order[-observation_members:])
+    return table.select_members(~pool), table.select_members(pool)
+
+
+def magnitude_set(posterior, level=0.95):
+    """The smallest set of magnitudes (strings as in the summary) holding ``level`` of the
+    magnitude posterior ({"6.5": p, ...})."""
+    chosen, total = [], 0.0
+    for mw, p in sorted(posterior.items(), key=lambda kv: -kv[1]):
+        chosen.append(mw)
+        total += p
+        if total >= level - 1e-12:
+            break
+    return chosen
+
+
+def study_trial(model, pool, n_sites, fallen, candidates, rng):
+    """One truth test of the study: a dict, or None when no node of the drawn slice ever
+    shows a fall in the observation pool."""
+    table = model.table
+    s = int(rng.integers(len(table.slices)))
+    strike = float(rng.choice(candidates.strikes_deg))
+    nodes = [(i, j) for i in range(len(table.distances_km))
+             for j in range(len(table.azimuths_deg)) if pool.toppled[s, i, j].any()]
+    if not nodes:
+        return None
+    picks = rng.choice(len(nodes), size=min(n_sites, len(nodes)), replace=False)
+    sites = []
+    for k, pick in enumerate(picks):
+        i, j = nodes[pick]
+        e, n = _site_position(table.distances_km[i], (table.azimuths_deg[j] + strike) % 360.0)
+        sites.append((f"S{k + 1}", e, n, draw_site_columns(pool, s, i, j, strike, fallen, rng)))
+    observations, truth = _frame(sites)
+    post = invert(model, observations, candidates)
+    summary = post.summary()
+    true_baz = math.degrees(math.atan2(truth[0], truth[1])) % 360.0
+    true_mw = f"{table.slices[s]['mw']:g}"
+    return {"slice": s, "mechanism": table.slices[s]["mechanism"], "true_mw": float(true_mw),
+            "sites": len(sites), "fallen_per_site": fallen, "strike_deg": strike,
+            "true_back_azimuth_deg": true_baz,
+            "standing_observed": sum(not c.fallen for *_, cols in sites for c in cols),
+            "back_azimuth_in_95": in_arc(true_baz, summary["back_azimuth_ci95_deg"]),
+            "width95_deg": summary["back_azimuth_ci95_width_deg"],
+            "epicentre_in_95": post.contains(*truth, level=0.95),
+            "credible_area_95_km2": summary["credible_area_95_km2"],
+            "mw_in_95": true_mw in magnitude_set(summary["magnitude_posterior"]),
+            "p_true_mw": summary["magnitude_posterior"].get(true_mw, 0.0),
+            "p_true_mechanism": summary["mechanism_posterior"].get(
+                table.slices[s]["mechanism"], 0.0)}
+
+
+def member_study(table, candidates, likelihood_members=LIKELIHOOD_MEMBERS,
+                 observation_members=OBSERVATION_MEMBERS, trials=STUDY_TRIALS,
+                 kernel_deg=DEFAULT_KERNEL_DEG, floor=DEFAULT_FLOOR, likelihoods=LIKELIHOODS,
+                 fallen_per_site=FALLEN_PER_SITE, site_counts=SITE_COUNTS, seed=STUDY_SEED,
+                 progress=None):
+    """Every trial of every (likelihood, L, S, K): a DataFrame, one row per trial (see the
+    module docstring).  L values above the members the likelihoods may use are left out."""
+    usable, pool = split_for_study(table, observation_members)
+    sizes = [n for n in likelihood_members if n <= usable.members.size]
+    if not sizes:
+        from pipeline.files import InputError
+        raise InputError(f"the table's {usable.members.size} likelihood members are fewer "
+                         f"than the smallest study size {min(likelihood_members)}")
+    order = np.sort(usable.members)
+    rows = []
+    for kind in likelihoods:
+        for size in sizes:
+            model = ForwardModel(usable.select_members(np.isin(usable.members, order[:size])),
+                                 kernel_deg, floor, kind)
+            for n_sites in site_counts:
+                for fallen in fallen_per_site:
+                    for trial in range(trials):
+                        rng = np.random.default_rng([seed, n_sites, fallen, trial])
+                        row = study_trial(model, pool, n_sites, fallen, candidates, rng)
+                        if row is not None:
+                            rows.append({"likelihood": kind, "likelihood_members": size,
+                                         **row, "trial": trial})
+                    if progress:
+                        progress(kind, size, n_sites, fallen)
+    return pd.DataFrame(rows)
+
+
+def study_summary(trials):
+    """Per (likelihood, L, S, K): coverages with Wilson intervals, widths, areas, Mw."""
+    rows = []
+    keys = ["likelihood", "likelihood_members", "sites", "fallen_per_site"]
+    for key, g in trials.groupby(keys):
+        n = len(g)
+        hit = int(g["back_azimuth_in_95"].sum())
+        ci = wilson_interval(hit, n)
+        rows.append({**dict(zip(keys, key)), "fallen_total": key[2] * key[3], "trials": n,
+                     "coverage_back_azimuth_95": hit / n, "coverage_ci95": ci,
+                     "calibrated": bool(ci[0] <= 0.95 <= ci[1]),
+                     "width_median_deg": float(g["width95_deg"].median()),
+                     "bounded_30_fraction": float((g["width95_deg"] <= BOUND_DEG).mean()),
+                     "coverage_epicentre_95": float(g["epicentre_in_95"].mean()),
+                     "credible_area_95_km2_median": float(g["credible_area_95_km2"].median()),
+                     "coverage_mw_95": float(g["mw_in_95"].mean()),
+                     "p_true_mw_median": float(g["p_true_mw"].median()),
+                     "p_true_mechanism_median": float(g["p_true_mechanism"].median())})
+    return pd.DataFrame(rows)
+
+
+def study_answer(summary):
+    """The sentence per likelihood at its largest L: the fewest columns (S sites x K fallen
+    per site) whose median 95 % arc is within +-30 deg with calibrated coverage, or what
+    the largest configuration reaches instead."""
+    out = {}
+    for kind, g in summary.groupby("likelihood"):
+        size = int(g["likelihood_members"].max())
+        at = g[g["likelihood_members"] == size].sort_values(["fallen_total", "sites"])
+        ok = at[(at["width_median_deg"] <= BOUND_DEG) & at["calibrated"]]
+        smallest = g[g["likelihood_members"] == g["likelihood_members"].min()]
+        big = at.iloc[-1]
+        trend = smallest[(smallest["sites"] == big["sites"])
+                         & (smallest["fallen_per_site"] == big["fallen_per_site"])]
+        if not ok.empty:
+            first = ok.iloc[0]
+            text = (f"{kind} likelihood, {size} members per node: {int(first['sites'])} site(s) "
+                    f"with {int(first['fallen_per_site'])} fallen column(s) each bound the back "
+                    f"azimuth to +-30 deg (median 95 % arc {first['width_median_deg']:.0f} deg, "
+                    f"coverage {first['coverage_back_azimuth_95']:.2f} "
+                    f"[{first['coverage_ci95'][0]:.2f}, {first['coverage_ci95'][1]:.2f}])")
+        else:
+            text = (f"{kind} likelihood, {size} members per node: no tested configuration "
+                    f"bounds the back azimuth to +-30 deg with calibrated coverage (the most "
+                    f"columns: coverage {big['coverage_back_azimuth_95']:.2f})")
+        text += (f"; with the most columns tested ({int(big['sites'])} site(s) x "
+                 f"{int(big['fallen_per_site'])} fallen) the median arc is "
+                 f"{big['width_median_deg']:.0f} deg")
+        if not trend.empty and int(trend.iloc[0]["likelihood_members"]) != size:
+            text += (f" ({trend.iloc[0]['width_median_deg']:.0f} deg with "
+                     f"{int(trend.iloc[0]['likelihood_members'])} members)")
+        text += (f", the epicentre's 95 % area {big['credible_area_95_km2_median']:.0f} km^2 "
+                 f"(coverage {big['coverage_epicentre_95']:.2f}) and the true magnitude lies "
+                 f"in the 95 % set in {big['coverage_mw_95']:.2f} of the trials")
+        out[kind] = text
+    return out

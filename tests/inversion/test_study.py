@@ -1,0 +1,61 @@
+"""The member study on toy tables: observations never from likelihood members, the same
+draws for every likelihood size, and a sharper direction density narrowing the arcs."""
+import numpy as np
+
+from pipeline.inversion.posterior import CandidateGrid
+from pipeline.inversion.study import (magnitude_set, member_study, split_for_study,
+                                      study_answer, study_summary)
+
+
+def test_observations_come_from_members_no_likelihood_uses(make_away_table):
+    table = make_away_table(members=20)
+    usable, pool = split_for_study(table, observation_members=6)
+    assert list(pool.members) == list(range(14, 20))
+    assert not set(usable.members) & set(pool.members)
+
+
+def test_more_likelihood_members_narrow_the_arc_on_the_same_draws(make_away_table):
+    table = make_away_table(members=40, scatter_deg=25.0, p_fall=(1.0, 0.8, 0.6, 0.4))
+    grid = CandidateGrid(radius_km=22, step_km=1.5, strike_step_deg=30)
+    trials = member_study(table, grid, likelihood_members=(3, 24, 48), observation_members=16,
+                          trials=4, likelihoods=("independent",), fallen_per_site=(1, 10),
+                          site_counts=(1,))
+    assert sorted(trials["likelihood_members"].unique()) == [3, 24]     # 48 does not fit
+    a = trials[trials["likelihood_members"] == 3].set_index(["fallen_per_site", "trial"])
+    b = trials[trials["likelihood_members"] == 24].set_index(["fallen_per_site", "trial"])
+    for key in ("strike_deg", "true_back_azimuth_deg", "standing_observed", "slice"):
+        assert (a[key] == b[key]).all()                  # the draws do not depend on L
+    summary = study_summary(trials)
+    ten = summary[summary["fallen_per_site"] == 10].set_index("likelihood_members")
+    assert ten.loc[24, "width_median_deg"] < ten.loc[3, "width_median_deg"]
+    assert np.allclose(summary["p_true_mw_median"], 1.0)   # one magnitude in the table
+    answer = study_answer(summary)
+    assert set(answer) == {"independent"} and "24 members per node" in answer["independent"]
+
+
+def test_the_magnitude_set_holds_95_percent():
+    assert magnitude_set({"6": 0.5, "6.5": 0.46, "7": 0.04}) == ["6", "6.5"]
+    assert magnitude_set({"6": 0.96, "7": 0.04}) == ["6"]
+
+
+def test_member_study_command_on_a_table_file(make_away_table, tmp_path, capsys):
+    """invert --member-study --table FILE: no YADE, the four files, the answer printed."""
+    import json
+
+    from pipeline import cli
+    table = make_away_table(members=24, scatter_deg=20.0, p_fall=(1.0, 0.8, 0.6, 0.4))
+    path = tmp_path / "forward_table_toy.npz"
+    table.save(path)
+    out = tmp_path / "inversion" / "member-study"
+    assert cli.main(["invert", "--member-study", "--table", str(path), "--out", str(out),
+                     "--trials", "2", "--radius", "22", "--step", "2"]) == 0
+    for name in ("member_study.csv", "member_study_summary.csv", "member_study.png"):
+        assert (out / name).stat().st_size > 0
+    result = json.loads((out / "member_study.json").read_text())
+    assert result["likelihood_members"] == [3, 6]          # 24 - 16 observed: 8 usable
+    assert set(result["answer"]) == {"independent", "predictive"}
+    assert "members per node" in capsys.readouterr().out
+    assert cli.main(["invert", "--member-study", "--demo"]) == 2
+    from pipeline.report import member_study_section
+    section = member_study_section(tmp_path)
+    assert result["answer"]["predictive"] in section and "member_study.png" in section
