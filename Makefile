@@ -34,17 +34,30 @@ records: setup
 # was reduced; make paper-question, make invert-demo and campaign fragility give them
 # in full).  The ensembles' nominal runs are the records campaign's (copied, not rerun).
 PAPER_BATCH ?= 1
-campaigns: records
-	$(PY) -m pipeline campaign verification --jobs $(JOBS)
-	$(PY) -m pipeline campaign slenderness --jobs $(JOBS)
-	$(PY) -m pipeline campaign friction --jobs $(JOBS)
-	$(PY) -m pipeline campaign records --jobs $(JOBS)
-	$(PY) -m pipeline campaign synthetic --jobs $(JOBS)
-	$(PY) -m pipeline campaign ensemble --set nearsource --out results/paper-question \
-	  --members $(PAPER_BATCH) --max-members $(PAPER_BATCH) --animations 0 --jobs $(JOBS)
-	$(PY) -m pipeline campaign columns --jobs $(JOBS)
-	$(PY) -m pipeline campaign fragility --levels 1,2,4,8 --members 1 --jobs $(JOBS)
-	$(PY) -m pipeline invert --demo --quick --jobs $(JOBS)
+FRAGILITY_LEVELS := 1,2,4,8
+STEP_TIMES := results/run-all-steps.tsv
+# $(call timed,NAME,COMMAND): run COMMAND, append NAME and its wall seconds to STEP_TIMES
+define timed
+@s=$$(date +%s.%N); $(2); rc=$$?; e=$$(date +%s.%N); \
+  awk -v n='$(1)' -v s=$$s -v e=$$e -v rc=$$rc 'BEGIN{printf "%s\t%.1f\t%d\n", n, e - s, rc}' \
+  >> $(STEP_TIMES); exit $$rc
+endef
+
+campaigns: setup
+	@mkdir -p results && printf 'step\twall_s\texit\n' > $(STEP_TIMES)
+	$(call timed,records,$(PY) -m pipeline records --all)
+	$(call timed,verification,$(PY) -m pipeline campaign verification --jobs $(JOBS))
+	$(call timed,slenderness,$(PY) -m pipeline campaign slenderness --jobs $(JOBS))
+	$(call timed,friction,$(PY) -m pipeline campaign friction --jobs $(JOBS))
+	$(call timed,records campaign,$(PY) -m pipeline campaign records --jobs $(JOBS))
+	$(call timed,synthetic,$(PY) -m pipeline campaign synthetic --jobs $(JOBS))
+	$(call timed,paper question (reduced),$(PY) -m pipeline campaign ensemble --set nearsource \
+	  --out results/paper-question --members $(PAPER_BATCH) --max-members $(PAPER_BATCH) \
+	  --animations 0 --jobs $(JOBS))
+	$(call timed,real columns,$(PY) -m pipeline campaign columns --jobs $(JOBS))
+	$(call timed,fragility (reduced),$(PY) -m pipeline campaign fragility \
+	  --levels $(FRAGILITY_LEVELS) --members 1 --jobs $(JOBS))
+	$(call timed,inversion demo (quick),$(PY) -m pipeline invert --demo --quick --jobs $(JOBS))
 
 run-all: campaigns
 	$(PY) -m pipeline report

@@ -13,7 +13,7 @@ from pathlib import Path
 from pipeline import RESULTS_DIR, __version__
 from pipeline.files import write_text
 from pipeline.report.campaigns import (columns_section, convergence_section, ensemble_section,
-                                       fragility_section, paper_question_section,
+                                       fragility_section, paper_question_section, run_all_section,
                                        shake_table_section, speed_section, sweep_section,
                                        verification_section)
 from pipeline.report.inversion import inversion_section, member_study_section
@@ -27,7 +27,7 @@ __all__ = ["build_report", "back_azimuth_table", "columns_section", "convergence
            "correlation_table", "paper_question_section",
            "ensemble_section", "fragility_section", "inversion_section",
            "member_study_section", "per_record_table",
-           "processing_section", "record_orientation", "records_section", "records_statements",
+           "processing_section", "record_orientation", "records_section", "records_statements", "run_all_section",
            "shake_table_section", "speed_section", "sweep_section", "synthetic_section",
            "toppled_fractions", "verification_section", "wilson_interval", "with_back_azimuth"]
 
@@ -61,7 +61,7 @@ def build_report(results=RESULTS_DIR):
         convergence_section(results), fragility_section(results), columns_section(results),
         inversion_section(results), member_study_section(results),
         records_section(results), processing_section(results), synthetic_section(results),
-        speed_section(results)]
+        speed_section(results), run_all_section(results)]
     text = "\n".join(head + body)
     write_text(results / "REPORT.md", text)
     return results / "REPORT.md"

@@ -281,3 +281,24 @@ def convergence_section(results):
              _figure(results, Path(results) / "convergence" / "convergence.png",
                      "convergence on distributions")]
     return "\n".join(lines)
+
+
+def run_all_section(results):
+    """What the last `make run-all` cost: its steps' wall times (results/run-all-steps.tsv,
+    written by the Makefile), including what was reduced to fit."""
+    path = Path(results) / "run-all-steps.tsv"
+    frame = _read_csv(path) if path.exists() else None
+    if frame is None:
+        return ""
+    frame = pd.read_csv(path, sep="\t")
+    total = float(frame["wall_s"].sum())
+    frame["wall (min)"] = (frame["wall_s"] / 60).round(1)
+    return ("## What this run-all cost\n\n"
+            f"Wall time of the last `make run-all`'s steps on this machine (from "
+            f"`{path.relative_to(results)}`): {total / 60:.1f} min in all, the venv and the "
+            "report not counted.  Reduced in size: the paper's question (one member per "
+            "record beside the nominal run; `make paper-question` sizes every record by its "
+            "error), fragility (4 levels, one member; `campaign fragility`: 8 x 4) and the "
+            "inversion (the quick grid; `make invert-demo`, `make invert-study`).  Runs "
+            "finished earlier are reused, so a second run-all costs far less.\n\n"
+            + _table(frame[["step", "wall (min)", "exit"]]) + "\n")
