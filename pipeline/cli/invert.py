@@ -2,6 +2,8 @@
 
     python -m pipeline invert OBSERVATIONS.json [--out DIR] [--quick] [--scheduler ADDRESS]
     python -m pipeline invert --demo [--grid demo]          # make invert-demo
+    python -m pipeline invert --member-study                # make invert-study
+    python -m pipeline invert --hidden-truth TRUTH.json --table FILE
 """
 import math
 import os
@@ -74,6 +76,11 @@ def setup(p):
                    "machine ran 'demo'); the options below override it")
     p.add_argument("--demo", action="store_true",
                    help="synthetic truth tests and the paper's scenario (make invert-demo)")
+    p.add_argument("--hidden-truth", type=Path, default=None, metavar="TRUTH.json",
+                   help="a hidden-truth test: the source you choose, twin models simulated "
+                   "at your sites (members no table uses), inverted with the forward table; "
+                   "writes observations.json and the inversion with the truth checked "
+                   "(schema: docs/inversion.md)")
     p.add_argument("--member-study", action="store_true",
                    help="truth tests at 3, 6, 12, 24 and 48 likelihood members per node "
                    "(observed columns from 16 members no likelihood uses): how many fallen "
@@ -269,8 +276,10 @@ def forward_table(args, grid, sibling_of=None):
 def run(args):
     from pipeline.inversion import run_inversion
     from pipeline.inversion.observations import load_observations
-    if args.demo + args.member_study + (args.observations is not None) != 1:
-        raise InputError("give one of an OBSERVATIONS.json file, --demo or --member-study")
+    if (args.demo + args.member_study + (args.observations is not None)
+            + (args.hidden_truth is not None)) != 1:
+        raise InputError("give one of an OBSERVATIONS.json file, --demo, --member-study or "
+                         "--hidden-truth TRUTH.json")
     if args.trials is not None and not ((args.demo or args.member_study)
                                         and 1 <= args.trials <= 1000):
         raise InputError("--trials (1-1000) goes with --demo or --member-study")
@@ -282,6 +291,8 @@ def run(args):
         return _run_demo(args, preset, grid, candidates)
     if args.member_study:
         return _run_member_study(args, grid, candidates)
+    if args.hidden_truth is not None:
+        return _run_hidden_truth(args, grid, candidates)
     observations = load_observations(args.observations)
     described = described_columns(observations, args.observations.parent)
     out = args.out or RESULTS_DIR / "inversion" / args.observations.stem
@@ -416,6 +427,47 @@ def _run_member_study(args, grid, candidates):
         "elapsed_s": round(time.monotonic() - started, 1)})
     for text in answer.values():
         print(text)
+    print(f"wrote {out} ({time.monotonic() - started:.0f} s)")
+    return 0
+
+
+def _run_hidden_truth(args, grid, candidates):
+    """invert --hidden-truth: the forward table, the hidden members' runs at the truth's
+    sites (campaign inversion-truth in OUT/truth-runs), observations.json from them, and
+    the inversion with the truth marked and checked (inversion_summary.json: truth)."""
+    from pipeline.campaign import run_campaign
+    from pipeline.files import write_json
+    from pipeline.inversion import run_inversion
+    from pipeline.inversion.grid import TableGrid
+    from pipeline.inversion.observations import parse_observations
+    from pipeline.inversion.truth import check_hidden, load_truth
+    truth = load_truth(args.hidden_truth)
+    out = args.out or RESULTS_DIR / "inversion" / f"truth-{args.hidden_truth.stem}"
+    if out.exists() and not out.is_dir():
+        raise InputError(f"--out {out} is a file, not a directory")
+    started = time.monotonic()
+    table, info = forward_table(args, grid)
+    table_grid = TableGrid(**table.info["grid"]) if table.info.get("grid") else grid
+    check_hidden(truth, table_grid)
+    print(f"hidden truth: {sum(s[3] for s in truth.sites)} twin runs at "
+          f"{len(truth.sites)} site(s)", flush=True)
+    result = run_campaign("inversion-truth", jobs=_check_jobs(args.jobs),
+                          campaign_dir=out / "truth-runs", animations=0,
+                          options={"truth": truth, "grid": table_grid, "jobs": args.jobs},
+                          scheduler=args.scheduler)
+    data = {"sites": [{"name": name, "east_km": e, "north_km": n,
+                       "columns": result["sites"][name]}
+                      for name, e, n, _ in truth.sites]}
+    write_json(out / "observations.json", data)
+    observations = parse_observations(data, "observations.json")
+    summary = run_inversion(observations, out, table, candidates, args.kernel_deg, args.floor,
+                            forward_info=info, likelihood=args.likelihood,
+                            truth=truth.as_truth())
+    check = summary["truth"]["check"]
+    print(f"{observations.n_fallen} of {observations.n_columns} simulated columns fell; the "
+          f"95 % regions hold the true epicentre: {check['epicentre_in_95']}, back azimuth: "
+          f"{check['back_azimuth_in_95']}, distance: {check['distance_in_95']}, magnitude: "
+          f"{check['mw_in_95']}; MAP epicentre {check['map_epicentre_error_km']:.1f} km off")
     print(f"wrote {out} ({time.monotonic() - started:.0f} s)")
     return 0
 

@@ -194,18 +194,28 @@ def _node_name(sl, key, r, a):
     return f"{_slice_tag(sl)}_{key[:6]}_r{r:g}_t{a:05.1f}"
 
 
-def slice_motions(grid, motion_dir, jobs=None):
+def slice_motions(grid, motion_dir, jobs=None, positions=None):
     """Compute (or reuse) the node motions of every slice; {slice: [npz paths in node
     order]}.  A slice is recomputed only when its manifest's key (hash of every parameter)
-    differs or a file is missing; the pyprop8 calls of all slices share ``jobs`` processes."""
+    differs or a file is missing; the pyprop8 calls of all slices share ``jobs`` processes.
+    ``positions``: (distances km, azimuths from strike deg) of receivers instead of the
+    grid's nodes (a hidden-truth test's sites, :mod:`pipeline.inversion.truth`)."""
     from pipeline.motion.synthetics import numerics
     num = numerics(grid.duration_s, SAMPLING_HZ, grid.fmax_hz)
-    r, a, x, y = node_positions(grid)
+    if positions is None:
+        r, a, x, y = node_positions(grid)
+    else:
+        r, a = (np.asarray(v, float) for v in positions)
+        x, y = r * np.sin(np.radians(a)), r * np.cos(np.radians(a))
     out, tasks, todo = {}, [], []
     for sl in grid.slices():
         key = _slice_key(grid, sl, num)
+        if positions is not None:
+            key = content_hash(key, r.round(9).tolist(), a.round(9).tolist())
         directory = Path(motion_dir) / f"{_slice_tag(sl)}_{key}"
-        paths = [directory / f"{_node_name(sl, key, ri, ai)}.npz" for ri, ai in zip(r, a)]
+        paths = [directory / (f"{_node_name(sl, key, ri, ai)}.npz" if positions is None
+                              else f"{_slice_tag(sl)}_{key[:6]}_site{k:03d}.npz")
+                 for k, (ri, ai) in enumerate(zip(r, a))]
         out[sl] = paths
         manifest = directory / "manifest.json"
         if manifest.is_file() and all(p.is_file() for p in paths) and \

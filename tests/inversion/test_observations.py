@@ -99,7 +99,7 @@ def test_missing_file_and_option_errors(tmp_path, capsys):
     assert "observations file not found" in capsys.readouterr().err
     good = tmp_path / "good.json"
     good.write_text(json.dumps({"sites": [GOOD_SITE]}))
-    for argv, message in (([], "give an OBSERVATIONS.json file or --demo"),
+    for argv, message in (([], "give one of an OBSERVATIONS.json file, --demo"),
                           (["--radius", "-3"], "--radius must lie in"),
                           (["--quick", "--grid", "full"], "--quick is --grid quick"),
                           (["--azimuth-step", "7"], "--azimuth-step must divide 360"),
