@@ -31,7 +31,7 @@ from pipeline.inversion.likelihood import (DEFAULT_FLOOR, DEFAULT_KERNEL_DEG, LI
                                            ForwardModel)
 from pipeline.inversion.observations import ColumnObservation, Observations, Site
 from pipeline.inversion.posterior import in_arc, invert
-from pipeline.stats.circular import angle_difference_deg
+from pipeline.stats.circular import angle_difference_deg, azimuth_deg
 
 FALLEN_PER_SITE = (1, 3, 10, 30)
 SITE_COUNTS = (1, 3)
@@ -106,7 +106,7 @@ def truth_trial(model, pool, mechanism, n_sites, fallen, candidates, rng):
     observations, truth = _frame(sites)
     post = invert(model, observations, candidates)
     summary = post.summary()
-    true_baz = math.degrees(math.atan2(truth[0], truth[1])) % 360.0
+    true_baz = azimuth_deg(truth[0], truth[1])
     map_error = angle_difference_deg(summary["back_azimuth_map_deg"], true_baz)
     d = math.hypot(*truth)
     lo, hi = summary["distance_ci95_km"]
@@ -272,7 +272,7 @@ def paper_scenario(model, obs_table, source_name, candidates):
     observations, truth = _frame(all_sites)
     joint = invert(model, observations, candidates)
     js = joint.summary()
-    true_baz = math.degrees(math.atan2(*truth)) % 360.0
+    true_baz = azimuth_deg(*truth)
     joint_row = {"source": source_name, "sites": len(all_sites),
                  "fallen": observations.n_fallen, "columns": observations.n_columns,
                  "epicentre_error_km": math.hypot(js["map_epicentre_km"][0] - truth[0],

@@ -24,6 +24,7 @@ import pandas as pd
 from scipy.special import logsumexp
 
 from pipeline.files import InputError
+from pipeline.stats.circular import azimuth_deg
 
 BAZ_BIN_DEG = 2.0
 SUBGRID = 5
@@ -153,7 +154,7 @@ class Posterior:
     def back_azimuth_marginal(self):
         """(bin centres deg, mass) of the azimuth from the first site to the epicentre."""
         e, n, mass = self._subsamples()
-        baz = np.mod(np.degrees(np.arctan2(e, n)), 360.0)
+        baz = azimuth_deg(e, n)
         edges = np.arange(0.0, 360.0 + BAZ_BIN_DEG / 2, BAZ_BIN_DEG)
         hist, _ = np.histogram(baz, bins=edges, weights=mass)
         return edges[:-1] + BAZ_BIN_DEG / 2, hist / hist.sum()
@@ -260,7 +261,7 @@ class Posterior:
             "strike_deg": self.strikes_deg[f_idx],
             "east_km": np.round(east, 6), "north_km": np.round(north, 6),
             "distance_km": np.round(np.hypot(east, north), 6),
-            "back_azimuth_deg": np.round(np.mod(np.degrees(np.arctan2(east, north)), 360.0), 4),
+            "back_azimuth_deg": np.round(azimuth_deg(east, north), 4),
             "log_prior": self.log_prior.ravel() if self.log_prior.size == s_idx.size else
             np.broadcast_to(self.log_prior, self.probability.shape).ravel(),
             "log_likelihood": self.log_likelihood.ravel(),

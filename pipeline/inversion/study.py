@@ -17,7 +17,6 @@ within +-30 deg, the coverage and median size of the epicentre's 95 % credible a
 the magnitude's: whether the true Mw lies in the smallest set of table magnitudes holding
 95 % of the posterior, and the posterior probability of the true Mw.
 """
-import math
 
 import numpy as np
 import pandas as pd
@@ -27,6 +26,7 @@ from pipeline.inversion.demo import BOUND_DEG, FALLEN_PER_SITE, SITE_COUNTS, _fr
 from pipeline.inversion.likelihood import DEFAULT_FLOOR, DEFAULT_KERNEL_DEG, LIKELIHOODS, \
     ForwardModel
 from pipeline.inversion.posterior import in_arc, invert
+from pipeline.stats.circular import azimuth_deg
 from pipeline.stats.ensemble import wilson_interval
 
 LIKELIHOOD_MEMBERS = (3, 6, 12, 24, 48)
@@ -78,7 +78,7 @@ def study_trial(model, pool, n_sites, fallen, candidates, rng):
     observations, truth = _frame(sites)
     post = invert(model, observations, candidates)
     summary = post.summary()
-    true_baz = math.degrees(math.atan2(truth[0], truth[1])) % 360.0
+    true_baz = azimuth_deg(truth[0], truth[1])
     true_mw = f"{table.slices[s]['mw']:g}"
     return {"slice": s, "mechanism": table.slices[s]["mechanism"], "true_mw": float(true_mw),
             "sites": len(sites), "fallen_per_site": fallen, "strike_deg": strike,

@@ -30,8 +30,9 @@ import numpy as np
 from pipeline.campaign import Campaign, register
 from pipeline.campaign.definitions import column_specs, run_column_spec
 from pipeline.campaign.tables import collect
-from pipeline.files import InputError, write_json
+from pipeline.files import InputError
 from pipeline.inversion.grid import MECHANISMS, slice_motions
+from pipeline.stats.circular import azimuth_deg
 from pipeline.userfiles import read_text
 from pipeline.userfiles import keys_text as _keys
 
@@ -64,8 +65,7 @@ class HiddenTruth:
         """(distances km, azimuths from the strike deg) of the sites from the epicentre."""
         de = np.array([s[1] - self.east_km for s in self.sites])
         dn = np.array([s[2] - self.north_km for s in self.sites])
-        azimuth = np.degrees(np.arctan2(de, dn))
-        return np.hypot(de, dn), np.mod(azimuth - self.strike_deg, 360.0)
+        return np.hypot(de, dn), np.mod(azimuth_deg(de, dn) - self.strike_deg, 360.0)
 
     def as_truth(self):
         """What the inversion should find, in its frame (km East/North of the first site;
@@ -73,7 +73,7 @@ class HiddenTruth:
         e = self.east_km - self.sites[0][1]
         n = self.north_km - self.sites[0][2]
         return {"epicentre_km": [e, n], "distance_km": math.hypot(e, n),
-                "back_azimuth_deg": math.degrees(math.atan2(e, n)) % 360.0,
+                "back_azimuth_deg": azimuth_deg(e, n),
                 "mechanism": self.mechanism, "strike_deg": self.strike_deg,
                 "depth_km": self.depth_km, "mw": self.mw}
 

@@ -33,6 +33,13 @@ def wrap_deg(angle_deg, period=360.0):
     return out if out.ndim else float(out)
 
 
+def azimuth_deg(east, north):
+    """Azimuth (deg clockwise from North, in [0, 360)) of the vector (east, north); arrays
+    element-wise, a float for scalars."""
+    out = np.mod(np.degrees(np.arctan2(east, north)), 360.0)
+    return out if np.ndim(out) else float(out)
+
+
 def angle_difference_deg(a, b):
     """Angle a - b (deg) wrapped into (-180, 180]; NaN stays NaN."""
     return wrap_deg(np.asarray(a, dtype=float) - np.asarray(b, dtype=float))

@@ -48,3 +48,10 @@ def test_direction_statistics_sees_the_imposed_alignment(runs_table):
     assert abs(row["axial_mean_difference_deg"]) < 15
 
 
+
+
+def test_azimuth_of_a_vector_clockwise_from_north():
+    from pipeline.stats.circular import azimuth_deg
+    assert azimuth_deg(0.0, 1.0) == 0.0 and azimuth_deg(1.0, 0.0) == 90.0
+    assert azimuth_deg(0.0, -2.0) == 180.0 and azimuth_deg(-1.0, 0.0) == 270.0
+    assert np.allclose(azimuth_deg(np.array([1.0, -1.0]), np.array([1.0, 1.0])), [45.0, 315.0])
