@@ -104,7 +104,8 @@ def run_campaign(name, jobs=None, records=None, campaign_dir=None, animations=1,
 def reuse_finished(specs, campaign_dir, worker):
     """Copy into ``campaign_dir/runs`` the unfinished specs' runs that a campaign beside it
     (a directory of the same parent with a campaign.json of a campaign with the same
-    worker) has finished: the run id hashes the motion, the parameters and the model code,
+    worker) has finished (campaigns run this for directories inside results/, where the
+    project's campaigns live; one elsewhere, e.g. ``--out /data/x``, runs everything): the run id hashes the motion, the parameters and the model code,
     so a run computed once is not computed again.  A spec that keeps its trajectory takes
     only a run that kept one.  Returns how many runs were copied."""
     import json
@@ -152,7 +153,8 @@ def _run_specs(campaign, name, specs, campaign_dir, jobs, animations, executor, 
     """Execute the specs and write the campaign's outputs (see :func:`run_campaign`)."""
     from pipeline.campaign.executor import execute
     with DirectoryLock(campaign_dir, wait=False):
-        reused = reuse_finished(specs, campaign_dir, campaign.worker)
+        inside = RESULTS_DIR.resolve() in Path(campaign_dir).resolve().parents
+        reused = reuse_finished(specs, campaign_dir, campaign.worker) if inside else 0
         if reused:
             print(f"{Path(campaign_dir).name}: {reused} run(s) copied from campaigns beside it "
                   "(same run id: same motion, parameters and model code)", flush=True)
