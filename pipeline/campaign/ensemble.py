@@ -267,7 +267,6 @@ def ensemble_outputs(specs, campaign_dir, failures, animations, figures=True):
                                        if sp["record_id"] == record_id)
         if described:
             summary["column_file"] = described["column_file"]["name"]
-        write_json(out / "ensemble_summary.json", summary)
         summaries.append(summary)
         if figures:
             written += plot_ensemble(sub, summary, out)
@@ -277,8 +276,8 @@ def ensemble_outputs(specs, campaign_dir, failures, animations, figures=True):
                   f"[{col['p_toppled_ci95'][0]:.2f}, {col['p_toppled_ci95'][1]:.2f}]"
                   + ("" if az is None else f", mean downfall {az:.0f} deg "
                      f"(R {col['resultant_length']:.2f})"))
+    write_summaries(campaign_dir, summaries)
     if len(records) > 1:
-        write_json(campaign_dir / "ensemble_summaries.json", summaries)
         pooled = pooled_summary(runs)
         if pooled is not None:
             write_json(campaign_dir / POOLED_FILE, pooled)
@@ -465,18 +464,43 @@ def members_needed(summary, precision, batch, cap, arc_deg=None):
     return need
 
 
+def write_summaries(campaign_dir, summaries):
+    """Each record's ensemble_summary.json (in ``campaign_dir``, or its record's folder when
+    there are several) and, for several records, ensemble_summaries.json with all."""
+    campaign_dir = Path(campaign_dir)
+    for summary in summaries:
+        out = campaign_dir if len(summaries) == 1 else campaign_dir / summary["record"]
+        write_json(out / "ensemble_summary.json", summary)
+    if len(summaries) > 1:
+        write_json(campaign_dir / "ensemble_summaries.json", summaries)
+
+
+def written_summaries(campaign_dir, n_records):
+    """The summaries :func:`write_summaries` wrote for a campaign of ``n_records`` records."""
+    import json
+    campaign_dir = Path(campaign_dir)
+    path = campaign_dir / ("ensemble_summaries.json" if n_records > 1 else
+                           "ensemble_summary.json")
+    if not path.exists():
+        return []
+    data = json.loads(path.read_text())
+    return data if n_records > 1 else [data]
+
+
 def run_sized(run, records, campaign_dir, options):
     """Add members in Latin-hypercube batches of ``options["members"]`` to the records not
     yet converged (:func:`converged`) until all are or ``max_members`` is reached; each
     record's ensemble_summary.json gets ``sizing`` (target, members, why it stopped).
-    ``run(options)`` runs the campaign once and returns its outputs dict."""
+    ``run(options)`` runs the campaign once (its outputs write the summaries, read back
+    here with :func:`written_summaries`) and returns its outputs dict."""
     batch, cap = options["members"], options["max_members"]
     precision, arc = options["precision"], options["arc_deg"]
     counts = {rec: min(batch, cap) for rec in records}
     while True:
         result = run({**options, "batch": batch, "record_members": dict(counts)})
+        summaries = written_summaries(campaign_dir, len(counts))
         pending = {}
-        for summary in result.get("summaries", []):
+        for summary in summaries:
             rec = summary["record_input"]
             ok, why = converged(summary, precision, arc)
             if not ok and counts[rec] < cap:
@@ -488,18 +512,12 @@ def run_sized(run, records, campaign_dir, options):
         if not pending:
             break
         for rec, why in pending.items():
-            summary = next(x for x in result["summaries"] if x["record_input"] == rec)
+            summary = next(x for x in summaries if x["record_input"] == rec)
             more = members_needed(summary, precision, batch, cap, arc) - counts[rec]
             print(f"{rec}: {why} after {counts[rec]} members: adding {more}", flush=True)
             counts[rec] += more
-    for summary in result.get("summaries", []):
-        out = Path(campaign_dir)
-        if len(result["summaries"]) > 1:
-            out = out / summary["record"]
-        write_json(out / "ensemble_summary.json", summary)
-    if len(result.get("summaries", [])) > 1:
-        write_json(Path(campaign_dir) / "ensemble_summaries.json", result["summaries"])
-    return result
+    write_summaries(campaign_dir, summaries)
+    return {**result, "summaries": summaries}
 
 
 def ensemble_options(parser):

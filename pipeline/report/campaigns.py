@@ -222,13 +222,21 @@ def paper_question_section(results):
         if summaries.exists() else []
     capped = sum(1 for s in sizing if s and s.get("stopped_by") == "member cap")
     precision = next((s["precision"] for s in sizing if s), None)
+    fixed = bool(sizing) and all(s and s["max_members"] == s["batch"] for s in sizing)
     size = (f"{sizes[0]}" if len(sizes) == 1 else f"{sizes[0]}-{sizes[-1]}")
+    plural = "" if size == "1" else "s"
+    if fixed:
+        how = ("; a fixed ensemble, run-all's reduced size (`make paper-question` sizes every "
+               "record's ensemble by its error)")
+    elif precision is not None:
+        how = (f"; members were added until P(toppled)'s 95 % interval was within "
+               f"+-{precision:g} ({capped} of {len(sizing)} records stopped by the member "
+               "cap instead)")
+    else:
+        how = ""
     lines = [title, f"{pooled['question']}  {pooled['records']} near-source records with a back "
-             f"azimuth, {size} members per record (plus the nominal run, left out)"
-             + ("" if precision is None else
-                f"; members were added until P(toppled)'s 95 % interval was within "
-                f"+-{precision:g} ({capped} of {len(sizing)} records stopped by the member "
-                "cap instead)") + ".  Every record weighs alike; the 95 % intervals are a "
+             f"azimuth, {size} member{plural} per record (plus the nominal run, left out)"
+             + how + ".  Every record weighs alike; the 95 % intervals are a "
              "two-stage bootstrap (records drawn again, then their members), so they hold both "
              "the choice of records and the ensembles' Monte Carlo error (MC error: the "
              "bootstrap's standard deviation).  In brackets: the value of falls that ignore "

@@ -46,7 +46,8 @@ def test_strong_pulse_topples_every_member_away_from_the_push(tmp_path, capsys):
     record = _motion(tmp_path / "pulse.npz", 30.0, 8.0)
     out = tmp_path / "ens"
     assert cli.main(["campaign", "ensemble", "--record", str(record), "--members", "4",
-                     "--out", str(out), "--jobs", "2", "--animations", "0"]) == 0
+                     "--max-members", "4", "--out", str(out), "--jobs", "2",
+                     "--animations", "0"]) == 0
     summary = json.loads((out / "ensemble_summary.json").read_text())
     assert summary["members"] == 4 and summary["back_azimuth_deg"] == 120.0
     for col in summary["columns"]:
@@ -60,15 +61,19 @@ def test_strong_pulse_topples_every_member_away_from_the_push(tmp_path, capsys):
 
 
 @pytest.mark.yade
-def test_sub_threshold_motion_never_topples(tmp_path):
+def test_sub_threshold_motion_never_topples_and_the_ensemble_grows_to_its_precision(tmp_path):
+    """Below the threshold no member can move (the pre-check runs no YADE): P = 0, and the
+    campaign itself adds a batch of 3 until the Wilson interval is within +-0.2 (0 of n:
+    upper bound 3.84 / (n + 3.84) <= 0.4 needs n >= 6)."""
     record = _motion(tmp_path / "weak.npz", 0.0, 0.3)
     out = tmp_path / "ens"
     assert cli.main(["campaign", "ensemble", "--record", str(record), "--members", "3",
-                     "--out", str(out), "--animations", "0"]) == 0
+                     "--precision", "0.2", "--out", str(out), "--animations", "0"]) == 0
     summary = json.loads((out / "ensemble_summary.json").read_text())
     for col in summary["columns"]:
         assert col["p_toppled"] == 0.0 and col["mean_downfall_azimuth_deg"] is None
-        assert col["p_toppled_ci95"][0] == 0.0
+        assert col["p_toppled_ci95"][0] == 0.0 and col["p_toppled_ci95"][1] <= 0.4
+    assert summary["members"] == 6 and summary["sizing"]["stopped_by"] == "precision"
 
 
 def fake_campaign(p_true, tmp_path):
@@ -78,6 +83,7 @@ def fake_campaign(p_true, tmp_path):
     calls = []
 
     def run(options):
+        """Writes the summaries where the campaign's outputs write them."""
         calls.append(dict(options["record_members"]))
         summaries = []
         for rec, n in options["record_members"].items():
@@ -86,7 +92,8 @@ def fake_campaign(p_true, tmp_path):
                 {"column": "drums", "members": n, "toppled": k, "p_toppled": k / n,
                  "p_toppled_ci95": wilson_interval(k, n), "mean_azimuth_ci95_deg": None,
                  "resultant_length": None}]})
-        return {"summaries": summaries}
+        ensemble.write_summaries(tmp_path, summaries)
+        return {"figures": []}
     return ensemble, run, calls
 
 

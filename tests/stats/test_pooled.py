@@ -102,3 +102,24 @@ def test_the_pooled_figure_takes_records_where_nothing_fell(tmp_path):
     pooled = pooled_summary(runs, resamples=50)
     assert pooled["columns"][0]["records_with_falls"] == 1
     assert plot_pooled(runs, pooled, tmp_path).exists()
+
+
+def test_the_report_section_says_the_size_and_the_answer(tmp_path):
+    import json
+
+    from pipeline.report import paper_question_section
+    rng = np.random.default_rng(9)
+    rows = [{"record_id": f"R{r}", "member": m, "column": c, "toppled": bool(rng.random() < .5),
+             "back_azimuth_deg": 10.0 * r, "downfall_azimuth_deg": float(rng.uniform(0, 360))}
+            for r in range(5) for m in (-1, 0) for c in ("drums", "monolithic")]
+    pooled = pooled_summary(pd.DataFrame(rows), resamples=100)
+    base = tmp_path / "paper-question"
+    base.mkdir()
+    (base / "pooled_summary.json").write_text(json.dumps(pooled))
+    sizing = {"precision": 0.1, "arc_deg": 60.0, "batch": 1, "max_members": 1, "members": 1,
+              "stopped_by": "member cap", "open": "P(toppled) +-0.4"}
+    (base / "ensemble_summaries.json").write_text(json.dumps(
+        [{"record": f"R{r}", "sizing": sizing} for r in range(5)]))
+    text = paper_question_section(tmp_path)
+    assert "1 member per record" in text and "a fixed ensemble" in text
+    assert pooled["columns"][0]["answer"] in text
