@@ -11,9 +11,10 @@ from pathlib import Path
 import numpy as np
 
 from pipeline.constants import MODEL_GRAVITY
-from pipeline.files import InputError, code_hash, write_json
+from pipeline.files import InputError, code_hash
 from pipeline.provenance import software_versions
 from pipeline.outcome.columns import summarise
+from pipeline.outcome.summary import RunSummary
 from pipeline.scenario import Column, Contact, Numerics, run_yade, scene_params, write_scenario
 
 
@@ -104,19 +105,12 @@ def geometry_parameters(column):
                             else g.name), "geometry": g.to_dict()}
 
 
-def still_outcome(columns):
-    """Per-column outcome of columns that never moved."""
-    return [{"column": c["name"], "toppled": False, "downfall_azimuth_deg": None,
-             "impact_time_s": None, "impact_point_m": None, "max_tilt_deg": 0.0,
-             "base_slip_m": 0.0, "position_m": [c["x"], c["y"]], "bodies": []}
-            for c in columns]
-
-
 def simulate(motion, out_dir, column=None, contact=None, numerics=None, window=None,
              rotate_deg=0.0, scale=1.0, back_azimuth=None, record=None, motion_file=None,
              timeout_s=None):
     """Run one scenario of ``motion`` (a processed :class:`~pipeline.motion.Motion`) and
-    write ``out_dir/summary.json`` last (atomically); return the summary dict.
+    write ``out_dir/summary.json`` last (atomically); return its
+    :class:`~pipeline.outcome.summary.RunSummary`.
 
     column, contact, numerics: parameter dataclasses (defaults: the paper's).
     """
@@ -154,21 +148,18 @@ def simulate(motion, out_dir, column=None, contact=None, numerics=None, window=N
                   "quiet_motion": numerics.quiet_motion}
     provenance = {"software": software_versions(), "motion": motion.meta.get("processing"),
                   "code": {"scenario": run_code_version(), "packages": list(RUN_CODE)}}
+    record = record or motion.record_id
     if trajectory is None:
-        summary = {"record": record or motion.record_id, "back_azimuth_deg": drive.back_azimuth,
-                   "parameters": parameters, "columns": still_outcome(params["columns"]),
-                   "simulated": False,
-                   "note": "not simulated: the horizontal acceleration stays below the uplift "
-                   "and sliding thresholds at every sample, so no body can move",
-                   "simulated_s": 0.0, "simulated_window_s": None,
-                   "motion_end_s": drive.duration, "stopped_early": False,
-                   "time_step_s": None, "wall_s": time.perf_counter() - started,
-                   "provenance": provenance}
+        summary = RunSummary.still(
+            record, params["columns"], back_azimuth_deg=drive.back_azimuth,
+            parameters=parameters,
+            note="not simulated: the horizontal acceleration stays below the uplift and "
+                 "sliding thresholds at every sample, so no body can move",
+            motion_end_s=drive.duration, wall_s=time.perf_counter() - started,
+            provenance=provenance)
     else:
-        summary = summarise(trajectory, record=record or motion.record_id,
-                            back_azimuth_deg=drive.back_azimuth, parameters=parameters,
-                            provenance=provenance)
-        if "quiet_after_s" in params:
-            summary["quiet_after_s"] = params["quiet_after_s"]
-    write_json(out_dir / "summary.json", summary)
+        summary = summarise(trajectory, record=record, back_azimuth_deg=drive.back_azimuth,
+                            parameters=parameters, provenance=provenance,
+                            quiet_after_s=params.get("quiet_after_s"))
+    summary.save(out_dir / "summary.json")
     return summary

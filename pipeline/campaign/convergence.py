@@ -24,6 +24,7 @@ from pathlib import Path
 import numpy as np
 
 from pipeline.campaign import Campaign, register
+from pipeline.campaign.run_dirs import finished_summary
 from pipeline.campaign.definitions import column_specs, run_code_version, run_column_spec
 from pipeline.campaign.ensemble import (DEFAULT_SEED, ENSEMBLE_RANGES, check_seed,
                                         sample_batches)
@@ -87,14 +88,11 @@ def convergence_outputs(specs, campaign_dir, failures, animations, figures=True)
 
 def wall_per_member(specs, campaign_dir):
     """{variant: mean wall time (s) of its finished YADE runs} from their summary.json."""
-    import json
     times = {}
     for spec in specs:
-        path = Path(campaign_dir) / "runs" / spec["run_id"] / "summary.json"
-        if path.exists():
-            wall = json.loads(path.read_text()).get("wall_s")
-            if wall is not None:
-                times.setdefault(spec["variant"], []).append(float(wall))
+        summary = finished_summary(campaign_dir, spec["run_id"])
+        if summary is not None:
+            times.setdefault(spec["variant"], []).append(summary.wall_s)
     return {name: float(np.mean(times[name])) for name in VARIANTS if name in times}
 
 

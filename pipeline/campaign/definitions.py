@@ -6,6 +6,7 @@ from pathlib import Path
 from pipeline.constants import COLUMN_KINDS
 from pipeline import RESULTS_DIR, paper
 from pipeline.campaign import Campaign, register
+from pipeline.campaign.run_dirs import finished_summary
 from pipeline.campaign.column_file import (add_campaign_options, add_column_file_argument,
                                            matched_kn,
                                            add_stiffness_argument, at_slenderness,
@@ -285,31 +286,30 @@ def columns_table(specs, campaign_dir):
     from pipeline.scenario.geometry import ColumnGeometry
     rows = []
     for spec in specs:
-        path = Path(campaign_dir) / "runs" / spec["run_id"] / "summary.json"
-        if not path.exists():
+        summary = finished_summary(campaign_dir, spec["run_id"])
+        if summary is None:
             continue
-        summary = json.loads(path.read_text())
         geometry = ColumnGeometry.from_dict(spec["params"]["column_file"])
         shapes = {"drums": geometry, "monolithic": geometry.monolithic()}
-        for col in summary["columns"]:
-            g = shapes[col["column"]]
-            struck = sorted((b for b in col["bodies"] if b["struck"]),
+        for col in summary.columns:
+            g = shapes[col.column]
+            struck = sorted((b for b in col.bodies if b["struck"]),
                             key=lambda b: b["impact_time_s"])
             first = struck[0] if struck else None
             rows.append({
                 "description": geometry.name, "record_id": spec["record_id"],
-                "column": col["column"], "toppled": col["toppled"],
-                "downfall_azimuth_deg": col["downfall_azimuth_deg"],
-                "impact_time_s": col["impact_time_s"],
+                "column": col.column, "toppled": col.toppled,
+                "downfall_azimuth_deg": col.downfall_azimuth_deg,
+                "impact_time_s": col.impact_time_s,
                 "first_to_strike": None if first is None else first.get(
                     "name", f"body {first['index']}"),
                 "first_to_strike_index": None if first is None else first["index"],
                 "struck_bodies": len(struck), "bodies": len(g.bodies()),
-                "max_tilt_deg": col["max_tilt_deg"], "base_slip_m": col["base_slip_m"],
+                "max_tilt_deg": col.max_tilt_deg, "base_slip_m": col.base_slip_m,
                 "uplift_ratio": round(g.uplift_ratio(), 4), "height_m": g.height,
                 "mass_kg": round(sum(b.mass for b in g.bodies())),
-                "kn": summary["parameters"]["kn"],
-                "back_azimuth_deg": summary["back_azimuth_deg"], "run_id": spec["run_id"]})
+                "kn": summary.parameters["kn"],
+                "back_azimuth_deg": summary.back_azimuth_deg, "run_id": spec["run_id"]})
     return pd.DataFrame(rows, columns=COLUMNS_TABLE)
 
 

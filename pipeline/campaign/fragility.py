@@ -32,7 +32,6 @@ With ``--column-file`` the members are the described column with the sampled hei
 diameter tolerances (its tilt and offsets as described, none sampled), and the 2D block
 has each member's overall height and base width (:func:`block_size`).
 """
-import json
 import math
 import time
 from pathlib import Path
@@ -42,6 +41,7 @@ import pandas as pd
 
 from pipeline import paper
 from pipeline.campaign import Campaign, register
+from pipeline.campaign.run_dirs import finished_summary
 from pipeline.campaign.column_file import (add_column_file_argument, add_stiffness_argument,
                                            check_stiffness, column_kn, mark,
                                            read_campaign_options, summary_entry)
@@ -409,8 +409,7 @@ def fragility_outputs(specs, campaign_dir, failures, animations, figures=True):
         return {"code_version": run_code_version(), **summary_entry(specs), "figures": []}
     done = set(runs["run_id"])
     blocks, cost = block_runs([s for s in specs if s["run_id"] in done])
-    wall = [json.loads((campaign_dir / "runs" / r / "summary.json").read_text()).get("wall_s")
-            for r in done]
+    wall = [finished_summary(campaign_dir, r).wall_s for r in done]
     simulated = runs.drop_duplicates("run_id")["simulated"].astype(bool)
     cost.update({"yade_runs": int(simulated.sum()), "runs_not_simulated": int((~simulated).sum()),
                  "yade_wall_s_total": round(float(sum(w or 0.0 for w in wall)), 1)})

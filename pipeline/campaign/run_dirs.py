@@ -7,6 +7,7 @@ from pathlib import Path
 from tqdm import tqdm
 
 from pipeline.files import ToolError, write_text
+from pipeline.outcome.summary import RunSummary
 
 
 class RunError(ToolError):
@@ -22,6 +23,13 @@ def book_finished(spec, exc, runs_dir, failures, bar):
             write_error(runs_dir / spec["run_id"], exc)
         tqdm.write(f"run {spec['run_id']} ({spec.get('record')}) failed: {exc}")
     bar.update()
+
+
+def finished_summary(campaign_dir, run_id):
+    """The :class:`~pipeline.outcome.summary.RunSummary` of run ``run_id`` of the campaign
+    in ``campaign_dir``; None while the run has not finished."""
+    path = Path(campaign_dir) / "runs" / run_id / "summary.json"
+    return RunSummary.load(path) if path.exists() else None
 
 
 def keep_only_summary(run_dir):

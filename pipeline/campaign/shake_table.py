@@ -17,7 +17,6 @@ F1, confusion) are reported per split beside the trivial baselines ("never overt
 figure ``shake_table_rates.png`` (observed and predicted rate per PGA x PGV/PGA bin).
 """
 import itertools
-import json
 import math
 from datetime import date
 from pathlib import Path
@@ -27,6 +26,7 @@ import pandas as pd
 
 from pipeline import RESULTS_DIR
 from pipeline.campaign import Campaign, register
+from pipeline.campaign.run_dirs import finished_summary
 from pipeline.campaign.column_file import add_column_file_argument
 from pipeline.files import InputError, write_csv, write_json
 from pipeline.records import RECORDS_DIR
@@ -166,15 +166,13 @@ def outputs(specs_, campaign_dir, failures, animations, figures=True):
     campaign_dir = Path(campaign_dir)
     rows = []
     for spec in specs_:
-        path = campaign_dir / "runs" / spec["run_id"] / "summary.json"
-        if not path.exists():
+        summary = finished_summary(campaign_dir, spec["run_id"])
+        if summary is None:
             continue
-        summary = json.loads(path.read_text())
-        column = summary["columns"][0]
+        column = summary.columns[0]
         rows.append({"test": spec["test"], "stage": spec["stage"],
                      "grid_point": spec["grid_point"], "observed": spec["observed"],
-                     "predicted": bool(column["toppled"]),
-                     "max_tilt_deg": column["max_tilt_deg"],
+                     "predicted": column.toppled, "max_tilt_deg": column.max_tilt_deg,
                      "run_id": spec["run_id"]})
     table = pd.DataFrame(rows)
     per_point = {}

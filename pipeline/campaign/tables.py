@@ -1,7 +1,6 @@
 """Campaign tables from the run summaries: runs.csv (one row per run and column) and
 impacts.csv (one row per struck body), and the same tables as Parquet (runs.parquet,
 impacts.parquet: typed columns, compressed, fast to read for large campaigns)."""
-import json
 import math
 import os
 from pathlib import Path
@@ -11,6 +10,7 @@ import pyarrow as pa
 import pyarrow.parquet  # noqa: F401  (pandas' to_parquet engine, loaded before any run)
 
 from pipeline.files import atomic_path, write_csv
+from pipeline.campaign.run_dirs import finished_summary
 from pipeline.motion import Motion
 from pipeline.motion.measures import record_parameters
 
@@ -55,10 +55,9 @@ def _tables(specs, campaign, campaign_dir):
     record_params = {}
     run_rows, impact_rows = [], []
     for spec in specs:
-        path = runs_dir / spec["run_id"] / "summary.json"
-        if not path.exists():
+        summary = finished_summary(campaign_dir, spec["run_id"])
+        if summary is None:
             continue
-        summary = json.loads(path.read_text())
         if spec["motion_file"] not in record_params:
             motion = Motion.load(spec["motion_file"])
             site = {k: motion.meta[k] for k in SYNTHETIC_SITE_KEYS if k in motion.meta}
@@ -66,28 +65,28 @@ def _tables(specs, campaign, campaign_dir):
                 site["site_id"] = site.pop("station")
             record_params[spec["motion_file"]] = {**record_parameters(motion), **site}
         rp = record_params[spec["motion_file"]]
-        p = summary["parameters"]
+        p = summary.parameters
         base = {"campaign": campaign, "run_id": spec["run_id"], "record_id": spec["record_id"],
                 "hd": p["hd"], "height_m": p["height_m"], "n_drums": p["n_drums"],
                 "mu_s": p["mu_s"], "mu_k": p["mu_k"], "kn": p["kn"], "damping": p["damping"]}
-        for col in summary["columns"]:
-            point = col["impact_point_m"] or [math.nan, math.nan]
+        for col in summary.columns:
+            point = col.impact_point_m or [math.nan, math.nan]
             run_rows.append({
-                **base, "column": col["column"], "toppled": col["toppled"],
-                "downfall_azimuth_deg": _nan(col["downfall_azimuth_deg"]),
-                "impact_time_s": _nan(col["impact_time_s"]), "impact_x_m": point[0],
-                "impact_y_m": point[1], "max_tilt_deg": col["max_tilt_deg"],
-                "base_slip_m": col.get("base_slip_m"), "simulated": summary.get("simulated", True),
-                "simulated_from_s": _nan((summary.get("simulated_window_s") or [None])[0]),
-                "simulated_s": summary.get("simulated_s"),
+                **base, "column": col.column, "toppled": col.toppled,
+                "downfall_azimuth_deg": _nan(col.downfall_azimuth_deg),
+                "impact_time_s": _nan(col.impact_time_s), "impact_x_m": point[0],
+                "impact_y_m": point[1], "max_tilt_deg": col.max_tilt_deg,
+                "base_slip_m": col.base_slip_m, "simulated": summary.simulated,
+                "simulated_from_s": _nan((summary.simulated_window_s or [None])[0]),
+                "simulated_s": summary.simulated_s,
                 **{k: v if isinstance(v, str) else _nan(v) for k, v in rp.items()},
-                "back_azimuth_deg": _nan(summary["back_azimuth_deg"]),
+                "back_azimuth_deg": _nan(summary.back_azimuth_deg),
                 "motion_file": spec["motion_file"],
                 "run_dir": os.path.relpath(runs_dir / spec["run_id"], campaign_dir)})
-            for body in col["bodies"]:
+            for body in col.bodies:
                 if body["struck"]:
                     impact_rows.append({
-                        "run_id": spec["run_id"], "column": col["column"],
+                        "run_id": spec["run_id"], "column": col.column,
                         "body_index": body["index"], "impact_time_s": body["impact_time_s"],
                         "x_m": body["impact_point_m"][0], "y_m": body["impact_point_m"][1],
                         "hd": p["hd"], "mu_s": p["mu_s"], "record_id": spec["record_id"]})

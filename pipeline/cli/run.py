@@ -103,9 +103,9 @@ def run(args):
         summary = simulate(motion, out, column=column, contact=contact, numerics=numerics,
                            window=args.window, rotate_deg=args.rotate, scale=args.scale,
                            back_azimuth=args.back_azimuth)
-    if not summary["simulated"]:
-        print(f"note: {summary['note']}")
-    elif not any(c["max_tilt_deg"] > 0.1 for c in summary["columns"]):
+    if not summary.simulated:
+        print(f"note: {summary.note}")
+    elif not any(c.max_tilt_deg > 0.1 for c in summary.columns):
         print("note: the motion did not make any column rock (max tilt below 0.1 deg)")
     if getattr(column.geometry, "mesh_path", None):
         rock = column.geometry
@@ -125,21 +125,22 @@ def run(args):
             print(f"note: with --kn {contact.kn:g} this column rocks on its contact springs "
                   f"at {hz:.1f} Hz (the paper's column at 13.5 Hz): raise --kn (campaign "
                   "columns does) for rigid-block behaviour")
-    for col in summary["columns"]:
-        if col["toppled"]:
-            first = min((b for b in col["bodies"] if b["struck"]),
-                        key=lambda b: b["impact_time_s"])
-            label = first.get("name") or f"body {first['index']}"
-            more = f" (first to strike: {label})" if column.geometry is not None else ""
-            if col.get("toppled_by") == "rests past its critical angle":
-                print(f"{col['column']:>10}: overturned toward "
-                      f"{col['downfall_azimuth_deg']:.0f} deg (past its critical angle from "
-                      f"{col['impact_time_s']:.2f} s on)")
-                continue
-            print(f"{col['column']:>10}: toppled toward {col['downfall_azimuth_deg']:.0f} deg "
-                  f"at {col['impact_time_s']:.2f} s{more}")
-        else:
-            print(f"{col['column']:>10}: standing (max tilt {col['max_tilt_deg']:.1f} deg)")
-    print(f"wrote {out / 'summary.json'} ({summary['simulated_s']:.1f} s simulated in "
-          f"{summary['wall_s']:.1f} s)")
+    for col in summary.columns:
+        if not col.toppled:
+            print(f"{col.column:>10}: standing (max tilt {col.max_tilt_deg:.1f} deg)")
+            continue
+        if col.toppled_by == "rests past its critical angle":
+            print(f"{col.column:>10}: overturned toward {col.downfall_azimuth_deg:.0f} deg "
+                  f"(past its critical angle from {col.impact_time_s:.2f} s on)")
+            continue
+        first = min((b for b in col.bodies if b["struck"]), default=None,
+                    key=lambda b: b["impact_time_s"])
+        more = ""
+        if column.geometry is not None and first is not None:
+            more = f" (first to strike: {first.get('name') or 'body %d' % first['index']})"
+        how = "" if col.toppled_by in (None, "impact") else f" ({col.toppled_by})"
+        print(f"{col.column:>10}: toppled toward {col.downfall_azimuth_deg:.0f} deg "
+              f"at {col.impact_time_s:.2f} s{more}{how}")
+    print(f"wrote {out / 'summary.json'} ({summary.simulated_s:.1f} s simulated in "
+          f"{summary.wall_s:.1f} s)")
     return 0

@@ -11,6 +11,7 @@ import pandas as pd
 
 from pipeline import files
 from pipeline.campaign.definitions import run_code_version
+from pipeline.campaign.run_dirs import finished_summary
 from pipeline.constants import COLUMN_TYPES as COLUMNS
 from pipeline.files import InputError
 
@@ -63,7 +64,6 @@ class ForwardTable:
     # -------------------------------------------------------------- construction
     @classmethod
     def from_runs(cls, specs, campaign_dir, grid):
-        runs_dir = Path(campaign_dir) / "runs"
         sl = grid.slices()
         members = np.arange(grid.members)
         columns = grid.columns
@@ -75,17 +75,16 @@ class ForwardTable:
         wall, simulated = 0.0, 0
         na = len(grid.azimuths_deg)
         for spec in specs:
-            path = runs_dir / spec["run_id"] / "summary.json"
-            if not path.exists():
+            summary = finished_summary(campaign_dir, spec["run_id"])
+            if summary is None:
                 continue
-            summary = json.loads(path.read_text())
-            wall += float(summary.get("wall_s") or 0.0)
-            simulated += bool(summary.get("simulated", True))
+            wall += summary.wall_s
+            simulated += summary.simulated
             i, j = divmod(spec["node"], na)
-            for col in summary["columns"]:
-                c = columns.index(col["column"])
-                fell = bool(col["toppled"]) and col["downfall_azimuth_deg"] is not None
-                value = col["downfall_azimuth_deg"] if fell else np.nan
+            for col in summary.columns:
+                c = columns.index(col.column)
+                fell = col.toppled and col.downfall_azimuth_deg is not None
+                value = col.downfall_azimuth_deg if fell else np.nan
                 index = (spec["slice"], i, j, c)
                 if spec["member"] < 0:
                     ntop[index], naz[index], nval[index] = fell, value, True

@@ -20,13 +20,13 @@ centre of mass: circles and polygons).  The downfall azimuth points from the
 column's initial axis to the mass-weighted mean of the centres of mass of
 the struck bodies at their first strike (clockwise from North, degrees).
 """
-import math
 
 import numpy as np
 from scipy.spatial.transform import Rotation
 
 from pipeline.constants import MODEL_GRAVITY
 from pipeline.motion import azimuth_deg
+from pipeline.outcome.summary import ColumnOutcome, RunSummary
 
 CONTACT_TOLERANCE_M = 0.02   # a rim this close to the pedestal top has struck it
 LIES_DEG = 60.0              # tilt past which the scene takes a body as lying (fallen)
@@ -199,16 +199,15 @@ def total_energy(trajectory, g=MODEL_GRAVITY):
     return energy
 
 
-def summarise(trajectory, record=None, back_azimuth_deg=None, parameters=None,
-              provenance=None):
-    """summary.json content of one run."""
-    back = None if back_azimuth_deg is None or not math.isfinite(back_azimuth_deg) else float(
-        back_azimuth_deg)
-    return {"record": record, "back_azimuth_deg": back, "parameters": parameters or {},
-            "columns": column_outcomes(trajectory), "simulated": True,
-            "simulated_s": trajectory.simulated_s,
-            "simulated_window_s": [trajectory.start_s, float(trajectory.t[-1])
-                                   if len(trajectory.t) else trajectory.start_s],
-            "motion_end_s": trajectory.motion_end, "stopped_early": trajectory.stopped_early,
-            "time_step_s": trajectory.dt, "wall_s": trajectory.wall_s,
-            "provenance": provenance or {}}
+def summarise(trajectory, record, back_azimuth_deg=None, parameters=None, provenance=None,
+              quiet_after_s=None):
+    """The :class:`~pipeline.outcome.summary.RunSummary` of a simulated run."""
+    return RunSummary(
+        record=record, back_azimuth_deg=back_azimuth_deg, parameters=parameters or {},
+        columns=[ColumnOutcome(**c) for c in column_outcomes(trajectory)],
+        simulated_s=trajectory.simulated_s,
+        simulated_window_s=[trajectory.start_s, float(trajectory.t[-1])
+                            if len(trajectory.t) else trajectory.start_s],
+        motion_end_s=trajectory.motion_end, stopped_early=bool(trajectory.stopped_early),
+        time_step_s=trajectory.dt, wall_s=trajectory.wall_s, provenance=provenance or {},
+        quiet_after_s=quiet_after_s)

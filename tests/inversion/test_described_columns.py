@@ -5,6 +5,7 @@ import json
 import numpy as np
 import pytest
 
+from pipeline.outcome.summary import RunSummary
 from pipeline import cli
 from pipeline.campaign.column_file import column_kn, description
 from pipeline.files import InputError, write_json
@@ -41,9 +42,10 @@ def test_from_runs_of_a_described_grid(tmp_path):
     for node in range(len(node_positions(grid)[0])):
         for member in (-1, 0):
             run_id = f"n{node}m{member}"
-            write_json(tmp_path / "runs" / run_id / "summary.json", {
-                "wall_s": 1.0, "columns": [{"column": "drums", "toppled": node == 1,
-                                            "downfall_azimuth_deg": 33.0 if node else None}]})
+            RunSummary(record=run_id, wall_s=1.0, columns=[
+                {"column": "drums", "toppled": node == 1,
+                 "downfall_azimuth_deg": 33.0 if node else None}]).save(
+                tmp_path / "runs" / run_id / "summary.json")
             specs.append({"run_id": run_id, "slice": 0, "node": node, "member": member})
     table = ForwardTable.from_runs(specs, tmp_path, grid)
     assert table.columns == ("drums",) and table.toppled.shape == (1, 1, 2, 1, 1)

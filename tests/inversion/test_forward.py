@@ -4,7 +4,8 @@ import json
 import numpy as np
 import pytest
 
-from pipeline.files import InputError, write_json
+from pipeline.outcome.summary import RunSummary
+from pipeline.files import InputError
 from pipeline.inversion.forward import member_parameters
 from pipeline.inversion.grid import GRIDS, TableGrid, node_positions, subevent_layout
 from pipeline.inversion.table import ForwardTable
@@ -54,12 +55,12 @@ def test_from_runs_places_each_outcome(tmp_path):
         for member in (-1, 0, 1):
             run_id = f"n{node}m{member}"
             fell = node == 1 and member >= 0           # node 1 = (5 km, 180)
-            write_json(tmp_path / "runs" / run_id / "summary.json", {
-                "wall_s": 2.0, "simulated": True, "columns": [
+            RunSummary(record=run_id, wall_s=2.0, simulated=True, columns=[
                     {"column": "drums", "toppled": fell,
                      "downfall_azimuth_deg": 100.0 + member if fell else None},
                     {"column": "monolithic", "toppled": member == -1,
-                     "downfall_azimuth_deg": 7.0 if member == -1 else None}]})
+                     "downfall_azimuth_deg": 7.0 if member == -1 else None}]).save(
+                tmp_path / "runs" / run_id / "summary.json")
             specs.append({"run_id": run_id, "slice": 0, "node": node, "member": member})
     table = ForwardTable.from_runs(specs, tmp_path, grid)
     assert table.toppled.shape == (1, 2, 2, 2, 2)

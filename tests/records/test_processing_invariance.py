@@ -90,10 +90,10 @@ def test_same_column_outcome_with_ten_minutes_of_noise_appended(tmp_path):
         acc, vel, disp, _ = processing.process(data, dt)
         summary = simulate(Motion(dt, acc, vel, disp, meta={"record_id": name}), tmp_path / name,
                            column=Column("monolithic"))
-        outcomes.append(summary["columns"][0])
+        outcomes.append(summary.columns[0])
     base, noisy = outcomes
-    assert base["toppled"] == noisy["toppled"]
-    if base["toppled"]:
-        gap = abs((base["downfall_azimuth_deg"] - noisy["downfall_azimuth_deg"] + 180) % 360 - 180)
+    assert base.toppled == noisy.toppled
+    if base.toppled:
+        gap = abs((base.downfall_azimuth_deg - noisy.downfall_azimuth_deg + 180) % 360 - 180)
         assert gap < 2.0
-        assert noisy["impact_time_s"] == pytest.approx(base["impact_time_s"], abs=0.05)
+        assert noisy.impact_time_s == pytest.approx(base.impact_time_s, abs=0.05)

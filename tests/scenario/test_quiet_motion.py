@@ -93,17 +93,17 @@ def test_skipped_lead_in_gives_the_same_fall_on_the_motion_clock(tmp_path):
                      np.zeros((int(8 / DT), 3))])
     motion = motion_of(acc)
     skip, full = run(tmp_path, "skip", motion, "skip"), run(tmp_path, "full", motion, "simulate")
-    (s,), (f,) = skip["columns"], full["columns"]
-    assert s["toppled"] and f["toppled"]
-    assert abs((s["downfall_azimuth_deg"] - f["downfall_azimuth_deg"] + 180) % 360 - 180) < 2.0
-    assert s["impact_time_s"] == pytest.approx(f["impact_time_s"], abs=0.05)
+    (s,), (f,) = skip.columns, full.columns
+    assert s.toppled and f.toppled
+    assert abs((s.downfall_azimuth_deg - f.downfall_azimuth_deg + 180) % 360 - 180) < 2.0
+    assert s.impact_time_s == pytest.approx(f.impact_time_s, abs=0.05)
     # the pulse first reaches the threshold at 6 s + asin(threshold / A) / (2 pi) x 1 s
     first = 6.0 + math.asin(THRESHOLD / amplitude) / (2 * math.pi)
-    assert skip["simulated_window_s"][0] == pytest.approx(first - 1.0, abs=DT)
-    assert full["simulated_window_s"][0] == 0.0
-    assert skip["simulated_s"] == pytest.approx(full["simulated_s"] - (first - 1.0), abs=0.1)
+    assert skip.simulated_window_s[0] == pytest.approx(first - 1.0, abs=DT)
+    assert full.simulated_window_s[0] == 0.0
+    assert skip.simulated_s == pytest.approx(full.simulated_s - (first - 1.0), abs=0.1)
     traj = Trajectory.load(tmp_path / "skip" / "trajectory.npz")
-    assert traj.t[0] >= skip["simulated_window_s"][0]
+    assert traj.t[0] >= skip.simulated_window_s[0]
     # the pedestal displacement is the motion's, on the motion's clock
     expected = np.column_stack([np.interp(traj.t, motion.dt * np.arange(motion.npts),
                                           motion.disp[:, j]) for j in range(3)])
@@ -119,12 +119,12 @@ def test_quiet_tail_ends_the_run_once_the_column_rests_seated(tmp_path):
     acc = np.vstack([np.zeros((int(2 / DT), 3)), blip, sine(20.0, 0.3 * THRESHOLD, 2.0, 1)])
     motion = motion_of(acc)
     skip, full = run(tmp_path, "skip", motion, "skip"), run(tmp_path, "full", motion, "simulate")
-    assert skip["quiet_after_s"] == pytest.approx(2.04, abs=2 * DT)
-    assert skip["simulated_window_s"][1] < skip["quiet_after_s"] + 2.0
-    assert full["simulated_window_s"][1] >= full["motion_end_s"]
+    assert skip.quiet_after_s == pytest.approx(2.04, abs=2 * DT)
+    assert skip.simulated_window_s[1] < skip.quiet_after_s + 2.0
+    assert full.simulated_window_s[1] >= full.motion_end_s
     for summary in (skip, full):
-        (c,) = summary["columns"]
-        assert not c["toppled"] and c["max_tilt_deg"] < 0.05
+        (c,) = summary.columns
+        assert not c.toppled and c.max_tilt_deg < 0.05
 
 
 @pytest.mark.yade
@@ -134,9 +134,9 @@ def test_a_rocking_column_is_not_stopped_by_the_quiet_tail(tmp_path):
     acc = np.vstack([sine(1.0, 1.9, 1.0, 1), sine(12.0, 0.5 * THRESHOLD, 2.0, 1)])
     motion = motion_of(acc)
     skip, full = run(tmp_path, "skip", motion, "skip"), run(tmp_path, "full", motion, "simulate")
-    assert skip["quiet_after_s"] < 1.0 < skip["columns"][0]["max_tilt_deg"]
-    assert skip["simulated_window_s"][1] >= skip["motion_end_s"]
-    assert skip["simulated_window_s"][1] == pytest.approx(full["simulated_window_s"][1], abs=0.2)
+    assert skip.quiet_after_s < 1.0 < skip.columns[0].max_tilt_deg
+    assert skip.simulated_window_s[1] >= skip.motion_end_s
+    assert skip.simulated_window_s[1] == pytest.approx(full.simulated_window_s[1], abs=0.2)
 
 
 def test_ready_made_motion_is_cut_at_its_signal_end_like_a_record(tmp_path):

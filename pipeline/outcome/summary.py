@@ -1,0 +1,168 @@
+"""What one run says, as it flows from the YADE scene to every table: :class:`RunSummary`
+(a run's ``summary.json``) holding one :class:`ColumnOutcome` per column.  Built by
+:func:`pipeline.outcome.columns.summarise` (a simulated run) or :meth:`RunSummary.still`
+(a run the pre-check skipped), written once by :meth:`RunSummary.save` and read back
+only by :meth:`RunSummary.load`."""
+import json
+import math
+from dataclasses import dataclass, field, fields
+from pathlib import Path
+
+from pipeline.files import InputError, write_json
+
+
+def _azimuth_or_none(value, name):
+    if value is None:
+        return None
+    value = float(value)
+    if not (math.isfinite(value) and 0.0 <= value < 360.0):
+        raise InputError(f"{name} {value:g} not in [0, 360)")
+    return value
+
+
+def _non_negative(value, name):
+    """``value`` as a float >= 0 (None stays None: not known)."""
+    if value is None:
+        return None
+    try:
+        value = float(value)
+    except (TypeError, ValueError):
+        raise InputError(f"{name} must be a number, got {value!r}") from None
+    if not (math.isfinite(value) and value >= 0.0):
+        raise InputError(f"{name} must be a finite number >= 0, got {value!r}")
+    return value
+
+
+@dataclass(frozen=True, kw_only=True)
+class ColumnOutcome:
+    """One column of a run: toppled or standing, downfall azimuth (deg clockwise from
+    North, None when standing), first impact time (s, motion clock) and point (m, pedestal
+    frame, mass-weighted), largest tilt (deg), base slip (m), initial position (m), the
+    rule that decided the fall (``toppled_by``) and one dict per body
+    (:mod:`pipeline.outcome.columns`)."""
+    column: str
+    toppled: bool
+    toppled_by: str = None
+    downfall_azimuth_deg: float = None
+    impact_time_s: float = None
+    impact_point_m: list = None
+    max_tilt_deg: float = 0.0
+    base_slip_m: float = 0.0
+    position_m: list = field(default_factory=lambda: [0.0, 0.0])
+    bodies: list = field(default_factory=list)
+
+    def __post_init__(self):
+        if not isinstance(self.column, str) or not self.column:
+            raise InputError(f"column outcome: column name {self.column!r}")
+        if not isinstance(self.toppled, bool):
+            raise InputError(f"column {self.column}: toppled must be true or false")
+        object.__setattr__(self, "downfall_azimuth_deg", _azimuth_or_none(
+            self.downfall_azimuth_deg, f"column {self.column}: downfall_azimuth_deg"))
+        if self.downfall_azimuth_deg is not None and not self.toppled:
+            raise InputError(f"column {self.column}: a downfall azimuth but not toppled")
+        object.__setattr__(self, "max_tilt_deg", _non_negative(
+            self.max_tilt_deg, f"column {self.column}: max_tilt_deg"))
+        object.__setattr__(self, "base_slip_m", _non_negative(
+            self.base_slip_m, f"column {self.column}: base_slip_m"))
+
+    @classmethod
+    def standing(cls, name, x_m, y_m):
+        """A column that never moved, at (x_m, y_m) on the pedestal."""
+        return cls(column=name, toppled=False, position_m=[x_m, y_m])
+
+
+@dataclass(frozen=True, kw_only=True)
+class RunSummary:
+    """One run (``summary.json``): the record and its back azimuth (deg, None when
+    unknown), the run's parameters, one :class:`ColumnOutcome` per column, whether YADE
+    ran (``simulated``; ``note`` says why not), the simulated time and window (s, motion
+    clock), the motion's end (s), whether the scene stopped early, the time step (s),
+    wall time (s), provenance, and ``quiet_after_s`` (s) when the quiet tail was cut."""
+    record: str
+    back_azimuth_deg: float = None
+    parameters: dict = field(default_factory=dict)
+    columns: tuple = ()
+    simulated: bool = True
+    note: str = None
+    simulated_s: float = 0.0
+    simulated_window_s: list = None
+    motion_end_s: float = 0.0
+    stopped_early: bool = False
+    time_step_s: float = None
+    wall_s: float = 0.0
+    provenance: dict = field(default_factory=dict)
+    quiet_after_s: float = None
+
+    OPTIONAL = ("note", "quiet_after_s")     # written only when set
+
+    def __post_init__(self):
+        if not isinstance(self.record, str):
+            raise InputError(f"run summary: record must be a name, got {self.record!r}")
+        back = self.back_azimuth_deg
+        if back is not None and not math.isfinite(float(back)):
+            back = None                         # an unknown back azimuth
+        object.__setattr__(self, "back_azimuth_deg",
+                           _azimuth_or_none(back, "run summary: back_azimuth_deg"))
+        columns = tuple(c if isinstance(c, ColumnOutcome) else ColumnOutcome(**c)
+                        for c in self.columns)
+        if len({c.column for c in columns}) != len(columns):
+            raise InputError("run summary: a column is named twice")
+        object.__setattr__(self, "columns", columns)
+        for name in ("simulated_s", "motion_end_s", "wall_s"):
+            object.__setattr__(self, name, _non_negative(getattr(self, name),
+                                                         f"run summary: {name}"))
+        if not isinstance(self.simulated, bool) or not isinstance(self.stopped_early, bool):
+            raise InputError("run summary: simulated and stopped_early must be true or false")
+
+    @classmethod
+    def still(cls, record, columns, **values):
+        """A run YADE never ran: every column standing (``columns``: scene column dicts
+        with name, x, y)."""
+        return cls(record=record, simulated=False,
+                   columns=[ColumnOutcome.standing(c["name"], c["x"], c["y"])
+                            for c in columns], **values)
+
+    def column(self, name):
+        """The :class:`ColumnOutcome` of column ``name``."""
+        for c in self.columns:
+            if c.column == name:
+                return c
+        raise KeyError(name)
+
+    def to_dict(self):
+        out = {}
+        for f in fields(self):
+            value = getattr(self, f.name)
+            if f.name in self.OPTIONAL and value is None:
+                continue
+            out[f.name] = ([{g.name: getattr(c, g.name) for g in fields(c)} for c in value]
+                           if f.name == "columns" else value)
+        return out
+
+    def save(self, path):
+        """Write ``summary.json`` atomically (a run's last act)."""
+        write_json(path, self.to_dict())
+        return Path(path)
+
+    @classmethod
+    def load(cls, path):
+        """The summary at ``path`` (a ``summary.json`` or the run directory holding it)."""
+        path = Path(path)
+        if path.is_dir():
+            path = path / "summary.json"
+        try:
+            data = json.loads(path.read_text())
+        except FileNotFoundError:
+            raise InputError(f"run summary not found: {path}") from None
+        except (OSError, ValueError) as exc:
+            raise InputError(f"{path}: not a run summary ({exc})") from None
+        known = {f.name for f in fields(cls)}
+        unknown = sorted(set(data) - known) if isinstance(data, dict) else None
+        if unknown is None or unknown or "record" not in data:
+            what = "not an object" if unknown is None else (
+                f"unknown keys {', '.join(unknown)}" if unknown else "no record")
+            raise InputError(f"{path}: not a run summary ({what})")
+        try:
+            return cls(**data)
+        except (TypeError, InputError) as exc:
+            raise InputError(f"{path}: not a run summary ({exc})") from None
