@@ -167,11 +167,9 @@ def perturbed(data, height_factor=1.0, diameter_factor=1.0, tilt_deg=0.0,
 
 def mark(specs, data):
     """Name the description in each spec (``description``; outputs and tables show it)."""
-    if data is not None:
-        for spec in specs:
-            spec["description"] = data["name"]
-            spec["column_description"] = data
-    return specs
+    if data is None:
+        return specs
+    return [s.tagged(description=data["name"], column_description=data) for s in specs]
 
 
 def summary_entry(specs):

@@ -60,10 +60,8 @@ def convergence_specs(records, campaign_dir, members=DEFAULT_MEMBERS, seed=DEFAU
             for m, p in enumerate(params):
                 runs.append((record, {**p, **numerics}))
                 tags.append((name, m))
-    specs = column_specs(runs, campaign_dir)
-    for spec, (name, m) in zip(specs, tags):
-        spec.update(variant=name, member=m, seed=seed, keep_trajectory=False)
-    return specs
+    return column_specs(runs, campaign_dir, [{"variant": name, "member": m} for name, m in tags],
+                        seed=seed, keep_trajectory=False)
 
 
 def convergence_outputs(specs, campaign_dir, failures, animations, figures=True):

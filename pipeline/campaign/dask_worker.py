@@ -45,7 +45,7 @@ def run_task(worker, spec, motion, client_run_dir, code, token):
     with tempfile.TemporaryDirectory(prefix=f"{TASK_PREFIX}-{token}-",
                                      dir=_scratch_directory()) as tmp:
         tmp = Path(tmp)
-        spec = dict(spec)
+        spec = dict(spec)        # a plain dict on the worker: its motion file is moved
         swaps = []
         if motion is not None:
             path = tmp / "input" / Path(spec["motion_file"]).name

@@ -7,6 +7,7 @@ from pipeline.constants import COLUMN_KINDS
 from pipeline import RESULTS_DIR, paper
 from pipeline.campaign import Campaign, register
 from pipeline.campaign.run_dirs import finished_summary
+from pipeline.campaign.spec import RunSpec
 from pipeline.campaign.column_file import (add_campaign_options, add_column_file_argument,
                                            matched_kn,
                                            add_stiffness_argument, at_slenderness,
@@ -35,9 +36,10 @@ def motion_cache(campaign_dir):
     return campaign_dir / "motions"
 
 
-def column_specs(runs, campaign_dir):
-    """Resolve (record, parameters) pairs into run specs: each record processed once,
-    record ids unique, run id = hash(code, motion content, parameters)."""
+def column_specs(runs, campaign_dir, tags=None, **common):
+    """Resolve (record, parameters) pairs into :class:`~pipeline.campaign.spec.RunSpec`:
+    each record processed once, record ids unique, run id = hash(code, motion content,
+    parameters); ``tags``: one dict per run, ``common``: tags of every run."""
     version = run_code_version()
     cache = motion_cache(campaign_dir)
     resolved, ids = {}, {}
@@ -53,12 +55,12 @@ def column_specs(runs, campaign_dir):
             record_id = f"{record_id}-{path.stem[:6]}"      # two files with one stem
         ids[record_id] = path
         resolved[record] = (record_id, path)
-    specs = []
-    for record, params in runs:
-        record_id, path = resolved[record]
-        specs.append({"record": str(record), "record_id": record_id, "motion_file": str(path),
-                      "params": params, "run_id": content_hash(version, path, params)})
-    return specs
+    tags = [{}] * len(runs) if tags is None else list(tags)
+    if len(tags) != len(runs):
+        raise ValueError("column_specs: one tags dict per run")
+    return [RunSpec.create(record, resolved[record][0], resolved[record][1], params, version,
+                           **common, **more)
+            for (record, params), more in zip(runs, tags)]
 
 
 def run_column_spec(spec, run_dir):
@@ -265,10 +267,8 @@ def columns_specs(records, campaign_dir, column_files=None, column="both",
     for g in geometries:
         kn = matched_kn(g) if stiffness == "matched" else paper.COLUMN_KN_N_M
         runs += [(r, twin(column=column, column_file=g.to_dict(), kn=kn)) for r in recs]
-    specs = column_specs(runs, campaign_dir)
-    for spec in specs:
-        spec["description"] = spec["params"]["column_file"]["name"]
-    return specs
+    return column_specs(runs, campaign_dir,
+                        tags=[{"description": p["column_file"]["name"]} for _, p in runs])
 
 
 COLUMNS_TABLE = ["description", "record_id", "column", "toppled", "downfall_azimuth_deg",

@@ -236,12 +236,9 @@ def ensemble_specs(records, campaign_dir, record=None, column="both", members=DE
         runs.append((rec, nominal_params))
         runs += [(rec, p) for p in member_params[:counts[rec]]]
         member_numbers += range(-1, counts[rec])        # -1: the nominal run
-    specs = mark(column_specs(runs, campaign_dir), data)
-    for spec, member in zip(specs, member_numbers):
-        spec["member"] = member
-        spec["seed"] = seed
-        spec["keep_trajectory"] = spec["member"] < KEPT_TRAJECTORIES   # summaries for all
-    return specs
+    # trajectories of the first members only: summaries for all
+    tags = [{"member": m, "keep_trajectory": m < KEPT_TRAJECTORIES} for m in member_numbers]
+    return mark(column_specs(runs, campaign_dir, tags, seed=seed), data)
 
 
 def ensemble_outputs(specs, campaign_dir, failures, animations, figures=True):

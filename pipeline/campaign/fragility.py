@@ -133,10 +133,8 @@ def fragility_specs(records, campaign_dir, levels=DEFAULT_LEVELS, members=DEFAUL
                 runs.append((record, {**params, "scale": scale}))
                 extra.append({"level_m_s2": level, "level_index": li, "member": mi,
                               "scale": scale})
-    specs = mark(column_specs(runs, campaign_dir), data)
-    for spec, more in zip(specs, extra):
-        spec.update(more, seed=seed, azimuths=azimuths, levels=list(levels))
-    return specs
+    return mark(column_specs(runs, campaign_dir, extra, seed=seed, azimuths=azimuths,
+                             levels=list(levels)), data)
 
 
 def block_size(params):

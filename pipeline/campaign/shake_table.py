@@ -156,10 +156,7 @@ def specs(records, campaign_dir, experiments=EXPERIMENTS, specimen=SPECIMEN, out
             runs.append((str(row.motion_path), params))
             meta.append({"test": row.test, "observed": bool(row.observed), "stage": stage,
                          "grid_point": _label(point), "point": point})
-    out = column_specs(runs, campaign_dir)
-    for spec, extra in zip(out, meta):
-        spec.update(extra)
-    return out
+    return column_specs(runs, campaign_dir, meta)
 
 def outputs(specs_, campaign_dir, failures, animations, figures=True):
     """Per-run table of this stage and its scores per grid point."""

@@ -77,10 +77,7 @@ def forward_specs(records, campaign_dir, grid=None, jobs=None, **_):
                 runs.append((str(path), p))
                 info.append({"slice": s, "node": node, "member": member,
                              "distance_km": float(r[node]), "azimuth_deg": float(a[node])})
-    specs = column_specs(runs, campaign_dir)
-    for spec, extra in zip(specs, info):
-        spec.update(extra, keep_trajectory=False, grid=grid.as_dict())
-    return specs
+    return column_specs(runs, campaign_dir, info, keep_trajectory=False, grid=grid.as_dict())
 
 
 def table_path(campaign_dir, grid):

@@ -183,10 +183,8 @@ def truth_specs(records, campaign_dir, truth=None, grid=None, jobs=None, **_):
         for member in range(twins):
             runs.append((str(path), params[member]))
             info.append({"site": name, "member": member})
-    specs = column_specs(runs, campaign_dir)
-    for spec, extra in zip(specs, info):
-        spec.update(extra, keep_trajectory=False, strike_deg=truth.strike_deg)
-    return specs
+    return column_specs(runs, campaign_dir, info, keep_trajectory=False,
+                        strike_deg=truth.strike_deg)
 
 
 def truth_observations(specs, campaign_dir):

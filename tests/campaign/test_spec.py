@@ -1,0 +1,40 @@
+"""RunSpec: a run's id comes from what defines the run, never from a campaign's tags; a
+spec cannot be changed after it is made."""
+import pickle
+
+import numpy as np
+import pytest
+
+from pipeline.campaign.spec import RunSpec
+from pipeline.files import InputError
+
+
+def test_the_run_id_follows_motion_content_and_parameters_not_tags(tmp_path):
+    a, b = tmp_path / "a.npz", tmp_path / "b.npz"
+    np.savez(a, x=np.arange(3))
+    b.write_bytes(a.read_bytes())                      # same content, other name
+    one = RunSpec.create("A", "A", a, {"hd": 6.0}, "code1", member=3)
+    assert RunSpec.create("B", "B", b, {"hd": 6.0}, "code1").run_id == one.run_id
+    assert RunSpec.create("A", "A", a, {"hd": 6.1}, "code1").run_id != one.run_id
+    assert RunSpec.create("A", "A", a, {"hd": 6.0}, "code2").run_id != one.run_id
+    tagged = one.tagged(member=4, seed=9)
+    assert tagged.run_id == one.run_id and tagged["member"] == 4 and one["member"] == 3
+    assert dict(tagged) == {"record": "A", "record_id": "A", "motion_file": str(a),
+                            "params": {"hd": 6.0}, "run_id": one.run_id, "member": 4, "seed": 9}
+    assert RunSpec.from_dict(tagged.to_dict()) == tagged
+    assert pickle.loads(pickle.dumps(tagged)) == tagged        # to a Dask worker and back
+
+
+def test_a_spec_is_read_only_and_checked():
+    spec = RunSpec("A", "A", "/m.npz", {}, "id1")
+    with pytest.raises(TypeError):
+        spec["member"] = 1
+    with pytest.raises(AttributeError):
+        spec.run_id = "other"
+    assert spec.get("member", -9) == -9 and "run_id" in spec
+    with pytest.raises(InputError, match="hide a field"):
+        RunSpec("A", "A", "/m.npz", {}, "id1", {"run_id": "x"})
+    with pytest.raises(InputError, match="run_id"):
+        RunSpec("A", "A", "/m.npz", {}, "")
+    with pytest.raises(InputError, match="lacks params"):
+        RunSpec.from_dict({"record": "A", "record_id": "A", "motion_file": "m", "run_id": "i"})
