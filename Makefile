@@ -88,7 +88,7 @@ paper-question: records
 
 # the docs/ tree as a website (results/site; mkdocs --strict fails on a broken link)
 docs: setup
-	@$(PY) -c "import mkdocs" 2>/dev/null || $(PY) -m pip install -q -e '.[docs]'
+	@$(PY) -c "import mkdocs, mkdocs_macros" 2>/dev/null || $(PY) -m pip install -q -e '.[docs]'
 	$(PY) -m mkdocs build --quiet
 
 invert-demo: setup

@@ -1,0 +1,87 @@
+"""Numbers and tables of the documentation, read from the files the project writes
+(``results/bench/bench.json`` from ``make bench``, ``results/run-all-steps.tsv`` and
+``results/REPORT.md`` from ``make run-all``), so no measurement is typed by hand.  The docs
+pages call these through the mkdocs-macros hook :mod:`pipeline.report.docs_macros`; a
+file not written yet renders as a note saying which command writes it."""
+import csv
+import json
+from functools import reduce
+
+from pipeline import RESULTS_DIR
+
+BENCH_JSON = RESULTS_DIR / "bench" / "bench.json"
+RUN_ALL_STEPS = RESULTS_DIR / "run-all-steps.tsv"
+REPORT = RESULTS_DIR / "REPORT.md"
+
+
+def _not_yet(command):
+    return f"*(not measured yet: run `{command}`)*"
+
+
+def _bench(path=BENCH_JSON):
+    return json.loads(path.read_text()) if path.is_file() else None
+
+
+def bench_value(key, fmt="{:.2f}", path=BENCH_JSON):
+    """One number of ``bench.json`` by its dotted ``key`` (list items by index), formatted
+    with ``fmt``; a note while ``make bench`` has not run or the key is missing."""
+    data = _bench(path)
+    if data is None:
+        return _not_yet("make bench")
+    try:
+        value = reduce(lambda v, k: v[int(k)] if isinstance(v, list) else v[k],
+                       key.split("."), data)
+    except (KeyError, IndexError, ValueError, TypeError):
+        return _not_yet("make bench")
+    return fmt.format(value)
+
+
+def bench_speed_table(path=BENCH_JSON):
+    """Markdown table of bench section 2: microseconds per step, cost against the still
+    scene and simulated seconds per wall second (with YADE's start-up) per scene."""
+    data = _bench(path)
+    if data is None or "speed" not in data:
+        return _not_yet("make bench")
+    lines = ["| scene | us/step | x still | simulated s per wall s (with start-up) |",
+             "|---|---|---|---|"]
+    for name, row in data["speed"]["scenes"].items():
+        lines.append(f"| {name}: {row['scene']} | {row['us_per_step']:.1f} | "
+                     f"{row['cost_vs_still']:.2f} | {row['sim_s_per_wall_s']:.2f} "
+                     f"({row['sim_s_per_wall_s_with_startup']:.2f}) |")
+    return "\n".join(lines)
+
+
+def engine_shares(path=BENCH_JSON, least_pct=2.0):
+    """'engine share %' of bench section 1 (twin model, shaking), largest first, engines
+    below ``least_pct`` left out."""
+    data = _bench(path)
+    if data is None or "engine_timing" not in data:
+        return _not_yet("make bench")
+    rows = sorted(data["engine_timing"]["engines"], key=lambda e: -e["share_pct"])
+    return ", ".join(f"{e['engine']} {e['share_pct']:.0f} %" for e in rows
+                     if e["share_pct"] >= least_pct)
+
+
+def run_all_steps(path=RUN_ALL_STEPS):
+    """Markdown table of ``make run-all``'s steps and their wall minutes, with the total."""
+    if not path.is_file():
+        return _not_yet("make run-all")
+    with path.open() as handle:
+        rows = list(csv.DictReader(handle, delimiter="\t"))
+    if not rows:
+        return _not_yet("make run-all")
+    keys = list(rows[0])
+    step, seconds = keys[0], next((k for k in keys if k.endswith("_s")), keys[-1])
+    total = sum(float(r[seconds]) for r in rows)
+    lines = ["| step | wall (min) |", "|---|---|"]
+    lines += [f"| {r[step]} | {float(r[seconds]) / 60:.1f} |" for r in rows]
+    lines.append(f"| **total** | **{total / 60:.1f}** |")
+    return "\n".join(lines)
+
+
+def report(path=REPORT):
+    """``results/REPORT.md`` itself, its headings moved one level down."""
+    if not path.is_file():
+        return _not_yet("make run-all")
+    return "\n".join("#" + line if line.startswith("#") else line
+                     for line in path.read_text().splitlines())
