@@ -33,8 +33,7 @@ class Campaign:
     worker: Callable
     outputs: Callable
     label: str = "runs"
-    options: Callable = None       # options(parser): campaign-specific command-line options
-    read_options: Callable = None  # read_options(args) -> dict of keyword options for specs
+    options: type = None           # its own options: a CampaignOptions dataclass
     driver: Callable = None        # driver(run, records, campaign_dir, options): runs it
     #                                (several times: ensembles sized by their error)
 

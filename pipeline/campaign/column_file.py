@@ -37,37 +37,6 @@ def column_file_help(many=False):
             + ", ".join(example_names()) + ")")
 
 
-def add_column_file_argument(parser, note="", many=False, dest="column_file"):
-    """``--column-file NAME_OR_FILE`` (``many``: a comma-separated list) on ``parser``;
-    ``note``: what this command does with it."""
-    parser.add_argument("--column-file", dest=dest, default=None,
-                        metavar="NAME_OR_FILE,..." if many else "NAME_OR_FILE",
-                        help=column_file_help(many) + (f"; {note}" if note else ""))
-
-
-def add_stiffness_argument(parser, note=""):
-    """``--stiffness matched|paper``: the contact stiffness of described columns."""
-    parser.add_argument("--stiffness", choices=STIFFNESS_CHOICES, default="matched",
-                        help=(f"{note}: " if note else "") + "contact stiffness per point: "
-                        "matched (default) raises the paper's kn for heavy columns so that "
-                        "each rocks on its contact springs no slower than the paper's column "
-                        f"(13.5 Hz); paper: {paper.COLUMN_KN_N_M:g} N/m for all")
-
-
-CAMPAIGN_NOTE = ("the described column stands in the drums' place and a monolith of its "
-                 "outline in the monolith's")
-
-
-def add_campaign_options(parser, note=""):
-    """``--column-file`` and ``--stiffness`` of a campaign that shakes one column model."""
-    add_column_file_argument(parser, CAMPAIGN_NOTE + (f"; {note}" if note else ""))
-    add_stiffness_argument(parser, "with --column-file")
-
-
-def read_campaign_options(args):
-    return {"column_file": args.column_file, "stiffness": args.stiffness}
-
-
 def description(column_file, meshes=False):
     """The validated description dict of a shipped example's name, a file or a dict;
     None for None.  InputError (one line) for an unknown name, a missing file or a

@@ -18,12 +18,15 @@ comparisons rejects at 5 %.  Outputs: ``convergence.json`` (every number, the te
 p-values, the verdict and the CPU time per member of each variant), ``convergence.csv``
 and ``convergence.png``.
 """
+from dataclasses import dataclass
 import math
 from pathlib import Path
 
 import numpy as np
 
 from pipeline.campaign import Campaign, register
+from pipeline.campaign.options import CampaignOptions
+from pipeline.scenario.parameters import param
 from pipeline.campaign.run_dirs import finished_summary
 from pipeline.campaign.definitions import column_specs, run_code_version, run_column_spec
 from pipeline.campaign.ensemble import (DEFAULT_SEED, ENSEMBLE_RANGES, check_seed,
@@ -150,24 +153,20 @@ def _rows(result):
     return frame
 
 
-def convergence_options(parser):
-    parser.add_argument("--members", type=int, default=DEFAULT_MEMBERS,
-                        help=f"members per record and variant (default {DEFAULT_MEMBERS}; "
-                        "2-10000)")
-    parser.add_argument("--seed", type=int, default=DEFAULT_SEED,
-                        help=f"seed of the first variant's Latin hypercube (default "
-                        f"{DEFAULT_SEED}; variant k: seed + k)")
+@dataclass(frozen=True)
+class ConvergenceOptions(CampaignOptions):
+    members: int = param(DEFAULT_MEMBERS, "", "members per record and variant", 2, 10000,
+                         flag="--members")
+    seed: int = param(DEFAULT_SEED, "", "seed of the first variant's Latin hypercube "
+                      "(variant k: seed + k)", flag="--seed")
 
-
-def read_options(args):
-    if not (isinstance(args.members, int) and 2 <= args.members <= 10000):
-        raise InputError(f"--members must be an integer in [2, 10000], got {args.members!r}")
-    if check_seed(args.seed) + len(VARIANTS) > 2 ** 63:
-        raise InputError(f"--seed must be below 2^63 - {len(VARIANTS)} (variant k: seed + k)")
-    return {"members": args.members, "seed": args.seed}
+    def check(self):
+        if check_seed(self.seed) + len(VARIANTS) > 2 ** 63:
+            raise InputError(f"--seed must be below 2^63 - {len(VARIANTS)} (variant k: "
+                             "seed + k)")
 
 
 register(Campaign("convergence", "the model's convergence judged on ensembles: P(toppled) and "
                   "fall directions at 16, 32, 64 rim points and time step factor 0.15",
                   convergence_specs, run_column_spec, convergence_outputs, label="members",
-                  options=convergence_options, read_options=read_options))
+                  options=ConvergenceOptions))

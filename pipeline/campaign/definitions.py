@@ -1,18 +1,18 @@
 """The campaigns: the paper's experiments and the verification, one definition each."""
 import dataclasses
+from dataclasses import dataclass
 import json
 from pathlib import Path
 
 from pipeline.constants import COLUMN_KINDS
 from pipeline import RESULTS_DIR, paper
 from pipeline.campaign import Campaign, register
+from pipeline.campaign.options import (CAMPAIGN_NOTE, CampaignOptions, ColumnFileOptions,
+                                       column_file_param, stiffness_param)
 from pipeline.campaign.run_dirs import finished_summary
 from pipeline.campaign.spec import RunSpec
-from pipeline.campaign.column_file import (add_campaign_options, add_column_file_argument,
-                                           matched_kn,
-                                           add_stiffness_argument, at_slenderness,
-                                           check_stiffness, column_kn, description, mark,
-                                           read_campaign_options, summary_entry)
+from pipeline.campaign.column_file import (at_slenderness, check_stiffness, column_kn,
+                                           description, mark, matched_kn, summary_entry)
 from pipeline.campaign.tables import collect, write_tables
 from pipeline.files import (InputError, code_hash, content_hash, csv_true_column,
                             write_csv)
@@ -20,6 +20,7 @@ from pipeline.motion import Motion
 from pipeline.records import catalog, catalog_row, processed_motion, resolve
 from pipeline.records.processing import signal_end_s
 from pipeline.scenario import Column, Contact, Numerics
+from pipeline.scenario.parameters import param
 from pipeline.simulate import run_code_version, simulate
 from pipeline.stats.circular import direction_statistics
 
@@ -76,6 +77,13 @@ def run_column_spec(spec, run_dir):
     numerics = Numerics(**{k: p.pop(k) for k in list(p) if k in NUMERICS_FIELDS})
     simulate(Motion.load(spec["motion_file"]), run_dir, column=column, contact=contact,
              numerics=numerics, record=spec["record_id"], motion_file=spec["motion_file"], **p)
+
+
+@dataclass(frozen=True)
+class SlendernessOptions(ColumnFileOptions):
+    column_file: str = column_file_param(
+        CAMPAIGN_NOTE + "; its block heights are scaled by one factor to each h/d of the "
+        "sweep (overall height over base width)")
 
 
 def twin(**params):
@@ -166,16 +174,13 @@ register(Campaign(
     "slenderness", f"h/d {paper.SLENDERNESS_HD[0]:g}-{paper.SLENDERNESS_HD[-1]:g} on the "
     "paper's sweep record and the pulse record",
     slenderness_specs, run_column_spec, column_outputs("slenderness", "hd"),
-    options=lambda parser: add_campaign_options(
-        parser, "its block heights are scaled by one factor to each h/d of the sweep (overall "
-        "height over base width)"),
-    read_options=read_campaign_options))
+    options=SlendernessOptions))
 
 register(Campaign(
     "friction", f"mu_s {paper.FRICTION_MU_S[0]:g}-{paper.FRICTION_MU_S[-1]:g} "
     f"(mu_k = {paper.MU_K_OVER_MU_S:g} mu_s)",
     friction_specs, run_column_spec, column_outputs("friction", "mu_s"),
-    options=add_campaign_options, read_options=read_campaign_options))
+    options=ColumnFileOptions))
 
 
 def _nearsource_records():
@@ -194,7 +199,7 @@ register(Campaign(
     "records", "the twin model under the paper's record selection (record set nearsource; "
     "--set all / fema for the others)",
     records_specs, run_column_spec, column_outputs("records"),
-    options=add_campaign_options, read_options=read_campaign_options))
+    options=ColumnFileOptions))
 
 
 def signal_window(record):
@@ -245,7 +250,7 @@ def synthetic_outputs(specs, campaign_dir, failures, animations, figures=True):
 
 register(Campaign("synthetic", "the twin model at synthetic sites around two sources",
                   synthetic_specs, run_column_spec, synthetic_outputs,
-                  options=add_campaign_options, read_options=read_campaign_options))
+                  options=ColumnFileOptions))
 
 
 # ---------------------------------------------------------------- real columns
@@ -339,25 +344,25 @@ def columns_outputs(specs, campaign_dir, failures, animations, figures=True):
             "figures": [str(p.relative_to(campaign_dir)) for p in written]}
 
 
-def columns_options(parser):
-    add_column_file_argument(parser, "default: all shipped", many=True, dest="column_files")
-    parser.add_argument("--column", choices=COLUMN_KINDS, default="both",
-                        help="both (default): each description and a monolith of its "
-                        "outline; drums: the description only; monolithic: the monolith only")
-    add_stiffness_argument(parser)
+@dataclass(frozen=True)
+class ColumnsOptions(CampaignOptions):
+    column_files: str = column_file_param("default: all shipped", many=True)
+    column: str = param("both", "", "both: each description and a monolith of its outline; "
+                        "drums: the description only; monolithic: the monolith only",
+                        flag="--column", choices=COLUMN_KINDS)
+    stiffness: str = stiffness_param("")
 
-
-def columns_read_options(args):
-    files = [f for f in (args.column_files or "").split(",") if f]
-    return {"column_files": files or None, "column": args.column, "stiffness": args.stiffness}
+    def kwargs(self):
+        files = [f for f in (self.column_files or "").split(",") if f]
+        return {"column_files": files or None, "column": self.column,
+                "stiffness": self.stiffness}
 
 
 register(Campaign(
     "columns", "real columns from descriptions (shipped: the paper's two, a Doric peristyle "
     "column, a Roman granite column) compared on the same records: toppled, direction, "
     "which block falls first",
-    columns_specs, run_column_spec, columns_outputs, options=columns_options,
-    read_options=columns_read_options))
+    columns_specs, run_column_spec, columns_outputs, options=ColumnsOptions))
 
 
 # ---------------------------------------------------------------- verification

@@ -35,6 +35,7 @@ every block, the tilt added to the described one, drum offsets on the blocks abo
 first that are not joined), and ``kn_factor`` multiplies the description's contact
 stiffness (``--stiffness``, as in ``campaign columns``).
 """
+from dataclasses import dataclass
 import math
 from pathlib import Path
 
@@ -44,9 +45,10 @@ from scipy.stats import qmc
 from pipeline.constants import COLUMN_KINDS
 from pipeline import paper
 from pipeline.campaign import Campaign, register
-from pipeline.campaign.column_file import (add_column_file_argument, add_stiffness_argument,
-                                           check_stiffness, column_kn, mark, perturbed,
-                                           read_campaign_options, summary_entry)
+from pipeline.campaign.column_file import (check_stiffness, column_kn, mark, perturbed,
+                                           summary_entry)
+from pipeline.campaign.options import CampaignOptions, column_file_param, stiffness_param
+from pipeline.scenario.parameters import param
 from pipeline.campaign.column_file import description as column_file_description
 from pipeline.campaign.definitions import column_specs, run_code_version, run_column_spec
 from pipeline.campaign.tables import collect, write_parquet
@@ -517,35 +519,41 @@ def run_sized(run, records, campaign_dir, options):
     return {**result, "summaries": summaries}
 
 
-def ensemble_options(parser):
-    parser.add_argument("--record", metavar="ID_OR_FILE", default=None,
-                        help="catalogue id, record file or processed .npz")
-    parser.add_argument("--column", choices=COLUMN_KINDS, default="both",
-                        help="column model (default both: the twin model)")
-    parser.add_argument("--members", type=int, default=DEFAULT_MEMBERS,
-                        help=f"members of the first Latin-hypercube batch, and of each batch "
-                        f"added (default {DEFAULT_MEMBERS})")
-    parser.add_argument("--precision", type=float, default=DEFAULT_PRECISION,
-                        help="members are added until P(toppled)'s 95 %% interval is within "
-                        f"+- this (default {DEFAULT_PRECISION:g}; 0-0.5)")
-    parser.add_argument("--arc-deg", type=float, default=DEFAULT_ARC_DEG,
-                        help="... and, where falls gather, the mean direction's 95 %% "
-                        f"interval narrower than this (deg, default {DEFAULT_ARC_DEG:g})")
-    parser.add_argument("--max-members", type=int, default=DEFAULT_MAX_MEMBERS,
-                        help="the most members per record (default "
-                        f"{DEFAULT_MAX_MEMBERS}; equal to --members: a fixed ensemble)")
-    parser.add_argument("--seed", type=int, default=DEFAULT_SEED,
-                        help=f"seed of the Latin hypercube (default {DEFAULT_SEED})")
-    parser.add_argument("--vary", action="append", default=[], metavar="NAME=LO,HI",
-                        help="override a range: " + ", ".join(
-                            f"{k} {v[0]:g}-{v[1]:g}" for k, v in ENSEMBLE_RANGES.items())
-                        + "; scale=LO,HI samples an amplitude scaling")
-    add_column_file_argument(parser, "every member is the described column with the sampled "
-                             "height and diameter tolerances on every block, the tilt added "
-                             "to its own and the drum offsets on the blocks above the first "
-                             "(joined blocks keep theirs); with --column both a monolith of "
-                             "its outline stands beside it")
-    add_stiffness_argument(parser, "with --column-file, what kn_factor multiplies")
+@dataclass(frozen=True)
+class EnsembleOptions(CampaignOptions):
+    record: str = param(None, "", "catalogue id, record file or processed .npz",
+                        flag="--record", metavar="ID_OR_FILE")
+    column: str = param("both", "", "column model (both: the twin model)", flag="--column",
+                        choices=COLUMN_KINDS)
+    members: int = param(DEFAULT_MEMBERS, "", "members of the first Latin-hypercube batch, "
+                         "and of each batch added", 1, 10000, flag="--members")
+    precision: float = param(DEFAULT_PRECISION, "", "members are added until P(toppled)'s "
+                             "95 % interval is within +- this", 0.0, 0.5, flag="--precision")
+    arc_deg: float = param(DEFAULT_ARC_DEG, "deg", "... and, where falls gather, the mean "
+                           "direction's 95 % interval narrower than this", 0.0, 360.0,
+                           flag="--arc-deg")
+    max_members: int = param(DEFAULT_MAX_MEMBERS, "", "the most members per record (equal "
+                             "to --members: a fixed ensemble)", 1, 10000, flag="--max-members")
+    seed: int = param(DEFAULT_SEED, "", "seed of the Latin hypercube", flag="--seed")
+    vary: tuple = param((), "", "override a range: " + ", ".join(
+        f"{k} {v[0]:g}-{v[1]:g}" for k, v in ENSEMBLE_RANGES.items())
+        + "; scale=LO,HI samples an amplitude scaling", flag="--vary", metavar="NAME=LO,HI")
+    column_file: str = column_file_param(
+        "every member is the described column with the sampled height and diameter "
+        "tolerances on every block, the tilt added to its own and the drum offsets on the "
+        "blocks above the first (joined blocks keep theirs); with --column both a monolith "
+        "of its outline stands beside it")
+    stiffness: str = stiffness_param("with --column-file, what kn_factor multiplies")
+
+    def check(self):
+        if not self.members <= self.max_members:
+            raise InputError(f"--max-members must lie in [--members, 10000], got "
+                             f"{self.max_members}")
+        check_seed(self.seed)
+        parse_vary(self.vary)
+
+    def kwargs(self):
+        return {**super().kwargs(), "vary": parse_vary(self.vary)}
 
 
 def parse_vary(items):
@@ -572,22 +580,7 @@ def parse_vary(items):
     return ranges
 
 
-def read_options(args):
-    if not (isinstance(args.members, int) and 1 <= args.members <= 10000):
-        raise InputError(f"--members must be an integer in [1, 10000], got {args.members!r}")
-    if not args.members <= args.max_members <= 10000:
-        raise InputError(f"--max-members must lie in [--members, 10000], got {args.max_members}")
-    if not (math.isfinite(args.precision) and 0.0 <= args.precision <= 0.5):
-        raise InputError(f"--precision must lie in [0, 0.5], got {args.precision:g}")
-    if not (math.isfinite(args.arc_deg) and 0.0 <= args.arc_deg <= 360.0):
-        raise InputError(f"--arc-deg must lie in [0, 360], got {args.arc_deg:g}")
-    return {"record": args.record, "column": args.column, "members": args.members,
-            "max_members": args.max_members, "precision": args.precision,
-            "arc_deg": args.arc_deg, "seed": check_seed(args.seed),
-            "vary": parse_vary(args.vary), **read_campaign_options(args)}
-
-
 register(Campaign("ensemble", "N members with sampled friction, damping, stiffness, "
                   "geometry tolerances and rim phase: probabilities of toppling and direction",
                   ensemble_specs, run_column_spec, ensemble_outputs, label="members",
-                  options=ensemble_options, read_options=read_options, driver=run_sized))
+                  options=EnsembleOptions, driver=run_sized))

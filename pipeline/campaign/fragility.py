@@ -32,6 +32,7 @@ With ``--column-file`` the members are the described column with the sampled hei
 diameter tolerances (its tilt and offsets as described, none sampled), and the 2D block
 has each member's overall height and base width (:func:`block_size`).
 """
+from dataclasses import dataclass
 import math
 import time
 from pathlib import Path
@@ -42,9 +43,9 @@ import pandas as pd
 from pipeline import paper
 from pipeline.campaign import Campaign, register
 from pipeline.campaign.run_dirs import finished_summary
-from pipeline.campaign.column_file import (add_column_file_argument, add_stiffness_argument,
-                                           check_stiffness, column_kn, mark,
-                                           read_campaign_options, summary_entry)
+from pipeline.campaign.column_file import (check_stiffness, column_kn, mark, summary_entry)
+from pipeline.campaign.options import CampaignOptions, column_file_param, stiffness_param
+from pipeline.scenario.parameters import param
 from pipeline.campaign.column_file import description as column_file_description
 from pipeline.campaign.definitions import (column_specs, motion_cache, pulse_record,
                                            run_code_version, run_column_spec)
@@ -438,36 +439,35 @@ def fragility_outputs(specs, campaign_dir, failures, animations, figures=True):
             "figures": [str(Path(p).relative_to(campaign_dir)) for p in written]}
 
 
-def fragility_options(parser):
-    parser.add_argument("--levels", default=",".join(f"{v:g}" for v in DEFAULT_LEVELS),
-                        metavar="A,A,...",
-                        help="horizontal PGA targets of the scaled records (m/s^2; default "
-                        "8 levels 0.5-8, geometric)")
-    parser.add_argument("--members", type=int, default=DEFAULT_MEMBERS,
-                        help=f"ensemble members per record and level (default {DEFAULT_MEMBERS}; "
-                        "sampled like campaign ensemble, the same at every level)")
-    parser.add_argument("--column", choices=COLUMN_KINDS, default="both",
-                        help="column model (default both: the twin model)")
-    parser.add_argument("--seed", type=int, default=ensemble.DEFAULT_SEED,
-                        help=f"seed of the Latin hypercube (default {ensemble.DEFAULT_SEED})")
-    parser.add_argument("--azimuths", type=int, default=DEFAULT_AZIMUTHS,
-                        help="2D block: shaking directions over 180 deg for its worst case "
-                        f"(default {DEFAULT_AZIMUTHS})")
-    add_column_file_argument(parser, "every member is the described column with the sampled "
-                             "height and diameter tolerances (tilt and offsets as described); "
-                             "the 2D block has its overall height and base width")
-    add_stiffness_argument(parser, "with --column-file, what kn_factor multiplies")
+@dataclass(frozen=True)
+class FragilityOptions(CampaignOptions):
+    levels: str = param(",".join(f"{v:g}" for v in DEFAULT_LEVELS), "m/s^2",
+                        "horizontal PGA targets of the scaled records (8 levels 0.5-8, "
+                        "geometric)", flag="--levels", metavar="A,A,...")
+    members: int = param(DEFAULT_MEMBERS, "", "ensemble members per record and level "
+                         "(sampled like campaign ensemble, the same at every level)", 1, 10000,
+                         flag="--members")
+    column: str = param("both", "", "column model (both: the twin model)", flag="--column",
+                        choices=COLUMN_KINDS)
+    seed: int = param(ensemble.DEFAULT_SEED, "", "seed of the Latin hypercube", flag="--seed")
+    azimuths: int = param(DEFAULT_AZIMUTHS, "", "2D block: shaking directions over 180 deg for "
+                          "its worst case", 1, 360, flag="--azimuths")
+    column_file: str = column_file_param(
+        "every member is the described column with the sampled height and diameter "
+        "tolerances (tilt and offsets as described); the 2D block has its overall height and "
+        "base width")
+    stiffness: str = stiffness_param("with --column-file, what kn_factor multiplies")
 
+    def check(self):
+        parse_levels(self.levels)
+        ensemble.check_seed(self.seed)
 
-def read_options(args):
-    return {"levels": parse_levels(args.levels), "members": args.members,
-            "column": args.column, "seed": ensemble.check_seed(args.seed),
-            "azimuths": args.azimuths,
-            **read_campaign_options(args)}
+    def kwargs(self):
+        return {**super().kwargs(), "levels": parse_levels(self.levels)}
 
 
 register(Campaign("fragility", "P(toppled | PGA, PGV, PGV/PGA) by incremental dynamic analysis: "
                   "records scaled to a PGA ladder, a small ensemble per level, lognormal and "
                   "logistic fits, the 2D rigid block side by side (default records GM20, NF04)",
                   fragility_specs, run_column_spec, fragility_outputs, label="runs",
-                  options=fragility_options, read_options=read_options))
+                  options=FragilityOptions))

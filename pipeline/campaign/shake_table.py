@@ -16,6 +16,7 @@ F1, confusion) are reported per split beside the trivial baselines ("never overt
 ``experiments.csv`` (per test and parameter set), ``shake_table.json`` (scores), the
 figure ``shake_table_rates.png`` (observed and predicted rate per PGA x PGV/PGA bin).
 """
+from dataclasses import dataclass
 import itertools
 import math
 from datetime import date
@@ -27,7 +28,8 @@ import pandas as pd
 from pipeline import RESULTS_DIR
 from pipeline.campaign import Campaign, register
 from pipeline.campaign.run_dirs import finished_summary
-from pipeline.campaign.column_file import add_column_file_argument
+from pipeline.campaign.options import CampaignOptions, column_file_param
+from pipeline.scenario.parameters import param
 from pipeline.files import InputError, write_csv, write_json
 from pipeline.records import RECORDS_DIR
 from pipeline.stats.classification import scores
@@ -277,40 +279,47 @@ def summarise(table, specimen, calibration, label, point, options):
 def _f(value):
     return "n/a" if value is None else f"{value:.3f}"
 
-def add_options(parser):
-    parser.add_argument("--experiments", type=Path, default=EXPERIMENTS, metavar="CSV",
-                        help="experiment table (default: the SP1 granite tests shipped in "
-                        "records/shake_table/tests.csv)")
-    parser.add_argument("--outcome", default=OUTCOME, metavar="COLUMN",
-                        help=f"column of the observed outcome, 1 = overturned (default {OUTCOME})")
-    add_column_file_argument(parser, "the specimen: a mesh specimen or column description "
-                             "(default records/shake_table/sp1.json, the scanned rock SP1)")
-    parser.add_argument("--validate-from", default=VALIDATE_FROM, metavar="YYYY-MM-DD",
-                        help="tests from this date on are held out for validation; the "
-                        f"earlier ones calibrate (default {VALIDATE_FROM})")
-    parser.add_argument("--grid", default=DEFAULT_GRID, metavar="NAME=V,V;NAME=V",
-                        help="parameter sets the calibration chooses from (Cartesian product; "
-                        f"default '{DEFAULT_GRID}'; names: "
-                        f"{', '.join([*GRID_CONTACT, *GRID_SPECIMEN, *GRID_MOTION])})")
-    parser.add_argument("--axis-deg", type=float, default=AXIS_DEG, metavar="DEG",
-                        help="azimuth of the table's shaking line, for the PGA-threshold "
-                        f"baseline's critical angle (default {AXIS_DEG:g}: East-West)")
-    parser.add_argument("--tests", default=None, metavar="TEST,TEST",
-                        help="only these tests (a quick look; default all)")
+@dataclass(frozen=True)
+class ShakeTableOptions(CampaignOptions):
+    experiments: Path = param(EXPERIMENTS, "", "experiment table (default: the SP1 granite "
+                              "tests shipped in records/shake_table/tests.csv)",
+                              flag="--experiments", metavar="CSV")
+    outcome: str = param(OUTCOME, "", "column of the observed outcome, 1 = overturned",
+                         flag="--outcome", metavar="COLUMN")
+    column_file: str = column_file_param(
+        "the specimen: a mesh specimen or column description (default "
+        "records/shake_table/sp1.json, the scanned rock SP1)")
+    validate_from: str = param(VALIDATE_FROM, "", "tests from this date on are held out for "
+                               "validation; the earlier ones calibrate",
+                               flag="--validate-from", metavar="YYYY-MM-DD")
+    grid: str = param(DEFAULT_GRID, "", "parameter sets the calibration chooses from "
+                      "(Cartesian product; names: "
+                      f"{', '.join([*GRID_CONTACT, *GRID_SPECIMEN, *GRID_MOTION])})",
+                      flag="--grid", metavar="NAME=V,V;NAME=V")
+    axis_deg: float = param(AXIS_DEG, "deg", "azimuth of the table's shaking line, for the "
+                            "PGA-threshold baseline's critical angle (90: East-West)",
+                            0.0, 360.0, flag="--axis-deg", metavar="DEG")
+    tests: str = param(None, "", "only these tests (a quick look; default all)",
+                       flag="--tests", metavar="TEST,TEST")
 
-def read_options(args):
-    try:
-        date.fromisoformat(args.validate_from)
-    except ValueError:
-        raise InputError(f"--validate-from {args.validate_from!r}: expected yyyy-mm-dd") from None
-    parse_grid(args.grid)
-    load_experiments(args.experiments, args.outcome)
-    if not (math.isfinite(args.axis_deg) and 0.0 <= args.axis_deg < 360.0):
-        raise InputError(f"--axis-deg must be in [0, 360), got {args.axis_deg:g}")
-    tests = [t for t in (args.tests or "").split(",") if t] or None
-    return {"experiments": args.experiments, "outcome": args.outcome,
-            "specimen": args.column_file or SPECIMEN, "validate_from": args.validate_from,
-            "grid": args.grid, "tests": tests, "axis_deg": args.axis_deg}
+    def check(self):
+        try:
+            date.fromisoformat(self.validate_from)
+        except (TypeError, ValueError):
+            raise InputError(f"--validate-from {self.validate_from!r}: expected "
+                             "yyyy-mm-dd") from None
+        if self.axis_deg >= 360.0:
+            raise InputError(f"--axis-deg must be in [0, 360), got {self.axis_deg:g}")
+        parse_grid(self.grid)
+        load_experiments(self.experiments, self.outcome)
+
+    def kwargs(self):
+        return {"experiments": self.experiments, "outcome": self.outcome,
+                "specimen": self.column_file or SPECIMEN,
+                "validate_from": self.validate_from, "grid": self.grid,
+                "tests": [t for t in (self.tests or "").split(",") if t] or None,
+                "axis_deg": self.axis_deg}
+
 
 def _worker(spec, run_dir):
     from pipeline.campaign.definitions import run_column_spec
@@ -319,7 +328,6 @@ def _worker(spec, run_dir):
 register(Campaign(
     "shake-table", "a specimen (default the scanned granite rock SP1) against shake-table "
     "experiments: calibrate on the early tests, validate on the held-out later ones",
-    specs, _worker, outputs, label="experiments", options=add_options,
-    read_options=read_options, driver=drive))
+    specs, _worker, outputs, label="experiments", options=ShakeTableOptions, driver=drive))
 
 RESULTS = RESULTS_DIR / "shake-table"

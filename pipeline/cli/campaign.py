@@ -5,6 +5,7 @@
 from pathlib import Path
 
 from pipeline import campaign
+from pipeline.cli._fields import add_arguments, from_args
 from pipeline.files import InputError
 from pipeline.records import sets
 
@@ -41,7 +42,7 @@ def setup(p):
         q.add_argument("--animations", type=int, default=1,
                        help="number of toppled runs to animate as GIF (default 1)")
         if definition.options:
-            definition.options(q)
+            add_arguments(q, definition.options)
 
 
 def run(args):
@@ -56,7 +57,11 @@ def run(args):
             raise InputError("give either --records or --set, not both")
         records = sets.record_ids(record_set)
     definition = campaign.get(args.name)
-    options = definition.read_options(args) if definition.read_options else {}
+    options = {}
+    if definition.options:
+        options = from_args(definition.options, args).kwargs()
+        if definition.options.TAKES_JOBS:
+            options["jobs"] = args.jobs
     def run_once(opts):
         return campaign.run_campaign(args.name, jobs=args.jobs, records=records,
                                      campaign_dir=args.out, animations=args.animations,

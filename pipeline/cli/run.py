@@ -6,13 +6,12 @@ import math
 from pathlib import Path
 
 from pipeline import RESULTS_DIR
-from pipeline.campaign.column_file import add_column_file_argument
 from pipeline.constants import COLUMN_TYPES
 from pipeline.files import DirectoryLock, InputError
 from pipeline.records import processed_motion, resolve
 from pipeline.scenario import Column, Contact, Numerics
-from pipeline.scenario.parameters import (add_arguments, check_cost, check_time_step,
-                                          from_args, scene_params)
+from pipeline.cli._fields import add_arguments, add_column_file_argument, from_args
+from pipeline.scenario.parameters import check_cost, check_time_step, scene_params
 from pipeline.scenario.runner import wall_limit_s
 from pipeline.simulate import MAX_SCALE, back_azimuth_of, check_scale, simulate
 

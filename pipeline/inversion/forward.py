@@ -25,11 +25,14 @@ column parameters at every node).  The runs are the campaign ``inversion-forward
 executor, so they are cached by content (run id = hash of motion, parameters and code) and
 a second inversion reuses every finished run.
 """
+from dataclasses import dataclass
 import time
 from pathlib import Path
 
 from pipeline import RESULTS_DIR
 from pipeline.campaign import Campaign, register
+from pipeline.campaign.options import CampaignOptions
+from pipeline.scenario.parameters import param
 from pipeline.campaign.definitions import column_specs, run_column_spec
 from pipeline.files import InputError, write_csv
 from pipeline.inversion.grid import GRIDS, TableGrid, node_positions, slice_motions
@@ -114,16 +117,17 @@ def run_forward(grid, campaign_dir=None, jobs=None, scheduler=None):
     return table, cost
 
 
-def _forward_options(parser):
-    parser.add_argument("--grid", choices=sorted(GRIDS), default="full",
-                        help="forward grid preset (see python -m pipeline invert --help)")
+@dataclass(frozen=True)
+class ForwardOptions(CampaignOptions):
+    grid: str = param("full", "", "forward grid preset (see python -m pipeline invert --help)",
+                      flag="--grid", choices=tuple(sorted(GRIDS)))
+    TAKES_JOBS = True           # pyprop8 shares the command's processes
 
-
-def _read_forward_options(args):
-    return {"grid": GRIDS[args.grid], "jobs": args.jobs}
+    def kwargs(self):
+        return {"grid": GRIDS[self.grid]}
 
 
 register(Campaign("inversion-forward", "forward table of the source inversion: twin-model "
                   "ensembles at (mechanism, depth, magnitude, distance, azimuth from strike)",
                   forward_specs, run_column_spec, forward_outputs, label="runs",
-                  options=_forward_options, read_options=_read_forward_options))
+                  options=ForwardOptions))

@@ -31,12 +31,14 @@ STABLE_DT_FRACTION = 0.75
 CONVERGED_DT_FACTOR = 0.3     # outcomes converged up to this factor (make bench, section 5)
 
 
-def param(default, unit, help, low=None, high=None, flag=None, low_open=False, choices=None):
+def param(default, unit, help, low=None, high=None, flag=None, low_open=False, choices=None,
+          metavar=None):
     """A dataclass field with unit, help text, bounds [low, high] (low excluded when
-    ``low_open``) and its command-line flag."""
+    ``low_open``), its command-line flag and the flag's metavar (the command line builds
+    the flags: :mod:`pipeline.cli._fields`)."""
     return field(default=default, metadata={"unit": unit, "help": help, "low": low, "high": high,
                                             "low_open": low_open, "flag": flag,
-                                            "choices": choices})
+                                            "choices": choices, "metavar": metavar})
 
 
 def check_fields(obj):
@@ -326,32 +328,6 @@ def check_rims(geometry, rim_sphere_radius):
         if min(sizes) < 4 * rim_sphere_radius:
             raise InputError(f"{geometry.name}: block {k} is {min(sizes):g} m thin, less "
                              f"than 4 contact sphere radii ({rim_sphere_radius:g} m)")
-
-
-def add_arguments(parser, cls, names=None):
-    """Add the flagged fields of parameter dataclass ``cls`` to an argparse parser,
-    with their defaults, units and help (defaults None: the dataclass decides)."""
-    for f in dataclasses.fields(cls):
-        meta = f.metadata
-        if not meta.get("flag") or (names is not None and f.name not in names):
-            continue
-        unit = f" ({meta['unit']})" if meta.get("unit") else ""
-        default = "" if f.default is None else f"; default {f.default:g}" \
-            if isinstance(f.default, (int, float)) else f"; default {f.default}"
-        bounds = "" if meta.get("low") is None else f"; {meta['low']:g}-{meta['high']:g}"
-        kwargs = {"dest": f.name, "default": None, "help": f"{meta['help']}{unit}{default}{bounds}"}
-        if meta.get("choices"):
-            kwargs["choices"] = meta["choices"]
-        else:
-            kwargs["type"] = int if f.type in (int, "int") else float
-        parser.add_argument(meta["flag"], **kwargs)
-
-
-def from_args(cls, args, **fixed):
-    """An instance of ``cls`` from parsed arguments (fields left None keep defaults)."""
-    values = {f.name: getattr(args, f.name) for f in dataclasses.fields(cls)
-              if getattr(args, f.name, None) is not None}
-    return cls(**{**values, **fixed})
 
 
 def split_options(options):

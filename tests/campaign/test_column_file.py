@@ -10,6 +10,7 @@ import math
 import numpy as np
 import pytest
 
+from pipeline.cli._fields import from_args
 from pipeline import campaign, cli, paper
 from pipeline.campaign import fragility
 from pipeline.campaign.column_file import at_slenderness, column_file_help, perturbed
@@ -129,7 +130,7 @@ def test_one_option_definition_and_help_text(name):
     action = next(a for a in sub._actions if "--column-file" in a.option_strings)
     assert action.help.startswith(column_file_help(many=name == "columns"))
     args = parser.parse_args(["campaign", name, "--column-file", DORIC])
-    options = campaign.get(name).read_options(args)
+    options = from_args(campaign.get(name).options, args).kwargs()
     assert DORIC in (options.get("column_file"), *(options.get("column_files") or []))
 
 

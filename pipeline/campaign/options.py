@@ -1,0 +1,50 @@
+"""A campaign's own options, declared as :func:`~pipeline.scenario.parameters.param`
+fields of a frozen dataclass (the command line builds their flags:
+:mod:`pipeline.cli._fields`).  ``__post_init__`` checks every value before any work;
+:meth:`CampaignOptions.kwargs` gives the keyword options of the campaign's ``specs``."""
+from dataclasses import dataclass, fields
+
+from pipeline import paper
+from pipeline.campaign.column_file import STIFFNESS_CHOICES, column_file_help
+from pipeline.scenario.parameters import check_fields, param
+
+CAMPAIGN_NOTE = ("the described column stands in the drums' place and a monolith of its "
+                 "outline in the monolith's")
+STIFFNESS_HELP = ("contact stiffness per point: matched raises the paper's kn for heavy "
+                  "columns so that each rocks on its contact springs no slower than the "
+                  f"paper's column (13.5 Hz); paper: {paper.COLUMN_KN_N_M:g} N/m for all")
+
+
+def column_file_param(note="", many=False):
+    """The ``--column-file NAME_OR_FILE`` field; ``note``: what the campaign does with it."""
+    return param(None, "", column_file_help(many) + (f"; {note}" if note else ""),
+                 flag="--column-file", metavar="NAME_OR_FILE,..." if many else "NAME_OR_FILE")
+
+
+def stiffness_param(note="with --column-file"):
+    return param("matched", "", (f"{note}: " if note else "") + STIFFNESS_HELP,
+                 flag="--stiffness", choices=STIFFNESS_CHOICES)
+
+
+@dataclass(frozen=True)
+class CampaignOptions:
+    """No options of its own.  Subclasses declare fields and may add :meth:`check`."""
+    TAKES_JOBS = False          # the specs want the command's --jobs (keyword ``jobs``)
+
+    def __post_init__(self):
+        check_fields(self)
+        self.check()
+
+    def check(self):
+        """Checks across fields (InputError)."""
+
+    def kwargs(self):
+        """Keyword options of the campaign's ``specs``."""
+        return {f.name: getattr(self, f.name) for f in fields(self)}
+
+
+@dataclass(frozen=True)
+class ColumnFileOptions(CampaignOptions):
+    """A campaign of the twin model that can shake a described column instead."""
+    column_file: str = column_file_param(CAMPAIGN_NOTE)
+    stiffness: str = stiffness_param()
