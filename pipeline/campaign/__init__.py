@@ -6,11 +6,15 @@ campaign, verification included, goes through :func:`run_campaign`: the
 executor (:mod:`pipeline.campaign.executor`) runs what is not finished yet,
 then the campaign writes its tables and figures.
 
-A run spec is a dict with ``run_id`` (content hash of its inputs and of the code
-that turns them into an outcome), ``record``/``record_id`` and the parameters.
+A run spec is a :class:`~pipeline.campaign.spec.RunSpec` (its ``run_id`` the content hash
+of its inputs and of the code that turns them into an outcome); a finished run leaves a
+:class:`~pipeline.outcome.summary.RunSummary`.
 """
+import importlib
 import os
+import pkgutil
 import shutil
+from importlib.metadata import entry_points
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable
@@ -44,13 +48,18 @@ def register(campaign):
     return campaign
 
 
+ENTRY_POINTS = "toppling_columns.campaigns"
+
+
 def discover():
     """Import every module of this package (found with pkgutil, as readers and commands
-    are): each campaign module registers its definitions when imported."""
-    import importlib
-    import pkgutil
+    are) and the campaign modules of the stages above it, named as entry points
+    ``toppling_columns.campaigns`` in pyproject.toml: each registers its definitions when
+    imported."""
     for info in pkgutil.iter_modules(__path__):
         importlib.import_module(f"{__name__}.{info.name}")
+    for entry in entry_points(group=ENTRY_POINTS):
+        importlib.import_module(entry.value)
 
 
 def get(name):

@@ -13,8 +13,6 @@ from pathlib import Path
 from pipeline.constants import COLUMN_TYPES
 from pipeline import RESULTS_DIR
 from pipeline.files import InputError
-from pipeline.inversion import forward as _forward  # noqa: F401  (registers the campaign
-#                                                     inversion-forward before `campaign`)
 
 NAME = "invert"
 ORDER = 45

@@ -38,3 +38,17 @@ def test_a_spec_is_read_only_and_checked():
         RunSpec("A", "A", "/m.npz", {}, "")
     with pytest.raises(InputError, match="lacks params"):
         RunSpec.from_dict({"record": "A", "record_id": "A", "motion_file": "m", "run_id": "i"})
+
+
+def test_every_campaign_is_found_without_importing_its_module_first():
+    """Campaigns outside pipeline.campaign (the inversion's) come from the entry points,
+    not from a command that happens to import them."""
+    import subprocess
+    import sys
+    code = ("from pipeline import campaign; import sys; "
+            "print(' '.join(campaign.names())); "
+            "print('pipeline.cli.invert' in sys.modules)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         check=True).stdout.split("\n")
+    assert {"inversion-forward", "inversion-truth", "ensemble"} <= set(out[0].split())
+    assert out[1] == "False"
