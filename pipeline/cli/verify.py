@@ -6,7 +6,7 @@
 """
 from pathlib import Path
 
-from pipeline import RESULTS_DIR
+from pipeline import RESULTS_DIR, paper
 from pipeline.files import write_json
 from pipeline.verification import (MARBLE_BLOCK, PULSE_BLOCK, verify_housner, verify_sine_pulse,
                                    verify_sliding)
@@ -34,7 +34,8 @@ def setup(p):
     sl.add_argument("--mu-s", type=float, nargs="+", default=None, help="static friction values")
     sl.add_argument("--theta0-deg", type=float, default=10.0, help="initial tilt (10 deg)")
     sl.add_argument("--friction", choices=["switch", "static"], default="switch",
-                    help="switch: mu_s sticking, mu_k = 0.84 mu_s sliding (default); "
+                    help=f"switch: mu_s sticking, mu_k = {paper.MU_K_OVER_MU_S:g} mu_s sliding "
+                    "(default); "
                     "static: mu_s only, to see the effect of the kinetic coefficient")
     for q in (h, s, sl):
         q.add_argument("--kn", type=float, default=None, help="face contact stiffness N/m")

@@ -79,8 +79,9 @@ class Contact:
                            "the explicit contact law is unstable above ~1.2)",
                            0.0, 1.0, "--damping")
     mu_s: float = param(paper.MU_STATIC, "", "static friction coefficient", 0.01, 2.0, "--mu-s")
-    mu_k: float = param(None, "", "kinetic friction coefficient (default: 0.6 with the paper's "
-                        "mu_s 0.7, else 0.84 mu_s)", None, None, "--mu-k")
+    mu_k: float = param(None, "", "kinetic friction coefficient (default: "
+                        f"{paper.MU_KINETIC:g} with the paper's mu_s {paper.MU_STATIC:g}, else "
+                        f"{paper.MU_K_OVER_MU_S:g} mu_s)", None, None, "--mu-k")
 
     def __post_init__(self):
         if self.mu_k is None:
