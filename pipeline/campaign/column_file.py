@@ -29,7 +29,7 @@ STIFFNESS_CHOICES = ("matched", "paper")
 
 def column_file_help(many=False):
     """Help text of ``--column-file`` (without what a command adds)."""
-    from pipeline.scenario.geometry import example_names
+    from pipeline.scenario.column_format import example_names
     what = ("comma-separated column descriptions" if many else
             "the column as found, from a description")
     return (f"{what} (JSON, or YAML with PyYAML; docs/columns-and-model.md) or "

@@ -260,7 +260,8 @@ def columns_specs(records, campaign_dir, column_files=None, column="both",
     (default: the sweep record and the pulse record), each with a monolith of its
     outline beside it (``column`` both); ``stiffness`` "matched" gives each column the
     contact stiffness of :func:`matched_kn`, "paper" the paper's kn for all."""
-    from pipeline.scenario.geometry import ColumnGeometry, example_names
+    from pipeline.scenario.column_format import example_names
+    from pipeline.scenario.geometry import ColumnGeometry
     names = list(column_files) if column_files else example_names()
     geometries = [ColumnGeometry.load(name) for name in names]
     if column not in COLUMN_KINDS:

@@ -177,7 +177,8 @@ def described_member(data, v, seed, index):
     """Member ``index`` of a described column from its sampled values ``v``.  Validated
     before anything runs without the sampled offsets (sizes, tilts, statics: milliseconds;
     a member with offset joints takes about a second), whose size is checked alone."""
-    from pipeline.scenario.geometry import MAX_OFFSET_M, ColumnGeometry
+    from pipeline.scenario.column_format import MAX_OFFSET_M
+    from pipeline.scenario.geometry import ColumnGeometry
     args = (data, 1 + v.get("height_tolerance", 0.0), 1 + v.get("diameter_tolerance", 0.0),
             v.get("tilt_deg", 0.0), v.get("tilt_azimuth_deg", 0.0))
     member = perturbed(*args, v.get("drum_offset_mm", 0.0) / 1000.0,

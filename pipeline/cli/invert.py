@@ -199,7 +199,7 @@ def described_columns(observations, base_dir="."):
     column file (a shipped example's name, or a file, relative to ``base_dir`` (the
     observations file's folder) when it is there); one-line errors before anything runs."""
     from pipeline.campaign.column_file import description
-    from pipeline.scenario.geometry import example_names
+    from pipeline.scenario.column_format import example_names
     out = {}
     for name in observations.column_types():
         if name in COLUMN_TYPES:

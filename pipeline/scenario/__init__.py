@@ -5,7 +5,8 @@ A scenario directory holds ``params.json`` (every parameter), ``motion.npz``
 :mod:`pipeline.motion`) and ``scene.py``, an unchanged copy of
 ``yade_scripts/column_scene.py``; running it writes ``trajectory.npz``.
 """
-from pipeline.scenario.geometry import ColumnGeometry, ColumnSpec
+from pipeline.scenario.bodies import ColumnSpec
+from pipeline.scenario.geometry import ColumnGeometry
 from pipeline.scenario.parameters import (PEDESTAL, Block, Column, Contact, Numerics,
                                           scene_params)
 from pipeline.scenario.runner import YadeError, run_yade

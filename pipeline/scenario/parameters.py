@@ -12,7 +12,8 @@ from dataclasses import dataclass, field
 from pipeline.constants import COLUMN_KINDS, COLUMN_TYPES
 from pipeline import paper
 from pipeline.files import InputError
-from pipeline.scenario.geometry import ColumnGeometry, ColumnSpec
+from pipeline.scenario.bodies import ColumnSpec
+from pipeline.scenario.geometry import ColumnGeometry
 
 RIM_SPHERE_RADIUS_M = 0.005   # rim contact spheres of the columns
 MIN_BODY_SIZE_M = 10 * RIM_SPHERE_RADIUS_M   # a drum must hold its two rims of spheres

@@ -9,16 +9,11 @@ from scipy import integrate
 
 from pipeline.files import InputError
 from pipeline.scenario import Block, Column, scene_params
-from pipeline.scenario.geometry import (
-    Box,
-    ColumnGeometry,
-    ColumnSpec,
-    Frustum,
-    Outline,
-    contact_outline,
-    example_names,
-    perimeter_points,
-)
+from pipeline.scenario.bodies import ColumnSpec
+from pipeline.scenario.column_format import example_names
+from pipeline.scenario.geometry import ColumnGeometry
+from pipeline.scenario.outline import Outline, contact_outline, perimeter_points
+from pipeline.scenario.solids import Box, Frustum
 
 DENSITY = 2700.0
 

@@ -31,14 +31,14 @@ from pipeline.inversion.observations import (  # noqa: E402
     parse_observations,
 )
 from pipeline.userfiles import MAX_FILE_BYTES  # noqa: E402
-from pipeline.scenario.geometry import (  # noqa: E402
+from pipeline.scenario.column_format import (  # noqa: E402
     BLOCK_KEYS,
     EXAMPLES_DIR,
     OPTIONAL_BLOCK_KEYS,
     TOP_KEYS,
-    ColumnGeometry,
     example_names,
 )
+from pipeline.scenario.geometry import ColumnGeometry  # noqa: E402
 
 yaml = pytest.importorskip("yaml")
 
