@@ -15,6 +15,7 @@ from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
+from pipeline import PROJECT_ROOT
 
 
 class ToolError(Exception):
@@ -94,7 +95,6 @@ def code_hash(*packages):
     """Hex digest (16 chars) of every ``*.py`` file under the named sub-packages or
     modules of :mod:`pipeline` (e.g. ``"scenario", "simulate"``), else of project
     directories (``"yade_scripts"``): it changes whenever the code of a stage changes."""
-    from pipeline import PROJECT_ROOT
     h = hashlib.sha256()
     for name in packages:
         package = PROJECT_ROOT / "pipeline" / name

@@ -2,6 +2,7 @@
 import functools
 import importlib.metadata
 from pathlib import Path
+from pipeline import __version__
 
 YADE_PY_PATH = "/usr/lib/x86_64-linux-gnu/yade-double/py"   # Debian 12's package
 
@@ -20,7 +21,6 @@ def yade_version():
 
 def software_versions():
     """Versions (dict) of the package, obspy, numpy, scipy and YADE, for provenance."""
-    from pipeline import __version__
     versions = {"toppling-columns": __version__}
     for dist in ("obspy", "numpy", "scipy"):
         try:

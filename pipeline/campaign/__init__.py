@@ -21,6 +21,8 @@ from typing import Callable
 
 from pipeline import RESULTS_DIR
 from pipeline.files import DirectoryLock, InputError, ToolError, write_json
+from pipeline.campaign.executor import EXECUTORS
+from pipeline.campaign.executor import execute
 
 CAMPAIGNS = {}
 
@@ -84,7 +86,6 @@ def run_campaign(name, jobs=None, records=None, campaign_dir=None, animations=1,
     Ctrl-C stops within seconds: no new run starts, running YADE processes end,
     the tables of the finished runs are written, then KeyboardInterrupt propagates.
     """
-    from pipeline.campaign.executor import EXECUTORS
     campaign = get(name)
     if executor is not None and executor not in EXECUTORS:
         raise InputError(f"--executor must be one of {', '.join(EXECUTORS)}, got {executor!r}")
@@ -159,7 +160,6 @@ def reuse_finished(specs, campaign_dir, worker):
 
 def _run_specs(campaign, name, specs, campaign_dir, jobs, animations, executor, scheduler):
     """Execute the specs and write the campaign's outputs (see :func:`run_campaign`)."""
-    from pipeline.campaign.executor import execute
     with DirectoryLock(campaign_dir, wait=False):
         inside = RESULTS_DIR.resolve() in Path(campaign_dir).resolve().parents
         reused = reuse_finished(specs, campaign_dir, campaign.worker) if inside else 0

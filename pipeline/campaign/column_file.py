@@ -23,13 +23,14 @@ import math
 
 from pipeline import paper
 from pipeline.files import InputError
+from pipeline.scenario.column_format import example_names
+from pipeline.scenario.geometry import ColumnGeometry
 
 STIFFNESS_CHOICES = ("matched", "paper")
 
 
 def column_file_help(many=False):
     """Help text of ``--column-file`` (without what a command adds)."""
-    from pipeline.scenario.column_format import example_names
     what = ("comma-separated column descriptions" if many else
             "the column as found, from a description")
     return (f"{what} (JSON, or YAML with PyYAML; docs/columns-and-model.md) or "
@@ -42,7 +43,6 @@ def description(column_file, meshes=False):
     None for None.  InputError (one line) for an unknown name, a missing file or a
     description that does not validate, and for a mesh specimen unless ``meshes`` (a
     campaign that scales or perturbs blocks cannot take one)."""
-    from pipeline.scenario.geometry import ColumnGeometry
     if column_file is None:
         return None
     if isinstance(column_file, dict):
@@ -68,7 +68,6 @@ def check_stiffness(stiffness):
 def column_kn(data, stiffness="matched"):
     """Contact stiffness per point (N/m) for a description: the campaign ``columns`` rule
     (:func:`matched_kn`) or the paper's kn."""
-    from pipeline.scenario.geometry import ColumnGeometry
     check_stiffness(stiffness)
     if stiffness == "paper":
         return paper.COLUMN_KN_N_M
@@ -77,7 +76,6 @@ def column_kn(data, stiffness="matched"):
 
 def slenderness_of(data):
     """Overall height over base width of a description."""
-    from pipeline.scenario.geometry import ColumnGeometry
     g = ColumnGeometry.from_dict(data)
     return g.height / g.base_width
 
@@ -90,7 +88,6 @@ def at_slenderness(data, hd):
     """The description with every block height multiplied by hd / (its height / base
     width), so that its overall h/d is ``hd``; validated (InputError when the scaled
     column breaks a limit of the format, e.g. a block above 30 m)."""
-    from pipeline.scenario.geometry import ColumnGeometry
     factor = hd / slenderness_of(data)
     blocks = [{**b, "height": round(b["height"] * factor, 9)} for b in data["blocks"]]
     scaled = {**data, "name": _name(data, f" at h/d {hd:g}"), "blocks": blocks}
@@ -154,7 +151,6 @@ def matched_kn(geometry):
     slower than the paper's column does with the paper's kn (13.5 Hz): the paper's kn for
     columns of its size, more for heavier ones (kn scales with the square of the
     frequency), rounded to two significant digits."""
-    from pipeline.scenario.geometry import ColumnGeometry
     reference = ColumnGeometry.monolith(paper.COLUMN_HEIGHT_M,
                                         paper.COLUMN_HEIGHT_M / paper.COLUMN_HD,
                                         paper.MARBLE_DENSITY_KG_M3)

@@ -33,6 +33,8 @@ from pipeline.campaign.ensemble import (DEFAULT_SEED, ENSEMBLE_RANGES, check_see
                                         sample_batches)
 from pipeline.campaign.tables import collect
 from pipeline.files import InputError, write_csv, write_json
+from pipeline.stats.circular import circular_summary
+from pipeline.stats.ensemble import compare_ensembles, holm_reject, wilson_interval
 
 DEFAULT_RECORDS = ("RSN126-GAZLI", "RC-CCC", "NF04")
 DEFAULT_MEMBERS = 32
@@ -100,8 +102,6 @@ def wall_per_member(specs, campaign_dir):
 def compare_variants(runs, cost_per_member=None):
     """Every variant's P(toppled) and fall directions against the defaults' (see the
     module docstring); ``cost_per_member``: {variant: wall s per member}."""
-    from pipeline.stats.circular import circular_summary
-    from pipeline.stats.ensemble import compare_ensembles, holm_reject, wilson_interval
     rows = []
     for (record_id, column), group in runs.groupby(["record_id", "column"], sort=True):
         ref = group[group["variant"] == REFERENCE]

@@ -23,6 +23,17 @@ from pipeline.scenario import Column, Contact, Numerics
 from pipeline.scenario.parameters import param
 from pipeline.simulate import run_code_version, simulate
 from pipeline.stats.circular import direction_statistics
+from pipeline import figures as figure_module
+from pipeline.records import sets
+from pipeline.motion import synthetics
+from pipeline.motion.synthetics import rupture_centre
+from pipeline.stats.circular import direction_table
+from pipeline.stats.location import locate_source_from_falls
+from pipeline.scenario.column_format import example_names
+from pipeline.scenario.geometry import ColumnGeometry
+from pipeline.files import write_text
+from pipeline import verification
+from pipeline.files import write_json
 
 
 NUMERICS_FIELDS = {f.name for f in dataclasses.fields(Numerics)}
@@ -118,7 +129,6 @@ def column_outputs(name, size_by=None):
         if not runs.empty:
             write_csv(campaign_dir / "direction_statistics.csv", direction_statistics(runs))
             if figures:
-                from pipeline import figures as figure_module   # matplotlib: not after Ctrl-C
                 written = figure_module.campaign_figures(name, runs, impacts, campaign_dir,
                                                          size_by, animations)
         toppled = runs.groupby("column")["toppled"].agg(["sum", "count"]) if not runs.empty \
@@ -184,7 +194,6 @@ register(Campaign(
 
 
 def _nearsource_records():
-    from pipeline.records import sets
     return sets.record_ids("nearsource")
 
 
@@ -215,7 +224,6 @@ def signal_window(record):
 
 
 def synthetic_specs(records, campaign_dir, column_file=None, stiffness="matched"):
-    from pipeline.motion import synthetics
     data = description(column_file, meshes=True)
     check_stiffness(stiffness)
     paths = list(records) if records else [
@@ -230,9 +238,6 @@ def synthetic_specs(records, campaign_dir, column_file=None, stiffness="matched"
 
 def synthetic_outputs(specs, campaign_dir, failures, animations, figures=True):
     from pipeline.figures.synthetic_map import plot_downfall_map
-    from pipeline.motion.synthetics import rupture_centre
-    from pipeline.stats.circular import direction_table
-    from pipeline.stats.location import locate_source_from_falls
     result = column_outputs("synthetic")(specs, campaign_dir, failures, animations, figures)
     runs, _ = collect(specs, "synthetic", campaign_dir)
     if runs.empty or "source" not in runs.columns:
@@ -260,8 +265,6 @@ def columns_specs(records, campaign_dir, column_files=None, column="both",
     (default: the sweep record and the pulse record), each with a monolith of its
     outline beside it (``column`` both); ``stiffness`` "matched" gives each column the
     contact stiffness of :func:`matched_kn`, "paper" the paper's kn for all."""
-    from pipeline.scenario.column_format import example_names
-    from pipeline.scenario.geometry import ColumnGeometry
     names = list(column_files) if column_files else example_names()
     geometries = [ColumnGeometry.load(name) for name in names]
     if column not in COLUMN_KINDS:
@@ -289,7 +292,6 @@ def columns_table(specs, campaign_dir):
     threshold (g units, statics) beside them."""
     import pandas as pd
 
-    from pipeline.scenario.geometry import ColumnGeometry
     rows = []
     for spec in specs:
         summary = finished_summary(campaign_dir, spec["run_id"])
@@ -332,7 +334,6 @@ def columns_outputs(specs, campaign_dir, failures, animations, figures=True):
     write_csv(campaign_dir / "columns.csv", table)
     shown = table.drop(columns=["run_id", "back_azimuth_deg", "first_to_strike_index"])
     text = shown.to_markdown(index=False, floatfmt=".3g") if not table.empty else "(no runs)"
-    from pipeline.files import write_text
     write_text(campaign_dir / "columns.md", "# Real columns on the same records\n\n"
                "uplift_ratio: rocking threshold / g from statics (d/h for a cylinder).\n\n"
                + text + "\n")
@@ -368,7 +369,6 @@ register(Campaign(
 
 # ---------------------------------------------------------------- verification
 def verification_specs(records, campaign_dir):
-    from pipeline import verification
     if records:
         raise InputError("the verification campaign takes no --records")
     version = content_hash(run_code_version(), code_hash("verification", "rocking"))
@@ -379,9 +379,7 @@ def verification_specs(records, campaign_dir):
 
 
 def verification_outputs(specs, campaign_dir, failures, animations, figures=True):
-    from pipeline import verification
     from pipeline.figures.verification import plot_verification
-    from pipeline.files import write_json
     results = []
     for spec in specs:
         path = Path(campaign_dir) / "runs" / spec["run_id"] / "summary.json"
@@ -398,7 +396,6 @@ def verification_outputs(specs, campaign_dir, failures, animations, figures=True
 
 
 def _verification_worker(spec, run_dir):
-    from pipeline import verification
     verification.run_spec(spec, run_dir)
 
 

@@ -56,6 +56,13 @@ from pipeline.files import InputError, write_csv, write_json
 from pipeline.scenario import Contact, Numerics
 from pipeline.scenario.parameters import check_time_step
 from pipeline.simulate import check_scale
+from pipeline.scenario.column_format import MAX_OFFSET_M
+from pipeline.scenario.geometry import ColumnGeometry
+from pipeline.stats.circular import angle_difference_deg
+from pipeline.stats.ensemble import pooled_answer
+from pipeline.stats.circular import circular_summary
+from pipeline.stats.ensemble import (bootstrap_mean_azimuth_ci, direction_fractions,
+                                     wilson_interval)
 
 DEFAULT_MEMBERS = 16
 KEPT_TRAJECTORIES = 2          # the nominal run and the first members keep trajectory.npz
@@ -177,8 +184,6 @@ def described_member(data, v, seed, index):
     """Member ``index`` of a described column from its sampled values ``v``.  Validated
     before anything runs without the sampled offsets (sizes, tilts, statics: milliseconds;
     a member with offset joints takes about a second), whose size is checked alone."""
-    from pipeline.scenario.column_format import MAX_OFFSET_M
-    from pipeline.scenario.geometry import ColumnGeometry
     args = (data, 1 + v.get("height_tolerance", 0.0), 1 + v.get("diameter_tolerance", 0.0),
             v.get("tilt_deg", 0.0), v.get("tilt_azimuth_deg", 0.0))
     member = perturbed(*args, v.get("drum_offset_mm", 0.0) / 1000.0,
@@ -305,8 +310,6 @@ def pooled_summary(runs, resamples=2000):
     azimuth (:func:`pipeline.stats.ensemble.pooled_answer` per column: every record
     weighs alike; intervals hold the choice of records and the members' Monte Carlo
     error); None for fewer than two such records."""
-    from pipeline.stats.circular import angle_difference_deg
-    from pipeline.stats.ensemble import pooled_answer
     members = runs[(runs["member"] >= 0) & runs["back_azimuth_deg"].notna()]
     records = list(dict.fromkeys(members["record_id"]))
     if len(records) < 2:
@@ -375,9 +378,6 @@ def mean_direction_error_deg(azimuths_deg):
 
 def summarise(runs, record_id, seed):
     """``ensemble_summary.json`` content of one record (see the module docstring)."""
-    from pipeline.stats.circular import circular_summary
-    from pipeline.stats.ensemble import (bootstrap_mean_azimuth_ci, direction_fractions,
-                                         wilson_interval)
     back = runs["back_azimuth_deg"].dropna()
     back = float(back.iloc[0]) if len(back) else None
     members = runs[runs["member"] >= 0]
@@ -440,7 +440,6 @@ def members_needed(summary, precision, batch, cap, arc_deg=None):
     fractions toppled so far: a record far from its precision gets several batches in one
     round instead of a round per batch; likewise for a mean direction's interval wider
     than ``arc_deg`` where falls gather (its width shrinks as 1 / sqrt(falls))."""
-    from pipeline.stats.ensemble import wilson_interval
     current = summary["columns"][0]["members"] if summary["columns"] else 0
     need = min(cap, current + batch)
     for col in summary["columns"]:

@@ -56,6 +56,10 @@ from pipeline.files import InputError, write_csv, write_json
 from pipeline.motion import Motion
 from pipeline.motion.measures import horizontal_peak, record_parameters
 from pipeline.records import processed_motion
+from pipeline.rocking import rocking_response_sampled
+from pipeline.stats.ensemble import wilson_interval
+from pipeline.stats.ensemble import binned_fractions, fragility_fit, logistic_surface
+from pipeline.rocking import block_constants
 
 DEFAULT_LEVELS = tuple(round(float(v), 3) for v in np.geomspace(0.5, 8.0, 8))   # m/s^2
 DEFAULT_MEMBERS = 4
@@ -205,7 +209,6 @@ def block_runs(specs, azimuths=None, max_step=BLOCK_MAX_STEP_S, t_after=BLOCK_T_
 
 def _block_batch(group, motion_file, rp, along, directions, dt, max_step, t_after):
     """Rows of the 2D table for ``group`` (specs of one motion), integrated at once."""
-    from pipeline.rocking import rocking_response_sampled
     n_az = len(directions)
     rows = []
     sizes = np.array([block_size(s["params"]) for s in group], float)
@@ -258,7 +261,6 @@ def _fall_azimuth(shaking_azimuth, direction):
 
 def level_table(table):
     """Fraction toppled per record and level (and over all records), one column per model."""
-    from pipeline.stats.ensemble import wilson_interval
     rows = []
     pooled = table.assign(record_id="all records")
     for (record, level), group in pd.concat([table, pooled]).groupby(
@@ -293,7 +295,6 @@ def summarise(table, specs, cost):
     dimensionless}}}, "comparison": [{column, block, im, median_3d, median_2d,
     ratio_3d_to_2d, ...}], "levels": [per record and level fractions],
     "block2d": {...}, "cost": {...}}"""
-    from pipeline.stats.ensemble import binned_fractions, fragility_fit, logistic_surface
     first = specs[0]
     blocks = table[table["model"] == "2D"]
     alpha = float(blocks["alpha_rad"].median()) if len(blocks) else None
@@ -302,7 +303,6 @@ def summarise(table, specs, cost):
         sizes = np.array([block_size(s["params"]) for s in specs], float)
         hd = float(np.median(sizes[:, 0] / sizes[:, 1]))
         height = float(np.median(sizes[:, 0]))
-        from pipeline.rocking import block_constants
         c = block_constants(height, height / hd)
         alpha, p = c["alpha"], c["p"]
     described = summary_entry(specs)

@@ -33,6 +33,9 @@ from pipeline.scenario.parameters import param
 from pipeline.files import InputError, write_csv, write_json
 from pipeline.records import RECORDS_DIR
 from pipeline.stats.classification import scores
+from pipeline.scenario.geometry import ColumnGeometry
+from pipeline.campaign.definitions import column_specs
+from pipeline.campaign.definitions import run_column_spec
 
 EXPERIMENTS = RECORDS_DIR / "shake_table" / "tests.csv"
 SPECIMEN = RECORDS_DIR / "shake_table" / "sp1.json"
@@ -123,7 +126,6 @@ def _label(point):
 
 def _run_params(specimen, point):
     """Run parameters of one grid point: the specimen alone at the table's centre."""
-    from pipeline.scenario.geometry import ColumnGeometry
     description = dict(specimen)
     for key in GRID_SPECIMEN:
         if key in point:
@@ -138,8 +140,6 @@ def specs(records, campaign_dir, experiments=EXPERIMENTS, specimen=SPECIMEN, out
           tests=None, axis_deg=AXIS_DEG):
     """Run specs of one stage: every grid point on the calibration tests, or the chosen
     point on the validation tests."""
-    from pipeline.campaign.definitions import column_specs
-    from pipeline.scenario.geometry import ColumnGeometry
     if records:
         raise InputError("the shake-table campaign takes its motions from --experiments, "
                          "not --records")
@@ -195,7 +195,6 @@ def best_point(result):
 def drive(run, records, campaign_dir, options):
     """Calibrate on the tests before ``validate_from``, validate the chosen parameters on
     the others, write experiments.csv, shake_table.json and the rates figure."""
-    from pipeline.scenario.geometry import ColumnGeometry
     campaign_dir = Path(campaign_dir)
     frame = load_experiments(options["experiments"], options["outcome"])
     if options.get("tests"):
@@ -322,7 +321,6 @@ class ShakeTableOptions(CampaignOptions):
 
 
 def _worker(spec, run_dir):
-    from pipeline.campaign.definitions import run_column_spec
     run_column_spec(spec, run_dir)
 
 register(Campaign(

@@ -7,6 +7,8 @@ import numpy as np
 from pipeline.figures.style import COLUMN_COLOURS, COLUMN_LABELS, COLUMN_MARKERS, new_figure
 from pipeline.files import save_figure
 from pipeline.stats.ensemble import circular_density
+from pipeline.stats.circular import angle_difference_deg
+from pipeline.stats.ensemble import wilson_interval
 
 BIN_DEG = 10.0
 
@@ -76,8 +78,6 @@ def plot_pooled(members, pooled, out_dir):
     interval per column, records by their mean; (right) the falls' downfall minus back
     azimuth, every record weighing alike, against what falls that ignore the epicentre
     give (a flat histogram), with the pooled answer in the titles."""
-    from pipeline.stats.circular import angle_difference_deg
-    from pipeline.stats.ensemble import wilson_interval
     out_dir = Path(out_dir)
     rows = members[(members["member"] >= 0) & members["back_azimuth_deg"].notna()]
     records = pooled["record_ids"]
@@ -145,7 +145,6 @@ def plot_convergence(members, result, out_dir):
     """``convergence.png``: per record (rows) and column (columns) the empirical
     distribution of the fall directions of every numerical variant, about the defaults'
     mean direction, with P(toppled) and the tests' p-values in the legend."""
-    from pipeline.stats.circular import angle_difference_deg
     rows = result["rows"]
     records = list(dict.fromkeys(r["record"] for r in rows))
     columns = list(dict.fromkeys(r["column"] for r in rows))

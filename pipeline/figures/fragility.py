@@ -9,6 +9,7 @@ from scipy import stats
 from pipeline.figures.style import COLUMN_COLOURS, COLUMN_LABELS, COLUMN_MARKERS, figure
 from pipeline.files import save_figure
 from pipeline.stats.ensemble import logistic_probability
+from pipeline.stats.ensemble import wilson_interval
 
 BLOCK_STYLE = {"block2d": {"color": "0.35", "ls": "--", "marker": "D",
                            "label": "2D block, strongest azimuth"},
@@ -97,7 +98,6 @@ def plot_curves(table, summary, path):
 def plot_levels(table, path):
     """Fraction toppled per PGA level, one panel per record and one for all records; the 3D
     columns (with Wilson bands) against the 2D block."""
-    from pipeline.stats.ensemble import wilson_interval
     records = list(dict.fromkeys(table["record_id"]))
     panels = records + (["all records"] if len(records) > 1 else [])
     fig = figure(figsize=(5 * len(panels), 4))

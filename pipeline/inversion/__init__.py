@@ -18,6 +18,10 @@ import time
 from pathlib import Path
 
 from pipeline.files import DirectoryLock, write_csv, write_json
+from pipeline.inversion.likelihood import DEFAULT_FLOOR, DEFAULT_KERNEL_DEG, ForwardModel
+from pipeline.inversion.posterior import invert
+from pipeline.inversion.posterior import in_arc
+from pipeline.inversion.study import magnitude_set
 
 EXAMPLES_DIR = Path(__file__).resolve().parent / "examples"
 
@@ -61,8 +65,6 @@ def run_inversion(observations, out_dir, table, candidates, kernel_deg=None, flo
     outputs into ``out_dir`` (locked while writing); return the summary dict.  ``truth``
     (a hidden-truth test's source: :meth:`pipeline.inversion.truth.HiddenTruth.as_truth`)
     is marked in the figures and checked against the credible regions (``truth.check``)."""
-    from pipeline.inversion.likelihood import DEFAULT_FLOOR, DEFAULT_KERNEL_DEG, ForwardModel
-    from pipeline.inversion.posterior import invert
     started = time.monotonic()
     model = ForwardModel(table, DEFAULT_KERNEL_DEG if kernel_deg is None else kernel_deg,
                          DEFAULT_FLOOR if floor is None else floor,
@@ -79,8 +81,6 @@ def run_inversion(observations, out_dir, table, candidates, kernel_deg=None, flo
 def truth_check(post, truth):
     """Whether the posterior's credible regions hold a known source (``truth``: epicentre_km
     in the inversion's frame, back_azimuth_deg, distance_km, mechanism, mw)."""
-    from pipeline.inversion.posterior import in_arc
-    from pipeline.inversion.study import magnitude_set
     summary = post.summary()
     east, north = truth["epicentre_km"]
     lo, hi = summary["distance_ci95_km"]

@@ -32,6 +32,8 @@ from pipeline.inversion.likelihood import (DEFAULT_FLOOR, DEFAULT_KERNEL_DEG, LI
 from pipeline.inversion.observations import ColumnObservation, Observations, Site
 from pipeline.inversion.posterior import in_arc, invert
 from pipeline.stats.circular import angle_difference_deg, azimuth_deg
+from pipeline.motion.synthetics import SOURCES
+from pipeline.files import InputError
 
 FALLEN_PER_SITE = (1, 3, 10, 30)
 SITE_COUNTS = (1, 3)
@@ -198,7 +200,6 @@ def bound_answer(narrow):
 # ---------------------------------------------------------------- paper scenario
 def paper_grid(main_grid, source_name, quick=False):
     """The forward grid holding the nominal twin runs at the paper's sites of one source."""
-    from pipeline.motion.synthetics import SOURCES
     src = SOURCES[source_name]
     mech = PAPER_MECHANISMS[source_name]
     return main_grid.replace(mechanisms=((mech, src["dip_deg"], src["rake_deg"]),),
@@ -209,7 +210,6 @@ def paper_grid(main_grid, source_name, quick=False):
 
 def paper_nodes(table, source_name):
     """(slice, ring indices, azimuth indices) of the paper's sites in ``table`` or None."""
-    from pipeline.motion.synthetics import SOURCES
     src = SOURCES[source_name]
     try:
         s = table.slice_index(PAPER_MECHANISMS[source_name], src["depth_km"], src["mw"])
@@ -227,7 +227,6 @@ def paper_nodes(table, source_name):
 def paper_scenario(model, obs_table, source_name, candidates):
     """Per site of the paper's rings: what its twin (nominal run) shows and what the
     inversion of that one site gives; plus the joint inversion of all sites."""
-    from pipeline.motion.synthetics import SOURCES
     src = SOURCES[source_name]
     strike = src["strike_deg"]
     s, rings, azimuths = paper_nodes(obs_table, source_name)
@@ -299,7 +298,6 @@ def run_demo(table, out_dir, candidates, paper_tables=None, trials=DEFAULT_TRIAL
     started = time.monotonic()
     likelihood_half, pool = split_members(table)
     if len(likelihood_half.members) == 0 or len(pool.members) == 0:
-        from pipeline.files import InputError
         raise InputError("the demo needs at least two ensemble members (--members 2)")
     examples, frames = {}, []
     for kind in likelihoods:

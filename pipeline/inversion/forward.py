@@ -37,6 +37,9 @@ from pipeline.campaign.definitions import column_specs, run_column_spec
 from pipeline.files import InputError, write_csv
 from pipeline.inversion.grid import GRIDS, TableGrid, node_positions, slice_motions
 from pipeline.inversion.table import ForwardTable
+from pipeline.campaign.column_file import column_kn
+from pipeline.campaign.ensemble import nominal, sample_members
+from pipeline.campaign import run_campaign
 
 DEFAULT_FORWARD_DIR = RESULTS_DIR / "inversion-forward"
 
@@ -49,8 +52,6 @@ MEMBER_BATCH = 6    # members are drawn in Latin-hypercube batches of 6 (seeds s
 def member_parameters(grid):
     """[(member, params)]: member -1 is the nominal twin run, 0.. the ensemble members
     (batch b of MEMBER_BATCH members: Latin hypercube with seed ``grid.seed + b``)."""
-    from pipeline.campaign.column_file import column_kn
-    from pipeline.campaign.ensemble import nominal, sample_members
     if grid.column_file is None:
         column, described = "both", {}
     else:                   # the described column alone, stiffness as in `campaign columns`
@@ -105,7 +106,6 @@ def forward_outputs(specs, campaign_dir, failures, animations, figures=True):
 
 def run_forward(grid, campaign_dir=None, jobs=None, scheduler=None):
     """Run (or reuse) the forward campaign of ``grid``; return (ForwardTable, cost dict)."""
-    from pipeline.campaign import run_campaign
     campaign_dir = Path(campaign_dir or DEFAULT_FORWARD_DIR)
     extra = {"scheduler": scheduler} if scheduler else {}
     started = time.monotonic()

@@ -15,6 +15,11 @@ import numpy as np
 from pipeline.constants import COLUMN_TYPES
 from pipeline.files import InputError, content_hash, die_with_parent, write_json
 from pipeline.motion import Motion
+from pipeline.motion.synthetics import SOURCES, moment_from_mw
+from pipeline.motion.synthetics import CRUST_LAYERS, LEAD_TIME_S
+from pipeline.motion.synthetics import numerics
+from pipeline.motion.synthetics.compute import _point_source_task
+from pipeline.campaign.column_file import description
 
 GENERATOR_VERSION = 1          # bump when the written motions change
 REFERENCE_MW = 6.5             # the paper scenario's magnitude: the sub-event template's
@@ -80,7 +85,6 @@ class TableGrid:
     def __post_init__(self):
         object.__setattr__(self, "mechanisms", parse_mechanisms(self.mechanisms))
         if self.column_file is not None:
-            from pipeline.campaign.column_file import description
             object.__setattr__(self, "column_file", description(self.column_file))
         for name in ("depths_km", "magnitudes", "distances_km"):
             values = tuple(sorted(float(v) for v in getattr(self, name)))
@@ -160,7 +164,6 @@ GRIDS = {
 def subevent_layout(mw):
     """Sub-events of a source of magnitude ``mw`` with strike 0 (North) and its hypocentre
     at the origin: list of dicts x_km, y_km, delay_s, m0_nm, rise_s, duration_s."""
-    from pipeline.motion.synthetics import SOURCES, moment_from_mw
     template = SOURCES[TEMPLATE_SOURCE]
     scale = 10.0 ** (0.5 * (mw - REFERENCE_MW))
     along = np.asarray(template["subevents_along_strike_km"], float) * scale
@@ -179,7 +182,6 @@ def node_positions(grid):
 
 
 def _slice_key(grid, sl, num):
-    from pipeline.motion.synthetics import CRUST_LAYERS, LEAD_TIME_S
     return content_hash(GENERATOR_VERSION, list(sl), subevent_layout(sl[4]), CRUST_LAYERS,
                         LEAD_TIME_S, grid.distances_km, float(grid.azimuth_step_deg),
                         grid.fmax_hz, grid.duration_s, SAMPLING_HZ, num)
@@ -200,7 +202,6 @@ def slice_motions(grid, motion_dir, jobs=None, positions=None):
     differs or a file is missing; the pyprop8 calls of all slices share ``jobs`` processes.
     ``positions``: (distances km, azimuths from strike deg) of receivers instead of the
     grid's nodes (a hidden-truth test's sites, :mod:`pipeline.inversion.truth`)."""
-    from pipeline.motion.synthetics import numerics
     num = numerics(grid.duration_s, SAMPLING_HZ, grid.fmax_hz)
     if positions is None:
         r, a, x, y = node_positions(grid)
@@ -230,7 +231,6 @@ def slice_motions(grid, motion_dir, jobs=None, positions=None):
                           dict(sub, depth_km=sl[3]), num, grid.fmax_hz))
     if not todo:
         return out
-    from pipeline.motion.synthetics.compute import _point_source_task
     jobs = max(1, min(jobs or os.cpu_count() or 1, len(tasks)))
     started = time.monotonic()
     print(f"inversion-forward: pyprop8 for {len(todo)} source slice(s), {len(r)} receivers, "

@@ -25,6 +25,7 @@ from scipy.special import logsumexp
 
 from pipeline.files import InputError
 from pipeline.stats.circular import azimuth_deg
+from pipeline.inversion.likelihood import ForwardModel
 
 BAZ_BIN_DEG = 2.0
 SUBGRID = 5
@@ -329,7 +330,6 @@ def in_arc(angle_deg, arc):
 def invert(model, observations, grid):
     """Posterior of ``observations`` over the candidates of ``grid`` (a CandidateGrid) with
     the forward model ``model`` (a likelihood.ForwardModel)."""
-    from pipeline.inversion.likelihood import ForwardModel
     keep = grid.slice_mask(model.table)
     if not keep.all():
         model = ForwardModel(model.table.select_slices(keep), model.kernel_deg, model.floor,

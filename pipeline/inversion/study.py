@@ -28,6 +28,7 @@ from pipeline.inversion.likelihood import DEFAULT_FLOOR, DEFAULT_KERNEL_DEG, LIK
 from pipeline.inversion.posterior import in_arc, invert
 from pipeline.stats.circular import azimuth_deg
 from pipeline.stats.ensemble import wilson_interval
+from pipeline.files import InputError
 
 LIKELIHOOD_MEMBERS = (3, 6, 12, 24, 48)
 OBSERVATION_MEMBERS = 16
@@ -40,7 +41,6 @@ def split_for_study(table, observation_members=OBSERVATION_MEMBERS):
     observation pool: those last members)."""
     order = np.sort(table.members)
     if not 1 <= observation_members < order.size:
-        from pipeline.files import InputError
         raise InputError(f"the member study needs more than {observation_members} members "
                          f"per node (the table has {order.size})")
     pool = np.isin(table.members, order[-observation_members:])

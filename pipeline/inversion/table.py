@@ -14,6 +14,7 @@ from pipeline.campaign.definitions import run_code_version
 from pipeline.campaign.run_dirs import finished_summary
 from pipeline.constants import COLUMN_TYPES as COLUMNS
 from pipeline.files import InputError
+from pipeline.stats.circular import circular_summary
 
 @dataclass
 class ForwardTable:
@@ -225,7 +226,6 @@ class ForwardTable:
     def cells(self):
         """One row per node and column: members, toppled, P (k/n), mean downfall azimuth
         in the strike frame and relative to the direction from epicentre to site."""
-        from pipeline.stats.circular import circular_summary
         rows = []
         for index in np.ndindex(self.toppled.shape[:4]):
             s, i, j, c = index

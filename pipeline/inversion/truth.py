@@ -35,6 +35,8 @@ from pipeline.inversion.grid import MECHANISMS, slice_motions
 from pipeline.stats.circular import azimuth_deg
 from pipeline.userfiles import read_text
 from pipeline.userfiles import keys_text as _keys
+from pipeline.inversion.forward import MEMBER_BATCH
+from pipeline.inversion.forward import member_parameters
 
 TRUTH_SEED = 7_000_001           # far beyond any table's seed + batch
 MAX_TWINS = 50
@@ -158,7 +160,6 @@ def truth_grid(truth, grid):
 
 def check_hidden(truth, table_grid):
     """InputError when the table's member batches could hold the hidden seed's members."""
-    from pipeline.inversion.forward import MEMBER_BATCH
     batches = -(-table_grid.members // MEMBER_BATCH)
     if table_grid.seed <= truth.seed < table_grid.seed + max(batches, 1):
         raise InputError(f"truth seed {truth.seed} is one of the forward table's member "
@@ -168,7 +169,6 @@ def check_hidden(truth, table_grid):
 
 def truth_specs(records, campaign_dir, truth=None, grid=None, jobs=None, **_):
     """Run specs: at every site its ``twins`` hidden members on the site's motion."""
-    from pipeline.inversion.forward import member_parameters
     if records:
         raise InputError("the inversion-truth campaign takes no --records")
     if truth is None or grid is None:

@@ -6,6 +6,7 @@ import numpy as np
 from scipy.integrate import cumulative_trapezoid
 
 from pipeline.motion import Motion
+from pipeline import rocking
 
 
 def one_sine_pulse(azimuth_deg=0.0, amplitude=5.0, period=1.0, duration=6.0, dt=0.005):
@@ -27,7 +28,6 @@ def phased_sine_pulse(amplitude, omega, psi, dt=0.001, tail_s=4.0):
     """a(t) = A sin(omega t + psi) from phase psi to 2 pi along East, then zero for
     ``tail_s`` seconds (the pulse of :func:`pipeline.rocking.sine_pulse`), integrated
     to velocity and displacement (trapezoid)."""
-    from pipeline import rocking
     acc_func, t_pulse = rocking.sine_pulse(amplitude, omega, psi)
     t = np.arange(0.0, t_pulse + tail_s, dt)
     acc_e = np.array([acc_func(ti) for ti in t])

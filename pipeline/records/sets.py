@@ -27,6 +27,8 @@ import pandas as pd
 from pipeline import paper
 from pipeline.files import InputError, csv_true, write_json
 from pipeline.records.catalog import catalog
+from pipeline.motion.measures import record_parameters
+from pipeline.records import CACHE_DIR, processed_motion, resolve
 
 SETS = {
     "nearsource": (f"three components, compass horizontals, known back azimuth, epicentral "
@@ -115,8 +117,6 @@ def horizontal_pga(record_id, cache_dir=None):
     otherwise the record is processed (or its cached motion loaded) through
     :func:`pipeline.records.processed_motion` and the value written there.
     """
-    from pipeline.motion.measures import record_parameters
-    from pipeline.records import CACHE_DIR, processed_motion, resolve
     cache_dir = Path(cache_dir) if cache_dir is not None else CACHE_DIR
     source = resolve(record_id)
     key = source.key()

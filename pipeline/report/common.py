@@ -4,6 +4,7 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
+from pipeline.stats.circular import circular_summary
 
 
 def _read_csv(path):
@@ -22,7 +23,6 @@ def _figure(results, path, caption):
 
 def _spread(azimuths):
     """Axial spread (deg) of downfall azimuths: circular std of doubled angles, halved."""
-    from pipeline.stats.circular import circular_summary
     values = np.asarray([a for a in azimuths if math.isfinite(a)])
     if len(values) < 2:
         return None

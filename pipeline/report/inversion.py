@@ -5,6 +5,7 @@ from pathlib import Path
 import pandas as pd
 
 from pipeline.report.common import _figure, _fmt, _pct, _table
+from pipeline.inversion.grid import GRIDS
 
 
 def inversion_section(results):
@@ -38,7 +39,6 @@ def inversion_section(results):
            f"{forward.get('code_version')}) and read with `--table`."
            if forward.get("reused_file") else ".") + "\n")
     if runs:
-        from pipeline.inversion.grid import GRIDS
         full = GRIDS["full"]
         lines.append(f"The default (`full`) grid, {len(full.mechanisms)} mechanisms x "
                      f"{len(full.depths_km)} depths x {len(full.magnitudes)} magnitudes x "

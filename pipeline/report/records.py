@@ -9,6 +9,14 @@ import pandas as pd
 from pipeline.files import csv_true, csv_true_column
 from pipeline.report.common import _figure, _float, _fmt, _p, _percent, _read_csv, _table
 from pipeline.stats.ensemble import wilson_interval
+from pipeline import paper
+from pipeline.records.catalog import catalog_row
+from pipeline.motion import Motion
+from pipeline.stats.circular import direction_table
+from pipeline.stats.circular import direction_statistics
+from pipeline.stats.circular import direction_differences
+from pipeline.stats.circular import direction_class
+from pipeline.records import peer_check
 
 
 REFERENCE_NAMES = {"back_azimuth": "back azimuth", "max_acc": "largest acceleration",
@@ -22,7 +30,6 @@ FEMA_SOURCE_FILE = "fema_p695.npz"
 def toppled_fractions(runs):
     """Per column type: records toppled / run, fraction and Wilson 95 % interval, beside the
     paper's (``paper.RECORDS_TOPPLED_*``)."""
-    from pipeline import paper
     papers = {"drums": paper.RECORDS_TOPPLED_DRUMS, "monolithic": paper.RECORDS_TOPPLED_MONOLITH}
     rows = []
     for column, group in runs.groupby("column", sort=True):
@@ -43,13 +50,11 @@ def record_orientation(record_id, motion_file=None):
     """(compass, fema) of a run's record: whether its horizontals are compass azimuths and
     whether it is a FEMA P695 pair (catalogue row, else the motion's meta; unknown: True,
     False)."""
-    from pipeline.records.catalog import catalog_row
     row = catalog_row(str(record_id))
     if row is not None:
         compass = csv_true(str(row.get("horizontals_compass")))
         return compass, row.get("source_file") == FEMA_SOURCE_FILE
     if isinstance(motion_file, str) and Path(motion_file).is_file():
-        from pipeline.motion import Motion
         meta = Motion.load(motion_file).meta
         compass = meta.get("horizontals_compass", True)
         return csv_true(compass if isinstance(compass, bool) else str(compass)), \
@@ -75,7 +80,6 @@ def back_azimuth_table(runs):
     """Per column type: toward / away / transverse counts relative to the back azimuth, the
     counts uniform directions would give (1/4, 1/4, 1/2), directional and axial mean
     difference, resultant length and Rayleigh p (``direction_table``)."""
-    from pipeline.stats.circular import direction_table
     subset = with_back_azimuth(runs)
     if subset.empty:
         return pd.DataFrame()
@@ -90,7 +94,6 @@ def correlation_table(runs):
     """Per column type and reference (back azimuth, largest acceleration, velocity,
     displacement): pairs, mean difference, Rayleigh p (directional and axial) and the
     circular-circular correlation (``direction_statistics``, all records together)."""
-    from pipeline.stats.circular import direction_statistics
     subset = with_back_azimuth(runs)
     if subset.empty:
         return pd.DataFrame()
@@ -108,7 +111,6 @@ def correlation_table(runs):
 def per_record_table(runs):
     """One row per record: id, distance, back azimuth, PGA, and per column type the downfall
     azimuth (or "stands") and its class relative to the back azimuth."""
-    from pipeline.stats.circular import direction_differences
     runs = runs.copy()
     runs["toppled"] = csv_true_column(runs["toppled"].astype(str))
     comparable = set(with_back_azimuth(runs).index)
@@ -135,7 +137,6 @@ def per_record_table(runs):
 
 def records_statements(fractions, directions, correlations):
     """Plain-language findings generated from the three tables (a list of paragraphs)."""
-    from pipeline.stats.circular import direction_class
     out = []
     answers, tested = [], []
     for column in sorted(set(fractions["column"]) if not fractions.empty else []):
@@ -321,7 +322,6 @@ def records_section(results):
 def processing_section(results):
     """The processing checked against PEER's own records (results/records/peer_check.csv,
     written by ``records``): median and worst ratios, pulse-like records listed."""
-    from pipeline.records import peer_check
     table = _read_csv(results / "records" / "peer_check.csv")
     if table is None or table.empty:
         return "## Processing against PEER's records\n\nNot run yet (`python -m pipeline records --all`).\n"
