@@ -18,10 +18,21 @@ def inversion_section(results):
         return title + "\nNot run yet (`make invert-demo`).\n"
     demo = json.loads(path.read_text())
     inv = Path(results) / "inversion"
+    lines = [title]
+    for part in (_forward_table_lines, _likelihood_lines, _coverage_lines, _narrowing_lines,
+                 _paper_scenario_lines, _example_lines):
+        lines += part(demo)
+    for fig in demo.get("figures", []):
+        lines.append(_figure(results, inv / fig, Path(fig).parent.name or Path(fig).stem))
+    return "\n".join(lines)
+
+
+def _forward_table_lines(demo):
+    """The forward table's grid and cost, and what the default grid would cost."""
+    lines = []
     forward = demo.get("forward_table", {})
     grid = forward.get("grid") or {}
     costs = forward.get("costs", {})
-    lines = [title]
     runs = sum((c.get("runs") or 0) for c in costs.values())
     wall = sum((c.get("yade_wall_s") or 0) for c in costs.values())
     mechs = ", ".join(m[0] for m in grid.get("mechanisms", []))
@@ -46,6 +57,11 @@ def inversion_section(results):
                      f"azimuths x {full.members + 1} runs = {full.n_runs()} runs, would take "
                      f"about {full.n_runs() * wall / runs / 2 / 3600:.0f} h on 2 cores at "
                      "that rate: the demo runs the smaller grid above.\n")
+    return lines
+
+
+def _likelihood_lines(demo):
+    lines = []
     like = demo.get("likelihood", {})
     lines.append(
         f"Likelihood from members {like.get('members_likelihood')}, \"observed\" columns drawn "
@@ -53,6 +69,12 @@ def inversion_section(results):
         f"{_fmt(like.get('kernel_deg'))} deg, floor {_fmt(like.get('floor'), 2)}, observed "
         f"azimuths with {_fmt(demo.get('observation_uncertainty_deg'))} deg (1 sigma) errors. "
         f"Candidates: {demo.get('prior', '')}.\n")
+    return lines
+
+
+def _coverage_lines(demo):
+    """(a) coverage of the truth tests per likelihood."""
+    lines = []
     coverage = demo.get("coverage", {})
     if coverage and "trials" in coverage:            # one likelihood (older summaries)
         coverage = {"independent": coverage}
@@ -67,6 +89,12 @@ def inversion_section(results):
             f"distance interval the true distance in {_pct(cov.get('distance_95'))}; the 68 % "
             f"arc in {_pct(cov.get('back_azimuth_68'))}.")
     lines.append("")
+    return lines
+
+
+def _narrowing_lines(demo):
+    """(b) how the back azimuth narrows, (c) how many columns bound it, the findings."""
+    lines = []
     narrow = pd.DataFrame(demo.get("narrowing", []))
     if not narrow.empty:
         if "likelihood" not in narrow.columns:
@@ -104,6 +132,12 @@ def inversion_section(results):
                      "the back azimuth to +-30 deg (median 95 % arc <= 60 deg)?\n\n"
                      + "\n".join(f"- {a}" for a in answers) + "\n")
         lines.append(_inversion_findings(demo, narrow) + "\n")
+    return lines
+
+
+def _paper_scenario_lines(demo):
+    """The paper's scenario inverted site by site and jointly."""
+    lines = []
     paper = demo.get("paper_scenario", {})
     per = paper.get("per_source", [])
     if per:
@@ -132,15 +166,18 @@ def inversion_section(results):
                 f"km^2); most probable mechanism {mech} "
                 f"({j['mechanism_posterior'][mech]:.2f}).")
         lines.append("")
+    return lines
+
+
+def _example_lines(demo):
+    lines = []
     example = demo.get("example")
     if example:
         lo, hi = example["back_azimuth_ci95_deg"]
         lines.append(f"Example file `{example['file']}`: back azimuth from site A "
                      f"{example['back_azimuth_map_deg']:.0f} deg, 95 % arc [{lo:.0f}, {hi:.0f}]"
                      f", 95 % area {example['credible_area_95_km2']:.0f} km^2.\n")
-    for fig in demo.get("figures", []):
-        lines.append(_figure(results, inv / fig, Path(fig).parent.name or Path(fig).stem))
-    return "\n".join(lines)
+    return lines
 
 
 def _inversion_findings(demo, narrow):
