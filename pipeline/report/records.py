@@ -137,92 +137,112 @@ def per_record_table(runs):
 
 def records_statements(fractions, directions, correlations):
     """Plain-language findings generated from the three tables (a list of paragraphs)."""
-    out = []
-    answers, tested = [], []
+    out, answers, tested = [], [], []
     for column in sorted(set(fractions["column"]) if not fractions.empty else []):
-        f = fractions[fractions["column"] == column].iloc[0]
-        text = (f"**{COLUMN_NAMES.get(column, column)}.** {f['toppled']} of {f['records']} records "
-                f"toppled it in one run each ({_percent(f['fraction'])}, 95 % interval "
-                f"{_percent(f['ci_low'])}-{_percent(f['ci_high'])}; each run is a sample: a "
-                f"record near its threshold can flip with a CPU's last bits, so the count is "
-                f"known to its interval, not exactly)")
-        if "paper_toppled" in f and math.isfinite(_float(f.get("paper_fraction"))):
-            inside = f["ci_low"] <= f["paper_fraction"] <= f["ci_high"]
-            text += (f"; the paper: {int(f['paper_toppled'])} of {int(f['paper_records'])} "
-                     f"({_percent(f['paper_fraction'])}, {_percent(f['paper_ci_low'])}-"
-                     f"{_percent(f['paper_ci_high'])}), "
-                     + ("inside" if inside else "outside") + " our interval")
-        text += "."
-        d = directions[directions["column"] == column] if not directions.empty else directions
-        if d.empty or int(d.iloc[0]["n_toppled"]) == 0:
-            text += " No fall of this column has a back azimuth to compare with."
-            out.append(text)
-            continue
-        d = d.iloc[0]
-        n = int(d["n_toppled"])
-        text += (f" Of the {n} {'fall' if n == 1 else 'falls'} with a known back azimuth, "
-                 f"{int(d['toward'])} "
-                 f"{'was' if int(d['toward']) == 1 else 'were'} toward "
-                 f"the epicentre (within 45 deg of the back azimuth), {int(d['away'])} away and "
-                 f"{int(d['transverse'])} transverse; directions independent of the source "
-                 f"would give about {n / 4:.1f}, {n / 4:.1f} and {n / 2:.1f}.")
-        p_dir, p_ax = _float(d.get("rayleigh_p")), _float(d.get("axial_rayleigh_p"))
-        if n < MIN_FALLS:
-            text += (f" Too few falls (fewer than {MIN_FALLS}) to test whether they are "
-                     "concentrated relative to the back azimuth.")
-            out.append(text)
-            continue
-        tested.append(column)
-        text += (f" Rayleigh test of downfall minus back azimuth: p = {_p(p_dir)} (as an axis: "
-                 f"p = {_p(p_ax)}): ")
-        findings = []
-        if math.isfinite(p_dir) and p_dir < ALPHA:
-            where = str(direction_class(d["mean_diff_deg"]))
-            findings.append(f"the falls are concentrated {where} (mean difference "
-                            f"{d['mean_diff_deg']:+.0f} deg, R = {d['resultant_length']:.2f})")
-        if math.isfinite(p_ax) and p_ax < ALPHA:
-            axis = ("along the line to the epicentre" if abs(d["axial_mean_diff_deg"]) <= 45
-                    else "transverse to the line to the epicentre")
-            findings.append(f"the fall axes group {axis} (axial mean difference "
-                            f"{d['axial_mean_diff_deg']:+.0f} deg, R = "
-                            f"{d['axial_resultant_length']:.2f})")
-        if findings:
-            text += "; ".join(findings) + f" at the {100 * ALPHA:g} % level."
-            answers.append((column, "; ".join(findings), "transverse" in " ".join(findings)))
-        else:
-            text += (f"the directions are not concentrated relative to the back azimuth at the "
-                     f"{100 * ALPHA:g} % level.")
-        c = correlations[correlations["column"] == column] if not correlations.empty else None
-        if c is not None and not c.empty:
-            parts = []
-            for _, r in c.iterrows():
-                value = _float(r["circcorr"])
-                if math.isfinite(value):
-                    parts.append(f"{REFERENCE_NAMES.get(r['reference'], r['reference'])} "
-                                 f"{value:+.2f}")
-            finite = c[np.isfinite(c["circcorr"].astype(float))]
-            if parts:
-                text += " Circular correlation of the downfall azimuths with the " + ", ".join(
-                    parts)
-            else:
-                text += (" Circular correlations need at least 3 falls and varying reference "
-                         "directions: not defined here")
-            if not finite.empty:
-                strength = finite["circcorr"].astype(float).abs().sort_values(ascending=False)
-                best = finite.loc[strength.index[0]]
-                error = 1.0 / math.sqrt(n)         # standard error of a correlation of n falls
-                if len(strength) > 1 and strength.iloc[0] - strength.iloc[1] < error:
-                    text += (f"; no reference stands out: the largest |r| "
-                             f"({abs(float(best['circcorr'])):.2f}, "
-                             f"{REFERENCE_NAMES.get(best['reference'])}) exceeds the next by "
-                             f"less than the standard error 1/sqrt({n}) = {error:.2f}, so "
-                             "another CPU's single runs may rank them otherwise")
-                else:
-                    text += (f"; strongest with the {REFERENCE_NAMES.get(best['reference'])} "
-                             f"(|r| = {abs(float(best['circcorr'])):.2f}, standard error "
-                             f"{error:.2f})")
-            text += "."
+        text, answer = _column_statement(column, fractions, directions, correlations)
         out.append(text)
+        if answer is not None:
+            tested.append(column)
+            if answer:
+                answers.append((column, *answer))
+    out += _paper_answer(fractions, tested, answers)
+    return out
+
+
+def _column_statement(column, fractions, directions, correlations):
+    """(paragraph, answer) of one column type: answer None when its falls are too few to
+    test, () when tested without a finding, else (findings, whether transverse)."""
+    f = fractions[fractions["column"] == column].iloc[0]
+    text = (f"**{COLUMN_NAMES.get(column, column)}.** {f['toppled']} of {f['records']} records "
+            f"toppled it in one run each ({_percent(f['fraction'])}, 95 % interval "
+            f"{_percent(f['ci_low'])}-{_percent(f['ci_high'])}; each run is a sample: a "
+            f"record near its threshold can flip with a CPU's last bits, so the count is "
+            f"known to its interval, not exactly)")
+    if "paper_toppled" in f and math.isfinite(_float(f.get("paper_fraction"))):
+        inside = f["ci_low"] <= f["paper_fraction"] <= f["ci_high"]
+        text += (f"; the paper: {int(f['paper_toppled'])} of {int(f['paper_records'])} "
+                 f"({_percent(f['paper_fraction'])}, {_percent(f['paper_ci_low'])}-"
+                 f"{_percent(f['paper_ci_high'])}), "
+                 + ("inside" if inside else "outside") + " our interval")
+    text += "."
+    d = directions[directions["column"] == column] if not directions.empty else directions
+    if d.empty or int(d.iloc[0]["n_toppled"]) == 0:
+        return text + " No fall of this column has a back azimuth to compare with.", None
+    d = d.iloc[0]
+    n = int(d["n_toppled"])
+    text += (f" Of the {n} {'fall' if n == 1 else 'falls'} with a known back azimuth, "
+             f"{int(d['toward'])} "
+             f"{'was' if int(d['toward']) == 1 else 'were'} toward "
+             f"the epicentre (within 45 deg of the back azimuth), {int(d['away'])} away and "
+             f"{int(d['transverse'])} transverse; directions independent of the source "
+             f"would give about {n / 4:.1f}, {n / 4:.1f} and {n / 2:.1f}.")
+    p_dir, p_ax = _float(d.get("rayleigh_p")), _float(d.get("axial_rayleigh_p"))
+    if n < MIN_FALLS:
+        return text + (f" Too few falls (fewer than {MIN_FALLS}) to test whether they are "
+                       "concentrated relative to the back azimuth."), None
+    text += (f" Rayleigh test of downfall minus back azimuth: p = {_p(p_dir)} (as an axis: "
+             f"p = {_p(p_ax)}): ")
+    findings = []
+    if math.isfinite(p_dir) and p_dir < ALPHA:
+        where = str(direction_class(d["mean_diff_deg"]))
+        findings.append(f"the falls are concentrated {where} (mean difference "
+                        f"{d['mean_diff_deg']:+.0f} deg, R = {d['resultant_length']:.2f})")
+    if math.isfinite(p_ax) and p_ax < ALPHA:
+        axis = ("along the line to the epicentre" if abs(d["axial_mean_diff_deg"]) <= 45
+                else "transverse to the line to the epicentre")
+        findings.append(f"the fall axes group {axis} (axial mean difference "
+                        f"{d['axial_mean_diff_deg']:+.0f} deg, R = "
+                        f"{d['axial_resultant_length']:.2f})")
+    answer = ()
+    if findings:
+        text += "; ".join(findings) + f" at the {100 * ALPHA:g} % level."
+        answer = ("; ".join(findings), "transverse" in " ".join(findings))
+    else:
+        text += (f"the directions are not concentrated relative to the back azimuth at the "
+                 f"{100 * ALPHA:g} % level.")
+    text += _correlation_text(column, correlations, n)
+    return text, answer
+
+
+def _correlation_text(column, correlations, n):
+    """The circular correlations of one column type's falls, and which reference leads."""
+    text = ""
+    c = correlations[correlations["column"] == column] if not correlations.empty else None
+    if c is not None and not c.empty:
+        parts = []
+        for _, r in c.iterrows():
+            value = _float(r["circcorr"])
+            if math.isfinite(value):
+                parts.append(f"{REFERENCE_NAMES.get(r['reference'], r['reference'])} "
+                             f"{value:+.2f}")
+        finite = c[np.isfinite(c["circcorr"].astype(float))]
+        if parts:
+            text += " Circular correlation of the downfall azimuths with the " + ", ".join(
+                parts)
+        else:
+            text += (" Circular correlations need at least 3 falls and varying reference "
+                     "directions: not defined here")
+        if not finite.empty:
+            strength = finite["circcorr"].astype(float).abs().sort_values(ascending=False)
+            best = finite.loc[strength.index[0]]
+            error = 1.0 / math.sqrt(n)         # standard error of a correlation of n falls
+            if len(strength) > 1 and strength.iloc[0] - strength.iloc[1] < error:
+                text += (f"; no reference stands out: the largest |r| "
+                         f"({abs(float(best['circcorr'])):.2f}, "
+                         f"{REFERENCE_NAMES.get(best['reference'])}) exceeds the next by "
+                         f"less than the standard error 1/sqrt({n}) = {error:.2f}, so "
+                         "another CPU's single runs may rank them otherwise")
+            else:
+                text += (f"; strongest with the {REFERENCE_NAMES.get(best['reference'])} "
+                         f"(|r| = {abs(float(best['circcorr'])):.2f}, standard error "
+                         f"{error:.2f})")
+        text += "."
+    return text
+
+
+def _paper_answer(fractions, tested, answers):
+    """The answer to the paper's question over both column types."""
+    out = []
     question = ("**Answer to the paper's question** (do toppled columns point to the "
                 "source?): ")
     if not tested:
