@@ -149,7 +149,8 @@ def setup(p):
                    "site's own falls inform its next column; calibrated when there are many "
                    "more columns per site than members per node)")
     c.add_argument("--trials", type=int, default=None,
-                   help="--demo: trials per configuration (default 20)")
+                   help="trials per configuration (--demo: default 20; --member-study: "
+                   "default 200)")
 
 
 CANDIDATE_PRESETS = {"quick": {"radius_km": 12.0, "step_km": 1.0, "strike_step_deg": 90.0},
