@@ -156,10 +156,14 @@ class DirectoryLock:
         return False
 
 
-def die_with_parent():
+def die_with_parent(parent_pid=None):
     """In a child process (``preexec_fn``, a Pool's ``initializer``): be killed when the
-    parent dies, even by kill -9 (Linux PR_SET_PDEATHSIG), and leave Ctrl-C to the parent."""
+    parent dies, even by kill -9 (Linux PR_SET_PDEATHSIG), and leave Ctrl-C to the parent.
+    ``parent_pid``: the parent's pid, taken in the parent before the fork: a child whose
+    parent died before the death signal was armed (a kill in between) exits at once."""
     ctypes.CDLL("libc.so.6", use_errno=True).prctl(1, signal.SIGKILL)   # 1: PR_SET_PDEATHSIG
+    if parent_pid is not None and os.getppid() != parent_pid:
+        os._exit(1)
     signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 

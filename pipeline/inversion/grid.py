@@ -236,7 +236,7 @@ def slice_motions(grid, motion_dir, jobs=None, positions=None):
     print(f"inversion-forward: pyprop8 for {len(todo)} source slice(s), {len(r)} receivers, "
           f"{len(tasks)} sub-events on {jobs} process(es)", flush=True)
     if jobs > 1:
-        with Pool(jobs, initializer=die_with_parent) as pool:
+        with Pool(jobs, initializer=die_with_parent, initargs=(os.getpid(),)) as pool:
             results = pool.map(_point_source_task, tasks)      # in order: reproducible sums
     else:
         results = [_point_source_task(t) for t in tasks]

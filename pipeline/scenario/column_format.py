@@ -1,5 +1,5 @@
 """The column description file (JSON, YAML optional): limits, keys and the parsing of a
-description into :class:`~pipeline.scenario.solids.ColumnBlock`\ s; the shipped examples.
+description into :class:`~pipeline.scenario.solids.ColumnBlock` objects; the shipped examples.
 Schema: docs/columns-and-model.md; the column it describes:
 :class:`pipeline.scenario.geometry.ColumnGeometry`."""
 import json

@@ -23,6 +23,7 @@ import subprocess
 import tempfile
 import threading
 import time
+from functools import partial
 from pathlib import Path
 
 from pipeline import YADE_SCRIPTS_DIR
@@ -106,7 +107,7 @@ def _run_once(run_dir, timeout_s):
         proc = subprocess.Popen([DEBIAN_PYTHON, str(WRAPPER), "scene.py"], cwd=run_dir,
                                 stdout=log, stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL,
                                 env=_environment(tmpdir), start_new_session=True,
-                                preexec_fn=die_with_parent)
+                                preexec_fn=partial(die_with_parent, os.getpid()))
         proc.tmpdir = tmpdir
         with _RUNNING_LOCK:
             _RUNNING.add(proc)
@@ -175,7 +176,7 @@ def _server():
                                 stdin=subprocess.PIPE, stdout=subprocess.DEVNULL,
                                 stderr=subprocess.DEVNULL, pass_fds=(write_fd,),
                                 env=_environment(tmpdir), start_new_session=True,
-                                preexec_fn=die_with_parent)
+                                preexec_fn=partial(die_with_parent, os.getpid()))
     except BaseException:
         _remove_tmp(tmpdir)
         raise

@@ -63,6 +63,22 @@ def test_invert_says_what_the_default_grid_costs_and_refuses_hours_of_work(tmp_p
     assert not (tmp_path / "out").exists() and not (tmp_path / "forward").exists()
 
 
+def test_a_child_whose_parent_died_before_it_armed_the_death_signal_exits():
+    """The race a kill can hit: the parent gone before the child's initializer ran (its
+    parent is then another process): the child exits at once; with its real parent it
+    lives on."""
+    import subprocess
+    import sys
+    code = ("import os, sys; from pipeline.files import die_with_parent; "
+            "die_with_parent(int(sys.argv[1])); print('alive')")
+    orphan = subprocess.run([sys.executable, "-c", code, "1"], capture_output=True, text=True,
+                            timeout=60)
+    assert orphan.returncode == 1 and orphan.stdout == ""
+    own = subprocess.run([sys.executable, "-c", code.replace("int(sys.argv[1])", "os.getppid()")],
+                         capture_output=True, text=True, timeout=60)
+    assert own.returncode == 0 and own.stdout == "alive\n"
+
+
 def test_pool_workers_die_with_their_parent(tmp_path):
     """kill -9 of a command leaves no pool worker (pyprop8's) running: the initializer
     the pools use ties each worker to its parent."""
@@ -73,7 +89,8 @@ def test_pool_workers_die_with_their_parent(tmp_path):
     import time
     script = ("import time\nfrom multiprocessing import Pool\n"
               "from pipeline.files import die_with_parent\n"
-              "pool = Pool(2, initializer=die_with_parent)\n"
+              "import os\n"
+              "pool = Pool(2, initializer=die_with_parent, initargs=(os.getpid(),))\n"
               "print(' '.join(str(p.pid) for p in pool._pool), flush=True)\n"
               "pool.map(time.sleep, [60, 60])\n")
     proc = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE, text=True)

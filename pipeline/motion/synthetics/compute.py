@@ -172,7 +172,8 @@ def generate_sources(source_names, rings_km=(5, 10, 20), azimuth_step_deg=30, du
                         unit="sub-event")
         calls = [task for _, task in tasks]
         parallel = jobs > 1 and len(tasks) > 1
-        pool_or_none = Pool(min(jobs, len(tasks)), initializer=die_with_parent) if parallel \
+        pool_or_none = Pool(min(jobs, len(tasks)), initializer=die_with_parent,
+                            initargs=(os.getpid(),)) if parallel \
             else contextlib.nullcontext()
         with pool_or_none as pool:
             results = (pool.imap(_point_source_task, calls) if parallel    # in order:
