@@ -21,8 +21,7 @@ from typing import Callable
 
 from pipeline import RESULTS_DIR
 from pipeline.files import DirectoryLock, InputError, ToolError, write_json
-from pipeline.campaign.executor import EXECUTORS
-from pipeline.campaign.executor import execute
+from pipeline.campaign.executor import EXECUTORS, execute
 
 CAMPAIGNS = {}
 

@@ -14,26 +14,20 @@ from pipeline.campaign.spec import RunSpec
 from pipeline.campaign.column_file import (at_slenderness, check_stiffness, column_kn,
                                            description, mark, matched_kn, summary_entry)
 from pipeline.campaign.tables import collect, write_tables
-from pipeline.files import (InputError, code_hash, content_hash, csv_true_column,
-                            write_csv)
-from pipeline.motion import Motion
-from pipeline.records import catalog, catalog_row, processed_motion, resolve
+from pipeline.files import (InputError, code_hash, content_hash, csv_true_column, write_csv,
+                            write_json, write_text)
+from pipeline.motion import Motion, synthetics
+from pipeline.records import catalog, catalog_row, processed_motion, resolve, sets
 from pipeline.records.processing import signal_end_s
 from pipeline.scenario import Column, Contact, Numerics
 from pipeline.scenario.parameters import param
 from pipeline.simulate import run_code_version, simulate
-from pipeline.stats.circular import direction_statistics
-from pipeline import figures as figure_module
-from pipeline.records import sets
-from pipeline.motion import synthetics
+from pipeline.stats.circular import direction_statistics, direction_table
 from pipeline.motion.synthetics import rupture_centre
-from pipeline.stats.circular import direction_table
 from pipeline.stats.location import locate_source_from_falls
 from pipeline.scenario.column_format import example_names
 from pipeline.scenario.geometry import ColumnGeometry
-from pipeline.files import write_text
 from pipeline import verification
-from pipeline.files import write_json
 
 
 NUMERICS_FIELDS = {f.name for f in dataclasses.fields(Numerics)}
@@ -129,6 +123,7 @@ def column_outputs(name, size_by=None):
         if not runs.empty:
             write_csv(campaign_dir / "direction_statistics.csv", direction_statistics(runs))
             if figures:
+                from pipeline import figures as figure_module   # matplotlib: not after Ctrl-C
                 written = figure_module.campaign_figures(name, runs, impacts, campaign_dir,
                                                          size_by, animations)
         toppled = runs.groupby("column")["toppled"].agg(["sum", "count"]) if not runs.empty \

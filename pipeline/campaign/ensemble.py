@@ -48,20 +48,17 @@ from pipeline.campaign import Campaign, register
 from pipeline.campaign.column_file import (check_stiffness, column_kn, mark, perturbed,
                                            summary_entry)
 from pipeline.campaign.options import CampaignOptions, column_file_param, stiffness_param
-from pipeline.scenario.parameters import param
+from pipeline.scenario.parameters import check_time_step, param
 from pipeline.campaign.column_file import description as column_file_description
 from pipeline.campaign.definitions import column_specs, run_code_version, run_column_spec
 from pipeline.campaign.tables import collect, write_parquet
 from pipeline.files import InputError, write_csv, write_json
 from pipeline.scenario import Contact, Numerics
-from pipeline.scenario.parameters import check_time_step
 from pipeline.simulate import check_scale
 from pipeline.scenario.column_format import MAX_OFFSET_M
 from pipeline.scenario.geometry import ColumnGeometry
-from pipeline.stats.circular import angle_difference_deg
-from pipeline.stats.ensemble import pooled_answer
-from pipeline.stats.circular import circular_summary
-from pipeline.stats.ensemble import (bootstrap_mean_azimuth_ci, direction_fractions,
+from pipeline.stats.circular import angle_difference_deg, circular_summary
+from pipeline.stats.ensemble import (bootstrap_mean_azimuth_ci, direction_fractions, pooled_answer,
                                      wilson_interval)
 
 DEFAULT_MEMBERS = 16

@@ -56,10 +56,9 @@ from pipeline.files import InputError, write_csv, write_json
 from pipeline.motion import Motion
 from pipeline.motion.measures import horizontal_peak, record_parameters
 from pipeline.records import processed_motion
-from pipeline.rocking import rocking_response_sampled
-from pipeline.stats.ensemble import wilson_interval
-from pipeline.stats.ensemble import binned_fractions, fragility_fit, logistic_surface
-from pipeline.rocking import block_constants
+from pipeline.rocking import block_constants, rocking_response_sampled
+from pipeline.stats.ensemble import (binned_fractions, fragility_fit, logistic_surface,
+                                     wilson_interval)
 
 DEFAULT_LEVELS = tuple(round(float(v), 3) for v in np.geomspace(0.5, 8.0, 8))   # m/s^2
 DEFAULT_MEMBERS = 4

@@ -3,7 +3,7 @@ what defines the run (the code, the processed motion's content and the parameter
 two campaigns asking for the same run share it; what a campaign adds for its own
 bookkeeping (member, seed, node, ...) lives in ``tags`` and changes no run id."""
 from collections.abc import Mapping
-from dataclasses import dataclass, field, fields, replace
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from pipeline.files import InputError, content_hash
@@ -23,6 +23,8 @@ class RunSpec(Mapping):
     run_id: str
     tags: dict = field(default_factory=dict)
 
+    CORE = ("record", "record_id", "motion_file", "params", "run_id")   # the fields, in order
+
     def __post_init__(self):
         for name in ("record", "record_id", "motion_file", "run_id"):
             if not isinstance(getattr(self, name), str) or not getattr(self, name):
@@ -30,7 +32,7 @@ class RunSpec(Mapping):
                                  f"{getattr(self, name)!r}")
         if not isinstance(self.params, dict) or not isinstance(self.tags, dict):
             raise InputError("run spec: params and tags must be mappings")
-        clash = set(self.tags) & {f.name for f in fields(self)}
+        clash = set(self.tags) & {*self.CORE, "tags"}
         if clash:
             raise InputError(f"run spec: tag {sorted(clash)[0]!r} would hide a field")
 
@@ -46,23 +48,21 @@ class RunSpec(Mapping):
 
     def to_dict(self):
         """The flat dict (fields then tags), as campaign files hold a spec."""
-        return {"record": self.record, "record_id": self.record_id,
-                "motion_file": self.motion_file, "params": self.params,
-                "run_id": self.run_id, **self.tags}
+        return {**{name: getattr(self, name) for name in self.CORE}, **self.tags}
 
     @classmethod
     def from_dict(cls, data):
-        core = ("record", "record_id", "motion_file", "params", "run_id")
-        missing = [k for k in core if k not in data]
+        missing = [k for k in cls.CORE if k not in data]
         if missing:
             raise InputError(f"run spec lacks {', '.join(missing)}")
-        return cls(*(data[k] for k in core), {k: v for k, v in data.items() if k not in core})
+        return cls(*(data[k] for k in cls.CORE),
+                   {k: v for k, v in data.items() if k not in cls.CORE})
 
     # read-only mapping over the flat dict
     def __getitem__(self, key):
         if key in self.tags:
             return self.tags[key]
-        if key in ("record", "record_id", "motion_file", "params", "run_id"):
+        if key in self.CORE:
             return getattr(self, key)
         raise KeyError(key)
 
@@ -70,7 +70,7 @@ class RunSpec(Mapping):
         return iter(self.to_dict())
 
     def __len__(self):
-        return 5 + len(self.tags)
+        return len(self.CORE) + len(self.tags)
 
     def __hash__(self):
-        return hash((self.run_id, tuple(sorted(self.tags, key=str))))
+        return hash(self.run_id)

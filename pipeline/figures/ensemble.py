@@ -6,9 +6,8 @@ import numpy as np
 
 from pipeline.figures.style import COLUMN_COLOURS, COLUMN_LABELS, COLUMN_MARKERS, new_figure
 from pipeline.files import save_figure
-from pipeline.stats.ensemble import circular_density
+from pipeline.stats.ensemble import circular_density, wilson_interval
 from pipeline.stats.circular import angle_difference_deg
-from pipeline.stats.ensemble import wilson_interval
 
 BIN_DEG = 10.0
 

@@ -8,8 +8,7 @@ from scipy import stats
 
 from pipeline.figures.style import COLUMN_COLOURS, COLUMN_LABELS, COLUMN_MARKERS, figure
 from pipeline.files import save_figure
-from pipeline.stats.ensemble import logistic_probability
-from pipeline.stats.ensemble import wilson_interval
+from pipeline.stats.ensemble import logistic_probability, wilson_interval
 
 BLOCK_STYLE = {"block2d": {"color": "0.35", "ls": "--", "marker": "D",
                            "label": "2D block, strongest azimuth"},

@@ -26,14 +26,13 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from pipeline.files import write_csv, write_json
+from pipeline.files import InputError, write_csv, write_json
 from pipeline.inversion.likelihood import (DEFAULT_FLOOR, DEFAULT_KERNEL_DEG, LIKELIHOODS,
                                            ForwardModel)
 from pipeline.inversion.observations import ColumnObservation, Observations, Site
 from pipeline.inversion.posterior import in_arc, invert
 from pipeline.stats.circular import angle_difference_deg, azimuth_deg
 from pipeline.motion.synthetics import SOURCES
-from pipeline.files import InputError
 
 FALLEN_PER_SITE = (1, 3, 10, 30)
 SITE_COUNTS = (1, 3)
@@ -307,7 +306,6 @@ def run_demo(table, out_dir, candidates, paper_tables=None, trials=DEFAULT_TRIAL
         examples.update({(kind,) + key: value for key, value in found.items()})
     trials_frame = pd.concat(frames, ignore_index=True)
     if trials_frame.empty:
-        from pipeline.files import InputError
         raise InputError("no column of the table's observation half ever fell: nothing to "
                          "test (a grid with stronger shaking: closer rings, higher Mw)")
     write_csv(out_dir / "truth_tests.csv", trials_frame)

@@ -15,9 +15,7 @@ import numpy as np
 from pipeline.constants import COLUMN_TYPES
 from pipeline.files import InputError, content_hash, die_with_parent, write_json
 from pipeline.motion import Motion
-from pipeline.motion.synthetics import SOURCES, moment_from_mw
-from pipeline.motion.synthetics import CRUST_LAYERS, LEAD_TIME_S
-from pipeline.motion.synthetics import numerics
+from pipeline.motion.synthetics import CRUST_LAYERS, LEAD_TIME_S, SOURCES, moment_from_mw, numerics
 from pipeline.motion.synthetics.compute import _point_source_task
 from pipeline.campaign.column_file import description
 

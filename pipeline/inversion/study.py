@@ -109,7 +109,6 @@ def member_study(table, candidates, likelihood_members=LIKELIHOOD_MEMBERS,
     usable, pool = split_for_study(table, observation_members)
     sizes = [n for n in likelihood_members if n <= usable.members.size]
     if not sizes:
-        from pipeline.files import InputError
         raise InputError(f"the table's {usable.members.size} likelihood members are fewer "
                          f"than the smallest study size {min(likelihood_members)}")
     order = np.sort(usable.members)

@@ -35,8 +35,7 @@ from pipeline.inversion.grid import MECHANISMS, slice_motions
 from pipeline.stats.circular import azimuth_deg
 from pipeline.userfiles import read_text
 from pipeline.userfiles import keys_text as _keys
-from pipeline.inversion.forward import MEMBER_BATCH
-from pipeline.inversion.forward import member_parameters
+from pipeline.inversion.forward import MEMBER_BATCH, member_parameters
 
 TRUTH_SEED = 7_000_001           # far beyond any table's seed + batch
 MAX_TWINS = 50

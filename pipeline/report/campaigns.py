@@ -291,16 +291,25 @@ def convergence_section(results):
     return "\n".join(lines)
 
 
+def run_all_steps(path):
+    """The steps of the last `make run-all` (``run-all-steps.tsv``, written by the
+    Makefile: step, wall_s, exit) with their wall minutes; None before the first."""
+    path = Path(path)
+    if not path.exists() or path.stat().st_size <= 1:
+        return None
+    frame = pd.read_csv(path, sep="\t")
+    frame["wall (min)"] = (frame["wall_s"] / 60).round(1)
+    return frame
+
+
 def run_all_section(results):
-    """What the last `make run-all` cost: its steps' wall times (results/run-all-steps.tsv,
-    written by the Makefile), including what was reduced to fit."""
+    """What the last `make run-all` cost: its steps' wall times, including what was
+    reduced to fit."""
     path = Path(results) / "run-all-steps.tsv"
-    frame = _read_csv(path) if path.exists() else None
+    frame = run_all_steps(path)
     if frame is None:
         return ""
-    frame = pd.read_csv(path, sep="\t")
     total = float(frame["wall_s"].sum())
-    frame["wall (min)"] = (frame["wall_s"] / 60).round(1)
     return ("## What this run-all cost\n\n"
             f"Wall time of the last `make run-all`'s steps on this machine (from "
             f"`{path.relative_to(results)}`): {total / 60:.1f} min in all, the venv and the "

@@ -3,11 +3,11 @@
 ``results/REPORT.md`` from ``make run-all``), so no measurement is typed by hand.  The docs
 pages call these through the mkdocs-macros hook :mod:`pipeline.report.docs_macros`; a
 file not written yet renders as a note saying which command writes it."""
-import csv
 import json
 from functools import reduce
 
 from pipeline import RESULTS_DIR
+from pipeline.report import campaigns
 
 BENCH_JSON = RESULTS_DIR / "bench" / "bench.json"
 RUN_ALL_STEPS = RESULTS_DIR / "run-all-steps.tsv"
@@ -63,19 +63,14 @@ def engine_shares(path=BENCH_JSON, least_pct=2.0):
 
 
 def run_all_steps(path=RUN_ALL_STEPS):
-    """Markdown table of ``make run-all``'s steps and their wall minutes, with the total."""
-    if not path.is_file():
+    """Markdown table of ``make run-all``'s steps and their wall minutes, with the total
+    (read by :func:`pipeline.report.campaigns.run_all_steps`, as the REPORT reads them)."""
+    frame = campaigns.run_all_steps(path)
+    if frame is None or frame.empty:
         return _not_yet("make run-all")
-    with path.open() as handle:
-        rows = list(csv.DictReader(handle, delimiter="\t"))
-    if not rows:
-        return _not_yet("make run-all")
-    keys = list(rows[0])
-    step, seconds = keys[0], next((k for k in keys if k.endswith("_s")), keys[-1])
-    total = sum(float(r[seconds]) for r in rows)
     lines = ["| step | wall (min) |", "|---|---|"]
-    lines += [f"| {r[step]} | {float(r[seconds]) / 60:.1f} |" for r in rows]
-    lines.append(f"| **total** | **{total / 60:.1f}** |")
+    lines += [f"| {r.step} | {r.wall_s / 60:.1f} |" for r in frame.itertuples()]
+    lines.append(f"| **total** | **{frame['wall_s'].sum() / 60:.1f}** |")
     return "\n".join(lines)
 
 

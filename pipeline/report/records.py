@@ -12,10 +12,8 @@ from pipeline.stats.ensemble import wilson_interval
 from pipeline import paper
 from pipeline.records.catalog import catalog_row
 from pipeline.motion import Motion
-from pipeline.stats.circular import direction_table
-from pipeline.stats.circular import direction_statistics
-from pipeline.stats.circular import direction_differences
-from pipeline.stats.circular import direction_class
+from pipeline.stats.circular import (direction_class, direction_differences, direction_statistics,
+                                     direction_table)
 from pipeline.records import peer_check
 
 

@@ -49,10 +49,10 @@ import numpy as np
 from pipeline.constants import MODEL_GRAVITY
 from pipeline.files import InputError
 from pipeline.scenario.bodies import _build, _statics
-from pipeline.scenario.column_format import (_check_keys, _number, _one_line, _parse_block,
-                                             _parse_json, _parse_yaml, example_names)
 from pipeline.scenario.column_format import (DENSITY_RANGE, EXAMPLES_DIR, MAX_BLOCKS,
-                                             MAX_COLUMN_HEIGHT_M, TOP_KEYS)
+                                             MAX_COLUMN_HEIGHT_M, TOP_KEYS, _check_keys, _number,
+                                             _one_line, _parse_block, _parse_json, _parse_yaml,
+                                             example_names)
 from pipeline.scenario.mesh import MESH_SUFFIXES, MeshSpecimen
 from pipeline.scenario.outline import perimeter_points
 from pipeline.scenario.solids import Box, ColumnBlock, Frustum
