@@ -424,10 +424,10 @@ def quiet_motion(work, records=QUIET_RECORDS):
         row = {"record": record}
         for mode in ("skip", "simulate"):
             s = summaries[(record, mode)]
-            row[mode] = {"simulated_s": s["simulated_s"], "wall_s": s["wall_s"],
-                         "window_s": s["simulated_window_s"], "motion_end_s": s["motion_end_s"],
-                         "columns": {c["column"]: (c["toppled"], c["downfall_azimuth_deg"])
-                                     for c in s["columns"]}}
+            row[mode] = {"simulated_s": s.simulated_s, "wall_s": s.wall_s,
+                         "window_s": s.simulated_window_s, "motion_end_s": s.motion_end_s,
+                         "columns": {c.column: (c.toppled, c.downfall_azimuth_deg)
+                                     for c in s.columns}}
         rows.append(row)
     total = {mode: sum(r[mode]["simulated_s"] for r in rows) for mode in ("skip", "simulate")}
     wall = {mode: sum(r[mode]["wall_s"] for r in rows) for mode in ("skip", "simulate")}
