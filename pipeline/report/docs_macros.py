@@ -1,9 +1,42 @@
 """mkdocs-macros hook (``mkdocs.yml``: ``module_name``): the docs pages' measured numbers
-and tables from :mod:`pipeline.report.docs_numbers`."""
+and tables from :mod:`pipeline.report.docs_numbers`; the REPORT's figures that a page
+shows are copied beside the page in the built site."""
+import shutil
+from pathlib import Path
+
+from pipeline import RESULTS_DIR
 from pipeline.report import docs_numbers
+
+NUMBERS = ("bench_value", "bench_speed_table", "engine_shares", "run_all_steps",
+           "run_all_minutes", "value")
+WITH_FIGURES = ("report", "report_section")
 
 
 def define_env(env):
-    for name in ("bench_value", "bench_speed_table", "engine_shares", "run_all_steps",
-                 "report"):
+    env.variables["_figures"] = set()          # (page url, figure path under results/)
+    for name in NUMBERS:
         env.macro(getattr(docs_numbers, name), name)
+
+    def with_figures(function):
+        def macro(*args, **kwargs):
+            text = function(*args, **kwargs)
+            page_url = env.page.url if env.page is not None else ""
+            env.variables["_figures"].update(
+                (page_url, figure) for figure in docs_numbers.figures(text))
+            return text
+        macro.__doc__ = function.__doc__
+        return macro
+
+    for name in WITH_FIGURES:
+        env.macro(with_figures(getattr(docs_numbers, name)), name)
+
+
+def on_post_build(env):
+    """Copy each figure a page shows from ``results/`` to where the page's link points."""
+    site = Path(env.conf["site_dir"])
+    for page_url, figure in env.variables.get("_figures", ()):
+        source = RESULTS_DIR / figure
+        if source.is_file():
+            target = site / page_url / figure
+            target.parent.mkdir(parents=True, exist_ok=True)
+            shutil.copyfile(source, target)

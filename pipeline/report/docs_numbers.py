@@ -1,9 +1,11 @@
 """Numbers and tables of the documentation, read from the files the project writes
 (``results/bench/bench.json`` from ``make bench``, ``results/run-all-steps.tsv`` and
-``results/REPORT.md`` from ``make run-all``), so no measurement is typed by hand.  The docs
-pages call these through the mkdocs-macros hook :mod:`pipeline.report.docs_macros`; a
-file not written yet renders as a note saying which command writes it."""
+``results/REPORT.md`` from ``make run-all``, the JSON summaries of :data:`SOURCES`), so no
+measurement is typed by hand.  The docs pages call these through the mkdocs-macros hook
+:mod:`pipeline.report.docs_macros`; a file not written yet renders as a note saying which
+command writes it."""
 import json
+import re
 from functools import reduce
 
 from pipeline import RESULTS_DIR
@@ -12,6 +14,15 @@ from pipeline.report import campaigns
 BENCH_JSON = RESULTS_DIR / "bench" / "bench.json"
 RUN_ALL_STEPS = RESULTS_DIR / "run-all-steps.tsv"
 REPORT = RESULTS_DIR / "REPORT.md"
+# the JSON summaries the docs quote (paths under results/) and the command writing each
+SOURCES = {
+    "bench/bench.json": "make bench",
+    "verification/verification.json": "make run-all",
+    "shake-table/shake_table.json": "make shake-table",
+    "inversion/demo_summary.json": "make run-all",
+    "inversion/member-study/member_study.json": "make invert-study",
+}
+FIGURE = re.compile(r"!\[[^\]]*\]\(([^)\s]+)\)")
 
 
 def _not_yet(command):
@@ -22,18 +33,33 @@ def _bench(path=BENCH_JSON):
     return json.loads(path.read_text()) if path.is_file() else None
 
 
+def _json_value(path, key, fmt, times, command):
+    data = _bench(path)
+    if data is None:
+        return _not_yet(command)
+    try:
+        found = reduce(lambda v, k: v[int(k)] if isinstance(v, list) else v[k],
+                       key.split("."), data)
+    except (KeyError, IndexError, ValueError, TypeError):
+        return _not_yet(command)
+    return fmt.format(found * times if isinstance(found, (int, float))
+                      and not isinstance(found, bool) else found)
+
+
 def bench_value(key, fmt="{:.2f}", path=BENCH_JSON):
     """One number of ``bench.json`` by its dotted ``key`` (list items by index), formatted
     with ``fmt``; a note while ``make bench`` has not run or the key is missing."""
-    data = _bench(path)
-    if data is None:
-        return _not_yet("make bench")
-    try:
-        value = reduce(lambda v, k: v[int(k)] if isinstance(v, list) else v[k],
-                       key.split("."), data)
-    except (KeyError, IndexError, ValueError, TypeError):
-        return _not_yet("make bench")
-    return fmt.format(value)
+    return _json_value(path, key, fmt, 1, "make bench")
+
+
+def value(source, key, fmt="{:.2f}", times=1, root=RESULTS_DIR):
+    """One value of the JSON file ``source`` (a key of :data:`SOURCES`, a path under
+    ``results/``) by its dotted ``key``, multiplied by ``times`` (100 for a percentage) and
+    formatted with ``fmt``; a note naming the command while the file or the key is not
+    there."""
+    if source not in SOURCES:
+        raise ValueError(f"docs: {source!r} is not one of the quoted files {sorted(SOURCES)}")
+    return _json_value(root / source, key, fmt, times, SOURCES[source])
 
 
 def bench_speed_table(path=BENCH_JSON):
@@ -74,9 +100,38 @@ def run_all_steps(path=RUN_ALL_STEPS):
     return "\n".join(lines)
 
 
+def run_all_minutes(path=RUN_ALL_STEPS):
+    """The last ``make run-all``'s wall time in minutes (the sum of its steps)."""
+    frame = campaigns.run_all_steps(path)
+    if frame is None or frame.empty:
+        return _not_yet("make run-all")
+    return f"{frame['wall_s'].sum() / 60:.0f}"
+
+
 def report(path=REPORT):
     """``results/REPORT.md`` itself, its headings moved one level down."""
     if not path.is_file():
         return _not_yet("make run-all")
     return "\n".join("#" + line if line.startswith("#") else line
                      for line in path.read_text().splitlines())
+
+
+def report_section(heading, path=REPORT, command="make run-all"):
+    """The section of ``results/REPORT.md`` whose ``## `` heading starts with ``heading``,
+    without that heading and with its inner headings two levels down (for a page's
+    ``###``); a note naming ``command`` while the REPORT or the section is not there."""
+    if not path.is_file():
+        return _not_yet(command)
+    lines, inside = [], False
+    for line in path.read_text().splitlines():
+        if line.startswith("## "):
+            inside = line[3:].startswith(heading)
+            continue
+        if inside:
+            lines.append("##" + line if line.startswith("#") else line)
+    return "\n".join(lines).strip() or _not_yet(command)
+
+
+def figures(text):
+    """The figure paths (relative to ``results/``) a piece of the REPORT shows."""
+    return FIGURE.findall(text)

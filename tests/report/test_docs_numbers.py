@@ -8,7 +8,8 @@ from pathlib import Path
 from pipeline.report import docs_numbers
 
 ROOT = Path(__file__).resolve().parents[2]
-MACROS = ("bench_value", "bench_speed_table", "engine_shares", "run_all_steps", "report")
+MACROS = ("bench_value", "bench_speed_table", "engine_shares", "run_all_steps",
+          "run_all_minutes", "value", "report", "report_section")
 
 
 def _bench(tmp_path):
@@ -47,6 +48,85 @@ def test_run_all_steps_add_up(tmp_path):
     path.write_text("step\twall_s\texit\nrecords\t60.0\t0\nsynthetic\t480.0\t0\n")
     table = docs_numbers.run_all_steps(path)
     assert "| records | 1.0 |" in table and "| **total** | **9.0** |" in table
+    assert docs_numbers.run_all_minutes(path) == "9"
+
+
+def test_values_of_the_quoted_files(tmp_path):
+    target = tmp_path / "shake-table" / "shake_table.json"
+    target.parent.mkdir()
+    target.write_text(json.dumps({"splits": {"validation": {"model": {
+        "accuracy": 0.8614, "accuracy_95": [0.81, 0.9]}}}, "validate_from": "2021-08-01"}))
+    value = docs_numbers.value
+    source = "shake-table/shake_table.json"
+    assert value(source, "splits.validation.model.accuracy", "{:.3f}", root=tmp_path) == "0.861"
+    assert value(source, "splits.validation.model.accuracy", "{:.0f}", 100,
+                 root=tmp_path) == "86"
+    assert value(source, "splits.validation.model.accuracy_95.1", root=tmp_path) == "0.90"
+    assert value(source, "validate_from", "{}", root=tmp_path) == "2021-08-01"
+    assert "make shake-table" in value(source, "splits.nothing", root=tmp_path)
+    assert "make invert-study" in value("inversion/member-study/member_study.json", "x",
+                                        root=tmp_path)
+    try:
+        value("somewhere/else.json", "x", root=tmp_path)
+    except ValueError as error:
+        assert "somewhere/else.json" in str(error)
+    else:
+        raise AssertionError("a file the docs do not quote was accepted")
+
+
+REPORT_TEXT = """# Toppling columns: results report
+
+## Verification against rocking theory
+
+- Housner free rocking: impact times within 2.2 %
+
+### A table
+
+![Fig. 4](verification/fig4_housner.png)
+
+## Slenderness sweep (hd)
+
+- drums topple from h/d 7
+"""
+
+
+def test_a_report_section_is_quoted_whole_and_only(tmp_path):
+    path = tmp_path / "REPORT.md"
+    path.write_text(REPORT_TEXT)
+    section = docs_numbers.report_section("Verification", path)
+    assert section.startswith("- Housner free rocking: impact times within 2.2 %")
+    assert "##### A table" in section and "h/d 7" not in section
+    assert docs_numbers.figures(section) == ["verification/fig4_housner.png"]
+    assert "make run-all" in docs_numbers.report_section("Fragility", path)
+    assert "make invert-study" in docs_numbers.report_section(
+        "How many", tmp_path / "none.md", command="make invert-study")
+
+
+def test_the_site_shows_the_figures_of_the_quoted_sections(tmp_path, monkeypatch):
+    from pipeline.report import docs_macros
+    results = tmp_path / "results"
+    (results / "verification").mkdir(parents=True)
+    (results / "verification" / "fig4_housner.png").write_bytes(b"png")
+    (results / "REPORT.md").write_text(REPORT_TEXT)
+    monkeypatch.setattr(docs_macros, "RESULTS_DIR", results)
+
+    class Page:
+        url = "campaigns/"
+
+    class Env:
+        def __init__(self):
+            self.macros, self.variables, self.page = {}, {}, Page()
+            self.conf = {"site_dir": str(tmp_path / "site")}
+
+        def macro(self, function, name):
+            self.macros[name] = function
+
+    env = Env()
+    docs_macros.define_env(env)
+    text = env.macros["report_section"]("Verification", results / "REPORT.md")
+    assert "fig4_housner.png" in text
+    docs_macros.on_post_build(env)
+    assert (tmp_path / "site" / "campaigns" / "verification" / "fig4_housner.png").is_file()
 
 
 def test_every_macro_the_docs_call_exists():
@@ -57,7 +137,7 @@ def test_every_macro_the_docs_call_exists():
 
     class Env:
         def __init__(self):
-            self.macros = {}
+            self.macros, self.variables = {}, {}
 
         def macro(self, function, name):
             self.macros[name] = function
