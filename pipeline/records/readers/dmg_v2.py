@@ -74,12 +74,41 @@ def _check_components(stream, name):
 
 
 def _read_channel(block, offset, name, info):
+    """One channel's block as an obspy Trace (m/s^2); its station and event facts merged
+    into ``info`` (a second channel must name the same station)."""
     where = f"channel at line {offset + 1}"
     chan = _CHAN.search(block[0])
     if not chan:
         raise InputError(f"{name}: {where}: no 'CHAN n: <orientation>' in {one_line(block[0])!r}")
     number_, orient = chan.group(1), re.sub(r"\s+", " ", chan.group(2).upper())
     where = f"channel {number_} (line {offset + 1})"
+    trace, header = _acceleration(block, name, where)
+    trace.stats.channel = f"CH{number_}"
+    if orient in {"UP"}:
+        trace.stats.azimuth, trace.stats.dip = 0.0, VERTICAL_UP
+    elif orient in {"DOWN", "DWN"}:
+        trace.stats.azimuth, trace.stats.dip = 0.0, VERTICAL_DOWN
+    else:
+        trace.stats.azimuth, trace.stats.dip = float(orient.split()[0]) % 360.0, 0.0
+    repeat = _search(header[1:], r"^\s*CHAN\s+(\d+)\s*:\s*(\S+(?:\s*DEG)?)")
+    if repeat and repeat.group(1) != number_:
+        raise InputError(f"{name}: {where}: header names channel {repeat.group(1)}")
+
+    code, start_time, channel_info = _header_facts(header, name, where)
+    trace.stats.network, trace.stats.station = "CE", code
+    if start_time is not None:
+        trace.stats.starttime = start_time
+    for key, value in channel_info.items():
+        if key in info and info[key] != value and key in ("station_lat", "station_lon", "station"):
+            raise InputError(f"{name}: {where}: {key} {value} differs from the first channel's "
+                             f"{info[key]}")
+        info.setdefault(key, value)
+    return trace
+
+
+def _acceleration(block, name, where):
+    """The channel's acceleration block as a Trace (m/s^2, its sample interval set) and the
+    text header above it."""
     data_rows = [i for i, line in enumerate(block) if _DATA.match(line)]
     accel = next((i for i in data_rows if _DATA.match(block[i]).group(2).upper() == "ACCEL"), None)
     if accel is None:
@@ -112,20 +141,14 @@ def _read_channel(block, offset, name, info):
         raise InputError(f"{name}: {where}: acceleration block has {found} samples, "
                          f"header says {npts}")
     values, _ = fixed_width_values(body, WIDTH, PER_LINE, npts, name, f"{where} acceleration")
-
     trace = Trace(values * scale)
     trace.stats.delta = dt
-    trace.stats.channel = f"CH{number_}"
-    if orient in {"UP"}:
-        trace.stats.azimuth, trace.stats.dip = 0.0, VERTICAL_UP
-    elif orient in {"DOWN", "DWN"}:
-        trace.stats.azimuth, trace.stats.dip = 0.0, VERTICAL_DOWN
-    else:
-        trace.stats.azimuth, trace.stats.dip = float(orient.split()[0]) % 360.0, 0.0
-    repeat = _search(header[1:], r"^\s*CHAN\s+(\d+)\s*:\s*(\S+(?:\s*DEG)?)")
-    if repeat and repeat.group(1) != number_:
-        raise InputError(f"{name}: {where}: header names channel {repeat.group(1)}")
+    return trace, header
 
+
+def _header_facts(header, name, where):
+    """Station code, trigger time (or None) and the station/event facts of a channel's text
+    header (coordinates in degrees, depth km)."""
     station = _search(header, r"STATION\s+NO\.\s*(\S+)\s+([\d.]+)\s*([NS])\s*,\s*"
                               r"([\d.]+)\s*([EW])")
     if not station:
@@ -133,10 +156,7 @@ def _read_channel(block, offset, name, info):
     code = station.group(1)
     lat = _coordinate(station.group(2), station.group(3), name, where)
     lon = _coordinate(station.group(4), station.group(5), name, where)
-    trace.stats.network, trace.stats.station = "CE", code
     start_time = _time(header, "TRIGGER TIME", name, where)
-    if start_time is not None:
-        trace.stats.starttime = start_time
 
     channel_info = {"station_lat": lat, "station_lon": lon}
     line_no = next(i for i, line in enumerate(header) if "STATION NO." in line.upper())
@@ -155,7 +175,6 @@ def _read_channel(block, offset, name, info):
         channel_info["event_lon"] = _coordinate(hypo.group(3), hypo.group(4), name, where)
         if hypo.group(5):
             channel_info["event_depth_km"] = float(hypo.group(5))
-        preliminary = "PRELIMINARY" in hypo.string.upper()
     mag = _search(header, r"\b(?:M[LSW]?|MAG)\s*=\s*([\d.]+)")
     if mag:
         channel_info["magnitude"] = float(mag.group(1))
@@ -166,15 +185,10 @@ def _read_channel(block, offset, name, info):
         channel_info["lowest_usable_hz"], channel_info["highest_usable_hz"] = lo1, hi0
         channel_info["notes"] = (f"CSMIP/DMG Volume 2: corrected acceleration, band-pass ramps "
                                  f"{lo0:g}-{lo1:g} and {hi0:g}-{hi1:g} Hz")
-    if hypo and preliminary:
+    if hypo and "PRELIMINARY" in hypo.string.upper():
         channel_info["notes"] = (channel_info.get("notes", "CSMIP/DMG Volume 2")
                                  + "; hypocentre in the header is a preliminary solution")
-    for key, value in channel_info.items():
-        if key in info and info[key] != value and key in ("station_lat", "station_lon", "station"):
-            raise InputError(f"{name}: {where}: {key} {value} differs from the first channel's "
-                             f"{info[key]}")
-        info.setdefault(key, value)
-    return trace
+    return code, start_time, channel_info
 
 
 def _search(lines, pattern):

@@ -137,28 +137,7 @@ def _read_channel(lines, start, name, index):
         raise InputError(f"{name}: {where}: no 'Component' line (line {start + 13})")
     component = comp.group(1)
 
-    ints_f, _ = fixed_width_values(lines[start + TEXT_ROWS:start + TEXT_ROWS + INT_ROWS], WIDTH,
-                                   PER_LINE, INT_ROWS * PER_LINE, name, f"{where} integer header")
-    reals_f, _ = fixed_width_values(
-        lines[start + TEXT_ROWS + INT_ROWS:start + TEXT_ROWS + INT_ROWS + REAL_ROWS], WIDTH,
-        PER_LINE, REAL_ROWS * PER_LINE, name, f"{where} real header")
-    ints = ints_f.reshape(INT_ROWS, PER_LINE)
-    reals = reals_f.reshape(REAL_ROWS, PER_LINE)
-
-    npts = int(ints[3, 0] if level == "V1" else ints[3, 3])
-    stated = re.search(r"Number of points\s+(\d+)", text[9])
-    if not stated:
-        raise InputError(f"{name}: {where}: no 'Number of points' line")
-    if int(stated.group(1)) != npts or npts <= 0:
-        raise InputError(f"{name}: {where}: text header says {stated.group(1)} points, "
-                         f"integer header {npts}")
-    dt = float(reals[2, 5])
-    if not (np.isfinite(dt) and dt > 0):
-        raise InputError(f"{name}: {where}: sample interval {dt:g} s is not positive")
-    interval = re.search(r"(?:intervals of|at)\s+([\d.]+)\s*s", text[10])
-    if interval and abs(number(interval.group(1), "sample interval", name) - dt) > 1e-6:
-        raise InputError(f"{name}: {where}: text header interval {interval.group(1)} s, "
-                         f"real header {dt:g} s")
+    ints, reals, npts, dt = _headers(lines, start, text, level, name, where)
 
     scale = _scale(text, level, name, where)
     azimuth, dip = _orientation(component, name, where)
@@ -169,17 +148,7 @@ def _read_channel(lines, start, name, index):
         raise InputError(f"{name}: {where}: site coordinates {one_line(text[1])[:40]!r} disagree "
                          f"with the real header ({reals[1, 0]:g}, {reals[1, 1]:g})")
 
-    data_start = start + TEXT_ROWS + INT_ROWS + REAL_ROWS
-    values, used = fixed_width_values(lines[data_start:], WIDTH, PER_LINE, npts, name,
-                                      f"{where} {component} acceleration")
-    end = data_start + used
-    if level == "V2":  # velocity and displacement blocks follow
-        for count in (int(ints[3, 4]), int(ints[3, 5])):
-            end += -(-count // PER_LINE)
-    if end > len(lines) or (end < len(lines) and lines[end].strip()
-                            and not _TITLE.match(lines[end])):
-        raise InputError(f"{name}: {where} {component}: the sample blocks do not end where the "
-                         f"header counts say (line {end + 1}); wrong sample count")
+    values, end = _samples(lines, start, ints, npts, level, component, name, where)
 
     trace = Trace(values * scale)
     trace.stats.network, trace.stats.station, trace.stats.location = "NZ", station, ""
@@ -203,6 +172,51 @@ def _read_channel(lines, start, name, index):
         channel["band"] = (lo1, hi0)  # pass band between the two transition bands
         channel["band_text"] = f"{lo0:g}-{lo1:g} and {hi0:g}-{hi1:g}"
     return channel, end
+
+
+def _headers(lines, start, text, level, name, where):
+    """The channel's integer and real headers (arrays of their rows), its sample count and
+    sample interval (s), checked against the text header."""
+    ints_f, _ = fixed_width_values(lines[start + TEXT_ROWS:start + TEXT_ROWS + INT_ROWS], WIDTH,
+                                   PER_LINE, INT_ROWS * PER_LINE, name, f"{where} integer header")
+    reals_f, _ = fixed_width_values(
+        lines[start + TEXT_ROWS + INT_ROWS:start + TEXT_ROWS + INT_ROWS + REAL_ROWS], WIDTH,
+        PER_LINE, REAL_ROWS * PER_LINE, name, f"{where} real header")
+    ints = ints_f.reshape(INT_ROWS, PER_LINE)
+    reals = reals_f.reshape(REAL_ROWS, PER_LINE)
+
+    npts = int(ints[3, 0] if level == "V1" else ints[3, 3])
+    stated = re.search(r"Number of points\s+(\d+)", text[9])
+    if not stated:
+        raise InputError(f"{name}: {where}: no 'Number of points' line")
+    if int(stated.group(1)) != npts or npts <= 0:
+        raise InputError(f"{name}: {where}: text header says {stated.group(1)} points, "
+                         f"integer header {npts}")
+    dt = float(reals[2, 5])
+    if not (np.isfinite(dt) and dt > 0):
+        raise InputError(f"{name}: {where}: sample interval {dt:g} s is not positive")
+    interval = re.search(r"(?:intervals of|at)\s+([\d.]+)\s*s", text[10])
+    if interval and abs(number(interval.group(1), "sample interval", name) - dt) > 1e-6:
+        raise InputError(f"{name}: {where}: text header interval {interval.group(1)} s, "
+                         f"real header {dt:g} s")
+    return ints, reals, npts, dt
+
+
+def _samples(lines, start, ints, npts, level, component, name, where):
+    """The channel's acceleration samples (file units) and the line after its last sample
+    block (V2: after the velocity and displacement blocks)."""
+    data_start = start + TEXT_ROWS + INT_ROWS + REAL_ROWS
+    values, used = fixed_width_values(lines[data_start:], WIDTH, PER_LINE, npts, name,
+                                      f"{where} {component} acceleration")
+    end = data_start + used
+    if level == "V2":  # velocity and displacement blocks follow
+        for count in (int(ints[3, 4]), int(ints[3, 5])):
+            end += -(-count // PER_LINE)
+    if end > len(lines) or (end < len(lines) and lines[end].strip()
+                            and not _TITLE.match(lines[end])):
+        raise InputError(f"{name}: {where} {component}: the sample blocks do not end where the "
+                         f"header counts say (line {end + 1}); wrong sample count")
+    return values, end
 
 
 def _dms(groups, hemispheres, name, where):
