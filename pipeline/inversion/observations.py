@@ -185,21 +185,7 @@ def parse_observations(data, source="observations"):
         if unknown:
             raise InputError(f"{where}: unknown key(s) {_keys(unknown)} (known: "
                              f"{', '.join(sorted(SITE_KEYS))})")
-        has_km = "east_km" in site or "north_km" in site
-        has_geo = "latitude" in site or "longitude" in site
-        if has_km == has_geo:
-            raise InputError(f"{where}: give either east_km and north_km or latitude and "
-                             "longitude")
-        if has_km:
-            if "east_km" not in site or "north_km" not in site:
-                raise InputError(f"{where}: needs both east_km and north_km")
-            position = ("km", _number(site["east_km"], f"{where}: east_km", -1e4, 1e4),
-                        _number(site["north_km"], f"{where}: north_km", -1e4, 1e4))
-        else:
-            if "latitude" not in site or "longitude" not in site:
-                raise InputError(f"{where}: needs both latitude and longitude")
-            position = ("geo", _number(site["latitude"], f"{where}: latitude", -90.0, 90.0),
-                        _number(site["longitude"], f"{where}: longitude", -180.0, 360.0))
+        position = _position(site, where)
         columns = site.get("columns")
         if not isinstance(columns, list) or not columns:
             raise InputError(f"{where}: 'columns' must be a non-empty list")
@@ -213,8 +199,43 @@ def parse_observations(data, source="observations"):
     if len(kinds) > 1:
         raise InputError(f"{source}: mixes east_km/north_km and latitude/longitude between "
                          "sites; use one for all")
+    out = _local_sites(raw)
+    for site in out:                  # one rule, whether sites come in km or in degrees
+        if math.hypot(site.east_km, site.north_km) > MAX_REGION_KM:
+            raise InputError(f"{source}: site {_show(site.name)} lies "
+                             f"{math.hypot(site.east_km, site.north_km):.0f} km from the "
+                             f"first site (more than {MAX_REGION_KM:g} km: not one region)")
+    for k, a in enumerate(out):
+        for b in out[:k]:
+            if math.hypot(a.east_km - b.east_km, a.north_km - b.north_km) < 1e-6:
+                raise InputError(f"{source}: sites {_show(b.name)} and {_show(a.name)} are "
+                                 "at the same place; list their columns under one site")
+    return Observations(tuple(out), source)
+
+
+def _position(site, where):
+    """A site's position as ("km", east, north) or ("geo", latitude, longitude)."""
+    has_km = "east_km" in site or "north_km" in site
+    has_geo = "latitude" in site or "longitude" in site
+    if has_km == has_geo:
+        raise InputError(f"{where}: give either east_km and north_km or latitude and "
+                         "longitude")
+    if has_km:
+        if "east_km" not in site or "north_km" not in site:
+            raise InputError(f"{where}: needs both east_km and north_km")
+        return ("km", _number(site["east_km"], f"{where}: east_km", -1e4, 1e4),
+                _number(site["north_km"], f"{where}: north_km", -1e4, 1e4))
+    if "latitude" not in site or "longitude" not in site:
+        raise InputError(f"{where}: needs both latitude and longitude")
+    return ("geo", _number(site["latitude"], f"{where}: latitude", -90.0, 90.0),
+            _number(site["longitude"], f"{where}: longitude", -180.0, 360.0))
+
+
+def _local_sites(raw):
+    """Sites in km East/North of the first one, from (name, position, columns) tuples
+    whose positions are all in km or all in degrees (then via obspy's geodesic)."""
     out = []
-    if kinds == {"km"}:
+    if raw[0][1][0] == "km":
         _, e0, n0 = raw[0][1]
         for name, (_, e, n), cols in raw:
             out.append(Site(name, e - e0, n - n0, cols))
@@ -229,17 +250,7 @@ def parse_observations(data, source="observations"):
                 east = dist_m / 1e3 * math.sin(math.radians(az))
                 north = dist_m / 1e3 * math.cos(math.radians(az))
             out.append(Site(name, east, north, cols, lat, lon))
-    for site in out:                  # one rule, whether sites come in km or in degrees
-        if math.hypot(site.east_km, site.north_km) > MAX_REGION_KM:
-            raise InputError(f"{source}: site {_show(site.name)} lies "
-                             f"{math.hypot(site.east_km, site.north_km):.0f} km from the "
-                             f"first site (more than {MAX_REGION_KM:g} km: not one region)")
-    for k, a in enumerate(out):
-        for b in out[:k]:
-            if math.hypot(a.east_km - b.east_km, a.north_km - b.north_km) < 1e-6:
-                raise InputError(f"{source}: sites {_show(b.name)} and {_show(a.name)} are "
-                                 "at the same place; list their columns under one site")
-    return Observations(tuple(out), source)
+    return out
 
 
 def load_observations(path):
