@@ -57,7 +57,17 @@ def _weights(text):
 def setup(p):
     from pipeline.inversion.grid import GRIDS, MECHANISMS
     from pipeline.inversion.likelihood import DEFAULT_FLOOR, DEFAULT_KERNEL_DEG
-    full, quick = GRIDS["full"], GRIDS["quick"]
+    _what_to_run(p, GRIDS)
+    _forward_grid(p.add_argument_group("forward grid (the table: one ensemble per node)"),
+                  GRIDS["full"], MECHANISMS)
+    _candidates(p.add_argument_group("candidates and prior"), DEFAULT_KERNEL_DEG,
+                DEFAULT_FLOOR)
+
+
+def _what_to_run(p, grids):
+    """The observations, the modes (--demo, --hidden-truth, --member-study), the table and
+    where runs go."""
+    quick = grids["quick"]
     p.add_argument("observations", nargs="?", type=Path, metavar="OBSERVATIONS.json",
                    help="sites with their fallen and standing columns (schema: docs/inversion.md)")
     p.add_argument("--out", type=Path, default=None, metavar="DIR",
@@ -69,7 +79,7 @@ def setup(p):
                    f"{quick.azimuth_step_deg:g} deg, {quick.members} members, "
                    f"{quick.duration_s:g} s motions to {quick.fmax_hz:g} Hz; candidates "
                    "within 12 km, strike every 90 deg")
-    p.add_argument("--grid", choices=sorted(GRIDS), default=None,
+    p.add_argument("--grid", choices=sorted(grids), default=None,
                    help="forward-grid preset (default full; --quick = quick; the demo "
                    "machine ran 'demo'); the options below override it")
     p.add_argument("--demo", action="store_true",
@@ -98,10 +108,13 @@ def setup(p):
     p.add_argument("--forward-dir", type=Path, default=None, metavar="DIR",
                    help="campaign directory of the forward runs (default "
                    "results/inversion-forward)")
-    g = p.add_argument_group("forward grid (the table: one ensemble per node)")
+
+
+def _forward_grid(g, full, mechanisms):
+    """The forward grid's options; their defaults from the ``full`` preset."""
     g.add_argument("--mechanisms", default=None, metavar="LIST",
                    help="comma-separated, of " + ", ".join(
-                       f"{k} (dip {v[0]:g}, rake {v[1]:g})" for k, v in MECHANISMS.items())
+                       f"{k} (dip {v[0]:g}, rake {v[1]:g})" for k, v in mechanisms.items())
                    + " or NAME:DIP:RAKE (default: " + ",".join(m[0] for m in full.mechanisms)
                    + ")")
     g.add_argument("--depths", default=None, metavar="KM,KM",
@@ -124,7 +137,10 @@ def setup(p):
                    help=f"synthetics up to this frequency (default {full.fmax_hz:g})")
     g.add_argument("--duration", type=float, default=None, metavar="S",
                    help=f"motion duration (default {full.duration_s:g} s)")
-    c = p.add_argument_group("candidates and prior")
+
+
+def _candidates(c, kernel_deg, floor):
+    """The candidate sources, the prior and the likelihood's options."""
     c.add_argument("--radius", type=float, default=None, metavar="KM",
                    help="epicentres within this distance of a site (default 30; quick 12; "
                    "demo 25)")
@@ -136,12 +152,12 @@ def setup(p):
                    help="prior weights of the mechanisms (default: equal)")
     c.add_argument("--gr-b", type=float, default=None, metavar="B",
                    help="Gutenberg-Richter prior on magnitude, 10^(-B M) (default uniform)")
-    c.add_argument("--kernel-deg", type=float, default=DEFAULT_KERNEL_DEG,
+    c.add_argument("--kernel-deg", type=float, default=kernel_deg,
                    help=f"width of the von Mises kernel on ensemble falls (default "
-                   f"{DEFAULT_KERNEL_DEG:g})")
-    c.add_argument("--floor", type=float, default=DEFAULT_FLOOR,
+                   f"{kernel_deg:g})")
+    c.add_argument("--floor", type=float, default=floor,
                    help=f"fraction of uniform density mixed into every direction density "
-                   f"(default {DEFAULT_FLOOR:g})")
+                   f"(default {floor:g})")
     c.add_argument("--likelihood", choices=("independent", "predictive"),
                    default="independent",
                    help="independent (default): product over columns; predictive: columns "
