@@ -295,15 +295,7 @@ def summarise(table, specs, cost):
     ratio_3d_to_2d, ...}], "levels": [per record and level fractions],
     "block2d": {...}, "cost": {...}}"""
     first = specs[0]
-    blocks = table[table["model"] == "2D"]
-    alpha = float(blocks["alpha_rad"].median()) if len(blocks) else None
-    p = float(blocks["p_per_s"].median()) if len(blocks) else None
-    if alpha is None:
-        sizes = np.array([block_size(s["params"]) for s in specs], float)
-        hd = float(np.median(sizes[:, 0] / sizes[:, 1]))
-        height = float(np.median(sizes[:, 0]))
-        c = block_constants(height, height / hd)
-        alpha, p = c["alpha"], c["p"]
+    alpha, p = _block_alpha_p(table, specs)
     described = summary_entry(specs)
     column_file = described["column_file"]["name"] if described else None
     descriptions = {
@@ -313,40 +305,8 @@ def summarise(table, specs, cost):
         else f"3D YADE column as described in {column_file}",
         "block2d": "2D rigid block (Housner), shaken along the strongest azimuth",
         "block2d_worst": f"2D rigid block, worst of {first['azimuths']} azimuths over 180 deg"}
-    columns = {}
-    for name in [c for c in (*MODELS_3D, *MODELS_2D) if c in set(table["column"])]:
-        sub = table[table["column"] == name]
-        y = sub["toppled"].astype(bool).to_numpy()
-        stood_to, toppled_from = _brackets(sub.groupby("level_m_s2")["toppled"].mean())
-        entry = {"model": "3D" if name in MODELS_3D else "2D", "description": descriptions[name],
-                 "runs": len(sub), "toppled": int(y.sum()),
-                 "all_stood_up_to_m_s2": stood_to, "all_toppled_from_m_s2": toppled_from}
-        for im, (key, unit, _) in INTENSITY_MEASURES.items():
-            values = sub[key].astype(float).to_numpy()
-            entry[im] = {**fragility_fit(values, y), "unit": unit,
-                         "bins": binned_fractions(values, y)}
-        entry["logistic"] = logistic_surface(sub["pga_m_s2"].astype(float),
-                                             sub["pgv_pga_s"].astype(float), y, alpha=alpha, p=p)
-        columns[name] = entry
-    comparison = []
-    for column in MODELS_3D:
-        for block in MODELS_2D:
-            if column not in columns or block not in columns:
-                continue
-            for im in INTENSITY_MEASURES:
-                m3, m2 = columns[column][im]["median"], columns[block][im]["median"]
-                comparison.append({
-                    "column": column, "block": block, "im": im, "median_3d": m3,
-                    "median_2d": m2, "ratio_3d_to_2d": None if m3 is None or m2 is None
-                    else m3 / m2, "beta_3d": columns[column][im]["beta"],
-                    "beta_2d": columns[block][im]["beta"],
-                    "p_toppled_3d": columns[column]["toppled"] / columns[column]["runs"],
-                    "p_toppled_2d": columns[block]["toppled"] / columns[block]["runs"],
-                    **({"all_stood_up_to_3d": columns[column]["all_stood_up_to_m_s2"],
-                        "all_stood_up_to_2d": columns[block]["all_stood_up_to_m_s2"],
-                        "all_toppled_from_3d": columns[column]["all_toppled_from_m_s2"],
-                        "all_toppled_from_2d": columns[block]["all_toppled_from_m_s2"]}
-                       if im == "PGA" else {})})
+    columns = _column_fits(table, descriptions, alpha, p)
+    comparison = _comparison(columns)
     levels = level_table(table)
     return _finite({
         "records": list(dict.fromkeys(s["record_id"] for s in specs)),
@@ -366,6 +326,65 @@ def summarise(table, specs, cost):
                                   "vertical motion, no sliding",
                     "integrator": "pipeline.rocking.rocking_response_sampled"},
         "cost": cost})
+
+
+def _block_alpha_p(table, specs):
+    """The 2D block's slenderness angle alpha (rad) and frequency parameter p (1/s): the
+    medians of its runs, or from the members' sizes when no block ran."""
+    blocks = table[table["model"] == "2D"]
+    if len(blocks):
+        return float(blocks["alpha_rad"].median()), float(blocks["p_per_s"].median())
+    sizes = np.array([block_size(s["params"]) for s in specs], float)
+    hd = float(np.median(sizes[:, 0] / sizes[:, 1]))
+    height = float(np.median(sizes[:, 0]))
+    c = block_constants(height, height / hd)
+    return c["alpha"], c["p"]
+
+
+def _column_fits(table, descriptions, alpha, p):
+    """Per column type present: counts, the bracketing levels, a lognormal fit and binned
+    fractions per intensity measure, and the logistic surface in (PGA, PGV/PGA)."""
+    columns = {}
+    for name in [c for c in (*MODELS_3D, *MODELS_2D) if c in set(table["column"])]:
+        sub = table[table["column"] == name]
+        y = sub["toppled"].astype(bool).to_numpy()
+        stood_to, toppled_from = _brackets(sub.groupby("level_m_s2")["toppled"].mean())
+        entry = {"model": "3D" if name in MODELS_3D else "2D", "description": descriptions[name],
+                 "runs": len(sub), "toppled": int(y.sum()),
+                 "all_stood_up_to_m_s2": stood_to, "all_toppled_from_m_s2": toppled_from}
+        for im, (key, unit, _) in INTENSITY_MEASURES.items():
+            values = sub[key].astype(float).to_numpy()
+            entry[im] = {**fragility_fit(values, y), "unit": unit,
+                         "bins": binned_fractions(values, y)}
+        entry["logistic"] = logistic_surface(sub["pga_m_s2"].astype(float),
+                                             sub["pgv_pga_s"].astype(float), y, alpha=alpha, p=p)
+        columns[name] = entry
+    return columns
+
+
+def _comparison(columns):
+    """3D column against 2D block per intensity measure: medians, their ratio, betas,
+    P(toppled) and (PGA) the bracketing levels."""
+    comparison = []
+    for column in MODELS_3D:
+        for block in MODELS_2D:
+            if column not in columns or block not in columns:
+                continue
+            for im in INTENSITY_MEASURES:
+                m3, m2 = columns[column][im]["median"], columns[block][im]["median"]
+                comparison.append({
+                    "column": column, "block": block, "im": im, "median_3d": m3,
+                    "median_2d": m2, "ratio_3d_to_2d": None if m3 is None or m2 is None
+                    else m3 / m2, "beta_3d": columns[column][im]["beta"],
+                    "beta_2d": columns[block][im]["beta"],
+                    "p_toppled_3d": columns[column]["toppled"] / columns[column]["runs"],
+                    "p_toppled_2d": columns[block]["toppled"] / columns[block]["runs"],
+                    **({"all_stood_up_to_3d": columns[column]["all_stood_up_to_m_s2"],
+                        "all_stood_up_to_2d": columns[block]["all_stood_up_to_m_s2"],
+                        "all_toppled_from_3d": columns[column]["all_toppled_from_m_s2"],
+                        "all_toppled_from_2d": columns[block]["all_toppled_from_m_s2"]}
+                       if im == "PGA" else {})})
+    return comparison
 
 
 def _brackets(fraction_by_level):
