@@ -291,13 +291,44 @@ def run_demo(table, out_dir, candidates, paper_tables=None, trials=DEFAULT_TRIAL
     ``table``; writes into ``out_dir``: truth_tests.csv, narrowing.csv,
     paper_scenario_sites.csv, demo_summary.json and figures.  ``paper_tables``: {source
     name: table holding the nominal runs at the paper's sites}."""
-    from pipeline.figures.inversion import plot_interval_widths
-    from pipeline.inversion import write_outputs
     out_dir = Path(out_dir)
     started = time.monotonic()
     likelihood_half, pool = split_members(table)
     if len(likelihood_half.members) == 0 or len(pool.members) == 0:
         raise InputError("the demo needs at least two ensemble members (--members 2)")
+    trials_frame, narrow, figures = _truth_test_outputs(
+        likelihood_half, pool, candidates, trials, kernel_deg, floor, likelihoods, out_dir,
+        forward_info)
+    coverage = _coverage(trials_frame)
+    # one column per type and site: both likelihoods give the same paper-scenario numbers
+    paper_sites, paper_joint, paper_figures = _paper_outputs(
+        ForwardModel(table, kernel_deg, floor), paper_tables, candidates, out_dir,
+        forward_info)
+    figures += paper_figures
+    summary = {
+        "forward_table": forward_info or {},
+        "likelihood": {"kinds": list(likelihoods), "kernel_deg": kernel_deg, "floor": floor,
+                       "members_likelihood": likelihood_half.members.tolist(),
+                       "members_observations": pool.members.tolist()},
+        "candidate_grid": candidates.as_dict(), "prior": candidates.prior_statement(),
+        "observation_uncertainty_deg": OBS_UNCERTAINTY_DEG,
+        "trials_per_configuration": trials, "coverage": coverage,
+        "narrowing": narrow.to_dict(orient="records"),
+        "bound_30_deg": bound_answer(narrow),
+        "paper_scenario": {"joint": paper_joint,
+                           "per_source": _paper_per_source(paper_sites)},
+        "figures": [str(Path(f).relative_to(out_dir)) for f in figures],
+        "demo_s": round(time.monotonic() - started, 1)}
+    write_json(out_dir / "demo_summary.json", summary)
+    return summary
+
+
+def _truth_test_outputs(likelihood_half, pool, candidates, trials, kernel_deg, floor,
+                        likelihoods, out_dir, forward_info):
+    """The truth tests with each likelihood: truth_tests.csv, narrowing.csv and its figure,
+    the example inversions; returns (trials, narrowing, figure paths)."""
+    from pipeline.figures.inversion import plot_interval_widths
+    from pipeline.inversion import write_outputs
     examples, frames = {}, []
     for kind in likelihoods:
         model = ForwardModel(likelihood_half, kernel_deg, floor, kind)
@@ -322,7 +353,12 @@ def run_demo(table, out_dir, candidates, paper_tables=None, trials=DEFAULT_TRIAL
                           title=f"Synthetic truth test ({kind} likelihood): {mech}, "
                                 f"{n_sites} sites, {fallen} fallen columns each")
             figures += [sub / "posterior_map.png", sub / "marginals.png"]
-    coverage = {kind: {
+    return trials_frame, narrow, figures
+
+
+def _coverage(trials_frame):
+    """Per likelihood: the trials and the fraction whose truth lies in each region."""
+    return {kind: {
         "trials": int(len(g)),
         "back_azimuth_95": float(g["back_azimuth_in_95"].mean()),
         "back_azimuth_hpd95": float(g["back_azimuth_in_hpd95"].mean()),
@@ -331,9 +367,13 @@ def run_demo(table, out_dir, candidates, paper_tables=None, trials=DEFAULT_TRIAL
         "epicentre_68": float(g["epicentre_in_68"].mean()),
         "distance_95": float(g["distance_in_95"].mean())}
         for kind, g in trials_frame.groupby("likelihood", sort=False)}
-    # one column per type and site: both likelihoods give the same paper-scenario numbers
-    full_model = ForwardModel(table, kernel_deg, floor)
-    paper_rows, paper_joint = [], []
+
+
+def _paper_outputs(full_model, paper_tables, candidates, out_dir, forward_info):
+    """The paper's sources inverted site by site and all sites together:
+    paper_scenario_sites.csv and the maps; returns (per-site rows, joint rows, figures)."""
+    from pipeline.inversion import write_outputs
+    paper_rows, paper_joint, figures = [], [], []
     for source_name, obs_table in (paper_tables or {}).items():
         if obs_table is None or paper_nodes(obs_table, source_name) is None:
             continue
@@ -352,22 +392,7 @@ def run_demo(table, out_dir, candidates, paper_tables=None, trials=DEFAULT_TRIAL
     paper_sites = pd.concat(paper_rows, ignore_index=True) if paper_rows else pd.DataFrame()
     if not paper_sites.empty:
         write_csv(out_dir / "paper_scenario_sites.csv", paper_sites)
-    summary = {
-        "forward_table": forward_info or {},
-        "likelihood": {"kinds": list(likelihoods), "kernel_deg": kernel_deg, "floor": floor,
-                       "members_likelihood": likelihood_half.members.tolist(),
-                       "members_observations": pool.members.tolist()},
-        "candidate_grid": candidates.as_dict(), "prior": candidates.prior_statement(),
-        "observation_uncertainty_deg": OBS_UNCERTAINTY_DEG,
-        "trials_per_configuration": trials, "coverage": coverage,
-        "narrowing": narrow.to_dict(orient="records"),
-        "bound_30_deg": bound_answer(narrow),
-        "paper_scenario": {"joint": paper_joint,
-                           "per_source": _paper_per_source(paper_sites)},
-        "figures": [str(Path(f).relative_to(out_dir)) for f in figures],
-        "demo_s": round(time.monotonic() - started, 1)}
-    write_json(out_dir / "demo_summary.json", summary)
-    return summary
+    return paper_sites, paper_joint, figures
 
 
 def _paper_per_source(sites):
