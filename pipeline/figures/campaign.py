@@ -99,22 +99,7 @@ def plot_impact_map(runs, impacts, motion, path, size_by="hd", title=None):
     ``impacts`` must hold one record only; ``motion`` is that record's
     processed-motion npz (path or mapping).  Writes a PNG to ``path``.
     """
-    if size_by not in PARAMETER_LABELS:
-        raise InputError(f"size_by must be one of {sorted(PARAMETER_LABELS)}, got {size_by!r}")
-    runs = checked_runs(runs, ["record_id", "column", "toppled", size_by])
-    records = sorted(set(runs["record_id"].astype(str)))
-    if len(records) != 1:
-        raise InputError(f"impact map needs the runs of one record, got {len(records)}: "
-                         f"{', '.join(records[:5])}")
-    impacts = _checked_impacts(impacts, ["column", "x_m", "y_m", size_by])
-    if not impacts.empty:
-        if "record_id" in impacts.columns:
-            impacts = impacts[impacts["record_id"].astype(str) == records[0]]
-        if not np.isfinite(impacts[size_by].to_numpy(float)).all():
-            raise InputError(f"impacts table has non-finite '{size_by}' values")
-    disp, meta = horizontal_displacement(motion)
-    if not np.isfinite(runs[size_by].to_numpy(float)).all():
-        raise InputError(f"runs table has non-finite '{size_by}' values")
+    runs, impacts, record, disp, meta = _impact_map_inputs(runs, impacts, motion, size_by)
 
     label = PARAMETER_LABELS[size_by]
     size = _size_scale(runs[size_by])
@@ -151,27 +136,55 @@ def plot_impact_map(runs, impacts, motion, path, size_by="hd", title=None):
             note = "no impact on the pedestal\n" + note
         ax.text(0.02, 0.02, note, transform=ax.transAxes, fontsize=8, va="bottom",
                 bbox=dict(fc="white", ec="0.8", alpha=0.9))
-        ax.set_xlim(-limit, limit)
-        ax.set_ylim(-limit, limit)
-        ax.set_aspect("equal")
-        ax.set_xlabel("East (m)")
-        ax.set_ylabel("North (m)")
+        _map_axes(ax, limit, scale)
         ax.set_title(f"{COLUMN_LABELS[column]}: centre-of-mass impact points", fontsize=10, pad=28)
-        ax.grid(True, lw=0.3)
-        top = ax.secondary_xaxis("top", functions=(lambda x: 100 * x / scale,
-                                                   lambda d: d * scale / 100))
-        top.set_xlabel("hodogram dx (cm)", fontsize=8, color="0.4")
-        top.tick_params(labelsize=7, colors="0.4")
-        right = ax.secondary_yaxis("right", functions=(lambda y: 100 * y / scale,
-                                                       lambda d: d * scale / 100))
-        right.set_ylabel("hodogram dy (cm)", fontsize=8, color="0.4")
-        right.tick_params(labelsize=7, colors="0.4")
         _north_arrow(ax)
         ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.1), ncol=3)
-    fig.suptitle(title or f"Impact points for record {records[0]}, swept {label}")
+    fig.suptitle(title or f"Impact points for record {record}, swept {label}")
     fig.tight_layout()
     files.save_figure(fig, path, dpi=120)
     return Path(path)
+
+
+def _impact_map_inputs(runs, impacts, motion, size_by):
+    """The impact map's tables checked (one record, finite ``size_by``), the record's id and
+    its horizontal ground displacement (m, E/N) with the motion's metadata."""
+    if size_by not in PARAMETER_LABELS:
+        raise InputError(f"size_by must be one of {sorted(PARAMETER_LABELS)}, got {size_by!r}")
+    runs = checked_runs(runs, ["record_id", "column", "toppled", size_by])
+    records = sorted(set(runs["record_id"].astype(str)))
+    if len(records) != 1:
+        raise InputError(f"impact map needs the runs of one record, got {len(records)}: "
+                         f"{', '.join(records[:5])}")
+    impacts = _checked_impacts(impacts, ["column", "x_m", "y_m", size_by])
+    if not impacts.empty:
+        if "record_id" in impacts.columns:
+            impacts = impacts[impacts["record_id"].astype(str) == records[0]]
+        if not np.isfinite(impacts[size_by].to_numpy(float)).all():
+            raise InputError(f"impacts table has non-finite '{size_by}' values")
+    disp, meta = horizontal_displacement(motion)
+    if not np.isfinite(runs[size_by].to_numpy(float)).all():
+        raise InputError(f"runs table has non-finite '{size_by}' values")
+    return runs, impacts, records[0], disp, meta
+
+
+def _map_axes(ax, limit, scale):
+    """Square East/North axes of half-width ``limit`` (m) with the hodogram's dx/dy axes (cm;
+    ``scale`` plot m per ground m) on top and right."""
+    ax.set_xlim(-limit, limit)
+    ax.set_ylim(-limit, limit)
+    ax.set_aspect("equal")
+    ax.set_xlabel("East (m)")
+    ax.set_ylabel("North (m)")
+    ax.grid(True, lw=0.3)
+    top = ax.secondary_xaxis("top", functions=(lambda x: 100 * x / scale,
+                                               lambda d: d * scale / 100))
+    top.set_xlabel("hodogram dx (cm)", fontsize=8, color="0.4")
+    top.tick_params(labelsize=7, colors="0.4")
+    right = ax.secondary_yaxis("right", functions=(lambda y: 100 * y / scale,
+                                                   lambda d: d * scale / 100))
+    right.set_ylabel("hodogram dy (cm)", fontsize=8, color="0.4")
+    right.tick_params(labelsize=7, colors="0.4")
 
 
 def _polar_axes(fig, position):
