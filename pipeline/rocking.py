@@ -495,18 +495,7 @@ def rocking_response_sampled(height, width, acc, dt, t_after=30.0, restitution=N
     if not (dt > 0 and max_step > 0 and t_after >= 0):
         raise InputError(f"dt {dt}, max_step {max_step} must be positive, t_after >= 0")
     n_samples, n_cases = acc.shape
-    height = np.broadcast_to(np.asarray(height, float), (n_cases,))
-    width = np.broadcast_to(np.asarray(width, float), (n_cases,))
-    if not (np.all(height > 0) and np.all(width > 0)):
-        raise InputError("block heights and widths must be positive")
-    alpha = np.arctan(width / height)
-    R = 0.5 * np.hypot(height, width)
-    p2 = 3.0 * g / (4.0 * R)
-    I0 = 4.0 / 3.0 * R ** 2
-    eta = (1.0 - 1.5 * np.sin(alpha) ** 2 if restitution is None
-           else np.broadcast_to(np.asarray(restitution, float), (n_cases,)))
-    if np.any((eta < 0) | (eta > 1)):
-        raise InputError("coefficient of restitution must lie in [0, 1]")
+    alpha, R, p2, I0, eta = _block_arrays(height, width, restitution, n_cases, g)
     uplift = g * np.tan(alpha)
     omega_rest = _BATCH_REST_OMEGA_FRACTION * np.sqrt(p2) * alpha
 
@@ -524,10 +513,6 @@ def rocking_response_sampled(height, width, acc, dt, t_after=30.0, restitution=N
     impacts = np.zeros(n_cases, int)
     max_abs = np.zeros(n_cases)
     zero = np.zeros(n_cases)
-
-    def rhs(th, s, a):
-        phi = s * alpha - th
-        return -p2 * (np.sin(phi) + a / g * np.cos(phi))
 
     free_steps = math.ceil(t_after / h)
     total = (n_samples - 1) * sub + free_steps
@@ -560,26 +545,13 @@ def rocking_response_sampled(height, width, acc, dt, t_after=30.0, restitution=N
             continue
         steps += 1
         # classical Runge-Kutta on the active blocks
-        s = side
-        k1t, k1w = omega, rhs(theta, s, a0)
-        k2t, k2w = omega + 0.5 * h * k1w, rhs(theta + 0.5 * h * k1t, s, a1)
-        k3t, k3w = omega + 0.5 * h * k2w, rhs(theta + 0.5 * h * k2t, s, a1)
-        k4t, k4w = omega + h * k3w, rhs(theta + h * k3t, s, a2)
-        new_theta = theta + h / 6.0 * (k1t + 2 * k2t + 2 * k3t + k4t)
-        new_omega = omega + h / 6.0 * (k1w + 2 * k2w + 2 * k3w + k4w)
+        new_theta, new_omega = _rk4_step(theta, omega, side, (a0, a1, a2), h, alpha, p2, g)
         # impacts: theta crossed 0 (to the other side of the pivot)
-        hit = active & (s * new_theta < 0)
+        hit = active & (side * new_theta < 0)
         if hit.any():
-            frac = np.where(hit, theta / np.where(hit, theta - new_theta, 1.0), 0.0)
-            omega_hit = eta * (omega + frac * (new_omega - omega))
-            rest = hit & (np.abs(omega_hit) < omega_rest)
-            new_theta = np.where(hit, omega_hit * (1.0 - frac) * h, new_theta)
-            new_omega = np.where(hit, omega_hit, new_omega)
+            new_theta, new_omega, side = _impact(theta, omega, new_theta, new_omega, side,
+                                                 hit, eta, omega_rest, h)
             impacts += hit
-            side = np.where(hit, -s, side)
-            side = np.where(rest, 0.0, side)
-            new_theta = np.where(rest, 0.0, new_theta)
-            new_omega = np.where(rest, 0.0, new_omega)
         theta = np.where(active, new_theta, theta)
         omega = np.where(active, new_omega, omega)
         max_abs = np.maximum(max_abs, np.abs(theta))
@@ -598,6 +570,58 @@ def rocking_response_sampled(height, width, acc, dt, t_after=30.0, restitution=N
                 overturn_direction=direction, first_side=first_side, uplift_time=uplift_time,
                 n_impacts=impacts, max_abs_theta=max_abs, alpha=alpha, p=np.sqrt(p2),
                 restitution=np.asarray(eta, float), steps=steps, decided=done.copy())
+
+
+def _block_arrays(height, width, restitution, n_cases, g):
+    """Per block of :func:`rocking_response_sampled`: alpha (rad), R (m), p^2 (1/s^2),
+    I0 / m (m^2) and the restitution eta, the inputs checked."""
+    height = np.broadcast_to(np.asarray(height, float), (n_cases,))
+    width = np.broadcast_to(np.asarray(width, float), (n_cases,))
+    if not (np.all(height > 0) and np.all(width > 0)):
+        raise InputError("block heights and widths must be positive")
+    alpha = np.arctan(width / height)
+    R = 0.5 * np.hypot(height, width)
+    p2 = 3.0 * g / (4.0 * R)
+    I0 = 4.0 / 3.0 * R ** 2
+    eta = (1.0 - 1.5 * np.sin(alpha) ** 2 if restitution is None
+           else np.broadcast_to(np.asarray(restitution, float), (n_cases,)))
+    if np.any((eta < 0) | (eta > 1)):
+        raise InputError("coefficient of restitution must lie in [0, 1]")
+    return alpha, R, p2, I0, eta
+
+
+def _rk4_step(theta, omega, side, accelerations, h, alpha, p2, g):
+    """One classical Runge-Kutta step of h (s) of the rocking equation about the pivots
+    ``side`` (+1/-1), the ground acceleration at the step's start, middle and end."""
+    a0, a1, a2 = accelerations
+
+    def rhs(th, a):
+        phi = side * alpha - th
+        return -p2 * (np.sin(phi) + a / g * np.cos(phi))
+
+    k1t, k1w = omega, rhs(theta, a0)
+    k2t, k2w = omega + 0.5 * h * k1w, rhs(theta + 0.5 * h * k1t, a1)
+    k3t, k3w = omega + 0.5 * h * k2w, rhs(theta + 0.5 * h * k2t, a1)
+    k4t, k4w = omega + h * k3w, rhs(theta + h * k3t, a2)
+    return (theta + h / 6.0 * (k1t + 2 * k2t + 2 * k3t + k4t),
+            omega + h / 6.0 * (k1w + 2 * k2w + 2 * k3w + k4w))
+
+
+def _impact(theta, omega, new_theta, new_omega, side, hit, eta, omega_rest, h):
+    """The blocks ``hit`` (theta crossed 0 in the step): the impact placed by linear
+    interpolation, omega times eta, the rest of the step to first order on the other
+    pivot; a block slower than ``omega_rest`` after it comes to rest.  Returns the new
+    theta, omega and pivot sides."""
+    frac = np.where(hit, theta / np.where(hit, theta - new_theta, 1.0), 0.0)
+    omega_hit = eta * (omega + frac * (new_omega - omega))
+    rest = hit & (np.abs(omega_hit) < omega_rest)
+    new_theta = np.where(hit, omega_hit * (1.0 - frac) * h, new_theta)
+    new_omega = np.where(hit, omega_hit, new_omega)
+    side = np.where(hit, -side, side)
+    side = np.where(rest, 0.0, side)
+    new_theta = np.where(rest, 0.0, new_theta)
+    new_omega = np.where(rest, 0.0, new_omega)
+    return new_theta, new_omega, side
 
 
 def _below_barrier(theta, omega, alpha, R, I0, g):
