@@ -346,29 +346,15 @@ def _integrate(c, acc_func, t_end, theta0, omega0, eta, g, max_impacts, still_af
         if t >= t_end:
             break
         if resting:
-            if abs(acc(t)) >= c["uplift_acc"] * (1.0 - 1e-12):
-                side = -int(np.sign(acc(t)))
-                resting = False
-                uplifts.append(t)
-                continue
-            if still_after is not None and t >= still_after:
+            if still_after is not None and t >= still_after \
+                    and abs(acc(t)) < c["uplift_acc"] * (1.0 - 1e-12):
                 stop_reason = "rest"
                 break
-            t_stop = t_end if still_after is None else min(t_end, still_after)
-            uplift = _event(lambda tt, y: abs(acc(tt)) - c["uplift_acc"], 1, True)
-            sol = solve_ivp(lambda tt, y: [0.0, 0.0], (t, t_stop), [0.0, 0.0],
-                            events=uplift, max_step=rest_max_step)
-            grid = sample_grid(t, sol.t[-1])
-            if grid is not None:
-                samples_t.append(grid)
-                samples_y.append(np.zeros((2, grid.size)))
-            if sol.status == 1:
-                t = float(sol.t_events[0][0])
-                side = -int(np.sign(acc(t)))
+            t, side = _rest(t, t_end, still_after, acc, c["uplift_acc"], rest_max_step,
+                            sample_grid, samples_t, samples_y)
+            if side:
                 resting = False
                 uplifts.append(t)
-            else:
-                t = t_stop
             continue
 
         free = still_after is not None and t >= still_after
@@ -442,6 +428,26 @@ def _integrate(c, acc_func, t_end, theta0, omega0, eta, g, max_impacts, still_af
                 first_side=_first_side(uplifts, theta0, omega0, acc),
                 max_abs_theta=max_abs, stop_reason=stop_reason, alpha=alpha, p=c["p"],
                 restitution=eta)
+
+
+def _rest(t, t_end, still_after, acc, uplift_acc, max_step, sample_grid, samples_t, samples_y):
+    """A block at rest from t (s) until the ground acceleration reaches ``uplift_acc``
+    (m/s^2) or the segment ends (t_end, or the still phase from ``still_after``); the rest
+    samples appended.  Returns the time reached and the pivot side of the uplift (0: none)."""
+    if abs(acc(t)) >= uplift_acc * (1.0 - 1e-12):
+        return t, -int(np.sign(acc(t)))
+    t_stop = t_end if still_after is None else min(t_end, still_after)
+    uplift = _event(lambda tt, y: abs(acc(tt)) - uplift_acc, 1, True)
+    sol = solve_ivp(lambda tt, y: [0.0, 0.0], (t, t_stop), [0.0, 0.0],
+                    events=uplift, max_step=max_step)
+    grid = sample_grid(t, sol.t[-1])
+    if grid is not None:
+        samples_t.append(grid)
+        samples_y.append(np.zeros((2, grid.size)))
+    if sol.status == 1:
+        t = float(sol.t_events[0][0])
+        return t, -int(np.sign(acc(t)))
+    return t_stop, 0
 
 
 def _first_side(uplifts, theta0, omega0, acc):
