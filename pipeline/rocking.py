@@ -361,22 +361,10 @@ def _integrate(c, acc_func, t_end, theta0, omega0, eta, g, max_impacts, still_af
         t_stop = t_end if (still_after is None or free) else min(t_end, still_after)
         last_swing = max_impacts is not None and len(impacts) >= max_impacts
         s = side
-
-        if linearised:
-            def rhs(tt, y):
-                return [y[1], -p2 * (s * alpha - y[0] + acc(tt) / g)]
-        else:
-            def rhs(tt, y):
-                phi = s * alpha - y[0]
-                return [y[1], -p2 * (math.sin(phi) + acc(tt) / g * math.cos(phi))]
-
-        impact = _event(lambda tt, y: y[0], -s, True)
-        fallen = _event(lambda tt, y: s * y[0] - 0.5 * math.pi, 1, True)
-        # a segment starting at rest would trigger its own peak event at once
-        peak = _event(lambda tt, y: y[1], -s, (free or last_swing) and omega != 0)
         t_start = t
-        sol = solve_ivp(rhs, (t, t_stop), [theta, omega], method="DOP853", rtol=_RTOL,
-                        atol=_ATOL, events=(impact, fallen, peak), dense_output=True)
+        # a segment starting at rest would trigger its own peak event at once
+        sol = _swing(t, t_stop, theta, omega, s, alpha, p2, g, acc, linearised,
+                     (free or last_swing) and omega != 0)
         grid = sample_grid(t_start, sol.t[-1])
         if grid is not None and grid.size:
             samples_t.append(grid)
@@ -413,11 +401,8 @@ def _integrate(c, acc_func, t_end, theta0, omega0, eta, g, max_impacts, still_af
     else:
         raise RuntimeError(f"rocking integration exceeded {_MAX_EVENTS} events")
 
-    if samples_t:
-        ts = np.concatenate(samples_t)
-        ys = np.concatenate(samples_y, axis=1)
-    else:
-        ts, ys = np.empty(0), np.empty((2, 0))
+    ts, ys = ((np.concatenate(samples_t), np.concatenate(samples_y, axis=1)) if samples_t
+              else (np.empty(0), np.empty((2, 0))))
     return dict(t=ts, theta=ys[0], omega=ys[1],
                 impact_times=np.array(impacts), impact_omega_before=np.array(omega_before),
                 impact_omega_after=np.array(omega_after), uplift_times=np.array(uplifts),
@@ -428,6 +413,25 @@ def _integrate(c, acc_func, t_end, theta0, omega0, eta, g, max_impacts, still_af
                 first_side=_first_side(uplifts, theta0, omega0, acc),
                 max_abs_theta=max_abs, stop_reason=stop_reason, alpha=alpha, p=c["p"],
                 restitution=eta)
+
+
+def _swing(t, t_stop, theta, omega, s, alpha, p2, g, acc, linearised, peak_armed):
+    """One rocking segment about the pivot on side ``s`` from (t, theta, omega) to t_stop
+    or its first terminal event: impact (theta 0), overturn (|theta| pi/2) or, when
+    ``peak_armed``, the next peak; solve_ivp's solution (DOP853, dense)."""
+    if linearised:
+        def rhs(tt, y):
+            return [y[1], -p2 * (s * alpha - y[0] + acc(tt) / g)]
+    else:
+        def rhs(tt, y):
+            phi = s * alpha - y[0]
+            return [y[1], -p2 * (math.sin(phi) + acc(tt) / g * math.cos(phi))]
+
+    impact = _event(lambda tt, y: y[0], -s, True)
+    fallen = _event(lambda tt, y: s * y[0] - 0.5 * math.pi, 1, True)
+    peak = _event(lambda tt, y: y[1], -s, peak_armed)
+    return solve_ivp(rhs, (t, t_stop), [theta, omega], method="DOP853", rtol=_RTOL,
+                     atol=_ATOL, events=(impact, fallen, peak), dense_output=True)
 
 
 def _rest(t, t_end, still_after, acc, uplift_acc, max_step, sample_grid, samples_t, samples_y):
