@@ -419,12 +419,16 @@ def _run_member_study(args, grid, candidates):
     table, info = forward_table(args, grid)
     trials = STUDY_TRIALS if args.trials is None else args.trials
 
-    def progress(kind, size, n_sites, fallen):
-        print(f"  {kind}, {size} members, {n_sites} site(s) x {fallen} fallen: done",
-              flush=True)
+    jobs = _check_jobs(args.jobs)
+    print(f"member study: {trials} trials per configuration on {jobs} process(es)",
+          flush=True)
+
+    def progress(kind, size):
+        print(f"  {kind} likelihood, {size} members: done "
+              f"({time.monotonic() - started:.0f} s)", flush=True)
 
     rows = member_study(table, candidates, trials=trials, kernel_deg=args.kernel_deg,
-                        floor=args.floor, progress=progress)
+                        floor=args.floor, jobs=jobs, progress=progress)
     if rows.empty:
         raise InputError("no column of the observed members ever fell: nothing to test "
                          "(a grid with stronger shaking: closer rings, higher Mw)")

@@ -19,6 +19,10 @@ the magnitude's: whether the true Mw lies in the smallest set of table magnitude
 95 % of the posterior, and the posterior probability of the true Mw.
 """
 
+import os
+from functools import partial
+from multiprocessing import Pool
+
 import numpy as np
 import pandas as pd
 
@@ -29,7 +33,7 @@ from pipeline.inversion.likelihood import DEFAULT_FLOOR, DEFAULT_KERNEL_DEG, LIK
 from pipeline.inversion.posterior import in_arc, invert
 from pipeline.stats.circular import azimuth_deg
 from pipeline.stats.ensemble import wilson_interval
-from pipeline.files import InputError
+from pipeline.files import InputError, die_with_parent
 
 LIKELIHOOD_MEMBERS = (3, 6, 12, 24, 48)
 OBSERVATION_MEMBERS = 16
@@ -103,31 +107,54 @@ def member_study(table, candidates, likelihood_members=LIKELIHOOD_MEMBERS,
                  observation_members=OBSERVATION_MEMBERS, trials=STUDY_TRIALS,
                  kernel_deg=DEFAULT_KERNEL_DEG, floor=DEFAULT_FLOOR, likelihoods=LIKELIHOODS,
                  fallen_per_site=FALLEN_PER_SITE, site_counts=SITE_COUNTS, seed=STUDY_SEED,
-                 progress=None):
+                 jobs=1, progress=None):
     """Every trial of every (likelihood, L, S, K): a DataFrame, one row per trial (see the
-    module docstring).  L values above the members the likelihoods may use are left out."""
+    module docstring).  L values above the members the likelihoods may use are left out.
+    The (likelihood, L) configurations run on ``jobs`` processes; each trial's draws are
+    seeded by S, K and the trial alone, so the rows are the same for any ``jobs``;
+    ``progress(kind, L)`` is called as each configuration is done."""
     usable, pool = split_for_study(table, observation_members)
     sizes = [n for n in likelihood_members if n <= usable.members.size]
     if not sizes:
         raise InputError(f"the table's {usable.members.size} likelihood members are fewer "
                          f"than the smallest study size {min(likelihood_members)}")
-    order = np.sort(usable.members)
+    configurations = [(kind, size) for kind in likelihoods for size in sizes]
+    work = partial(_configuration_trials, usable, pool, candidates, kernel_deg, floor,
+                   site_counts, fallen_per_site, trials, seed)
+    jobs = max(1, min(jobs, len(configurations)))
     rows = []
-    for kind in likelihoods:
-        for size in sizes:
-            model = ForwardModel(usable.select_members(np.isin(usable.members, order[:size])),
-                                 kernel_deg, floor, kind)
-            for n_sites in site_counts:
-                for fallen in fallen_per_site:
-                    for trial in range(trials):
-                        rng = np.random.default_rng([seed, n_sites, fallen, trial])
-                        row = study_trial(model, pool, n_sites, fallen, candidates, rng)
-                        if row is not None:
-                            rows.append({"likelihood": kind, "likelihood_members": size,
-                                         **row, "trial": trial})
-                    if progress:
-                        progress(kind, size, n_sites, fallen)
+    if jobs > 1:
+        with Pool(jobs, initializer=die_with_parent, initargs=(os.getpid(),)) as workers:
+            for (kind, size), part in zip(configurations,
+                                          workers.imap(work, configurations)):
+                rows += part
+                if progress:
+                    progress(kind, size)
+    else:
+        for kind, size in configurations:
+            rows += work((kind, size))
+            if progress:
+                progress(kind, size)
     return pd.DataFrame(rows)
+
+
+def _configuration_trials(usable, pool, candidates, kernel_deg, floor, site_counts,
+                          fallen_per_site, trials, seed, configuration):
+    """The rows of one (likelihood kind, L members) configuration, every S and K."""
+    kind, size = configuration
+    order = np.sort(usable.members)
+    model = ForwardModel(usable.select_members(np.isin(usable.members, order[:size])),
+                         kernel_deg, floor, kind)
+    rows = []
+    for n_sites in site_counts:
+        for fallen in fallen_per_site:
+            for trial in range(trials):
+                rng = np.random.default_rng([seed, n_sites, fallen, trial])
+                row = study_trial(model, pool, n_sites, fallen, candidates, rng)
+                if row is not None:
+                    rows.append({"likelihood": kind, "likelihood_members": size,
+                                 **row, "trial": trial})
+    return rows
 
 
 def study_summary(trials):

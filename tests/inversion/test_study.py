@@ -33,6 +33,22 @@ def test_more_likelihood_members_narrow_the_arc_on_the_same_draws(make_away_tabl
     assert set(answer) == {"independent"} and "24 members per node" in answer["independent"]
 
 
+def test_the_rows_do_not_depend_on_the_processes(make_away_table):
+    """Two processes give the same trials, row for row, as one (each trial's draws are
+    seeded by S, K and the trial), and progress reports every configuration."""
+    table = make_away_table(members=24, scatter_deg=20.0, p_fall=(1.0, 0.8, 0.6, 0.4))
+    grid = CandidateGrid(radius_km=22, step_km=2, strike_step_deg=30)
+    kwargs = dict(likelihood_members=(3, 6), observation_members=16, trials=2,
+                  fallen_per_site=(1, 3), site_counts=(1,))
+    done = []
+    one = member_study(table, grid, jobs=1, **kwargs)
+    two = member_study(table, grid, jobs=2, progress=lambda *c: done.append(c), **kwargs)
+    assert len(one) > 0
+    assert one.equals(two)
+    assert done == [("independent", 3), ("independent", 6), ("predictive", 3),
+                    ("predictive", 6)]
+
+
 def test_the_magnitude_set_holds_95_percent():
     assert magnitude_set({"6": 0.5, "6.5": 0.46, "7": 0.04}) == ["6", "6.5"]
     assert magnitude_set({"6": 0.96, "7": 0.04}) == ["6"]
