@@ -325,22 +325,15 @@ def _integrate(c, acc_func, t_end, theta0, omega0, eta, g, max_impacts, still_af
             return 0.0
         return float(acc_func(t))
 
-    samples_t, samples_y = [], []
-    impacts, omega_before, omega_after = [], [], []
-    uplifts, peak_t, peak_theta = [], [], []
+    samples = _Samples(dt_out)
+    events = {key: [] for key in ("impact_times", "impact_omega_before", "impact_omega_after",
+                                  "uplift_times", "peak_times", "peak_theta")}
     t = 0.0
     theta, omega = float(theta0), float(omega0)
     side = int(np.sign(theta) or np.sign(omega))
     resting = side == 0
     overturned, overturn_time, stop_reason = False, None, "t_end"
     max_abs = abs(theta)
-
-    def sample_grid(t_a, t_b):
-        if dt_out is None:
-            return None
-        k0 = math.ceil(t_a / dt_out - 1e-9)
-        k1 = math.floor(t_b / dt_out + 1e-9)
-        return np.arange(k0, k1 + 1) * dt_out if k1 >= k0 else np.empty(0)
 
     for _ in range(_MAX_EVENTS):
         if t >= t_end:
@@ -350,31 +343,23 @@ def _integrate(c, acc_func, t_end, theta0, omega0, eta, g, max_impacts, still_af
                     and abs(acc(t)) < c["uplift_acc"] * (1.0 - 1e-12):
                 stop_reason = "rest"
                 break
-            t, side = _rest(t, t_end, still_after, acc, c["uplift_acc"], rest_max_step,
-                            sample_grid, samples_t, samples_y)
+            t, side = _rest(t, t_end, still_after, acc, c["uplift_acc"], rest_max_step, samples)
             if side:
                 resting = False
-                uplifts.append(t)
+                events["uplift_times"].append(t)
             continue
 
         free = still_after is not None and t >= still_after
         t_stop = t_end if (still_after is None or free) else min(t_end, still_after)
-        last_swing = max_impacts is not None and len(impacts) >= max_impacts
+        last_swing = max_impacts is not None and len(events["impact_times"]) >= max_impacts
         s = side
         t_start = t
         # a segment starting at rest would trigger its own peak event at once
         sol = _swing(t, t_stop, theta, omega, s, alpha, p2, g, acc, linearised,
                      (free or last_swing) and omega != 0)
-        grid = sample_grid(t_start, sol.t[-1])
-        if grid is not None and grid.size:
-            samples_t.append(grid)
-            samples_y.append(sol.sol(grid))
-        max_abs = max(max_abs, float(np.max(np.abs(sol.y[0]))))
-        for tp, yp in zip(sol.t_events[2], sol.y_events[2]):
-            if tp > t_start:
-                peak_t.append(float(tp))
-                peak_theta.append(float(yp[0]))
-                max_abs = max(max_abs, abs(float(yp[0])))
+        samples.add_segment(t_start, sol.t[-1], sol.sol)
+        max_abs = max(max_abs, float(np.max(np.abs(sol.y[0]))),
+                      *_record_peaks(sol, t_start, events))
         t, (theta, omega) = float(sol.t[-1]), sol.y[:, -1]
         if sol.status != 1:  # reached t_stop: end of run or start of the still phase
             continue
@@ -385,34 +370,78 @@ def _integrate(c, acc_func, t_end, theta0, omega0, eta, g, max_impacts, still_af
         if sol.t_events[2].size and sol.t_events[2][-1] > t_start and (free or last_swing):
             stop_reason = "safe" if free else "max_impacts"
             t, (theta, omega) = float(sol.t_events[2][-1]), sol.y_events[2][-1]
-            _append_state(samples_t, samples_y, dt_out, t, theta, omega)
+            samples.add_state(t, theta, omega)
             break
         # impact: theta = 0, angular velocity reduced, pivot changes side
-        t, omega_in = float(sol.t_events[0][0]), float(sol.y_events[0][0][1])
-        impacts.append(t)
-        omega_before.append(omega_in)
-        omega_out = eta * omega_in
-        omega_after.append(omega_out)
-        _append_state(samples_t, samples_y, dt_out, t, 0.0, omega_in)
-        theta, omega, side = 0.0, omega_out, -s
-        if abs(omega_out) < omega_rest:
-            omega, resting = 0.0, True
-        _append_state(samples_t, samples_y, dt_out, t, 0.0, omega)
+        t, omega, resting = _impact_at(sol, eta, omega_rest, events, samples)
+        theta, side = 0.0, -s
     else:
         raise RuntimeError(f"rocking integration exceeded {_MAX_EVENTS} events")
 
-    ts, ys = ((np.concatenate(samples_t), np.concatenate(samples_y, axis=1)) if samples_t
-              else (np.empty(0), np.empty((2, 0))))
+    ts, ys = samples.arrays()
     return dict(t=ts, theta=ys[0], omega=ys[1],
-                impact_times=np.array(impacts), impact_omega_before=np.array(omega_before),
-                impact_omega_after=np.array(omega_after), uplift_times=np.array(uplifts),
-                peak_times=np.array(peak_t), peak_theta=np.array(peak_theta),
+                **{key: np.array(values) for key, values in events.items()},
                 overturned=overturned,
                 overturn_direction=int(np.sign(theta)) if overturned else 0,
-                overturn_time=overturn_time, n_impacts=len(impacts),
-                first_side=_first_side(uplifts, theta0, omega0, acc),
+                overturn_time=overturn_time, n_impacts=len(events["impact_times"]),
+                first_side=_first_side(events["uplift_times"], theta0, omega0, acc),
                 max_abs_theta=max_abs, stop_reason=stop_reason, alpha=alpha, p=c["p"],
                 restitution=eta)
+
+
+def _record_peaks(sol, t_start, events):
+    """The swing's peaks after t_start (s) appended to ``events``; their |theta| (rad)."""
+    for tp, yp in zip(sol.t_events[2], sol.y_events[2]):
+        if tp > t_start:
+            events["peak_times"].append(float(tp))
+            events["peak_theta"].append(float(yp[0]))
+            yield abs(float(yp[0]))
+
+
+def _impact_at(sol, eta, omega_rest, events, samples):
+    """The swing's impact (theta 0): omega times eta, at rest below ``omega_rest`` (rad/s);
+    recorded in ``events`` and ``samples``.  Returns its time (s), omega after it (rad/s)
+    and whether the block rests."""
+    t, omega_in = float(sol.t_events[0][0]), float(sol.y_events[0][0][1])
+    omega_out = eta * omega_in
+    events["impact_times"].append(t)
+    events["impact_omega_before"].append(omega_in)
+    events["impact_omega_after"].append(omega_out)
+    samples.add_state(t, 0.0, omega_in)
+    resting = abs(omega_out) < omega_rest
+    omega = 0.0 if resting else omega_out
+    samples.add_state(t, 0.0, omega)
+    return t, omega, resting
+
+
+class _Samples:
+    """The states (theta rad, omega rad/s) an integration returns: every ``dt_out`` s of
+    each segment (None: none) and the states at events, in time order."""
+
+    def __init__(self, dt_out):
+        self.dt_out, self.t, self.y = dt_out, [], []
+
+    def add_segment(self, t_a, t_b, states):
+        """The grid times in [t_a, t_b] (s), their states from ``states(times)`` (2, n)."""
+        if self.dt_out is None:
+            return
+        k0 = math.ceil(t_a / self.dt_out - 1e-9)
+        k1 = math.floor(t_b / self.dt_out + 1e-9)
+        if k1 >= k0:
+            grid = np.arange(k0, k1 + 1) * self.dt_out
+            self.t.append(grid)
+            self.y.append(states(grid))
+
+    def add_state(self, t, theta, omega):
+        if self.dt_out is not None:
+            self.t.append(np.array([t]))
+            self.y.append(np.array([[theta], [omega]]))
+
+    def arrays(self):
+        """Times (n,) s and states (2, n)."""
+        if not self.t:
+            return np.empty(0), np.empty((2, 0))
+        return np.concatenate(self.t), np.concatenate(self.y, axis=1)
 
 
 def _swing(t, t_stop, theta, omega, s, alpha, p2, g, acc, linearised, peak_armed):
@@ -434,7 +463,7 @@ def _swing(t, t_stop, theta, omega, s, alpha, p2, g, acc, linearised, peak_armed
                      atol=_ATOL, events=(impact, fallen, peak), dense_output=True)
 
 
-def _rest(t, t_end, still_after, acc, uplift_acc, max_step, sample_grid, samples_t, samples_y):
+def _rest(t, t_end, still_after, acc, uplift_acc, max_step, samples):
     """A block at rest from t (s) until the ground acceleration reaches ``uplift_acc``
     (m/s^2) or the segment ends (t_end, or the still phase from ``still_after``); the rest
     samples appended.  Returns the time reached and the pivot side of the uplift (0: none)."""
@@ -444,10 +473,7 @@ def _rest(t, t_end, still_after, acc, uplift_acc, max_step, sample_grid, samples
     uplift = _event(lambda tt, y: abs(acc(tt)) - uplift_acc, 1, True)
     sol = solve_ivp(lambda tt, y: [0.0, 0.0], (t, t_stop), [0.0, 0.0],
                     events=uplift, max_step=max_step)
-    grid = sample_grid(t, sol.t[-1])
-    if grid is not None:
-        samples_t.append(grid)
-        samples_y.append(np.zeros((2, grid.size)))
+    samples.add_segment(t, sol.t[-1], lambda grid: np.zeros((2, grid.size)))
     if sol.status == 1:
         t = float(sol.t_events[0][0])
         return t, -int(np.sign(acc(t)))
@@ -458,12 +484,6 @@ def _first_side(uplifts, theta0, omega0, acc):
     if theta0 or omega0:
         return int(np.sign(theta0) or np.sign(omega0))
     return -int(np.sign(acc(uplifts[0]))) if uplifts else 0
-
-
-def _append_state(samples_t, samples_y, dt_out, t, theta, omega):
-    if dt_out is not None:
-        samples_t.append(np.array([t]))
-        samples_y.append(np.array([[theta], [omega]]))
 
 
 # ---------------------------------------------------------------- many blocks at once
@@ -497,6 +517,43 @@ def rocking_response_sampled(height, width, acc, dt, t_after=30.0, restitution=N
     max_abs_theta (rad); plus alpha, p, restitution (arrays), steps (int),
     decided (bool: outcome certain when the integration stopped).
     """
+    acc = _checked_samples(acc, dt, max_step, t_after)
+    n_samples, n_cases = acc.shape
+    blocks = _Blocks(*_block_arrays(height, width, restitution, n_cases, g), g)
+    sub = max(1, math.ceil(dt / max_step - 1e-9))
+    h = dt / sub
+    total = (n_samples - 1) * sub + math.ceil(t_after / h)
+    steps = 0
+    # every block rests until the first sample that reaches an uplift threshold
+    strong = np.any(np.abs(acc) >= blocks.uplift_acc * (1.0 - 1e-12), axis=1)
+    first = max(int(np.argmax(strong)) - 1, 0) if strong.any() else n_samples - 1
+    for step in range(first * sub, total):
+        k, j = divmod(step, sub)
+        t = step * h
+        in_motion = k < n_samples - 1
+        if in_motion:
+            ground = tuple(acc[k] + (acc[k + 1] - acc[k]) * (f / sub) for f in (j, j + 0.5, j + 1))
+        else:
+            ground = (blocks.zero,) * 3
+            if step == (n_samples - 1) * sub:       # the motion is over: decide the safe
+                blocks.decide_safe()
+        blocks.uplift(ground[0], t)
+        active = (blocks.side != 0) & ~blocks.done
+        if not active.any():
+            if blocks.done.all() or not in_motion:
+                break
+            continue
+        steps += 1
+        blocks.advance(active, ground, h, t)
+        if not in_motion:                      # free rocking: decided once below the barrier
+            blocks.decide_safe()
+        if blocks.done.all():
+            break
+    return blocks.result(steps)
+
+
+def _checked_samples(acc, dt, max_step, t_after):
+    """The ground accelerations (m/s^2) as an (n, N) array, the sampling checked."""
     acc = np.asarray(acc, float)
     if acc.ndim == 1:
         acc = acc[:, None]
@@ -504,82 +561,77 @@ def rocking_response_sampled(height, width, acc, dt, t_after=30.0, restitution=N
         raise InputError("acc must be finite samples of shape (n >= 2,) or (n, N)")
     if not (dt > 0 and max_step > 0 and t_after >= 0):
         raise InputError(f"dt {dt}, max_step {max_step} must be positive, t_after >= 0")
-    n_samples, n_cases = acc.shape
-    alpha, R, p2, I0, eta = _block_arrays(height, width, restitution, n_cases, g)
-    uplift = g * np.tan(alpha)
-    omega_rest = _BATCH_REST_OMEGA_FRACTION * np.sqrt(p2) * alpha
+    return acc
 
-    sub = max(1, math.ceil(dt / max_step - 1e-9))
-    h = dt / sub
-    theta = np.zeros(n_cases)
-    omega = np.zeros(n_cases)
-    side = np.zeros(n_cases)              # +1 / -1 pivot side, 0 at rest
-    done = np.zeros(n_cases, bool)
-    overturned = np.zeros(n_cases, bool)
-    overturn_time = np.full(n_cases, np.nan)
-    direction = np.zeros(n_cases, int)
-    first_side = np.zeros(n_cases, int)
-    uplift_time = np.full(n_cases, np.nan)
-    impacts = np.zeros(n_cases, int)
-    max_abs = np.zeros(n_cases)
-    zero = np.zeros(n_cases)
 
-    free_steps = math.ceil(t_after / h)
-    total = (n_samples - 1) * sub + free_steps
-    steps = 0
-    # every block rests until the first sample that reaches an uplift threshold
-    strong = np.any(np.abs(acc) >= uplift * (1.0 - 1e-12), axis=1)
-    first = max(int(np.argmax(strong)) - 1, 0) if strong.any() else n_samples - 1
-    for step in range(first * sub, total):
-        k, j = divmod(step, sub)
-        t = step * h
-        in_motion = k < n_samples - 1
-        if in_motion:
-            a0 = acc[k] + (acc[k + 1] - acc[k]) * (j / sub)
-            a1 = acc[k] + (acc[k + 1] - acc[k]) * ((j + 0.5) / sub)
-            a2 = acc[k] + (acc[k + 1] - acc[k]) * ((j + 1) / sub)
-        else:
-            a0 = a1 = a2 = zero
-            if step == (n_samples - 1) * sub:       # the motion is over: decide the safe
-                done |= (side == 0) | _below_barrier(theta, omega, alpha, R, I0, g)
-        # uplift from rest
-        start = (side == 0) & ~done & (np.abs(a0) >= uplift * (1.0 - 1e-12))
+class _Blocks:
+    """The state of N rocking blocks of :func:`rocking_response_sampled`: angles (rad),
+    angular velocities (rad/s), pivot sides (+1 / -1, 0 at rest) and what happened."""
+
+    def __init__(self, alpha, R, p2, I0, eta, g):
+        n_cases = alpha.size
+        self.alpha, self.R, self.p2, self.I0, self.eta, self.g = alpha, R, p2, I0, eta, g
+        self.uplift_acc = g * np.tan(alpha)
+        self.omega_rest = _BATCH_REST_OMEGA_FRACTION * np.sqrt(p2) * alpha
+        self.zero = np.zeros(n_cases)
+        self.theta = np.zeros(n_cases)
+        self.omega = np.zeros(n_cases)
+        self.side = np.zeros(n_cases)
+        self.done = np.zeros(n_cases, bool)
+        self.overturned = np.zeros(n_cases, bool)
+        self.overturn_time = np.full(n_cases, np.nan)
+        self.direction = np.zeros(n_cases, int)
+        self.first_side = np.zeros(n_cases, int)
+        self.uplift_time = np.full(n_cases, np.nan)
+        self.impacts = np.zeros(n_cases, int)
+        self.max_abs = np.zeros(n_cases)
+
+    def decide_safe(self):
+        """Without ground motion: blocks at rest or below their barrier are decided."""
+        self.done |= (self.side == 0) | _below_barrier(self.theta, self.omega, self.alpha,
+                                                       self.R, self.I0, self.g)
+
+    def uplift(self, a0, t):
+        """Blocks at rest lift off where the ground acceleration a0 (m/s^2) at t (s)
+        reaches their threshold."""
+        start = (self.side == 0) & ~self.done & (np.abs(a0) >= self.uplift_acc * (1.0 - 1e-12))
         if start.any():
-            side = np.where(start, -np.sign(a0), side)
-            first_side = np.where(start & (first_side == 0), -np.sign(a0), first_side).astype(int)
-            uplift_time = np.where(start & np.isnan(uplift_time), t, uplift_time)
-        active = (side != 0) & ~done
-        if not active.any():
-            if done.all() or not in_motion:
-                break
-            continue
-        steps += 1
-        # classical Runge-Kutta on the active blocks
-        new_theta, new_omega = _rk4_step(theta, omega, side, (a0, a1, a2), h, alpha, p2, g)
+            self.side = np.where(start, -np.sign(a0), self.side)
+            self.first_side = np.where(start & (self.first_side == 0), -np.sign(a0),
+                                       self.first_side).astype(int)
+            self.uplift_time = np.where(start & np.isnan(self.uplift_time), t, self.uplift_time)
+
+    def advance(self, active, ground, h, t):
+        """One step of h (s) from t (s) for the ``active`` blocks: Runge-Kutta, impacts,
+        overturning."""
+        theta, omega = self.theta, self.omega
+        new_theta, new_omega = _rk4_step(theta, omega, self.side, ground, h, self.alpha,
+                                         self.p2, self.g)
         # impacts: theta crossed 0 (to the other side of the pivot)
-        hit = active & (side * new_theta < 0)
+        hit = active & (self.side * new_theta < 0)
         if hit.any():
-            new_theta, new_omega, side = _impact(theta, omega, new_theta, new_omega, side,
-                                                 hit, eta, omega_rest, h)
-            impacts += hit
-        theta = np.where(active, new_theta, theta)
-        omega = np.where(active, new_omega, omega)
-        max_abs = np.maximum(max_abs, np.abs(theta))
+            new_theta, new_omega, self.side = _impact(theta, omega, new_theta, new_omega,
+                                                      self.side, hit, self.eta,
+                                                      self.omega_rest, h)
+            self.impacts += hit
+        self.theta = theta = np.where(active, new_theta, theta)
+        self.omega = np.where(active, new_omega, omega)
+        self.max_abs = np.maximum(self.max_abs, np.abs(theta))
         fell = active & (np.abs(theta) >= 0.5 * math.pi)
         if fell.any():
-            overturned |= fell
-            overturn_time = np.where(fell, t + h, overturn_time)
-            direction = np.where(fell, np.sign(theta), direction).astype(int)
-            max_abs = np.where(fell, 0.5 * math.pi, max_abs)
-            done |= fell
-        if not in_motion:                      # free rocking: decided once below the barrier
-            done |= (side == 0) | _below_barrier(theta, omega, alpha, R, I0, g)
-        if done.all():
-            break
-    return dict(overturned=overturned, overturn_time=overturn_time,
-                overturn_direction=direction, first_side=first_side, uplift_time=uplift_time,
-                n_impacts=impacts, max_abs_theta=max_abs, alpha=alpha, p=np.sqrt(p2),
-                restitution=np.asarray(eta, float), steps=steps, decided=done.copy())
+            self.overturned |= fell
+            self.overturn_time = np.where(fell, t + h, self.overturn_time)
+            self.direction = np.where(fell, np.sign(theta), self.direction).astype(int)
+            self.max_abs = np.where(fell, 0.5 * math.pi, self.max_abs)
+            self.done |= fell
+
+    def result(self, steps):
+        return dict(overturned=self.overturned, overturn_time=self.overturn_time,
+                    overturn_direction=self.direction, first_side=self.first_side,
+                    uplift_time=self.uplift_time, n_impacts=self.impacts,
+                    max_abs_theta=self.max_abs, alpha=self.alpha, p=np.sqrt(self.p2),
+                    restitution=np.asarray(self.eta, float), steps=steps,
+                    decided=self.done.copy())
 
 
 def _block_arrays(height, width, restitution, n_cases, g):
