@@ -8,7 +8,7 @@ from pipeline import RESULTS_DIR
 from pipeline.report import docs_numbers
 
 NUMBERS = ("bench_value", "bench_speed_table", "engine_shares", "run_all_steps",
-           "run_all_minutes", "value")
+           "run_all_minutes", "time_step_table", "value")
 WITH_FIGURES = ("report", "report_section")
 
 

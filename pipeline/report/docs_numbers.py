@@ -88,6 +88,30 @@ def engine_shares(path=BENCH_JSON, least_pct=2.0):
                      if e["share_pct"] >= least_pct)
 
 
+def time_step_table(path=BENCH_JSON):
+    """Markdown table of bench section 9: per model and contact damping, the allowed time
+    step factor and the largest body rotation (deg) of a still column held on a still
+    pedestal at that factor and at 1.3x it, the larger of the two libm paths."""
+    data = _bench(path)
+    if data is None or "time_step_limit" not in data:
+        return _not_yet("make bench")
+    rows = data["time_step_limit"]["rows"]
+    ratios = sorted({r["ratio_to_limit"] for r in rows})
+    largest = {}
+    for r in rows:
+        key = (r["model"], r["damping"], r["ratio_to_limit"])
+        largest[key] = max(largest.get(key, 0.0), r["rotation_deg"])
+    factor = {(r["model"], r["damping"]): r["dt_factor"] for r in rows
+              if r["ratio_to_limit"] == 1.0}
+    lines = ["| model | damping | allowed factor | "
+             + " | ".join(f"rotation (deg) at {k:g}x" for k in ratios) + " |",
+             "|---|---|---|" + "---|" * len(ratios)]
+    for model, damping in sorted(factor):
+        cells = " | ".join(f"{largest[(model, damping, k)]:.3g}" for k in ratios)
+        lines.append(f"| {model} | {damping:g} | {factor[(model, damping)]:.3f} | {cells} |")
+    return "\n".join(lines)
+
+
 def run_all_steps(path=RUN_ALL_STEPS):
     """Markdown table of ``make run-all``'s steps and their wall minutes, with the total
     (read by :func:`pipeline.report.campaigns.run_all_steps`, as the REPORT reads them)."""

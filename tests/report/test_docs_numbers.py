@@ -9,7 +9,7 @@ from pipeline.report import docs_numbers
 
 ROOT = Path(__file__).resolve().parents[2]
 MACROS = ("bench_value", "bench_speed_table", "engine_shares", "run_all_steps",
-          "run_all_minutes", "value", "report", "report_section")
+          "run_all_minutes", "time_step_table", "value", "report", "report_section")
 
 
 def _bench(tmp_path):
@@ -33,6 +33,18 @@ def test_bench_numbers_are_the_files(tmp_path):
     assert docs_numbers.bench_value("two_x.scenes.no friction switch.x_default",
                                     path=path) == "1.18"
     assert docs_numbers.bench_value("engine_timing.engines.1.engine", "{}", path) == "B"
+
+
+def test_time_step_table_takes_the_worse_libm_path(tmp_path):
+    rows = [{"libm": libm, "damping": 0.36, "ratio_to_limit": ratio, "model": "twin",
+             "dt_factor": 0.235 * ratio, "rotation_deg": rotation}
+            for libm, ratio, rotation in (("native", 1.0, 1e-4), ("second", 1.0, 3e-4),
+                                          ("native", 1.3, 2.5), ("second", 1.3, 1.5))]
+    path = tmp_path / "bench.json"
+    path.write_text(json.dumps({"time_step_limit": {"seconds": 5.0, "rows": rows}}))
+    table = docs_numbers.time_step_table(path)
+    assert "| twin | 0.36 | 0.235 | 0.0003 | 2.5 |" in table
+    assert "make bench" in docs_numbers.time_step_table(tmp_path / "none.json")
 
 
 def test_without_the_files_the_docs_say_what_to_run(tmp_path):
