@@ -7,7 +7,7 @@ from pathlib import Path
 from pipeline import RESULTS_DIR
 from pipeline.report import docs_numbers
 
-NUMBERS = ("bench_value", "bench_speed_table", "engine_shares", "run_all_steps",
+NUMBERS = ("bench_value", "column_examples", "column_sources", "bench_speed_table", "engine_shares", "run_all_steps",
            "run_all_minutes", "time_step_table", "value")
 WITH_FIGURES = ("report", "report_section")
 

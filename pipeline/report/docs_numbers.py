@@ -8,8 +8,11 @@ import json
 import re
 from functools import reduce
 
-from pipeline import RESULTS_DIR
+from pipeline import RESULTS_DIR, paper
+from pipeline.campaign.column_file import matched_kn
 from pipeline.report import campaigns
+from pipeline.scenario.column_format import example_names
+from pipeline.scenario.geometry import ColumnGeometry
 
 BENCH_JSON = RESULTS_DIR / "bench" / "bench.json"
 RUN_ALL_STEPS = RESULTS_DIR / "run-all-steps.tsv"
@@ -109,6 +112,38 @@ def time_step_table(path=BENCH_JSON):
     for model, damping in sorted(factor):
         cells = " | ".join(f"{largest[(model, damping, k)]:.3g}" for k in ratios)
         lines.append(f"| {model} | {damping:g} | {factor[(model, damping)]:.3f} | {cells} |")
+    return "\n".join(lines)
+
+
+def column_examples(names=None):
+    """Markdown table of the shipped column descriptions (or ``names``, a file or a name
+    each), computed from the files as ``run`` computes them: blocks and rigid bodies, mass
+    (t), uplift ratio (rocking threshold / g) beside base diameter / height, the frequency
+    (Hz) of the column rocking on the paper's contact stiffness and the stiffness that
+    ``campaign columns`` matches to the paper's column."""
+    lines = ["| name | blocks -> bodies | mass | uplift ratio (d/h) | rocking on the "
+             f"paper's kn ({paper.COLUMN_KN_N_M:.2g} N/m) | matched kn |",
+             "|---|---|---|---|---|---|"]
+    for name in names or example_names():
+        column = ColumnGeometry.load(name)
+        bodies = column.bodies()
+        mass_t = sum(body.mass for body in bodies) / 1000.0
+        lines.append(f"| `{column.name}` | {len(column.blocks)} -> {len(bodies)} | "
+                     f"{mass_t:.3g} t | {column.uplift_ratio():.3f} "
+                     f"({column.base_width / column.height:.3f}) | "
+                     f"{column.contact_rocking_hz(paper.COLUMN_KN_N_M):.1f} Hz | "
+                     f"{matched_kn(column):.2g} N/m |")
+    return "\n".join(lines)
+
+
+def column_sources(names=None):
+    """Markdown list of the shipped column descriptions' (or ``names``') ``source`` and
+    ``notes``, as the files state them."""
+    lines = []
+    for name in names or example_names():
+        column = ColumnGeometry.load(name)
+        lines.append(f"- `{column.name}`: {column.source or '(no source given)'}"
+                     + (f" *Notes:* {column.notes}" if column.notes else ""))
     return "\n".join(lines)
 
 

@@ -8,7 +8,7 @@ from pathlib import Path
 from pipeline.report import docs_numbers
 
 ROOT = Path(__file__).resolve().parents[2]
-MACROS = ("bench_value", "bench_speed_table", "engine_shares", "run_all_steps",
+MACROS = ("bench_value", "column_examples", "column_sources", "bench_speed_table", "engine_shares", "run_all_steps",
           "run_all_minutes", "time_step_table", "value", "report", "report_section")
 
 
@@ -45,6 +45,24 @@ def test_time_step_table_takes_the_worse_libm_path(tmp_path):
     table = docs_numbers.time_step_table(path)
     assert "| twin | 0.36 | 0.235 | 0.0003 | 2.5 |" in table
     assert "make bench" in docs_numbers.time_step_table(tmp_path / "none.json")
+
+
+def test_column_table_states_what_a_cylinder_is(tmp_path):
+    # a marble cylinder: mass rho pi d^2 h / 4, uplift ratio d / h (statics of one block)
+    path = tmp_path / "cylinder.json"
+    path.write_text(json.dumps({"name": "cylinder", "density": 2500.0, "blocks": [
+        {"shape": "frustum", "height": 2.0, "bottom_diameter": 0.5, "top_diameter": 0.5}]}))
+    row = docs_numbers.column_examples([str(path)]).splitlines()[-1]
+    cells = [c.strip() for c in row.strip("|").split("|")]
+    mass_t = 2500.0 * 3.141592653589793 * 0.25 ** 2 * 2.0 / 1000.0
+    assert cells[:4] == ["`cylinder`", "1 -> 1", f"{mass_t:.3g} t", "0.250 (0.250)"]
+
+
+def test_column_sources_are_the_files_words():
+    for path in sorted((ROOT / "pipeline" / "scenario" / "columns").glob("*.json")):
+        stated = json.loads(path.read_text())
+        line = docs_numbers.column_sources([str(path)])
+        assert stated["source"] in line and stated.get("notes", "") in line
 
 
 def test_without_the_files_the_docs_say_what_to_run(tmp_path):
