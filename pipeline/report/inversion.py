@@ -6,6 +6,7 @@ import pandas as pd
 
 from pipeline.report.common import _figure, _fmt, _pct, _table
 from pipeline.inversion.grid import GRIDS
+from pipeline.simulate import run_code_version
 
 
 def inversion_section(results):
@@ -205,6 +206,26 @@ def _inversion_findings(demo, narrow):
             "can tell.")
 
 
+def _table_provenance(info):
+    """One sentence on the forward table a study used: runs, YADE time, file, model code
+    (and whether it is this checkout's)."""
+    if info.get("runs") is None:
+        return ""
+    text = f"The forward table: {info['runs']} runs"
+    if info.get("yade_wall_s") is not None:
+        text += f", {info['yade_wall_s'] / 3600:.1f} h of YADE time"
+    if info.get("reused_file"):
+        text += f", read from `{Path(info['table']).name}`"
+    code = info.get("code_version")
+    if code:
+        here = run_code_version()
+        text += f", model code {code}" + ("" if code == here else
+                                          f" (this checkout's is {here}: the table was "
+                                          "computed by another version of the code that "
+                                          "defines a run)")
+    return text + ".\n"
+
+
 def member_study_section(results):
     """How many fallen columns bound the source (invert --member-study, make invert-study):
     the answer per likelihood, the table at the largest likelihood size and the figure."""
@@ -225,6 +246,7 @@ def member_study_section(results):
              f"last {study['observation_members']} members, which no likelihood uses; the "
              f"likelihood from the first {', '.join(map(str, study['likelihood_members']))}; "
              f"{study['trials']} trials per configuration, the same draws for every size.\n"]
+    lines.append(_table_provenance(study.get("forward_table") or {}))
     lines += [f"- {text}." for text in study["answer"].values()]
     largest = summary[summary["likelihood_members"] == summary["likelihood_members"].max()]
     table = largest[["likelihood", "sites", "fallen_per_site", "trials",

@@ -1,5 +1,7 @@
 """The member study on toy tables: observations never from likelihood members, the same
 draws for every likelihood size, and a sharper direction density narrowing the arcs."""
+import dataclasses
+
 import numpy as np
 
 from pipeline.inversion.posterior import CandidateGrid
@@ -60,6 +62,8 @@ def test_member_study_command_on_a_table_file(make_away_table, tmp_path, capsys)
 
     from pipeline import cli
     table = make_away_table(members=24, scatter_deg=20.0, p_fall=(1.0, 0.8, 0.6, 0.4))
+    table = dataclasses.replace(table, info={**table.info, "runs": 1536, "yade_wall_s": 7200.0,
+                                             "code_version": "0123abcd"})
     path = tmp_path / "forward_table_toy.npz"
     table.save(path)
     out = tmp_path / "inversion" / "member-study"
@@ -75,3 +79,6 @@ def test_member_study_command_on_a_table_file(make_away_table, tmp_path, capsys)
     from pipeline.report import member_study_section
     section = member_study_section(tmp_path)
     assert result["answer"]["predictive"] in section and "member_study.png" in section
+    # the table's provenance, and that it came from another version of the model code
+    assert "The forward table: 1536 runs, 2.0 h of YADE time, read from " \
+           "`forward_table_toy.npz`, model code 0123abcd (this checkout's is" in section
