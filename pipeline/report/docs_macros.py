@@ -8,7 +8,8 @@ from pipeline import RESULTS_DIR
 from pipeline.report import docs_numbers
 
 NUMBERS = ("bench_value", "column_examples", "column_sources", "bench_speed_table", "engine_shares", "run_all_steps",
-           "run_all_minutes", "time_step_table", "value")
+           "run_all_minutes", "time_step_table", "value",
+           "record_value", "record_rocking_hd")
 WITH_FIGURES = ("report", "report_section")
 
 

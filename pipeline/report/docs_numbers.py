@@ -8,7 +8,10 @@ import json
 import re
 from functools import reduce
 
+import pandas as pd
+
 from pipeline import RESULTS_DIR, paper
+from pipeline.constants import MODEL_GRAVITY
 from pipeline.campaign.column_file import matched_kn
 from pipeline.report import campaigns
 from pipeline.scenario.column_format import example_names
@@ -16,6 +19,7 @@ from pipeline.scenario.geometry import ColumnGeometry
 
 BENCH_JSON = RESULTS_DIR / "bench" / "bench.json"
 RUN_ALL_STEPS = RESULTS_DIR / "run-all-steps.tsv"
+RECORDS_TABLE = RESULTS_DIR / "records" / "records.csv"
 REPORT = RESULTS_DIR / "REPORT.md"
 # the JSON summaries the docs quote (paths under results/) and the command writing each
 SOURCES = {
@@ -145,6 +149,31 @@ def column_sources(names=None):
         lines.append(f"- `{column.name}`: {column.source or '(no source given)'}"
                      + (f" *Notes:* {column.notes}" if column.notes else ""))
     return "\n".join(lines)
+
+
+def _record_row(record, path):
+    if not path.is_file():
+        return None
+    table = pd.read_csv(path).set_index("id")
+    return table.loc[record] if record in table.index else None
+
+
+def record_value(record, column, fmt="{:.2f}", path=RECORDS_TABLE):
+    """One value of a processed record's row in ``records.csv`` (Table 1, written by
+    ``records``): e.g. ``pga_h`` (m/s^2) of ``GM20``."""
+    row = _record_row(record, path)
+    if row is None or column not in row:
+        return _not_yet("make run-all")
+    return fmt.format(row[column])
+
+
+def record_rocking_hd(record, fmt="{:.1f}", path=RECORDS_TABLE):
+    """The slenderness h/d below which a rigid cylinder cannot rock on a record's strongest
+    horizontal acceleration: uplift needs a_h >= g d/h, so h/d < g / PGA_h."""
+    row = _record_row(record, path)
+    if row is None:
+        return _not_yet("make run-all")
+    return fmt.format(MODEL_GRAVITY / row["pga_h"])
 
 
 def run_all_steps(path=RUN_ALL_STEPS):

@@ -9,7 +9,8 @@ from pipeline.report import docs_numbers
 
 ROOT = Path(__file__).resolve().parents[2]
 MACROS = ("bench_value", "column_examples", "column_sources", "bench_speed_table", "engine_shares", "run_all_steps",
-          "run_all_minutes", "time_step_table", "value", "report", "report_section")
+          "run_all_minutes", "time_step_table", "value", "report", "report_section",
+          "record_value", "record_rocking_hd")
 
 
 def _bench(tmp_path):
@@ -63,6 +64,15 @@ def test_column_sources_are_the_files_words():
         stated = json.loads(path.read_text())
         line = docs_numbers.column_sources([str(path)])
         assert stated["source"] in line and stated.get("notes", "") in line
+
+
+def test_record_values_are_table_1(tmp_path):
+    path = tmp_path / "records.csv"
+    path.write_text("id,label,pga_h\nGM20,Izmit,2.4525\n")
+    assert docs_numbers.record_value("GM20", "pga_h", path=path) == "2.45"
+    assert docs_numbers.record_rocking_hd("GM20", path=path) == "4.0"   # 9.81 / 2.4525
+    assert "make run-all" in docs_numbers.record_value("NF99", "pga_h", path=path)
+    assert "make run-all" in docs_numbers.record_rocking_hd("GM20", path=tmp_path / "x.csv")
 
 
 def test_without_the_files_the_docs_say_what_to_run(tmp_path):
