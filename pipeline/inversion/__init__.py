@@ -19,8 +19,7 @@ from pathlib import Path
 
 from pipeline.files import DirectoryLock, write_csv, write_json
 from pipeline.inversion.likelihood import DEFAULT_FLOOR, DEFAULT_KERNEL_DEG, ForwardModel
-from pipeline.inversion.posterior import in_arc, invert
-from pipeline.inversion.study import magnitude_set
+from pipeline.inversion.posterior import in_arc, invert, magnitude_set
 
 EXAMPLES_DIR = Path(__file__).resolve().parent / "examples"
 

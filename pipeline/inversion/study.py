@@ -30,7 +30,7 @@ from pipeline.inversion.demo import BOUND_DEG, FALLEN_PER_SITE, SITE_COUNTS, _fr
     _site_position, draw_site_columns
 from pipeline.inversion.likelihood import DEFAULT_FLOOR, DEFAULT_KERNEL_DEG, LIKELIHOODS, \
     ForwardModel
-from pipeline.inversion.posterior import in_arc, invert
+from pipeline.inversion.posterior import in_arc, invert, magnitude_set
 from pipeline.stats.circular import azimuth_deg
 from pipeline.stats.ensemble import wilson_interval
 from pipeline.files import InputError, die_with_parent
@@ -50,18 +50,6 @@ def split_for_study(table, observation_members=OBSERVATION_MEMBERS):
                          f"per node (the table has {order.size})")
     pool = np.isin(table.members, order[-observation_members:])
     return table.select_members(~pool), table.select_members(pool)
-
-
-def magnitude_set(posterior, level=0.95):
-    """The smallest set of magnitudes (strings as in the summary) holding ``level`` of the
-    magnitude posterior ({"6.5": p, ...})."""
-    chosen, total = [], 0.0
-    for mw, p in sorted(posterior.items(), key=lambda kv: -kv[1]):
-        chosen.append(mw)
-        total += p
-        if total >= level - 1e-12:
-            break
-    return chosen
 
 
 def study_trial(model, pool, n_sites, fallen, candidates, rng):

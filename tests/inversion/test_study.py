@@ -4,9 +4,8 @@ import dataclasses
 
 import numpy as np
 
-from pipeline.inversion.posterior import CandidateGrid
-from pipeline.inversion.study import (magnitude_set, member_study, split_for_study,
-                                      study_answer, study_summary)
+from pipeline.inversion.posterior import CandidateGrid, magnitude_set
+from pipeline.inversion.study import member_study, split_for_study, study_answer, study_summary
 
 
 def test_observations_come_from_members_no_likelihood_uses(make_away_table):
