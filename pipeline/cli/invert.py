@@ -406,9 +406,10 @@ def _run_demo(args, preset, grid, candidates):
 def _run_member_study(args, grid, candidates):
     """invert --member-study: the forward table (run, reused or --table), then the study's
     truth tests; writes member_study.csv (one row per trial), member_study_summary.csv,
-    member_study.json (the answer per likelihood) and member_study.png."""
+    member_study.json (the answer per likelihood), member_study.png (the back azimuth) and
+    member_study_source.png (the epicentre and the magnitude)."""
     from pipeline.files import write_csv, write_json
-    from pipeline.figures.inversion import plot_member_study
+    from pipeline.figures.inversion import plot_member_study, plot_member_study_source
     from pipeline.inversion.study import (LIKELIHOOD_MEMBERS, OBSERVATION_MEMBERS,
                                           STUDY_TRIALS, member_study, study_answer,
                                           study_summary)
@@ -437,12 +438,13 @@ def _run_member_study(args, grid, candidates):
     write_csv(out / "member_study.csv", rows)
     write_csv(out / "member_study_summary.csv", summary)
     figure = plot_member_study(summary, out / "member_study.png")
+    source_figure = plot_member_study_source(summary, out / "member_study_source.png")
     write_json(out / "member_study.json", {
         "answer": answer, "likelihood_members": sorted(summary["likelihood_members"].unique()
                                                        .tolist()),
         "requested_likelihood_members": list(LIKELIHOOD_MEMBERS),
         "observation_members": OBSERVATION_MEMBERS, "trials": trials,
-        "forward_table": info, "figure": figure.name,
+        "forward_table": info, "figure": figure.name, "source_figure": source_figure.name,
         "elapsed_s": round(time.monotonic() - started, 1)})
     for text in answer.values():
         print(text)

@@ -196,40 +196,67 @@ def plot_member_study(summary, path):
     """The member study: per likelihood (rows) the median 95 % back-azimuth arc and its
     coverage (with Wilson intervals) against the likelihood members per node; colour: fallen
     columns per site, line style: sites."""
+    panels = [("width_median_deg", None, "median width of the 95 % back-azimuth arc (deg)",
+               "arc width", (0, 365), 60.0, "+-30 deg"),
+              ("coverage_back_azimuth_95", "coverage_ci95",
+               "coverage of the 95 % arc (Wilson 95 %)", "coverage", (0, 1.02), 0.95, "95 %")]
+    _plot_study_panels(summary, path, panels, "How many fallen columns bound the back "
+                       "azimuth? (truth tests, observed columns from members no likelihood "
+                       "uses)")
+    return path
+
+
+def plot_member_study_source(summary, path):
+    """The member study for the epicentre and the magnitude: per likelihood (rows) the
+    median 95 % credible area of the epicentre, and the coverage of the epicentre's 95 %
+    region and of the 95 % set of magnitudes (Wilson intervals), against the likelihood
+    members per node."""
+    panels = [("credible_area_95_km2_median", None, "median 95 % credible area (km^2)",
+               "epicentre: area", None, None, None),
+              ("coverage_epicentre_95", "coverage_epicentre_ci95",
+               "coverage of the 95 % region (Wilson 95 %)", "epicentre: coverage", (0, 1.02),
+               0.95, "95 %"),
+              ("coverage_mw_95", "coverage_mw_ci95", "true Mw in the 95 % set (Wilson 95 %)",
+               "magnitude: coverage", (0, 1.02), 0.95, "95 %")]
+    _plot_study_panels(summary, path, panels, "What the columns tell of the epicentre and "
+                       "the magnitude (the same truth tests)")
+    return path
+
+
+def _plot_study_panels(summary, path, panels, title):
+    """One row per likelihood, one panel per (column, interval column, y label, title,
+    y limits, reference line, its label) of ``summary`` against the likelihood members."""
     kinds = sorted(summary["likelihood"].unique())
-    fig, axes = new_figure(len(kinds), 2, figsize=(12, 4.2 * len(kinds)), squeeze=False)
+    fig, axes = new_figure(len(kinds), len(panels), figsize=(6 * len(panels), 4.2 * len(kinds)),
+                           squeeze=False)
     fallen = sorted(summary["fallen_per_site"].unique())
     styles = {1: "-", 3: "--"}
     for row, kind in zip(axes, kinds):
-        width_ax, cover_ax = row
         g = summary[summary["likelihood"] == kind]
-        for (sites, k), h in g.groupby(["sites", "fallen_per_site"]):
-            h = h.sort_values("likelihood_members")
-            style = dict(color=f"C{fallen.index(k)}", ls=styles.get(sites, ":"),
-                         marker="o", ms=4, label=f"{sites} site(s) x {k} fallen")
-            width_ax.plot(h["likelihood_members"], h["width_median_deg"], **style)
-            lo = [c[0] for c in h["coverage_ci95"]]
-            hi = [c[1] for c in h["coverage_ci95"]]
-            cover_ax.plot(h["likelihood_members"], h["coverage_back_azimuth_95"], **style)
-            cover_ax.fill_between(h["likelihood_members"], lo, hi, color=style["color"],
-                                  alpha=0.08)
-        width_ax.axhline(60.0, color="k", lw=1, ls=":", label="+-30 deg")
-        cover_ax.axhline(0.95, color="k", lw=1, ls=":", label="95 %")
-        for ax in row:
+        sizes = sorted(g["likelihood_members"].unique())
+        for ax, (column, interval, ylabel, name, ylim, line, line_label) in zip(row, panels):
+            for (sites, k), h in g.groupby(["sites", "fallen_per_site"]):
+                h = h.sort_values("likelihood_members")
+                style = dict(color=f"C{fallen.index(k)}", ls=styles.get(sites, ":"),
+                             marker="o", ms=4, label=f"{sites} site(s) x {k} fallen")
+                ax.plot(h["likelihood_members"], h[column], **style)
+                if interval is not None:
+                    ax.fill_between(h["likelihood_members"], [c[0] for c in h[interval]],
+                                    [c[1] for c in h[interval]], color=style["color"],
+                                    alpha=0.08)
+            if line is not None:
+                ax.axhline(line, color="k", lw=1, ls=":", label=line_label)
             ax.set_xscale("log", base=2)
-            ax.set_xticks(sorted(g["likelihood_members"].unique()),
-                          [str(v) for v in sorted(g["likelihood_members"].unique())])
+            ax.set_xticks(sizes, [str(v) for v in sizes])
             ax.set_xlabel("likelihood members per node")
+            ax.set_ylabel(ylabel)
+            if ylim is None:
+                ax.set_yscale("log")
+            else:
+                ax.set_ylim(*ylim)
+            ax.set_title(f"{kind} likelihood: {name}", fontsize=10)
             ax.grid(alpha=0.3)
-        width_ax.set_ylabel("median width of the 95 % back-azimuth arc (deg)")
-        width_ax.set_ylim(0, 365)
-        cover_ax.set_ylabel("coverage of the 95 % arc (Wilson 95 %)")
-        cover_ax.set_ylim(0, 1.02)
-        width_ax.set_title(f"{kind} likelihood: arc width", fontsize=10)
-        cover_ax.set_title(f"{kind} likelihood: coverage", fontsize=10)
-        width_ax.legend(fontsize=7, ncol=2)
-    fig.suptitle("How many fallen columns bound the back azimuth? (truth tests, observed "
-                 "columns from members no likelihood uses)", fontsize=11)
+        row[0].legend(fontsize=7, ncol=2)
+    fig.suptitle(title, fontsize=11)
     fig.tight_layout()
     save_figure(fig, path, dpi=110)
-    return path

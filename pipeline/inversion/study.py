@@ -159,8 +159,11 @@ def study_summary(trials):
                      "width_median_deg": float(g["width95_deg"].median()),
                      "bounded_30_fraction": float((g["width95_deg"] <= BOUND_DEG).mean()),
                      "coverage_epicentre_95": float(g["epicentre_in_95"].mean()),
+                     "coverage_epicentre_ci95": wilson_interval(int(g["epicentre_in_95"].sum()),
+                                                                n),
                      "credible_area_95_km2_median": float(g["credible_area_95_km2"].median()),
                      "coverage_mw_95": float(g["mw_in_95"].mean()),
+                     "coverage_mw_ci95": wilson_interval(int(g["mw_in_95"].sum()), n),
                      "p_true_mw_median": float(g["p_true_mw"].median()),
                      "p_true_mechanism_median": float(g["p_true_mechanism"].median())})
     return pd.DataFrame(rows)

@@ -68,7 +68,8 @@ def test_member_study_command_on_a_table_file(make_away_table, tmp_path, capsys)
     out = tmp_path / "inversion" / "member-study"
     assert cli.main(["invert", "--member-study", "--table", str(path), "--out", str(out),
                      "--trials", "2", "--radius", "22", "--step", "2"]) == 0
-    for name in ("member_study.csv", "member_study_summary.csv", "member_study.png"):
+    for name in ("member_study.csv", "member_study_summary.csv", "member_study.png",
+                 "member_study_source.png"):
         assert (out / name).stat().st_size > 0
     result = json.loads((out / "member_study.json").read_text())
     assert result["likelihood_members"] == [3, 6]          # 24 - 16 observed: 8 usable
@@ -78,6 +79,7 @@ def test_member_study_command_on_a_table_file(make_away_table, tmp_path, capsys)
     from pipeline.report import member_study_section
     section = member_study_section(tmp_path)
     assert result["answer"]["predictive"] in section and "member_study.png" in section
+    assert "member_study_source.png" in section
     # the table's provenance, and that it came from another version of the model code
     assert "The forward table: 1536 runs, 2.0 h of YADE time, read from " \
            "`forward_table_toy.npz`, model code 0123abcd (this checkout's is" in section
