@@ -445,6 +445,10 @@ def _run_member_study(args, grid, candidates):
         "requested_likelihood_members": list(LIKELIHOOD_MEMBERS),
         "observation_members": OBSERVATION_MEMBERS, "trials": trials,
         "forward_table": info, "figure": figure.name, "source_figure": source_figure.name,
+        "toppled_fraction_by_slice": [
+            {**{k: sl[k] for k in ("mechanism", "depth_km", "mw")},
+             "fraction": round(float(table.toppled[i][table.valid[i]].mean()), 4)}
+            for i, sl in enumerate(table.slices)],
         "elapsed_s": round(time.monotonic() - started, 1)})
     for text in answer.values():
         print(text)

@@ -226,6 +226,20 @@ def _table_provenance(info):
     return text + ".\n"
 
 
+def _toppled_by_slice(slices):
+    """One sentence: the share of the table's columns that toppled per slice, and what a
+    slice where none toppled means for the magnitude."""
+    if not slices:
+        return ""
+    parts = [f"{s['mechanism']} Mw {s['mw']:g} at {s['depth_km']:g} km: {s['fraction']:.2f}"
+             for s in slices]
+    text = "Columns toppled in the table (all nodes and members): " + "; ".join(parts) + "."
+    if any(s["fraction"] == 0 for s in slices):
+        text += (" A slice where no column topples is excluded by a single fallen column, so "
+                 "the magnitude's coverage below tells only that.")
+    return text + "\n"
+
+
 def member_study_section(results):
     """How many fallen columns bound the source (invert --member-study, make invert-study):
     the answer per likelihood, the table at the largest likelihood size and the figure."""
@@ -247,6 +261,7 @@ def member_study_section(results):
              f"likelihood from the first {', '.join(map(str, study['likelihood_members']))}; "
              f"{study['trials']} trials per configuration, the same draws for every size.\n"]
     lines.append(_table_provenance(study.get("forward_table") or {}))
+    lines.append(_toppled_by_slice(study.get("toppled_fraction_by_slice") or []))
     lines += [f"- {text}." for text in study["answer"].values()]
     largest = summary[summary["likelihood_members"] == summary["likelihood_members"].max()]
     table = largest[["likelihood", "sites", "fallen_per_site", "trials",

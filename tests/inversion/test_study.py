@@ -34,6 +34,29 @@ def test_more_likelihood_members_narrow_the_arc_on_the_same_draws(make_away_tabl
     assert set(answer) == {"independent"} and "24 members per node" in answer["independent"]
 
 
+def test_the_answer_names_the_fewest_columns_that_bound_or_narrow():
+    import pandas as pd
+    rows = []
+    for size, coverage in ((3, 0.55), (48, 0.88)):
+        for sites, fallen, width in ((1, 30, 150.0), (3, 10, 55.0), (3, 30, 20.0)):
+            calibrated = size == 48 and (sites, fallen) == (3, 10) and coverage > 0
+            rows.append({"likelihood": "independent", "likelihood_members": size,
+                         "sites": sites, "fallen_per_site": fallen,
+                         "fallen_total": sites * fallen, "width_median_deg": width,
+                         "coverage_back_azimuth_95": 0.93 if calibrated else coverage,
+                         "coverage_ci95": (0.89, 0.96) if calibrated else (0.83, 0.92),
+                         "calibrated": calibrated, "credible_area_95_km2_median": 4.0,
+                         "coverage_epicentre_95": 0.8, "coverage_mw_95": 1.0})
+    summary = pd.DataFrame(rows)
+    bound = study_answer(summary)["independent"]
+    assert "48 members per node: 3 site(s) with 10 fallen column(s) each bound" in bound
+    assert "(20 deg, coverage 0.55 with 3 members)" in bound
+    summary["calibrated"] = False
+    narrow = study_answer(summary)["independent"]
+    assert "no tested configuration bounds" in narrow
+    assert "3 site(s) x 10 fallen narrow the median 95 % arc to 55 deg" in narrow
+
+
 def test_the_rows_do_not_depend_on_the_processes(make_away_table):
     """Two processes give the same trials, row for row, as one (each trial's draws are
     seeded by S, K and the trial), and progress reports every configuration."""
@@ -80,6 +103,9 @@ def test_member_study_command_on_a_table_file(make_away_table, tmp_path, capsys)
     section = member_study_section(tmp_path)
     assert result["answer"]["predictive"] in section and "member_study.png" in section
     assert "member_study_source.png" in section
+    fractions = [s["fraction"] for s in result["toppled_fraction_by_slice"]]
+    assert len(fractions) == len(table.slices) and all(0 < f < 1 for f in fractions)
+    assert f"Mw {table.slices[0]['mw']:g}" in section and "Columns toppled in the table" in section
     # the table's provenance, and that it came from another version of the model code
     assert "The forward table: 1536 runs, 2.0 h of YADE time, read from " \
            "`forward_table_toy.npz`, model code 0123abcd (this checkout's is" in section
