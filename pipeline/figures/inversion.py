@@ -256,7 +256,7 @@ def _plot_study_panels(summary, path, panels, title):
                 ax.set_ylim(*ylim)
             ax.set_title(f"{kind} likelihood: {name}", fontsize=10)
             ax.grid(alpha=0.3)
-        row[0].legend(fontsize=7, ncol=2)
+        row[-1].legend(fontsize=7, ncol=2, loc="lower left")
     fig.suptitle(title, fontsize=11)
     fig.tight_layout()
     save_figure(fig, path, dpi=110)
