@@ -367,10 +367,9 @@ def verification_specs(records, campaign_dir):
     if records:
         raise InputError("the verification campaign takes no --records")
     version = content_hash(run_code_version(), code_hash("verification", "rocking"))
-    specs = verification.campaign_specs()
-    for spec in specs:
-        spec["run_id"] = content_hash(version, {k: v for k, v in spec.items() if k != "run_id"})
-    return specs
+    return [{**spec, "run_id": content_hash(version, {k: v for k, v in spec.items()
+                                                      if k != "run_id"})}
+            for spec in verification.campaign_specs()]
 
 
 def verification_outputs(specs, campaign_dir, failures, animations, figures=True):
