@@ -2,44 +2,15 @@
 imports inside functions: the layers contract (import-linter, make test) orders the stages,
 this keeps the modules of one stage in order too."""
 import grimp
+import networkx as nx
 
 
 def _circles(graph):
-    """Strongly connected groups of more than one module (Tarjan), iteratively."""
-    index, low, on_stack, stack, found = {}, {}, set(), [], []
-    for root in sorted(graph.modules):
-        if root in index:
-            continue
-        work = [(root, iter(sorted(graph.find_modules_directly_imported_by(root))))]
-        index[root] = low[root] = len(index)
-        stack.append(root)
-        on_stack.add(root)
-        while work:
-            module, imported = work[-1]
-            step = next(imported, None)
-            if step is not None:
-                if step not in index:
-                    index[step] = low[step] = len(index)
-                    stack.append(step)
-                    on_stack.add(step)
-                    work.append((step, iter(sorted(graph.find_modules_directly_imported_by(step)))))
-                elif step in on_stack:
-                    low[module] = min(low[module], index[step])
-                continue
-            work.pop()
-            if work:
-                low[work[-1][0]] = min(low[work[-1][0]], low[module])
-            if low[module] == index[module]:
-                group = []
-                while True:
-                    member = stack.pop()
-                    on_stack.discard(member)
-                    group.append(member)
-                    if member == module:
-                        break
-                if len(group) > 1:
-                    found.append(sorted(group))
-    return found
+    """The groups of more than one module that import each other, round in a circle."""
+    edges = nx.DiGraph((module, imported) for module in graph.modules
+                       for imported in graph.find_modules_directly_imported_by(module))
+    return sorted(sorted(group) for group in nx.strongly_connected_components(edges)
+                  if len(group) > 1)
 
 
 def test_the_circle_finder_finds_a_circle():
