@@ -410,6 +410,7 @@ def _run_member_study(args, grid, candidates):
     member_study_source.png (the epicentre and the magnitude)."""
     from pipeline.files import write_csv, write_json
     from pipeline.figures.inversion import plot_member_study, plot_member_study_source
+    from pipeline.inversion.demo import BOUND_DEG
     from pipeline.inversion.study import (LIKELIHOOD_MEMBERS, OBSERVATION_MEMBERS,
                                           STUDY_TRIALS, member_study, study_answer,
                                           study_summary)
@@ -437,7 +438,7 @@ def _run_member_study(args, grid, candidates):
     answer = study_answer(summary)
     write_csv(out / "member_study.csv", rows)
     write_csv(out / "member_study_summary.csv", summary)
-    figure = plot_member_study(summary, out / "member_study.png")
+    figure = plot_member_study(summary, out / "member_study.png", BOUND_DEG)
     source_figure = plot_member_study_source(summary, out / "member_study_source.png")
     write_json(out / "member_study.json", {
         "answer": answer, "likelihood_members": sorted(summary["likelihood_members"].unique()
@@ -445,10 +446,7 @@ def _run_member_study(args, grid, candidates):
         "requested_likelihood_members": list(LIKELIHOOD_MEMBERS),
         "observation_members": OBSERVATION_MEMBERS, "trials": trials,
         "forward_table": info, "figure": figure.name, "source_figure": source_figure.name,
-        "toppled_fraction_by_slice": [
-            {**{k: sl[k] for k in ("mechanism", "depth_km", "mw")},
-             "fraction": round(float(table.toppled[i][table.valid[i]].mean()), 4)}
-            for i, sl in enumerate(table.slices)],
+        "toppled_fraction_by_slice": table.toppled_fraction_by_slice(),
         "elapsed_s": round(time.monotonic() - started, 1)})
     for text in answer.values():
         print(text)

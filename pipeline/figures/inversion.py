@@ -192,12 +192,13 @@ def plot_interval_widths(table, path):
     return path
 
 
-def plot_member_study(summary, path):
+def plot_member_study(summary, path, bound_deg):
     """The member study: per likelihood (rows) the median 95 % back-azimuth arc and its
-    coverage (with Wilson intervals) against the likelihood members per node; colour: fallen
-    columns per site, line style: sites."""
+    coverage (with Wilson intervals) against the likelihood members per node, the arc
+    width ``bound_deg`` (deg) that counts as bounded marked; colour: fallen columns per
+    site, line style: sites."""
     panels = [("width_median_deg", None, "median width of the 95 % back-azimuth arc (deg)",
-               "arc width", (0, 365), 60.0, "+-30 deg"),
+               "arc width", (0, 365), bound_deg, f"+-{bound_deg / 2:g} deg"),
               ("coverage_back_azimuth_95", "coverage_ci95",
                "coverage of the 95 % arc (Wilson 95 %)", "coverage", (0, 1.02), 0.95, "95 %")]
     _plot_study_panels(summary, path, panels, "How many fallen columns bound the back "

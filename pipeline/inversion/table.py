@@ -223,6 +223,13 @@ class ForwardTable:
                 return k
         raise KeyError((mechanism, depth_km, mw))
 
+    def toppled_fraction_by_slice(self):
+        """Per source slice: its mechanism, depth (km), Mw and the share of its finished
+        runs' columns (all nodes and members) that toppled."""
+        return [{**{k: sl[k] for k in ("mechanism", "depth_km", "mw")},
+                 "fraction": round(float(self.toppled[i][self.valid[i]].mean()), 4)}
+                for i, sl in enumerate(self.slices)]
+
     def cells(self):
         """One row per node and column: members, toppled, P (k/n), mean downfall azimuth
         in the strike frame and relative to the direction from epicentre to site."""

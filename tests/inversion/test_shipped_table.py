@@ -32,3 +32,17 @@ def test_the_shipped_outcomes_are_outcomes():
     # a fallen column has a downfall azimuth in [0, 360), a standing one none
     assert np.all((table.azimuth_deg[fallen] >= 0) & (table.azimuth_deg[fallen] < 360))
     assert np.all(np.isnan(table.azimuth_deg[~fallen]))
+
+
+def test_toppled_fraction_counts_the_fallen_columns():
+    slices = [{"mechanism": "strike-slip", "dip_deg": 90.0, "rake_deg": 180.0,
+               "depth_km": 10.0, "mw": mw} for mw in (6.0, 7.0)]
+    # two nodes (azimuths 0 and 180 deg), 4 members: Mw 6 topples nothing, Mw 7 topples
+    # 6 of 8 columns at one node and 4 of 8 at the other: 10 of 16
+    standing = [[None] * 4, [None] * 4]
+    falls = [[[standing, standing]],
+             [[[[10.0, 20.0, None, 30.0], [40.0, None, 50.0, 60.0]],
+               [[10.0, None, None, 30.0], [None, None, 50.0, 60.0]]]]]
+    table = ForwardTable.toy(slices, [2.5], [0.0, 180.0], falls)
+    assert [s["fraction"] for s in table.toppled_fraction_by_slice()] == [0.0, 0.625]
+    assert [s["mw"] for s in table.toppled_fraction_by_slice()] == [6.0, 7.0]
