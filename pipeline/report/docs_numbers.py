@@ -36,12 +36,12 @@ def _not_yet(command):
     return f"*(not measured yet: run `{command}`)*"
 
 
-def _bench(path=BENCH_JSON):
+def _read_json(path=BENCH_JSON):
     return json.loads(path.read_text()) if path.is_file() else None
 
 
 def _json_value(path, key, fmt, times, command):
-    data = _bench(path)
+    data = _read_json(path)
     if data is None:
         return _not_yet(command)
     try:
@@ -72,7 +72,7 @@ def value(source, key, fmt="{:.2f}", times=1, root=RESULTS_DIR):
 def bench_speed_table(path=BENCH_JSON):
     """Markdown table of bench section 2: microseconds per step, cost against the still
     scene and simulated seconds per wall second (with YADE's start-up) per scene."""
-    data = _bench(path)
+    data = _read_json(path)
     if data is None or "speed" not in data:
         return _not_yet("make bench")
     lines = ["| scene | us/step | x still | simulated s per wall s (with start-up) |",
@@ -87,7 +87,7 @@ def bench_speed_table(path=BENCH_JSON):
 def engine_shares(path=BENCH_JSON, least_pct=2.0):
     """'engine share %' of bench section 1 (twin model, shaking), largest first, engines
     below ``least_pct`` left out."""
-    data = _bench(path)
+    data = _read_json(path)
     if data is None or "engine_timing" not in data:
         return _not_yet("make bench")
     rows = sorted(data["engine_timing"]["engines"], key=lambda e: -e["share_pct"])
@@ -99,7 +99,7 @@ def time_step_table(path=BENCH_JSON):
     """Markdown table of bench section 9: per model and contact damping, the allowed time
     step factor and the largest body rotation (deg) of a still column held on a still
     pedestal at that factor and at 1.3x it, the larger of the two libm paths."""
-    data = _bench(path)
+    data = _read_json(path)
     if data is None or "time_step_limit" not in data:
         return _not_yet("make bench")
     rows = data["time_step_limit"]["rows"]
