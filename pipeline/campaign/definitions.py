@@ -1,7 +1,6 @@
 """The campaigns: the paper's experiments and the verification, one definition each."""
 import dataclasses
 from dataclasses import dataclass
-import json
 from pathlib import Path
 
 from pipeline.constants import COLUMN_KINDS
@@ -366,19 +365,15 @@ register(Campaign(
 def verification_specs(records, campaign_dir):
     if records:
         raise InputError("the verification campaign takes no --records")
-    version = content_hash(run_code_version(), code_hash("verification", "rocking"))
-    return [{**spec, "run_id": content_hash(version, {k: v for k, v in spec.items()
-                                                      if k != "run_id"})}
-            for spec in verification.campaign_specs()]
+    return verification.campaign_checks(
+        content_hash(run_code_version(), code_hash("verification", "rocking")))
 
 
 def verification_outputs(specs, campaign_dir, failures, animations, figures=True):
     from pipeline.figures.verification import plot_verification
-    results = []
-    for spec in specs:
-        path = Path(campaign_dir) / "runs" / spec["run_id"] / "summary.json"
-        if path.exists():
-            results.append((spec, json.loads(path.read_text())))
+    runs = Path(campaign_dir) / "runs"
+    results = [(check, verification.CheckResult.load(runs / check.run_id))
+               for check in specs if (runs / check.run_id / "summary.json").exists()]
     summary = verification.summarise_campaign(results)
     summary["figures"] = ([p.name for p in plot_verification(results, campaign_dir)]
                           if figures else [])
@@ -389,10 +384,6 @@ def verification_outputs(specs, campaign_dir, failures, animations, figures=True
     return {"figures": summary["figures"]}
 
 
-def _verification_worker(spec, run_dir):
-    verification.run_spec(spec, run_dir)
-
-
 register(Campaign("verification", "Housner, one-sine pulse and sliding checks over ranges",
-                  verification_specs, _verification_worker, verification_outputs,
+                  verification_specs, verification.run_check, verification_outputs,
                   label="verification runs"))

@@ -7,9 +7,8 @@
 from pathlib import Path
 
 from pipeline import RESULTS_DIR, paper
-from pipeline.files import write_json
-from pipeline.verification import (MARBLE_BLOCK, PULSE_BLOCK, verify_housner, verify_sine_pulse,
-                                   verify_sliding)
+from pipeline.verification import (MARBLE_BLOCK, PULSE_BLOCK, CheckResult, verify_housner,
+                                   verify_sine_pulse, verify_sliding)
 
 NAME = "verify"
 ORDER = 30
@@ -70,6 +69,6 @@ def run(args):
                   f", slip at impacts {1000 * r['slip_at_impacts_m']:.1f} mm")
         print(f"Augusti & Sinopoli: pure rocking needs mu_s > {result['augusti_sinopoli_mu_min']:.3f}")
     out = args.out or RESULTS_DIR / "verification" / f"{args.test}.json"
-    write_json(out, result)
+    CheckResult(result).save(out)
     print(f"{'PASSED' if result['passed'] else 'FAILED'}; wrote {out}")
     return 0 if result["passed"] else 1

@@ -22,7 +22,7 @@ def plot_verification(results, out_dir):
         ax.plot(n, rocking.housner_closed_form(r0, const["energy_ratio"], 5), "k-", lw=0.8)
         for z, marker in zip(CAMPAIGN_DAMPING, ("x", "o")):
             for s, r in results:
-                if s["kind"] == "housner" and s["theta0_ratio"] == r0 and s["damping"] == z:
+                if s.kind == "housner" and s["theta0_ratio"] == r0 and s["damping"] == z:
                     peaks = [r0] + r["yade"]["peaks_over_alpha"]
                     ax.plot(np.arange(len(peaks)), peaks, marker, ms=6, mfc="none",
                             color="C0" if z == CAMPAIGN_DAMPING[0] else "C3",
@@ -46,7 +46,7 @@ def plot_verification(results, out_dir):
     markers = {0: "o", 1: "^", 2: "s"}
     for name, code in codes.items():
         pts = [(s["amplitude_ratio"], s["omega_ratio"]) for s, r in results
-               if s["kind"] == "sine-pulse" and r["yade"]["mode"] == name]
+               if s.kind == "sine-pulse" and r["yade"]["mode"] == name]
         if pts:
             ax.scatter(*zip(*pts), marker=markers[code], c="k", s=40, label=f"YADE: {name}")
         ax.scatter([], [], marker="s", c=[cmap(code)], s=80, label=f"integration: {name}")
@@ -58,12 +58,12 @@ def plot_verification(results, out_dir):
     written.append(path)
     # Fig. 6: horizontal position of the base centre for each mu_s
     fig, ax = new_figure(figsize=(8, 5), constrained_layout=True)
-    for s, r in sorted([x for x in results if x[0]["kind"] == "sliding"],
+    for s, r in sorted([x for x in results if x[0].kind == "sliding"],
                        key=lambda x: -x[0]["mu_s"]):
         run = r["runs"][0]
         ax.plot(run["t"], 1000 * np.asarray(run["base_x_m"]), lw=1,
                 label=f"mu_s {run['mu_s']:g}" + ("" if run["pure_rocking"] else " (slides)"))
-    mu_min = next((r["augusti_sinopoli_mu_min"] for s, r in results if s["kind"] == "sliding"), None)
+    mu_min = next((r["augusti_sinopoli_mu_min"] for s, r in results if s.kind == "sliding"), None)
     ax.set(xlabel="time (s)", ylabel="base centre, East (mm)",
            title=f"Rock-sliding test, marble block from 10 deg (eq. 8: mu_s > {mu_min:.3f})"
            if mu_min else "Rock-sliding test")

@@ -34,6 +34,20 @@ MAX_AMPLITUDE_RATIO = 50.0  # one-sine pulse: amplitude / (alpha g)
 MAX_OMEGA_RATIO = 50.0      # one-sine pulse: omega / p (a pulse of ~20 time steps at most)
 
 
+def check_theta0_ratio(theta0_ratio):
+    """InputError unless 0 < theta0 / alpha < 1 (a block released inside its stability)."""
+    if not 0 < theta0_ratio < 1:
+        raise InputError(f"theta0 ratio must be between 0 and 1, got {theta0_ratio}")
+
+
+def check_pulse_ratios(amplitude_ratio, omega_ratio):
+    """InputError unless the one-sine pulse's A / (alpha g) and omega / p are in range."""
+    if not (0 < amplitude_ratio <= MAX_AMPLITUDE_RATIO and 0 < omega_ratio <= MAX_OMEGA_RATIO):
+        raise InputError(f"--amplitude-ratio must be in (0, {MAX_AMPLITUDE_RATIO:g}] and "
+                         f"--omega-ratio in (0, {MAX_OMEGA_RATIO:g}] (the pulse must last "
+                         f"steps of the model), got {amplitude_ratio:g} and {omega_ratio:g}")
+
+
 def run_block(run_dir, height, width, depth, theta0=0.0, motion=None, duration=5.0,
               density=paper.MARBLE_DENSITY_KG_M3, record_hz=1000.0, **options):
     """Run the block scene; return (t, theta, trajectory) with theta in rad (+ = leaning East).
@@ -75,8 +89,7 @@ def verify_housner(height=MARBLE_BLOCK["height"], width=MARBLE_BLOCK["width"],
                    **contact):
     """Free rocking from theta0 = R alpha: YADE against Housner's nonlinear equation
     (integrated) and his closed form (eq 6), first n_impacts impacts."""
-    if not 0 < theta0_ratio < 1:
-        raise InputError(f"theta0 ratio must be between 0 and 1, got {theta0_ratio}")
+    check_theta0_ratio(theta0_ratio)
     if isinstance(n_impacts, bool) or not isinstance(n_impacts, int) or \
             not 1 <= n_impacts <= MAX_IMPACTS:
         raise InputError(f"--impacts must be an integer in [1, {MAX_IMPACTS}], got {n_impacts!r}")
@@ -138,10 +151,7 @@ def verify_sine_pulse(height=PULSE_BLOCK["height"], width=PULSE_BLOCK["width"],
                       run_dir=None, **contact):
     """One-sine pulse of amplitude K alpha g and circular frequency W p: YADE against
     the integration (overturned or not, impacts before overturning, direction)."""
-    if not (0 < amplitude_ratio <= MAX_AMPLITUDE_RATIO and 0 < omega_ratio <= MAX_OMEGA_RATIO):
-        raise InputError(f"--amplitude-ratio must be in (0, {MAX_AMPLITUDE_RATIO:g}] and "
-                         f"--omega-ratio in (0, {MAX_OMEGA_RATIO:g}] (the pulse must last "
-                         f"steps of the model), got {amplitude_ratio:g} and {omega_ratio:g}")
+    check_pulse_ratios(amplitude_ratio, omega_ratio)
     contact = {**dataclasses.asdict(Contact()), **contact}
     const = rocking.block_constants(height, width)
     ref = rocking.sine_pulse_response(height, width, amplitude_ratio, omega_ratio)
