@@ -14,6 +14,7 @@ from pipeline import RESULTS_DIR, paper
 from pipeline.constants import MODEL_GRAVITY
 from pipeline.campaign.column_file import matched_kn
 from pipeline.report import campaigns
+from pipeline.scenario import Column, Contact, scene_params
 from pipeline.scenario.column_format import example_names
 from pipeline.scenario.geometry import ColumnGeometry
 
@@ -117,6 +118,35 @@ def time_step_table(path=BENCH_JSON):
         cells = " | ".join(f"{largest[(model, damping, k)]:.3g}" for k in ratios)
         lines.append(f"| {model} | {damping:g} | {factor[(model, damping)]:.3f} | {cells} |")
     return "\n".join(lines)
+
+
+def bench_convergence_table(path=BENCH_JSON):
+    """Markdown table of bench section 5: the twin model's downfall azimuth (deg) per
+    column under the one-sine pulse toward N30E at each time-step factor and number of rim
+    points, with the wall time of the run (s)."""
+    data = _read_json(path)
+    if data is None or "convergence" not in data:
+        return _not_yet("make bench")
+    rows = {}
+    for r in data["convergence"]:
+        row = rows.setdefault((r["parameter"], r["value"]), {"wall_s": r["wall_s"]})
+        row[r["column"]] = r["downfall_azimuth_deg"] if r["toppled"] else None
+    columns = sorted({r["column"] for r in data["convergence"]})
+    lines = ["| setting | " + " | ".join(f"{c} azimuth (deg)" for c in columns)
+             + " | wall (s) |", "|---|" + "---|" * (len(columns) + 1)]
+    for (parameter, setting), row in rows.items():
+        cells = " | ".join("standing" if row.get(c) is None else f"{row[c]:.1f}"
+                           for c in columns)
+        name = "time-step factor" if parameter == "dt_factor" else parameter.replace("_", " ")
+        lines.append(f"| {name} {setting:.3g} | {cells} | {row['wall_s']:.1f} |")
+    return "\n".join(lines)
+
+
+def twin_time_step(fmt="factor {factor:.3f}, {step_us:.0f} us"):
+    """The twin model's time step with the paper's contact, as ``run`` computes it."""
+    params = scene_params(columns=Column("both").specs(), contact=Contact(),
+                          motion_duration=1.0, t_max=1.0)
+    return fmt.format(factor=params["dt_factor"], step_us=1e6 * params["time_step_s"])
 
 
 def column_examples(names=None):

@@ -8,8 +8,9 @@ from pathlib import Path
 from pipeline.report import docs_numbers
 
 ROOT = Path(__file__).resolve().parents[2]
-MACROS = ("bench_value", "column_examples", "column_sources", "bench_speed_table", "engine_shares", "run_all_steps",
-          "run_all_minutes", "time_step_table", "value", "report", "report_section",
+MACROS = ("bench_convergence_table", "bench_value", "column_examples", "column_sources",
+          "bench_speed_table", "engine_shares", "run_all_steps", "run_all_minutes",
+          "time_step_table", "twin_time_step", "value", "report", "report_section",
           "record_value", "record_rocking_hd")
 
 
@@ -46,6 +47,23 @@ def test_time_step_table_takes_the_worse_libm_path(tmp_path):
     table = docs_numbers.time_step_table(path)
     assert "| twin | 0.36 | 0.235 | 0.0003 | 2.5 |" in table
     assert "make bench" in docs_numbers.time_step_table(tmp_path / "none.json")
+
+
+def test_convergence_table_has_a_row_per_setting_and_a_cell_per_column(tmp_path):
+    rows = [{"parameter": parameter, "value": value, "column": column, "toppled": toppled,
+             "downfall_azimuth_deg": azimuth, "impact_time_s": 3.0, "wall_s": wall}
+            for parameter, value, column, toppled, azimuth, wall in (
+                ("dt_factor", 0.235, "drums", True, 27.55, 4.0),
+                ("dt_factor", 0.235, "monolithic", True, 32.87, 4.0),
+                ("rim_points", 8, "drums", True, 58.43, 3.79),
+                ("rim_points", 8, "monolithic", False, None, 3.79))]
+    path = tmp_path / "bench.json"
+    path.write_text(json.dumps({"convergence": rows}))
+    table = docs_numbers.bench_convergence_table(path).splitlines()
+    assert table[0] == "| setting | drums azimuth (deg) | monolithic azimuth (deg) | wall (s) |"
+    assert table[2:] == ["| time-step factor 0.235 | 27.6 | 32.9 | 4.0 |",
+                         "| rim points 8 | 58.4 | standing | 3.8 |"]
+    assert "make bench" in docs_numbers.bench_convergence_table(tmp_path / "none.json")
 
 
 def test_column_table_states_what_a_cylinder_is(tmp_path):
