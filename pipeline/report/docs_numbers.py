@@ -4,6 +4,7 @@
 measurement is typed by hand.  The docs pages call these through the mkdocs-macros hook
 :mod:`pipeline.report.docs_macros`; a file not written yet renders as a note saying which
 command writes it."""
+import importlib
 import json
 import re
 from functools import reduce
@@ -118,6 +119,13 @@ def time_step_table(path=BENCH_JSON):
         cells = " | ".join(f"{largest[(model, damping, k)]:.3g}" for k in ratios)
         lines.append(f"| {model} | {damping:g} | {factor[(model, damping)]:.3f} | {cells} |")
     return "\n".join(lines)
+
+
+def setting(name, fmt="{:g}"):
+    """A setting of the code by its dotted ``name`` (``package.module.NAME``), formatted:
+    the docs quote it from its one home."""
+    module, _, attribute = name.rpartition(".")
+    return fmt.format(getattr(importlib.import_module(module), attribute))
 
 
 def bench_convergence_table(path=BENCH_JSON):

@@ -10,7 +10,7 @@ from pipeline.report import docs_numbers
 ROOT = Path(__file__).resolve().parents[2]
 MACROS = ("bench_convergence_table", "bench_value", "column_examples", "column_sources",
           "bench_speed_table", "engine_shares", "run_all_steps", "run_all_minutes",
-          "time_step_table", "twin_time_step", "value", "report", "report_section",
+          "setting", "time_step_table", "twin_time_step", "value", "report", "report_section",
           "record_value", "record_rocking_hd")
 
 
@@ -47,6 +47,12 @@ def test_time_step_table_takes_the_worse_libm_path(tmp_path):
     table = docs_numbers.time_step_table(path)
     assert "| twin | 0.36 | 0.235 | 0.0003 | 2.5 |" in table
     assert "make bench" in docs_numbers.time_step_table(tmp_path / "none.json")
+
+
+def test_a_setting_is_quoted_from_its_module():
+    from pipeline.cli import invert
+    assert docs_numbers.setting("pipeline.cli.invert.FORWARD_RUN_CORE_S", "{:.3f}") == \
+        f"{invert.FORWARD_RUN_CORE_S:.3f}"
 
 
 def test_convergence_table_has_a_row_per_setting_and_a_cell_per_column(tmp_path):
