@@ -80,6 +80,20 @@ def save_figure(fig, path, **kwargs):
         fig.savefig(tmp, format=path.suffix.lstrip("."), **kwargs)
 
 
+def read_run_json(path, what):
+    """(path, data) of a run's JSON file: ``path`` itself or ``summary.json`` in the run
+    directory ``path``; a one-line InputError naming the file and ``what`` it should be."""
+    path = Path(path)
+    if path.is_dir():
+        path = path / "summary.json"
+    try:
+        return path, json.loads(path.read_text())
+    except FileNotFoundError:
+        raise InputError(f"{what} not found: {path}") from None
+    except (OSError, ValueError) as exc:
+        raise InputError(f"{path}: not a {what} ({exc})") from None
+
+
 def content_hash(*parts):
     """Hex digest (16 chars) of JSON-serialisable parts and file contents (Path)."""
     h = hashlib.sha256()

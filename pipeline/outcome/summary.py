@@ -3,12 +3,11 @@
 :func:`pipeline.outcome.columns.summarise` (a simulated run) or :meth:`RunSummary.still`
 (a run the pre-check skipped), written once by :meth:`RunSummary.save` and read back
 only by :meth:`RunSummary.load`."""
-import json
 import math
 from dataclasses import dataclass, field, fields
 from pathlib import Path
 
-from pipeline.files import InputError, write_json
+from pipeline.files import InputError, read_run_json, write_json
 
 
 def _azimuth_or_none(value, name):
@@ -147,15 +146,7 @@ class RunSummary:
     @classmethod
     def load(cls, path):
         """The summary at ``path`` (a ``summary.json`` or the run directory holding it)."""
-        path = Path(path)
-        if path.is_dir():
-            path = path / "summary.json"
-        try:
-            data = json.loads(path.read_text())
-        except FileNotFoundError:
-            raise InputError(f"run summary not found: {path}") from None
-        except (OSError, ValueError) as exc:
-            raise InputError(f"{path}: not a run summary ({exc})") from None
+        path, data = read_run_json(path, "run summary")
         known = {f.name for f in fields(cls)}
         unknown = sorted(set(data) - known) if isinstance(data, dict) else None
         if unknown is None or unknown or "record" not in data:

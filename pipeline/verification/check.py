@@ -5,12 +5,11 @@
 creation; both read like the flat dicts the campaign's files hold."""
 from collections.abc import Mapping
 from dataclasses import dataclass, field
-import json
 import math
 from pathlib import Path
 
 from pipeline import paper, rocking
-from pipeline.files import InputError, content_hash, write_json
+from pipeline.files import InputError, content_hash, read_run_json, write_json
 from pipeline.scenario import Contact
 from pipeline.verification.checks import (check_pulse_ratios, check_theta0_ratio,
                                           verify_housner, verify_sine_pulse, verify_sliding)
@@ -152,15 +151,9 @@ class CheckResult(Mapping):
     @classmethod
     def load(cls, path):
         """The result at ``path`` (a ``summary.json`` or the run directory holding it)."""
-        path = Path(path)
-        if path.is_dir():
-            path = path / "summary.json"
+        path, data = read_run_json(path, "verification result")
         try:
-            return cls(json.loads(path.read_text()))
-        except FileNotFoundError:
-            raise InputError(f"verification result not found: {path}") from None
-        except (OSError, ValueError) as exc:
-            raise InputError(f"{path}: not a verification result ({exc})") from None
+            return cls(data)
         except InputError as exc:
             raise InputError(f"{path}: {exc}") from None
 
