@@ -14,7 +14,9 @@ as the two-sample tests assume.
 Against the defaults, per record and column: P(toppled) by Fisher's exact test, the
 fall directions by Kuiper's two-sample test (:func:`pipeline.stats.ensemble.
 compare_ensembles`); a difference is called when Holm's correction over all the
-comparisons rejects at 5 %.  Outputs: ``convergence.json`` (every number, the tests'
+comparisons rejects at 5 %.  Where every member of every variant fell (or none did),
+P(toppled) is not put to the test: ``p_toppled_untested`` names those records and
+columns.  Outputs: ``convergence.json`` (every number, the tests'
 p-values, the verdict and the CPU time per member of each variant), ``convergence.csv``
 and ``convergence.png``.
 """
@@ -132,11 +134,15 @@ def compare_variants(runs, cost_per_member=None):
               if r.get("fisher_differs") or r.get("kuiper_differs")]
     cost_per_member = cost_per_member or {}
     n_tests = sum(r is not None for r in reject)
+    # where every setting's members all fell (or all stood), Fisher's test cannot fail
+    untested = sorted({f"{r['record']} {r['column']}" for r in rows} - {
+        f"{r['record']} {r['column']}" for r in rows if 0.0 < r["p_toppled"] < 1.0})
     verdict = (f"convergence: {n_tests} comparisons with the defaults (Fisher's exact test on "
                f"P(toppled), Kuiper's test on the fall directions, Holm at {ALPHA:g}): "
                + ("none differs" if not differ else "differs: " + "; ".join(differ)))
     return {"reference": REFERENCE, "variants": VARIANTS, "alpha": ALPHA,
             "comparisons": n_tests, "differing": differ, "verdict": verdict,
+            "p_toppled_untested": untested,
             "wall_s_per_member": cost_per_member,
             "cost_vs_default": {k: v / cost_per_member[REFERENCE] for k, v in
                                 cost_per_member.items()} if REFERENCE in cost_per_member

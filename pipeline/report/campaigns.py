@@ -283,12 +283,22 @@ def convergence_section(results):
              "step factor 0.15; each setting against the defaults: Fisher's exact test on "
              "P(toppled), Kuiper's two-sample test on the fall directions, Holm's correction "
              f"over all {conv['comparisons']} comparisons at {conv['alpha']:g}.\n",
-             f"**{conv['verdict']}.**  Cost per member relative to the defaults: "
+             f"**{conv['verdict']}.**  " + _untested(conv.get("p_toppled_untested"))
+             + "Cost per member relative to the defaults: "
              + ", ".join(f"{k} {v:.2f}x" for k, v in cost.items()) + ".\n",
              _table(pd.DataFrame(rows)) + "\n",
              _figure(results, Path(results) / "convergence" / "convergence.png",
                      "convergence on distributions")]
     return "\n".join(lines)
+
+
+def _untested(pairs):
+    """The sentence on records and columns whose P(toppled) no setting put to the test."""
+    if not pairs:
+        return ""
+    return (f"P(toppled) is not tested for {', '.join(pairs)}: every member of every "
+            "setting fell there (or none did), so Fisher's test cannot tell settings "
+            "apart; only the fall directions are compared.  ")
 
 
 def run_all_steps(path):

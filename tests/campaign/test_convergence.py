@@ -29,6 +29,16 @@ def test_a_turned_distribution_is_called_and_a_resampled_one_is_not():
     assert set(result["differing"]) == {"R drums rim 64", "R drums dt 0.15"}
     assert result["cost_vs_default"] == {"default": 1.0, "rim 64": 3.0}
     assert "fisher_p" not in by["default"]          # the reference is not tested against itself
+    assert result["p_toppled_untested"] == []
+
+
+def test_a_record_where_every_member_fell_is_named_untested():
+    rng = np.random.default_rng(3)
+    rows = [dict(r, record_id="ALL") for r in
+            _members(rng, "default", 20, 1.0, 10.0) + _members(rng, "rim 32", 20, 1.0, 12.0)]
+    rows += _members(rng, "default", 20, 0.5, 10.0) + _members(rng, "rim 32", 20, 1.0, 10.0)
+    result = compare_variants(pd.DataFrame(rows))
+    assert result["p_toppled_untested"] == ["ALL drums"]
 
 
 def test_the_rim_phase_spans_one_spacing_of_each_setting():
@@ -48,3 +58,16 @@ def test_specs_sample_each_setting_independently(tmp_path):
     assert [p["dt_factor"] for p in by["dt 0.15"]] == [0.15] * 3
     assert all("rim_points" not in p and "dt_factor" not in p for p in by["default"])
     assert [p["mu_s"] for p in by["default"]] != [p["mu_s"] for p in by["rim 32"]]
+
+
+def test_the_report_says_where_p_toppled_was_not_tested(tmp_path):
+    import json
+    from pipeline.report.campaigns import convergence_section
+    rng = np.random.default_rng(5)
+    rows = _members(rng, "default", 10, 1.0, 10.0) + _members(rng, "rim 32", 10, 1.0, 12.0)
+    result = compare_variants(pd.DataFrame(rows), {"default": 10.0, "rim 32": 25.0})
+    (tmp_path / "convergence").mkdir()
+    (tmp_path / "convergence" / "convergence.json").write_text(json.dumps(result))
+    text = convergence_section(tmp_path)
+    assert "P(toppled) is not tested for R drums" in text
+    assert "rim 32 2.50x" in text
