@@ -5,8 +5,9 @@ shows one fall turning by 2.6-60 deg with the rim points), so convergence is ask
 what the project reports: an ensemble's P(toppled) and distribution of fall directions.
 For each record (default ``DEFAULT_RECORDS``: two records where every member of both
 columns falls and one where about half of them fall, so that P(toppled) is put to the
-test as well as the directions) the twin model's ensemble (the ``ensemble`` campaign's sampled friction,
-damping, stiffness, tolerances, tilt, offsets and rim phase) runs at each of
+test as well as the directions) the twin model's ensemble (the ``ensemble`` campaign's
+sampled friction, damping, stiffness, tolerances, tilt, offsets and rim phase) runs at
+each of
 ``VARIANTS``: the defaults (16 rim points, time step factor 0.3 or the stability limit
 at the member's damping, 0.19-0.3), 32 and 64 rim points, and time step factor 0.15.
 Each variant samples its own members (seed + its index): the samples are independent,

@@ -4,7 +4,7 @@
 :class:`~pipeline.outcome.summary.RunSummary` is).  Both are read-only and validated on
 creation; both read like the flat dicts the campaign's files hold."""
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 import math
 from pathlib import Path
 
@@ -43,7 +43,6 @@ class Check(Mapping):
     kind: str
     setting: dict
     run_id: str
-    record: str = field(init=False)
 
     def __post_init__(self):
         if self.kind not in KINDS:
@@ -62,7 +61,11 @@ class Check(Mapping):
             check_pulse_ratios(values["amplitude_ratio"], values["omega_ratio"])
         else:
             Contact(mu_s=values["mu_s"], mu_k=paper.MU_K_OVER_MU_S * values["mu_s"])
-        object.__setattr__(self, "record", self.kind)
+
+    @property
+    def record(self):
+        """What campaign files name a run's record: the kind (a check has no motion)."""
+        return self.kind
 
     @classmethod
     def create(cls, kind, code_version, **setting):
@@ -118,8 +121,6 @@ class CheckResult(Mapping):
     the campaign reads (:data:`RESULT_KEYS`).  Written by :meth:`save`, read by
     :meth:`load`; reads like that dict (``result["yade"]["mode"]``)."""
     values: dict
-    kind: str = field(init=False)
-    passed: bool = field(init=False)
 
     def __post_init__(self):
         if not isinstance(self.values, dict):
@@ -140,8 +141,14 @@ class CheckResult(Mapping):
             missing.append(f"runs with {', '.join(SLIDING_ROW_KEYS)}")
         if missing:
             raise InputError(f"verification result ({kind}): lacks {', '.join(missing)}")
-        object.__setattr__(self, "kind", kind)
-        object.__setattr__(self, "passed", passed)
+
+    @property
+    def kind(self):
+        return self.values["test"]
+
+    @property
+    def passed(self):
+        return self.values["passed"]
 
     def save(self, path):
         """Write ``summary.json`` atomically (a run's last act)."""
