@@ -20,11 +20,13 @@ setup: .venv/.installed
 	touch $@
 
 # the layers of the stages (import-linter contract in pyproject.toml), the YADE physics
-# tests on glibc's second libm path (another CPU's last bits), then all
+# tests on glibc's second libm path (another CPU's last bits), then all; on every core
+# (pytest-xdist, a test file per worker at a time: its module fixtures are made once)
+TEST_WORKERS ?= auto
 test: setup
 	.venv/bin/lint-imports
-	$(PY) -m pytest -q -m libm --second-libm tests
-	$(PY) -m pytest -q tests
+	$(PY) -m pytest -q -n $(TEST_WORKERS) --dist loadfile -m libm --second-libm tests
+	$(PY) -m pytest -q -n $(TEST_WORKERS) --dist loadfile tests
 
 records: setup
 	$(PY) -m pipeline records --all

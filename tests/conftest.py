@@ -1,6 +1,7 @@
 """Shared fixtures: the Agg backend, analytic pulse motions, hand-built trajectories."""
 import math
 import os
+import signal
 
 import matplotlib
 import numpy as np
@@ -23,6 +24,10 @@ def pytest_addoption(parser):
 
 
 def pytest_configure(config):
+    if signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
+        # started in the background (nohup, `make test &`): the Ctrl-C tests' commands
+        # would inherit the ignored SIGINT and never see it
+        signal.signal(signal.SIGINT, signal.default_int_handler)
     if config.getoption("--second-libm"):
         from pipeline.scenario.runner import SECOND_LIBM_TUNABLES
         os.environ["GLIBC_TUNABLES"] = SECOND_LIBM_TUNABLES

@@ -125,9 +125,10 @@ def cluster(tmp_path_factory):
         cluster.stop()
 
 
-def task_yade_processes():
-    """{pid: parent pid} of scene processes running in a Dask task's temporary directory
-    (in the worker's local directory)."""
+def task_yade_processes(cluster):
+    """{pid: parent pid} of the cluster's workers' scene processes running in a Dask
+    task's temporary directory (not those of tests running beside: pytest-xdist)."""
+    workers = {proc.pid for proc in cluster.processes}
     found = {}
     for pid in filter(str.isdigit, os.listdir("/proc")):
         try:
@@ -136,7 +137,7 @@ def task_yade_processes():
             parent = int(Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[1])
         except (OSError, ValueError):
             continue
-        if b"run_scene.py" in cmd and f"/{TASK_PREFIX}-" in cwd:
+        if b"run_scene.py" in cmd and f"/{TASK_PREFIX}-" in cwd and parent in workers:
             found[int(pid)] = parent
     return found
 
@@ -218,9 +219,9 @@ def test_ctrl_c_on_a_cluster_stops_and_kills_its_runs(tmp_path, cluster):
     out = tmp_path / "camp"
     proc = cli_process(*campaign_args(records, out, "--scheduler", cluster.address))
     deadline = time.monotonic() + 60
-    while not task_yade_processes() and time.monotonic() < deadline:
+    while not task_yade_processes(cluster) and time.monotonic() < deadline:
         time.sleep(0.05)
-    assert task_yade_processes(), "no YADE run started on the workers"
+    assert task_yade_processes(cluster), "no YADE run started on the workers"
     sent = time.monotonic()
     proc.send_signal(signal.SIGINT)
     proc.communicate(timeout=60)
@@ -228,9 +229,9 @@ def test_ctrl_c_on_a_cluster_stops_and_kills_its_runs(tmp_path, cluster):
     assert proc.returncode == 130
     assert json.loads((out / "campaign.json").read_text())["interrupted"] is True
     deadline = time.monotonic() + 5
-    while task_yade_processes() and time.monotonic() < deadline:
+    while task_yade_processes(cluster) and time.monotonic() < deadline:
         time.sleep(0.05)
-    assert not task_yade_processes(), "the workers kept running the interrupted campaign"
+    assert not task_yade_processes(cluster), "the workers kept running the interrupted campaign"
 
 
 @pytest.mark.yade
@@ -243,7 +244,7 @@ def test_a_killed_worker_loses_no_finished_result(tmp_path, cluster):
 
     def ready():        # a result is in, and the third worker runs YADE
         return (any(out.glob("runs/*/summary.json"))
-                and victim.pid in task_yade_processes().values())
+                and victim.pid in task_yade_processes(cluster).values())
 
     deadline = time.monotonic() + 90
     while not ready() and time.monotonic() < deadline:
@@ -258,4 +259,4 @@ def test_a_killed_worker_loses_no_finished_result(tmp_path, cluster):
     for run_id, summary in finished.items():         # finished results kept as they were
         assert (out / "runs" / run_id / "summary.json").read_bytes() == summary
     assert len(pd.read_csv(out / "runs.csv")) == 12  # 6 runs x 2 columns
-    assert not task_yade_processes()
+    assert not task_yade_processes(cluster)
