@@ -273,8 +273,15 @@ def test_two_runs_into_one_directory(tmp_path):
     while not yade_processes(out) and time.monotonic() < deadline:
         time.sleep(0.05)
     assert yade_processes(out), "the first run did not start YADE"
-    second = cli_process("run", "--record", str(record), "--out", str(out))
-    _, err = second.communicate(timeout=60)
+    paused = yade_processes(out)           # the first run is still running when the second
+    for pid in paused:                     # starts, however slow the machine
+        os.kill(pid, signal.SIGSTOP)
+    try:
+        second = cli_process("run", "--record", str(record), "--out", str(out))
+        _, err = second.communicate(timeout=60)
+    finally:
+        for pid in paused:
+            os.kill(pid, signal.SIGCONT)
     assert second.returncode == 2 and err.count("\n") == 1 and "in use" in err
     first.communicate(timeout=120)
     assert first.returncode == 0
