@@ -22,8 +22,13 @@ directory (large ensembles).  Ctrl-C starts no new run, kills the running YADE
 processes (on a Dask cluster: the campaign's own, through the workers), closes a
 local cluster and returns what finished; the caller writes its tables and
 exits 130.
+
+Once the first runs are done (as many as run at once), a campaign whose rest takes
+``FORECAST_FROM_S`` or more says how long, measured on this machine: a warning from
+``WARN_FROM_S`` on.
 """
 import os
+import time
 from concurrent.futures import FIRST_COMPLETED, ThreadPoolExecutor, wait
 from pathlib import Path
 
@@ -37,6 +42,8 @@ from pipeline.scenario.runner import kill_running, reuse_processes
 
 EXECUTORS = ("threads", "dask")
 DEFAULT_EXECUTOR = "threads"    # why: docs/campaigns.md, "On a cluster: Dask" (start-up, ports)
+FORECAST_FROM_S = 600.0         # a campaign says how long its rest takes from 10 min on
+WARN_FROM_S = 3600.0            # ... and warns from an hour on
 
 
 def execute(specs, campaign_dir, jobs, worker, label="runs", executor=None, scheduler=None):
@@ -66,7 +73,8 @@ def execute(specs, campaign_dir, jobs, worker, label="runs", executor=None, sche
           f"{len(todo)} to run with {where}", flush=True)
     if not todo:
         return [], False
-    bar = tqdm(total=len(specs), initial=done, unit="run", dynamic_ncols=True)
+    bar = ForecastBar(total=len(specs), initial=done, unit="run", dynamic_ncols=True,
+                      name=Path(campaign_dir).name, first=min(jobs or 4, len(todo)))
     try:
         if executor == "threads":
             with reuse_processes():        # one YADE process per thread, not per run
@@ -74,6 +82,40 @@ def execute(specs, campaign_dir, jobs, worker, label="runs", executor=None, sche
         return execute_dask(todo, runs_dir, jobs, worker, bar, scheduler)
     finally:
         bar.close()
+
+
+class ForecastBar(tqdm):
+    """The campaign's progress bar.  Once the ``first`` runs of this session are done it
+    says, once, how long the rest takes at the pace so far (wall time on this machine;
+    runs start longest first, so the pace is a slow one) when that is ``FORECAST_FROM_S``
+    or more, as a warning from ``WARN_FROM_S`` on."""
+
+    def __init__(self, *args, name, first, **kwargs):
+        super().__init__(*args, **kwargs)
+        self.name, self.first, self.said = name, first, False
+        self.started = time.monotonic()
+
+    def update(self, n=1):
+        shown = super().update(n)
+        finished, left = self.n - self.initial, self.total - self.n
+        if not self.said and finished >= self.first and left > 0:
+            self.said = True
+            rest_s = left * (time.monotonic() - self.started) / finished
+            if rest_s >= FORECAST_FROM_S:
+                self.write(f"{'warning: ' if rest_s >= WARN_FROM_S else ''}{self.name}: the "
+                           f"other {left} runs take about {duration_text(rest_s)} at the pace "
+                           f"of the first {finished}; Ctrl-C stops the campaign and the "
+                           "same command resumes it, keeping every finished run")
+        return shown
+
+
+def duration_text(seconds):
+    """'40 min', '2.5 h', '3.0 d': a wall time as people say it."""
+    if seconds < 5400:
+        return f"{seconds / 60:.0f} min"
+    if seconds < 2 * 86400:
+        return f"{seconds / 3600:.1f} h"
+    return f"{seconds / 86400:.1f} d"
 
 
 def motion_seconds(spec, durations):

@@ -1,0 +1,59 @@
+"""A campaign says how long its rest takes, measured on its first runs, and warns before
+hours of work; short campaigns say nothing."""
+import re
+import time
+from pathlib import Path
+
+import pytest
+
+from pipeline.campaign import executor
+from pipeline.campaign.executor import duration_text, execute
+from pipeline.files import write_json
+
+
+def sleeper(seconds):
+    def worker(spec, run_dir):
+        time.sleep(seconds)
+        write_json(Path(run_dir) / "summary.json", {})
+    return worker
+
+
+def specs(n):
+    return [{"run_id": f"r{k}"} for k in range(n)]
+
+
+@pytest.mark.parametrize("warn_from_s, head", [(1e9, ""), (0.5, "warning: ")])
+def test_a_long_campaign_says_its_rest_once_after_its_first_runs(tmp_path, capsys, monkeypatch,
+                                                                 warn_from_s, head):
+    monkeypatch.setattr(executor, "FORECAST_FROM_S", 0.5)
+    monkeypatch.setattr(executor, "WARN_FROM_S", warn_from_s)
+    assert execute(specs(10), tmp_path, 2, sleeper(0.2)) == ([], False)
+    lines = [line for line in capsys.readouterr().out.splitlines() if "take about" in line]
+    assert len(lines) == 1
+    found = re.fullmatch(rf"{head}{tmp_path.name}: the other (\d+) runs take about \d+ min at "
+                         r"the pace of the first (\d+); Ctrl-C stops the campaign and the "
+                         r"same command resumes it, keeping every finished run", lines[0])
+    assert found, lines[0]
+    rest, first = map(int, found.groups())
+    assert first == 2 and rest == 8         # 2 run at once: said after the first 2
+
+
+def test_a_short_campaign_says_nothing_more(tmp_path, capsys):
+    assert execute(specs(4), tmp_path, 2, sleeper(0.05)) == ([], False)
+    assert "take about" not in capsys.readouterr().out
+
+
+def test_a_resumed_campaign_paces_only_the_runs_it_computes(tmp_path, capsys, monkeypatch):
+    """Runs finished before the resume are not counted as done in no time."""
+    monkeypatch.setattr(executor, "FORECAST_FROM_S", 0.5)
+    assert execute(specs(3), tmp_path, 1, sleeper(0.0)) == ([], False)
+    capsys.readouterr()
+    assert execute(specs(8), tmp_path, 1, sleeper(0.2)) == ([], False)
+    line, = [x for x in capsys.readouterr().out.splitlines() if "take about" in x]
+    assert "the other 4 runs" in line and "the first 1;" in line
+
+
+@pytest.mark.parametrize("seconds, text", [(0, "0 min"), (2399, "40 min"), (5400, "1.5 h"),
+                                           (9000, "2.5 h"), (3 * 86400, "3.0 d")])
+def test_durations_as_people_say_them(seconds, text):
+    assert duration_text(seconds) == text
