@@ -121,11 +121,13 @@ def time_step_table(path=BENCH_JSON):
     return "\n".join(lines)
 
 
-def setting(name, fmt="{:g}"):
-    """A setting of the code by its dotted ``name`` (``package.module.NAME``), formatted:
-    the docs quote it from its one home."""
+def setting(name, fmt="{:g}", times=1):
+    """A setting of the code by its dotted ``name`` (``package.module.NAME``), multiplied by
+    ``times`` (1/60: seconds as minutes) and formatted: the docs quote it from its one
+    home."""
     module, _, attribute = name.rpartition(".")
-    return fmt.format(getattr(importlib.import_module(module), attribute))
+    value = getattr(importlib.import_module(module), attribute)
+    return fmt.format(value * times if times != 1 else value)
 
 
 def bench_convergence_table(path=BENCH_JSON):

@@ -53,6 +53,9 @@ def test_a_setting_is_quoted_from_its_module():
     from pipeline.cli import invert
     assert docs_numbers.setting("pipeline.cli.invert.FORWARD_RUN_CORE_S", "{:.3f}") == \
         f"{invert.FORWARD_RUN_CORE_S:.3f}"
+    from pipeline.campaign import executor
+    assert docs_numbers.setting("pipeline.campaign.executor.FORECAST_FROM_S", "{:g}", 1 / 60) \
+        == f"{executor.FORECAST_FROM_S / 60:g}"
 
 
 def test_convergence_table_has_a_row_per_setting_and_a_cell_per_column(tmp_path):
