@@ -7,7 +7,8 @@
 from pathlib import Path
 
 from pipeline import RESULTS_DIR, paper
-from pipeline.verification import (MARBLE_BLOCK, PULSE_BLOCK, CheckResult, verify_housner,
+from pipeline.verification import (MARBLE_BLOCK, PULSE_BLOCK, SLIDING_BELOW, SLIDING_MU,
+                                   CheckResult, check_sliding_mus, verify_housner,
                                    verify_sine_pulse, verify_sliding)
 
 NAME = "verify"
@@ -30,7 +31,10 @@ def setup(p):
     s.add_argument("--amplitude-ratio", type=float, required=True, help="A / (alpha g)")
     s.add_argument("--omega-ratio", type=float, default=5.0, help="omega / p (5)")
     sl = sub.add_parser("sliding", help="rock-sliding test vs friction (paper Fig. 6)")
-    sl.add_argument("--mu-s", type=float, nargs="+", default=None, help="static friction values")
+    sl.add_argument("--mu-s", type=float, nargs="+", default=None,
+                    help=f"static friction values, one at least at or below {SLIDING_BELOW:g} x "
+                    f"the Augusti & Sinopoli limit (default: {max(SLIDING_MU):g} down to "
+                    f"{min(SLIDING_MU):g})")
     sl.add_argument("--theta0-deg", type=float, default=10.0, help="initial tilt (10 deg)")
     sl.add_argument("--friction", choices=["switch", "static"], default="switch",
                     help=f"switch: mu_s sticking, mu_k = {paper.MU_K_OVER_MU_S:g} mu_s sliding "
@@ -62,6 +66,8 @@ def run(args):
               f"{result['integration']['mode']} (direction {result['integration']['direction']:+d})")
     else:
         kwargs = {"mu_values": tuple(args.mu_s)} if args.mu_s else {}
+        if args.mu_s:
+            check_sliding_mus(args.mu_s)
         result = verify_sliding(theta0_deg=args.theta0_deg, friction=args.friction, **kwargs,
                                 **contact)
         for r in result["runs"]:

@@ -6,8 +6,8 @@ import numpy as np
 
 from pipeline.verification.check import KINDS, Check, CheckResult
 from pipeline.verification.checks import (HOUSNER_DAMPING, MARBLE_BLOCK, PULSE_BLOCK,
-                                          SLIDING_MU, verify_housner, verify_sine_pulse,
-                                          verify_sliding)
+                                          SLIDING_BELOW, SLIDING_MU, check_sliding_mus,
+                                          verify_housner, verify_sine_pulse, verify_sliding)
 
 CAMPAIGN_THETA0 = (0.2, 0.4, 0.6, 0.8, 0.95)
 CAMPAIGN_DAMPING = (0.36, 1.0)
@@ -74,6 +74,6 @@ def summarise_campaign(results):
     return out
 
 
-__all__ = ["HOUSNER_DAMPING", "MARBLE_BLOCK", "PULSE_BLOCK", "SLIDING_MU", "verify_housner",
-           "verify_sine_pulse", "verify_sliding", "KINDS", "Check", "CheckResult",
+__all__ = ["HOUSNER_DAMPING", "MARBLE_BLOCK", "PULSE_BLOCK", "SLIDING_BELOW", "SLIDING_MU",
+           "check_sliding_mus", "verify_housner", "verify_sine_pulse", "verify_sliding", "KINDS", "Check", "CheckResult",
            "campaign_checks", "run_check", "summarise_campaign"]

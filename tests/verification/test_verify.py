@@ -59,3 +59,23 @@ def test_verify_cli_writes_json(tmp_path):
                          capture_output=True, text=True)
     assert bad.returncode == 2 and bad.stderr.count("\n") == 1
     assert not (tmp_path / "bad.json").exists()
+
+
+@pytest.mark.parametrize("mu_s, message", [
+    (["0.4"], "--mu-s needs a value at or below 0.134"),       # 0.9 x 0.6 / 4.04
+    (["0.1", "0"], "--mu-s 0 outside")])
+def test_verify_sliding_refuses_what_it_cannot_check_before_any_run(tmp_path, capsys,
+                                                                    monkeypatch, mu_s, message):
+    """mu_s values that cannot show where sliding starts (none below the Augusti & Sinopoli
+    limit) or out of range: one line, exit 2, no run and nothing written."""
+    from pipeline import cli
+    from pipeline.cli import verify as command
+
+    def no_run(**kwargs):
+        raise AssertionError("a run started")
+    monkeypatch.setattr(command, "verify_sliding", no_run)
+    out = tmp_path / "sliding.json"
+    assert cli.main(["verify", "sliding", "--mu-s", *mu_s, "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and message in err, err
+    assert not out.exists()
