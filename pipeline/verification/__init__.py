@@ -75,5 +75,5 @@ def summarise_campaign(results):
 
 
 __all__ = ["HOUSNER_DAMPING", "MARBLE_BLOCK", "PULSE_BLOCK", "SLIDING_BELOW", "SLIDING_MU",
-           "check_sliding_mus", "verify_housner", "verify_sine_pulse", "verify_sliding", "KINDS", "Check", "CheckResult",
-           "campaign_checks", "run_check", "summarise_campaign"]
+           "check_sliding_mus", "verify_housner", "verify_sine_pulse", "verify_sliding", "KINDS",
+           "Check", "CheckResult", "campaign_checks", "run_check", "summarise_campaign"]
