@@ -15,7 +15,6 @@ from pathlib import Path
 import numpy as np
 from obspy import UTCDateTime
 from obspy.geodetics import gps2dist_azimuth
-from obspy.signal.rotate import rotate2zne
 
 from pipeline import PROJECT_ROOT, RECORDS_DIR, RESULTS_DIR
 from pipeline.files import InputError, code_hash, content_hash
@@ -195,6 +194,7 @@ def to_east_north_up(stream, name, needs_vertical=True):
     vertical = verticals[0] if verticals else None
     z = np.asarray(vertical.data[:n], dtype=float) if vertical else np.zeros(n)
     z_dip = vertical.stats.dip if vertical else -90.0
+    from obspy.signal.rotate import rotate2zne   # here: obspy.signal takes 2 s to import
     try:
         up, north, east = rotate2zne(z, 0.0, z_dip,
                                      h1, horizontals[0].stats.azimuth, 0.0,
