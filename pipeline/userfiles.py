@@ -1,7 +1,10 @@
 """What the loaders of user-written files (column descriptions, observations) share:
 bounds checked before and right after parsing, and short one-line renderings of
 whatever a file holds, for the one-line errors."""
+import math
 import reprlib
+
+from pipeline.files import InputError
 
 MAX_FILE_BYTES = 1_000_000   # a column description or an observations file is a few kB
 MAX_NESTING = 16             # they nest 4-5 deep
@@ -46,6 +49,33 @@ def show(value, most=80):
     except ValueError:                    # an int beyond Python's str conversion limit
         return f"<{type(value).__name__}>"
     return text if len(text) <= most else text[:most - 3] + "..."
+
+
+def number(value, what, low=None, high=None, unit="", low_open=False):
+    """``value`` read from a file as a float: InputError (one line naming ``what``) unless
+    it is a finite JSON/YAML number (not a bool) within [low, high] (``low_open``: above
+    low), ``unit`` for the message.  Compared exactly, also for integers beyond a float."""
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or \
+            (isinstance(value, float) and not math.isfinite(value)):
+        raise InputError(f"{what} must be a finite number, got {show(value)}")
+    if (low is not None and (value <= low if low_open else value < low)) or \
+            (high is not None and value > high):
+        bounds = f"{'(' if low_open else '['}{'-inf' if low is None else f'{low:g}'}, " \
+                 f"{'inf' if high is None else f'{high:g}'}]"
+        raise InputError(f"{what} {number_text(value)} outside the allowed range {bounds} {unit}"
+                         .rstrip())
+    try:
+        return float(value)
+    except OverflowError:                        # an integer beyond any float, no bound
+        raise InputError(f"{what} {show(value)} is beyond a float's range") from None
+
+
+def number_text(value):
+    """A number from a file as ``{:g}`` formats it (a short repr beyond a float's range)."""
+    try:
+        return f"{float(value):g}"
+    except OverflowError:
+        return show(value)
 
 
 def keys_text(keys, most=8):

@@ -29,6 +29,7 @@ from pipeline.userfiles import Unreadable as _Unreadable
 from pipeline.userfiles import json_int as _json_int
 from pipeline.userfiles import keys_text as _keys
 from pipeline.userfiles import nesting as _nesting
+from pipeline.userfiles import number as _number
 from pipeline.userfiles import show as _show
 
 MAX_REGION_KM = 300.0   # sites further from the first are not one region (the forward
@@ -110,21 +111,6 @@ class Observations:
                                            c.uncertainty_deg) for c in s.columns)
             sites.append(Site(s.name, east, north, cols))
         return Observations(tuple(sites), self.source, dict(self.meta))
-
-
-def _number(value, what, low=None, high=None):
-    if isinstance(value, bool) or not isinstance(value, (int, float)):
-        raise InputError(f"{what} must be a number, got {_show(value)}")
-    try:
-        value = float(value)
-    except OverflowError:                     # an int beyond any float
-        raise InputError(f"{what} must lie in [{low:g}, {high:g}], got {_show(value)}") \
-            from None
-    if not math.isfinite(value):
-        raise InputError(f"{what} must be finite, got {value!r}")
-    if (low is not None and value < low) or (high is not None and value > high):
-        raise InputError(f"{what} must lie in [{low:g}, {high:g}], got {value:g}")
-    return value
 
 
 def _file_name(text):

@@ -35,6 +35,7 @@ from pipeline.inversion.grid import MECHANISMS, slice_motions
 from pipeline.stats.circular import azimuth_deg
 from pipeline.userfiles import read_text
 from pipeline.userfiles import keys_text as _keys
+from pipeline.userfiles import number as _number
 from pipeline.inversion.forward import MEMBER_BATCH, member_parameters
 
 TRUTH_SEED = 7_000_001           # far beyond any table's seed + batch
@@ -77,13 +78,6 @@ class HiddenTruth:
                 "back_azimuth_deg": azimuth_deg(e, n),
                 "mechanism": self.mechanism, "strike_deg": self.strike_deg,
                 "depth_km": self.depth_km, "mw": self.mw}
-
-
-def _number(value, where, low, high):
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or \
-            not math.isfinite(value) or not low <= value <= high:
-        raise InputError(f"{where} must be a number in [{low:g}, {high:g}], got {value!r}")
-    return float(value)
 
 
 def parse_truth(data, source="truth"):

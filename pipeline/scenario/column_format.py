@@ -12,6 +12,8 @@ from pipeline.userfiles import MAX_INT_DIGITS, MAX_NESTING
 from pipeline.userfiles import Unreadable as _Unreadable
 from pipeline.userfiles import json_int as _json_int
 from pipeline.userfiles import keys_text as _keys
+from pipeline.userfiles import number as _number
+from pipeline.userfiles import number_text as _g
 from pipeline.userfiles import show as _show
 
 EXAMPLES_DIR = Path(__file__).with_name("columns")
@@ -29,25 +31,6 @@ BLOCK_KEYS = {"frustum": {"height", "bottom_diameter", "top_diameter"},
               "box": {"height", "width", "depth"}}
 OPTIONAL_BLOCK_KEYS = {"shape", "density", "name", "offset_m", "tilt_deg", "tilt_azimuth_deg",
                        "tilt_mode", "joined", "notes"}
-
-
-def _number(value, what, low, high, unit, low_open=False):
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or \
-            (isinstance(value, float) and not math.isfinite(value)):
-        raise InputError(f"{what} must be a finite number, got {_show(value)}")
-    if (value <= low if low_open else value < low) or value > high:   # exact for any int
-        bracket = "(" if low_open else "["
-        raise InputError(f"{what} {_g(value)} outside the plausible range {bracket}{low:g}, "
-                         f"{high:g}] {unit}".rstrip())
-    return float(value)
-
-
-def _g(number):
-    """A number from a file as ``{:g}`` formats it (a short repr beyond a float's range)."""
-    try:
-        return f"{float(number):g}"
-    except OverflowError:
-        return _show(number)
 
 
 def _one_line(text, most=200):

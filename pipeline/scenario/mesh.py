@@ -37,7 +37,7 @@ import numpy as np
 from pipeline.constants import MODEL_GRAVITY
 from pipeline.files import InputError
 from pipeline.scenario.outline import perimeter_points
-from pipeline.userfiles import keys_text, show
+from pipeline.userfiles import keys_text, number, show
 
 MESH_SUFFIXES = (".obj", ".ply", ".stl")   # the mesh files trimesh reads here
 
@@ -275,12 +275,7 @@ class MeshSpecimen:
 def _number(data, key, default, low, high, where):
     if key not in data:
         return default
-    value = data[key]
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or \
-            not math.isfinite(value) or not low <= value <= high:
-        raise InputError(f"{where}: '{key}' must be a number in [{low:g}, {high:g}], got "
-                         f"{show(value)}")
-    return float(value)
+    return number(data[key], f"{where}: '{key}'", low, high)
 
 
 def _spread(points, n):

@@ -5,12 +5,12 @@
 creation; both read like the flat dicts the campaign's files hold."""
 from collections.abc import Mapping
 from dataclasses import dataclass
-import math
 from pathlib import Path
 
 from pipeline import paper, rocking
 from pipeline.files import InputError, content_hash, read_run_json, write_json
 from pipeline.scenario import Contact
+from pipeline.userfiles import number
 from pipeline.verification.checks import (check_pulse_ratios, check_theta0_ratio,
                                           verify_housner, verify_sine_pulse, verify_sliding)
 
@@ -25,13 +25,6 @@ RESULT_KEYS = {"housner": ("max_rel_error_impact_times", "max_rel_error_peaks",
                "sine-pulse": ("yade",),
                "sliding": ("runs", "augusti_sinopoli_mu_min")}
 SLIDING_ROW_KEYS = ("mu_s", "pure_rocking", "t", "base_x_m")
-
-
-def _number(value, name):
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or \
-            not math.isfinite(value):
-        raise InputError(f"verification check: {name} must be a finite number, got {value!r}")
-    return float(value)
 
 
 @dataclass(frozen=True)
@@ -53,7 +46,8 @@ class Check(Mapping):
                              f"exactly {', '.join(KINDS[self.kind])}")
         if not isinstance(self.run_id, str) or not self.run_id:
             raise InputError(f"verification check: run id must be a name, got {self.run_id!r}")
-        values = {k: _number(v, k) for k, v in self.setting.items()}
+        values = {k: number(v, f"verification check: {k}")
+                  for k, v in self.setting.items()}
         if self.kind == "housner":
             check_theta0_ratio(values["theta0_ratio"])
             Contact(damping=values["damping"])

@@ -29,7 +29,7 @@ def test_sites_in_the_strike_frame():
 
 @pytest.mark.parametrize("change, message", [
     ({"source": dict(SOURCE, mechanism="oblique")}, "mechanism must be one of"),
-    ({"source": dict(SOURCE, mw=8.5)}, "mw must be a number in"),
+    ({"source": dict(SOURCE, mw=8.5)}, r"mw 8.5 outside the allowed range \[4.5, 7.5\]"),
     ({"sites": [{"name": "A", "east_km": 0.0, "north_km": 0.0, "twins": 1}]},
      "from the epicentre"),
     ({"sites": [{"name": "A", "east_km": 5.0, "north_km": 0.0, "twins": 0}]}, "twins"),

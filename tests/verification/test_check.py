@@ -20,6 +20,7 @@ from pipeline.verification import Check, CheckResult, campaign_checks, run_check
     ("sine-pulse", {"amplitude_ratio": True, "omega_ratio": 5.0}, "finite number"),
     ("sine-pulse", {"amplitude_ratio": 6.5, "omega_ratio": 0.0}, "--omega-ratio"),
     ("sliding", {"mu_s": 0.0}, "--mu-s"),
+    ("sliding", {"mu_s": 10 ** 400}, "mu_s 1000000.*0000 is beyond a float's range"),
 ])
 def test_a_bad_check_is_refused_on_creation_in_one_line(kind, setting, words):
     with pytest.raises(InputError, match=words) as err:
