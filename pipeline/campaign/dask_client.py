@@ -160,8 +160,9 @@ def close_dask(client, cluster, token=None, interrupted=False, futures=()):
     workers of a cluster we don't own, and end the idle YADE processes its workers kept
     for the next task (they would end by themselves after SERVE_IDLE_S).  Kill a local
     cluster's worker processes (their YADE processes die with them; a graceful close
-    takes seconds) and close it and the client.  Best effort: nothing here may keep
-    Ctrl-C from returning."""
+    takes seconds) and close it and the client.  Best effort, bounded: Ctrl-C returns
+    within about CONNECT_TIMEOUT_S on a cluster we don't own (its runs killed first: a
+    busy worker may answer only after seconds) and CLOSE_TIMEOUT_S on a local one."""
     if client is not None and (interrupted or cluster is None):
         def stop():
             if interrupted:
@@ -174,7 +175,9 @@ def close_dask(client, cluster, token=None, interrupted=False, futures=()):
                     client.run(end_served_processes, on_error="ignore")
         stopping = threading.Thread(target=stop, daemon=True)     # an unreachable worker
         stopping.start()                                          # must not hold Ctrl-C up
-        stopping.join(CLOSE_TIMEOUT_S if interrupted else CONNECT_TIMEOUT_S)
+        # a cluster we don't own keeps running what is not killed: wait as long as for
+        # reaching it (a busy worker answers in seconds); a local one dies below
+        stopping.join(CONNECT_TIMEOUT_S if cluster is None else CLOSE_TIMEOUT_S)
     if cluster is not None:             # results in, or Ctrl-C: nothing to wait for
         _kill_local_workers(cluster)
     for closing in (client, cluster):
