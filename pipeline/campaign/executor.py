@@ -74,7 +74,8 @@ def execute(specs, campaign_dir, jobs, worker, label="runs", executor=None, sche
     if not todo:
         return [], False
     bar = ForecastBar(total=len(specs), initial=done, unit="run", dynamic_ncols=True,
-                      name=Path(campaign_dir).name, first=min(jobs or 4, len(todo)))
+                      name=Path(campaign_dir).name, first=min(jobs or 4, len(todo)),
+                      weights=[motion_seconds(spec, durations) for spec in todo])
     try:
         if executor == "threads":
             with reuse_processes():        # one YADE process per thread, not per run
@@ -86,21 +87,30 @@ def execute(specs, campaign_dir, jobs, worker, label="runs", executor=None, sche
 
 class ForecastBar(tqdm):
     """The campaign's progress bar.  Once the ``first`` runs of this session are done it
-    says, once, how long the rest takes at the pace so far (wall time on this machine;
-    runs start longest first, so the pace is a slow one) when that is ``FORECAST_FROM_S``
-    or more, as a warning from ``WARN_FROM_S`` on."""
+    says, once, how long the rest takes at the pace so far (wall time on this machine)
+    when that is ``FORECAST_FROM_S`` or more, as a warning from ``WARN_FROM_S`` on.
+    ``weights``: the runs' seconds of motion in the order they start (longest first); the
+    pace is per second of motion, so that the long first runs do not stretch the
+    forecast (per run when the motions' lengths are unknown)."""
 
-    def __init__(self, *args, name, first, **kwargs):
+    clock = staticmethod(time.monotonic)
+
+    def __init__(self, *args, name, first, weights=(), **kwargs):
         super().__init__(*args, **kwargs)
         self.name, self.first, self.said = name, first, False
-        self.started = time.monotonic()
+        self.weights = list(weights) if all(w > 0 for w in weights) else []
+        self.started = self.clock()
 
     def update(self, n=1):
         shown = super().update(n)
         finished, left = self.n - self.initial, self.total - self.n
         if not self.said and finished >= self.first and left > 0:
             self.said = True
-            rest_s = left * (time.monotonic() - self.started) / finished
+            pace_s = (self.clock() - self.started) / finished           # per run
+            rest_s = left * pace_s
+            if len(self.weights) == finished + left:                     # per motion second
+                done = sum(self.weights[:finished])
+                rest_s = sum(self.weights[finished:]) * pace_s * finished / done
             if rest_s >= FORECAST_FROM_S:
                 self.write(f"{'warning: ' if rest_s >= WARN_FROM_S else ''}{self.name}: the "
                            f"other {left} runs take about {duration_text(rest_s)} at the pace "

@@ -1,5 +1,6 @@
 """A campaign says how long its rest takes, measured on its first runs, and warns before
 hours of work; short campaigns say nothing."""
+import io
 import re
 import time
 from pathlib import Path
@@ -57,3 +58,21 @@ def test_a_resumed_campaign_paces_only_the_runs_it_computes(tmp_path, capsys, mo
                                            (9000, "2.5 h"), (3 * 86400, "3.0 d")])
 def test_durations_as_people_say_them(seconds, text):
     assert duration_text(seconds) == text
+
+
+@pytest.mark.parametrize("weights, rest_s", [([4, 4, 1, 1, 1, 1, 1, 1], 3.0),   # per motion s
+                                             ([], 12.0),                        # per run
+                                             ([4, 4, 0, 1, 1, 1, 1, 1], 12.0)])  # one unknown
+def test_the_pace_is_per_second_of_motion_so_long_first_runs_do_not_stretch_it(
+        monkeypatch, capsys, weights, rest_s):
+    """Two runs of 4 s of motion done in 4 s on 2 cores: six runs of 1 s left take 3 s,
+    not the 12 s that a pace per run would say."""
+    monkeypatch.setattr(executor, "FORECAST_FROM_S", 0.0)
+    said = []
+    monkeypatch.setattr(executor, "duration_text", lambda s: said.append(s) or "x")
+    bar = executor.ForecastBar(total=8, initial=0, name="c", first=2, weights=weights,
+                               file=io.StringIO())
+    bar.started, bar.clock = 0.0, lambda: 4.0
+    bar.update()
+    bar.update()
+    assert said == [pytest.approx(rest_s)]
