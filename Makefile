@@ -21,8 +21,9 @@ setup: .venv/.installed
 
 # the layers of the stages (import-linter contract in pyproject.toml), the YADE physics
 # tests on glibc's second libm path (another CPU's last bits), then all; on every core
-# (pytest-xdist, a test file per worker at a time: its module fixtures are made once)
-TEST_WORKERS ?= auto
+# (pytest-xdist, a test file per worker at a time: its module fixtures are made once;
+# as many workers as nproc says, not xdist's "auto", which counts physical cores only)
+TEST_WORKERS ?= $(JOBS)
 test: setup
 	.venv/bin/lint-imports
 	$(PY) -m pytest -q -n $(TEST_WORKERS) --dist loadfile -m libm --second-libm tests
