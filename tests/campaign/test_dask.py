@@ -1,7 +1,6 @@
 """The Dask executor: tasks carry their inputs, a campaign on an existing cluster gives the
 local run's ids and outcomes, a killed worker loses no finished result, Ctrl-C stops it."""
 import json
-import os
 import signal
 import socket
 import subprocess
@@ -11,6 +10,7 @@ import time
 from pathlib import Path
 
 import pandas as pd
+import psutil
 import pytest
 
 from pipeline import cli
@@ -125,37 +125,37 @@ def cluster(tmp_path_factory):
         cluster.stop()
 
 
-def task_yade_processes(cluster):
-    """{pid: parent pid} of the cluster's workers' scene processes running in a Dask
-    task's temporary directory (not those of tests running beside: pytest-xdist)."""
-    workers = {proc.pid for proc in cluster.processes}
+def scene_processes(cluster):
+    """{pid: (worker pid, working directory)} of the scene processes (run_scene.py) that
+    the cluster's live worker processes started, running or idle (psutil): not those of
+    tests running beside (pytest-xdist)."""
     found = {}
-    for pid in filter(str.isdigit, os.listdir("/proc")):
-        try:
-            cmd = Path(f"/proc/{pid}/cmdline").read_bytes()
-            cwd = os.readlink(f"/proc/{pid}/cwd")
-            parent = int(Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[1])
-        except (OSError, ValueError):
+    for worker in cluster.processes:
+        if worker.poll() is not None:
             continue
-        if b"run_scene.py" in cmd and f"/{TASK_PREFIX}-" in cwd and parent in workers:
-            found[int(pid)] = parent
+        try:
+            children = psutil.Process(worker.pid).children()
+        except psutil.NoSuchProcess:
+            continue
+        for child in children:
+            try:
+                if any("run_scene.py" in part for part in child.cmdline()):
+                    found[child.pid] = (worker.pid, child.cwd())
+            except (psutil.NoSuchProcess, psutil.AccessDenied):
+                continue
     return found
+
+
+def task_yade_processes(cluster):
+    """{pid: worker pid} of the cluster's scene processes running in a Dask task's
+    temporary directory."""
+    return {pid: worker for pid, (worker, cwd) in scene_processes(cluster).items()
+            if f"/{TASK_PREFIX}-" in cwd}
 
 
 def worker_yade_processes(cluster):
-    """pids of scene processes (run_scene.py) whose parent is one of the cluster's
-    processes, running or idle."""
-    workers = {proc.pid for proc in cluster.processes if proc.poll() is None}
-    found = []
-    for pid in filter(str.isdigit, os.listdir("/proc")):
-        try:
-            cmd = Path(f"/proc/{pid}/cmdline").read_bytes()
-            parent = int(Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[1])
-        except (OSError, ValueError):
-            continue
-        if b"run_scene.py" in cmd and parent in workers:
-            found.append(int(pid))
-    return found
+    """pids of the cluster's scene processes, running or idle."""
+    return list(scene_processes(cluster))
 
 
 def campaign_args(records, out, *extra):

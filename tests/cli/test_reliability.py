@@ -9,6 +9,7 @@ import time
 from pathlib import Path
 
 import numpy as np
+import psutil
 import pytest
 from obspy import Stream, Trace
 
@@ -354,61 +355,36 @@ def test_kill_9_leaves_no_yade_behind_and_resume_completes(tmp_path):
     resume_completes(records, out)
 
 
-def process_tree(root):
-    """pids of ``root`` and of its descendants (/proc)."""
-    children = {}
-    for pid in filter(str.isdigit, os.listdir("/proc")):
+def listening_sockets(root):
+    """(address, port) of the listening TCP sockets that process ``root`` and its
+    descendants hold (psutil): this test's own, not those of tests running beside it
+    (pytest-xdist)."""
+    found = set()
+    try:
+        procs = [psutil.Process(root)]
+        procs += procs[0].children(recursive=True)
+    except psutil.NoSuchProcess:
+        return found
+    for proc in procs:
         try:
-            parent = int(Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[1])
-        except (OSError, ValueError, IndexError):
+            found.update(tuple(c.laddr) for c in proc.net_connections(kind="tcp")
+                         if c.status == psutil.CONN_LISTEN)
+        except (psutil.NoSuchProcess, psutil.AccessDenied):
             continue
-        children.setdefault(parent, []).append(int(pid))
-    tree, todo = set(), [root]
-    while todo:
-        pid = todo.pop()
-        tree.add(pid)
-        todo.extend(children.get(pid, ()))
-    return tree
-
-
-def listening_sockets(pids):
-    """Inodes of the listening TCP sockets (/proc/net/tcp, tcp6) that ``pids`` hold: this
-    test's own, not those of tests running beside it (pytest-xdist)."""
-    listening = set()
-    for name in ("tcp", "tcp6"):
-        path = Path("/proc/net") / name
-        if path.exists():
-            for line in path.read_text().splitlines()[1:]:
-                fields = line.split()
-                if fields[3] == "0A":
-                    listening.add(fields[9])
-    held = set()
-    for pid in pids:
-        try:
-            fds = os.listdir(f"/proc/{pid}/fd")
-        except OSError:
-            continue
-        for fd in fds:
-            try:
-                link = os.readlink(f"/proc/{pid}/fd/{fd}")
-            except OSError:
-                continue
-            if link.startswith("socket:["):
-                held.add(link[len("socket:["):-1])
-    return listening & held
+    return found
 
 
 def test_the_socket_watch_sees_a_child_listening():
     """The watch below can fail: a child process that listens on a port is seen."""
     me = os.getpid()
-    before = listening_sockets(process_tree(me))
+    before = listening_sockets(me)
     child = subprocess.Popen([sys.executable, "-c", "import socket, sys, time; "
                               "s = socket.socket(); s.bind(('127.0.0.1', 0)); s.listen(); "
                               "print('up', flush=True); time.sleep(30)"],
                              stdout=subprocess.PIPE, text=True)
     try:
         assert child.stdout.readline().strip() == "up"
-        assert listening_sockets(process_tree(me)) - before
+        assert listening_sockets(me) - before
     finally:
         child.kill()
         child.wait()
@@ -417,13 +393,13 @@ def test_the_socket_watch_sees_a_child_listening():
 @pytest.mark.yade
 def test_a_run_opens_no_listening_socket(tmp_path, capsys):
     me = os.getpid()
-    before = listening_sockets(process_tree(me))
+    before = listening_sockets(me)
     record = write_motion_npz(tmp_path / "pulse.npz")
     seen, done = set(), threading.Event()
 
     def watch():
         while not done.is_set():
-            seen.update(listening_sockets(process_tree(me)) - before)
+            seen.update(listening_sockets(me) - before)
             time.sleep(0.05)
 
     watcher = threading.Thread(target=watch)
