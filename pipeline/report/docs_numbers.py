@@ -126,8 +126,7 @@ def setting(name, fmt="{:g}", times=1):
     ``times`` (1/60: seconds as minutes) and formatted: the docs quote it from its one
     home."""
     module, _, attribute = name.rpartition(".")
-    value = getattr(importlib.import_module(module), attribute)
-    return fmt.format(value * times if times != 1 else value)
+    return fmt.format(getattr(importlib.import_module(module), attribute) * times)
 
 
 def bench_convergence_table(path=BENCH_JSON):
