@@ -51,6 +51,7 @@ from pipeline.campaign.options import CampaignOptions, column_file_param, stiffn
 from pipeline.scenario.parameters import check_time_step, param
 from pipeline.campaign.column_file import description as column_file_description
 from pipeline.campaign.definitions import column_specs, run_code_version, run_column_spec
+from pipeline.campaign.run_dirs import finished_summary
 from pipeline.campaign.tables import collect, write_parquet
 from pipeline.files import InputError, write_csv, write_json
 from pipeline.scenario import Contact, Numerics
@@ -282,6 +283,7 @@ def ensemble_outputs(specs, campaign_dir, failures, animations, figures=True):
     if len(records) > 1:
         pooled = pooled_summary(runs)
         if pooled is not None:
+            pooled["cost"] = yade_cost(campaign_dir, runs["run_id"])
             write_json(campaign_dir / POOLED_FILE, pooled)
             if figures:
                 from pipeline.figures.ensemble import plot_pooled
@@ -327,6 +329,15 @@ def pooled_summary(runs, resamples=2000):
             "members_per_record": {r: int((members["record_id"] == r).sum()
                                           / members["column"].nunique()) for r in records},
             "columns": columns}
+
+
+def yade_cost(campaign_dir, run_ids):
+    """What the finished runs ``run_ids`` of the campaign in ``campaign_dir`` cost: their
+    number and their YADE processes' wall times summed (s); a campaign on ``--jobs`` N
+    parallel processes takes about 1/N of that in wall time."""
+    done = [finished_summary(campaign_dir, r) for r in dict.fromkeys(run_ids)]
+    done = [s for s in done if s is not None]
+    return {"runs": len(done), "yade_wall_s_total": round(float(sum(s.wall_s for s in done)), 1)}
 
 
 def pooled_sentence(answer):

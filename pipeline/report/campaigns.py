@@ -254,6 +254,12 @@ def paper_question_section(results):
     lines.append(_table(pd.DataFrame(rows)) + "\n")
     for col in pooled["columns"]:
         lines.append(f"- **{col['column']}**: {col['answer']}.")
+    cost = pooled.get("cost")
+    if cost:
+        lines.append(f"\nCost: {cost['runs']} YADE runs (the nominal runs among them), "
+                     f"{cost['yade_wall_s_total'] / 3600:.1f} process-hours (the runs' wall "
+                     "times summed; on N parallel YADE processes the campaign takes about "
+                     "1/N of that).")
     lines.append("\nSingle runs per record (campaign records, below) are samples of these "
                  "distributions.\n")
     lines.append(_figure(results, base / "pooled.png", "the paper's question from ensembles"))

@@ -123,3 +123,25 @@ def test_the_report_section_says_the_size_and_the_answer(tmp_path):
     text = paper_question_section(tmp_path)
     assert "1 member per record" in text and "a fixed ensemble" in text
     assert pooled["columns"][0]["answer"] in text
+
+
+def test_the_cost_is_the_finished_runs_wall_times_summed_once_each(tmp_path):
+    import json
+
+    from pipeline.campaign.ensemble import yade_cost
+    from pipeline.report import paper_question_section
+    walls = {"a1": 1800.0, "b2": 5400.0, "c3": 0.0}          # c3: a run YADE never ran
+    for run_id, wall in walls.items():
+        folder = tmp_path / "paper-question" / "runs" / run_id
+        folder.mkdir(parents=True)
+        (folder / "summary.json").write_text(json.dumps({"record": "R", "wall_s": wall}))
+    # a run listed once per column counts once; an unfinished run costs nothing yet
+    cost = yade_cost(tmp_path / "paper-question", ["a1", "a1", "b2", "c3", "unfinished"])
+    assert cost == {"runs": 3, "yade_wall_s_total": 7200.0}
+    rows = [{"record_id": f"R{r}", "member": m, "column": "drums", "toppled": False,
+             "back_azimuth_deg": 10.0, "downfall_azimuth_deg": np.nan}
+            for r in range(3) for m in (-1, 0)]
+    pooled = {**pooled_summary(pd.DataFrame(rows), resamples=20), "cost": cost}
+    (tmp_path / "paper-question" / "pooled_summary.json").write_text(json.dumps(pooled))
+    assert "3 YADE runs" in paper_question_section(tmp_path)
+    assert "2.0 process-hours" in paper_question_section(tmp_path)
