@@ -2,15 +2,13 @@
 model code checked by hash against the client's."""
 import functools
 import json
-import os
-import signal
 import socket
 import tempfile
 import traceback
 from pathlib import Path
 
 from pipeline.files import ToolError, code_hash
-from pipeline.scenario.runner import reuse_processes
+from pipeline.scenario.runner import reuse_processes, stop_scenes
 from pipeline.simulate import RUN_CODE
 
 TASK_PREFIX = "toppling"        # Dask keys and worker temporary directories
@@ -105,26 +103,8 @@ def _swap(value, swaps):
 
 
 def kill_task_processes(token):
-    """Kill this worker's YADE processes of campaign ``token`` (run with Client.run after
-    Ctrl-C): children of this process whose working directory lies in a temporary
-    directory of that campaign.  Returns their pids."""
-    mark = f"/{TASK_PREFIX}-{token}-"
-    me, killed = os.getpid(), []
-    for pid in filter(str.isdigit, os.listdir("/proc")):
-        try:
-            stat = Path(f"/proc/{pid}/stat").read_text()
-            parent = int(stat.rsplit(")", 1)[1].split()[1])
-            cwd = os.readlink(f"/proc/{pid}/cwd")
-        except (OSError, ValueError, IndexError):
-            continue
-        if parent == me and mark in cwd:
-            pid = int(pid)
-            try:
-                if os.getpgid(pid) == pid:                # YADE leads its own group
-                    os.killpg(pid, signal.SIGKILL)
-                else:
-                    os.kill(pid, signal.SIGKILL)
-                killed.append(pid)
-            except ProcessLookupError:
-                pass
-    return killed
+    """Kill this worker's YADE processes of campaign ``token`` and refuse the scenes its
+    tasks have yet to start (run with Client.run after Ctrl-C:
+    :func:`pipeline.scenario.runner.stop_scenes` on the campaign's temporary
+    directories).  Returns their pids."""
+    return stop_scenes(f"/{TASK_PREFIX}-{token}-")

@@ -47,6 +47,7 @@ SCENES_PER_PROCESS = 200           # a served process is replaced after this man
 SERVE_IDLE_S = 120.0               # a served process ends itself after this long without a scene
 _SERVED = threading.local()        # this thread's serving process (reuse_processes)
 _REUSE = {"depth": 0}
+_STOPPED = set()                   # marks of run directories whose scenes stop_scenes() ends
 
 
 class YadeError(ToolError):
@@ -75,6 +76,8 @@ def run_yade(run_dir, timeout_s=None):
     out.unlink(missing_ok=True)
     if timeout_s is None:
         timeout_s = wall_limit_s(json.loads((run_dir / "params.json").read_text())["t_max"])
+    with _RUNNING_LOCK:
+        _refuse_stopped(run_dir)     # before any file or process (checked again at the start)
     start = time.perf_counter()
     if _REUSE["depth"] and "\n" not in str(run_dir):
         code = _run_served(run_dir, timeout_s)
@@ -104,12 +107,18 @@ def _run_once(run_dir, timeout_s):
     """One scene in a fresh process; its exit code (negative: killed by a signal)."""
     with open(run_dir / "yade.log", "w") as log:
         tmpdir = tempfile.mkdtemp(prefix=TMP_PREFIX)
-        proc = subprocess.Popen([DEBIAN_PYTHON, str(WRAPPER), "scene.py"], cwd=run_dir,
-                                stdout=log, stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL,
-                                env=_environment(tmpdir), start_new_session=True,
-                                preexec_fn=partial(die_with_parent, os.getpid()))
-        proc.tmpdir = tmpdir
-        with _RUNNING_LOCK:
+        with _RUNNING_LOCK:                      # refused or seen by stop_scenes()
+            try:
+                _refuse_stopped(run_dir)
+                proc = subprocess.Popen(
+                    [DEBIAN_PYTHON, str(WRAPPER), "scene.py"], cwd=run_dir, stdout=log,
+                    stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL,
+                    env=_environment(tmpdir), start_new_session=True,
+                    preexec_fn=partial(die_with_parent, os.getpid()))
+            except BaseException:
+                _remove_tmp(tmpdir)
+                raise
+            proc.tmpdir, proc.run_dir = tmpdir, str(run_dir)
             _RUNNING.add(proc)
         try:
             return proc.wait(timeout=timeout_s)
@@ -198,11 +207,14 @@ def _run_served(run_dir, timeout_s):
     try:
         return _answer(proc, run_dir, timeout_s)
     finally:
-        proc.last_used, proc.busy = time.monotonic(), False
+        proc.last_used, proc.busy, proc.run_dir = time.monotonic(), False, ""
 
 
 def _answer(proc, run_dir, timeout_s):
     """Send ``run_dir`` to the serving process ``proc``; the scene's exit code."""
+    with _RUNNING_LOCK:                          # refused or seen by stop_scenes()
+        _refuse_stopped(run_dir)
+        proc.run_dir = str(run_dir)
     try:
         proc.stdin.write(os.fsencode(run_dir) + b"\n")     # any bytes a path may hold
         proc.stdin.flush()
@@ -238,6 +250,26 @@ def kill_running():
             os.killpg(proc.pid, signal.SIGKILL)
         except ProcessLookupError:
             pass
+
+
+def stop_scenes(mark):
+    """Kill this process's YADE processes that run a scene whose run directory's path
+    contains ``mark``, and refuse such scenes from now on (Ctrl-C of a Dask campaign on a
+    worker: a task about to start its scene is refused rather than missed).  Their pids."""
+    with _RUNNING_LOCK:
+        _STOPPED.add(mark)
+        procs = [p for p in _RUNNING
+                 if p.returncode is None and mark in getattr(p, "run_dir", "")]
+        for proc in procs:
+            with contextlib.suppress(ProcessLookupError):
+                os.killpg(proc.pid, signal.SIGKILL)
+    return [p.pid for p in procs]
+
+
+def _refuse_stopped(run_dir):
+    """Raise YadeError when ``run_dir`` is a scene stop_scenes() ended (hold _RUNNING_LOCK)."""
+    if any(mark in str(run_dir) for mark in _STOPPED):
+        raise YadeError(f"{run_dir}: not run, its campaign was stopped")
 
 
 def _kill(proc):

@@ -1,6 +1,7 @@
 """The runner's reused YADE processes (campaign threads): the same trajectory to the last
 bit as a fresh process, failures and timeouts that leave the next scene unharmed, and no
 process left behind."""
+import contextlib
 import os
 import threading
 import time
@@ -152,3 +153,39 @@ def test_yade_processes_leave_no_temporary_directory(tmp_path, monkeypatch):
     assert len(noted) >= 2 and all(m.startswith("/tmp/yade-") for m in noted), made
     assert not any(glob.glob(m) for m in noted)
     assert list(scratch.iterdir()) == []
+
+
+@pytest.mark.parametrize("served", [False, True])
+def test_stopped_scenes_are_killed_and_those_not_started_are_refused(tmp_path, monkeypatch,
+                                                                     served):
+    """Ctrl-C of a Dask campaign on a worker: the scenes under the campaign's mark die at
+    once, a scene not yet started is refused, and other scenes run on."""
+    monkeypatch.setattr(runner, "_STOPPED", set())
+    running = scene(tmp_path / "mark-1" / "running")
+    (running / "scene.py").write_text("import time\ntime.sleep(60)\n")
+    errors = []
+
+    def work():
+        try:
+            run_yade(running, timeout_s=60.0)
+        except YadeError as exc:
+            errors.append(str(exc))
+
+    with runner.reuse_processes() if served else contextlib.nullcontext():
+        thread = threading.Thread(target=work)
+        thread.start()
+        deadline = time.monotonic() + 30
+        while not any(getattr(p, "run_dir", "") == str(running) for p in list(runner._RUNNING)):
+            assert time.monotonic() < deadline, "the scene did not start"
+            time.sleep(0.02)
+        started = time.monotonic()
+        pids = runner.stop_scenes("/mark-1/")
+        thread.join(timeout=30)
+        assert not thread.is_alive() and time.monotonic() - started < 10
+        assert len(pids) == 1 and gone(pids[0])
+        assert errors and "stopped by signal 9" in errors[0]
+        with pytest.raises(YadeError, match="not run, its campaign was stopped"):
+            run_yade(scene(tmp_path / "mark-1" / "later"))
+        assert not (tmp_path / "mark-1" / "later" / "yade.log").exists()
+        assert same(run_yade(scene(tmp_path / "mark-2" / "other")),
+                    run_yade(scene(tmp_path / "fresh")))
