@@ -475,7 +475,36 @@ def two_x(work, shaking_s):
                  "still_rotation_deg": rotation_from_start_deg(run_yade(run_dir))}]
     return {"shaking_s": shaking_s, "scenes": rows, "accuracy": accuracy,
             "still_column": STILL_COLUMN, "still_s": STILL_S,
-            "still_rotation_limit_deg": STILL_ROTATION_DEG}
+            "still_rotation_limit_deg": STILL_ROTATION_DEG,
+            "members_per_scene": members_per_scene(work, shaking)}
+
+
+MEMBERS_PER_SCENE = (1, 2, 4)      # twin members sharing one YADE scene
+MEMBER_SPACING_M = 10.0            # North of each other: a fallen column reaches ~4 m
+
+
+def members_per_scene(work, shaking):
+    """The issue's first idea for 2x members per CPU-hour, measured: n twin members
+    (drums and monolith each) in one scene on one pedestal under one motion, spaced
+    MEMBER_SPACING_M apart so that they never touch, for the motion's duration (no early
+    stop).  Per n: the loop's wall s, wall s per member and members per wall hour
+    against one member per scene (``x_one``)."""
+    rows = []
+    for n in MEMBERS_PER_SCENE:
+        specs = [dataclasses.replace(spec, name=f"{spec.name}{k}", y=MEMBER_SPACING_M * k)
+                 for k in range(n) for spec in Column("both").specs()]
+        params = scene_params(columns=specs, numerics=Numerics(rest_duration_s=1e9),
+                              motion_duration=shaking.duration, t_max=shaking.duration)
+        run_dir = work / f"two_x_members_{n}"
+        patch_scene(write_scenario(run_dir, params, shaking), fixed=True)
+        traj = run_timed(run_dir)
+        loop = traj.extra["loop_wall_s"]
+        rows.append({"members": n, "time_step_s": traj.dt, "loop_wall_s": loop,
+                     "wall_s_per_member": loop / n, "members_per_wall_hour": 3600.0 * n / loop,
+                     "cpu_pct": 100.0 * traj.extra["loop_cpu_s"] / loop})
+    for row in rows:
+        row["x_one"] = row["members_per_wall_hour"] / rows[0]["members_per_wall_hour"]
+    return rows
 
 
 # ---------------------------------------------------------------- 9. time-step limit
@@ -721,6 +750,13 @@ def print_two_x(t):
               f"{r['sim_s_per_wall_s']:13.2f}{r['x_default']:10.2f}{r['cpu_pct']:7.0f}")
     print("   no friction switch: mu_s only, YADE's C++ engines alone (the most a C++ "
           "static/kinetic friction law could give)")
+    print(f"   several twin members in one scene ({MEMBER_SPACING_M:g} m apart, one pedestal, "
+          "one motion), side by side:")
+    print(f"   {'members':>10}{'loop wall s':>13}{'wall s/member':>15}{'members/h':>11}"
+          f"{'x one':>7}{'CPU %':>7}")
+    for r in t["members_per_scene"]:
+        print(f"   {r['members']:>10}{r['loop_wall_s']:13.2f}{r['wall_s_per_member']:15.2f}"
+              f"{r['members_per_wall_hour']:11.0f}{r['x_one']:7.2f}{r['cpu_pct']:7.0f}")
     for a in t["accuracy"]:
         still_ok = a["still_rotation_deg"] < t["still_rotation_limit_deg"]
         housner = (f"refused ({a['housner_refused']})" if a["housner_refused"] else

@@ -25,7 +25,7 @@ exits 130.
 
 Once the first runs are done (as many as run at once), a campaign whose rest takes
 ``FORECAST_FROM_S`` or more says how long, measured on this machine: a warning from
-``WARN_FROM_S`` on.
+``WARN_FROM_S`` on; it says it again when the pace moves the rest by ``REVISE_FACTOR``.
 """
 import os
 import time
@@ -44,6 +44,7 @@ EXECUTORS = ("threads", "dask")
 DEFAULT_EXECUTOR = "threads"    # why: docs/campaigns.md, "On a cluster: Dask" (start-up, ports)
 FORECAST_FROM_S = 600.0         # a campaign says how long its rest takes from 10 min on
 WARN_FROM_S = 3600.0            # ... and warns from an hour on
+REVISE_FACTOR = 1.5             # ... and says it again when the pace moves it this much
 
 
 def execute(specs, campaign_dir, jobs, worker, label="runs", executor=None, scheduler=None):
@@ -87,36 +88,64 @@ def execute(specs, campaign_dir, jobs, worker, label="runs", executor=None, sche
 
 class ForecastBar(tqdm):
     """The campaign's progress bar.  Once the ``first`` runs of this session are done it
-    says, once, how long the rest takes at the pace so far (wall time on this machine)
-    when that is ``FORECAST_FROM_S`` or more, as a warning from ``WARN_FROM_S`` on.
-    ``weights``: the runs' seconds of motion in the order they start (longest first); the
-    pace is per second of motion, so that the long first runs do not stretch the
-    forecast (per run when the motions' lengths are unknown)."""
+    says how long the rest takes at the pace so far (wall time on this machine) when that
+    is ``FORECAST_FROM_S`` or more, as a warning from ``WARN_FROM_S`` on; and says it
+    again, at the pace of the runs done since, when that pace puts the rest
+    ``REVISE_FACTOR`` times and ``FORECAST_FROM_S`` longer or shorter than the last
+    forecast (looked at once ``2 first`` runs more are done).  ``weights``: the runs' seconds of motion in the order they start
+    (longest first); the pace is per second of motion, so that the long first runs do
+    not stretch the forecast (per run when the motions' lengths are unknown)."""
 
     clock = staticmethod(time.monotonic)
 
     def __init__(self, *args, name, first, weights=(), **kwargs):
         super().__init__(*args, **kwargs)
-        self.name, self.first, self.said = name, first, False
+        self.name, self.first = name, first
         self.weights = list(weights) if all(w > 0 for w in weights) else []
         self.started = self.clock()
+        self.forecast = None        # the last: (clock, rest s, runs finished then)
 
     def update(self, n=1):
         shown = super().update(n)
         finished, left = self.n - self.initial, self.total - self.n
-        if not self.said and finished >= self.first and left > 0:
-            self.said = True
-            pace_s = (self.clock() - self.started) / finished           # per run
-            rest_s = left * pace_s
-            if len(self.weights) == finished + left:                     # per motion second
-                done = sum(self.weights[:finished])
-                rest_s = sum(self.weights[finished:]) * pace_s * finished / done
+        if finished < self.first or left <= 0:
+            return shown
+        now = self.clock()
+        if self.forecast is None:
+            rest_s = self.rest_s(now, finished, left)
+            self.forecast = (now, rest_s, finished)
             if rest_s >= FORECAST_FROM_S:
-                self.write(f"{'warning: ' if rest_s >= WARN_FROM_S else ''}{self.name}: the "
-                           f"other {left} runs take about {duration_text(rest_s)} at the pace "
-                           f"of the first {finished}; Ctrl-C stops the campaign and the "
-                           "same command resumes it, keeping every finished run")
+                self.say(rest_s, left, f"the first {finished}")
+            return shown
+        said_at, said_rest_s, said_finished = self.forecast
+        if finished - said_finished < 2 * self.first:      # runs end in bursts of `first`
+            return shown
+        expected_s = max(said_rest_s - (now - said_at), 0.0)
+        rest_s = self.rest_s(now, finished, left, since=(said_at, said_finished))
+        moved = (rest_s > REVISE_FACTOR * expected_s or rest_s * REVISE_FACTOR < expected_s)
+        if moved and abs(rest_s - expected_s) >= FORECAST_FROM_S <= rest_s:
+            self.forecast = (now, rest_s, finished)
+            self.say(rest_s, left, f"the last {finished - said_finished}",
+                     revised=said_rest_s)
         return shown
+
+    def rest_s(self, now, finished, left, since=None):
+        """Wall seconds the ``left`` runs take at the pace of the ``finished`` ones, or of
+        those finished ``since`` (clock, runs finished then)."""
+        start, before = since or (self.started, 0)
+        pace_s = (now - start) / (finished - before)                     # per run
+        if len(self.weights) == finished + left:                         # per motion second
+            done_s = sum(self.weights[before:finished])
+            return sum(self.weights[finished:]) * pace_s * (finished - before) / done_s
+        return left * pace_s
+
+    def say(self, rest_s, left, pace_of, revised=None):
+        """One line: the rest's duration (as a warning from WARN_FROM_S on)."""
+        head = "warning: " if rest_s >= WARN_FROM_S else ""
+        change = "" if revised is None else f" (said {duration_text(revised)} before)"
+        self.write(f"{head}{self.name}: the other {left} runs take about "
+                   f"{duration_text(rest_s)} at the pace of {pace_of}{change}; Ctrl-C stops "
+                   "the campaign and the same command resumes it, keeping every finished run")
 
 
 def duration_text(seconds):

@@ -1,5 +1,6 @@
 """A campaign says how long its rest takes, measured on its first runs, and warns before
 hours of work; short campaigns say nothing."""
+import contextlib
 import io
 import re
 import time
@@ -76,3 +77,54 @@ def test_the_pace_is_per_second_of_motion_so_long_first_runs_do_not_stretch_it(
     bar.update()
     bar.update()
     assert said == [pytest.approx(rest_s)]
+
+
+def forecast_lines(paces_s, first=2, weights=()):
+    """The lines a ForecastBar of len(paces_s) runs says (tqdm.write: on stdout) when run k
+    finishes paces_s[k] wall seconds after run k - 1 (a fake clock)."""
+    clock = [0.0]
+    bar = executor.ForecastBar(total=len(paces_s), initial=0, name="c", first=first,
+                               weights=weights, file=io.StringIO())
+    bar.started, bar.clock = 0.0, lambda: clock[0]
+    with contextlib.redirect_stdout(io.StringIO()) as out:
+        for pace in paces_s:
+            clock[0] += pace
+            bar.update()
+    return [line for line in out.getvalue().splitlines() if "take about" in line]
+
+
+def test_a_steady_pace_is_said_once(monkeypatch):
+    monkeypatch.setattr(executor, "FORECAST_FROM_S", 60.0)
+    lines = forecast_lines([100.0] * 20)
+    assert len(lines) == 1 and "the other 18 runs take about 30 min" in lines[0]
+
+
+def test_a_pace_that_slows_is_said_again_with_what_was_said_before(monkeypatch):
+    """Two quick runs say 18 x 10 s = 3 min; the next four runs of 100 s each put the
+    other 14 at 23 min: said again, once (the pace then holds), naming the earlier
+    forecast."""
+    monkeypatch.setattr(executor, "FORECAST_FROM_S", 60.0)
+    lines = forecast_lines([10.0, 10.0] + [100.0] * 18)
+    assert len(lines) == 2, lines
+    assert "the other 18 runs take about 3 min at the pace of the first 2;" in lines[0]
+    assert ("the other 14 runs take about 23 min at the pace of the last 4 (said 3 min "
+            "before); Ctrl-C stops") in lines[1]
+
+
+def test_the_revision_paces_per_second_of_motion(monkeypatch):
+    """Runs of 4 s of motion first, then of 1 s at 4x the wall time per motion second:
+    the revision counts the motion seconds left (14 x 1 s at 20 s per s), not the runs."""
+    monkeypatch.setattr(executor, "FORECAST_FROM_S", 60.0)
+    lines = forecast_lines([20.0, 20.0] + [20.0] * 18, weights=[4, 4] + [1] * 18)
+    assert len(lines) == 2, lines
+    assert "the other 18 runs take about 2 min at the pace of the first 2;" in lines[0]
+    assert "the other 14 runs take about 5 min at the pace of the last 4" in lines[1]
+
+
+def test_a_pace_that_speeds_up_is_said_again_and_nothing_below_the_threshold(monkeypatch):
+    monkeypatch.setattr(executor, "FORECAST_FROM_S", 60.0)
+    lines = forecast_lines([100.0, 100.0] + [10.0] * 38)
+    assert len(lines) == 2, lines
+    assert "the other 34 runs take about 6 min at the pace of the last 4 (said 63 min" in lines[1]
+    monkeypatch.setattr(executor, "FORECAST_FROM_S", 1e9)
+    assert forecast_lines([10.0, 10.0] + [100.0] * 18) == []
