@@ -3,7 +3,7 @@ import os
 import time
 
 from pipeline.files import InputError
-from pipeline.motion.synthetics import (GMM_VS30_M_S, QUICK_DURATION_S, QUICK_FMAX_HZ, SOURCES,
+from pipeline.motion.synthetics import (AZIMUTH_STEP_DEG, GMM_VS30_M_S, RINGS_KM, QUICK_DURATION_S, QUICK_FMAX_HZ, SOURCES,
                                         generate_sources, source_parameters,
                                         write_gmm_summary)
 
@@ -26,14 +26,19 @@ def _float_list(text):
 
 def setup(parser):
     parser.add_argument("--source", default="all", help=f"one of {', '.join(SOURCES)} or 'all'")
-    parser.add_argument("--rings", default="5,10,20", help="ring radii in km (default 5,10,20)")
-    parser.add_argument("--step", type=float, default=30.0,
-                        help="azimuth step between sites in degrees (default 30)")
+    parser.add_argument("--rings", default=",".join(f"{r:g}" for r in RINGS_KM),
+                        help="ring radii in km (default %(default)s)")
+    parser.add_argument("--step", type=float, default=AZIMUTH_STEP_DEG,
+                        help="azimuth step between sites in degrees (default %(default)g)")
     parser.add_argument("--quick", action="store_true",
                         help=f"fmax {QUICK_FMAX_HZ:g} Hz, {QUICK_DURATION_S:g} s, "
                         "written to results/synthetics-quick")
     parser.add_argument("--jobs", type=int, default=os.cpu_count() or 1,
                         help="parallel processes (default: all cores)")
+    parser.add_argument("--ship", action="store_true",
+                        help="compute the sources anew (no cache) and write their pyprop8 "
+                        "displacements to records/synthetics/ (maintainers: after a change of "
+                        "the generator, its settings or pyprop8; see records/synthetics/README.md)")
 
 
 def run(args):
@@ -41,9 +46,12 @@ def run(args):
     for name in names:
         source_parameters(name)
     rings = _float_list(args.rings)
+    if args.ship and (args.quick or rings != RINGS_KM or args.step != AZIMUTH_STEP_DEG):
+        raise InputError("--ship writes the displacements of the default settings only: "
+                         "drop --quick, --rings and --step")
     started = time.monotonic()
     generated = generate_sources(names, rings, args.step, quick=args.quick,
-                                 jobs=max(1, args.jobs))
+                                 jobs=max(1, args.jobs), ship=args.ship)
     for name, paths in generated.items():
         print(f"{name}: {len(paths)} sites in {paths[0].parent}")
     print(f"{time.monotonic() - started:.0f} s (cached when ~0)")

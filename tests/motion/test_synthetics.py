@@ -2,6 +2,7 @@
 
 pyprop8 calls are kept tiny (fmax <= 1 Hz, a few receivers, short windows).
 """
+import hashlib
 import json
 import math
 
@@ -199,6 +200,61 @@ def test_generate_writes_motions_with_exact_geometry_and_caches(tiny_source, tmp
     assert list(summary["ring_km"]) == [4.0, 8.0] and list(summary["n_sites"]) == [4, 4]
     ratios = summary.filter(like="ratio_").to_numpy()
     assert np.isfinite(ratios).all() and (ratios > 0).all()
+
+
+def test_shipped_displacements_are_used_instead_of_pyprop8_and_written_as_computed(
+        tiny_source, tmp_path, monkeypatch):
+    """A shipped file with the settings' cache key replaces the pyprop8 calls and gives
+    the motions computing gives; another key or ``ship`` computes (and ``ship`` writes
+    the file); a damaged file is named in one line."""
+    kwargs = dict(rings_km=(4,), azimuth_step_deg=180, duration_s=8.0, sampling_hz=100.0,
+                  fmax_hz=1.0)
+    monkeypatch.setattr(generate_module, "SHIPPED_DIR", tmp_path / "shipped")
+    computed = syn.generate_sources([tiny_source], out_dir=tmp_path / "a", ship=True,
+                                    **kwargs)[tiny_source]
+    shipped = generate_module.shipped_path(tiny_source)
+    with np.load(shipped) as data:
+        assert data["displacement_m"].shape[:2] == (2, 3)
+        assert str(data["pyprop8_version"]) == generate_module.PYPROP8_VERSION
+
+    def no_pyprop8(*args, **kwargs):
+        raise AssertionError("pyprop8 called")
+
+    monkeypatch.setattr(generate_module, "point_source_displacement", no_pyprop8)
+    from_file = syn.generate_sources([tiny_source], out_dir=tmp_path / "b", **kwargs)[tiny_source]
+    for a, b in zip(computed, from_file):
+        np.testing.assert_array_equal(Motion.load(a).acc, Motion.load(b).acc)
+    manifest = json.loads((tmp_path / "b" / tiny_source / "manifest.json").read_text())
+    assert manifest["displacements"].endswith(f"shipped/{tiny_source}.npz")
+    with pytest.raises(AssertionError, match="pyprop8 called"):     # another key: computed
+        syn.generate_sources([tiny_source], out_dir=tmp_path / "c", **dict(kwargs, fmax_hz=0.8))
+    shipped.write_bytes(b"not an npz")
+    with pytest.raises(InputError, match=r"shipped/tiny.npz: not a shipped synthetics file"):
+        syn.generate_sources([tiny_source], out_dir=tmp_path / "d", **kwargs)
+
+
+def test_the_shipped_displacements_are_the_default_sources_and_near_the_gmm_medians(
+        tmp_path, monkeypatch):
+    """records/synthetics holds each source at the default settings (else run-all computes
+    them: `python -m pipeline synthetics --ship`), with the SHA-256 its README states; the
+    motions made from them (no pyprop8 call) have ring-median RotD50 PGA and PGV within a
+    factor 2 of the NGA-West2 medians (CY14, BSSA14), an independent reference."""
+    readme = (generate_module.SHIPPED_DIR / "README.md").read_text()
+    for name in syn.SOURCES:
+        path = generate_module.shipped_path(name)
+        assert f"{hashlib.sha256(path.read_bytes()).hexdigest()}  {path.name}" in readme
+
+    def no_pyprop8(*args, **kwargs):
+        raise AssertionError("pyprop8 called: records/synthetics is not of the default "
+                             "settings and this pyprop8")
+
+    monkeypatch.setattr(generate_module, "point_source_displacement", no_pyprop8)
+    syn.generate_sources(list(syn.SOURCES), out_dir=tmp_path)
+    summary = pd.read_csv(tmp_path / "gmm_check.csv")
+    assert sorted(summary["source"].unique()) == sorted(syn.SOURCES)
+    assert list(summary["ring_km"].unique()) == list(syn.RINGS_KM)
+    ratios = summary[[f"ratio_{m}_{g}" for m in ("pga", "pgv") for g in ("cy14", "bssa14")]]
+    assert ((ratios > 0.5) & (ratios < 2.0)).all().all(), summary.to_string()
 
 
 def test_site_table_geometry():

@@ -26,8 +26,9 @@ from pipeline.motion.synthetics.compute import (band_limited_motion, generate, g
                                                  point_source_displacement)
 from pipeline.motion.synthetics.gmm import (GMM_VS30_M_S, gmm_check, gmm_summary, rotd50,
                                             rupture_distances, write_gmm_summary)
-from pipeline.motion.synthetics.sites import (DEFAULT_OUT_DIR, QUICK_DURATION_S, QUICK_FMAX_HZ,
-                                               QUICK_OUT_DIR, site_table)
+from pipeline.motion.synthetics.sites import (AZIMUTH_STEP_DEG, DEFAULT_OUT_DIR, QUICK_DURATION_S,
+                                               QUICK_FMAX_HZ, QUICK_OUT_DIR, RINGS_KM,
+                                               site_table)
 from pipeline.motion.synthetics.sources import (CRUST_LAYERS, LEAD_TIME_S, SOURCES,
                                                 moment_from_mw, rupture_centre,
                                                 source_parameters, subevents)

@@ -14,16 +14,19 @@ from pyprop8.utils import clp_filter, make_moment_tensor, rtf2xyz, stf_trapezoid
 from threadpoolctl import threadpool_limits
 from tqdm import tqdm
 
-from pipeline import files
+from pipeline import PROJECT_ROOT, RECORDS_DIR, files
 from pipeline.files import InputError, die_with_parent
 from pipeline.motion import Motion
 from pipeline.motion.synthetics.gmm import gmm_check, write_gmm_summary
-from pipeline.motion.synthetics.sites import settings, site_table
+from pipeline.motion.synthetics.sites import AZIMUTH_STEP_DEG, RINGS_KM, settings, site_table
 from pipeline.motion.synthetics.sources import (CRUST_LAYERS, LEAD_TIME_S, source_parameters,
                                                 subevents)
 
 GENERATOR_VERSION = 2  # bump when the written motions change
 PYPROP8_VERSION = importlib.metadata.version("pyprop8")
+# the sources' summed sub-event displacements at the default settings, computed by this
+# project and shipped so that a fresh checkout need not recompute them (README there)
+SHIPPED_DIR = RECORDS_DIR / "synthetics"
 
 
 def numerics(duration_s, sampling_hz, fmax_hz, layers=CRUST_LAYERS):
@@ -121,7 +124,7 @@ def _cache_key(source_name, cfg, num):
                               CRUST_LAYERS, LEAD_TIME_S, params, num)
 
 
-def generate(source_name, rings_km=(5, 10, 20), azimuth_step_deg=30, duration_s=30.0,
+def generate(source_name, rings_km=RINGS_KM, azimuth_step_deg=AZIMUTH_STEP_DEG, duration_s=30.0,
              sampling_hz=100.0, fmax_hz=10.0, out_dir=None, quick=False, jobs=None):
     """Compute (or reuse) the synthetic motions of all sites of one source.
 
@@ -138,12 +141,16 @@ def generate(source_name, rings_km=(5, 10, 20), azimuth_step_deg=30, duration_s=
                             fmax_hz, out_dir, quick, jobs)[source_name]
 
 
-def generate_sources(source_names, rings_km=(5, 10, 20), azimuth_step_deg=30, duration_s=30.0,
-                     sampling_hz=100.0, fmax_hz=10.0, out_dir=None, quick=False, jobs=None):
+def generate_sources(source_names, rings_km=RINGS_KM, azimuth_step_deg=AZIMUTH_STEP_DEG,
+                     duration_s=30.0,
+                     sampling_hz=100.0, fmax_hz=10.0, out_dir=None, quick=False, jobs=None,
+                     ship=False):
     """:func:`generate` for several sources at once: {source name: npz paths}.  The
     sub-events of every source to compute share one pool of ``jobs`` processes (two
     sources of five sub-events on 2 cores: five rounds of pyprop8 calls instead of six);
-    each source's motions are the same as computed alone."""
+    each source's motions are the same as computed alone.  A source whose displacements
+    ``SHIPPED_DIR`` holds for the same cache key and pyprop8 version is not recomputed;
+    ``ship``: compute every source (no cache) and write its displacements there."""
     cfg = settings(rings_km, azimuth_step_deg, duration_s, sampling_hz, fmax_hz, out_dir, quick)
     num = numerics(cfg["duration_s"], cfg["sampling_hz"], cfg["fmax_hz"])
     plans, tasks = {}, []
@@ -154,10 +161,14 @@ def generate_sources(source_names, rings_km=(5, 10, 20), azimuth_step_deg=30, du
         manifest_path = cfg["base"] / name / "manifest.json"
         key = _cache_key(name, cfg, num)
         plans[name] = {"src": src, "sites": sites, "paths": paths, "key": key}
-        if (manifest_path.is_file() and all(p.is_file() for p in paths)
+        if (not ship and manifest_path.is_file() and all(p.is_file() for p in paths)
                 and json.loads(manifest_path.read_text()).get("cache_key") == key):
             if not (cfg["base"] / name / "gmm_check_sites.csv").is_file():
                 _write_gmm_check(name, cfg)
+            continue
+        shipped = None if ship else load_shipped(name, key, len(sites), num["nt"])
+        if shipped is not None:
+            plans[name]["shipped"] = shipped
             continue
         mechanism = (src["strike_deg"], src["dip_deg"], src["rake_deg"])
         for _, sub in subevents(name).iterrows():
@@ -185,12 +196,56 @@ def generate_sources(source_names, rings_km=(5, 10, 20), azimuth_step_deg=30, du
         elapsed = time.monotonic() - started
         for name, total in totals.items():
             _write_source(name, plans[name], total, cfg, num, elapsed, jobs)
+            if ship:
+                save_shipped(name, plans[name]["key"], total, elapsed, jobs)
+    for name, plan in plans.items():
+        if "shipped" in plan:
+            path = shipped_path(name)
+            origin = str(path.relative_to(PROJECT_ROOT) if path.is_relative_to(PROJECT_ROOT)
+                         else path)
+            print(f"{name}: pyprop8 displacements from {origin} (the same parameters and "
+                  "pyprop8 version; not recomputed)", flush=True)
+            _write_source(name, plan, plan["shipped"], cfg, num, 0.0, 0, origin=origin)
     write_gmm_summary(cfg["base"])
     return {name: plans[name]["paths"] for name in source_names}
 
 
-def _write_source(name, plan, total, cfg, num, elapsed, jobs):
-    """Write one source's site motions, its GMM check and its manifest (last)."""
+def shipped_path(source_name):
+    return SHIPPED_DIR / f"{source_name}.npz"
+
+
+def load_shipped(source_name, key, n_sites, nt):
+    """The shipped displacements (m, sites x 3 x nt, the sum of the source's sub-events)
+    of ``source_name`` when computed with cache key ``key`` by this pyprop8 version, else
+    None; InputError naming the file when it is not such an array."""
+    path = shipped_path(source_name)
+    if not path.is_file():
+        return None
+    try:
+        with np.load(path, allow_pickle=False) as data:
+            if str(data["cache_key"]) != key or str(data["pyprop8_version"]) != PYPROP8_VERSION:
+                return None
+            disp = np.array(data["displacement_m"], dtype=float)
+    except (OSError, ValueError, KeyError) as exc:
+        raise InputError(f"{path}: not a shipped synthetics file ({exc})") from None
+    if disp.shape != (n_sites, 3, nt) or not np.isfinite(disp).all():
+        raise InputError(f"{path}: displacement_m must be {n_sites} x 3 x {nt} finite values, "
+                         f"got shape {disp.shape}")
+    return disp
+
+
+def save_shipped(source_name, key, total, elapsed_s, jobs):
+    """Write ``total`` (m, sites x 3 x nt) to ``SHIPPED_DIR`` with its cache key, the
+    pyprop8 version and what computing it cost (atomically)."""
+    files.write_npz(shipped_path(source_name), cache_key=np.array(key),
+                    pyprop8_version=np.array(PYPROP8_VERSION),
+                    displacement_m=np.asarray(total, dtype=float),
+                    compute_seconds=np.array(round(elapsed_s, 1)), jobs=np.array(jobs))
+
+
+def _write_source(name, plan, total, cfg, num, elapsed, jobs, origin="computed"):
+    """Write one source's site motions, its GMM check and its manifest (last);
+    ``origin``: where the displacements came from ("computed" or the shipped file)."""
     source_dir = cfg["base"] / name
     manifest_path = source_dir / "manifest.json"
     manifest_path.unlink(missing_ok=True)
@@ -206,7 +261,7 @@ def _write_source(name, plan, total, cfg, num, elapsed, jobs):
         "crust_layers_thickness_vp_vs_rho": [  # thickness null: the half-space
             [None if math.isinf(layer[0]) else layer[0], *layer[1:]] for layer in CRUST_LAYERS],
         "settings": {k: v for k, v in cfg.items() if k != "base"}, "numerics": num,
-        "compute_seconds": round(elapsed, 1), "jobs": jobs,
+        "displacements": origin, "compute_seconds": round(elapsed, 1), "jobs": jobs,
         "sites": [p.name for p in plan["paths"]]})
 
 

@@ -8,7 +8,7 @@ import pandas as pd
 from pipeline import files
 from pipeline.constants import STANDARD_GRAVITY
 from pipeline.motion import Motion
-from pipeline.motion.synthetics.sites import site_table
+from pipeline.motion.synthetics.sites import AZIMUTH_STEP_DEG, RINGS_KM, site_table
 from pipeline.motion.synthetics.sources import SOURCES, source_parameters, subevents
 
 GMM_VS30_M_S = 760.0  # reference rock for the ground-motion-model check
@@ -45,7 +45,7 @@ def rupture_distances(source_name, x_km, y_km):
     return to_segment(points, a, b), to_segment(points, a * surface, b * surface), rx
 
 
-def gmm_check(source_names=tuple(SOURCES), rings_km=(5, 10, 20), azimuth_step_deg=30,
+def gmm_check(source_names=tuple(SOURCES), rings_km=RINGS_KM, azimuth_step_deg=AZIMUTH_STEP_DEG,
               out_dir=None, quick=False):
     """Per-site synthetic PGA/PGV against NGA-West2 medians (pygmm), DataFrame.
 

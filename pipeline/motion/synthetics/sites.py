@@ -14,6 +14,8 @@ DEFAULT_OUT_DIR = RESULTS_DIR / "synthetics"
 QUICK_OUT_DIR = RESULTS_DIR / "synthetics-quick"
 QUICK_FMAX_HZ = 2.5
 QUICK_DURATION_S = 20.0
+RINGS_KM = (5.0, 10.0, 20.0)     # default site rings around the epicentre
+AZIMUTH_STEP_DEG = 30.0          # default step between the sites of a ring
 
 
 def settings(rings_km, azimuth_step_deg, duration_s, sampling_hz, fmax_hz, out_dir, quick):
@@ -29,7 +31,7 @@ def settings(rings_km, azimuth_step_deg, duration_s, sampling_hz, fmax_hz, out_d
             "fmax_hz": float(fmax_hz), "base": base}
 
 
-def site_table(source_name, rings_km=(5, 10, 20), azimuth_step_deg=30, out_dir=None,
+def site_table(source_name, rings_km=RINGS_KM, azimuth_step_deg=AZIMUTH_STEP_DEG, out_dir=None,
                quick=False):
     """Sites on rings around the epicentre of ``source_name``.
 
