@@ -170,6 +170,14 @@ class DirectoryLock:
         return False
 
 
+def check_jobs(jobs):
+    """The number of parallel processes a ``--jobs`` option asks for: None is every core;
+    InputError below 1."""
+    if jobs is not None and jobs < 1:
+        raise InputError(f"--jobs must be at least 1, got {jobs}")
+    return jobs or os.cpu_count() or 1
+
+
 def die_with_parent(parent_pid=None):
     """In a child process (``preexec_fn``, a Pool's ``initializer``): be killed when the
     parent dies, even by kill -9 (Linux PR_SET_PDEATHSIG), and leave Ctrl-C to the parent.

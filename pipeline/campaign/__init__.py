@@ -20,7 +20,7 @@ from pathlib import Path
 from typing import Callable
 
 from pipeline import RESULTS_DIR
-from pipeline.files import DirectoryLock, InputError, ToolError, write_json
+from pipeline.files import DirectoryLock, InputError, ToolError, check_jobs, write_json
 from pipeline.campaign.executor import EXECUTORS, execute
 
 CAMPAIGNS = {}
@@ -90,10 +90,8 @@ def run_campaign(name, jobs=None, records=None, campaign_dir=None, animations=1,
         raise InputError(f"--executor must be one of {', '.join(EXECUTORS)}, got {executor!r}")
     if scheduler and executor == "threads":
         raise InputError("--scheduler runs on a Dask cluster: drop --executor threads")
-    if jobs is None and not scheduler:      # on a cluster: as many as it has worker threads
-        jobs = os.cpu_count() or 1
-    if jobs is not None and jobs < 1:
-        raise InputError(f"--jobs must be at least 1, got {jobs}")
+    if jobs is not None or not scheduler:   # on a cluster: as many as it has worker threads
+        jobs = check_jobs(jobs)
     campaign_dir = Path(campaign_dir or RESULTS_DIR / name)
     if campaign_dir.exists() and not campaign_dir.is_dir():
         raise InputError(f"--out {campaign_dir} is a file, not a directory")

@@ -6,13 +6,12 @@
     python -m pipeline invert --hidden-truth TRUTH.json --table FILE
 """
 import math
-import os
 import time
 from pathlib import Path
 
 from pipeline.constants import COLUMN_TYPES
 from pipeline import RESULTS_DIR
-from pipeline.files import InputError
+from pipeline.files import InputError, check_jobs
 
 NAME = "invert"
 ORDER = 45
@@ -205,12 +204,6 @@ def build_grids(args):
     return preset, grid, candidates
 
 
-def _check_jobs(jobs):
-    if jobs is not None and jobs < 1:
-        raise InputError(f"--jobs must be at least 1, got {jobs}")
-    return jobs or os.cpu_count() or 1
-
-
 def described_columns(observations, base_dir="."):
     """{column name in the observations: its description dict} for every column that is a
     column file (a shipped example's name, or a file, relative to ``base_dir`` (the
@@ -282,8 +275,8 @@ def forward_table(args, grid, sibling_of=None):
                 "reused_file": True}
         return table, info
     if not args.scheduler:
-        preflight(grid, args.forward_dir, _check_jobs(args.jobs), args.allow_long)
-    table, cost = run_forward(grid, args.forward_dir, _check_jobs(args.jobs), args.scheduler)
+        preflight(grid, args.forward_dir, check_jobs(args.jobs), args.allow_long)
+    table, cost = run_forward(grid, args.forward_dir, check_jobs(args.jobs), args.scheduler)
     return table, {**cost, "grid": grid.as_dict(), "grid_key": grid.key(),
                    "code_version": table.info.get("code_version"), "reused_file": False}
 
@@ -300,7 +293,7 @@ def run(args):
         raise InputError("--trials (1-1000) goes with --demo or --member-study")
     from pipeline.inversion.likelihood import check_model_options
     check_model_options(args.kernel_deg, args.floor, getattr(args, "likelihood", "independent"))
-    _check_jobs(args.jobs)
+    check_jobs(args.jobs)
     preset, grid, candidates = build_grids(args)
     if args.demo:
         return _run_demo(args, preset, grid, candidates)
@@ -369,7 +362,7 @@ def _run_demo(args, preset, grid, candidates):
                 print(f"paper scenario, {source}: no {sibling.name} beside --table: skipped")
             continue
         paper_tables[source], cost = run_forward(pgrid, args.forward_dir,
-                                                 _check_jobs(args.jobs), args.scheduler)
+                                                 check_jobs(args.jobs), args.scheduler)
         costs[f"paper_{source}"] = {**cost, "grid": pgrid.as_dict()}
     summary = run_demo(table, out, candidates, paper_tables, DEFAULT_TRIALS if args.trials is None else args.trials,
                        args.kernel_deg, args.floor, forward_info={**info, "costs": costs,
@@ -421,7 +414,7 @@ def _run_member_study(args, grid, candidates):
     table, info = forward_table(args, grid)
     trials = STUDY_TRIALS if args.trials is None else args.trials
 
-    jobs = _check_jobs(args.jobs)
+    jobs = check_jobs(args.jobs)
     print(f"member study: {trials} trials per configuration on {jobs} process(es)",
           flush=True)
 
@@ -474,7 +467,7 @@ def _run_hidden_truth(args, grid, candidates):
     check_hidden(truth, table_grid)
     print(f"hidden truth: {sum(s[3] for s in truth.sites)} twin runs at "
           f"{len(truth.sites)} site(s)", flush=True)
-    result = run_campaign("inversion-truth", jobs=_check_jobs(args.jobs),
+    result = run_campaign("inversion-truth", jobs=check_jobs(args.jobs),
                           campaign_dir=out / "truth-runs", animations=0,
                           options={"truth": truth, "grid": table_grid, "jobs": args.jobs},
                           scheduler=args.scheduler)

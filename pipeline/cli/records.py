@@ -1,10 +1,12 @@
 """``records``: process strong-motion records into npz, Table 1 (records.csv) and figures."""
+import os
+from multiprocessing import Pool
 from pathlib import Path
 
 import pandas as pd
 
 from pipeline import RESULTS_DIR, files
-from pipeline.files import InputError
+from pipeline.files import InputError, check_jobs, die_with_parent
 from pipeline.motion import Motion
 from pipeline.motion.measures import record_parameters
 from pipeline.records import CACHE_DIR, build_motion, peer_check, processed_motion, resolve, sets
@@ -31,6 +33,8 @@ def setup(parser):
     parser.add_argument("--out", type=Path, default=None,
                         help="output directory (default results/records)")
     parser.add_argument("--no-figures", action="store_true", help="skip the per-record figures")
+    parser.add_argument("--jobs", type=int, default=None,
+                        help="processes drawing the figures (default: all cores)")
 
 
 def parameters_table(motions):
@@ -48,7 +52,6 @@ def parameters_table(motions):
 
 
 def run(args):
-    from pipeline.figures.records import plot_motion
     specs = sets.record_ids("all") if args.all else []
     if args.record_set:
         specs += [i for i in sets.record_ids(args.record_set) if i not in specs]
@@ -57,6 +60,7 @@ def run(args):
         raise InputError("name records (ids or files) or use --all or --set NAME")
     if args.back_azimuth is not None and not 0.0 <= args.back_azimuth < 360.0:
         raise InputError(f"--back-azimuth {args.back_azimuth:g} not in [0, 360)")
+    jobs = check_jobs(args.jobs)
     out_dir = args.out if args.out is not None else DEFAULT_OUT
     if out_dir.exists() and not out_dir.is_dir():
         raise InputError(f"--out {out_dir} exists and is not a directory")
@@ -83,12 +87,14 @@ def run(args):
                             out_path, True))
             print(f"{record_id}: processed", flush=True)
 
+    figures = []
     for record_id, motion, out_path, fresh in motions:
         if fresh:
             motion.save(out_path)
         figure = out_path.with_suffix(".png")
         if not args.no_figures and (fresh or not figure.is_file()):
-            plot_motion(motion, figure)
+            figures.append((motion, figure))
+    plot_motions(figures, jobs)
     table = parameters_table([(rid, motion) for rid, motion, _, _ in motions])
     _update_table(Path(out_dir) / "records.csv", table)
     sources = {rid: spec for spec, (rid, _, _, _) in zip(specs, motions)}
@@ -100,6 +106,25 @@ def run(args):
         report_peer_check(pd.read_csv(Path(out_dir) / "peer_check.csv", dtype={"id": str}))
     print(f"wrote {len(motions)} records to {out_dir}", flush=True)
     return 0
+
+
+def plot_motions(figures, jobs):
+    """Draw each (motion, png path) of ``figures`` (:func:`~pipeline.figures.records.
+    plot_motion`), in ``jobs`` processes when there are several."""
+    from pipeline.figures.records import plot_motion
+    if jobs < 2 or len(figures) < 2:
+        for motion, path in figures:
+            plot_motion(motion, path)
+        return
+    with Pool(min(jobs, len(figures)), initializer=die_with_parent,
+              initargs=(os.getpid(),)) as pool:          # leaving it (Ctrl-C too) kills it
+        for _ in pool.imap_unordered(_plot_motion, figures, chunksize=4):
+            pass
+
+
+def _plot_motion(figure):
+    from pipeline.figures.records import plot_motion
+    plot_motion(*figure)
 
 
 def report_peer_check(table):

@@ -1,8 +1,7 @@
 """``synthetics``: synthetic near-field motions (pyprop8) around two M 6.5 sources."""
-import os
 import time
 
-from pipeline.files import InputError
+from pipeline.files import InputError, check_jobs
 from pipeline.motion.synthetics import (AZIMUTH_STEP_DEG, GMM_VS30_M_S, RINGS_KM, QUICK_DURATION_S, QUICK_FMAX_HZ, SOURCES,
                                         generate_sources, source_parameters,
                                         write_gmm_summary)
@@ -33,7 +32,7 @@ def setup(parser):
     parser.add_argument("--quick", action="store_true",
                         help=f"fmax {QUICK_FMAX_HZ:g} Hz, {QUICK_DURATION_S:g} s, "
                         "written to results/synthetics-quick")
-    parser.add_argument("--jobs", type=int, default=os.cpu_count() or 1,
+    parser.add_argument("--jobs", type=int, default=None,
                         help="parallel processes (default: all cores)")
     parser.add_argument("--ship", action="store_true",
                         help="compute the sources anew (no cache) and write their pyprop8 "
@@ -42,6 +41,7 @@ def setup(parser):
 
 
 def run(args):
+    check_jobs(args.jobs)
     names = list(SOURCES) if args.source == "all" else [args.source]
     for name in names:
         source_parameters(name)
@@ -51,7 +51,7 @@ def run(args):
                          "drop --quick, --rings and --step")
     started = time.monotonic()
     generated = generate_sources(names, rings, args.step, quick=args.quick,
-                                 jobs=max(1, args.jobs), ship=args.ship)
+                                 jobs=check_jobs(args.jobs), ship=args.ship)
     for name, paths in generated.items():
         print(f"{name}: {len(paths)} sites in {paths[0].parent}")
     print(f"{time.monotonic() - started:.0f} s (cached when ~0)")

@@ -14,6 +14,7 @@ import pytest
 from obspy import Stream, Trace
 
 from pipeline import cli
+from pipeline.files import check_jobs
 from pipeline.motion import Motion
 from pipeline.motion.pulses import one_sine_pulse
 
@@ -161,6 +162,21 @@ def test_bad_record_file_one_line_and_nothing_written(tmp_path, case, capsys):
     err = _one_line_error(capsys, cli.main(["run", "--record", str(path), "--out",
                                             str(tmp_path / "run")]))
     assert not (tmp_path / "run").exists()
+
+
+@pytest.mark.parametrize("command", [["records", "GM20"], ["synthetics", "--quick"]])
+@pytest.mark.parametrize("jobs", ["0", "-2"])
+def test_jobs_below_one_one_line_and_nothing_written(tmp_path, capsys, command, jobs):
+    """--jobs below 1 is refused, not taken as 1 (synthetics took max(1, jobs))."""
+    out = tmp_path / "out"
+    extra = ["--out", str(out)] if command[0] == "records" else []
+    err = _one_line_error(capsys, cli.main([*command, "--jobs", jobs, *extra]))
+    assert f"--jobs must be at least 1, got {jobs}" in err
+    assert not out.exists()
+
+
+def test_check_jobs_takes_every_core_by_default():
+    assert check_jobs(None) == (os.cpu_count() or 1) and check_jobs(3) == 3
 
 
 @pytest.mark.parametrize("case", sorted(PARAMETER_CASES))
