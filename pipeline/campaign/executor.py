@@ -25,7 +25,8 @@ exits 130.
 
 Once the first runs are done (as many as run at once), a campaign whose rest takes
 ``FORECAST_FROM_S`` or more says how long, measured on this machine: a warning from
-``WARN_FROM_S`` on; it says it again when the pace moves the rest by ``REVISE_FACTOR``.
+``WARN_FROM_S`` on; it says it again, a few times in hours at most, when the pace moves
+the rest by ``REVISE_FACTOR``.
 """
 import os
 import time
@@ -44,7 +45,7 @@ EXECUTORS = ("threads", "dask")
 DEFAULT_EXECUTOR = "threads"    # why: docs/campaigns.md, "On a cluster: Dask" (start-up, ports)
 FORECAST_FROM_S = 600.0         # a campaign says how long its rest takes from 10 min on
 WARN_FROM_S = 3600.0            # ... and warns from an hour on
-REVISE_FACTOR = 1.5             # ... and says it again when the pace moves it this much
+REVISE_FACTOR = 1.5             # ... and again when the pace moves it this much
 
 
 def execute(specs, campaign_dir, jobs, worker, label="runs", executor=None, scheduler=None):
@@ -89,12 +90,13 @@ def execute(specs, campaign_dir, jobs, worker, label="runs", executor=None, sche
 class ForecastBar(tqdm):
     """The campaign's progress bar.  Once the ``first`` runs of this session are done it
     says how long the rest takes at the pace so far (wall time on this machine) when that
-    is ``FORECAST_FROM_S`` or more, as a warning from ``WARN_FROM_S`` on; and says it
-    again, at the pace of the runs done since, when that pace puts the rest
-    ``REVISE_FACTOR`` times and ``FORECAST_FROM_S`` longer or shorter than the last
-    forecast (looked at once ``2 first`` runs more are done).  ``weights``: the runs' seconds of motion in the order they start
-    (longest first); the pace is per second of motion, so that the long first runs do
-    not stretch the forecast (per run when the motions' lengths are unknown)."""
+    is ``FORECAST_FROM_S`` or more, as a warning from ``WARN_FROM_S`` on.  It says it
+    again when the pace of every run done so far puts the rest ``REVISE_FACTOR`` times
+    (and ``FORECAST_FROM_S``) longer or shorter than the last forecast, at most once per
+    half the time the campaign has run and ``FORECAST_FROM_S`` apart (so a few times in
+    hours).  ``weights``: the runs' seconds of motion in the order they start (longest
+    first); the pace is per second of motion, so that the long first runs do not stretch
+    the forecast (per run when the motions' lengths are unknown)."""
 
     clock = staticmethod(time.monotonic)
 
@@ -103,7 +105,7 @@ class ForecastBar(tqdm):
         self.name, self.first = name, first
         self.weights = list(weights) if all(w > 0 for w in weights) else []
         self.started = self.clock()
-        self.forecast = None        # the last: (clock, rest s, runs finished then)
+        self.forecast = None        # the last said or looked at: (clock, rest s)
 
     def update(self, n=1):
         shown = super().update(n)
@@ -111,38 +113,35 @@ class ForecastBar(tqdm):
         if finished < self.first or left <= 0:
             return shown
         now = self.clock()
+        rest_s = self.rest_s(now, finished, left)
         if self.forecast is None:
-            rest_s = self.rest_s(now, finished, left)
-            self.forecast = (now, rest_s, finished)
+            self.forecast = (now, rest_s)
             if rest_s >= FORECAST_FROM_S:
                 self.say(rest_s, left, f"the first {finished}")
             return shown
-        said_at, said_rest_s, said_finished = self.forecast
-        if finished - said_finished < 2 * self.first:      # runs end in bursts of `first`
+        said_at, said_rest_s = self.forecast
+        if now - said_at < max(FORECAST_FROM_S, 0.5 * (now - self.started)):
             return shown
         expected_s = max(said_rest_s - (now - said_at), 0.0)
-        rest_s = self.rest_s(now, finished, left, since=(said_at, said_finished))
-        moved = (rest_s > REVISE_FACTOR * expected_s or rest_s * REVISE_FACTOR < expected_s)
+        moved = rest_s > REVISE_FACTOR * expected_s or rest_s * REVISE_FACTOR < expected_s
         if moved and abs(rest_s - expected_s) >= FORECAST_FROM_S <= rest_s:
-            self.forecast = (now, rest_s, finished)
-            self.say(rest_s, left, f"the last {finished - said_finished}",
-                     revised=said_rest_s)
+            self.forecast = (now, rest_s)
+            self.say(rest_s, left, f"all {finished} so far", expected_s=expected_s)
         return shown
 
-    def rest_s(self, now, finished, left, since=None):
-        """Wall seconds the ``left`` runs take at the pace of the ``finished`` ones, or of
-        those finished ``since`` (clock, runs finished then)."""
-        start, before = since or (self.started, 0)
-        pace_s = (now - start) / (finished - before)                     # per run
+    def rest_s(self, now, finished, left):
+        """Wall seconds the ``left`` runs take at the pace of the ``finished`` ones."""
+        pace_s = (now - self.started) / finished                         # per run
         if len(self.weights) == finished + left:                         # per motion second
-            done_s = sum(self.weights[before:finished])
-            return sum(self.weights[finished:]) * pace_s * (finished - before) / done_s
+            return sum(self.weights[finished:]) * pace_s * finished / sum(self.weights[:finished])
         return left * pace_s
 
-    def say(self, rest_s, left, pace_of, revised=None):
-        """One line: the rest's duration (as a warning from WARN_FROM_S on)."""
+    def say(self, rest_s, left, pace_of, expected_s=None):
+        """One line: the rest's duration (as a warning from WARN_FROM_S on); with
+        ``expected_s``, what the last forecast left for it."""
         head = "warning: " if rest_s >= WARN_FROM_S else ""
-        change = "" if revised is None else f" (said {duration_text(revised)} before)"
+        change = ("" if expected_s is None
+                  else f", not the {duration_text(expected_s)} said before")
         self.write(f"{head}{self.name}: the other {left} runs take about "
                    f"{duration_text(rest_s)} at the pace of {pace_of}{change}; Ctrl-C stops "
                    "the campaign and the same command resumes it, keeping every finished run")

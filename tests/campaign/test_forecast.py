@@ -2,6 +2,7 @@
 hours of work; short campaigns say nothing."""
 import contextlib
 import io
+import math
 import re
 import time
 from pathlib import Path
@@ -100,31 +101,39 @@ def test_a_steady_pace_is_said_once(monkeypatch):
 
 
 def test_a_pace_that_slows_is_said_again_with_what_was_said_before(monkeypatch):
-    """Two quick runs say 18 x 10 s = 3 min; the next four runs of 100 s each put the
-    other 14 at 23 min: said again, once (the pace then holds), naming the earlier
-    forecast."""
+    """Two runs of 10 s say 18 x 10 s = 3 min; after the third, of 100 s, all three
+    put the other 17 at 17 x 40 s = 11 min where the forecast left 80 s: said again.
+    The pace of all runs lags a change, so later lines follow, but each at least twice
+    as late as the one before: a few in hours."""
     monkeypatch.setattr(executor, "FORECAST_FROM_S", 60.0)
-    lines = forecast_lines([10.0, 10.0] + [100.0] * 18)
-    assert len(lines) == 2, lines
+    paces = [10.0, 10.0] + [100.0] * 18
+    lines = forecast_lines(paces)
     assert "the other 18 runs take about 3 min at the pace of the first 2;" in lines[0]
-    assert ("the other 14 runs take about 23 min at the pace of the last 4 (said 3 min "
-            "before); Ctrl-C stops") in lines[1]
-
-
-def test_the_revision_paces_per_second_of_motion(monkeypatch):
-    """Runs of 4 s of motion first, then of 1 s at 4x the wall time per motion second:
-    the revision counts the motion seconds left (14 x 1 s at 20 s per s), not the runs."""
-    monkeypatch.setattr(executor, "FORECAST_FROM_S", 60.0)
-    lines = forecast_lines([20.0, 20.0] + [20.0] * 18, weights=[4, 4] + [1] * 18)
-    assert len(lines) == 2, lines
-    assert "the other 18 runs take about 2 min at the pace of the first 2;" in lines[0]
-    assert "the other 14 runs take about 5 min at the pace of the last 4" in lines[1]
+    assert ("the other 17 runs take about 11 min at the pace of all 3 so far, not the 1 min "
+            "said before; Ctrl-C stops") in lines[1]
+    assert len(lines) <= 1 + math.log2(sum(paces) / sum(paces[:2]))
 
 
 def test_a_pace_that_speeds_up_is_said_again_and_nothing_below_the_threshold(monkeypatch):
+    """Two runs of 100 s say 63 min; runs of 10 s follow.  Not said again before the
+    campaign has run twice as long (t = 400 s, 22 runs): then 18 x 400/22 s = 5 min."""
     monkeypatch.setattr(executor, "FORECAST_FROM_S", 60.0)
     lines = forecast_lines([100.0, 100.0] + [10.0] * 38)
     assert len(lines) == 2, lines
-    assert "the other 34 runs take about 6 min at the pace of the last 4 (said 63 min" in lines[1]
+    assert lines[0].startswith("warning: c: the other 38 runs take about 63 min")
+    assert ("c: the other 18 runs take about 5 min at the pace of all 22 so far, not the 60 "
+            "min said before") in lines[1]
     monkeypatch.setattr(executor, "FORECAST_FROM_S", 1e9)
     assert forecast_lines([10.0, 10.0] + [100.0] * 18) == []
+
+
+def test_the_revision_paces_per_second_of_motion(monkeypatch):
+    """Runs of 4 s of motion, then of 1 s, each taking 20 s: first 18 x 1 s at 40/8 s per
+    s = 90 s; at t = 100 s (twice the first forecast's time and 60 s on) the other 15
+    runs take 15 s of motion at 100/11 s per s, not the 30 s the forecast left."""
+    monkeypatch.setattr(executor, "FORECAST_FROM_S", 60.0)
+    said = []
+    monkeypatch.setattr(executor, "duration_text", lambda s: said.append(s) or "x")
+    forecast_lines([20.0] * 20, weights=[4, 4] + [1] * 18)
+    # said: the first forecast, then the revision's "not the ... said before", then its rest
+    assert said[:3] == [pytest.approx(90.0), pytest.approx(30.0), pytest.approx(15 * 100 / 11)]
