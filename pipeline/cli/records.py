@@ -111,10 +111,9 @@ def run(args):
 def plot_motions(figures, jobs):
     """Draw each (motion, png path) of ``figures`` (:func:`~pipeline.figures.records.
     plot_motion`), in ``jobs`` processes when there are several."""
-    from pipeline.figures.records import plot_motion
     if jobs < 2 or len(figures) < 2:
-        for motion, path in figures:
-            plot_motion(motion, path)
+        for figure in figures:
+            _plot_motion(figure)
         return
     with Pool(min(jobs, len(figures)), initializer=die_with_parent,
               initargs=(os.getpid(),)) as pool:          # leaving it (Ctrl-C too) kills it
@@ -123,7 +122,7 @@ def plot_motions(figures, jobs):
 
 
 def _plot_motion(figure):
-    from pipeline.figures.records import plot_motion
+    from pipeline.figures.records import plot_motion      # matplotlib: not for --help
     plot_motion(*figure)
 
 

@@ -2,9 +2,9 @@
 import time
 
 from pipeline.files import InputError, check_jobs
-from pipeline.motion.synthetics import (AZIMUTH_STEP_DEG, GMM_VS30_M_S, RINGS_KM, QUICK_DURATION_S, QUICK_FMAX_HZ, SOURCES,
-                                        generate_sources, source_parameters,
-                                        write_gmm_summary)
+from pipeline.motion.synthetics import (AZIMUTH_STEP_DEG, GMM_VS30_M_S, QUICK_DURATION_S,
+                                        QUICK_FMAX_HZ, RINGS_KM, SOURCES, generate_sources,
+                                        source_parameters, write_gmm_summary)
 
 NAME = "synthetics"
 ORDER = 50
