@@ -120,13 +120,15 @@ def pulse(amplitude=PULSE["amplitude"]):
     return one_sine_pulse(PULSE["azimuth_deg"], amplitude, PULSE["period"], PULSE["duration"])
 
 
-def prepare(run_dir, kind="both", motion=None, t_max=None, timing=False, **numerics):
+def prepare(run_dir, kind="both", motion=None, t_max=None, timing=False, columns=None,
+            **numerics):
     """Write a scenario directory; t_max None: motion + tail with the default early stop,
     else exactly t_max simulated seconds (no early stop).  ``timing``: patch the copied
-    scene to record YADE's engine timing."""
+    scene to record YADE's engine timing; ``columns``: the scene's column specs instead of
+    ``Column(kind)``'s."""
     if t_max is not None:
         numerics.setdefault("rest_duration_s", 1e9)
-    params = scene_params(columns=Column(kind).specs(), numerics=Numerics(**numerics),
+    params = scene_params(columns=columns or Column(kind).specs(), numerics=Numerics(**numerics),
                           motion_duration=0.0 if motion is None else motion.duration,
                           t_max=t_max)
     patch_scene(write_scenario(run_dir, params, motion), t_max is not None, timing)
@@ -493,11 +495,8 @@ def members_per_scene(work, shaking):
     for n in MEMBERS_PER_SCENE:
         specs = [dataclasses.replace(spec, name=f"{spec.name}{k}", y=MEMBER_SPACING_M * k)
                  for k in range(n) for spec in Column("both").specs()]
-        params = scene_params(columns=specs, numerics=Numerics(rest_duration_s=1e9),
-                              motion_duration=shaking.duration, t_max=shaking.duration)
-        run_dir = work / f"two_x_members_{n}"
-        patch_scene(write_scenario(run_dir, params, shaking), fixed=True)
-        traj = run_timed(run_dir)
+        traj = run_timed(prepare(work / f"two_x_members_{n}", motion=shaking,
+                                 t_max=shaking.duration, columns=specs))
         loop = traj.extra["loop_wall_s"]
         rows.append({"members": n, "time_step_s": traj.dt, "loop_wall_s": loop,
                      "wall_s_per_member": loop / n, "members_per_wall_hour": 3600.0 * n / loop,

@@ -170,6 +170,14 @@ class DirectoryLock:
         return False
 
 
+def display_path(path):
+    """``path`` as people read it: relative to the project when inside it."""
+    try:
+        return str(Path(path).resolve().relative_to(PROJECT_ROOT))
+    except ValueError:
+        return str(path)
+
+
 def check_jobs(jobs):
     """The number of parallel processes a ``--jobs`` option asks for: None is every core;
     InputError below 1."""

@@ -113,8 +113,8 @@ class ForecastBar(tqdm):
         if finished < self.first or left <= 0:
             return shown
         now = self.clock()
-        rest_s = self.rest_s(now, finished, left)
         if self.forecast is None:
+            rest_s = self.rest_s(now, finished, left)
             self.forecast = (now, rest_s)
             if rest_s >= FORECAST_FROM_S:
                 self.say(rest_s, left, f"the first {finished}")
@@ -123,6 +123,7 @@ class ForecastBar(tqdm):
         if now - said_at < max(FORECAST_FROM_S, 0.5 * (now - self.started)):
             return shown
         expected_s = max(said_rest_s - (now - said_at), 0.0)
+        rest_s = self.rest_s(now, finished, left)
         moved = rest_s > REVISE_FACTOR * expected_s or rest_s * REVISE_FACTOR < expected_s
         if moved and abs(rest_s - expected_s) >= FORECAST_FROM_S <= rest_s:
             self.forecast = (now, rest_s)

@@ -41,7 +41,7 @@ def setup(parser):
 
 
 def run(args):
-    check_jobs(args.jobs)
+    jobs = check_jobs(args.jobs)
     names = list(SOURCES) if args.source == "all" else [args.source]
     for name in names:
         source_parameters(name)
@@ -51,7 +51,7 @@ def run(args):
                          "drop --quick, --rings and --step")
     started = time.monotonic()
     generated = generate_sources(names, rings, args.step, quick=args.quick,
-                                 jobs=check_jobs(args.jobs), ship=args.ship)
+                                 jobs=jobs, ship=args.ship)
     for name, paths in generated.items():
         print(f"{name}: {len(paths)} sites in {paths[0].parent}")
     print(f"{time.monotonic() - started:.0f} s (cached when ~0)")

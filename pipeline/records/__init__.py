@@ -16,8 +16,8 @@ import numpy as np
 from obspy import UTCDateTime
 from obspy.geodetics import gps2dist_azimuth
 
-from pipeline import PROJECT_ROOT, RECORDS_DIR, RESULTS_DIR
-from pipeline.files import InputError, code_hash, content_hash
+from pipeline import RECORDS_DIR, RESULTS_DIR
+from pipeline.files import InputError, code_hash, content_hash, display_path
 from pipeline.provenance import software_versions
 from pipeline.motion import Motion
 from pipeline.records import processing
@@ -231,7 +231,7 @@ def _motion_meta(source, row, info, back_azimuth, has_vertical):
             "mechanism": row.get("mechanism"), "has_vertical": bool(has_vertical),
             "horizontals_compass": row.get("horizontals_compass", True),
             "orientation": row.get("orientation", "as-recorded"),
-            "source_file": _display_path(source.path), "source_key": row.get("source_key"),
+            "source_file": display_path(source.path), "source_key": row.get("source_key"),
             "units": {"dt": "s", "acc": "m/s^2", "vel": "m/s", "disp": "m"},
             "columns": ["East", "North", "Up"]}
     coords = {k: pick(k) for k in ("station_lat", "station_lon", "event_lat", "event_lon")}
@@ -267,10 +267,3 @@ def _motion_meta(source, row, info, back_azimuth, has_vertical):
     if row.get("notes"):
         meta["notes"] = (meta.get("notes", "") + "; " + row["notes"]).lstrip("; ")
     return meta
-
-
-def _display_path(path):
-    try:
-        return str(Path(path).resolve().relative_to(PROJECT_ROOT))
-    except ValueError:
-        return str(path)

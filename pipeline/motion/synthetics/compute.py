@@ -14,8 +14,8 @@ from pyprop8.utils import clp_filter, make_moment_tensor, rtf2xyz, stf_trapezoid
 from threadpoolctl import threadpool_limits
 from tqdm import tqdm
 
-from pipeline import PROJECT_ROOT, RECORDS_DIR, files
-from pipeline.files import InputError, die_with_parent
+from pipeline import RECORDS_DIR, files
+from pipeline.files import InputError, die_with_parent, display_path
 from pipeline.motion import Motion
 from pipeline.motion.synthetics.gmm import gmm_check, write_gmm_summary
 from pipeline.motion.synthetics.sites import AZIMUTH_STEP_DEG, RINGS_KM, settings, site_table
@@ -142,9 +142,8 @@ def generate(source_name, rings_km=RINGS_KM, azimuth_step_deg=AZIMUTH_STEP_DEG, 
 
 
 def generate_sources(source_names, rings_km=RINGS_KM, azimuth_step_deg=AZIMUTH_STEP_DEG,
-                     duration_s=30.0,
-                     sampling_hz=100.0, fmax_hz=10.0, out_dir=None, quick=False, jobs=None,
-                     ship=False):
+                     duration_s=30.0, sampling_hz=100.0, fmax_hz=10.0, out_dir=None,
+                     quick=False, jobs=None, ship=False):
     """:func:`generate` for several sources at once: {source name: npz paths}.  The
     sub-events of every source to compute share one pool of ``jobs`` processes (two
     sources of five sub-events on 2 cores: five rounds of pyprop8 calls instead of six);
@@ -200,9 +199,7 @@ def generate_sources(source_names, rings_km=RINGS_KM, azimuth_step_deg=AZIMUTH_S
                 save_shipped(name, plans[name]["key"], total, elapsed, jobs)
     for name, plan in plans.items():
         if "shipped" in plan:
-            path = shipped_path(name)
-            origin = str(path.relative_to(PROJECT_ROOT) if path.is_relative_to(PROJECT_ROOT)
-                         else path)
+            origin = display_path(shipped_path(name))
             print(f"{name}: pyprop8 displacements from {origin} (the same parameters and "
                   "pyprop8 version; not recomputed)", flush=True)
             _write_source(name, plan, plan["shipped"], cfg, num, 0.0, 0, origin=origin)
