@@ -38,11 +38,23 @@ def check_scale(value, flag="--scale"):
         raise InputError(f"{flag} {value!r} outside the allowed range [0, {MAX_SCALE:g}]")
 
 
+def motion_window(motion, window):
+    """``window`` = (start_s, end_s) on the record's clock (s after the record's first
+    sample, as every time a user reads) as times on ``motion``'s own clock."""
+    start, end = (float(t) - motion.start_in_file_s for t in window)
+    if -1e-9 < start < 0.0:         # the motion's first sample, but for round-off
+        start = 0.0
+    if not (math.isfinite(start) and math.isfinite(end) and 0.0 <= start < end):
+        raise InputError(f"window {window[0]:g}-{window[1]:g} s (record's clock) must lie "
+                         f"within the motion, which starts at {motion.start_in_file_s:g} s")
+    return start, end
+
+
 def drive_motion(motion, window=None, rotate_deg=0.0, scale=1.0):
-    """The pedestal's motion: ``motion`` cut to ``window`` = (start_s, end_s), turned
-    clockwise by ``rotate_deg`` and scaled by ``scale``."""
+    """The pedestal's motion: ``motion`` cut to ``window`` = (start_s, end_s) on the
+    record's clock, turned clockwise by ``rotate_deg`` and scaled by ``scale``."""
     if window is not None:
-        motion = motion.window(*window)
+        motion = motion.window(*motion_window(motion, window))
     return motion.rotate(rotate_deg).scale(scale)
 
 
@@ -110,7 +122,8 @@ def simulate(motion, out_dir, column=None, contact=None, numerics=None, window=N
              timeout_s=None):
     """Run one scenario of ``motion`` (a processed :class:`~pipeline.motion.Motion`) and
     write ``out_dir/summary.json`` last (atomically); return its
-    :class:`~pipeline.outcome.summary.RunSummary`.
+    :class:`~pipeline.outcome.summary.RunSummary`.  ``window`` (s) and the summary's
+    times are on the record's clock; the scene and its trajectory on the motion's.
 
     column, contact, numerics: parameter dataclasses (defaults: the paper's).
     """
@@ -122,8 +135,8 @@ def simulate(motion, out_dir, column=None, contact=None, numerics=None, window=N
     drive = drive_motion(motion, window, rotate_deg, scale)
     signal_end = motion.meta.get("signal_end_s")
     if signal_end is not None:          # the stop checks treat the motion as over there
-        signal_end = float(min(max(signal_end - (window[0] if window else 0.0), 0.0),
-                               drive.duration))
+        shift = drive.start_in_file_s - motion.start_in_file_s     # the window's start
+        signal_end = float(min(max(signal_end - shift, 0.0), drive.duration))
     params = scene_params(columns=column.specs(), contact=contact, numerics=numerics,
                           motion_duration=drive.duration,
                           t_max=None if signal_end is None else signal_end + numerics.tail_s)
@@ -155,11 +168,13 @@ def simulate(motion, out_dir, column=None, contact=None, numerics=None, window=N
             parameters=parameters,
             note="not simulated: the horizontal acceleration stays below the uplift and "
                  "sliding thresholds at every sample, so no body can move",
-            motion_end_s=drive.duration, wall_s=time.perf_counter() - started,
-            provenance=provenance)
+            motion_end_s=drive.duration + drive.start_in_file_s,
+            wall_s=time.perf_counter() - started, provenance=provenance,
+            start_in_file_s=drive.start_in_file_s)
     else:
         summary = summarise(trajectory, record=record, back_azimuth_deg=drive.back_azimuth,
                             parameters=parameters, provenance=provenance,
-                            quiet_after_s=params.get("quiet_after_s"))
+                            quiet_after_s=params.get("quiet_after_s"),
+                            start_in_file_s=drive.start_in_file_s)
     summary.save(out_dir / "summary.json")
     return summary

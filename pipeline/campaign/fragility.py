@@ -199,15 +199,17 @@ def block_runs(specs, azimuths=None, max_step=BLOCK_MAX_STEP_S, t_after=BLOCK_T_
         for c in range(0, len(specs_of_motion), size):
             group = specs_of_motion[c:c + size]
             rows += _block_batch(group, motion_file, rp, along, directions, motion.dt,
-                                 max_step, t_after)
+                                 max_step, t_after, motion.start_in_file_s)
             cases += len(group) * n_az
     cost = {"block2d_cases": cases, "block2d_wall_s": round(time.perf_counter() - started, 3),
             "block2d_max_step_s": max_step}
     return pd.DataFrame(rows), cost
 
 
-def _block_batch(group, motion_file, rp, along, directions, dt, max_step, t_after):
-    """Rows of the 2D table for ``group`` (specs of one motion), integrated at once."""
+def _block_batch(group, motion_file, rp, along, directions, dt, max_step, t_after,
+                 start_in_file_s=0.0):
+    """Rows of the 2D table for ``group`` (specs of one motion), integrated at once;
+    times on the record's clock (the motion's + ``start_in_file_s``, s)."""
     n_az = len(directions)
     rows = []
     sizes = np.array([block_size(s["params"]) for s in group], float)
@@ -218,7 +220,7 @@ def _block_batch(group, motion_file, rp, along, directions, dt, max_step, t_afte
                                    dt, t_after=t_after, max_step=max_step)
     shape = (len(group), n_az)
     fell = out["overturned"].reshape(shape)
-    when = out["overturn_time"].reshape(shape)
+    when = out["overturn_time"].reshape(shape) + start_in_file_s
     side = out["overturn_direction"].reshape(shape)
     tilt = np.degrees(out["max_abs_theta"]).reshape(shape)
     for i, spec in enumerate(group):

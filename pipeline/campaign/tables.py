@@ -79,6 +79,7 @@ def _tables(specs, campaign, campaign_dir):
                 "base_slip_m": col.base_slip_m, "simulated": summary.simulated,
                 "simulated_from_s": _nan((summary.simulated_window_s or [None])[0]),
                 "simulated_s": summary.simulated_s,
+                "start_in_file_s": summary.start_in_file_s,
                 **{k: v if isinstance(v, str) else _nan(v) for k, v in rp.items()},
                 "back_azimuth_deg": _nan(summary.back_azimuth_deg),
                 "motion_file": spec["motion_file"],

@@ -8,6 +8,7 @@ from pathlib import Path
 from pipeline import RESULTS_DIR
 from pipeline.constants import COLUMN_TYPES
 from pipeline.files import DirectoryLock, InputError
+from pipeline.motion import RECORD_CLOCK
 from pipeline.records import processed_motion, resolve
 from pipeline.scenario import Column, Contact, Numerics
 from pipeline.cli._fields import add_arguments, add_column_file_argument, from_args
@@ -35,8 +36,8 @@ def setup(p):
     p.add_argument("--back-azimuth", type=float, default=None, metavar="DEG",
                    help="back azimuth to the epicentre when the record does not give it, [0, 360)")
     p.add_argument("--window", type=float, nargs=2, default=None, metavar=("START", "END"),
-                   help="use only this excerpt of the record (s); needed above "
-                   f"{MAX_DURATION_S:g} s")
+                   help="use only this excerpt of the record (s after the record's first "
+                   f"sample, as the times printed); needed above {MAX_DURATION_S:g} s")
     p.add_argument("--rotate", type=float, default=0.0, metavar="DEG",
                    help="turn the horizontal motion clockwise by DEG")
     p.add_argument("--scale", type=float, default=1.0,
@@ -67,8 +68,8 @@ def check_run_options(args):
             raise InputError(f"--column-file describes the column: drop {', '.join(given)}")
     if args.window is not None:
         start, end = args.window
-        if not (math.isfinite(start) and math.isfinite(end) and 0 <= start < end):
-            raise InputError(f"--window needs 0 <= START < END (finite), got {start:g} {end:g}")
+        if not (math.isfinite(start) and math.isfinite(end) and start < end):
+            raise InputError(f"--window needs START < END (finite), got {start:g} {end:g}")
 
 
 def run(args):
@@ -84,10 +85,13 @@ def run(args):
     motion, _ = processed_motion(args.record, back_azimuth=args.back_azimuth, cache_dir=None,
                                  mode=args.processing)
     if args.window:
-        if args.window[0] >= motion.duration:
-            raise InputError(f"--window starts at {args.window[0]:g} s, after the motion ends "
-                             f"({motion.duration:.1f} s)")
-        length = min(args.window[1], motion.duration) - args.window[0]
+        first, last = motion.start_in_file_s, motion.start_in_file_s + motion.duration
+        if not first - 1e-9 <= args.window[0] < last:
+            where = "before the motion starts" if args.window[0] < first else \
+                "after the motion ends"
+            raise InputError(f"--window starts at {args.window[0]:g} s, {where} (it spans "
+                             f"{first:.2f} to {last:.2f} s after the record's first sample)")
+        length = min(args.window[1], last) - args.window[0]
         if length > MAX_DURATION_S:
             raise InputError(f"--window spans {length:.0f} s: at most {MAX_DURATION_S:g} s "
                              "are simulated")
@@ -124,6 +128,9 @@ def run(args):
             print(f"note: with --kn {contact.kn:g} this column rocks on its contact springs "
                   f"at {hz:.1f} Hz (the paper's column at 13.5 Hz): raise --kn (campaign "
                   "columns does) for rigid-block behaviour")
+    if summary.start_in_file_s != 0.0:
+        print(f"times in {RECORD_CLOCK} (the simulated motion, and trajectory.npz's clock, "
+              f"start at {summary.start_in_file_s:.2f} s)")
     for col in summary.columns:
         if not col.toppled:
             print(f"{col.column:>10}: standing (max tilt {col.max_tilt_deg:.1f} deg)")

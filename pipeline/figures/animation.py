@@ -13,6 +13,7 @@ import numpy as np
 
 from pipeline.figures.style import COLUMN_COLOURS, figure
 from pipeline.files import InputError, atomic_path, write_text
+from pipeline.motion import Motion
 from pipeline.outcome import Trajectory
 from pipeline.outcome.columns import rotations
 from pipeline.scenario import PEDESTAL
@@ -31,6 +32,22 @@ def load(run):
     if not path.is_file():
         raise InputError(f"no trajectory found: {path}")
     return Trajectory.load(path)
+
+
+def start_in_file_s(run):
+    """Record time (s) of the first sample of the motion a run's trajectory is on (its
+    ``start_in_file_s``), from the ``motion.npz`` beside ``trajectory.npz``; None when
+    there is none (a :class:`Trajectory` given as such): times stay on the motion's clock."""
+    if isinstance(run, Trajectory):
+        return None
+    path = Path(run)
+    motion = (path if path.is_dir() else path.parent) / "motion.npz"
+    return Motion.load(motion).start_in_file_s if motion.is_file() else None
+
+
+def clock_label(offset):
+    """Which clock times shifted by ``offset`` (:func:`start_in_file_s`) are on."""
+    return "motion's clock" if offset is None else "record's clock"
 
 
 def body_parts(body):
@@ -97,6 +114,7 @@ def animate_run(run, path, fps=20, max_seconds=None, max_frames=600):
     from matplotlib import animation
 
     traj = load(run)
+    offset = start_in_file_s(run)
     path = Path(path)
     if path.suffix not in (".gif", ".mp4"):
         raise InputError(f"animation must be .gif or .mp4, got {path.name}")
@@ -139,7 +157,7 @@ def animate_run(run, path, fps=20, max_seconds=None, max_frames=600):
                                   body_lines[j]):
                 xyz = outline(rims)
                 line.set_data_3d(xyz[:, 0], xyz[:, 1], xyz[:, 2])
-        title.set_text(f"t = {t[k]:5.2f} s")
+        title.set_text(f"t = {t[k] + (offset or 0.0):5.2f} s ({clock_label(offset)})")
 
     if path.suffix == ".gif":
         # frames drawn here and quantised with Pillow's fast octree (its default
@@ -200,8 +218,10 @@ def frame_polydata(traj, k):
 
 
 def export_vtk(run, out_dir, every=5):
-    """Write frame_XXXXX.vtp files and run.pvd (time series) for ParaView; return the .pvd."""
+    """Write frame_XXXXX.vtp files and run.pvd (time series, s on the record's clock when
+    the run's motion.npz is found) for ParaView; return the .pvd."""
     traj = load(run)
+    offset = start_in_file_s(run) or 0.0
     if every < 1:
         raise InputError(f"every must be at least 1, got {every}")
     out_dir = Path(out_dir)
@@ -209,7 +229,7 @@ def export_vtk(run, out_dir, every=5):
     for n, k in enumerate(range(0, len(traj.t), every)):
         name = f"frame_{n:05d}.vtp"
         write_text(out_dir / name, _vtp(*frame_polydata(traj, k)))
-        entries.append(f'<DataSet timestep="{traj.t[k]:.4f}" file={quoteattr(name)}/>')
+        entries.append(f'<DataSet timestep="{traj.t[k] + offset:.4f}" file={quoteattr(name)}/>')
     pvd = out_dir / "run.pvd"
     write_text(pvd, '<?xml version="1.0"?>\n<VTKFile type="Collection" version="0.1">\n'
                "<Collection>\n" + "\n".join(entries) + "\n</Collection>\n</VTKFile>\n")

@@ -6,6 +6,7 @@ import numpy as np
 
 from pipeline.figures.style import COLUMN_COLOURS, COLUMN_LABELS, COLUMN_MARKERS, new_figure
 from pipeline.files import save_figure
+from pipeline.motion import RECORD_CLOCK
 from pipeline.stats.ensemble import circular_density, wilson_interval
 from pipeline.stats.circular import angle_difference_deg
 
@@ -61,7 +62,7 @@ def plot_ensemble(members, summary, out_dir):
         if times.size:
             ax.hist(times, bins=20, alpha=0.5, color=COLUMN_COLOURS.get(col["column"], "C2"),
                     label=f"{COLUMN_LABELS.get(col['column'], col['column'])} ({times.size} falls)")
-    ax.set_xlabel("time of the first impact (s)")
+    ax.set_xlabel(f"time of the first impact ({RECORD_CLOCK})")
     ax.set_ylabel("members")
     ax.set_title(f"Impact times: {summary['record']}")
     ax.grid(alpha=0.3)

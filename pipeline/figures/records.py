@@ -3,6 +3,7 @@ import numpy as np
 
 from pipeline.figures.style import figure
 from pipeline.files import save_figure
+from pipeline.motion import RECORD_CLOCK
 
 
 def plot_motion(motion, path):
@@ -10,7 +11,7 @@ def plot_motion(motion, path):
     displacement hodogram with its projections on the three coordinate planes."""
     meta, dt = motion.meta, motion.dt
     acc, disp = motion.acc, motion.disp * 100.0  # cm
-    time = np.arange(len(acc)) * dt
+    time = np.arange(len(acc)) * dt + motion.start_in_file_s       # the record's clock
     fig = figure(figsize=(12, 6.5))
     grid = fig.add_gridspec(3, 2, width_ratios=[1.1, 1.0])
     limit = max(np.max(np.abs(acc)), 1e-9) * 1.05
@@ -22,7 +23,7 @@ def plot_motion(motion, path):
         ax.grid(alpha=0.3)
         if i < 2:
             ax.tick_params(labelbottom=False)
-    ax.set_xlabel("time (s)")
+    ax.set_xlabel(f"time ({RECORD_CLOCK})")
     ax3 = fig.add_subplot(grid[:, 1], projection="3d")
     e, n, u = disp[:, 0], disp[:, 1], disp[:, 2]
     span = max(np.max(np.abs(disp)), 1e-9) * 1.1

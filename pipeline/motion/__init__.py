@@ -3,9 +3,17 @@
 A processed motion file (``.npz``) holds ``dt`` (s), ``acc`` (m/s^2), ``vel``
 (m/s), ``disp`` (m) as (n, 3) arrays with columns East, North, Up, and ``meta``,
 a JSON object (record id, event, station, ``back_azimuth_deg``,
-``epicentral_distance_km``, ``has_vertical``, ``processing`` provenance, ...).
+``epicentral_distance_km``, ``has_vertical``, ``processing`` provenance,
+``start_in_file_s``, ...).
 Records, synthetics and the YADE scene all read and write it through
 :meth:`Motion.load` and :meth:`Motion.save`.
+
+Two clocks: a motion's samples are ``dt`` apart from its first sample (the motion's
+clock: the YADE scene and its trajectory run on it); a user reads the record's clock,
+seconds after the record's first sample.  ``meta["start_in_file_s"]`` is the time on the
+record's clock of the motion's first sample (negative where the processing added zeros
+before the record; absent: 0, a motion that is its own record), so record time = motion
+time + ``start_in_file_s``.
 """
 import json
 import math
@@ -17,6 +25,7 @@ import numpy as np
 from pipeline.files import InputError, write_npz
 
 NPZ_KEYS = ("dt", "acc", "vel", "disp", "meta")
+RECORD_CLOCK = "s after the record's first sample"    # the unit of every time a user reads
 
 
 @dataclass(frozen=True)
@@ -46,6 +55,11 @@ class Motion:
         for key in ("acc", "vel", "disp"):
             if not np.all(np.isfinite(getattr(self, key))):
                 raise InputError(f"{name}: {key} holds NaN or infinite samples")
+        start = self.meta.get("start_in_file_s")
+        if start is not None and (isinstance(start, bool) or not isinstance(
+                start, (int, float)) or not math.isfinite(start)):
+            raise InputError(f"{name}: start_in_file_s must be a finite number (s), "
+                             f"got {start!r}")
 
     @property
     def npts(self):
@@ -60,6 +74,13 @@ class Motion:
     @property
     def record_id(self):
         return self.meta.get("record_id")
+
+    @property
+    def start_in_file_s(self):
+        """Time (s) on the record's clock (after the record's first sample) of this
+        motion's first sample: record time = motion time + start_in_file_s."""
+        value = self.meta.get("start_in_file_s")
+        return 0.0 if value is None else float(value)
 
     @property
     def back_azimuth(self):
@@ -113,7 +134,8 @@ class Motion:
 
     # ------------------------------------------------------------ transformations
     def window(self, start_s, end_s):
-        """Excerpt from ``start_s`` to ``end_s`` (s); displacement re-zeroed at its start."""
+        """Excerpt from ``start_s`` to ``end_s`` (s, the motion's clock); displacement
+        re-zeroed at its start; ``start_in_file_s`` moves with the first sample."""
         if not (math.isfinite(start_s) and math.isfinite(end_s) and 0 <= start_s < end_s):
             raise InputError(f"window must satisfy 0 <= start < end (finite), got "
                              f"{start_s}, {end_s}")
@@ -121,7 +143,8 @@ class Motion:
         if i0 >= self.npts - 1:
             raise InputError(f"window starts at {start_s} s, after the record ends "
                              f"({self.duration:.1f} s)")
-        meta = dict(self.meta, window_s=[float(start_s), float(min(end_s, self.duration))])
+        meta = dict(self.meta, window_s=[float(start_s), float(min(end_s, self.duration))],
+                    start_in_file_s=self.start_in_file_s + i0 * self.dt)
         return replace(self, acc=self.acc[i0:i1], vel=self.vel[i0:i1],
                        disp=self.disp[i0:i1] - self.disp[i0], meta=meta)
 

@@ -97,9 +97,10 @@ def tilt_deg(axis):
     return np.degrees(np.arccos(np.clip(axis[..., 2], -1.0, 1.0)))
 
 
-def column_outcomes(trajectory):
-    """List of per-column result dicts (see module docstring)."""
-    t = trajectory.t
+def column_outcomes(trajectory, start_in_file_s=0.0):
+    """List of per-column result dicts (see module docstring), times (s) on the record's
+    clock: the trajectory's (the motion's) clock + ``start_in_file_s``."""
+    t = trajectory.t + start_in_file_s
     pos = trajectory.pos
     axes = body_axes(trajectory.quat)
     columns = {}
@@ -200,14 +201,19 @@ def total_energy(trajectory, g=MODEL_GRAVITY):
 
 
 def summarise(trajectory, record, back_azimuth_deg=None, parameters=None, provenance=None,
-              quiet_after_s=None):
-    """The :class:`~pipeline.outcome.summary.RunSummary` of a simulated run."""
+              quiet_after_s=None, start_in_file_s=0.0):
+    """The :class:`~pipeline.outcome.summary.RunSummary` of a simulated run, its times on
+    the record's clock: the trajectory's clock (and ``quiet_after_s``'s, the scene's) +
+    ``start_in_file_s`` (s, the record time of the motion's first sample)."""
+    offset = float(start_in_file_s)
+    end = float(trajectory.t[-1]) if len(trajectory.t) else trajectory.start_s
     return RunSummary(
         record=record, back_azimuth_deg=back_azimuth_deg, parameters=parameters or {},
-        columns=[ColumnOutcome(**c) for c in column_outcomes(trajectory)],
+        columns=[ColumnOutcome(**c) for c in column_outcomes(trajectory, offset)],
         simulated_s=trajectory.simulated_s,
-        simulated_window_s=[trajectory.start_s, float(trajectory.t[-1])
-                            if len(trajectory.t) else trajectory.start_s],
-        motion_end_s=trajectory.motion_end, stopped_early=bool(trajectory.stopped_early),
+        simulated_window_s=[trajectory.start_s + offset, end + offset],
+        motion_end_s=trajectory.motion_end + offset,
+        stopped_early=bool(trajectory.stopped_early),
         time_step_s=trajectory.dt, wall_s=trajectory.wall_s, provenance=provenance or {},
-        quiet_after_s=quiet_after_s)
+        quiet_after_s=None if quiet_after_s is None else quiet_after_s + offset,
+        start_in_file_s=offset)

@@ -19,6 +19,19 @@ def _azimuth_or_none(value, name):
     return value
 
 
+def _finite(value, name):
+    """``value`` as a finite float (None stays None: not known)."""
+    if value is None:
+        return None
+    try:
+        value = float(value)
+    except (TypeError, ValueError):
+        raise InputError(f"{name} must be a number, got {value!r}") from None
+    if not math.isfinite(value):
+        raise InputError(f"{name} must be a finite number, got {value!r}")
+    return value
+
+
 def _non_negative(value, name):
     """``value`` as a float >= 0 (None stays None: not known)."""
     if value is None:
@@ -35,7 +48,7 @@ def _non_negative(value, name):
 @dataclass(frozen=True, kw_only=True)
 class ColumnOutcome:
     """One column of a run: toppled or standing, downfall azimuth (deg clockwise from
-    North, None when standing), first impact time (s, motion clock) and point (m, pedestal
+    North, None when standing), first impact time (s, record's clock) and point (m, pedestal
     frame, mass-weighted), largest tilt (deg), base slip (m), initial position (m), the
     rule that decided the fall (``toppled_by``) and one dict per body
     (:mod:`pipeline.outcome.columns`)."""
@@ -74,9 +87,15 @@ class ColumnOutcome:
 class RunSummary:
     """One run (``summary.json``): the record and its back azimuth (deg, None when
     unknown), the run's parameters, one :class:`ColumnOutcome` per column, whether YADE
-    ran (``simulated``; ``note`` says why not), the simulated time and window (s, motion
-    clock), the motion's end (s), whether the scene stopped early, the time step (s),
-    wall time (s), provenance, and ``quiet_after_s`` (s) when the quiet tail was cut."""
+    ran (``simulated``; ``note`` says why not), the simulated time (s) and window, the
+    motion's end, whether the scene stopped early, the time step (s), wall time (s),
+    provenance, ``quiet_after_s`` when the quiet tail was cut, and ``start_in_file_s``.
+
+    Every time (impact and past-90 times, window, motion end, quiet_after_s) is on the
+    record's clock: seconds after the record's first sample.  ``start_in_file_s`` is the
+    record time of the first sample of the motion the scene ran (negative: filter margin
+    before the record), so the scene's and ``trajectory.npz``'s clock reads
+    record time - start_in_file_s."""
     record: str
     back_azimuth_deg: float = None
     parameters: dict = field(default_factory=dict)
@@ -91,6 +110,7 @@ class RunSummary:
     wall_s: float = 0.0
     provenance: dict = field(default_factory=dict)
     quiet_after_s: float = None
+    start_in_file_s: float = 0.0
 
     OPTIONAL = ("note", "quiet_after_s")     # written only when set
 
@@ -107,9 +127,12 @@ class RunSummary:
         if len({c.column for c in columns}) != len(columns):
             raise InputError("run summary: a column is named twice")
         object.__setattr__(self, "columns", columns)
-        for name in ("simulated_s", "motion_end_s", "wall_s"):
+        for name in ("simulated_s", "wall_s"):
             object.__setattr__(self, name, _non_negative(getattr(self, name),
                                                          f"run summary: {name}"))
+        for name in ("motion_end_s", "start_in_file_s"):       # times: may be negative
+            object.__setattr__(self, name, _finite(getattr(self, name),
+                                                   f"run summary: {name}"))
         if not isinstance(self.simulated, bool) or not isinstance(self.stopped_early, bool):
             raise InputError("run summary: simulated and stopped_early must be true or false")
 

@@ -5,6 +5,7 @@ from pathlib import Path
 
 import pandas as pd
 
+from pipeline.motion import RECORD_CLOCK
 from pipeline.report.common import _figure, _fmt, _p, _read_csv, _spread, _table
 
 
@@ -24,7 +25,7 @@ def sweep_section(results, name, parameter, paper_notes):
                      "downfall azimuths (deg)": ", ".join(
                          f"{a:.0f}" for a in fell["downfall_azimuth_deg"]) or "-",
                      "axial spread (deg)": _fmt(_spread(fell["downfall_azimuth_deg"])),
-                     "impact times (s)": (f"{fell['impact_time_s'].min():.1f}-"
+                     f"impact times ({RECORD_CLOCK})": (f"{fell['impact_time_s'].min():.1f}-"
                                           f"{fell['impact_time_s'].max():.1f}") if len(fell) else "-"})
     lines.append(_table(pd.DataFrame(rows)) + "\n")
     for record in sorted(runs["record_id"].unique()):
