@@ -206,15 +206,16 @@ register(Campaign(
 
 
 def signal_window(record):
-    """[0, end] (s): a motion given ready-made (a synthetic npz) up to the end of its
-    signal, as the processing cuts records (:func:`~pipeline.records.processing.
-    signal_end_s`): its quiet tail would only keep a rocking column simulated.  None
-    for a record that the processing cuts anyway."""
+    """[start, end] (s, record's clock): a motion given ready-made (a synthetic npz) up
+    to the end of its signal, as the processing cuts records (:func:`~pipeline.records.
+    processing.signal_end_s`): its quiet tail would only keep a rocking column
+    simulated.  None for a record that the processing cuts anyway."""
     source = resolve(record)
     if not source.processed:
         return None
     motion = Motion.load(source.path)
-    return [0.0, round(float(signal_end_s(motion.acc, motion.dt)), 6)]
+    start = motion.start_in_file_s                     # windows are on the record's clock
+    return [start, round(start + float(signal_end_s(motion.acc, motion.dt)), 6)]
 
 
 def synthetic_specs(records, campaign_dir, column_file=None, stiffness="matched"):

@@ -133,6 +133,35 @@ def test_miniseed_round_trip(tmp_path):
     assert set(motion.meta["processing"]["software"]) >= {"obspy", "numpy", "scipy", "yade"}
 
 
+@pytest.mark.parametrize("lead_s, mode", [(0.0, "default"), (30.0, "default"),
+                                           (0.0, "none")])
+def test_a_processed_record_says_where_the_record_starts(tmp_path, lead_s, mode):
+    """A Ricker wavelet (2 Hz, symmetric: a zero-phase band-pass keeps its peak in place)
+    centred 20 s after the first sample of a 40 s file (50 s with 30 s of zeros before
+    it): the processed motion's peak, read on the record's clock (motion time +
+    ``start_in_file_s``), is where the file has it.  The processed motion starts the
+    filter's transient (a minute) before the wavelet's onset, before the file's first
+    sample (``start_in_file_s`` < 0); run as given, the motion is the record and the clocks agree."""
+    t = np.arange(0.0, 40.0, 1 / RATE)
+    arg = (math.pi * 2.0 * (t - 20.0)) ** 2
+    ricker = np.r_[np.zeros(int(round(lead_s * RATE))), (1 - 2 * arg) * np.exp(-arg)]
+    stream = Stream([Trace(scale * ricker, header={"station": "CLK", "channel": f"HN{c}",
+                                                   "sampling_rate": RATE})
+                     for scale, c in ((3.0, "E"), (1.5, "N"), (0.5, "Z"))])
+    path = tmp_path / "clock.mseed"
+    stream.write(str(path), format="MSEED")
+    motion, _ = records.processed_motion(path, cache_dir=None, mode=mode)
+    peak_s = np.argmax(np.hypot(motion.acc[:, 0], motion.acc[:, 1])) * motion.dt
+    assert peak_s + motion.start_in_file_s == pytest.approx(20.0 + lead_s, abs=0.5 / RATE)
+    transient = processing.filter_transient_s(processing.BAND["freqmin_hz"],
+                                              processing.BAND["corners"])
+    if mode == "none":
+        assert motion.start_in_file_s == 0.0
+    else:      # the filter's margin before the wavelet's first 0.1 % of energy, < 1 s early
+        centre = 20.0 + lead_s
+        assert centre - transient - 1.0 < motion.start_in_file_s < centre - transient
+
+
 def test_sac_round_trip_with_coordinates_and_azimuths(tmp_path):
     """Motion purely North recorded by sensors at 45 and 135 deg; the epicentre is
     1 degree due north of the station: back azimuth 0, distance about 111.2 km."""
