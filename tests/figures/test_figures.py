@@ -1,4 +1,5 @@
 """Campaign figures, animation geometry and VTK export."""
+import json
 import math
 import xml.etree.ElementTree as ET
 
@@ -64,6 +65,23 @@ def test_vtk_export_is_valid_xml_with_all_frames(tmp_path):
     n = animation.CIRCLE_SEGMENTS
     assert int(piece.get("NumberOfPoints")) == 4 + 2 * n          # pedestal + two rims
     assert int(piece.get("NumberOfPolys")) == 1 + 2 + n
+
+
+def test_a_run_directory_animates_on_the_record_clock(tmp_path):
+    """A run directory whose motion starts 30 s before the record's first sample: the
+    VTK series' time steps are the trajectory's times on the record's clock."""
+    traj = lying_east_trajectory()
+    np.savez(tmp_path / "trajectory.npz", t=traj.t, pos=traj.pos, quat=traj.quat,
+             bodies=np.array(json.dumps(traj.bodies)), vel=traj.vel, angvel=traj.angvel,
+             pedestal_disp=traj.pedestal_disp, dt=1e-4, motion_end=1.0, stopped_early=False)
+    zeros = np.zeros((3, 3))
+    Motion(0.5, zeros, zeros, zeros, meta={"start_in_file_s": -30.0}).save(
+        tmp_path / "motion.npz")
+    assert animation.start_in_file_s(tmp_path) == -30.0
+    assert animation.start_in_file_s(traj) is None          # no run directory: its own clock
+    pvd = animation.export_vtk(tmp_path, tmp_path / "vtk", every=1)
+    entries = ET.parse(pvd).getroot().find("Collection").findall("DataSet")
+    assert [float(e.get("timestep")) for e in entries] == [-30.0, -29.0]
 
 
 def test_animation_gif(tmp_path):
