@@ -14,6 +14,8 @@ def sweep_section(results, name, parameter, paper_notes):
     if runs is None:
         return f"## {name.capitalize()}\n\nNot run yet (`python -m pipeline campaign {name}`).\n"
     lines = [f"## {name.capitalize()} sweep ({parameter})\n"]
+    # a table written before runs.csv said its clock holds the processed motion's times
+    clock = RECORD_CLOCK if "start_in_file_s" in runs else "s, processed motion's clock"
     rows = []
     for (record, column), g in runs.groupby(["record_id", "column"]):
         g = g.sort_values(parameter)
@@ -25,8 +27,9 @@ def sweep_section(results, name, parameter, paper_notes):
                      "downfall azimuths (deg)": ", ".join(
                          f"{a:.0f}" for a in fell["downfall_azimuth_deg"]) or "-",
                      "axial spread (deg)": _fmt(_spread(fell["downfall_azimuth_deg"])),
-                     f"impact times ({RECORD_CLOCK})": (f"{fell['impact_time_s'].min():.1f}-"
-                                          f"{fell['impact_time_s'].max():.1f}") if len(fell) else "-"})
+                     f"impact times ({clock})": (f"{fell['impact_time_s'].min():.1f}-"
+                                                 f"{fell['impact_time_s'].max():.1f}")
+                     if len(fell) else "-"})
     lines.append(_table(pd.DataFrame(rows)) + "\n")
     for record in sorted(runs["record_id"].unique()):
         lines.append(_figure(results, results / name / f"impact_map_{record}.png",

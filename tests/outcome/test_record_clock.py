@@ -103,6 +103,10 @@ def test_a_run_on_a_padded_motion_reports_record_times_up_to_the_report(
     cells = dict(zip([c.strip() for c in header.strip("|").split("|")],
                      [c.strip() for c in row.strip("|").split("|")]))
     assert cells["impact times (s after the record's first sample)"] == "6.0-6.0"
+    # a table from before its clock was stated is not passed off as the record's
+    write_tables(tmp_path / "slenderness", runs.drop(columns="start_in_file_s"), impacts)
+    assert "impact times (s, processed motion's clock)" in \
+        sweep_section(tmp_path, "slenderness", "hd", "")
 
 
 def test_a_run_that_cannot_move_ends_on_the_record_clock(tmp_path):
