@@ -19,30 +19,23 @@ def _azimuth_or_none(value, name):
     return value
 
 
-def _finite(value, name):
-    """``value`` as a finite float (None stays None: not known)."""
+def _finite(value, name, minimum=-math.inf):
+    """``value`` as a finite float >= ``minimum`` (None stays None: not known)."""
     if value is None:
         return None
     try:
         value = float(value)
     except (TypeError, ValueError):
         raise InputError(f"{name} must be a number, got {value!r}") from None
-    if not math.isfinite(value):
-        raise InputError(f"{name} must be a finite number, got {value!r}")
+    if not (math.isfinite(value) and value >= minimum):
+        bound = "" if minimum == -math.inf else f" >= {minimum:g}"
+        raise InputError(f"{name} must be a finite number{bound}, got {value!r}")
     return value
 
 
 def _non_negative(value, name):
     """``value`` as a float >= 0 (None stays None: not known)."""
-    if value is None:
-        return None
-    try:
-        value = float(value)
-    except (TypeError, ValueError):
-        raise InputError(f"{name} must be a number, got {value!r}") from None
-    if not (math.isfinite(value) and value >= 0.0):
-        raise InputError(f"{name} must be a finite number >= 0, got {value!r}")
-    return value
+    return _finite(value, name, minimum=0.0)
 
 
 @dataclass(frozen=True, kw_only=True)

@@ -141,7 +141,8 @@ def test_a_processed_record_says_where_the_record_starts(tmp_path, lead_s, mode)
     it): the processed motion's peak, read on the record's clock (motion time +
     ``start_in_file_s``), is where the file has it.  The processed motion starts the
     filter's transient (a minute) before the wavelet's onset, before the file's first
-    sample (``start_in_file_s`` < 0); run as given, the motion is the record and the clocks agree."""
+    sample (``start_in_file_s`` < 0); run as given, the motion is the record and the
+    clocks agree."""
     t = np.arange(0.0, 40.0, 1 / RATE)
     arg = (math.pi * 2.0 * (t - 20.0)) ** 2
     ricker = np.r_[np.zeros(int(round(lead_s * RATE))), (1 - 2 * arg) * np.exp(-arg)]
