@@ -299,3 +299,14 @@ def test_a_hidden_truth_of_thousands_of_runs_hits_the_gate(tmp_path, capsys, mon
         ["invert", "--hidden-truth", str(small), "--quick", "--jobs", "2", "--out", str(out),
          "--forward-dir", str(fwd)]))
     assert err == "error: started\n" and "warning" not in out_text
+
+
+def test_a_units_line_in_words_is_a_comment_beside_the_units(tmp_path):
+    """As the shipped SP1 tables have it: '# units: g', then '# units: time_s = s, ...'
+    describing the columns; read, in g."""
+    from pipeline.constants import STANDARD_GRAVITY
+    from pipeline.records.readers import read_record
+    path = lab_table(tmp_path / "lab.txt", HEADER + ["# units: time_s = s, accel_g = g"],
+                     n=200, pga_g=0.5)
+    stream, _ = read_record(path)
+    assert np.abs(stream[0].data).max() == pytest.approx(0.5 * STANDARD_GRAVITY, rel=1e-5)

@@ -13,9 +13,11 @@ The file (plain or gzip-compressed) starts with ``#`` header lines; three are re
 
 Columns are separated by blanks or commas: time (s, uniformly sampled) and the
 acceleration components in the order of ``axes``; at most MAX_SAMPLES rows and
-MAX_DURATION_S seconds (checked before the table is parsed into arrays).  A header line
-given twice is refused (which one is meant?); a table whose header lacks its first line
-``# lab-table:`` is refused naming it.  A component the table does not have
+MAX_DURATION_S seconds (checked before the table is parsed into arrays).  Units or axes
+stated twice (two ``# units:`` lines that name units, two ``# axes:`` lines of axes; a
+``# units:`` line describing the columns in words is a comment), or a title, station or
+event given twice, are refused (which one is meant?); so is a table whose header lacks
+its first line ``# lab-table:``.  A component the table does not have
 is zero (a uniaxial table moves along its one axis only); the reader says which it added
 in ``info["zero_components"]``.
 """
@@ -59,7 +61,7 @@ def detect(path, head):
 def read(path, key=None):
     name = path.name
     text = read_bytes(path).decode("utf-8", errors="replace")
-    header, rows = {}, 0
+    lines, rows = {}, 0
     for line in text.splitlines():
         if not line.startswith("#"):
             if line.strip() and not line.lstrip().startswith("#"):
@@ -67,15 +69,12 @@ def read(path, key=None):
             continue
         match = HEADER.match(line)
         if match and not rows and match.group(1).lower() in KEYS:
-            field = match.group(1).lower()
-            if field in header:
-                raise InputError(f"{name}: '# {field}:' given twice ({header[field]!r} and "
-                                 f"{match.group(2)!r}): which one is meant?")
-            header[field] = match.group(2)
+            lines.setdefault(match.group(1).lower(), []).append(match.group(2))
     first = text.lstrip().splitlines()[0] if text.strip() else ""
     if not first.lower().startswith("# lab-table"):
         raise InputError(f"{name}: lab table without its first line '# lab-table: TITLE' "
                          f"(found {first[:40]!r})")
+    header = {field: _statement(field, values, name) for field, values in lines.items()}
     for required in ("units", "axes"):
         if required not in header:
             raise InputError(f"{name}: lab table without a '# {required}:' header line")
@@ -133,6 +132,32 @@ def read(path, key=None):
         if header.get(key_):
             info[key_] = header[key_]
     return stream, info
+
+
+def _statement(field, values, name):
+    """The value of a header line given on one or more lines: the units or axes among
+    ``# units:`` / ``# axes:`` lines (a line that states none is a comment; none at all:
+    the first, which the checks then refuse), the one title, station or event.
+    InputError when two lines state it."""
+    stated = values
+    if field == "units":
+        stated = [v for v in values if v.split() and v.split()[0] in UNITS]
+    elif field == "axes":
+        stated = [v for v in values if _are_axes(v)]
+    if len(stated) > 1:
+        raise InputError(f"{name}: '# {field}:' given twice ({stated[0]!r} and "
+                         f"{stated[1]!r}): which one is meant?")
+    return stated[0] if stated else values[0]
+
+
+def _are_axes(text):
+    """True if ``text`` is a list of axes (azimuths in [0, 360) or "up")."""
+    tokens = [a for a in re.split(r"[,\s]+", text) if a]
+    try:
+        return bool(tokens) and all(t.lower() == "up" or 0.0 <= float(t) < 360.0
+                                    for t in tokens)
+    except ValueError:
+        return False
 
 
 def _orientation(text, name):
