@@ -66,17 +66,21 @@ def run(args):
         options = from_args(definition.options, args).kwargs()
         if definition.options.TAKES_JOBS:
             options["jobs"] = args.jobs
+    gated = []          # a driver that asked the gate for all its runs at once
+
     def run_once(opts):
         return campaign.run_campaign(args.name, jobs=args.jobs, records=records,
                                      campaign_dir=args.out, animations=args.animations,
                                      options=opts, executor=args.executor,
-                                     scheduler=args.scheduler, allow_long=args.allow_long)
+                                     scheduler=args.scheduler,
+                                     allow_long=None if gated else args.allow_long)
 
     def gate(what, runs, run_core_s, advice=""):
-        """The long-run gate for a driver's own estimate before its first run (none on a
-        cluster of unknown size)."""
+        """The long-run gate for a driver's own estimate of all its runs, before the first
+        (none on a cluster of unknown size); its runs are then not asked again."""
         if args.jobs is not None or not args.scheduler:
             check_long(what, runs, run_core_s, check_jobs(args.jobs), args.allow_long, advice)
+        gated.append(what)
 
     if definition.driver is None:
         run_once(options)
