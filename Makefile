@@ -72,13 +72,14 @@ bench: setup
 # the scanned granite rock SP1 against 490 shake-table tests (calibrate June-July 2021,
 # validate August; 8 parameter sets): about 45 min on 2 cores
 shake-table: setup
-	$(PY) -m pipeline campaign shake-table $(if $(SHAKE_GRID),--grid "$(SHAKE_GRID)") --jobs $(JOBS)
+	$(PY) -m pipeline campaign shake-table $(if $(SHAKE_GRID),--grid "$(SHAKE_GRID)") --jobs $(JOBS) \
+	  --allow-long
 	$(PY) -m pipeline report
 
 # the model's convergence judged on distributions: the twin model's ensembles of 3 records
 # at 16 (default), 32 and 64 rim points and time step factor 0.15, 32 members each
 convergence: records
-	$(PY) -m pipeline campaign convergence --jobs $(JOBS)
+	$(PY) -m pipeline campaign convergence --jobs $(JOBS) --allow-long
 	$(PY) -m pipeline report
 
 # the paper's question at full precision: every near-source record's ensemble sized by its
@@ -86,7 +87,7 @@ convergence: records
 # it takes over the reduced ensembles of run-all (the same first members) and adds batches
 paper-question: records
 	$(PY) -m pipeline campaign ensemble --set nearsource --out results/paper-question \
-	  --members $(PAPER_BATCH) --jobs $(JOBS)
+	  --members $(PAPER_BATCH) --jobs $(JOBS) --allow-long
 	$(PY) -m pipeline report
 
 # the docs/ tree as a website (results/site; mkdocs --strict fails on a broken link)

@@ -186,6 +186,36 @@ def check_jobs(jobs):
     return jobs or os.cpu_count() or 1
 
 
+LONG_RUN_S = 3600.0     # a command estimated to take longer here needs --allow-long
+
+
+def check_long(what, runs, run_core_s, jobs, allow_long, advice="", unit="runs"):
+    """The gate of every long command (campaigns, invert, synthetics), before any run:
+    ``runs`` runs (``unit``: what one is) of ``run_core_s`` core seconds each (the
+    command's own cost model) on ``jobs`` cores.  InputError when that is over LONG_RUN_S
+    and ``allow_long`` is False; a warning line when it is over and allowed.  Returns the
+    estimate (wall s)."""
+    estimate = runs * run_core_s / max(jobs, 1)
+    if estimate <= LONG_RUN_S:
+        return estimate
+    said = (f"{what} ({runs} {unit}, {run_core_s:.3g} core-s each) would take about "
+            f"{duration_text(estimate)} on {jobs} core(s)")
+    if not allow_long:
+        raise InputError(f"{said}, over {LONG_RUN_S / 3600:g} h: add --allow-long to start "
+                         "it" + (f", or {advice}" if advice else ""))
+    print(f"warning: {said} (--allow-long)", flush=True)
+    return estimate
+
+
+def duration_text(seconds):
+    """'40 min', '2.5 h', '3.0 d': a wall time as people say it."""
+    if seconds < 5400:
+        return f"{seconds / 60:.0f} min"
+    if seconds < 2 * 86400:
+        return f"{seconds / 3600:.1f} h"
+    return f"{seconds / 86400:.1f} d"
+
+
 def die_with_parent(parent_pid=None):
     """In a child process (``preexec_fn``, a Pool's ``initializer``): be killed when the
     parent dies, even by kill -9 (Linux PR_SET_PDEATHSIG), and leave Ctrl-C to the parent.

@@ -20,8 +20,9 @@ from pathlib import Path
 from typing import Callable
 
 from pipeline import RESULTS_DIR
-from pipeline.files import DirectoryLock, InputError, ToolError, check_jobs, write_json
-from pipeline.campaign.executor import EXECUTORS, execute
+from pipeline.files import (DirectoryLock, InputError, ToolError, check_jobs, check_long,
+                            write_json)
+from pipeline.campaign.executor import EXECUTORS, RUN_CORE_S, execute
 
 CAMPAIGNS = {}
 
@@ -31,7 +32,8 @@ class Campaign:
     """name: command-line name; help: one line; specs(records, campaign_dir) -> run specs;
     worker(spec, run_dir) writes run_dir/summary.json; outputs(specs, campaign_dir,
     failures, animations, figures) writes tables (and figures unless ``figures`` is
-    False, after Ctrl-C) and returns a dict for campaign.json."""
+    False, after Ctrl-C) and returns a dict for campaign.json; run_core_s: core seconds
+    of one run, the long-run gate's estimate before any run."""
     name: str
     help: str
     specs: Callable
@@ -39,8 +41,9 @@ class Campaign:
     outputs: Callable
     label: str = "runs"
     options: type = None           # its own options: a CampaignOptions dataclass
-    driver: Callable = None        # driver(run, records, campaign_dir, options): runs it
-    #                                (several times: ensembles sized by their error)
+    driver: Callable = None        # driver(run, records, campaign_dir, options, gate):
+    #                                runs it (several times: ensembles sized by their error)
+    run_core_s: float = RUN_CORE_S
 
 
 def register(campaign):
@@ -77,8 +80,13 @@ def names():
 
 
 def run_campaign(name, jobs=None, records=None, campaign_dir=None, animations=1, options=None,
-                 executor=None, scheduler=None):
+                 executor=None, scheduler=None, allow_long=None):
     """Run (or resume) a campaign and write its outputs; return the outputs dict.
+
+    allow_long: False refuses (InputError, before any run) a campaign whose unfinished runs
+    are estimated at over an hour on ``jobs`` cores (:func:`pipeline.files.check_long`;
+    True runs it with a warning; None, for callers that asked the gate themselves, and on
+    a Dask cluster of unknown size (no ``jobs``): no gate).
 
     executor: "threads" (default) or "dask" (a local Dask cluster, or the existing one
     at ``scheduler``, e.g. "tcp://10.0.0.5:8786"); see :mod:`pipeline.campaign.executor`.
@@ -98,6 +106,11 @@ def run_campaign(name, jobs=None, records=None, campaign_dir=None, animations=1,
     existed = campaign_dir.exists()
     try:
         specs = campaign.specs(records, campaign_dir, **(options or {}))
+        if allow_long is not None and jobs is not None:
+            runs_dir = campaign_dir / "runs"
+            todo = sum(not (runs_dir / s["run_id"] / "summary.json").exists() for s in specs)
+            check_long(f"campaign {name}", todo, campaign.run_core_s, jobs, allow_long,
+                       "fewer records, members or parameter values")
         return _run_specs(campaign, name, specs, campaign_dir, jobs, animations, executor,
                           scheduler)
     except (InputError, ToolError, OSError):

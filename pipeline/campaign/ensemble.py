@@ -494,12 +494,14 @@ def written_summaries(campaign_dir, n_records):
     return data if n_records > 1 else [data]
 
 
-def run_sized(run, records, campaign_dir, options):
+def run_sized(run, records, campaign_dir, options, gate=None):
     """Add members in Latin-hypercube batches of ``options["members"]`` to the records not
     yet converged (:func:`converged`) until all are or ``max_members`` is reached; each
     record's ensemble_summary.json gets ``sizing`` (target, members, why it stopped).
     ``run(options)`` runs the campaign once (its outputs write the summaries, read back
-    here with :func:`written_summaries`) and returns its outputs dict."""
+    here with :func:`written_summaries`) and returns its outputs dict; it asks the
+    long-run gate before each batch (``gate``, for an estimate of the driver's own: not
+    used)."""
     batch, cap = options["members"], options["max_members"]
     precision, arc = options["precision"], options["arc_deg"]
     counts = {rec: min(batch, cap) for rec in records}

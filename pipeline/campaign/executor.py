@@ -37,7 +37,7 @@ from tqdm import tqdm
 
 from pipeline.campaign.dask_client import execute_dask
 from pipeline.campaign.run_dirs import book_finished, keep_only_summary
-from pipeline.files import DirectoryLock, InputError
+from pipeline.files import DirectoryLock, InputError, duration_text
 from pipeline.motion import Motion
 from pipeline.scenario.runner import kill_running, reuse_processes
 
@@ -46,6 +46,11 @@ DEFAULT_EXECUTOR = "threads"    # why: docs/campaigns.md, "On a cluster: Dask" (
 FORECAST_FROM_S = 600.0         # a campaign says how long its rest takes from 10 min on
 WARN_FROM_S = 3600.0            # ... and warns from an hour on
 REVISE_FACTOR = 1.5             # ... and again when the pace moves it this much
+RUN_CORE_S = 9.0                # core s of one twin-model run, for the estimate before any
+#                                 run (the gate, pipeline.files.check_long; make invert-demo:
+#                                 672 + 2 x 72 runs of 20 s motions in 48.6 min on 2 cores
+#                                 with the time-step factor 0.3, x 1.28 for the default 0.235
+#                                 at damping 0.36)
 
 
 def execute(specs, campaign_dir, jobs, worker, label="runs", executor=None, scheduler=None):
@@ -146,15 +151,6 @@ class ForecastBar(tqdm):
         self.write(f"{head}{self.name}: the other {left} runs take about "
                    f"{duration_text(rest_s)} at the pace of {pace_of}{change}; Ctrl-C stops "
                    "the campaign and the same command resumes it, keeping every finished run")
-
-
-def duration_text(seconds):
-    """'40 min', '2.5 h', '3.0 d': a wall time as people say it."""
-    if seconds < 5400:
-        return f"{seconds / 60:.0f} min"
-    if seconds < 2 * 86400:
-        return f"{seconds / 3600:.1f} h"
-    return f"{seconds / 86400:.1f} d"
 
 
 def motion_seconds(spec, durations):

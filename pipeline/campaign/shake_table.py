@@ -69,6 +69,8 @@ def load_experiments(path=EXPERIMENTS, outcome=OUTCOME):
     missing = [c for c in COLUMNS + (outcome,) if c not in frame.columns]
     if missing:
         raise InputError(f"{path.name}: missing column(s) {', '.join(missing)}")
+    if frame.empty:
+        raise InputError(f"{path.name}: no experiments (a header and no rows)")
     if frame["test"].duplicated().any():
         raise InputError(f"{path.name}: test {frame['test'][frame['test'].duplicated()].iloc[0]}"
                          " appears twice")
@@ -116,9 +118,22 @@ def parse_grid(text):
                              f"got {values!r}")
         if name in axes:
             raise InputError(f"--grid names {name} twice")
+        repeated = sorted({v for v in numbers if numbers.count(v) > 1})
+        if repeated:
+            raise InputError(f"--grid {name}: value {repeated[0]:g} given twice (each test "
+                             "would count twice)")
         axes[name] = numbers
     names = list(axes)
-    return [dict(zip(names, combo)) for combo in itertools.product(*axes.values())] or [{}]
+    points = [dict(zip(names, combo)) for combo in itertools.product(*axes.values())] or [{}]
+    for point in points:
+        mu_s = point.get("mu_s", DEFAULT_CONTACT["mu_s"])
+        mu_k = point.get("mu_k", DEFAULT_CONTACT["mu_k"])
+        if mu_k > mu_s:
+            said = {k: "" if k in point else " (default)" for k in ("mu_s", "mu_k")}
+            raise InputError(f"--grid: mu_k {mu_k:g}{said['mu_k']} above mu_s "
+                             f"{mu_s:g}{said['mu_s']}: kinetic friction must not exceed "
+                             "static (mu_k <= mu_s)")
+    return points
 
 def _label(point):
     return ", ".join(f"{k}={v:g}" for k, v in point.items()) or "defaults"
@@ -191,26 +206,40 @@ def best_point(result):
     _, _, label = max(ranked)
     return label, result["points"][label]
 
-def drive(run, records, campaign_dir, options):
+def drive(run, records, campaign_dir, options, gate=None):
     """Calibrate on the tests before ``validate_from``, validate the chosen parameters on
-    the others, write experiments.csv, shake_table.json and the rates figure."""
+    the others (none: the calibration's scores alone), write experiments.csv,
+    shake_table.json and the rates figure.  ``gate(what, runs, run_core_s, advice)``: the
+    long-run gate (:func:`pipeline.files.check_long`), asked before any run."""
     campaign_dir = Path(campaign_dir)
     frame = load_experiments(options["experiments"], options["outcome"])
     if options.get("tests"):
         frame = frame[frame["test"].isin(options["tests"])]
     simulated = frame[[p is not None for p in frame["motion_path"]]]
     early = int((simulated["day"] < date.fromisoformat(options["validate_from"])).sum())
+    late = len(simulated) - early
+    if not early:
+        raise InputError(f"no test with a motion before --validate-from "
+                         f"{options['validate_from']} ({len(simulated)} with a motion in "
+                         "all): nothing to calibrate on")
     points = len(parse_grid(options["grid"]))
-    runs = points * early + len(simulated) - early
+    runs = points * early + late
     print(f"shake-table: {points} parameter set(s) x {early} calibration tests, then the "
-          f"chosen set on {len(simulated) - early} validation tests: "
-          f"at most {runs} YADE runs, about {runs * RUN_CPU_S / 60:.0f} CPU-min (finished "
-          "runs are kept and not run again)", flush=True)
+          f"chosen set on {late} validation tests: at most {runs} YADE runs, about "
+          f"{runs * RUN_CPU_S / 60:.0f} CPU-min (finished runs are kept and not run again)",
+          flush=True)
+    if gate is not None:
+        gate("shake-table", runs, RUN_CPU_S, "a smaller --grid or --tests")
     calibration = run({**options, "stage": "calibration"})
     label, point = best_point(calibration)
     print(f"calibration: best {label} (accuracy {calibration['scores'][label]['accuracy']:.3f} "
           f"on {calibration['scores'][label]['n']} tests)", flush=True)
-    validation = run({**options, "stage": "validation", "chosen": point})
+    if late:
+        validation = run({**options, "stage": "validation", "chosen": point})
+    else:
+        print(f"no test from {options['validate_from']} on: the calibration's scores alone, "
+              "no validation", flush=True)
+        validation = calibration
     specimen = ColumnGeometry.load(options["specimen"])
     table = _experiment_table(frame, campaign_dir, label, options["validate_from"])
     write_csv(campaign_dir / "experiments.csv", table.drop(columns=["day", "motion_path"]))
@@ -250,7 +279,7 @@ def summarise(table, specimen, calibration, label, point, options):
     splits = {}
     for split in ("calibration", "validation", "all"):
         rows = table if split == "all" else table[table["split"] == split]
-        run = rows[[p is not None for p in rows["predicted"]]]
+        run = rows.loc[[p is not None for p in rows["predicted"]]]
         obs = run["observed"].to_numpy(bool)
         splits[split] = {
             "model": scores(obs, run["predicted"].astype(bool)),
@@ -309,14 +338,26 @@ class ShakeTableOptions(CampaignOptions):
         if self.axis_deg >= 360.0:
             raise InputError(f"--axis-deg must be in [0, 360), got {self.axis_deg:g}")
         parse_grid(self.grid)
-        load_experiments(self.experiments, self.outcome)
+        frame = load_experiments(self.experiments, self.outcome)
+        tests = self.test_names()
+        repeated = sorted({t for t in tests if tests.count(t) > 1})
+        if repeated:
+            raise InputError(f"--tests names {repeated[0]} twice: a test is run and counted "
+                             "once")
+        unknown = [t for t in tests if t not in set(frame["test"])]
+        if unknown:
+            raise InputError(f"--tests: unknown test(s) {', '.join(unknown)} (not in "
+                             f"{Path(self.experiments).name})")
+
+    def test_names(self):
+        """The tests of ``--tests`` (an empty list: all)."""
+        return [t.strip() for t in (self.tests or "").split(",") if t.strip()]
 
     def kwargs(self):
         return {"experiments": self.experiments, "outcome": self.outcome,
                 "specimen": self.column_file or SPECIMEN,
                 "validate_from": self.validate_from, "grid": self.grid,
-                "tests": [t for t in (self.tests or "").split(",") if t] or None,
-                "axis_deg": self.axis_deg}
+                "tests": self.test_names() or None, "axis_deg": self.axis_deg}
 
 
 def _worker(spec, run_dir):
@@ -325,6 +366,7 @@ def _worker(spec, run_dir):
 register(Campaign(
     "shake-table", "a specimen (default the scanned granite rock SP1) against shake-table "
     "experiments: calibrate on the early tests, validate on the held-out later ones",
-    specs, _worker, outputs, label="experiments", options=ShakeTableOptions, driver=drive))
+    specs, _worker, outputs, label="experiments", options=ShakeTableOptions, driver=drive,
+    run_core_s=RUN_CPU_S))
 
 RESULTS = RESULTS_DIR / "shake-table"

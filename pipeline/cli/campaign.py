@@ -6,7 +6,7 @@ from pathlib import Path
 
 from pipeline import campaign
 from pipeline.cli._fields import add_arguments, from_args
-from pipeline.files import InputError
+from pipeline.files import LONG_RUN_S, InputError, check_jobs, check_long
 from pipeline.records import sets
 
 NAME = "campaign"
@@ -41,6 +41,10 @@ def setup(p):
                        help=f"campaign directory (default results/{name})")
         q.add_argument("--animations", type=int, default=1,
                        help="number of toppled runs to animate as GIF (default 1)")
+        q.add_argument("--allow-long", action="store_true",
+                       help=f"start a campaign estimated to take over "
+                       f"{LONG_RUN_S / 3600:g} h on --jobs cores (refused otherwise, before "
+                       "any run)")
         if definition.options:
             add_arguments(q, definition.options)
 
@@ -62,16 +66,26 @@ def run(args):
         options = from_args(definition.options, args).kwargs()
         if definition.options.TAKES_JOBS:
             options["jobs"] = args.jobs
+    gated = []          # a driver that asked the gate for all its runs at once
+
     def run_once(opts):
         return campaign.run_campaign(args.name, jobs=args.jobs, records=records,
                                      campaign_dir=args.out, animations=args.animations,
                                      options=opts, executor=args.executor,
-                                     scheduler=args.scheduler)
+                                     scheduler=args.scheduler,
+                                     allow_long=None if gated else args.allow_long)
+
+    def gate(what, runs, run_core_s, advice=""):
+        """The long-run gate for a driver's own estimate of all its runs, before the first
+        (none on a cluster of unknown size); its runs are then not asked again."""
+        if args.jobs is not None or not args.scheduler:
+            check_long(what, runs, run_core_s, check_jobs(args.jobs), args.allow_long, advice)
+        gated.append(what)
 
     if definition.driver is None:
         run_once(options)
     else:
         given = list(records or []) + ([options["record"]] if options.get("record") else [])
         definition.driver(run_once, given, args.out or campaign.RESULTS_DIR / args.name,
-                          options)
+                          options, gate=gate)
     return 0

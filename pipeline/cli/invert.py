@@ -11,7 +11,8 @@ from pathlib import Path
 
 from pipeline.constants import COLUMN_TYPES
 from pipeline import RESULTS_DIR
-from pipeline.files import InputError, check_jobs
+from pipeline.campaign.executor import RUN_CORE_S as FORWARD_RUN_CORE_S
+from pipeline.files import LONG_RUN_S, InputError, check_jobs, check_long
 
 NAME = "invert"
 ORDER = 45
@@ -231,34 +232,34 @@ def described_columns(observations, base_dir="."):
     return out
 
 
-LONG_RUN_S = 3600.0     # a forward table estimated to take longer needs --allow-long
-FORWARD_RUN_CORE_S = 9.0   # wall s of one forward run on one core (make invert-demo:
-#                            672 + 2 x 72 runs in 48.6 min on 2 cores with the time-step
-#                            factor 0.3, x 1.28 for the default 0.235 at damping 0.36)
+def finished_runs(campaign_dir):
+    """How many runs a campaign directory holds finished (0 when there is none)."""
+    runs_dir = Path(campaign_dir) / "runs"
+    return sum(1 for _ in runs_dir.glob("*/summary.json")) if runs_dir.is_dir() else 0
 
 
-def preflight(grid, forward_dir, jobs, allow_long):
+def preflight(grid, forward_dir, jobs, allow_long, more_runs=0):
     """Say how many runs the forward table needs, how many may be cached and roughly how
-    long the rest takes on ``jobs`` cores; InputError past LONG_RUN_S without
-    ``allow_long``.  Returns the estimate (s)."""
+    long the rest (and ``more_runs`` twin runs of the same cost) take on ``jobs`` cores;
+    the long-run gate (:func:`pipeline.files.check_long`: InputError past LONG_RUN_S
+    without ``allow_long``).  Returns the estimate (s)."""
     from pipeline.inversion.forward import DEFAULT_FORWARD_DIR
-    runs_dir = Path(forward_dir or DEFAULT_FORWARD_DIR) / "runs"
-    done = sum(1 for _ in runs_dir.glob("*/summary.json")) if runs_dir.is_dir() else 0
+    forward_dir = Path(forward_dir or DEFAULT_FORWARD_DIR)
+    done = finished_runs(forward_dir)
     needed = grid.n_runs()
-    estimate = max(0, needed - done) * FORWARD_RUN_CORE_S / jobs
+    rest = max(0, needed - done)
     print(f"forward table: {needed} YADE runs, up to {min(done, needed)} of them cached in "
-          f"{runs_dir.parent}; the rest takes about {estimate / 60:.0f} min on {jobs} "
-          f"core(s) ({FORWARD_RUN_CORE_S:g} s a run)", flush=True)
-    if estimate > LONG_RUN_S and not allow_long:
-        raise InputError(f"this forward table ({needed} runs) would take about "
-                         f"{estimate / 3600:.1f} h here: add --allow-long to start it, or "
-                         "choose --grid demo or quick, or give a computed --table")
-    return estimate
+          f"{forward_dir}; the rest takes about {rest * FORWARD_RUN_CORE_S / jobs / 60:.0f} "
+          f"min on {jobs} core(s) ({FORWARD_RUN_CORE_S:g} s a run)", flush=True)
+    what = "this forward table" + (" and the hidden truth's runs" if more_runs else "")
+    return check_long(what, rest + more_runs, FORWARD_RUN_CORE_S, jobs, allow_long,
+                      "choose --grid demo or quick, or give a computed --table")
 
 
-def forward_table(args, grid, sibling_of=None):
+def forward_table(args, grid, sibling_of=None, more_runs=0):
     """(ForwardTable, info dict): the --table file (``sibling_of``: the table of ``grid``
-    beside that file), or the campaign's (run or reused)."""
+    beside that file), or the campaign's (run or reused); ``more_runs``: twin runs the
+    command starts after the table, counted by the long-run gate with it."""
     from pipeline.inversion.forward import run_forward, table_path
     from pipeline.inversion.table import ForwardTable
     path = args.table if sibling_of is None else \
@@ -275,7 +276,7 @@ def forward_table(args, grid, sibling_of=None):
                 "reused_file": True}
         return table, info
     if not args.scheduler:
-        preflight(grid, args.forward_dir, check_jobs(args.jobs), args.allow_long)
+        preflight(grid, args.forward_dir, check_jobs(args.jobs), args.allow_long, more_runs)
     table, cost = run_forward(grid, args.forward_dir, check_jobs(args.jobs), args.scheduler)
     return table, {**cost, "grid": grid.as_dict(), "grid_key": grid.key(),
                    "code_version": table.info.get("code_version"), "reused_file": False}
@@ -462,7 +463,11 @@ def _run_hidden_truth(args, grid, candidates):
     if out.exists() and not out.is_dir():
         raise InputError(f"--out {out} is a file, not a directory")
     started = time.monotonic()
-    table, info = forward_table(args, grid)
+    truth_runs = max(0, sum(s[3] for s in truth.sites) - finished_runs(out / "truth-runs"))
+    if args.table is not None and not args.scheduler:
+        check_long("the hidden truth's runs", truth_runs, FORWARD_RUN_CORE_S,
+                   check_jobs(args.jobs), args.allow_long, "fewer sites or twins")
+    table, info = forward_table(args, grid, more_runs=truth_runs)
     table_grid = TableGrid(**table.info["grid"]) if table.info.get("grid") else grid
     check_hidden(truth, table_grid)
     print(f"hidden truth: {sum(s[3] for s in truth.sites)} twin runs at "

@@ -1,10 +1,11 @@
 """``synthetics``: synthetic near-field motions (pyprop8) around two M 6.5 sources."""
 import time
 
-from pipeline.files import InputError, check_jobs
+from pipeline.files import LONG_RUN_S, InputError, check_jobs
 from pipeline.motion.synthetics import (AZIMUTH_STEP_DEG, GMM_VS30_M_S, QUICK_DURATION_S,
                                         QUICK_FMAX_HZ, RINGS_KM, SOURCES, generate_sources,
                                         source_parameters, write_gmm_summary)
+from pipeline.motion.synthetics.sites import MIN_AZIMUTH_STEP_DEG
 
 NAME = "synthetics"
 ORDER = 50
@@ -28,12 +29,17 @@ def setup(parser):
     parser.add_argument("--rings", default=",".join(f"{r:g}" for r in RINGS_KM),
                         help="ring radii in km (default %(default)s)")
     parser.add_argument("--step", type=float, default=AZIMUTH_STEP_DEG,
-                        help="azimuth step between sites in degrees (default %(default)g)")
+                        help=f"azimuth step between sites in degrees, "
+                        f"{MIN_AZIMUTH_STEP_DEG:g}-360 (default %(default)g)")
     parser.add_argument("--quick", action="store_true",
                         help=f"fmax {QUICK_FMAX_HZ:g} Hz, {QUICK_DURATION_S:g} s, "
                         "written to results/synthetics-quick")
     parser.add_argument("--jobs", type=int, default=None,
                         help="parallel processes (default: all cores)")
+    parser.add_argument("--allow-long", action="store_true",
+                        help=f"start a computation estimated to take over "
+                        f"{LONG_RUN_S / 3600:g} h on --jobs cores (refused otherwise, before "
+                        "it starts)")
     parser.add_argument("--ship", action="store_true",
                         help="compute the sources anew (no cache) and write their pyprop8 "
                         "displacements to records/synthetics/ (maintainers: after a change of "
@@ -51,7 +57,7 @@ def run(args):
                          "drop --quick, --rings and --step")
     started = time.monotonic()
     generated = generate_sources(names, rings, args.step, quick=args.quick,
-                                 jobs=jobs, ship=args.ship)
+                                 jobs=jobs, ship=args.ship, allow_long=args.allow_long)
     for name, paths in generated.items():
         print(f"{name}: {len(paths)} sites in {paths[0].parent}")
     print(f"{time.monotonic() - started:.0f} s (cached when ~0)")

@@ -91,9 +91,9 @@ def parse_truth(data, source="truth"):
     src = data["source"]
     if not isinstance(src, dict) or set(src) != SOURCE_KEYS:
         raise InputError(f"{source}: 'source' needs exactly {', '.join(sorted(SOURCE_KEYS))}")
-    if src["mechanism"] not in MECHANISMS:
+    if not isinstance(src["mechanism"], str) or src["mechanism"] not in MECHANISMS:
         raise InputError(f"{source}: source mechanism must be one of {', '.join(MECHANISMS)}, "
-                         f"got {src['mechanism']!r}")
+                         f"got {repr(src['mechanism'])[:60]}")
     where = f"{source}: source"
     values = {"strike_deg": _number(src["strike_deg"], f"{where} strike_deg", 0.0, 360.0),
               "depth_km": _number(src["depth_km"], f"{where} depth_km", 0.5, 40.0),

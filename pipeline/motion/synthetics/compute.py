@@ -27,6 +27,10 @@ PYPROP8_VERSION = importlib.metadata.version("pyprop8")
 # the sources' summed sub-event displacements at the default settings, computed by this
 # project and shipped so that a fresh checkout need not recompute them (README there)
 SHIPPED_DIR = RECORDS_DIR / "synthetics"
+# core s of pyprop8 per site, sub-event, time sample and wavenumber, the long-run gate's
+# estimate before any computation (the shipped displacements: 72 sites x 5 sub-events,
+# 751 samples x 2104 wavenumbers, took 198.3 s on 2 cores)
+PYPROP8_CORE_S_PER_SAMPLE = 7.0e-7
 
 
 def numerics(duration_s, sampling_hz, fmax_hz, layers=CRUST_LAYERS):
@@ -143,13 +147,16 @@ def generate(source_name, rings_km=RINGS_KM, azimuth_step_deg=AZIMUTH_STEP_DEG, 
 
 def generate_sources(source_names, rings_km=RINGS_KM, azimuth_step_deg=AZIMUTH_STEP_DEG,
                      duration_s=30.0, sampling_hz=100.0, fmax_hz=10.0, out_dir=None,
-                     quick=False, jobs=None, ship=False):
+                     quick=False, jobs=None, ship=False, allow_long=None):
     """:func:`generate` for several sources at once: {source name: npz paths}.  The
     sub-events of every source to compute share one pool of ``jobs`` processes (two
     sources of five sub-events on 2 cores: five rounds of pyprop8 calls instead of six);
     each source's motions are the same as computed alone.  A source whose displacements
     ``SHIPPED_DIR`` holds for the same cache key and pyprop8 version is not recomputed;
-    ``ship``: compute every source (no cache) and write its displacements there."""
+    ``ship``: compute every source (no cache) and write its displacements there.
+    ``allow_long``: False refuses a computation estimated at over an hour on ``jobs``
+    cores before it starts, True warns (:func:`pipeline.files.check_long`), None: no
+    gate."""
     cfg = settings(rings_km, azimuth_step_deg, duration_s, sampling_hz, fmax_hz, out_dir, quick)
     num = numerics(cfg["duration_s"], cfg["sampling_hz"], cfg["fmax_hz"])
     plans, tasks = {}, []
@@ -176,6 +183,14 @@ def generate_sources(source_names, rings_km=RINGS_KM, azimuth_step_deg=AZIMUTH_S
                                  sub, num, cfg["fmax_hz"])))
     if tasks:
         jobs = jobs or os.cpu_count() or 1
+        if allow_long is not None:
+            computed = list(dict.fromkeys(name for name, _ in tasks))
+            sites = sum(len(plans[name]["sites"]) for name in computed)
+            core_s = sum(len(call[0]) for _, call in tasks) * num["nt"] * num["nk"] \
+                * PYPROP8_CORE_S_PER_SAMPLE          # sites x sub-events x samples
+            files.check_long(f"synthetics of {', '.join(computed)}", sites, core_s / sites,
+                             jobs, allow_long, "a larger --step or fewer --rings",
+                             unit="sites")
         started = time.monotonic()
         totals = dict.fromkeys((name for name, _ in tasks), 0.0)
         progress = tqdm(total=len(tasks), desc="pyprop8 " + ", ".join(totals),

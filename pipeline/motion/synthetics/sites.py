@@ -16,6 +16,8 @@ QUICK_FMAX_HZ = 2.5
 QUICK_DURATION_S = 20.0
 RINGS_KM = (5.0, 10.0, 20.0)     # default site rings around the epicentre
 AZIMUTH_STEP_DEG = 30.0          # default step between the sites of a ring
+MIN_AZIMUTH_STEP_DEG = 0.01      # the finest: 36,000 sites a ring (the long-run gate
+#                                  weighs what that costs before any computation)
 
 
 def settings(rings_km, azimuth_step_deg, duration_s, sampling_hz, fmax_hz, out_dir, quick):
@@ -23,8 +25,11 @@ def settings(rings_km, azimuth_step_deg, duration_s, sampling_hz, fmax_hz, out_d
         fmax_hz = min(fmax_hz, QUICK_FMAX_HZ)
         duration_s = min(duration_s, QUICK_DURATION_S)
     rings = tuple(float(r) for r in rings_km)
-    if not rings or min(rings) <= 0 or not 0 < azimuth_step_deg <= 360:
-        raise InputError(f"impossible site rings {rings_km} km / azimuth step {azimuth_step_deg}")
+    if not rings or not all(math.isfinite(r) and r > 0 for r in rings):
+        raise InputError(f"impossible site rings {rings_km} km: give distances > 0")
+    if not MIN_AZIMUTH_STEP_DEG <= azimuth_step_deg <= 360:
+        raise InputError(f"azimuth step {azimuth_step_deg:g} deg outside "
+                         f"[{MIN_AZIMUTH_STEP_DEG:g}, 360]")
     base = Path(out_dir) if out_dir is not None else (QUICK_OUT_DIR if quick else DEFAULT_OUT_DIR)
     return {"rings_km": rings, "azimuth_step_deg": float(azimuth_step_deg),
             "duration_s": float(duration_s), "sampling_hz": float(sampling_hz),

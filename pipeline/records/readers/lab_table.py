@@ -12,7 +12,12 @@ The file (plain or gzip-compressed) starts with ``#`` header lines; three are re
     ...
 
 Columns are separated by blanks or commas: time (s, uniformly sampled) and the
-acceleration components in the order of ``axes``.  A component the table does not have
+acceleration components in the order of ``axes``; at most MAX_SAMPLES rows and
+MAX_DURATION_S seconds (checked before the table is parsed into arrays).  Units or axes
+stated twice (two ``# units:`` lines that name units, two ``# axes:`` lines of axes; a
+``# units:`` line describing the columns in words is a comment), or a title, station or
+event given twice, are refused (which one is meant?); so is a table whose header lacks
+its first line ``# lab-table:``.  A component the table does not have
 is zero (a uniaxial table moves along its one axis only); the reader says which it added
 in ``info["zero_components"]``.
 """
@@ -32,27 +37,50 @@ PRIORITY = 5
 UNITS = {"g": STANDARD_GRAVITY, "m/s^2": 1.0, "m/s2": 1.0, "m/s**2": 1.0}
 SAMPLING_TOLERANCE = 1e-3     # relative spread of the time steps allowed
 HEADER = re.compile(r"#\s*([A-Za-z_-]+)\s*:\s*(.*?)\s*$")
+KEYS = ("lab-table", "units", "axes", "station", "event")   # the header lines read
+MAX_SAMPLES = 2_000_000       # rows of a table (10 min at 3.3 kHz; the SP1 tests: 800 Hz)
+MAX_DURATION_S = 3600.0       # seconds a table may span (a shake-table test lasts minutes)
 
 
 def detect(path, head):
-    return head.lstrip().lower().startswith(b"# lab-table")
+    """A table that starts with ``# lab-table``, or with ``#`` lines holding a lab
+    table's header (``# units:``, ``# axes:``): :func:`read` then names what is missing."""
+    text = head.lstrip().lower()
+    if text.startswith(b"# lab-table"):
+        return True
+    lines = text.decode("utf-8", errors="replace").splitlines()
+    leading = []
+    for line in lines:
+        if not line.startswith("#"):
+            break
+        leading.append(line)
+    return any((match := HEADER.match(line)) and match.group(1) in ("units", "axes")
+               for line in leading)
 
 
 def read(path, key=None):
     name = path.name
     text = read_bytes(path).decode("utf-8", errors="replace")
-    header = {}
+    lines, rows = {}, 0
     for line in text.splitlines():
         if not line.startswith("#"):
-            if line.strip():
-                break
+            if line.strip() and not line.lstrip().startswith("#"):
+                rows += 1
             continue
         match = HEADER.match(line)
-        if match:
-            header.setdefault(match.group(1).lower(), match.group(2))
+        if match and not rows and match.group(1).lower() in KEYS:
+            lines.setdefault(match.group(1).lower(), []).append(match.group(2))
+    first = text.lstrip().splitlines()[0] if text.strip() else ""
+    if not first.lower().startswith("# lab-table"):
+        raise InputError(f"{name}: lab table without its first line '# lab-table: TITLE' "
+                         f"(found {first[:40]!r})")
+    header = {field: _statement(field, values, name) for field, values in lines.items()}
     for required in ("units", "axes"):
         if required not in header:
             raise InputError(f"{name}: lab table without a '# {required}:' header line")
+    if rows > MAX_SAMPLES:
+        raise InputError(f"{name}: {rows} rows, more than the {MAX_SAMPLES} a lab table may "
+                         "have")
     units = header["units"].split()[0] if header["units"] else ""
     if units not in UNITS:
         raise InputError(f"{name}: units {units!r}: expected one of {', '.join(UNITS)}")
@@ -75,6 +103,10 @@ def read(path, key=None):
     if dt <= 0 or np.abs(steps - dt).max() > SAMPLING_TOLERANCE * dt:
         raise InputError(f"{name}: time column is not uniformly increasing (steps "
                          f"{steps.min():.6g}-{steps.max():.6g} s)")
+    if data[-1, 0] - data[0, 0] > MAX_DURATION_S:
+        raise InputError(f"{name}: the table spans {data[-1, 0] - data[0, 0]:.6g} s (a time "
+                         f"step of {dt:.6g} s), more than the {MAX_DURATION_S:g} s a lab table "
+                         "may last: is the time column in seconds?")
     horizontal = [o for o in orientations if o[1] == 0.0]
     vertical = [o for o in orientations if o[1] != 0.0]
     if len(horizontal) > 2 or len(vertical) > 1 or not horizontal:
@@ -100,6 +132,32 @@ def read(path, key=None):
         if header.get(key_):
             info[key_] = header[key_]
     return stream, info
+
+
+def _statement(field, values, name):
+    """The value of a header line given on one or more lines: the units or axes among
+    ``# units:`` / ``# axes:`` lines (a line that states none is a comment; none at all:
+    the first, which the checks then refuse), the one title, station or event.
+    InputError when two lines state it."""
+    stated = values
+    if field == "units":
+        stated = [v for v in values if v.split() and v.split()[0] in UNITS]
+    elif field == "axes":
+        stated = [v for v in values if _are_axes(v)]
+    if len(stated) > 1:
+        raise InputError(f"{name}: '# {field}:' given twice ({stated[0]!r} and "
+                         f"{stated[1]!r}): which one is meant?")
+    return stated[0] if stated else values[0]
+
+
+def _are_axes(text):
+    """True if ``text`` is a list of axes (azimuths in [0, 360) or "up")."""
+    tokens = [a for a in re.split(r"[,\s]+", text) if a]
+    try:
+        return bool(tokens) and all(t.lower() == "up" or 0.0 <= float(t) < 360.0
+                                    for t in tokens)
+    except ValueError:
+        return False
 
 
 def _orientation(text, name):
