@@ -328,8 +328,15 @@ def run(args):
           f"{summary['distance_ci95_km'][1]:.1f} km; 95 % area "
           f"{summary['credible_area_95_km2']:.0f} km^2; most probable mechanism {mech} "
           f"({summary['mechanism_posterior'][mech]:.2f})")
+    _say_reach(summary)
     print(f"wrote {out} ({time.monotonic() - started:.0f} s)")
     return 0
+
+
+def _say_reach(summary):
+    """A warning line when the posterior piles against the edge of the inversion's reach."""
+    if summary.get("reach_warning"):
+        print(f"warning: {summary['reach_warning']}")
 
 
 def _run_demo(args, preset, grid, candidates):
@@ -484,6 +491,7 @@ def _run_hidden_truth(args, grid, candidates):
           f"95 % regions hold the true epicentre: {check['epicentre_in_95']}, back azimuth: "
           f"{check['back_azimuth_in_95']}, distance: {check['distance_in_95']}, magnitude: "
           f"{check['mw_in_95']}; MAP epicentre {check['map_epicentre_error_km']:.1f} km off")
+    _say_reach(summary)
     print(f"wrote {out} ({time.monotonic() - started:.0f} s)")
     return 0
 
