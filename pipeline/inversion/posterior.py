@@ -290,14 +290,15 @@ class Posterior:
                     "reach_edge_prior_fraction": None, "reach_warning": None}
         prior = np.exp(self.log_prior - logsumexp(self.log_prior)).sum(axis=(0, 1))
         fraction = float(self.epicentre[self.edge].sum())
+        prior_fraction = float(prior[self.edge].sum())
         warning = None
         if fraction > EDGE_WARNING_FRACTION:
-            warning = (f"{fraction:.0%} of the posterior lies in the outermost candidate "
-                       f"cells, {reach:g} km from a site ({self.info.get('reach_limit')}): "
-                       "the source may lie farther than this inversion can tell")
+            warning = (f"{fraction:.0%} of the posterior (of the prior: {prior_fraction:.0%}) "
+                       f"lies in the outermost candidate cells, {reach:g} km from a site "
+                       f"({self.info.get('reach_limit')}): the source may lie farther than "
+                       "this inversion can tell")
         return {"reach_km": float(reach), "reach_edge_fraction": fraction,
-                "reach_edge_prior_fraction": float(prior[self.edge].sum()),
-                "reach_warning": warning}
+                "reach_edge_prior_fraction": prior_fraction, "reach_warning": warning}
 
     def frame(self):
         """One row per candidate: posterior.csv."""

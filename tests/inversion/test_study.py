@@ -46,6 +46,7 @@ def test_the_answer_names_the_fewest_columns_that_bound_or_narrow():
                          "coverage_back_azimuth_95": 0.93 if calibrated else coverage,
                          "coverage_ci95": (0.89, 0.96) if calibrated else (0.83, 0.92),
                          "calibrated": calibrated, "credible_area_95_km2_median": 4.0,
+                         "coverage_distance_95": 0.9,
                          "coverage_epicentre_95": 0.8, "coverage_mw_95": 1.0})
     summary = pd.DataFrame(rows)
     bound = study_answer(summary)["independent"]
