@@ -8,9 +8,10 @@ within ``radius_km`` of some site and within the forward table's last ring of ev
 the table speaks for every candidate, none takes the last ring's values for a farther
 site (the inversion's reach).  The posterior's mass in the outermost cells of the
 candidates (``reach_edge_fraction``) says when the answer is "farther than the candidates
-reach": above ``EDGE_WARNING_FRACTION`` the summary holds a ``reach_warning``.  The prior is uniform over epicentre area, strike and
-depth; mechanisms uniform unless ``mechanism_prior`` gives weights; magnitudes uniform
-unless ``gr_b`` gives a Gutenberg-Richter b value (prior proportional to 10^(-b M)).
+reach": above ``EDGE_WARNING_FRACTION`` the summary holds a ``reach_warning``.  The prior
+is uniform over epicentre area, strike and depth; mechanisms uniform unless
+``mechanism_prior`` gives weights; magnitudes uniform unless ``gr_b`` gives a
+Gutenberg-Richter b value (prior proportional to 10^(-b M)).
 
 Frames: km East/North of the first site; the back azimuth is the azimuth from the first
 site to the epicentre.  Credible regions are highest-posterior-density (HPD) sets: for the
