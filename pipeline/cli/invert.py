@@ -386,7 +386,8 @@ def _run_demo(args, preset, grid, candidates):
                                                     "back_azimuth_ci68_deg",
                                                     "distance_ci95_km", "mechanism_posterior",
                                                     "credible_area_95_km2", "reach_km",
-                                                    "reach_edge_fraction", "reach_warning")}}
+                                                    "reach_limit", "reach_edge_fraction",
+                                                    "reach_warning")}}
     summary["elapsed_s"] = round(time.monotonic() - started, 1)
     from pipeline.files import write_json
     write_json(out / "demo_summary.json", summary)

@@ -282,12 +282,12 @@ class Posterior:
         return out
 
     def reach_summary(self):
-        """The inversion's reach (km from a site where the candidates end), the posterior's
-        and the prior's mass in the outermost cells, and a warning line (None) when the
-        posterior holds more than EDGE_WARNING_FRACTION there."""
+        """The inversion's reach (km from a site where the candidates end, and what ends
+        them), the posterior's and the prior's mass in the outermost cells, and a warning
+        line (None) when the posterior holds more than EDGE_WARNING_FRACTION there."""
         reach = self.info.get("reach_km")
         if self.edge is None or reach is None:
-            return {"reach_km": reach, "reach_edge_fraction": None,
+            return {"reach_km": reach, "reach_limit": None, "reach_edge_fraction": None,
                     "reach_edge_prior_fraction": None, "reach_warning": None}
         prior = np.exp(self.log_prior - logsumexp(self.log_prior)).sum(axis=(0, 1))
         fraction = float(self.epicentre[self.edge].sum())
@@ -298,7 +298,8 @@ class Posterior:
                        f"lies in the outermost candidate cells, {reach:g} km from a site "
                        f"({self.info.get('reach_limit')}): the source may lie farther than "
                        "this inversion can tell")
-        return {"reach_km": float(reach), "reach_edge_fraction": fraction,
+        return {"reach_km": float(reach), "reach_limit": self.info.get("reach_limit"),
+                "reach_edge_fraction": fraction,
                 "reach_edge_prior_fraction": prior_fraction, "reach_warning": warning}
 
     def frame(self):

@@ -166,7 +166,9 @@ def _paper_scenario_lines(demo):
                              p["back_azimuth_in_95_sites_with_falls"]),
                          "sites within +-30 deg": p["sites_within_30_deg"],
                          "MAP error (median deg)":
-                             _fmt(p["median_abs_map_error_deg_sites_with_falls"])})
+                             _fmt(p["median_abs_map_error_deg_sites_with_falls"]),
+                         **({"warned: may lie farther": p["sites_reach_warning"]}
+                            if "sites_reach_warning" in p else {})})
         lines.append("**The paper's scenario.** Each of the paper's sites (rings 5, 10, 20 km, "
                      "every 30 deg) inverted alone from what its twin columns (nominal "
                      "parameters) show:\n\n" + _table(pd.DataFrame(rows)) + "\n")
@@ -201,13 +203,13 @@ def _example_lines(demo):
 
 
 def _reach_sentence(summary):
-    """', candidates within R km of every site, F of the posterior in the outermost
-    cells' and the warning, from an inversion summary (older ones: nothing)."""
+    """'; the candidates end R km from the sites (what ends them), F of the posterior in
+    their outermost cells' and the warning, from an inversion summary (older: nothing)."""
     if summary.get("reach_km") is None:
         return ""
-    text = (f"; candidates within {summary['reach_km']:g} km of every site (the forward "
-            f"table's reach), {_pct(summary.get('reach_edge_fraction'))} of the posterior in "
-            "the outermost cells")
+    text = (f"; the candidates end {summary['reach_km']:g} km from the sites "
+            f"({summary.get('reach_limit')}), {_pct(summary.get('reach_edge_fraction'))} of "
+            "the posterior in their outermost cells")
     if summary.get("reach_warning"):
         text += ": the source may lie farther than the inversion can tell"
     return text
