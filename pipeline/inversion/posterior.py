@@ -408,7 +408,7 @@ def invert(model, observations, grid):
     requested, _ = grid.lattice(observations)
     east, north = grid.lattice(observations, last_ring)
     if east.size == 0:
-        raise OutOfReach(_out_of_reach(observations, last_ring, grid.radius_km))
+        raise OutOfReach(_out_of_reach(observations, last_ring, grid))
     strikes = grid.strikes_deg
     loglike = model.log_likelihood(observations, east, north, strikes)
     log_prior_slice = grid.log_prior_slices(model.table.slices)
@@ -438,18 +438,19 @@ def within_reach(east_km, north_km, sites_km, last_ring_km, radius_km):
     return bool(max(distances) <= last_ring_km + 1e-9 and min(distances) <= radius_km + 1e-9)
 
 
-def _out_of_reach(observations, last_ring, radius_km):
-    """The one-line reason why no epicentre is within reach of every site."""
+def _out_of_reach(observations, last_ring, grid):
+    """The one-line reason why no candidate epicentre is within reach of every site."""
     pairs = [(p, q) for k, p in enumerate(observations.sites)
              for q in observations.sites[k + 1:]] or [(observations.sites[0],) * 2]
     p, q = max(pairs, key=lambda pq: math.hypot(pq[0].east_km - pq[1].east_km,
                                                   pq[0].north_km - pq[1].north_km))
-    gap, a, b = math.hypot(p.east_km - q.east_km, p.north_km - q.north_km), p.name, q.name
+    gap = math.hypot(p.east_km - q.east_km, p.north_km - q.north_km)
     if gap > 2 * last_ring:
-        return (f"sites {a} and {b} lie {gap:.1f} km apart, but the forward table's rings end "
-                f"at {last_ring:g} km: no epicentre is within its reach of every site (invert "
-                f"fewer sites together, or use a table with rings to at least "
+        return (f"sites {p.name} and {q.name} lie {gap:.1f} km apart, but the forward table's "
+                f"rings end at {last_ring:g} km: no epicentre is within its reach of every "
+                f"site (invert fewer sites together, or use a table with rings to at least "
                 f"{gap / 2:.1f} km)")
-    return (f"no candidate epicentre lies within --radius {radius_km:g} km of a site and "
-            f"within the forward table's last ring ({last_ring:g} km) of every site: a "
-            "larger --radius, or a table with farther rings")
+    return (f"no cell of the candidate grid (--step {grid.step_km:g} km, --radius "
+            f"{grid.radius_km:g} km) lies within the forward table's last ring "
+            f"({last_ring:g} km) of every site (sites {p.name} and {q.name} lie {gap:.1f} km "
+            "apart): a finer --step, a larger --radius or a table with farther rings")

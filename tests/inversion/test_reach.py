@@ -131,3 +131,16 @@ def test_invert_warns_when_the_source_may_lie_beyond(table, tmp_path, capsys):
     assert summary["reach_edge_fraction"] > EDGE_WARNING_FRACTION
     printed = capsys.readouterr().out
     assert f"warning: {summary['reach_warning']}" in printed
+
+
+def test_a_region_thinner_than_a_cell_is_one_line(table):
+    """Sites 19 km apart: the points within 10 km of both form a lens 1 km wide (9 to 10 km
+    East of A) and 6.2 km long, between the cell centres of a 3 km grid (1.5, 4.5, 7.5,
+    10.5 km East); a 0.5 km grid has cells in it."""
+    observations = hidden_source((9.5, 1.0), {"A": (0.0, 0.0), "B": (19.0, 0.0)})
+    with pytest.raises(InputError, match=r"no cell of the candidate grid \(--step 3 km, "
+                                         r"--radius 30 km\) lies within the forward table's "
+                                         r"last ring \(10 km\) of every site"):
+        invert(ForwardModel(table), observations, CandidateGrid(radius_km=30, step_km=3))
+    finer = invert(ForwardModel(table), observations, CandidateGrid(radius_km=30, step_km=0.5))
+    assert finer.east_km.size > 0
