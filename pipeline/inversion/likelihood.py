@@ -21,8 +21,7 @@ log distance (clamped at the first and last ring: the inversion's candidates nev
 beyond the last ring of a site, :func:`pipeline.inversion.posterior.invert`) and in node
 azimuth (periodic).  Interpolating in the site frame moves a fall direction that is fixed
 relative to the source-to-site direction smoothly between nodes.  Log-likelihood = sum
-over columns
-(``likelihood="independent"``, the default).  Densities are per radian.
+over columns (``likelihood="independent"``, the default).  Densities are per radian.
 
 ``likelihood="predictive"`` accounts for the ensemble's own sampling error, which the
 product above ignores: columns at one site share one ground motion, and the node's fall
