@@ -474,6 +474,8 @@ def _run_hidden_truth(args, grid, candidates):
     table, info = forward_table(args, grid)
     table_grid = TableGrid(**table.info["grid"]) if table.info.get("grid") else grid
     check_hidden(truth, table_grid)
+    from pipeline.inversion.posterior import check_reach
+    check_reach(truth.sites, table.distances_km[-1], candidates)     # before any run
     print(f"hidden truth: {sum(s[3] for s in truth.sites)} twin runs at "
           f"{len(truth.sites)} site(s)", flush=True)
     result = run_campaign("inversion-truth", jobs=check_jobs(args.jobs),

@@ -31,6 +31,7 @@ from scipy.special import logsumexp
 from pipeline.files import InputError
 from pipeline.stats.circular import azimuth_deg
 from pipeline.inversion.likelihood import ForwardModel
+from pipeline.inversion.observations import Observations, Site
 
 BAZ_BIN_DEG = 2.0
 SUBGRID = 5
@@ -406,9 +407,7 @@ def invert(model, observations, grid):
         model.column_index(column)
     last_ring = float(model.table.distances_km[-1])
     requested, _ = grid.lattice(observations)
-    east, north = grid.lattice(observations, last_ring)
-    if east.size == 0:
-        raise OutOfReach(_out_of_reach(observations, last_ring, grid))
+    east, north = reached_lattice(observations, last_ring, grid)
     strikes = grid.strikes_deg
     loglike = model.log_likelihood(observations, east, north, strikes)
     log_prior_slice = grid.log_prior_slices(model.table.slices)
@@ -429,6 +428,24 @@ def invert(model, observations, grid):
             "sites_km": [[s.east_km, s.north_km] for s in observations.sites]}
     return Posterior(model.table.slices, strikes, east, north, grid.step_km, log_prior,
                      loglike, info=info, edge=grid.edge_cells(east, north))
+
+
+def reached_lattice(observations, last_ring_km, grid):
+    """The candidate epicentres of ``grid`` within ``last_ring_km`` of every site (east,
+    north km from the first site); OutOfReach (one line) when there is none."""
+    east, north = grid.lattice(observations, last_ring_km)
+    if east.size == 0:
+        raise OutOfReach(_out_of_reach(observations, last_ring_km, grid))
+    return east, north
+
+
+def check_reach(sites, last_ring_km, grid):
+    """OutOfReach (one line) when no candidate of ``grid`` lies within ``last_ring_km`` of
+    every site of ``sites`` ((name, east km, north km, ...) in any frame): before any run
+    whose observations would be inverted there."""
+    _, e0, n0 = sites[0][:3]
+    reached_lattice(Observations(tuple(Site(s[0], s[1] - e0, s[2] - n0, ()) for s in sites)),
+                    float(last_ring_km), grid)
 
 
 def within_reach(east_km, north_km, sites_km, last_ring_km, radius_km):

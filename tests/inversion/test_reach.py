@@ -144,3 +144,22 @@ def test_a_region_thinner_than_a_cell_is_one_line(table):
         invert(ForwardModel(table), observations, CandidateGrid(radius_km=30, step_km=3))
     finer = invert(ForwardModel(table), observations, CandidateGrid(radius_km=30, step_km=0.5))
     assert finer.east_km.size > 0
+
+
+def test_a_hidden_truth_out_of_reach_is_refused_before_any_run(table, tmp_path, capsys):
+    """invert --hidden-truth with sites 26 km apart and a table whose rings end at 10 km:
+    one line, exit 2, before pyprop8 or YADE, nothing written."""
+    import json
+    path = table.save(tmp_path / "toy.npz")
+    truth = tmp_path / "truth.json"
+    truth.write_text(json.dumps({
+        "source": {"mechanism": "strike-slip", "strike_deg": 30, "depth_km": 10, "mw": 6.5,
+                   "east_km": 0, "north_km": 0},
+        "sites": [{"name": "A", "east_km": -13, "north_km": 0, "twins": 1},
+                  {"name": "B", "east_km": 13, "north_km": 0, "twins": 1}]}))
+    out = tmp_path / "out"
+    assert cli.main(["invert", "--hidden-truth", str(truth), "--table", str(path),
+                     "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert "sites A and B lie 26.0 km apart" in err and len(err.strip().splitlines()) == 1
+    assert not out.exists()
