@@ -142,7 +142,7 @@ def _candidates(c, kernel_deg, floor):
     """The candidate sources, the prior and the likelihood's options."""
     c.add_argument("--radius", type=float, default=None, metavar="KM",
                    help="epicentres within this distance of a site (default 30; quick 12; "
-                   "demo 25)")
+                   "demo 25) and within the forward table's last ring of every site")
     c.add_argument("--step", type=float, default=None, metavar="KM",
                    help="epicentre grid spacing (default 1)")
     c.add_argument("--strike-step", type=float, default=None, metavar="DEG",
