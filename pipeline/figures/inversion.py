@@ -216,19 +216,23 @@ def plot_member_study(summary, path, bound_deg):
 
 
 def plot_member_study_source(summary, path):
-    """The member study for the epicentre and the magnitude: per likelihood (rows) the
-    median 95 % credible area of the epicentre, and the coverage of the epicentre's 95 %
-    region and of the 95 % set of magnitudes (Wilson intervals), against the likelihood
-    members per node."""
+    """The member study for the epicentre, the distance and the magnitude: per likelihood
+    (rows) the median 95 % credible area of the epicentre, and the coverage of the
+    epicentre's 95 % region, of the distance's 95 % interval and of the 95 % set of
+    magnitudes (Wilson intervals), against the likelihood members per node."""
     panels = [("credible_area_95_km2_median", None, "median 95 % credible area (km^2)",
                "epicentre: area", None, None, None),
               ("coverage_epicentre_95", "coverage_epicentre_ci95",
                "coverage of the 95 % region (Wilson 95 %)", "epicentre: coverage", (0, 1.02),
                0.95, "95 %"),
+              ("coverage_distance_95", "coverage_distance_ci95",
+               "coverage of the 95 % interval (Wilson 95 %)", "distance: coverage",
+               (0, 1.02), 0.95, "95 %"),
               ("coverage_mw_95", "coverage_mw_ci95", "true Mw in the 95 % set (Wilson 95 %)",
                "magnitude: coverage", (0, 1.02), 0.95, "95 %")]
-    _plot_study_panels(summary, path, panels, "What the columns tell of the epicentre and "
-                       "the magnitude (the same truth tests)")
+    panels = [panel for panel in panels if panel[0] in summary.columns]
+    _plot_study_panels(summary, path, panels, "What the columns tell of the epicentre, the "
+                       "distance and the magnitude (the same truth tests)")
     return path
 
 

@@ -321,8 +321,8 @@ def member_study_section(results):
     lines += ["", f"At {int(summary['likelihood_members'].max())} likelihood members per node:",
               "", _table(table.round(2)) + "\n",
               _figure(results, base / "member_study.png", "member study"),
-              "\nThe same truth tests for the epicentre and the magnitude (the standing "
-              "columns take part in the likelihood as much as the fallen ones):\n",
+              "\nThe same truth tests for the epicentre, the distance and the magnitude (the "
+              "standing columns take part in the likelihood as much as the fallen ones):\n",
               _figure(results, base / "member_study_source.png",
                       "member study: epicentre and magnitude")]
     return "\n".join(lines)
