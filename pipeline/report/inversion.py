@@ -298,11 +298,12 @@ def member_study_section(results):
     lines.append(_toppled_by_slice(study.get("toppled_fraction_by_slice") or []))
     if "trials_beyond" in summary.columns:
         lines.append("The trials' sources lie as sources come, off the table's nodes: the "
-                     "strike anywhere between the candidates' steps, and in a third of the "
-                     "trials each the sites on the table's nodes, between the rings the "
-                     "likelihood keeps (its inner rings left out) or the first beyond its "
-                     "last ring (left out: the source lies beyond the inversion's reach, "
-                     "and the answer wanted is a warning that it may lie farther).\n")
+                     "strike anywhere between the candidates' steps; the sites, in a third "
+                     "of the trials each, on the nodes of the likelihood's table, between "
+                     "the rings it keeps (its inner rings left out), or the first of them "
+                     "beyond its last ring (left out: the source lies beyond the "
+                     "inversion's reach, and the answer wanted is a warning that it may lie "
+                     "farther).\n")
     lines += [f"- {text}." for text in study["answer"].values()]
     largest = summary[summary["likelihood_members"] == summary["likelihood_members"].max()]
     names = {"fallen_per_site": "fallen per site",
