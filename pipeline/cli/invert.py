@@ -334,7 +334,13 @@ def run(args):
 
 
 def _say_reach(summary):
-    """A warning line when the posterior piles against the edge of the inversion's reach."""
+    """What the forward table's reach left out of the candidates asked for, and a warning
+    line when the posterior piles against the edge of the reach."""
+    if summary.get("beyond_table_fraction"):
+        print(f"candidates: within {summary['table_last_ring_km']:g} km of every site, where "
+              f"the forward table's rings end; {summary['beyond_table_fraction']:.0%} of the "
+              f"epicentres within --radius {summary['candidate_grid']['radius_km']:g} km of "
+              "a site lie beyond and are left out")
     if summary.get("reach_warning"):
         print(f"warning: {summary['reach_warning']}")
 

@@ -131,6 +131,8 @@ def test_invert_warns_when_the_source_may_lie_beyond(table, tmp_path, capsys):
     assert summary["reach_edge_fraction"] > EDGE_WARNING_FRACTION
     printed = capsys.readouterr().out
     assert f"warning: {summary['reach_warning']}" in printed
+    assert (f"{summary['beyond_table_fraction']:.0%} of the epicentres within --radius 30 km "
+            "of a site lie beyond") in printed
 
 
 def test_a_region_thinner_than_a_cell_is_one_line(table):
