@@ -90,18 +90,19 @@ def plot_posterior_map(post, observations, path, truth_km=None, title=None, arro
     if truth_km is not None:
         xs, ys = np.r_[xs, truth_km[0]], np.r_[ys, truth_km[1]]
     pad = max(0.15 * max(np.ptp(xs), np.ptp(ys)), 3.0 * post.step_km) + arrow_km
-    ax.set_xlim(max(xs.min() - pad, min(east_edges[0], xs.min())),
-                min(xs.max() + pad, max(east_edges[-1], xs.max())))
-    ax.set_ylim(max(ys.min() - pad, min(north_edges[0], ys.min())),
-                min(ys.max() + pad, max(north_edges[-1], ys.max())))
+    step = post.step_km                 # the lattice's bounds, or a true epicentre beyond
+    ax.set_xlim(max(xs.min() - pad, min(east_edges[0], xs.min() - step)),
+                min(xs.max() + pad, max(east_edges[-1], xs.max() + step)))
+    ax.set_ylim(max(ys.min() - pad, min(north_edges[0], ys.min() - step)),
+                min(ys.max() + pad, max(north_edges[-1], ys.max() + step)))
     ax.set_aspect("equal")
     ax.set_xlabel(f"East of site {observations.sites[0].name} (km)")
     ax.set_ylabel(f"North of site {observations.sites[0].name} (km)")
     reach = post.reach_summary()
     if reach["reach_km"] is not None:      # the coloured cells are the candidates
         title = (title or "Posterior of the epicentre") + (
-            f"\ncandidates end {reach['reach_km']:g} km from the sites ({reach['reach_limit']}); "
-            f"{reach['reach_edge_fraction']:.0%} of the posterior in its outermost cells"
+            f"\ncandidates end {reach['reach_km']:g} km from the sites ({reach['reach_limit']});"
+            f"\n{reach['reach_edge_fraction']:.0%} of the posterior in their outermost cells"
             + (": the source may lie farther" if reach["reach_warning"] else ""))
     ax.set_title(title or "Posterior of the epicentre")
     save_figure(fig, path, dpi=130, bbox_inches="tight")
