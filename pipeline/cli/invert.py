@@ -143,7 +143,7 @@ def _candidates(c, kernel_deg, floor):
     """The candidate sources, the prior and the likelihood's options."""
     c.add_argument("--radius", type=float, default=None, metavar="KM",
                    help="epicentres within this distance of a site (default 30; quick 12; "
-                   "demo 25)")
+                   "demo 25) and within the forward table's last ring of every site")
     c.add_argument("--step", type=float, default=None, metavar="KM",
                    help="epicentre grid spacing (default 1)")
     c.add_argument("--strike-step", type=float, default=None, metavar="DEG",
@@ -329,8 +329,21 @@ def run(args):
           f"{summary['distance_ci95_km'][1]:.1f} km; 95 % area "
           f"{summary['credible_area_95_km2']:.0f} km^2; most probable mechanism {mech} "
           f"({summary['mechanism_posterior'][mech]:.2f})")
+    _say_reach(summary)
     print(f"wrote {out} ({time.monotonic() - started:.0f} s)")
     return 0
+
+
+def _say_reach(summary):
+    """What the forward table's reach left out of the candidates asked for, and a warning
+    line when the posterior piles against the edge of the reach."""
+    if summary.get("beyond_table_fraction"):
+        print(f"candidates: within {summary['table_last_ring_km']:g} km of every site, where "
+              f"the forward table's rings end; {summary['beyond_table_fraction']:.0%} of the "
+              f"epicentres within --radius {summary['candidate_grid']['radius_km']:g} km of "
+              "a site lie beyond and are left out")
+    if summary.get("reach_warning"):
+        print(f"warning: {summary['reach_warning']}")
 
 
 def _run_demo(args, preset, grid, candidates):
@@ -379,7 +392,9 @@ def _run_demo(args, preset, grid, candidates):
                                                     "back_azimuth_ci95_deg",
                                                     "back_azimuth_ci68_deg",
                                                     "distance_ci95_km", "mechanism_posterior",
-                                                    "credible_area_95_km2")}}
+                                                    "credible_area_95_km2", "reach_km",
+                                                    "reach_limit", "reach_edge_fraction",
+                                                    "reach_warning")}}
     summary["elapsed_s"] = round(time.monotonic() - started, 1)
     from pipeline.files import write_json
     write_json(out / "demo_summary.json", summary)
@@ -470,6 +485,8 @@ def _run_hidden_truth(args, grid, candidates):
     table, info = forward_table(args, grid, more_runs=truth_runs)
     table_grid = TableGrid(**table.info["grid"]) if table.info.get("grid") else grid
     check_hidden(truth, table_grid)
+    from pipeline.inversion.posterior import check_reach
+    check_reach(truth.sites, table.distances_km[-1], candidates)     # before any run
     print(f"hidden truth: {sum(s[3] for s in truth.sites)} twin runs at "
           f"{len(truth.sites)} site(s)", flush=True)
     result = run_campaign("inversion-truth", jobs=check_jobs(args.jobs),
@@ -489,6 +506,7 @@ def _run_hidden_truth(args, grid, candidates):
           f"95 % regions hold the true epicentre: {check['epicentre_in_95']}, back azimuth: "
           f"{check['back_azimuth_in_95']}, distance: {check['distance_in_95']}, magnitude: "
           f"{check['mw_in_95']}; MAP epicentre {check['map_epicentre_error_km']:.1f} km off")
+    _say_reach(summary)
     print(f"wrote {out} ({time.monotonic() - started:.0f} s)")
     return 0
 

@@ -90,11 +90,20 @@ def plot_posterior_map(post, observations, path, truth_km=None, title=None, arro
     if truth_km is not None:
         xs, ys = np.r_[xs, truth_km[0]], np.r_[ys, truth_km[1]]
     pad = max(0.15 * max(np.ptp(xs), np.ptp(ys)), 3.0 * post.step_km) + arrow_km
-    ax.set_xlim(max(xs.min() - pad, east_edges[0]), min(xs.max() + pad, east_edges[-1]))
-    ax.set_ylim(max(ys.min() - pad, north_edges[0]), min(ys.max() + pad, north_edges[-1]))
+    step = post.step_km                 # the lattice's bounds, or a true epicentre beyond
+    ax.set_xlim(max(xs.min() - pad, min(east_edges[0], xs.min() - step)),
+                min(xs.max() + pad, max(east_edges[-1], xs.max() + step)))
+    ax.set_ylim(max(ys.min() - pad, min(north_edges[0], ys.min() - step)),
+                min(ys.max() + pad, max(north_edges[-1], ys.max() + step)))
     ax.set_aspect("equal")
     ax.set_xlabel(f"East of site {observations.sites[0].name} (km)")
     ax.set_ylabel(f"North of site {observations.sites[0].name} (km)")
+    reach = post.reach_summary()
+    if reach["reach_km"] is not None:      # the coloured cells are the candidates
+        title = (title or "Posterior of the epicentre") + (
+            f"\ncandidates end {reach['reach_km']:g} km from the sites ({reach['reach_limit']});"
+            f"\n{reach['reach_edge_fraction']:.0%} of the posterior in their outermost cells"
+            + (": the source may lie farther" if reach["reach_warning"] else ""))
     ax.set_title(title or "Posterior of the epicentre")
     save_figure(fig, path, dpi=130, bbox_inches="tight")
     return path
@@ -208,19 +217,23 @@ def plot_member_study(summary, path, bound_deg):
 
 
 def plot_member_study_source(summary, path):
-    """The member study for the epicentre and the magnitude: per likelihood (rows) the
-    median 95 % credible area of the epicentre, and the coverage of the epicentre's 95 %
-    region and of the 95 % set of magnitudes (Wilson intervals), against the likelihood
-    members per node."""
+    """The member study for the epicentre, the distance and the magnitude: per likelihood
+    (rows) the median 95 % credible area of the epicentre, and the coverage of the
+    epicentre's 95 % region, of the distance's 95 % interval and of the 95 % set of
+    magnitudes (Wilson intervals), against the likelihood members per node."""
     panels = [("credible_area_95_km2_median", None, "median 95 % credible area (km^2)",
                "epicentre: area", None, None, None),
               ("coverage_epicentre_95", "coverage_epicentre_ci95",
                "coverage of the 95 % region (Wilson 95 %)", "epicentre: coverage", (0, 1.02),
                0.95, "95 %"),
+              ("coverage_distance_95", "coverage_distance_ci95",
+               "coverage of the 95 % interval (Wilson 95 %)", "distance: coverage",
+               (0, 1.02), 0.95, "95 %"),
               ("coverage_mw_95", "coverage_mw_ci95", "true Mw in the 95 % set (Wilson 95 %)",
                "magnitude: coverage", (0, 1.02), 0.95, "95 %")]
-    _plot_study_panels(summary, path, panels, "What the columns tell of the epicentre and "
-                       "the magnitude (the same truth tests)")
+    panels = [panel for panel in panels if panel[0] in summary.columns]
+    _plot_study_panels(summary, path, panels, "What the columns tell of the epicentre, the "
+                       "distance and the magnitude (the same truth tests)")
     return path
 
 

@@ -46,6 +46,7 @@ def write_outputs(post, observations, out_dir, forward_info=None, truth=None, ti
                               "p_toppled": "(k + 1/2) / (n + 1) per node"},
                "candidate_grid": post.info.get("grid"),
                "beyond_table_fraction": post.info.get("beyond_table_fraction"),
+               "table_last_ring_km": post.info.get("table_last_ring_km"),
                "observations": observations.as_dict(),
                "n_columns": observations.n_columns, "n_fallen": observations.n_fallen,
                "forward_table": forward_info or {},
@@ -76,20 +77,31 @@ def run_inversion(observations, out_dir, table, candidates, kernel_deg=None, flo
     return summary
 
 
-def truth_check(post, truth):
+def truth_check(post, truth, summary=None):
     """Whether the posterior's credible regions hold a known source (``truth``: epicentre_km
-    in the inversion's frame, back_azimuth_deg, distance_km, mechanism, mw)."""
-    summary = post.summary()
+    in the inversion's frame, back_azimuth_deg, distance_km, mechanism, mw), whether the
+    source lies within the inversion's reach, and whether the outputs warn that it may lie
+    beyond (``*_or_warned``: the region holds the truth or the warning is there).
+    ``summary``: ``post.summary()`` when computed already."""
+    summary = post.summary() if summary is None else summary
     east, north = truth["epicentre_km"]
     lo, hi = summary["distance_ci95_km"]
     map_e, map_n = summary["map_epicentre_km"]
     mw = f"{truth['mw']:g}"
-    return {"epicentre_in_95": post.contains(east, north, level=0.95),
+    warned = summary["reach_warning"] is not None
+    epicentre_in_95 = post.contains(east, north, level=0.95)
+    distance_in_95 = bool(lo <= truth["distance_km"] <= hi)
+    return {"within_reach": post.within_reach(east, north),
+            "reach_warning": warned,
+            "epicentre_in_95_or_warned": epicentre_in_95 or warned,
+            "distance_in_95_or_warned": distance_in_95 or warned,
+            "epicentre_in_95": epicentre_in_95,
             "epicentre_in_68": post.contains(east, north, level=0.68),
             "back_azimuth_in_95": in_arc(truth["back_azimuth_deg"],
                                          summary["back_azimuth_ci95_deg"]),
-            "distance_in_95": bool(lo <= truth["distance_km"] <= hi),
+            "distance_in_95": distance_in_95,
             "map_epicentre_error_km": float(math.hypot(map_e - east, map_n - north)),
+            "reach_edge_fraction": summary["reach_edge_fraction"],
             "mw_in_95": mw in magnitude_set(summary["magnitude_posterior"]),
             "mw_in_table": mw in summary["magnitude_posterior"],
             "p_true_mechanism": summary["mechanism_posterior"].get(truth["mechanism"], 0.0)}

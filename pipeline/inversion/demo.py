@@ -30,7 +30,8 @@ from pipeline.files import InputError, write_csv, write_json
 from pipeline.inversion.likelihood import (DEFAULT_FLOOR, DEFAULT_KERNEL_DEG, LIKELIHOODS,
                                            ForwardModel)
 from pipeline.inversion.observations import ColumnObservation, Observations, Site
-from pipeline.inversion.posterior import in_arc, invert
+from pipeline.inversion import truth_check
+from pipeline.inversion.posterior import OutOfReach, in_arc, invert, within_reach
 from pipeline.stats.circular import angle_difference_deg, azimuth_deg
 from pipeline.motion.synthetics import SOURCES
 
@@ -105,20 +106,27 @@ def truth_trial(model, pool, mechanism, n_sites, fallen, candidates, rng):
         cols = draw_site_columns(pool, s, i, j, strike, fallen, rng)
         sites.append((f"S{k + 1}", e, n, cols))
     observations, truth = _frame(sites)
-    post = invert(model, observations, candidates)
-    summary = post.summary()
     true_baz = azimuth_deg(truth[0], truth[1])
-    map_error = angle_difference_deg(summary["back_azimuth_map_deg"], true_baz)
     d = math.hypot(*truth)
-    lo, hi = summary["distance_ci95_km"]
-    return {"mechanism": mechanism, "sites": len(sites), "fallen_per_site": fallen,
-            "strike_deg": strike, "true_back_azimuth_deg": true_baz, "true_distance_km": d,
-            "site_distances_km": " ".join(f"{math.hypot(e, n):g}" for _, e, n, _ in sites),
-            "standing_observed": sum(not c.fallen for _, _, _, cols in sites for c in cols),
-            "fallen_observed": sum(c.fallen for _, _, _, cols in sites for c in cols),
-            "epicentre_in_95": post.contains(*truth, level=0.95),
-            "epicentre_in_68": post.contains(*truth, level=0.68),
-            "back_azimuth_in_95": in_arc(true_baz, summary["back_azimuth_ci95_deg"]),
+    row = {"mechanism": mechanism, "sites": len(sites), "fallen_per_site": fallen,
+           "strike_deg": strike, "true_back_azimuth_deg": true_baz, "true_distance_km": d,
+           "site_distances_km": " ".join(f"{math.hypot(e, n):g}" for _, e, n, _ in sites),
+           "standing_observed": sum(not c.fallen for _, _, _, cols in sites for c in cols),
+           "fallen_observed": sum(c.fallen for _, _, _, cols in sites for c in cols),
+           "no_candidate": False}
+    try:
+        post = invert(model, observations, candidates)
+    except OutOfReach:
+        return {**row, **out_of_reach_row(truth, observations, table, candidates)}, None
+    summary = post.summary()
+    map_error = angle_difference_deg(summary["back_azimuth_map_deg"], true_baz)
+    check = truth_check(post, {"epicentre_km": truth, "back_azimuth_deg": true_baz,
+                               "distance_km": d, "mechanism": mechanism,
+                               "mw": table.slices[s]["mw"]}, summary)
+    return {**row,
+            "epicentre_in_95": check["epicentre_in_95"],
+            "epicentre_in_68": check["epicentre_in_68"],
+            "back_azimuth_in_95": check["back_azimuth_in_95"],
             "back_azimuth_in_68": in_arc(true_baz, summary["back_azimuth_ci68_deg"]),
             "back_azimuth_in_hpd95": any(in_arc(true_baz, a)
                                          for a in summary["back_azimuth_hpd95_arcs_deg"]),
@@ -127,10 +135,30 @@ def truth_trial(model, pool, mechanism, n_sites, fallen, candidates, rng):
             "hpd95_total_deg": sum((a[1] - a[0]) % 360.0 or 360.0
                                    for a in summary["back_azimuth_hpd95_arcs_deg"]),
             "map_back_azimuth_error_deg": map_error,
-            "distance_in_95": lo <= d <= hi,
+            "distance_in_95": check["distance_in_95"],
+            **{k: check[k] for k in REACH_KEYS},
             "credible_area_95_km2": summary["credible_area_95_km2"],
             "p_true_mechanism": summary["mechanism_posterior"].get(mechanism, 0.0)}, \
         (post, observations, truth)
+
+
+REACH_KEYS = ("within_reach", "reach_warning", "reach_edge_fraction",
+              "epicentre_in_95_or_warned", "distance_in_95_or_warned")
+
+
+def out_of_reach_row(truth, observations, table, candidates):
+    """What a truth test records when no candidate lies within the forward table's reach
+    of every site (the inversion refuses: it cannot tell): no region holds the truth,
+    the back azimuth is unbounded, and the answer counts as "beyond the reach"."""
+    sites = [(site.east_km, site.north_km) for site in observations.sites]
+    inside = within_reach(*truth, sites, float(table.distances_km[-1]), candidates.radius_km)
+    return {"epicentre_in_95": False, "epicentre_in_68": False, "back_azimuth_in_95": False,
+            "back_azimuth_in_68": False, "back_azimuth_in_hpd95": False,
+            "width95_deg": 360.0, "width68_deg": 360.0, "hpd95_total_deg": 360.0,
+            "map_back_azimuth_error_deg": np.nan, "distance_in_95": False,
+            "within_reach": inside, "reach_warning": True, "reach_edge_fraction": np.nan,
+            "epicentre_in_95_or_warned": True, "distance_in_95_or_warned": True,
+            "credible_area_95_km2": np.nan, "p_true_mechanism": np.nan, "no_candidate": True}
 
 
 def truth_tests(model, pool, candidates, trials=DEFAULT_TRIALS, seed=DEMO_SEED,
@@ -148,7 +176,7 @@ def truth_tests(model, pool, candidates, trials=DEFAULT_TRIALS, seed=DEMO_SEED,
                     if row is None:
                         break
                     rows.append({"likelihood": model.likelihood, **row, "trial": trial})
-                    if examples is not None and trial == 0:
+                    if examples is not None and trial == 0 and detail is not None:
                         examples[(mechanism, n_sites, fallen)] = detail
     return pd.DataFrame(rows)
 
@@ -168,6 +196,12 @@ def narrowing(trials):
                      "width68_median_deg": float(g["width68_deg"].median()),
                      "coverage_back_azimuth_95": float(g["back_azimuth_in_95"].mean()),
                      "coverage_epicentre_95": float(g["epicentre_in_95"].mean()),
+                     "coverage_distance_95": float(g["distance_in_95"].mean()),
+                     "coverage_epicentre_95_or_warned":
+                         float(g["epicentre_in_95_or_warned"].mean()),
+                     "coverage_distance_95_or_warned":
+                         float(g["distance_in_95_or_warned"].mean()),
+                     "reach_warning_fraction": float(g["reach_warning"].mean()),
                      "coverage_back_azimuth_68": float(g["back_azimuth_in_68"].mean()),
                      "bounded_30_fraction": float((w <= BOUND_DEG).mean()),
                      "median_abs_map_error_deg": float(
@@ -225,7 +259,9 @@ def paper_nodes(table, source_name):
 
 def paper_scenario(model, obs_table, source_name, candidates):
     """Per site of the paper's rings: what its twin (nominal run) shows and what the
-    inversion of that one site gives; plus the joint inversion of all sites."""
+    inversion of that one site gives; plus the joint inversion of the sites within half
+    the forward table's last ring of the source (then every candidate within that half of
+    the source is within the table's reach of every site; None when no ring is that near)."""
     src = SOURCES[source_name]
     strike = src["strike_deg"]
     s, rings, azimuths = paper_nodes(obs_table, source_name)
@@ -246,7 +282,8 @@ def paper_scenario(model, obs_table, source_name, candidates):
                 else:
                     cols.append(ColumnObservation(column, "standing"))
             name = f"r{obs_table.distances_km[i]:g}_az{site_az:03.0f}"
-            all_sites.append((name, e, n, tuple(cols)))
+            if obs_table.distances_km[i] <= model.table.distances_km[-1] / 2 + 1e-9:
+                all_sites.append((name, e, n, tuple(cols)))
             observations, truth = _frame([(name, e, n, tuple(cols))])
             post = invert(model, observations, candidates)
             summary = post.summary()
@@ -265,13 +302,17 @@ def paper_scenario(model, obs_table, source_name, candidates):
                                                                true_baz),
                          "epicentre_in_95": post.contains(*truth, level=0.95),
                          "credible_area_95_km2": summary["credible_area_95_km2"],
+                         "reach_warning": summary["reach_warning"] is not None,
                          "p_true_mechanism": summary["mechanism_posterior"].get(
                              PAPER_MECHANISMS[source_name], 0.0)})
+    if not all_sites:
+        return pd.DataFrame(rows), None, None
     observations, truth = _frame(all_sites)
     joint = invert(model, observations, candidates)
     js = joint.summary()
     true_baz = azimuth_deg(*truth)
     joint_row = {"source": source_name, "sites": len(all_sites),
+                 "sites_within_km": max(math.hypot(e, n) for _, e, n, _ in all_sites),
                  "fallen": observations.n_fallen, "columns": observations.n_columns,
                  "epicentre_error_km": math.hypot(js["map_epicentre_km"][0] - truth[0],
                                                   js["map_epicentre_km"][1] - truth[1]),
@@ -279,7 +320,9 @@ def paper_scenario(model, obs_table, source_name, candidates):
                  "credible_area_95_km2": js["credible_area_95_km2"],
                  "mechanism_posterior": js["mechanism_posterior"],
                  "strike_map_deg": js["map_candidate"]["strike_deg"],
-                 "true_strike_deg": strike}
+                 "true_strike_deg": strike, "reach_km": js["reach_km"],
+                 "reach_edge_fraction": js["reach_edge_fraction"],
+                 "reach_warning": js["reach_warning"]}
     return pd.DataFrame(rows), joint_row, (joint, observations, truth)
 
 
@@ -365,7 +408,11 @@ def _coverage(trials_frame):
         "epicentre_95": float(g["epicentre_in_95"].mean()),
         "back_azimuth_68": float(g["back_azimuth_in_68"].mean()),
         "epicentre_68": float(g["epicentre_in_68"].mean()),
-        "distance_95": float(g["distance_in_95"].mean())}
+        "distance_95": float(g["distance_in_95"].mean()),
+        "epicentre_95_or_warned": float(g["epicentre_in_95_or_warned"].mean()),
+        "distance_95_or_warned": float(g["distance_in_95_or_warned"].mean()),
+        "within_reach": float(g["within_reach"].mean()),
+        "reach_warning": float(g["reach_warning"].mean())}
         for kind, g in trials_frame.groupby("likelihood", sort=False)}
 
 
@@ -377,9 +424,12 @@ def _paper_outputs(full_model, paper_tables, candidates, out_dir, forward_info):
     for source_name, obs_table in (paper_tables or {}).items():
         if obs_table is None or paper_nodes(obs_table, source_name) is None:
             continue
-        sites, joint_row, (joint, observations, truth) = paper_scenario(
-            full_model, obs_table, source_name, candidates)
+        sites, joint_row, detail = paper_scenario(full_model, obs_table, source_name,
+                                                  candidates)
         paper_rows.append(sites)
+        if joint_row is None:
+            continue
+        joint, observations, truth = detail
         paper_joint.append(joint_row)
         sub = out_dir / f"paper_{source_name}_all_sites"
         write_outputs(joint, observations, sub, forward_info,
@@ -387,7 +437,9 @@ def _paper_outputs(full_model, paper_tables, candidates, out_dir, forward_info):
                              "mechanism": PAPER_MECHANISMS[source_name],
                              "back_azimuth_deg": math.degrees(math.atan2(*truth)) % 360,
                              "distance_km": math.hypot(*truth)},
-                      title=f"The paper's {source_name} source: all {len(sites)} sites' twins")
+                      title=f"The paper's {source_name} source: the twins of the "
+                            f"{joint_row['sites']} sites within "
+                            f"{joint_row['sites_within_km']:g} km")
         figures.append(sub / "posterior_map.png")
     paper_sites = pd.concat(paper_rows, ignore_index=True) if paper_rows else pd.DataFrame()
     if not paper_sites.empty:
@@ -412,6 +464,7 @@ def _paper_per_source(sites):
                     "back_azimuth_in_95_sites_with_falls":
                         None if fell.empty else float(fell["back_azimuth_in_95"].mean()),
                     "sites_within_30_deg": int((g["width95_deg"] <= BOUND_DEG).sum()),
+                    "sites_reach_warning": int(g["reach_warning"].sum()),
                     "median_abs_map_error_deg_sites_with_falls":
                         None if fell.empty else float(fell["map_error_deg"].abs().median())})
     return out

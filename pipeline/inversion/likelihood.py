@@ -17,10 +17,11 @@ A fallen column observed at geographic azimuth psi_obs contributes
 f(psi_obs - alpha) = sum_nodes w P_n d_n(psi_obs - alpha), a standing one
 sum_nodes w (1 - P_n): the sub-density of "fell toward psi" and the probability of
 standing are interpolated as mixtures of the four surrounding nodes, bilinearly in
-log distance (clamped at the first and last ring) and in node azimuth (periodic).
-Interpolating in the site frame moves a fall direction that is fixed relative to the
-source-to-site direction smoothly between nodes.  Log-likelihood = sum over columns
-(``likelihood="independent"``, the default).  Densities are per radian.
+log distance (clamped at the first and last ring: the inversion's candidates never lie
+beyond the last ring of a site, :func:`pipeline.inversion.posterior.invert`) and in node
+azimuth (periodic).  Interpolating in the site frame moves a fall direction that is fixed
+relative to the source-to-site direction smoothly between nodes.  Log-likelihood = sum
+over columns (``likelihood="independent"``, the default).  Densities are per radian.
 
 ``likelihood="predictive"`` accounts for the ensemble's own sampling error, which the
 product above ignores: columns at one site share one ground motion, and the node's fall

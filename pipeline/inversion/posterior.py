@@ -4,9 +4,14 @@ Candidates are the product of the forward table's slices (mechanism, depth, magn
 optionally a subset), strikes every ``strike_step_deg`` from 0, and epicentres on a
 square lattice of spacing ``step_km`` with the first site at the centre of a cell (the
 lattice maps onto itself when turned by 90 deg about the first site), every lattice point
-within ``radius_km`` of some site.  The prior is uniform over epicentre area, strike and
-depth; mechanisms uniform unless ``mechanism_prior`` gives weights; magnitudes uniform
-unless ``gr_b`` gives a Gutenberg-Richter b value (prior proportional to 10^(-b M)).
+within ``radius_km`` of some site and within the forward table's last ring of every site:
+the table speaks for every candidate, none takes the last ring's values for a farther
+site (the inversion's reach).  The posterior's mass in the outermost cells of the
+candidates (``reach_edge_fraction``) says when the answer is "farther than the candidates
+reach": above ``EDGE_WARNING_FRACTION`` the summary holds a ``reach_warning``.  The prior
+is uniform over epicentre area, strike and depth; mechanisms uniform unless
+``mechanism_prior`` gives weights; magnitudes uniform unless ``gr_b`` gives a
+Gutenberg-Richter b value (prior proportional to 10^(-b M)).
 
 Frames: km East/North of the first site; the back azimuth is the azimuth from the first
 site to the epicentre.  Credible regions are highest-posterior-density (HPD) sets: for the
@@ -26,10 +31,17 @@ from scipy.special import logsumexp
 from pipeline.files import InputError
 from pipeline.stats.circular import azimuth_deg
 from pipeline.inversion.likelihood import ForwardModel
+from pipeline.inversion.observations import Observations, Site
 
 BAZ_BIN_DEG = 2.0
 SUBGRID = 5
 LEVELS = (0.68, 0.95)
+EDGE_WARNING_FRACTION = 0.05   # posterior mass in the outermost cells that the 95 % regions
+#                                cannot leave out: the source may lie beyond the reach
+
+
+class OutOfReach(InputError):
+    """No candidate epicentre lies within the forward table's reach of every site."""
 
 
 @dataclass(frozen=True)
@@ -64,9 +76,9 @@ class CandidateGrid:
     def as_dict(self):
         return {k: (list(v) if isinstance(v, tuple) else v) for k, v in self.__dict__.items()}
 
-    def lattice(self, observations):
+    def lattice(self, observations, reach_km=math.inf):
         """Epicentres (east, north) km from the first site: cell centres within the radius
-        of a site."""
+        of a site and within ``reach_km`` (the forward table's last ring) of every site."""
         east = np.array([s.east_km for s in observations.sites])
         north = np.array([s.north_km for s in observations.sites])
         half = math.ceil((self.radius_km + np.hypot(east, north).max()) / self.step_km)
@@ -74,9 +86,23 @@ class CandidateGrid:
         ge, gn = np.meshgrid(axis, axis)
         ge, gn = ge.ravel(), gn.ravel()
         near = np.zeros(ge.shape, bool)
+        reached = np.ones(ge.shape, bool)
         for e, n in zip(east, north):
-            near |= np.hypot(ge - e, gn - n) <= self.radius_km + 1e-9
-        return ge[near], gn[near]
+            distance = np.hypot(ge - e, gn - n)
+            near |= distance <= self.radius_km + 1e-9
+            reached &= distance <= reach_km + 1e-9
+        keep = near & reached
+        return ge[keep], gn[keep]
+
+    def edge_cells(self, east_km, north_km):
+        """Bool mask of the candidate cells with a lattice neighbour (of the four) that is
+        not a candidate: the outermost cells, where the candidates end."""
+        i = np.round(np.asarray(east_km) / self.step_km - 0.5).astype(int)
+        j = np.round(np.asarray(north_km) / self.step_km - 0.5).astype(int)
+        i, j = i - i.min() + 1, j - j.min() + 1
+        inside = np.zeros((i.max() + 2, j.max() + 2), bool)
+        inside[i, j] = True
+        return ~(inside[i - 1, j] & inside[i + 1, j] & inside[i, j - 1] & inside[i, j + 1])
 
     def slice_mask(self, table):
         keep = []
@@ -133,6 +159,7 @@ class Posterior:
     log_prior: np.ndarray
     log_likelihood: np.ndarray
     info: dict = field(default_factory=dict)
+    edge: np.ndarray = None           # bool per epicentre: the outermost candidate cells
 
     def __post_init__(self):
         log_post = self.log_prior + self.log_likelihood
@@ -211,6 +238,14 @@ class Posterior:
             return False
         return bool(self.epicentre_region(level)[0][k])
 
+    def within_reach(self, east_km, north_km):
+        """Whether (east, north) km lies where candidates may lie (:func:`within_reach`;
+        True when the posterior does not know its sites)."""
+        if self.info.get("sites_km") is None:
+            return True
+        return within_reach(east_km, north_km, self.info["sites_km"],
+                            self.info["table_last_ring_km"], self.info["grid"]["radius_km"])
+
     # -------------------------------------------------------------- outputs
     def summary(self):
         centres, mass = self.back_azimuth_marginal()
@@ -242,9 +277,31 @@ class Posterior:
                                 "mw": s["mw"], "strike_deg": float(self.strikes_deg[joint[1]]),
                                 "epicentre_km": [float(self.east_km[joint[2]]),
                                                  float(self.north_km[joint[2]])]}
+        out.update(self.reach_summary())
         out["log_evidence"] = self.log_evidence
         out["candidates"] = int(self.probability.size)
         return out
+
+    def reach_summary(self):
+        """The inversion's reach (km from a site where the candidates end, and what ends
+        them), the posterior's and the prior's mass in the outermost cells, and a warning
+        line (None) when the posterior holds more than EDGE_WARNING_FRACTION there."""
+        reach = self.info.get("reach_km")
+        if self.edge is None or reach is None:
+            return {"reach_km": reach, "reach_limit": None, "reach_edge_fraction": None,
+                    "reach_edge_prior_fraction": None, "reach_warning": None}
+        prior = np.exp(self.log_prior - logsumexp(self.log_prior)).sum(axis=(0, 1))
+        fraction = float(self.epicentre[self.edge].sum())
+        prior_fraction = float(prior[self.edge].sum())
+        warning = None
+        if fraction > EDGE_WARNING_FRACTION:
+            warning = (f"{fraction:.0%} of the posterior (of the prior: {prior_fraction:.0%}) "
+                       f"lies in the outermost candidate cells, {reach:g} km from a site "
+                       f"({self.info.get('reach_limit')}): the source may lie farther than "
+                       "this inversion can tell")
+        return {"reach_km": float(reach), "reach_limit": self.info.get("reach_limit"),
+                "reach_edge_fraction": fraction,
+                "reach_edge_prior_fraction": prior_fraction, "reach_warning": warning}
 
     def frame(self):
         """One row per candidate: posterior.csv."""
@@ -348,20 +405,69 @@ def invert(model, observations, grid):
                              model.likelihood)
     for column in observations.column_types():
         model.column_index(column)
-    east, north = grid.lattice(observations)
+    last_ring = float(model.table.distances_km[-1])
+    requested, _ = grid.lattice(observations)
+    east, north = reached_lattice(observations, last_ring, grid)
     strikes = grid.strikes_deg
     loglike = model.log_likelihood(observations, east, north, strikes)
     log_prior_slice = grid.log_prior_slices(model.table.slices)
     log_prior = (log_prior_slice[:, None, None] - math.log(len(strikes)) - math.log(east.size)
                  + np.zeros(loglike.shape))
-    post = Posterior(model.table.slices, strikes, east, north, grid.step_km, log_prior,
-                     loglike, info={"grid": grid.as_dict(), "prior": grid.prior_statement(),
-                                    "kernel_deg": model.kernel_deg, "floor": model.floor,
-                                    "likelihood": model.likelihood})
-    reach = max(np.hypot(s.east_km - east, s.north_km - north).max()
-                for s in observations.sites)
-    post.info["beyond_table_fraction"] = float(np.mean(
-        [np.mean(np.hypot(s.east_km - east, s.north_km - north) >
-                 model.table.distances_km[-1]) for s in observations.sites]))
-    post.info["farthest_candidate_km"] = float(reach)
-    return post
+    farthest = max(np.hypot(s.east_km - east, s.north_km - north).max()
+                   for s in observations.sites)
+    info = {"grid": grid.as_dict(), "prior": grid.prior_statement(),
+            "kernel_deg": model.kernel_deg, "floor": model.floor,
+            "likelihood": model.likelihood, "table_last_ring_km": last_ring,
+            "reach_km": min(last_ring, grid.radius_km),
+            "reach_limit": "the forward table's last ring" if last_ring <= grid.radius_km
+            else "--radius",
+            # the share of the epicentres within --radius of a site that lie beyond the
+            # table's last ring from some site: left out, the table cannot speak for them
+            "beyond_table_fraction": 1.0 - east.size / requested.size,
+            "farthest_candidate_km": float(farthest),
+            "sites_km": [[s.east_km, s.north_km] for s in observations.sites]}
+    return Posterior(model.table.slices, strikes, east, north, grid.step_km, log_prior,
+                     loglike, info=info, edge=grid.edge_cells(east, north))
+
+
+def reached_lattice(observations, last_ring_km, grid):
+    """The candidate epicentres of ``grid`` within ``last_ring_km`` of every site (east,
+    north km from the first site); OutOfReach (one line) when there is none."""
+    east, north = grid.lattice(observations, last_ring_km)
+    if east.size == 0:
+        raise OutOfReach(_out_of_reach(observations, last_ring_km, grid))
+    return east, north
+
+
+def check_reach(sites, last_ring_km, grid):
+    """OutOfReach (one line) when no candidate of ``grid`` lies within ``last_ring_km`` of
+    every site of ``sites`` ((name, east km, north km, ...) in any frame): before any run
+    whose observations would be inverted there."""
+    _, e0, n0 = sites[0][:3]
+    reached_lattice(Observations(tuple(Site(s[0], s[1] - e0, s[2] - n0, ()) for s in sites)),
+                    float(last_ring_km), grid)
+
+
+def within_reach(east_km, north_km, sites_km, last_ring_km, radius_km):
+    """Whether (east, north) km lies within the forward table's last ring of every site
+    ((east, north) pairs) and within the radius of some site."""
+    distances = [math.hypot(e - east_km, n - north_km) for e, n in sites_km]
+    return bool(max(distances) <= last_ring_km + 1e-9 and min(distances) <= radius_km + 1e-9)
+
+
+def _out_of_reach(observations, last_ring, grid):
+    """The one-line reason why no candidate epicentre is within reach of every site."""
+    pairs = [(p, q) for k, p in enumerate(observations.sites)
+             for q in observations.sites[k + 1:]] or [(observations.sites[0],) * 2]
+    p, q = max(pairs, key=lambda pq: math.hypot(pq[0].east_km - pq[1].east_km,
+                                                  pq[0].north_km - pq[1].north_km))
+    gap = math.hypot(p.east_km - q.east_km, p.north_km - q.north_km)
+    if gap > 2 * last_ring:
+        return (f"sites {p.name} and {q.name} lie {gap:.1f} km apart, but the forward table's "
+                f"rings end at {last_ring:g} km: no epicentre is within its reach of every "
+                f"site (invert fewer sites together, or use a table with rings to at least "
+                f"{gap / 2:.1f} km)")
+    return (f"no cell of the candidate grid (--step {grid.step_km:g} km, --radius "
+            f"{grid.radius_km:g} km) lies within the forward table's last ring "
+            f"({last_ring:g} km) of every site (sites {p.name} and {q.name} lie {gap:.1f} km "
+            "apart): a finer --step, a larger --radius or a table with farther rings")

@@ -6,17 +6,28 @@ direction unknown.  Here the table's members are split once: the last
 ``observation_members`` are the "observed" columns, never used by a likelihood; the
 likelihood takes the first L members, for every L of ``likelihood_members`` that fits.
 A trial draws a table slice (mechanism, depth, magnitude) among those where some
-observation member falls, and a strike, at random, S sites at nodes where the observation
-members fall, and K fallen columns per site (the standing
-ones drawn on the way are observed too), as the demo does; each (likelihood, L, S, K) is
-inverted ``trials`` times with the same draws (seeded by S, K and the trial, not by L), so
-that a change with L is the likelihood's alone.
+observation member falls, a strike (uniform: between the candidates' strike steps), S
+sites at nodes where the observation members fall, and K fallen columns per site (the
+standing ones drawn on the way are observed too), as the demo does; each (likelihood, L,
+S, K) is inverted ``trials`` times with the same draws (seeded by S, K and the trial, not
+by L), so that a change with L is the likelihood's alone.
+
+The observed columns are runs, so they stand where the table has nodes; sources as they
+come lie off them.  A trial therefore also draws where its sites lie for the likelihood
+(``PLACEMENTS``, equally often): ``node`` (the likelihood's table holds the sites' nodes),
+``between`` (the likelihood's table leaves out the inner rings (or, with two rings, every
+other node azimuth) and the sites lie on those: between the rings it keeps) and
+``beyond`` (the likelihood's table leaves out the last ring and the first site lies on it:
+the source lies beyond the inversion's reach, and the right answer is a warning that it
+may lie farther).
 
 Per configuration: coverage of the 95 % back-azimuth arc (with its Wilson interval: a
 coverage is calibrated when the interval holds 0.95), its median width, the share of arcs
-within +-30 deg, the coverage and median size of the epicentre's 95 % credible area, and
-the magnitude's: whether the true Mw lies in the smallest set of table magnitudes holding
-95 % of the posterior, and the posterior probability of the true Mw.
+within +-30 deg, the coverage of the distance's 95 % interval and of the epicentre's 95 %
+credible area (and its median size), each also counting a warning that the source may lie
+beyond the reach as an answer (``*_or_warned``), per placement too, and the magnitude's:
+whether the true Mw lies in the smallest set of table magnitudes holding 95 % of the
+posterior, and the posterior probability of the true Mw.
 """
 
 import os
@@ -26,11 +37,12 @@ from multiprocessing import Pool
 import numpy as np
 import pandas as pd
 
-from pipeline.inversion.demo import BOUND_DEG, FALLEN_PER_SITE, SITE_COUNTS, _frame, \
-    _site_position, draw_site_columns
+from pipeline.inversion import truth_check
+from pipeline.inversion.demo import BOUND_DEG, FALLEN_PER_SITE, REACH_KEYS, SITE_COUNTS, \
+    _frame, _site_position, draw_site_columns, out_of_reach_row
 from pipeline.inversion.likelihood import DEFAULT_FLOOR, DEFAULT_KERNEL_DEG, LIKELIHOODS, \
     ForwardModel
-from pipeline.inversion.posterior import in_arc, invert, magnitude_set
+from pipeline.inversion.posterior import OutOfReach, invert, magnitude_set
 from pipeline.stats.circular import azimuth_deg
 from pipeline.stats.ensemble import wilson_interval
 from pipeline.files import InputError, die_with_parent
@@ -39,6 +51,7 @@ LIKELIHOOD_MEMBERS = (3, 6, 12, 24, 48)
 OBSERVATION_MEMBERS = 16
 STUDY_TRIALS = 200         # per configuration: Wilson intervals of about +-0.03 at 0.95
 STUDY_SEED = 2027
+PLACEMENTS = ("node", "between", "beyond")
 
 
 def split_for_study(table, observation_members=OBSERVATION_MEMBERS):
@@ -52,43 +65,96 @@ def split_for_study(table, observation_members=OBSERVATION_MEMBERS):
     return table.select_members(~pool), table.select_members(pool)
 
 
-def study_trial(model, pool, n_sites, fallen, candidates, rng):
+def held_out_nodes(table):
+    """{placement: (bool over the rings the likelihood's table keeps, node azimuth stride)}
+    for the placements ``table`` allows (see the module docstring)."""
+    nr, na = len(table.distances_km), len(table.azimuths_deg)
+    out = {"node": (np.ones(nr, bool), 1)}
+    if nr >= 3:
+        out["between"] = (np.isin(np.arange(nr), [0, nr - 1]), 1)
+    elif na >= 4 and na % 2 == 0:
+        out["between"] = (np.ones(nr, bool), 2)
+    if nr >= 2:
+        out["beyond"] = (np.arange(nr) < nr - 1, 1)
+    return out
+
+
+def _site_nodes(pool, s, placement, rings, stride):
+    """(nodes where the first site may lie, nodes for the others): (ring, azimuth) indices
+    where an observation member of slice ``s`` falls, for ``placement``."""
+    nr, na = pool.toppled.shape[1:3]
+    falls = [(i, j) for i in range(nr) for j in range(na) if pool.toppled[s, i, j].any()]
+    if placement == "between":
+        falls = [(i, j) for i, j in falls if not rings[i] or j % stride]
+        return falls, falls
+    if placement == "beyond":
+        return [(i, j) for i, j in falls if i == nr - 1], falls
+    return falls, falls
+
+
+def study_trial(models, pool, n_sites, fallen, candidates, rng):
     """One truth test of the study: a dict, or None when no observation member of the
     table ever falls.  A slice without falls (a magnitude too small to topple anything at
-    the table's rings) cannot be the truth of a test with fallen columns."""
-    table = model.table
+    the table's rings) cannot be the truth of a test with fallen columns.  ``models``:
+    {placement: ForwardModel} (:func:`held_out_nodes`); a placement whose nodes see no
+    fall is tried as ``node``."""
+    table = models["node"].table
     falling = np.flatnonzero(pool.toppled.reshape(len(table.slices), -1).any(axis=1))
     if not falling.size:
         return None
     s = int(rng.choice(falling))
-    strike = float(rng.choice(candidates.strikes_deg))
-    nodes = [(i, j) for i in range(len(table.distances_km))
-             for j in range(len(table.azimuths_deg)) if pool.toppled[s, i, j].any()]
-    if not nodes:
+    strike = float(rng.uniform(0.0, 360.0))
+    placement = str(rng.choice(PLACEMENTS))
+    if placement not in models:
+        placement = "node"
+    spec = held_out_nodes(table)[placement]
+    first, others = _site_nodes(pool, s, placement, *spec)
+    if not first:
+        placement = "node"
+        first, others = _site_nodes(pool, s, "node", *held_out_nodes(table)["node"])
+    if not first:
         return None
-    picks = rng.choice(len(nodes), size=min(n_sites, len(nodes)), replace=False)
+    model = models[placement]
+    start = first[int(rng.integers(len(first)))]
+    rest = [n for n in others if n != start]
+    picks = rng.choice(len(rest), size=min(n_sites - 1, len(rest)), replace=False)
     sites = []
-    for k, pick in enumerate(picks):
-        i, j = nodes[pick]
-        e, n = _site_position(table.distances_km[i], (table.azimuths_deg[j] + strike) % 360.0)
+    for k, (i, j) in enumerate([start] + [rest[p] for p in picks]):
+        e, n = _site_position(pool.distances_km[i], (pool.azimuths_deg[j] + strike) % 360.0)
         sites.append((f"S{k + 1}", e, n, draw_site_columns(pool, s, i, j, strike, fallen, rng)))
     observations, truth = _frame(sites)
-    post = invert(model, observations, candidates)
-    summary = post.summary()
     true_baz = azimuth_deg(truth[0], truth[1])
     true_mw = f"{table.slices[s]['mw']:g}"
-    return {"slice": s, "mechanism": table.slices[s]["mechanism"], "true_mw": float(true_mw),
-            "sites": len(sites), "fallen_per_site": fallen, "strike_deg": strike,
-            "true_back_azimuth_deg": true_baz,
-            "standing_observed": sum(not c.fallen for *_, cols in sites for c in cols),
-            "back_azimuth_in_95": in_arc(true_baz, summary["back_azimuth_ci95_deg"]),
+    row = {"slice": s, "mechanism": table.slices[s]["mechanism"], "true_mw": float(true_mw),
+           "sites": len(sites), "fallen_per_site": fallen, "strike_deg": strike,
+           "placement": placement, "true_back_azimuth_deg": true_baz,
+           "true_distance_km": float(np.hypot(*truth)),
+           "site_distances_km": " ".join(f"{np.hypot(e, n):g}" for _, e, n, _ in sites),
+           "standing_observed": sum(not c.fallen for *_, cols in sites for c in cols),
+           "no_candidate": False}
+    try:
+        post = invert(model, observations, candidates)
+    except OutOfReach:
+        lost = out_of_reach_row(truth, observations, model.table, candidates)
+        return {**row, **{k: lost[k] for k in ("back_azimuth_in_95", "width95_deg",
+                                               "epicentre_in_95", "distance_in_95",
+                                               "credible_area_95_km2", "no_candidate")},
+                **{k: lost[k] for k in REACH_KEYS}, "mw_in_95": False, "p_true_mw": np.nan,
+                "p_true_mechanism": np.nan}
+    summary = post.summary()
+    check = truth_check(post, {"epicentre_km": truth, "back_azimuth_deg": true_baz,
+                               "distance_km": row["true_distance_km"],
+                               "mechanism": row["mechanism"], "mw": float(true_mw)}, summary)
+    return {**row,
+            "back_azimuth_in_95": check["back_azimuth_in_95"],
             "width95_deg": summary["back_azimuth_ci95_width_deg"],
-            "epicentre_in_95": post.contains(*truth, level=0.95),
+            "epicentre_in_95": check["epicentre_in_95"],
+            "distance_in_95": check["distance_in_95"],
             "credible_area_95_km2": summary["credible_area_95_km2"],
+            **{k: check[k] for k in REACH_KEYS},
             "mw_in_95": true_mw in magnitude_set(summary["magnitude_posterior"]),
             "p_true_mw": summary["magnitude_posterior"].get(true_mw, 0.0),
-            "p_true_mechanism": summary["mechanism_posterior"].get(
-                table.slices[s]["mechanism"], 0.0)}
+            "p_true_mechanism": summary["mechanism_posterior"].get(row["mechanism"], 0.0)}
 
 
 def member_study(table, candidates, likelihood_members=LIKELIHOOD_MEMBERS,
@@ -131,14 +197,15 @@ def _configuration_trials(usable, pool, candidates, kernel_deg, floor, site_coun
     """The rows of one (likelihood kind, L members) configuration, every S and K."""
     kind, size = configuration
     order = np.sort(usable.members)
-    model = ForwardModel(usable.select_members(np.isin(usable.members, order[:size])),
-                         kernel_deg, floor, kind)
+    members = usable.select_members(np.isin(usable.members, order[:size]))
+    models = {placement: ForwardModel(members.select_nodes(*spec), kernel_deg, floor, kind)
+              for placement, spec in held_out_nodes(members).items()}
     rows = []
     for n_sites in site_counts:
         for fallen in fallen_per_site:
             for trial in range(trials):
                 rng = np.random.default_rng([seed, n_sites, fallen, trial])
-                row = study_trial(model, pool, n_sites, fallen, candidates, rng)
+                row = study_trial(models, pool, n_sites, fallen, candidates, rng)
                 if row is not None:
                     rows.append({"likelihood": kind, "likelihood_members": size,
                                  **row, "trial": trial})
@@ -146,13 +213,26 @@ def _configuration_trials(usable, pool, candidates, kernel_deg, floor, site_coun
 
 
 def study_summary(trials):
-    """Per (likelihood, L, S, K): coverages with Wilson intervals, widths, areas, Mw."""
+    """Per (likelihood, L, S, K): coverages with Wilson intervals, widths, areas, Mw, and
+    per placement the trials and the coverages (a warning counted as an answer for the
+    epicentre and the distance)."""
     rows = []
     keys = ["likelihood", "likelihood_members", "sites", "fallen_per_site"]
     for key, g in trials.groupby(keys):
         n = len(g)
         hit = int(g["back_azimuth_in_95"].sum())
         ci = wilson_interval(hit, n)
+        inside = g["within_reach"].astype(bool)
+        beyond = g[~inside]
+        per_placement = {}
+        for placement in PLACEMENTS:
+            part = g[g["placement"] == placement]
+            per_placement[f"trials_{placement}"] = len(part)
+            for column in ("back_azimuth_in_95", "epicentre_in_95_or_warned",
+                           "distance_in_95_or_warned"):
+                name = "coverage_" + column.replace("_in_", "_")
+                per_placement[f"{name}_{placement}"] = \
+                    float(part[column].mean()) if len(part) else np.nan
         rows.append({**dict(zip(keys, key)), "fallen_total": key[2] * key[3], "trials": n,
                      "coverage_back_azimuth_95": hit / n, "coverage_ci95": ci,
                      "calibrated": bool(ci[0] <= 0.95 <= ci[1]),
@@ -162,10 +242,24 @@ def study_summary(trials):
                      "coverage_epicentre_ci95": wilson_interval(int(g["epicentre_in_95"].sum()),
                                                                 n),
                      "credible_area_95_km2_median": float(g["credible_area_95_km2"].median()),
+                     "coverage_distance_95": float(g["distance_in_95"].mean()),
+                     "coverage_distance_ci95": wilson_interval(int(g["distance_in_95"].sum()),
+                                                               n),
+                     "coverage_epicentre_95_or_warned":
+                         float(g["epicentre_in_95_or_warned"].mean()),
+                     "coverage_distance_95_or_warned":
+                         float(g["distance_in_95_or_warned"].mean()),
+                     "beyond_reach_fraction": len(beyond) / n,
+                     "beyond_reach_warned": float(beyond["reach_warning"].mean())
+                     if len(beyond) else np.nan,
+                     "reach_warning_fraction": float(g["reach_warning"].mean()),
+                     "warned_within_reach": float(g[inside]["reach_warning"].mean())
+                     if inside.any() else np.nan,
                      "coverage_mw_95": float(g["mw_in_95"].mean()),
                      "coverage_mw_ci95": wilson_interval(int(g["mw_in_95"].sum()), n),
                      "p_true_mw_median": float(g["p_true_mw"].median()),
-                     "p_true_mechanism_median": float(g["p_true_mechanism"].median())})
+                     "p_true_mechanism_median": float(g["p_true_mechanism"].median()),
+                     **per_placement})
     return pd.DataFrame(rows)
 
 
@@ -212,7 +306,13 @@ def study_answer(summary):
                      f"{trend.iloc[0]['coverage_back_azimuth_95']:.2f} with "
                      f"{int(trend.iloc[0]['likelihood_members'])} members)")
         text += (f", the epicentre's 95 % area {big['credible_area_95_km2_median']:.0f} km^2 "
-                 f"(coverage {big['coverage_epicentre_95']:.2f}) and the true magnitude lies "
-                 f"in the 95 % set in {big['coverage_mw_95']:.2f} of the trials")
+                 f"(coverage {big['coverage_epicentre_95']:.2f}), the distance's 95 % "
+                 f"interval holds the truth in {big['coverage_distance_95']:.2f} of the trials")
+        if "coverage_epicentre_95_or_warned" in big:
+            text += (f" (the truth or a warning that the source may lie beyond the reach: "
+                     f"epicentre {big['coverage_epicentre_95_or_warned']:.2f}, distance "
+                     f"{big['coverage_distance_95_or_warned']:.2f})")
+        text += (f" and the true magnitude lies in the 95 % set in "
+                 f"{big['coverage_mw_95']:.2f} of the trials")
         out[kind] = text
     return out

@@ -180,6 +180,23 @@ class ForwardTable:
             nominal_azimuth_deg=pick(self.nominal_azimuth_deg),
             nominal_valid=pick(self.nominal_valid), info=dict(self.info))
 
+    def select_nodes(self, rings, azimuth_stride=1):
+        """A table with the rings where ``rings`` (bool over ``distances_km``) holds and
+        every ``azimuth_stride``-th node azimuth from 0 (still evenly spaced)."""
+        rings = np.asarray(rings, bool)
+        stride = int(azimuth_stride)
+
+        def pick(values):
+            return None if values is None else values[:, rings][:, :, ::stride]
+
+        return dataclasses.replace(
+            self, distances_km=self.distances_km[rings],
+            azimuths_deg=self.azimuths_deg[::stride], toppled=pick(self.toppled),
+            azimuth_deg=pick(self.azimuth_deg), valid=pick(self.valid),
+            nominal_toppled=pick(self.nominal_toppled),
+            nominal_azimuth_deg=pick(self.nominal_azimuth_deg),
+            nominal_valid=pick(self.nominal_valid), info=dict(self.info))
+
     # -------------------------------------------------------------- file
     def save(self, path):
         arrays = {"distances_km": self.distances_km, "azimuths_deg": self.azimuths_deg,

@@ -88,9 +88,22 @@ def _coverage_lines(demo):
             f"arc holds the true back azimuth in {_pct(cov.get('back_azimuth_95'))}, the 95 % "
             f"epicentre region the true epicentre in {_pct(cov.get('epicentre_95'))}, the 95 % "
             f"distance interval the true distance in {_pct(cov.get('distance_95'))}; the 68 % "
-            f"arc in {_pct(cov.get('back_azimuth_68'))}.")
+            f"arc in {_pct(cov.get('back_azimuth_68'))}." + _reach_coverage(cov))
     lines.append("")
     return lines
+
+
+def _reach_coverage(cov):
+    """What the truth tests' sources beyond the inversion's reach meant: the regions that
+    held the truth or a warning that it may lie farther (older summaries: nothing)."""
+    if cov.get("epicentre_95_or_warned") is None:
+        return ""
+    return (f"  The true source lay within the forward table's reach of every site in "
+            f"{_pct(cov.get('within_reach'))} of them; the 95 % region held it or the "
+            f"inversion warned that it may lie farther in "
+            f"{_pct(cov.get('epicentre_95_or_warned'))} (the distance: "
+            f"{_pct(cov.get('distance_95_or_warned'))}; a warning in "
+            f"{_pct(cov.get('reach_warning'))} of all).")
 
 
 def _narrowing_lines(demo):
@@ -153,19 +166,26 @@ def _paper_scenario_lines(demo):
                              p["back_azimuth_in_95_sites_with_falls"]),
                          "sites within +-30 deg": p["sites_within_30_deg"],
                          "MAP error (median deg)":
-                             _fmt(p["median_abs_map_error_deg_sites_with_falls"])})
+                             _fmt(p["median_abs_map_error_deg_sites_with_falls"]),
+                         **({"warned: may lie farther": p["sites_reach_warning"]}
+                            if "sites_reach_warning" in p else {})})
         lines.append("**The paper's scenario.** Each of the paper's sites (rings 5, 10, 20 km, "
                      "every 30 deg) inverted alone from what its twin columns (nominal "
                      "parameters) show:\n\n" + _table(pd.DataFrame(rows)) + "\n")
         for j in paper.get("joint", []):
             mech = max(j["mechanism_posterior"], key=j["mechanism_posterior"].get)
+            which = (f"the {j['sites']} sites within {j['sites_within_km']:g} km (half the "
+                     f"forward table's last ring: every candidate that near the source is "
+                     f"within the table's reach of every site)" if "sites_within_km" in j
+                     else f"all {j['sites']} sites")
             lines.append(
-                f"- {j['source']}, all {j['sites']} sites together ({j['fallen']} of "
+                f"- {j['source']}, {which} together ({j['fallen']} of "
                 f"{j['columns']} columns fell): most probable epicentre "
                 f"{j['epicentre_error_km']:.1f} km from the truth, inside the 95 % region: "
                 f"{'yes' if j['epicentre_in_95'] else 'no'} ({j['credible_area_95_km2']:.0f} "
                 f"km^2); most probable mechanism {mech} "
-                f"({j['mechanism_posterior'][mech]:.2f}).")
+                f"({j['mechanism_posterior'][mech]:.2f})."
+                + (f"  Warning: {j['reach_warning']}." if j.get("reach_warning") else ""))
         lines.append("")
     return lines
 
@@ -177,8 +197,22 @@ def _example_lines(demo):
         lo, hi = example["back_azimuth_ci95_deg"]
         lines.append(f"Example file `{example['file']}`: back azimuth from site A "
                      f"{example['back_azimuth_map_deg']:.0f} deg, 95 % arc [{lo:.0f}, {hi:.0f}]"
-                     f", 95 % area {example['credible_area_95_km2']:.0f} km^2.\n")
+                     f", 95 % area {example['credible_area_95_km2']:.0f} km^2"
+                     + _reach_sentence(example) + ".\n")
     return lines
+
+
+def _reach_sentence(summary):
+    """'; the candidates end R km from the sites (what ends them), F of the posterior in
+    their outermost cells' and the warning, from an inversion summary (older: nothing)."""
+    if summary.get("reach_km") is None:
+        return ""
+    text = (f"; the candidates end {summary['reach_km']:g} km from the sites "
+            f"({summary.get('reach_limit')}), {_pct(summary.get('reach_edge_fraction'))} of "
+            "the posterior in their outermost cells")
+    if summary.get("reach_warning"):
+        text += ": the source may lie farther than the inversion can tell"
+    return text
 
 
 def _inversion_findings(demo, narrow):
@@ -262,22 +296,34 @@ def member_study_section(results):
              f"{study['trials']} trials per configuration, the same draws for every size.\n"]
     lines.append(_table_provenance(study.get("forward_table") or {}))
     lines.append(_toppled_by_slice(study.get("toppled_fraction_by_slice") or []))
+    if "trials_beyond" in summary.columns:
+        lines.append("The trials' sources lie as sources come, off the table's nodes: the "
+                     "strike anywhere between the candidates' steps; the sites, in a third "
+                     "of the trials each, on the nodes of the likelihood's table, between "
+                     "the rings it keeps (its inner rings left out), or the first of them "
+                     "beyond its last ring (left out: the source lies beyond the "
+                     "inversion's reach, and the answer wanted is a warning that it may lie "
+                     "farther).\n")
     lines += [f"- {text}." for text in study["answer"].values()]
     largest = summary[summary["likelihood_members"] == summary["likelihood_members"].max()]
-    table = largest[["likelihood", "sites", "fallen_per_site", "trials",
-                     "coverage_back_azimuth_95", "width_median_deg", "coverage_epicentre_95",
-                     "credible_area_95_km2_median", "coverage_mw_95"]].rename(columns={
-                         "fallen_per_site": "fallen per site",
-                         "coverage_back_azimuth_95": "back-azimuth coverage",
-                         "width_median_deg": "median 95 % arc (deg)",
-                         "coverage_epicentre_95": "epicentre coverage",
-                         "credible_area_95_km2_median": "median 95 % area (km^2)",
-                         "coverage_mw_95": "Mw coverage"})
+    names = {"fallen_per_site": "fallen per site",
+             "coverage_back_azimuth_95": "back-azimuth coverage",
+             "width_median_deg": "median 95 % arc (deg)",
+             "coverage_distance_95": "distance coverage",
+             "coverage_epicentre_95": "epicentre coverage",
+             "coverage_epicentre_95_or_warned": "epicentre covered or warned",
+             "coverage_distance_95_or_warned": "distance covered or warned",
+             "beyond_reach_warned": "beyond the reach: warned",
+             "warned_within_reach": "within the reach: warned",
+             "credible_area_95_km2_median": "median 95 % area (km^2)",
+             "coverage_mw_95": "Mw coverage"}
+    table = largest[["likelihood", "sites", "fallen_per_site", "trials"]
+                    + [c for c in list(names)[1:] if c in largest.columns]].rename(columns=names)
     lines += ["", f"At {int(summary['likelihood_members'].max())} likelihood members per node:",
               "", _table(table.round(2)) + "\n",
               _figure(results, base / "member_study.png", "member study"),
-              "\nThe same truth tests for the epicentre and the magnitude (the standing "
-              "columns take part in the likelihood as much as the fallen ones):\n",
+              "\nThe same truth tests for the epicentre, the distance and the magnitude (the "
+              "standing columns take part in the likelihood as much as the fallen ones):\n",
               _figure(results, base / "member_study_source.png",
                       "member study: epicentre and magnitude")]
     return "\n".join(lines)

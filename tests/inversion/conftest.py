@@ -9,13 +9,13 @@ AZIMUTHS = tuple(np.arange(0.0, 360.0, 30.0))
 SLICES = (("strike-slip", 90.0, 180.0, 10.0, 6.5), ("thrust", 40.0, 90.0, 10.0, 6.5))
 
 
-def away_table(members=6, scatter_deg=8.0, seed=0, p_fall=None):
+def away_table(members=6, scatter_deg=8.0, seed=0, p_fall=None, distances=DISTANCES):
     """Every column falls away from the source: downfall (strike frame) = node azimuth +
-    noise, i.e. along the direction from epicentre to site.  ``p_fall``: per ring the
-    fraction of members that fall (default all)."""
+    noise, i.e. along the direction from epicentre to site.  ``p_fall``: per ring (of
+    ``distances`` km) the fraction of members that fall (default all)."""
     rng = np.random.default_rng(seed)
     rings = []
-    for i, _ in enumerate(DISTANCES):
+    for i, _ in enumerate(distances):
         nodes = []
         for theta in AZIMUTHS:
             cols = []
@@ -26,7 +26,7 @@ def away_table(members=6, scatter_deg=8.0, seed=0, p_fall=None):
             nodes.append(cols)
         rings.append(nodes)
     falls = [rings for _ in SLICES]          # mechanisms alike: the data cannot tell them
-    return ForwardTable.toy(SLICES, DISTANCES, AZIMUTHS, falls)
+    return ForwardTable.toy(SLICES, distances, AZIMUTHS, falls)
 
 
 def random_table(members=5, seed=3):

@@ -107,3 +107,8 @@ def test_demo_outputs_feed_the_report(tmp_path, make_away_table):
     for phrase in ("(a) Coverage", "(b) How the back azimuth narrows",
                    "(c) The paper's question", "The paper's scenario", "narrowing.png"):
         assert phrase in text
+    # the reach: the joint inversion takes the sites within half the table's last ring
+    # (the rings 5 and 10 of 20 km), and the coverage says what a warning answered
+    assert [j["sites"] for j in summary["paper_scenario"]["joint"]] == [2 * 12]
+    assert "the 24 sites within 10 km (half the forward table's last ring" in text
+    assert "or the inversion warned that it may lie farther in" in text

@@ -46,6 +46,7 @@ def test_the_answer_names_the_fewest_columns_that_bound_or_narrow():
                          "coverage_back_azimuth_95": 0.93 if calibrated else coverage,
                          "coverage_ci95": (0.89, 0.96) if calibrated else (0.83, 0.92),
                          "calibrated": calibrated, "credible_area_95_km2_median": 4.0,
+                         "coverage_distance_95": 0.9,
                          "coverage_epicentre_95": 0.8, "coverage_mw_95": 1.0})
     summary = pd.DataFrame(rows)
     bound = study_answer(summary)["independent"]
@@ -103,9 +104,39 @@ def test_member_study_command_on_a_table_file(make_away_table, tmp_path, capsys)
     section = member_study_section(tmp_path)
     assert result["answer"]["predictive"] in section and "member_study.png" in section
     assert "member_study_source.png" in section
+    assert "distance covered or warned" in section and "between the rings" in section
     fractions = [s["fraction"] for s in result["toppled_fraction_by_slice"]]
     assert len(fractions) == len(table.slices) and all(0 < f < 1 for f in fractions)
     assert f"Mw {table.slices[0]['mw']:g}" in section and "Columns toppled in the table" in section
     # the table's provenance, and that it came from another version of the model code
     assert "The forward table: 1536 runs, 2.0 h of YADE time, read from " \
            "`forward_table_toy.npz`, model code 0123abcd (this checkout's is" in section
+
+
+def test_truths_lie_off_the_likelihoods_nodes_too(make_away_table):
+    """Strikes between the candidates' steps; sites between the likelihood table's rings
+    (its inner rings 5 and 10 km left out) and beyond its last ring (20 km left out: the
+    source lies beyond the reach, and the inversion says so)."""
+    table = make_away_table(members=24, scatter_deg=20.0, p_fall=(1.0, 0.8, 0.6, 0.4))
+    grid = CandidateGrid(radius_km=22, step_km=2, strike_step_deg=30)
+    rows = member_study(table, grid, likelihood_members=(6,), observation_members=16,
+                        trials=8, likelihoods=("independent",), fallen_per_site=(3,),
+                        site_counts=(1, 3))
+    assert set(rows["placement"]) == {"node", "between", "beyond"}
+    assert (rows["strike_deg"] % 30 != 0).all()
+    distances = rows["site_distances_km"].str.split().apply(lambda d: [float(v) for v in d])
+    between = rows["placement"] == "between"
+    assert all(set(d) <= {5.0, 10.0} for d in distances[between])
+    beyond = rows["placement"] == "beyond"
+    assert all(d[0] == 20.0 for d in distances[beyond])
+    assert not rows.loc[beyond, "within_reach"].any()
+    assert rows.loc[beyond, "reach_warning"].all()          # said to lie farther
+    assert rows.loc[~beyond, "within_reach"].all()
+    summary = study_summary(rows)
+    for column in ("coverage_distance_95", "coverage_epicentre_95_or_warned",
+                   "coverage_distance_95_or_warned", "beyond_reach_warned",
+                   "warned_within_reach", "coverage_back_azimuth_95_between"):
+        assert column in summary
+    assert (summary["beyond_reach_warned"] == 1.0).all()
+    assert (summary["trials_node"] + summary["trials_between"] + summary["trials_beyond"]
+            == summary["trials"]).all()

@@ -71,6 +71,9 @@ def test_hidden_truth_end_to_end_on_a_toy_table(make_away_table, tmp_path, capsy
     summary = json.loads((out / "inversion_summary.json").read_text())
     assert summary["truth"]["back_azimuth_deg"] == pytest.approx(270.0)
     assert set(summary["truth"]["check"]) >= {"epicentre_in_95", "back_azimuth_in_95",
-                                              "mw_in_95", "map_epicentre_error_km"}
+                                              "mw_in_95", "map_epicentre_error_km",
+                                              "within_reach", "reach_warning",
+                                              "epicentre_in_95_or_warned"}
+    assert summary["truth"]["check"]["within_reach"]       # 4 km: within the 20 km rings
     assert math.isfinite(summary["truth"]["check"]["map_epicentre_error_km"])
     assert "simulated columns fell" in capsys.readouterr().out
