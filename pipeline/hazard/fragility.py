@@ -150,6 +150,8 @@ def load_campaign_fragility(path, column=None, form="pga-pgv"):
                          f"({surface.get('note') or 'no coefficients'})")
     b = tuple(float(coefficients[k]) for k in ("b0", "b1", "b2"))
     cov = surface.get("cov")
+    if cov is not None and not all(isinstance(v, (int, float)) for row in cov for v in row):
+        cov = None                       # a singular information matrix: written as nulls
     se = surface.get("se") or {}
     note = surface.get("note")
     if cov is None:
