@@ -1,7 +1,7 @@
 """``survival``: what a standing rock or column says about its site's hazard.
 
-    python -m pipeline survival --hazard records/hazard/oq_classical_case_14_hazard_curve-rlz-000_PGA.csv \\
-        --site 0 --median-g 0.3 --beta 0.4 --age-ka 15 --age-sd-ka 3
+    python -m pipeline survival --site 0 --median-g 0.3 --beta 0.4 --age-ka 15 \\
+        --age-sd-ka 3 --hazard records/hazard/oq_classical_case_14_hazard_curve-rlz-000_PGA.csv
     python -m pipeline survival --hazard curve.csv --fragility results/campaigns/fragility \\
         --column monolithic --pgv-pga-median 0.1 --pgv-pga-sigma 0.4 --age-ka 2.5
 
@@ -23,7 +23,8 @@ DESCRIPTION = (
     "hazard curve, the probability that it survived its age, the contribution by intensity "
     "and the largest factor on the hazard's rates (and intensities) that leaves survival "
     ">= 5 %%. Fragility: a stated lognormal over PGA (--median-g, --beta) or campaign "
-    "fragility's fragility.json (--fragility). See docs/survival.md.")
+    "fragility's fragility.json (--fragility) or a stated logistic surface in PGA and PGV/PGA "
+    "(--logistic). See docs/survival.md.")
 DEFAULT_OUT = RESULTS_DIR / "survival"
 COLUMNS = ("monolithic", "drums", "block2d", "block2d_worst")
 
@@ -47,6 +48,9 @@ def setup(p):
                    "with --beta for a set")
     p.add_argument("--beta", type=float, action="append", default=[], metavar="B",
                    help="its dispersion (natural log), 0.01-3")
+    p.add_argument("--logistic", action="append", default=[], metavar="B0,B1,B2",
+                   help="a stated logistic surface logit P = b0 + b1 ln(PGA / 1 m/s^2) + b2 "
+                   "ln(PGV/PGA / 1 s) (b1 > 0); repeat for a set")
     p.add_argument("--age-ka", type=float, required=True, metavar="KA",
                    help="the specimen's age in thousand years (above 0, at most 10000)")
     p.add_argument("--age-sd-ka", type=float, default=0.0, metavar="KA",
@@ -88,8 +92,10 @@ def check(args):
     if len(args.median_g) != len(args.beta):
         raise InputError(f"give one --beta per --median-g ({len(args.median_g)} medians, "
                          f"{len(args.beta)} betas)")
-    if not args.median_g and not args.fragility:
-        raise InputError("no fragility: give --median-g and --beta, or --fragility FILE")
+    for text in args.logistic:
+        parse_logistic(text)
+    if not args.median_g and not args.fragility and not args.logistic:
+        raise InputError("no fragility: give --median-g and --beta, --logistic or --fragility")
     if args.column is not None and not args.fragility:
         raise InputError("--column applies to --fragility files")
     if args.site is not None and args.site < 0:
@@ -126,13 +132,16 @@ def run(args):
     check(args)
     from pipeline.hazard import load_hazard
     from pipeline.hazard.assess import assess
-    from pipeline.hazard.fragility import (PGA_PGV_CORRELATION, Lognormal, RatioFromGmm,
-                                           RatioLognormal, load_campaign_fragility)
+    from pipeline.hazard.fragility import (PGA_PGV_CORRELATION, Logistic, Lognormal,
+                                           RatioFromGmm, RatioLognormal,
+                                           load_campaign_fragility)
     curve = load_hazard(args.hazard, args.site)
     specimens = [load_campaign_fragility(path, args.column, args.fragility_form)
                  for path in args.fragility]
     specimens += [Lognormal(m * STANDARD_GRAVITY, b, label=f"stated lognormal: median "
                             f"{m:g} g, beta {b:g}") for m, b in zip(args.median_g, args.beta)]
+    specimens += [Logistic(parse_logistic(text), label=f"stated logistic surface {text}")
+                  for text in args.logistic]
     ratio = None
     if args.pgv_pga_median is not None:
         ratio = RatioLognormal(args.pgv_pga_median, args.pgv_pga_sigma)
@@ -161,6 +170,19 @@ def run(args):
           f"{_g(bound)} leave 5 %")
     print(f"wrote {display_path(args.out / 'survival.json')} and survival.png")
     return 0
+
+
+def parse_logistic(text):
+    """'b0,b1,b2' -> (b0, b1, b2): finite numbers, b1 > 0 (P grows with PGA)."""
+    try:
+        values = tuple(float(v) for v in text.split(","))
+    except ValueError:
+        values = ()
+    if len(values) != 3 or not all(math.isfinite(v) for v in values):
+        raise InputError(f"--logistic {text!r}: expected three numbers B0,B1,B2")
+    if not values[1] > 0:
+        raise InputError(f"--logistic {text!r}: b1 must be positive (P grows with PGA)")
+    return values
 
 
 def _g(value):

@@ -173,7 +173,7 @@ def _site_set(curve, specimens, ratio_model, entries, age, age_sd):
 def _figure_data(curve, probability, headline, drawn, age, age_sd, specimens, ratio_model):
     """Arrays for :func:`pipeline.figures.survival.plot_survival`."""
     x, density = rate_density(curve.levels_m_s2, curve.rates_per_yr, probability)
-    ages = np.linspace(0.0, max(3.0 * (age + 2 * age_sd), 1.0), 200)
+    ages = np.linspace(0.0, 2.0 * (age + 2.0 * age_sd), 200)
     rate = headline["annual_overturning_rate_per_yr"]
     survival = np.array([survival_probability(rate, a) for a in ages])
     return {"levels_m_s2": curve.levels_m_s2, "rates_per_yr": curve.rates_per_yr,
