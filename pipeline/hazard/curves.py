@@ -1,6 +1,7 @@
 """The one loader of a site's hazard curve: annual rate of exceedance against PGA.
 
-Two formats, told apart by their second line:
+Three formats: a second line ``lon,lat...`` is OpenQuake's, a first ``{`` the USGS
+web service's, anything else a plain table.
 
 - OpenQuake's hazard-curve CSV as the engine exports it: a first line starting with
   ``#`` that states ``investigation_time`` (years) and ``imt`` (e.g. ``#,,,"generated_by=
@@ -9,6 +10,10 @@ Two formats, told apart by their second line:
   poe-<level>,...`` (older files ``PGA-<level>:float32``), then one row per site with the
   probability of exceedance (poe) over the investigation time T at each level (PGA in g).
   Annual rate = -ln(1 - poe) / T (Poisson).
+- The USGS hazard web service's static-curve JSON (NSHM editions; the earthquake-hazard-tool
+  response ``{"response": [{"metadata": {"imt": {"value": "PGA"}, "xlabel": "Ground Motion
+  (g)", "ylabel": "Annual Frequency of Exceedence", "xvals": [...]}, "data": [{"yvals":
+  [...]}]}, ...]}``): the PGA curve, annual rates as given.
 - A plain table: comment lines starting with ``#`` anywhere, then the header
   ``pga_<unit>,annual_rate_per_yr`` with unit ``g``, ``m_s2`` or ``cm_s2``, then one row
   per level: PGA and the annual rate of exceeding it (1/yr).
@@ -20,6 +25,7 @@ than two levels with a positive rate.  Said in ``notes``, never silent: levels d
 because their poe is 1 (an unbounded rate) and the rates of 0 at the top (the curve ends
 at the last positive rate; the first level of rate 0 is kept as ``zero_rate_from_m_s2``).
 """
+import json
 import math
 import re
 from dataclasses import dataclass
@@ -29,7 +35,7 @@ import numpy as np
 
 from pipeline.constants import STANDARD_GRAVITY
 from pipeline.files import InputError
-from pipeline.userfiles import Unreadable, read_text, show
+from pipeline.userfiles import Unreadable, json_int, read_text, show
 
 PLAIN_UNITS = {"g": STANDARD_GRAVITY, "m_s2": 1.0, "cm_s2": 0.01}    # factor to m/s^2
 PLAIN_RATE_COLUMN = "annual_rate_per_yr"
@@ -72,8 +78,10 @@ def load_hazard(path, site=None):
     if len(lines) > 1 and lines[1].lower().startswith("lon,lat"):
         return _openquake(path, lines, site)
     if site is not None:
-        raise InputError(f"--site applies to OpenQuake files with several sites; {path} is a "
-                         "plain table")
+        raise InputError(f"--site applies to OpenQuake files with several sites; {path} is "
+                         "not one")
+    if text.lstrip().startswith("{"):
+        return _usgs(path, text)
     return _plain(path, lines)
 
 
@@ -173,6 +181,50 @@ def _plain(path, lines):
     source = {"format": "plain table", "file": str(path), "imt": "PGA", "unit_in_file": unit}
     return _curve(np.array(levels), np.array(rates), PLAIN_UNITS[unit],
                   unit.replace("_s2", "/s^2"), str(path), source)
+
+
+def _usgs(path, text):
+    """The PGA curve of a USGS hazard web-service response (static curves: ``response``
+    a list of {metadata: {imt: {value}, xlabel "Ground Motion (g)", xvals, latitude,
+    longitude, edition, vs30}, data: [{yvals}]}, yvals annual frequencies of exceedance)."""
+    try:
+        data = json.loads(text, parse_int=json_int)
+    except (ValueError, Unreadable) as exc:
+        raise InputError(f"{path}: not JSON ({exc})") from None
+    curves = data.get("response") if isinstance(data, dict) else None
+    if not isinstance(curves, list) or not all(isinstance(c, dict) for c in curves):
+        raise InputError(f"{path}: not a USGS hazard-curve response (no 'response' list)")
+    imts = [((c.get("metadata") or {}).get("imt") or {}).get("value") for c in curves]
+    if None in imts:
+        raise InputError(f"{path}: missing IMT (a curve without metadata.imt.value)")
+    if "PGA" not in imts:
+        raise InputError(f"{path}: no PGA curve (IMTs: {', '.join(map(str, imts))}); survival "
+                         "uses PGA hazard curves")
+    curve = curves[imts.index("PGA")]
+    meta, rows = curve["metadata"], curve.get("data")
+    unit = re.search(r"\(([^)]*)\)\s*$", str(meta.get("xlabel", "")))
+    if not unit or unit.group(1) != "g":
+        raise InputError(f"{path}: unknown unit of PGA: xlabel {show(meta.get('xlabel'))} "
+                         "(expected 'Ground Motion (g)')")
+    if "annual" not in str(meta.get("ylabel", "")).lower():
+        raise InputError(f"{path}: ylabel {show(meta.get('ylabel'))} is not an annual "
+                         "frequency of exceedance")
+    if not isinstance(rows, list) or len(rows) != 1 or not isinstance(rows[0], dict):
+        raise InputError(f"{path}: expected one PGA data entry, got "
+                         f"{len(rows) if isinstance(rows, list) else show(rows)}")
+    x, y = meta.get("xvals"), rows[0].get("yvals")
+    if not (isinstance(x, list) and isinstance(y, list)) or len(x) != len(y):
+        raise InputError(f"{path}: xvals and yvals must be lists of one length")
+    for v in x + y:
+        if isinstance(v, bool) or not isinstance(v, (int, float)):
+            raise InputError(f"{path}: not a number: {show(v)}")
+    source = {"format": "USGS hazard web service (static curve)", "file": str(path),
+              "imt": "PGA", "unit_in_file": "g", "lat": meta.get("latitude"),
+              "lon": meta.get("longitude"),
+              "edition": (meta.get("edition") or {}).get("display"),
+              "vs30": (meta.get("vs30") or {}).get("display")}
+    return _curve(np.array(x, float), np.array(y, float), STANDARD_GRAVITY, "g", str(path),
+                  source)
 
 
 def _check_imt(imt, path):

@@ -1,5 +1,6 @@
 """The hazard-curve loader on the engine's own output (values the files state about
 themselves) and one-line errors for bad files."""
+import json
 import math
 
 import numpy as np
@@ -13,6 +14,7 @@ from pipeline.hazard import load_hazard
 
 CASE_14 = RECORDS_DIR / "hazard" / "oq_classical_case_14_hazard_curve-rlz-000_PGA.csv"
 CASE_1 = RECORDS_DIR / "hazard" / "oq_classical_case_1_hazard_curve-PGA.csv"
+USGS = RECORDS_DIR / "hazard" / "usgs_nshm2014r1_curves_-118_34_vs760.json"
 
 
 def _engine_table(path):
@@ -50,6 +52,42 @@ def test_openquake_single_site_old_header():
     np.testing.assert_allclose(curve.levels_m_s2 / STANDARD_GRAVITY, [0.1, 0.4, 0.6])
     np.testing.assert_allclose(curve.rates_per_yr, -np.log1p(-table.iloc[0, 3:].to_numpy(float)))
     assert curve.notes == () and curve.zero_rate_from_m_s2 is None
+
+
+def test_usgs_web_service_curve_as_it_states_itself():
+    response = json.loads(USGS.read_text())["response"]
+    pga = next(c for c in response if c["metadata"]["imt"]["value"] == "PGA")
+    assert pga["metadata"]["xlabel"] == "Ground Motion (g)"
+    curve = load_hazard(USGS)
+    np.testing.assert_allclose(curve.levels_m_s2, np.array(pga["metadata"]["xvals"]) * 9.80665,
+                               rtol=1e-12)
+    np.testing.assert_allclose(curve.rates_per_yr, pga["data"][0]["yvals"], rtol=1e-12)
+    assert (curve.source["lat"], curve.source["lon"]) == (34, -118)
+    assert curve.source["edition"] == "USGS NSHM 2014 Rev. 1" and curve.notes == ()
+
+
+def _usgs_variant(tmp_path, change):
+    data = json.loads(USGS.read_text())
+    change(data)
+    path = tmp_path / "usgs.json"
+    path.write_text(json.dumps(data))
+    return path
+
+
+@pytest.mark.parametrize("change, message", [
+    (lambda d: d["response"].pop(0), "no PGA curve"),
+    (lambda d: d["response"][0]["metadata"].pop("imt"), "missing IMT"),
+    (lambda d: d["response"][0]["metadata"].update(xlabel="Ground Motion (gal)"),
+     "unknown unit"),
+    (lambda d: d["response"][0]["data"][0]["yvals"].__setitem__(3, 0.9), "non-monotonic"),
+    (lambda d: d["response"][0]["data"][0]["yvals"].__setitem__(19, -1e-6),
+     "negative annual rate"),
+    (lambda d: d.pop("response"), "no 'response' list"),
+])
+def test_bad_usgs_files_one_line(tmp_path, change, message):
+    with pytest.raises(InputError, match=message) as caught:
+        load_hazard(_usgs_variant(tmp_path, change))
+    assert "\n" not in str(caught.value)
 
 
 def test_several_sites_need_a_choice():
