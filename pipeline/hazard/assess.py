@@ -28,6 +28,10 @@ ASSUMPTIONS = [
     "A fragility fitted to a campaign's pooled members (campaign fragility) holds the "
     "members' spread in its dispersion, as if each earthquake met another member; the rock "
     "or column has one set of the unknown contact parameters in every earthquake.",
+    "PGA is taken as the hazard curve defines it; no conversion between horizontal "
+    "components: campaign fragility's PGA is the peak of the horizontal acceleration "
+    "vector, larger than the RotD50 or geometric-mean PGA of most hazard models, so a "
+    "campaign fragility read against such a curve overstates the survival.",
     "A set of specimens shares one age and the site's earthquakes. common_shaking (the "
     "headline for a set): the specimens overturn independently given the motion of one "
     "event, P(all survive | PGA, PGV/PGA) = prod(1 - P_i); independent: each specimen meets "
@@ -54,7 +58,8 @@ def assess(curve, specimens, ratio_model, age_ka, age_sd_ka=0.0, draws=400, seed
         entry = _result(curve, probability, members, age, age_sd)
         entry = {"fragility": fragility.describe(), **entry}
         if drawn[k] is None:
-            entry["survival_interval_note"] = "no uncertainty stated for this fragility"
+            entry["survival_interval_note"] = "no uncertainty stated for this fragility" \
+                if draws else "--draws 0"
         entries.append(entry)
         warnings += [f"specimen {k}: {w}" for w in entry.pop("warnings")]
     if len(specimens) == 1:
@@ -71,6 +76,9 @@ def assess(curve, specimens, ratio_model, age_ka, age_sd_ka=0.0, draws=400, seed
         "annual_overturning_rate_per_yr": headline["annual_overturning_rate_per_yr"],
         "survival_probability": headline["survival_probability"],
         "survival_interval": headline["survival_interval"],
+        **({} if headline["survival_interval"] is not None else {
+            "survival_interval_note": "no uncertainty stated for the fragility" if draws
+            else "--draws 0"}),
         "rate_scale_bound_5pct": headline["rate_scale_bound_5pct"],
         "intensity_scale_bound_5pct": headline["intensity_scale_bound_5pct"],
         "contribution_by_intensity": headline["contribution_by_intensity"],

@@ -15,6 +15,7 @@ user states, the same at every level) or :class:`RatioFromGmm` (the median and s
 PGV and PGA from Boore et al. 2014 (pygmm) at a magnitude and distance, for example the
 mode of the hazard's disaggregation; ln PGV given ln PGA by their correlation).
 """
+import importlib.metadata
 import json
 import math
 from dataclasses import dataclass, field, replace
@@ -149,6 +150,9 @@ def load_campaign_fragility(path, column=None, form="pga-pgv"):
         raise InputError(f"{path}: column {column}: logistic surface not fitted "
                          f"({surface.get('note') or 'no coefficients'})")
     b = tuple(float(coefficients[k]) for k in ("b0", "b1", "b2"))
+    if not b[1] > 0:
+        raise InputError(f"{path}: column {column}: the logistic surface does not grow with "
+                         f"PGA (b1 = {b[1]:g})")
     cov = surface.get("cov")
     if cov is not None and not all(isinstance(v, (int, float)) for row in cov for v in row):
         cov = None                       # a singular information matrix: written as nulls
@@ -221,6 +225,7 @@ class RatioFromGmm:
                 "median_pga_m_s2": self.medians["pga_m_s2"],
                 "median_pgv_m_s": self.medians["pgv_m_s"],
                 "ln_std_pga": self.medians["ln_std_pga"], "ln_std_pgv": self.medians["ln_std_pgv"],
+                "pygmm": importlib.metadata.version("pygmm"),
                 "distribution": "lognormal given PGA: ln PGV | ln PGA by their correlation"}
 
 

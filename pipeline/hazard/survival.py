@@ -112,10 +112,14 @@ def rate_scale_bound(rate_per_yr, age_yr, age_sd_yr=0.0, floor=0.05):
     def excess(ln_f):
         return float(survival_probability(math.exp(ln_f) * rate_per_yr, age_yr, age_sd_yr)) - floor
     hi = math.log(closed)
-    while excess(hi) > 0:
+    for _ in range(60):                # survival falls to 0 as F grows: a bracket exists
+        if excess(hi) <= 0:
+            break
         hi += math.log(10.0)
     lo = hi - math.log(10.0)
-    while excess(lo) < 0:
+    for _ in range(60):
+        if excess(lo) >= 0:
+            break
         lo -= math.log(10.0)
     return math.exp(optimize.brentq(excess, lo, hi, xtol=1e-10))
 
