@@ -219,6 +219,9 @@ def test_command_with_a_campaign_fragility_and_a_set(tmp_path):
       "--pgv-pga-median", "0.1", "--pgv-pga-sigma", "0.3"], "not both"),
     (["--median-g", "0.3", "--beta", "0.4", "--draws", "-1"], "--draws"),
     ([], "no fragility"),
+    (["--logistic", "1,2"], "expected three numbers"),
+    (["--logistic=1,-2,3"], "b1 must be positive"),
+    (["--logistic=-3,3,1.5"], "PGV/PGA"),
 ])
 def test_command_refuses_bad_options_in_one_line(tmp_path, capsys, extra, message):
     out = tmp_path / "out"
