@@ -22,7 +22,7 @@ DESCRIPTION = (
     "The annual rate at which a specimen (or a set at one site) overturns under a site's "
     "hazard curve, the probability that it survived its age, the contribution by intensity "
     "and the largest factor on the hazard's rates (and intensities) that leaves survival "
-    ">= 5 %%. Fragility: a stated lognormal over PGA (--median-g, --beta) or campaign "
+    ">= 5 %. Fragility: a stated lognormal over PGA (--median-g, --beta) or campaign "
     "fragility's fragility.json (--fragility) or a stated logistic surface in PGA and PGV/PGA "
     "(--logistic). See docs/survival.md.")
 DEFAULT_OUT = RESULTS_DIR / "survival"
@@ -31,8 +31,9 @@ COLUMNS = ("monolithic", "drums", "block2d", "block2d_worst")
 
 def setup(p):
     p.add_argument("--hazard", type=Path, required=True, metavar="FILE",
-                   help="hazard curve: OpenQuake hazard-curve CSV or a plain table "
-                   "pga_<g|m_s2|cm_s2>,annual_rate_per_yr")
+                   help="hazard curve: OpenQuake hazard-curve CSV, USGS hazard web service "
+                   "JSON (static curves) or a plain table pga_<g|m_s2|cm_s2>,"
+                   "annual_rate_per_yr")
     p.add_argument("--site", type=int, default=None, metavar="N",
                    help="row (0-based) of an OpenQuake file with several sites")
     p.add_argument("--fragility", type=Path, action="append", default=[], metavar="FILE",
