@@ -5,14 +5,16 @@ import json
 import math
 
 import numpy as np
+import pandas as pd
 import pytest
 from scipy import integrate, stats
 
 from pipeline import RECORDS_DIR
+from pipeline.campaign.fragility import _column_fits, _finite
 from pipeline.cli import main
 from pipeline.hazard import load_hazard
-from pipeline.hazard.fragility import (Lognormal, Logistic, RatioFromGmm, RatioLognormal,
-                                       overturn_probability)
+from pipeline.hazard.fragility import (Logistic, Lognormal, RatioFromGmm, RatioLognormal,
+                                       load_campaign_fragility, overturn_probability)
 from pipeline.hazard.survival import (contribution_by_intensity, intensity_scale_bound,
                                       overturning_rate, rate_scale_bound, survival_probability)
 from pipeline.stats.ensemble import logistic_surface
@@ -246,3 +248,26 @@ def test_command_refuses_a_bad_hazard_file_and_writes_nothing(tmp_path, capsys):
     assert main(["survival", "--hazard", str(CASE_14), "--site", "0", "--fragility",
                  str(fragility), "--age-ka", "15", "--out", str(out)]) == 2
     assert "PGV/PGA" in capsys.readouterr().err and not out.exists()
+
+
+def test_reads_what_campaign_fragility_writes(tmp_path):
+    """The campaign's own fits (pipeline.campaign.fragility) written as fragility.json
+    and read back: the same numbers, the covariance used."""
+    rng = np.random.default_rng(5)
+    pga = np.repeat(np.geomspace(0.5, 8.0, 8), 60)
+    ratio = np.tile(np.repeat([0.05, 0.1, 0.2], 20), 8)
+    toppled = rng.random(pga.size) < Logistic((-4.0, 3.0, 1.0)).probability(pga, ratio)
+    table = pd.DataFrame({"column": "monolithic", "toppled": toppled, "pga_m_s2": pga,
+                          "pgv_m_s": pga * ratio, "pgv_pga_s": ratio,
+                          "level_m_s2": pga})
+    columns = _column_fits(table, {"monolithic": "3D YADE monolithic column"}, 0.165, 2.0)
+    path = tmp_path / "fragility.json"
+    path.write_text(json.dumps(_finite({"columns": columns})))
+    surface = load_campaign_fragility(tmp_path)
+    written = columns["monolithic"]["logistic"]
+    assert surface.coefficients == tuple(written["coefficients"][k] for k in ("b0", "b1", "b2"))
+    np.testing.assert_allclose(surface.cov, written["cov"])
+    lognormal = load_campaign_fragility(path, "monolithic", "pga")
+    written = columns["monolithic"]["PGA"]
+    assert lognormal.median_m_s2 == written["median"] and lognormal.beta == written["beta"]
+    assert lognormal.median_ci95 == tuple(written["median_ci95"])
