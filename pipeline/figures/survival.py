@@ -41,13 +41,19 @@ def plot_survival(data, path):
         ax_s.axvspan(age_ka - sd_ka, age_ka + sd_ka, color="0.85", label="age $\\pm$ 1 sd")
     p = data["survival_probability"]
     interval = data["survival_interval"]
-    err = None if interval is None else np.array([[p - interval[0]], [interval[1] - p]])
+    err = None if interval is None else np.array([[p - max(interval[0], p * 1e-6)],
+                                                   [interval[1] - p]]).clip(0)
     ax_s.errorbar([age_ka], [p], yerr=err, fmt="o", color="tab:red", capsize=3,
                   label="over the age" + (", 95 % fragility interval" if err is not None else ""))
     ax_s.axhline(0.05, color="0.5", ls=":", label="5 %")
     ax_s.set_xlabel("age (ka)")
     ax_s.set_ylabel("P(survived)")
-    ax_s.set_ylim(0, 1.02)
+    if p < 0.05:                       # a small survival: a log axis shows where it lies
+        low = max(min(p, float(np.min(data["survival"]))) / 3.0, 1e-15)
+        ax_s.set_yscale("log")
+        ax_s.set_ylim(low, 1.5)
+    else:
+        ax_s.set_ylim(0, 1.02)
     ax_s.set_xlim(0, ages_ka[-1])
     ax_s.legend(fontsize=8)
     ax_s.set_title("survival against age")
