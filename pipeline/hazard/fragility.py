@@ -26,7 +26,7 @@ from scipy import stats
 
 from pipeline.constants import STANDARD_GRAVITY
 from pipeline.files import InputError
-from pipeline.userfiles import Unreadable, read_text
+from pipeline.userfiles import Unreadable, number, read_text, show
 
 Z95 = stats.norm.ppf(0.975)
 RATIO_NODES = 24                  # Gauss-Hermite nodes over ln(PGV/PGA)
@@ -139,8 +139,11 @@ def load_campaign_fragility(path, column=None, form="pga-pgv"):
         if fit.get("median") is None:
             raise InputError(f"{path}: column {column}: PGA fragility not fitted "
                              f"({fit.get('note') or 'no median'})")
-        return Lognormal(float(fit["median"]), float(fit["beta"]),
-                         _pair(fit.get("median_ci95")), _pair(fit.get("beta_ci95")),
+        where = f"{path}: column {column}: PGA"
+        return Lognormal(number(fit["median"], f"{where} median", 0, None, "m/s^2", True),
+                         number(fit.get("beta"), f"{where} beta", 0, None, "", True),
+                         _pair(fit.get("median_ci95"), f"{where} median_ci95"),
+                         _pair(fit.get("beta_ci95"), f"{where} beta_ci95"),
                          label=label, note=fit.get("note"))
     if form != "pga-pgv":
         raise InputError(f"--fragility-form must be pga or pga-pgv, got {form!r}")
@@ -149,7 +152,8 @@ def load_campaign_fragility(path, column=None, form="pga-pgv"):
     if coefficients is None:
         raise InputError(f"{path}: column {column}: logistic surface not fitted "
                          f"({surface.get('note') or 'no coefficients'})")
-    b = tuple(float(coefficients[k]) for k in ("b0", "b1", "b2"))
+    b = tuple(number(coefficients.get(k), f"{path}: column {column}: logistic {k}")
+              for k in ("b0", "b1", "b2"))
     if not b[1] > 0:
         raise InputError(f"{path}: column {column}: the logistic surface does not grow with "
                          f"PGA (b1 = {b[1]:g})")
@@ -166,8 +170,16 @@ def load_campaign_fragility(path, column=None, form="pga-pgv"):
                     label=label, note=note)
 
 
-def _pair(value):
-    return None if value is None else (float(value[0]), float(value[1]))
+def _pair(value, what):
+    """A 95 % interval (lo, hi) from a file: positive numbers, lo <= hi; None stays None."""
+    if value is None:
+        return None
+    if not (isinstance(value, list) and len(value) == 2):
+        raise InputError(f"{what} must be a pair [lo, hi], got {show(value)}")
+    lo, hi = (number(v, what, 0, None, "", True) for v in value)
+    if lo > hi:
+        raise InputError(f"{what}: {lo:g} above {hi:g}")
+    return lo, hi
 
 
 # ---------------------------------------------------------------- PGV/PGA

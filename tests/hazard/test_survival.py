@@ -12,6 +12,7 @@ from scipy import integrate, stats
 from pipeline import RECORDS_DIR
 from pipeline.campaign.fragility import _column_fits, _finite
 from pipeline.cli import main
+from pipeline.files import InputError
 from pipeline.hazard import load_hazard
 from pipeline.hazard.fragility import (Logistic, Lognormal, RatioFromGmm, RatioLognormal,
                                        load_campaign_fragility, overturn_probability)
@@ -234,6 +235,23 @@ def test_command_refuses_bad_options_in_one_line(tmp_path, capsys, extra, messag
     err = capsys.readouterr().err.strip()
     assert message in err and len(err.splitlines()) == 1
     assert not out.exists()
+
+
+@pytest.mark.parametrize("change, message", [
+    (lambda d: d.pop("columns"), "no 'columns'"),
+    (lambda d: d["columns"]["monolithic"]["PGA"].update(median=None, note="not fitted here"),
+     "not fitted here"),
+    (lambda d: d["columns"]["monolithic"]["PGA"].update(median_ci95=[0, 3]), "median_ci95"),
+    (lambda d: d["columns"]["monolithic"]["PGA"].update(unit="g"), "unknown unit"),
+])
+def test_bad_fragility_files_one_line(tmp_path, change, message):
+    data = json.loads(_fragility_json(tmp_path / "fragility.json").read_text())
+    change(data)
+    path = tmp_path / "bad.json"
+    path.write_text(json.dumps(data))
+    with pytest.raises(InputError, match=message) as caught:
+        load_campaign_fragility(path, None, "pga")
+    assert "\n" not in str(caught.value)
 
 
 def test_command_refuses_a_bad_hazard_file_and_writes_nothing(tmp_path, capsys):
