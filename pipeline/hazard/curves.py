@@ -59,7 +59,7 @@ class HazardCurve:
 
 
 def load_hazard(path, site=None):
-    """The hazard curve in ``path`` (OpenQuake CSV or plain table, see the module);
+    """The hazard curve in ``path`` (OpenQuake CSV, USGS JSON or plain table: see the module);
     ``site``: the row (0-based) of an OpenQuake file with several sites."""
     path = Path(path)
     try:
