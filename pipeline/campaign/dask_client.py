@@ -157,22 +157,23 @@ def write_run_files(run_dir, files, clear=True):
 
 def close_dask(client, cluster, token=None, interrupted=False, futures=()):
     """Cancel what is left; after Ctrl-C kill the campaign's YADE processes on the
-    workers of a cluster we don't own, and end the idle YADE processes its workers kept
-    for the next task (they would end by themselves after SERVE_IDLE_S).  Kill a local
-    cluster's worker processes (their YADE processes die with them; a graceful close
-    takes seconds) and close it and the client.  Best effort, bounded: Ctrl-C returns
-    within about CONNECT_TIMEOUT_S on a cluster we don't own (its runs killed first: a
-    busy worker may answer only after seconds) and CLOSE_TIMEOUT_S on a local one."""
-    if client is not None and (interrupted or cluster is None):
+    workers of a cluster we don't own; end the idle YADE processes the workers kept for
+    the next task (they would end by themselves after SERVE_IDLE_S; a local cluster's
+    would die with their worker, leaving their temporary directories to the next
+    campaign).  Kill a local cluster's worker processes (their busy YADE processes die
+    with them; a graceful close takes seconds) and close it and the client.  Best effort,
+    bounded: Ctrl-C returns within about CONNECT_TIMEOUT_S on a cluster we don't own
+    (its runs killed first: a busy worker may answer only after seconds) and
+    CLOSE_TIMEOUT_S on a local one."""
+    if client is not None:
         def stop():
             if interrupted:
                 with contextlib.suppress(Exception):
                     client.cancel(futures)
-            if cluster is None:
-                with contextlib.suppress(Exception):
-                    if interrupted:
-                        client.run(kill_task_processes, token, on_error="ignore")
-                    client.run(end_served_processes, on_error="ignore")
+            with contextlib.suppress(Exception):
+                if interrupted and cluster is None:
+                    client.run(kill_task_processes, token, on_error="ignore")
+                client.run(end_served_processes, on_error="ignore")
         stopping = threading.Thread(target=stop, daemon=True)     # an unreachable worker
         stopping.start()                                          # must not hold Ctrl-C up
         # a cluster we don't own keeps running what is not killed: wait as long as for
