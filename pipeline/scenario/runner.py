@@ -167,8 +167,8 @@ def _run_once(run_dir, timeout_s):
         with _RUNNING_LOCK:                      # refused or seen by stop_scenes()
             try:
                 _refuse_stopped(run_dir)
-                proc = _start([DEBIAN_PYTHON, str(WRAPPER), "scene.py"], tmpdir, log, cwd=run_dir,
-                              stdin=subprocess.DEVNULL)
+                proc = _start([DEBIAN_PYTHON, str(WRAPPER), "scene.py"], tmpdir, log,
+                              cwd=run_dir, stdin=subprocess.DEVNULL)
             except BaseException:
                 _remove_tmp(tmpdir)
                 raise
