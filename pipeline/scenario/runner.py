@@ -139,14 +139,18 @@ def remove_orphaned_tmp(tmp_dir=None):
 
 
 def _alive(pid):
-    """Whether process ``pid`` exists (any user's; a zombie too)."""
+    """Whether process ``pid`` runs (any user's; not a zombie: it has ended)."""
     try:
         os.kill(pid, 0)
     except ProcessLookupError:
         return False
     except PermissionError:
         pass
-    return True
+    try:
+        stat = Path(f"/proc/{pid}/stat").read_text()
+    except OSError:
+        return True
+    return stat[stat.rindex(")") + 2:].split()[0] != "Z"
 
 
 def _start(args, note_dir, stdout, **popen):
@@ -301,13 +305,18 @@ def kill_running():
 def stop_scenes(mark):
     """Kill this process's YADE processes that run a scene whose run directory's path
     contains ``mark``, and refuse such scenes from now on (Ctrl-C of a Dask campaign on a
-    worker: a task about to start its scene is refused rather than missed).  Their pids."""
+    worker: a task about to start its scene is refused rather than missed).  Returns their
+    pids once their temporary directories are removed (by the threads that ran them, or
+    by themselves when stopped while YADE started; at most STOP_GRACE_S)."""
     with _RUNNING_LOCK:
         _STOPPED.add(mark)
         procs = [p for p in _RUNNING
                  if p.returncode is None and mark in getattr(p, "run_dir", "")]
         for proc in procs:
             _stop_group(proc)
+    deadline = time.monotonic() + STOP_GRACE_S
+    while any(os.path.exists(p.tmpdir) for p in procs) and time.monotonic() < deadline:
+        time.sleep(0.02)
     return [p.pid for p in procs]
 
 

@@ -405,18 +405,20 @@ def yade_temporary_dirs(tmp_path):
                   if p.name.startswith(("yade-", TMP_PREFIX)))
 
 
-def start_private_campaign(tmp_path, started):
-    """(records, campaign dir, CLI process, its YADE processes) of a 4-run campaign in a
-    private /tmp, once a YADE process runs (``started`` False) or YADE has started in it
-    and noted its temporary directory (True)."""
+def start_private_campaign(tmp_path, started, executor="threads"):
+    """(records, campaign dir, CLI process, its descendant processes) of a 4-run campaign
+    in a private /tmp, once a YADE process runs (``started`` False) or YADE has started in
+    it and noted its temporary directory (True)."""
     records, out = _campaign_records(tmp_path), tmp_path / "camp"
     proc = private_tmp_cli(tmp_path, "campaign", "records", "--records", records, "--out",
-                           str(out), "--jobs", "2", "--animations", "0")
+                           str(out), "--jobs", "2", "--animations", "0", "--executor",
+                           executor)
     deadline = time.monotonic() + 60
     while time.monotonic() < deadline:
-        children = [p for p in _descendants(proc.pid) if "run_scene.py" in _cmdline(p)]
+        children = _descendants(proc.pid)
+        yade = [p for p in children if "run_scene.py" in _cmdline(p)]
         noted = list((tmp_path / "tmp").glob(f"{TMP_PREFIX}*/yade_tmp_dir"))
-        if children and (noted or not started):
+        if yade and (noted or not started):
             return records, out, proc, children
         time.sleep(0.02)
     proc.kill()
@@ -438,11 +440,14 @@ def _cmdline(process):
 
 
 @pytest.mark.yade
-@pytest.mark.parametrize("started", [False, True])
-def test_sigterm_stops_a_campaign_with_one_line_and_leaves_nothing(tmp_path, started):
-    """A plain kill (SIGTERM) of a campaign, while YADE starts or once it runs a scene:
-    one line, exit status 143, no process and no temporary directory left."""
-    records, out, proc, yade = start_private_campaign(tmp_path, started)
+@pytest.mark.parametrize("started, executor", [(False, "threads"), (True, "threads"),
+                                               (True, "dask")])
+def test_sigterm_stops_a_campaign_with_one_line_and_leaves_nothing(tmp_path, started,
+                                                                   executor):
+    """A plain kill (SIGTERM) of a campaign, while YADE starts or once it runs a scene
+    (on a local Dask cluster too): one line, exit status 143, no process and no
+    temporary directory left."""
+    records, out, proc, yade = start_private_campaign(tmp_path, started, executor)
     proc.send_signal(signal.SIGTERM)
     _, err = proc.communicate(timeout=60)
     assert proc.returncode == 143, err
@@ -476,14 +481,19 @@ def test_kill_9_leaves_nothing_in_tmp_after_the_next_run(tmp_path, started):
 
 
 def test_the_next_campaign_removes_only_what_processes_gone_left(tmp_path):
-    """Note directories of a process that is gone are removed with the YADE directory
-    they name; those of a live process (this one), of an unknown owner (no pid in the
-    name) and directories that are no note stay."""
+    """Note directories of a process that is gone (or has ended, not yet reaped) are
+    removed with the YADE directory they name; those of a live process (this one), of an
+    unknown owner (no pid in the name) and directories that are no note stay."""
     from pipeline.scenario.runner import remove_orphaned_tmp
     gone = subprocess.Popen(["true"])
     gone.wait()                                    # reaped: its pid names no process
+    ended = subprocess.Popen(["true"])             # a zombie until reaped
+    deadline = time.monotonic() + 30
+    while psutil.Process(ended.pid).status() != psutil.STATUS_ZOMBIE:
+        assert time.monotonic() < deadline
+        time.sleep(0.01)
     made = {}
-    for owner in (gone.pid, os.getpid(), "x"):
+    for owner in (gone.pid, ended.pid, os.getpid(), "x"):
         yade = tmp_path / f"yade-{owner}"
         note = tmp_path / f"{TMP_PREFIX}{owner}-abc"
         yade.mkdir()
@@ -491,8 +501,9 @@ def test_the_next_campaign_removes_only_what_processes_gone_left(tmp_path):
         (note / "yade_tmp_dir").write_text(str(yade))
         made[owner] = (yade, note)
     (tmp_path / "yade-unnoted").mkdir()
-    assert remove_orphaned_tmp(tmp_path) == 1
-    assert not any(p.exists() for p in made[gone.pid])
+    assert remove_orphaned_tmp(tmp_path) == 2
+    ended.wait()
+    assert not any(p.exists() for owner in (gone.pid, ended.pid) for p in made[owner])
     assert all(p.exists() for owner in (os.getpid(), "x") for p in made[owner])
     assert (tmp_path / "yade-unnoted").exists()
 
