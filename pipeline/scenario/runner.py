@@ -59,7 +59,6 @@ SERVE_IDLE_S = 120.0               # a served process ends itself after this lon
 _SERVED = threading.local()        # this thread's serving process (reuse_processes)
 _REUSE = {"depth": 0}
 _STOPPED = set()                   # marks of run directories whose scenes stop_scenes() ends
-_SWEPT = []                        # remove_orphaned_tmp() ran in this process
 
 
 class YadeError(ToolError):
@@ -117,10 +116,8 @@ def _environment(note_dir):
 
 def _note_dir():
     """A new directory for a YADE process's note of its temporary directory, named after
-    this process; the first one of this process removes those of processes gone."""
-    if not _SWEPT:
-        _SWEPT.append(True)
-        remove_orphaned_tmp()
+    this process (those of processes gone are removed first)."""
+    remove_orphaned_tmp()
     return tempfile.mkdtemp(prefix=f"{TMP_PREFIX}{os.getpid()}-")
 
 
