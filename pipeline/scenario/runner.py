@@ -10,7 +10,8 @@ TMPDIR) and removes it only at a normal exit.  Each YADE process notes it in a d
 of its own, ``$TMPDIR/toppling-yade-<pid of this process>-XXXXXXXX``, from which it is
 removed when the process is killed; a process stopped while YADE still starts removes it
 itself (``run_scene.py``); and a campaign killed with SIGKILL, whose YADE processes died
-with it, leaves both to the next campaign (:func:`remove_orphaned_tmp`).
+with it, leaves both to the next YADE process started, by any run or campaign of the
+same user (:func:`remove_orphaned_tmp`).
 
 Within :func:`reuse_processes` (the campaign executor's threads, a Dask worker's tasks)
 each thread keeps one YADE process that runs its scenes one after the other
