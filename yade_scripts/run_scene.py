@@ -87,7 +87,7 @@ def start_yade():
 
     - it is noted in the directory named by TOPPLING_YADE_NOTE_DIR (file
       ``yade_tmp_dir``), from which the parent removes it after it killed this process
-      with SIGKILL (or, should the parent be gone too, the next campaign);
+      with SIGKILL (or, should the parent be gone too, the next run);
     - SIGTERM, the parent's stop before the note exists and the death signal this
       process gets should its parent die meanwhile, waits for the import (blocked):
       then this process removes the directory itself and ends by that SIGTERM.
