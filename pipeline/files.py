@@ -216,15 +216,18 @@ def duration_text(seconds):
     return f"{seconds / 86400:.1f} d"
 
 
-def die_with_parent(parent_pid=None):
+def die_with_parent(parent_pid=None, death_signal=signal.SIGKILL):
     """In a child process (``preexec_fn``, a Pool's ``initializer``): be killed when the
-    parent dies, even by kill -9 (Linux PR_SET_PDEATHSIG), and leave Ctrl-C to the parent.
-    ``parent_pid``: the parent's pid, taken in the parent before the fork: a child whose
-    parent died before the death signal was armed (a kill in between) exits at once."""
-    ctypes.CDLL("libc.so.6", use_errno=True).prctl(1, signal.SIGKILL)   # 1: PR_SET_PDEATHSIG
+    parent dies, even by kill -9 (Linux PR_SET_PDEATHSIG, sending ``death_signal``), and
+    leave Ctrl-C and SIGTERM handling to the parent (a Pool's workers take SIGTERM as
+    plain processes do).  ``parent_pid``: the parent's pid, taken in the parent before
+    the fork: a child whose parent died before the death signal was armed (a kill in
+    between) exits at once."""
+    ctypes.CDLL("libc.so.6", use_errno=True).prctl(1, death_signal)   # 1: PR_SET_PDEATHSIG
     if parent_pid is not None and os.getppid() != parent_pid:
         os._exit(1)
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
 
 
 def csv_true(value):

@@ -15,9 +15,12 @@
 # 1 s) is paid once per process instead of once per scene.  The process ends by itself
 # after IDLE_S seconds without a scene (a Dask worker keeps it between tasks; should its
 # campaign's client vanish, nothing stays behind for long) or when stdin closes.
+import ctypes
 import os
 import runpy
 import select
+import shutil
+import signal
 import sys
 import traceback
 
@@ -78,20 +81,43 @@ def serve(control_fd, idle_s):
         control.write(f"{code}\n")
 
 
-def note_tmp_dir():
-    """YADE makes /tmp/yade-XXXXXX per process (a fixed path, not TMPDIR) and removes it
-    only at a normal exit: tell the parent where it is (a file in the directory named by
-    TOPPLING_YADE_NOTE_DIR), so that it removes it after a kill too."""
+def start_yade():
+    """Import YADE, which makes /tmp/yade-XXXXXX for this process (a fixed path: not
+    TMPDIR) and removes it only at a normal exit, and leave no such directory behind:
+
+    - it is noted in the directory named by TOPPLING_YADE_NOTE_DIR (file
+      ``yade_tmp_dir``), from which the parent removes it after it killed this process
+      with SIGKILL (or, should the parent be gone too, the next run);
+    - SIGTERM, the parent's stop before the note exists and the death signal this
+      process gets should its parent die meanwhile, waits for the import (blocked):
+      then this process removes the directory itself and ends by that SIGTERM.
+    """
+    signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGTERM})   # YADE's threads inherit it
+    parent = os.getppid()
+    import yade  # noqa: F401  (boots YADE: plugins, O)
+    from yade import O
+    made = os.path.dirname(O.tmpFilename())
     note_dir = os.environ.get("TOPPLING_YADE_NOTE_DIR")
     if note_dir:
-        from yade import O
-        with open(os.path.join(note_dir, "yade_tmp_dir"), "w") as note:
-            note.write(os.path.dirname(O.tmpFilename()))
+        try:
+            with open(os.path.join(note_dir, "yade_tmp_dir.part"), "w") as note:
+                note.write(made)
+            os.replace(os.path.join(note_dir, "yade_tmp_dir.part"),
+                       os.path.join(note_dir, "yade_tmp_dir"))
+        except OSError:            # removed: the parent is gone, and its next run was here
+            pass
+    ctypes.CDLL("libc.so.6").prctl(1, signal.SIGKILL)    # 1: PR_SET_PDEATHSIG; noted now
+    if signal.SIGTERM in signal.sigpending() or os.getppid() != parent:
+        shutil.rmtree(made, ignore_errors=True)
+        if note_dir:
+            shutil.rmtree(note_dir, ignore_errors=True)
+        signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGTERM})   # ends here
+        os._exit(1)                                                    # (parent gone)
+    signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGTERM})
 
 
 if __name__ == "__main__":
-    import yade  # noqa: E402,F401  (boots YADE: plugins, O)
-    note_tmp_dir()
+    start_yade()
     if sys.argv[1] == "--serve":
         serve(int(sys.argv[2]), float(sys.argv[3]))
     else:

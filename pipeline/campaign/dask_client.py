@@ -12,7 +12,7 @@ from pathlib import Path
 from pipeline.campaign.dask_worker import TASK_PREFIX, WORKER_CODE, kill_task_processes, run_task
 from pipeline.campaign.run_dirs import RunError, book_finished, write_error
 from pipeline.files import DirectoryLock, ToolError, atomic_path, code_hash
-from pipeline.scenario.runner import end_served_processes
+from pipeline.scenario.runner import end_served_processes, remove_orphaned_tmp
 
 CONNECT_TIMEOUT_S = 10          # reaching an existing Dask scheduler (s)
 CLOSE_TIMEOUT_S = 1.0           # closing the local cluster after Ctrl-C
@@ -157,22 +157,23 @@ def write_run_files(run_dir, files, clear=True):
 
 def close_dask(client, cluster, token=None, interrupted=False, futures=()):
     """Cancel what is left; after Ctrl-C kill the campaign's YADE processes on the
-    workers of a cluster we don't own, and end the idle YADE processes its workers kept
-    for the next task (they would end by themselves after SERVE_IDLE_S).  Kill a local
-    cluster's worker processes (their YADE processes die with them; a graceful close
-    takes seconds) and close it and the client.  Best effort, bounded: Ctrl-C returns
-    within about CONNECT_TIMEOUT_S on a cluster we don't own (its runs killed first: a
-    busy worker may answer only after seconds) and CLOSE_TIMEOUT_S on a local one."""
-    if client is not None and (interrupted or cluster is None):
+    workers; end the idle YADE processes the workers kept for the next task (they would
+    end by themselves after SERVE_IDLE_S; a local cluster's would die with their worker,
+    leaving their temporary directories to the next campaign).  Kill a local cluster's
+    worker processes (what still runs dies with them; a graceful close takes seconds;
+    the temporary directories of those YADE processes are removed after) and close it
+    and the client.  Best effort, bounded: Ctrl-C returns within about
+    CONNECT_TIMEOUT_S on a cluster we don't own (its runs killed first: a busy worker may
+    answer only after seconds) and CLOSE_TIMEOUT_S on a local one."""
+    if client is not None:
         def stop():
             if interrupted:
                 with contextlib.suppress(Exception):
                     client.cancel(futures)
-            if cluster is None:
-                with contextlib.suppress(Exception):
-                    if interrupted:
-                        client.run(kill_task_processes, token, on_error="ignore")
-                    client.run(end_served_processes, on_error="ignore")
+            with contextlib.suppress(Exception):
+                if interrupted:
+                    client.run(kill_task_processes, token, on_error="ignore")
+                client.run(end_served_processes, on_error="ignore")
         stopping = threading.Thread(target=stop, daemon=True)     # an unreachable worker
         stopping.start()                                          # must not hold Ctrl-C up
         # a cluster we don't own keeps running what is not killed: wait as long as for
@@ -184,6 +185,8 @@ def close_dask(client, cluster, token=None, interrupted=False, futures=()):
         if closing is not None:
             with contextlib.suppress(Exception):
                 closing.close(timeout=CLOSE_TIMEOUT_S if interrupted else 10)
+    if cluster is not None:       # what YADE processes that died with a worker left
+        remove_orphaned_tmp()
 
 
 def _kill_local_workers(cluster):

@@ -4,7 +4,7 @@ Each module of this package is one command and defines ``NAME``, ``HELP``,
 ``setup(parser)`` and ``run(args) -> int``; commands are found with pkgutil, so
 a new command is one new module.  A :class:`~pipeline.files.ToolError` becomes
 one line on stderr: exit status 2 for bad input, 1 for other failures; Ctrl-C
-exits 130 after finished results are written.
+exits 130 (SIGTERM 143) after finished results are written.
 """
 import argparse
 import errno
@@ -12,7 +12,7 @@ import importlib
 import pkgutil
 import sys
 
-from pipeline import INTERRUPTED
+from pipeline import INTERRUPTED, interrupted_status
 from pipeline.files import InputError, ToolError
 
 
@@ -67,7 +67,7 @@ def main(argv=None):
         return 1
     except KeyboardInterrupt:
         print(INTERRUPTED, file=sys.stderr)
-        return 130
+        return interrupted_status()
     except OSError as exc:
         what = "disk full" if exc.errno == errno.ENOSPC else exc.strerror or str(exc)
         where = f": {exc.filename}" if exc.filename else ""

@@ -5,6 +5,14 @@ needs it), single-threaded, in its own process group, with a wall-clock limit;
 the child is killed when its parent dies (Linux ``PR_SET_PDEATHSIG``), so a
 killed campaign leaves no YADE behind.
 
+YADE makes a temporary directory /tmp/yade-XXXXXX per process (a fixed path, not
+TMPDIR) and removes it only at a normal exit.  Each YADE process notes it in a directory
+of its own, ``$TMPDIR/toppling-yade-<pid of this process>-XXXXXXXX``, from which it is
+removed when the process is killed; a process stopped while YADE still starts removes it
+itself (``run_scene.py``); and a campaign killed with SIGKILL, whose YADE processes died
+with it, leaves both to the next YADE process started, by any run or campaign of the
+same user (:func:`remove_orphaned_tmp`).
+
 Within :func:`reuse_processes` (the campaign executor's threads, a Dask worker's tasks)
 each thread keeps one YADE process that runs its scenes one after the other
 (``run_scene.py --serve``, ``O.reset()`` between scenes): YADE's start-up, about 1 s, is
@@ -16,6 +24,7 @@ itself after ``SERVE_IDLE_S`` without a scene.
 import contextlib
 import json
 import os
+import re
 import select
 import shutil
 import signal
@@ -33,6 +42,9 @@ from pipeline.provenance import YADE_PY_PATH
 
 DEBIAN_PYTHON = "/usr/bin/python3"
 TMP_PREFIX = "toppling-yade-"     # a YADE process's note of its temporary directory
+NOTE = "yade_tmp_dir"              # ... the file in it (run_scene.py writes it)
+OWNER = re.compile(re.escape(TMP_PREFIX) + r"(\d+)-")   # ... named after the campaign's pid
+STOP_GRACE_S = 30.0                # a YADE process stopped while starting ends within this
 # glibc picks its libm routines (exp, sin, pow...) by CPU feature: with these tunables a
 # YADE process takes the non-FMA/AVX2 ones, as an older or another vendor's CPU would, so
 # that one machine can show which results depend on a CPU's last bits (make test runs the
@@ -103,22 +115,66 @@ def _environment(note_dir):
     return env
 
 
+def _note_dir():
+    """A new directory for a YADE process's note of its temporary directory, named after
+    this process (those of processes gone are removed first)."""
+    remove_orphaned_tmp()
+    return tempfile.mkdtemp(prefix=f"{TMP_PREFIX}{os.getpid()}-")
+
+
+def remove_orphaned_tmp(tmp_dir=None):
+    """Remove this user's note directories in ``tmp_dir`` (default: the temporary
+    directory) whose campaign process is gone, and the YADE directories noted in them:
+    what a campaign killed with SIGKILL while YADE ran a scene leaves.  Their number."""
+    removed = 0
+    for note_dir in Path(tmp_dir or tempfile.gettempdir()).glob(TMP_PREFIX + "*"):
+        owner = OWNER.match(note_dir.name)
+        with contextlib.suppress(OSError):
+            if owner and note_dir.stat().st_uid == os.getuid() and not _alive(int(owner[1])):
+                _remove_tmp(note_dir)
+                removed += 1
+    return removed
+
+
+def _alive(pid):
+    """Whether process ``pid`` runs (any user's; not a zombie: it has ended)."""
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        pass
+    try:
+        stat = Path(f"/proc/{pid}/stat").read_text()
+    except OSError:
+        return True
+    return stat[stat.rindex(")") + 2:].split()[0] != "Z"
+
+
+def _start(args, note_dir, stdout, **popen):
+    """Start the YADE process ``args`` (run_scene.py) in a process group of its own; its
+    death signal is SIGTERM until YADE has started (run_scene.py), then SIGKILL."""
+    proc = subprocess.Popen(args, stdout=stdout, stderr=subprocess.STDOUT,
+                            env=_environment(note_dir), start_new_session=True,
+                            preexec_fn=partial(die_with_parent, os.getpid(), signal.SIGTERM),
+                            **popen)
+    proc.tmpdir = note_dir
+    return proc
+
+
 def _run_once(run_dir, timeout_s):
     """One scene in a fresh process; its exit code (negative: killed by a signal)."""
     with open(run_dir / "yade.log", "w") as log:
-        tmpdir = tempfile.mkdtemp(prefix=TMP_PREFIX)
+        tmpdir = _note_dir()
         with _RUNNING_LOCK:                      # refused or seen by stop_scenes()
             try:
                 _refuse_stopped(run_dir)
-                proc = subprocess.Popen(
-                    [DEBIAN_PYTHON, str(WRAPPER), "scene.py"], cwd=run_dir, stdout=log,
-                    stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL,
-                    env=_environment(tmpdir), start_new_session=True,
-                    preexec_fn=partial(die_with_parent, os.getpid()))
+                proc = _start([DEBIAN_PYTHON, str(WRAPPER), "scene.py"], tmpdir, log,
+                              cwd=run_dir, stdin=subprocess.DEVNULL)
             except BaseException:
                 _remove_tmp(tmpdir)
                 raise
-            proc.tmpdir, proc.run_dir = tmpdir, str(run_dir)
+            proc.run_dir = str(run_dir)
             _RUNNING.add(proc)
         try:
             return proc.wait(timeout=timeout_s)
@@ -178,20 +234,16 @@ def _server():
     if proc is not None:
         _kill(proc)
     read_fd, write_fd = os.pipe()
-    tmpdir = tempfile.mkdtemp(prefix=TMP_PREFIX)
+    tmpdir = _note_dir()
     try:
-        proc = subprocess.Popen([DEBIAN_PYTHON, str(WRAPPER), "--serve", str(write_fd),
-                                 str(SERVE_IDLE_S)],
-                                stdin=subprocess.PIPE, stdout=subprocess.DEVNULL,
-                                stderr=subprocess.DEVNULL, pass_fds=(write_fd,),
-                                env=_environment(tmpdir), start_new_session=True,
-                                preexec_fn=partial(die_with_parent, os.getpid()))
+        proc = _start([DEBIAN_PYTHON, str(WRAPPER), "--serve", str(write_fd),
+                       str(SERVE_IDLE_S)], tmpdir, subprocess.DEVNULL,
+                      stdin=subprocess.PIPE, pass_fds=(write_fd,))
     except BaseException:
         _remove_tmp(tmpdir)
         raise
     finally:
         os.close(write_fd)
-    proc.tmpdir = tmpdir
     proc.control = os.fdopen(read_fd, "rb")
     proc.scenes, proc.busy, proc.retired, proc.last_used = 0, True, False, time.monotonic()
     _SERVED.proc = proc
@@ -244,25 +296,25 @@ def kill_running():
     with _RUNNING_LOCK:
         procs = list(_RUNNING)
     for proc in procs:
-        if proc.returncode is not None:          # reaped: its pid is no longer its own
-            continue
-        try:
-            os.killpg(proc.pid, signal.SIGKILL)
-        except ProcessLookupError:
-            pass
+        if proc.returncode is None:              # reaped: its pid is no longer its own
+            _stop_group(proc)
 
 
 def stop_scenes(mark):
     """Kill this process's YADE processes that run a scene whose run directory's path
     contains ``mark``, and refuse such scenes from now on (Ctrl-C of a Dask campaign on a
-    worker: a task about to start its scene is refused rather than missed).  Their pids."""
+    worker: a task about to start its scene is refused rather than missed).  Returns their
+    pids once their temporary directories are removed (by the threads that ran them, or
+    by themselves when stopped while YADE started; at most STOP_GRACE_S)."""
     with _RUNNING_LOCK:
         _STOPPED.add(mark)
         procs = [p for p in _RUNNING
                  if p.returncode is None and mark in getattr(p, "run_dir", "")]
         for proc in procs:
-            with contextlib.suppress(ProcessLookupError):
-                os.killpg(proc.pid, signal.SIGKILL)
+            _stop_group(proc)
+    deadline = time.monotonic() + STOP_GRACE_S
+    while any(os.path.exists(p.tmpdir) for p in procs) and time.monotonic() < deadline:
+        time.sleep(0.02)
     return [p.pid for p in procs]
 
 
@@ -277,11 +329,12 @@ def _kill(proc):
     pipes).  A child already reaped is not signalled: its pid may belong to another
     process by now (unreaped, even when it has exited, its pid is still its own)."""
     if proc.returncode is None:
+        _stop_group(proc)
         try:
-            os.killpg(proc.pid, signal.SIGKILL)
-        except ProcessLookupError:
-            pass
-        proc.wait()
+            proc.wait(timeout=STOP_GRACE_S)
+        except subprocess.TimeoutExpired:
+            _stop_group(proc)                    # SIGKILL by now
+            proc.wait()
     with _RUNNING_LOCK:
         _RUNNING.discard(proc)
     for pipe in (proc.stdin, getattr(proc, "control", None)):
@@ -292,11 +345,23 @@ def _kill(proc):
         _remove_tmp(proc.tmpdir)
 
 
+def _stop_group(proc):
+    """Stop the child's process group: SIGKILL once YADE has started in it (its temporary
+    directory is noted: removed after), before that SIGTERM, which the child takes once
+    YADE has started, removing that directory itself; SIGKILL after all when a SIGTERM
+    did not end it within STOP_GRACE_S."""
+    started = os.path.exists(os.path.join(proc.tmpdir, NOTE))
+    first = vars(proc).setdefault("stop_sent", time.monotonic())
+    late = time.monotonic() - first > STOP_GRACE_S
+    with contextlib.suppress(ProcessLookupError):
+        os.killpg(proc.pid, signal.SIGKILL if started or late else signal.SIGTERM)
+
+
 def _remove_tmp(note_dir):
     """Remove the temporary directory YADE made for a process that has ended (named in
     ``note_dir``, by run_scene.py) and ``note_dir`` itself."""
     with contextlib.suppress(OSError):
-        made = (Path(note_dir) / "yade_tmp_dir").read_text().strip()
+        made = (Path(note_dir) / NOTE).read_text().strip()
         if Path(made).name.startswith("yade-"):
             shutil.rmtree(made, ignore_errors=True)
     shutil.rmtree(note_dir, ignore_errors=True)

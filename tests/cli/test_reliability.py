@@ -17,6 +17,7 @@ from pipeline import cli
 from pipeline.files import check_jobs
 from pipeline.motion import Motion
 from pipeline.motion.pulses import one_sine_pulse
+from pipeline.scenario.runner import TMP_PREFIX
 
 PROJECT = Path(__file__).resolve().parents[2]
 
@@ -346,17 +347,31 @@ def test_ctrl_c_stops_a_campaign_and_resume_completes(tmp_path):
 
 
 @pytest.mark.parametrize("delay_s", [0.2, 0.6])
-def test_ctrl_c_during_start_up_exits_130_with_one_line(tmp_path, delay_s):
-    """Ctrl-C while the command is still importing its modules: the same one line and
-    exit status 130 as later, no traceback, nothing written."""
+@pytest.mark.parametrize("stop, status", [(signal.SIGINT, 130), (signal.SIGTERM, 143)])
+def test_ctrl_c_during_start_up_exits_130_with_one_line(tmp_path, delay_s, stop, status):
+    """Ctrl-C (SIGTERM: a plain kill) while the command is still importing its modules:
+    the same one line and exit status 130 (143) as later, no traceback, nothing written."""
     out = tmp_path / "camp"
     proc = cli_process("campaign", "records", "--records", "GM20", "--out", str(out))
+    deadline = time.monotonic() + 30       # SIGTERM is caught from the command's first line
+    while not _catches(proc.pid, stop) and time.monotonic() < deadline:     # (a kill before
+        time.sleep(0.005)                  # it ends the process as any other, leaving nothing)
     time.sleep(delay_s)
-    proc.send_signal(signal.SIGINT)
+    proc.send_signal(stop)
     _, err = proc.communicate(timeout=60)
-    assert proc.returncode == 130, err
+    assert proc.returncode == status, err
     assert err.strip().splitlines() == ["interrupted: finished results are kept"]
     assert "Traceback" not in err
+
+
+def _catches(pid, signum):
+    """Whether process ``pid`` has a handler for signal ``signum`` (/proc: SigCgt)."""
+    try:
+        status = Path(f"/proc/{pid}/status").read_text()
+    except OSError:
+        return False
+    caught = int(status.split("SigCgt:")[1].split()[0], 16)
+    return bool(caught >> (signum - 1) & 1)
 
 
 @pytest.mark.yade
@@ -369,6 +384,141 @@ def test_kill_9_leaves_no_yade_behind_and_resume_completes(tmp_path):
         time.sleep(0.05)
     assert not yade_processes(out)
     resume_completes(records, out)
+
+
+# YADE makes /tmp/yade-XXXXXX per process, at that fixed path (not TMPDIR): a command run
+# by private_tmp_cli sees a /tmp of its own (``tmp_path/tmp``, in a mount namespace), so
+# that a test sees only its own YADE directories, not those of tests running beside it;
+# tmp_path is seen at its own path
+PRIVATE_TMP = """
+exec 3<"$2"
+mount --bind "$1" /tmp && mkdir -p "$2" && mount --no-canonicalize --bind /proc/self/fd/3 "$2" \
+  || exit 99
+exec 3<&-
+shift 2
+exec "$@"
+"""
+
+
+def private_tmp_cli(tmp_path, *args):
+    """The CLI (as cli_process) with /tmp = ``tmp_path/tmp``; skips the test when this
+    machine gives no user and mount namespace (``unshare -Urm``)."""
+    if subprocess.run(["unshare", "-Urm", "true"], capture_output=True).returncode != 0:
+        pytest.skip("no unprivileged mount namespace (unshare -Urm) for a private /tmp")
+    (tmp_path / "tmp").mkdir(exist_ok=True)
+    return subprocess.Popen(["unshare", "-Urm", "sh", "-c", PRIVATE_TMP, "sh",
+                             str(tmp_path / "tmp"), str(tmp_path), sys.executable, "-m",
+                             "pipeline", *args], cwd=PROJECT, stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True)
+
+
+def yade_temporary_dirs(tmp_path):
+    """What YADE processes and their notes left in the private /tmp of private_tmp_cli."""
+    return sorted(p.name for p in (tmp_path / "tmp").iterdir()
+                  if p.name.startswith(("yade-", TMP_PREFIX)))
+
+
+def start_private_campaign(tmp_path, started, executor="threads"):
+    """(records, campaign dir, CLI process, its descendant processes) of a 4-run campaign
+    in a private /tmp, once a YADE process runs (``started`` False) or YADE has started in
+    it and noted its temporary directory (True)."""
+    records, out = _campaign_records(tmp_path), tmp_path / "camp"
+    proc = private_tmp_cli(tmp_path, "campaign", "records", "--records", records, "--out",
+                           str(out), "--jobs", "2", "--animations", "0", "--executor",
+                           executor)
+    deadline = time.monotonic() + 60
+    while time.monotonic() < deadline:
+        children = _descendants(proc.pid)
+        yade = [p for p in children if "run_scene.py" in _cmdline(p)]
+        noted = list((tmp_path / "tmp").glob(f"{TMP_PREFIX}*/yade_tmp_dir"))
+        if yade and (noted or not started):
+            return records, out, proc, children
+        time.sleep(0.02)
+    proc.kill()
+    raise AssertionError(f"YADE did not start: {proc.communicate()[1]}")
+
+
+def _descendants(pid):
+    try:
+        return psutil.Process(pid).children(recursive=True)
+    except psutil.NoSuchProcess:
+        return []
+
+
+def _cmdline(process):
+    try:
+        return " ".join(process.cmdline())
+    except psutil.Error:
+        return ""
+
+
+@pytest.mark.yade
+@pytest.mark.parametrize("started, executor", [(False, "threads"), (True, "threads"),
+                                               (True, "dask")])
+def test_sigterm_stops_a_campaign_with_one_line_and_leaves_nothing(tmp_path, started,
+                                                                   executor):
+    """A plain kill (SIGTERM) of a campaign, while YADE starts or once it runs a scene
+    (on a local Dask cluster too): one line, exit status 143, no process and no
+    temporary directory left."""
+    records, out, proc, yade = start_private_campaign(tmp_path, started, executor)
+    proc.send_signal(signal.SIGTERM)
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == 143, err
+    lines = [line for line in err.splitlines() if line.strip() and "run/s" not in line]
+    assert lines == ["interrupted: finished results are kept"], err   # (and the progress bar)
+    _, alive = psutil.wait_procs(yade, timeout=30)
+    assert not alive
+    assert yade_temporary_dirs(tmp_path) == []
+    assert json.loads((out / "campaign.json").read_text())["interrupted"] is True
+
+
+@pytest.mark.yade
+@pytest.mark.parametrize("started", [False, True])
+def test_kill_9_leaves_nothing_in_tmp_after_the_next_run(tmp_path, started):
+    """kill -9 of a campaign while YADE starts (its YADE processes remove their temporary
+    directories themselves) or runs a scene (they die with it: the next campaign removes
+    them): after the next campaign nothing of the killed one is left in /tmp."""
+    records, out, proc, yade = start_private_campaign(tmp_path, started)
+    proc.kill()
+    proc.communicate(timeout=30)
+    _, alive = psutil.wait_procs(yade, timeout=30)
+    assert not alive
+    if started:
+        assert yade_temporary_dirs(tmp_path), "the test kills no YADE that noted its directory"
+    resume = private_tmp_cli(tmp_path, "campaign", "records", "--records", records, "--out",
+                             str(out), "--jobs", "2", "--animations", "0")
+    _, err = resume.communicate(timeout=300)
+    assert resume.returncode == 0, err
+    assert len(list(out.glob("runs/*/summary.json"))) == 4
+    assert yade_temporary_dirs(tmp_path) == []
+
+
+def test_the_next_campaign_removes_only_what_processes_gone_left(tmp_path):
+    """Note directories of a process that is gone (or has ended, not yet reaped) are
+    removed with the YADE directory they name; those of a live process (this one), of an
+    unknown owner (no pid in the name) and directories that are no note stay."""
+    from pipeline.scenario.runner import remove_orphaned_tmp
+    gone = subprocess.Popen(["true"])
+    gone.wait()                                    # reaped: its pid names no process
+    ended = subprocess.Popen(["true"])             # a zombie until reaped
+    deadline = time.monotonic() + 30
+    while psutil.Process(ended.pid).status() != psutil.STATUS_ZOMBIE:
+        assert time.monotonic() < deadline
+        time.sleep(0.01)
+    made = {}
+    for owner in (gone.pid, ended.pid, os.getpid(), "x"):
+        yade = tmp_path / f"yade-{owner}"
+        note = tmp_path / f"{TMP_PREFIX}{owner}-abc"
+        yade.mkdir()
+        note.mkdir()
+        (note / "yade_tmp_dir").write_text(str(yade))
+        made[owner] = (yade, note)
+    (tmp_path / "yade-unnoted").mkdir()
+    assert remove_orphaned_tmp(tmp_path) == 2
+    ended.wait()
+    assert not any(p.exists() for owner in (gone.pid, ended.pid) for p in made[owner])
+    assert all(p.exists() for owner in (os.getpid(), "x") for p in made[owner])
+    assert (tmp_path / "yade-unnoted").exists()
 
 
 def listening_sockets(root):
