@@ -384,26 +384,28 @@ def _posed(path, digest, scale, rotation_wxyz, rest_pose, heading_deg, tolerance
     if mesh.body_count > 1:
         raise InputError(f"{where}: mesh {name} holds {mesh.body_count} separate bodies: "
                          "one closed body per specimen (give each its own file)")
-    if abs(mesh.volume) <= ZERO_VOLUME * size ** 3:
+    with np.errstate(divide="ignore", invalid="ignore"):      # no centre of a flat mesh
+        flat = abs(mesh.volume) <= ZERO_VOLUME * size ** 3
+    if flat:
         raise InputError(f"{where}: mesh {name} encloses zero volume (a flat surface)")
     if mesh.volume < 0:
         mesh.invert()                      # inward-facing normals (a common scan export)
     hull = mesh.convex_hull
     settle = Rotation.identity()
     if rest_pose == "nearest":
-        pose_hull = hull
         if len(hull.faces) > MAX_POSE_HULL_FACES:
-            pose_hull = _coarse_hull(hull.vertices, MAX_POSE_HULL_FACES)
-            repairs.append(f"rest pose found on its convex hull simplified from "
-                           f"{len(hull.faces)} to {len(pose_hull.faces)} faces")
-        transforms, _ = trimesh.poses.compute_stable_poses(pose_hull,
-                                                           center_mass=mesh.center_mass)
-        if not len(transforms):
-            raise InputError(f"{where}: mesh {name}: no stable pose found")
-        ups = [np.linalg.inv(T[:3, :3]) @ [0.0, 0.0, 1.0] for T in transforms]
-        # the stable pose whose up direction is nearest the given orientation's
-        up = max(ups, key=lambda u: u[2])
-        settle, _ = Rotation.align_vectors([[0.0, 0.0, 1.0]], [up])
+            settle = _rolled(hull, mesh.center_mass)
+            repairs.append(f"rest pose found by rolling on its convex hull of "
+                           f"{len(hull.faces):,} faces (the stable poses are sought on "
+                           f"at most {MAX_POSE_HULL_FACES:,})")
+        else:
+            transforms, _ = mesh.compute_stable_poses()
+            if not len(transforms):
+                raise InputError(f"{where}: mesh {name}: no stable pose found")
+            ups = [np.linalg.inv(T[:3, :3]) @ [0.0, 0.0, 1.0] for T in transforms]
+            # the stable pose whose up direction is nearest the given orientation's
+            up = max(ups, key=lambda u: u[2])
+            settle, _ = Rotation.align_vectors([[0.0, 0.0, 1.0]], [up])
     turn = Rotation.from_euler("z", -heading_deg, degrees=True)
     matrix = _matrix(turn * settle)
     mesh.apply_transform(matrix)
@@ -564,18 +566,31 @@ def _close_base(mesh, loops, close_base, name):
     return capped, area
 
 
-def _coarse_hull(points, most):
-    """A convex hull of at most ``most`` faces inside the hull of ``points`` (k, 3): the
-    hull of one point per cell of a grid (the farthest from their mean), the grid
-    coarsened until the hull is small enough."""
-    import trimesh
-    order = np.argsort(-np.linalg.norm(points - points.mean(axis=0), axis=1), kind="stable")
-    points = points[order]
-    cells = int(math.sqrt(most / 6))
-    while True:
-        keys = np.floor((points - points.min(axis=0)) / (np.ptp(points, axis=0).max() / cells))
-        first = np.sort(np.unique(keys, axis=0, return_index=True)[1])
-        hull = trimesh.convex.convex_hull(points[first])
-        if len(hull.faces) <= most:
-            return hull
-        cells = int(cells * 0.8)
+def _rolled(hull, com):
+    """The rotation that sets a body down on the table as it rolls there (hull: its convex
+    hull, trimesh; com: its centre of mass, (3,)): from the hull face below the centre of
+    mass, it tips over the edge of each face the centre of mass lies beyond onto the
+    neighbouring face, until the centre of mass lies above the face it stands on."""
+    from scipy.spatial.transform import Rotation
+    normals, corners = hull.face_normals, hull.vertices[hull.faces]
+    down = normals[:, 2] < 0          # the face a vertical line down from com leaves by
+    drop = np.full(len(normals), np.inf)
+    drop[down] = ((corners[down, 0] - com) * normals[down]).sum(axis=1) / -normals[down, 2]
+    face = int(np.argmin(drop))
+    n = len(hull.vertices)
+    sides = np.sort(hull.faces[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2), axis=1)
+    keys = sides[:, 0] * n + sides[:, 1]
+    order = np.argsort(keys, kind="stable")
+    for _ in range(len(hull.faces)):              # each step lowers the centre of mass
+        a, b, c = corners[face]
+        normal = normals[face]
+        p = com - ((com - a) @ normal) * normal       # com projected onto the face
+        weights = np.linalg.solve(np.column_stack([b - a, c - a, normal]), p - a)[:2]
+        weights = np.array([1 - weights.sum(), *weights])   # barycentric, at a, b, c
+        if weights.min() >= -1e-12:
+            break
+        beyond = int(np.argmin(weights))               # the side opposite that corner
+        u, v = sorted(hull.faces[face][[(beyond + 1) % 3, (beyond + 2) % 3]])
+        found = order[np.searchsorted(keys, u * n + v, sorter=order):][:2] // 3
+        face = int(found[found != face][0])
+    return Rotation.align_vectors([[0.0, 0.0, -1.0]], [normals[face]])[0]
