@@ -337,7 +337,7 @@ def _posed(path, digest, scale, rotation_wxyz, rest_pose, heading_deg, tolerance
     """Mass properties (per kg), footprint and hull of the mesh in its rest pose, and what
     was repaired to read it (``close_base`` in metres)."""
     import trimesh
-    from scipy.spatial import ConvexHull
+    from scipy.spatial import ConvexHull, QhullError
     from scipy.spatial.transform import Rotation
 
     name = Path(path).name
@@ -391,6 +391,10 @@ def _posed(path, digest, scale, rotation_wxyz, rest_pose, heading_deg, tolerance
     if mesh.volume < 0:
         mesh.invert()                      # inward-facing normals (a common scan export)
     hull = mesh.convex_hull
+    inside = ((mesh.center_mass - hull.triangles_center) * hull.face_normals).sum(axis=1)
+    if not (inside < 0).all():     # the stable-pose search would sample it forever
+        raise InputError(f"{where}: mesh {name}: its centre of mass is not inside its convex "
+                         "hull (a self-intersecting or flat surface)")
     settle = Rotation.identity()
     if rest_pose == "nearest":
         if len(hull.faces) > MAX_POSE_HULL_FACES:
@@ -417,17 +421,25 @@ def _posed(path, digest, scale, rotation_wxyz, rest_pose, heading_deg, tolerance
     hull = hull + shift
     near = hull[hull[:, 2] <= tolerance + 1e-9]
     com = np.array(mesh.center_mass, float)
-    if len(near) < 3 or ConvexHull(near[:, :2], qhull_options="QJ").volume <= 0:
+    try:
+        outline = near[ConvexHull(near[:, :2]).vertices][:, :2] if len(near) >= 3 else None
+    except QhullError:                              # the points lie on a line
+        outline = None
+    if outline is None:
         raise InputError(f"{where}: fewer than 3 hull points within footprint_tolerance_m "
                          f"{tolerance:g} m of the table: it cannot stand (raise the tolerance)")
-    outline = near[ConvexHull(near[:, :2]).vertices][:, :2]
     from matplotlib.path import Path as Polygon
     if not Polygon(outline).contains_point(com[:2]):
         raise InputError(f"{where}: the centre of mass lies outside the footprint in this "
                          "pose: the specimen cannot stand (use rest_pose \"nearest\")")
+    inertia_per_kg = np.array(mesh.moment_inertia, float) / mesh.volume
+    moments = np.linalg.eigvalsh(inertia_per_kg)   # a solid's: positive, I3 <= I1 + I2
+    if moments[0] <= 0 or moments[2] > (moments[0] + moments[1]) * (1 + 1e-9):
+        raise InputError(f"{where}: mesh {name}: its surface crosses itself (its moments of "
+                         "inertia are not those of a solid)")
     landing = hull[hull[:, 2] > tolerance + 1e-9]
     return {"volume": float(mesh.volume), "com": com,
-            "inertia_per_kg": np.array(mesh.moment_inertia, float) / mesh.volume,
+            "inertia_per_kg": inertia_per_kg,
             "footprint": outline, "hull_points": landing,
             "extent": tuple(float(e) for e in np.ptp(mesh.vertices, axis=0)),
             "settled_by_deg": float(np.degrees((settle).magnitude())),
