@@ -3,7 +3,7 @@ mesh, its rest pose on the table, and contact points that follow its footprint a
 faces it can land on.
 
 A mesh specimen is given as a mesh file (``.obj``, ``.ply``, ``.stl``, read by trimesh)
-or as a JSON file that names one (schema in docs/columns-and-model.md, "Mesh specimens")::
+or as a JSON file that names one (schema in docs/shake-table.md, "Mesh specimens")::
 
     {"name": "SP1", "mesh": "SP1.obj", "mass_kg": 353.8,
      "units": "m", "rotation_wxyz": [1, 0, 0, 0], "rest_pose": "nearest",
@@ -20,6 +20,14 @@ or as a JSON file that names one (schema in docs/columns-and-model.md, "Mesh spe
 - ``footprint_tolerance_m``: the specimen stands on the hull's points within this height
   of the table (a rough base seats on its asperities); the outline of those points is
   the footprint, whose edges it rocks about.
+- ``close_base``: "fit" or the ground plane's height (in ``units``): an open base is
+  closed by a planar cap at that plane (fitted to the lowest hole's edge for "fit").
+
+The mesh is read as its geometry (:func:`_geometry`): vertices merged by position
+(texture coordinates and normals do not split a surface), degenerate and duplicate faces
+dropped, the winding made consistent; only then is it judged closed.  What was repaired
+is said in one line on stderr and kept as ``repairs`` in :meth:`MeshSpecimen.to_dict`.
+Every limit is checked before the heavy work (MAX_FACES, counted in the file's bytes).
 
 In the scene the specimen is one clump: contact spheres along the footprint's outline
 (the base rim, ``rim_points`` per full turn of its corners as a column's rim) and on up to
@@ -51,6 +59,7 @@ MAX_FACES = 1_000_000             # triangles of a mesh (a scan decimated for si
 MAX_POSE_HULL_FACES = 20_000      # the rest pose is found on a hull of at most this many
 ZERO_VOLUME = 1e-9                # volumes below this fraction of size^3 are flat surfaces
 CLOSE_BASE_REACH = 0.25           # the ground plane within this fraction of the size
+CLOSE_BASE_RANGE = (-1e7, 1e7)    # the ground plane's height, in the mesh's units
 DEFAULT_DENSITY = 2650.0          # kg/m^3, granite
 MASS_RANGE = (1e-3, 1e7)          # kg
 SIZE_RANGE_M = (0.02, 30.0)       # largest extent of a specimen
@@ -61,8 +70,7 @@ FOOTPRINT_TOLERANCE_RANGE_M = (0.0, 0.05)
 LANDING_POINTS_PER_RIM_POINT = 4
 KEYS = {"name", "mesh", "mass_kg", "density", "units", "rotation_wxyz", "rest_pose",
         "heading_deg", "footprint_tolerance_m", "close_base", "source", "notes",
-        "mesh_sha256", "repairs"}
-CLOSE_BASE_RANGE = (-1e7, 1e7)    # the ground plane's height, in the mesh's units
+        "mesh_sha256", "repairs"}     # the last two written by to_dict
 
 
 @dataclass(frozen=True)
@@ -183,7 +191,7 @@ class MeshSpecimen:
                              f"expected {DENSITY_RANGE[0]:g}-{DENSITY_RANGE[1]:g} kg/m^3 "
                              "(check 'mass_kg' and 'units')")
         if posed["repairs"]:
-            _say(f"{'warning' if posed['cap_area_m2'] else 'note'}: {where}: mesh "
+            _say(f"{'note' if posed['cap_area_m2'] is None else 'warning'}: {where}: mesh "
                  f"{mesh.name} read as its geometry: {', '.join(posed['repairs'])}")
         return cls(name.strip(), str(mesh), digest, options, float(mass), volume,
                    posed["com"], posed["inertia_per_kg"] * mass, posed["footprint"],
@@ -473,7 +481,7 @@ def _face_count(data, suffix):
         found = re.search(rb"element face (\d+)", data[:10_000])
         return int(found.group(1)) if found else None
     if data[:5].lower() == b"solid" and b"facet" in data[:1000]:
-        return data.count(b"facet")                                  # ASCII STL
+        return data.count(b"facet normal")                           # ASCII STL
     return struct.unpack("<I", data[80:84])[0] if len(data) >= 84 else None
 
 

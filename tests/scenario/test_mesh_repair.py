@@ -320,3 +320,33 @@ def test_an_open_sp1_base_closed_by_a_cap_stands_on_it(tmp_path):
     inside = 0.5 * abs(np.dot(outline[:, 0], np.roll(outline[:, 1], -1))
                        - np.dot(outline[:, 1], np.roll(outline[:, 0], -1)))
     assert inside >= area * 0.999      # the outline's hull holds the whole cap
+
+
+@pytest.mark.yade
+def test_sp1_with_uv_charts_gives_the_same_yade_run_to_the_last_bit(tmp_path):
+    """The shipped SP1 and SP1 written as PLY with a UV chart per triangle, rocked by the
+    same short pulse above SP1's uplift threshold: the same trajectory, bit for bit (two
+    paths in the same run)."""
+    from pipeline.motion import Motion
+    from pipeline.scenario import run_yade, scene_params, write_scenario
+    vertices, faces = sp1_as_written()
+    corners, triangles = split(vertices, faces)
+    uv = np.random.default_rng(2).random((len(corners), 2))
+    variant = load(write_ply(tmp_path / "sp1_uv.ply", corners, triangles, uv),
+                   mass_kg=SP1_MASS)
+    t = np.arange(0.0, 0.6, 0.005)
+    a = 1.5 * load(SP1).uplift_ratio() * 9.81 * np.sin(2 * np.pi * 2.5 * t)
+    zero = 0 * a
+    v = np.cumsum(a) * 0.005
+    motion = Motion(0.005, np.column_stack([a, zero, zero]), np.column_stack([v, zero, zero]),
+                    np.column_stack([np.cumsum(v) * 0.005, zero, zero]))
+    runs = []
+    for name, rock in (("shipped", load(SP1, mass_kg=SP1_MASS)), ("uv", variant)):
+        params = scene_params(columns=[ColumnSpec("monolithic", "monolithic", 0.0, 0.0, rock)],
+                              t_max=0.8)
+        write_scenario(tmp_path / name, params, motion)
+        runs.append(run_yade(tmp_path / name))
+    shipped, uv = runs
+    assert np.abs(shipped.quat[:, 0, 1:]).max() > 1e-4          # it moved
+    for key in ("t", "pos", "quat", "vel", "angvel"):
+        assert np.array_equal(getattr(shipped, key), getattr(uv, key)), key
