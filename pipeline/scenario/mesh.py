@@ -377,6 +377,8 @@ def _posed(path, digest, scale, rotation_wxyz, rest_pose, heading_deg, tolerance
             repairs.append(f"{_count(flipped, 'face')} turned to the winding of their "
                            "neighbours")
     cap_area = None
+    if mesh.is_watertight and close_base is not None:
+        repairs.append("closed already: 'close_base' not used")
     if not mesh.is_watertight and close_base is not None:
         loops = _boundary_loops(mesh)
         if loops:

@@ -282,6 +282,11 @@ def test_an_open_base_is_closed_on_request_by_a_cap_at_the_fitted_plane(tmp_path
                                          f"read as its geometry: open base closed by a "
                                          f"planar cap of {W * D:.4g} m^2") == 1
     assert rock.to_dict()["close_base"] == "fit"
+    closed = MeshSpecimen.from_dict({"mesh": str(export(box(), tmp_path / "closed.obj")),
+                                     "close_base": "fit"})
+    assert closed.repairs == ("closed already: 'close_base' not used",)
+    assert "note: specimen description: mesh closed.obj read as its geometry: closed " \
+        "already: 'close_base' not used" in capsys.readouterr().err
 
 
 def test_a_given_ground_plane_closes_the_base_where_it_is(tmp_path):
