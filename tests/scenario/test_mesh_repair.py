@@ -2,7 +2,6 @@
 vertices, per-face normals, UV charts, binary STL, faces wound at random) gives the
 specimen of the shipped file; open, flat, huge, split and absurd meshes answer in one
 line; an open base is closed on request; SP2's model loads as a closed mesh."""
-import json
 import signal
 from contextlib import contextmanager
 
