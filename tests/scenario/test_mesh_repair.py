@@ -354,3 +354,19 @@ def test_sp1_with_uv_charts_gives_the_same_yade_run_to_the_last_bit(tmp_path):
     assert np.abs(shipped.quat[:, 0, 1:]).max() > 1e-4          # it moved
     for key in ("t", "pos", "quat", "vel", "angvel"):
         assert np.array_equal(getattr(shipped, key), getattr(uv, key)), key
+
+
+@pytest.mark.parametrize("tilt_deg, height", [(4.0, H), (30.0, D)])
+def test_rolling_sets_a_tilted_box_down_as_statics_says(tmp_path, monkeypatch, tilt_deg,
+                                                        height):
+    """The rolling rest pose (used past MAX_POSE_HULL_FACES) on a box tilted about East:
+    within its critical angle atan(D / H) = 18.4 deg it rolls back onto its base, past it
+    onto its long side (height D)."""
+    monkeypatch.setattr(mesh_module, "MAX_POSE_HULL_FACES", 0)
+    tilt = trimesh.transformations.rotation_matrix(np.radians(tilt_deg), [1, 0, 0])
+    rock = MeshSpecimen.load(export(box().apply_transform(tilt), tmp_path / "tilted.obj"))
+    assert rock.repairs[0].startswith("rest pose found by rolling")
+    # the OBJ holds the turned box to 1e-8 m
+    assert rock.height == pytest.approx(height, abs=1e-7)
+    assert rock.settled_by_deg == pytest.approx(tilt_deg if height == H else 90 - tilt_deg,
+                                                abs=1e-5)
