@@ -171,10 +171,11 @@ class MeshSpecimen:
         if data.get("mesh_sha256") not in (None, digest):
             raise InputError(f"{where}: mesh {mesh.name} is not the file described "
                              "(its SHA-256 differs from 'mesh_sha256')")
-        faces = _face_count(content, mesh.suffix.lower())
-        if faces is not None and faces > MAX_FACES:
-            raise InputError(f"{where}: mesh {mesh.name} has {faces:,} faces, more than "
-                             f"{MAX_FACES:,}: decimate it first")
+        for count, what, most in zip(_declared(content, mesh.suffix.lower()),
+                                     ("vertices", "faces"), (3 * MAX_FACES, MAX_FACES)):
+            if count is not None and count > most:
+                raise InputError(f"{where}: mesh {mesh.name} has {count:,} {what}, more "
+                                 f"than {most:,}: decimate it first")
         del content
         options = {k: data[k] for k in ("mass_kg", "density", "units", "rotation_wxyz",
                                          "rest_pose", "heading_deg", "footprint_tolerance_m",
@@ -474,17 +475,20 @@ def _say(line):
 _SAID = set()
 
 
-def _face_count(data, suffix):
-    """Faces a mesh file declares (counted in its bytes, before it is read); None when
-    the file does not say."""
+def _declared(data, suffix):
+    """Vertices and faces a mesh file declares, counted in its bytes before it is read
+    (None where the file does not say)."""
     if suffix == ".obj":
-        return data.count(b"\nf ") + data.startswith(b"f ")
+        return tuple(data.count(b"\n" + key) + data.startswith(key) for key in (b"v ", b"f "))
     if suffix == ".ply":
-        found = re.search(rb"element face (\d+)", data[:10_000])
-        return int(found.group(1)) if found else None
+        header = data[:10_000]
+        return tuple(int(m.group(1)) if m else None for m in (
+            re.search(rb"element vertex (\d+)", header), re.search(rb"element face (\d+)", header)))
     if data[:5].lower() == b"solid" and b"facet" in data[:1000]:
-        return data.count(b"facet normal")                           # ASCII STL
-    return struct.unpack("<I", data[80:84])[0] if len(data) >= 84 else None
+        faces = data.count(b"facet normal")                            # ASCII STL
+    else:
+        faces = struct.unpack("<I", data[80:84])[0] if len(data) >= 84 else None
+    return (None if faces is None else 3 * faces), faces
 
 
 def _geometry(mesh, scale):

@@ -217,6 +217,15 @@ def test_too_many_faces_are_refused_before_the_mesh_is_read(tmp_path, monkeypatc
     refused(path, "has 1,280 faces, more than 1,000: decimate it first")
 
 
+def test_too_many_vertices_are_refused_before_the_mesh_is_read(tmp_path, monkeypatch):
+    path = tmp_path / "cloud.obj"                 # a point cloud with a tetrahedron
+    path.write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n" + "v 0.1 0.1 0.1\n" * 3000
+                    + "f 1 2 3\nf 1 4 2\nf 1 3 4\nf 2 4 3\n")
+    monkeypatch.setattr(mesh_module, "MAX_FACES", 1000)
+    monkeypatch.setattr(mesh_module, "_posed", None)                 # never reached
+    refused(path, "has 3,004 vertices, more than 3,000: decimate it first")
+
+
 def test_a_huge_hull_rolls_onto_its_rest_pose(tmp_path, monkeypatch):
     """An ellipsoid (semi-axes 0.2, 0.3, 0.4 m; every vertex on its hull) given standing
     on its long axis: past MAX_POSE_HULL_FACES hull faces it rolls from where it stands
