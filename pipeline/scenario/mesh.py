@@ -171,8 +171,8 @@ class MeshSpecimen:
         if data.get("mesh_sha256") not in (None, digest):
             raise InputError(f"{where}: mesh {mesh.name} is not the file described "
                              "(its SHA-256 differs from 'mesh_sha256')")
-        for count, what, most in zip(_declared(content, mesh.suffix.lower()),
-                                     ("vertices", "faces"), (3 * MAX_FACES, MAX_FACES)):
+        for count, what, most in zip(_declared(content, mesh.suffix.lower())[::-1],
+                                     ("faces", "vertices"), (MAX_FACES, 3 * MAX_FACES)):
             if count is not None and count > most:
                 raise InputError(f"{where}: mesh {mesh.name} has {count:,} {what}, more "
                                  f"than {most:,}: decimate it first")
