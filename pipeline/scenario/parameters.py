@@ -13,6 +13,7 @@ from pipeline.constants import COLUMN_KINDS, COLUMN_TYPES
 from pipeline import paper
 from pipeline.files import InputError
 from pipeline.scenario.bodies import ColumnSpec
+from pipeline.scenario.column_format import DENSITY_RANGE
 from pipeline.scenario.geometry import ColumnGeometry
 
 RIM_SPHERE_RADIUS_M = 0.005   # rim contact spheres of the columns
@@ -150,8 +151,8 @@ class Column:
     hd: float = param(paper.COLUMN_HD, "", "slenderness h/d", 1.0, 30.0, "--hd")
     height: float = param(paper.COLUMN_HEIGHT_M, "m", "column height", 0.1, 30.0, "--height")
     n_drums: int = param(paper.N_DRUMS, "", "number of drums", 1, 60, "--drums")
-    density: float = param(paper.MARBLE_DENSITY_KG_M3, "kg/m^3", "density", 100.0, 25000.0,
-                           "--density")
+    density: float = param(paper.MARBLE_DENSITY_KG_M3, "kg/m^3", "density",
+                           *DENSITY_RANGE, "--density")
     centred: bool = field(default=None, metadata={"help": "single column at the centre"})
     column_file: object = field(default=None, metadata={
         "help": "column description: a shipped example's name, a .json/.yaml file or the "
@@ -209,7 +210,7 @@ class Block:
     height: float = param(paper.MARBLE_BLOCK_M["height"], "m", "block height", 0.01, 30.0)
     width: float = param(paper.MARBLE_BLOCK_M["width"], "m", "block width (East)", 0.005, 30.0)
     depth: float = param(paper.MARBLE_BLOCK_M["depth"], "m", "block depth (North)", 0.005, 30.0)
-    density: float = param(paper.MARBLE_DENSITY_KG_M3, "kg/m^3", "density", 100.0, 25000.0)
+    density: float = param(paper.MARBLE_DENSITY_KG_M3, "kg/m^3", "density", *DENSITY_RANGE)
     theta0_rad: float = param(0.0, "rad", "initial tilt about North (+ leans East)", -1.5, 1.5)
 
     def __post_init__(self):

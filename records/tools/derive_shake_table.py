@@ -12,6 +12,8 @@ deterministically (reruns give the same bytes):
                       decimated 800 -> 200 Hz with scipy.signal.decimate
                       (q=4, ftype='fir', zero_phase=True); gzip mtime 0
 * ``SP1.obj``         byte copy of data/SP1_PBRmodel/SP1.obj
+* ``final_sp2_1.obj`` byte copy of models/SP2_PBRmodel/final_sp2_1.obj (SP2's mesh only:
+                      a file-format test; its outcomes stay held out)
 * ``sp1.json``        specimen description (mesh, mass, rest pose, table axis)
 * ``LICENSE``         the repository's GPL-3.0 text
 
@@ -47,6 +49,7 @@ SRC = {
     "info": f"{STR}/Earthquake_Records_Info.xlsx",
     "results": f"{STR}/Results_Granite.xlsx",
     "mesh": "data/SP1_PBRmodel/SP1.obj",
+    "sp2_mesh": "models/SP2_PBRmodel/final_sp2_1.obj",
     "yaml": "config/sp1.yaml",
     "license": "LICENSE",
 }
@@ -273,11 +276,12 @@ def main(argv=None) -> int:
 
     mesh = git_show(mirror, SRC["mesh"])
     (out / "SP1.obj").write_bytes(mesh)
+    (out / "final_sp2_1.obj").write_bytes(git_show(mirror, SRC["sp2_mesh"]))
     (out / "LICENSE").write_bytes(git_show(mirror, SRC["license"]))
     (out / "sp1.json").write_text(json.dumps(sp1_json(), indent=2) + "\n")
 
     print("SHA-256 of sources:")
-    for k in ("info", "results", "mesh", "yaml", "license"):
+    for k in ("info", "results", "mesh", "sp2_mesh", "yaml", "license"):
         print(f"    {sha256(git_show(mirror, SRC[k]))}  {SRC[k]}")
     n_mot = sum(1 for t in tests if t["motion_file"])
     print(f"tests: {len(tests)}, with motion: {n_mot}, missing: {len(tests) - n_mot}")

@@ -102,8 +102,14 @@ def test_an_open_mesh_is_refused(tmp_path):
     mesh.update_faces(np.arange(len(mesh.faces)) > 0)        # a hole
     path = tmp_path / "open.obj"
     mesh.export(path)
-    with pytest.raises(InputError, match="not watertight"):
+    with pytest.raises(InputError, match="not closed: 1 hole") as info:
         MeshSpecimen.from_dict({"mesh": str(path)})
+    # where: the removed triangle's edge (two box edges and a diagonal) and its centre
+    corners = mesh.vertices[trimesh.creation.box(extents=(W, D, H)).faces[0]]
+    around = sum(np.linalg.norm(corners - np.roll(corners, 1, axis=0), axis=1))
+    assert f"the largest {around:.3g} m around" in str(info.value)
+    assert "centred at (" + ", ".join(f"{c:.4g}" for c in corners.mean(axis=0)) \
+        in str(info.value)
 
 
 def sine(factor, ratio, freq=2.0, seconds=3.0, dt=0.005):
