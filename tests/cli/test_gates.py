@@ -117,7 +117,7 @@ def test_an_experiment_table_without_rows_is_one_line(tmp_path, capsys):
 def still_worker(spec, run_dir):
     """Stands in for YADE: the specimen stands."""
     from pipeline.outcome.summary import RunSummary
-    RunSummary.still(spec["record_id"], [{"name": "monolithic", "x": 0.0, "y": 0.0}]).save(
+    RunSummary.still(spec.record_id, [{"name": "monolithic", "x": 0.0, "y": 0.0}]).save(
         run_dir / "summary.json")
 
 

@@ -27,7 +27,7 @@ def test_chain_on_pulse_excerpt(tmp_path, capsys):
     runs, impacts = collect(specs, "smoke", tmp_path)
     assert sorted(runs["column"]) == ["drums", "monolithic"]
 
-    motion = Motion.load(specs[0]["motion_file"])
+    motion = Motion.load(specs[0].motion_file)
     acc_h = np.hypot(motion.acc[:, 0], motion.acc[:, 1])
     peak_time = acc_h.argmax() * motion.dt + motion.meta["start_in_file_s"]   # record's clock
     assert window[0] < peak_time < window[1]
@@ -47,13 +47,13 @@ def test_chain_on_pulse_excerpt(tmp_path, capsys):
     assert len(drums) >= 4 and (drums["impact_time_s"] >= first).all()
 
     # a second campaign pass finds the run done and does not repeat it
-    summary = tmp_path / "runs" / specs[0]["run_id"] / "summary.json"
+    summary = tmp_path / "runs" / specs[0].run_id / "summary.json"
     stamp = summary.stat().st_mtime_ns
     capsys.readouterr()
     assert execute(specs, tmp_path, 1, run_column_spec) == ([], False)
     assert "1 already done, 0 to run" in capsys.readouterr().out
     assert summary.stat().st_mtime_ns == stamp
-    assert json.loads(summary.read_text())["parameters"]["window_s"] == window
+    assert json.loads(summary.read_text())["parameters"]["window"] == window
 
 
 @pytest.mark.parametrize("args, message", [
@@ -85,7 +85,7 @@ def test_campaign_runs_start_longest_motion_first(tmp_path):
     started = []
 
     def worker(spec, run_dir):
-        started.append(spec["run_id"])
+        started.append(spec.run_id)
         write_json(Path(run_dir) / "summary.json", {})
 
     assert execute(specs, tmp_path, 1, worker) == ([], False)

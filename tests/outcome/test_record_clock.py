@@ -85,7 +85,7 @@ def test_a_run_on_a_padded_motion_reports_record_times_up_to_the_report(
     (col,) = summary.columns
     assert col.toppled and col.impact_time_s == pytest.approx(6.0, abs=1e-9)
     assert summary.start_in_file_s == pytest.approx(5.0, abs=1e-9)
-    assert summary.parameters["window_s"] == [5.0, 20.0]
+    assert summary.parameters["window"] == [5.0, 20.0]
     assert summary.motion_end_s == pytest.approx(20.0, abs=1e-9)
     # the quiet tail starts one sample after the pulse ends (10 + 1/0.75 s, record clock)
     assert summary.quiet_after_s == pytest.approx(10.0 + 1 / 0.75, abs=2 * DT)
