@@ -266,8 +266,8 @@ def ensemble_outputs(specs, campaign_dir, failures, animations, figures=True):
         write_csv(out / "members.csv", sub)
         write_parquet(out / "members.parquet", sub)
         summary = summarise(sub, record_id, specs[0].tags["seed"])
-        summary["record_input"] = next(sp["record"] for sp in specs
-                                       if sp["record_id"] == record_id)
+        summary["record_input"] = next(sp.record for sp in specs
+                                       if sp.record_id == record_id)
         if described:
             summary["column_file"] = described["column_file"]["name"]
         summaries.append(summary)
