@@ -190,7 +190,7 @@ def outputs(specs_, campaign_dir, failures, animations, figures=True):
     table = pd.DataFrame(rows)
     per_point = {}
     if len(table):
-        stage = specs_[0]["stage"]
+        stage = specs_[0].tags["stage"]
         write_csv(campaign_dir / f"{stage}.csv", table)
         for label, group in table.groupby("grid_point", sort=False):
             per_point[label] = scores(group["observed"], group["predicted"])
