@@ -256,13 +256,24 @@ class RunParams:
 
     GROUPS = ("column", "contact", "numerics", "drive")
 
+    def __post_init__(self):
+        for group in self.GROUPS:
+            if not isinstance(getattr(self, group), self.group_class(group)):
+                raise InputError(f"run parameters: {group} must be a "
+                                 f"{self.group_class(group).__name__}, got "
+                                 f"{type(getattr(self, group)).__name__}")
+
     @staticmethod
-    def names(group):
+    def group_class(group):
+        """The parameter dataclass of one group (``group``: a GROUPS name)."""
+        return {"column": Column, "contact": Contact, "numerics": Numerics,
+                "drive": Drive}[group]
+
+    @classmethod
+    def names(cls, group):
         """{flat name: field name} of one group's dataclass (``group``: a GROUPS name)."""
-        cls = {"column": Column, "contact": Contact, "numerics": Numerics,
-               "drive": Drive}[group]
         return {("column" if f.name == "kind" else f.name): f.name
-                for f in dataclasses.fields(cls) if f.init}
+                for f in dataclasses.fields(cls.group_class(group)) if f.init}
 
     @classmethod
     def from_dict(cls, data):
@@ -278,8 +289,7 @@ class RunParams:
         unknown = sorted(set(data) - known)
         if unknown:
             raise InputError(f"unknown run parameter(s): {', '.join(unknown)}")
-        return cls(Column(**groups["column"]), Contact(**groups["contact"]),
-                   Numerics(**groups["numerics"]), Drive(**groups["drive"]))
+        return cls(*(cls.group_class(g)(**groups[g]) for g in cls.GROUPS))
 
     def to_dict(self):
         """The flat dict of every parameter (JSON-serialisable)."""

@@ -15,7 +15,7 @@ from pipeline.files import InputError
 from pipeline.motion import Motion
 from pipeline.motion.pulses import one_sine_pulse
 from pipeline.outcome.summary import RunSummary
-from pipeline.scenario import Column, RunParams
+from pipeline.scenario import Column, Drive, RunParams
 from pipeline.scenario.geometry import ColumnGeometry
 from pipeline.scenario.parameters import dt_factor_for
 
@@ -77,6 +77,8 @@ def test_flat_names_are_one_spelling_of_the_parameter_classes():
         RunParams.from_dict({"hd": 0.5})
     with pytest.raises(InputError, match="--window needs START < END"):
         RunParams.from_dict({"window": [3.0, 1.0]})
+    with pytest.raises(InputError, match="column must be a Column, got Drive"):
+        RunParams(Drive((0.0, 1.0)))
 
 
 @pytest.mark.parametrize("name", list(_cases()))

@@ -74,14 +74,15 @@ def test_campaign_runs_start_longest_motion_first(tmp_path):
     """One worker thread: runs start in order of decreasing motion length (a window's
     length when the run has one), equal lengths in the campaign's order."""
     from pipeline.files import write_json
+    from pipeline.campaign.spec import RunSpec
     from pipeline.motion.pulses import one_sine_pulse
+    from pipeline.scenario import Drive, RunParams
     specs = []
     for name, seconds, window in (("a", 4.0, None), ("b", 9.0, None), ("c", 9.0, [0.0, 2.0]),
                                   ("d", 6.0, None), ("e", 9.0, None)):
         path = tmp_path / f"{name}.npz"
         one_sine_pulse(duration=seconds).save(path)
-        specs.append({"run_id": name, "motion_file": str(path),
-                      "params": {"window": window} if window else {}})
+        specs.append(RunSpec(name, name, str(path), RunParams(drive=Drive(window)), name))
     started = []
 
     def worker(spec, run_dir):
