@@ -12,6 +12,6 @@ from pipeline.scenario.parameters import (PEDESTAL, Block, Column, Contact, Driv
 from pipeline.scenario.runner import YadeError, run_yade
 from pipeline.scenario.writer import write_scenario
 
-__all__ = ["PEDESTAL", "Block", "Column", "ColumnGeometry", "ColumnSpec", "Contact", "Drive", "Numerics", "RunParams",
-           "scene_params",
+__all__ = ["PEDESTAL", "Block", "Column", "ColumnGeometry", "ColumnSpec", "Contact", "Drive",
+           "Numerics", "RunParams", "scene_params",
            "write_scenario", "run_yade", "YadeError"]
