@@ -235,8 +235,8 @@ def logistic_surface(pga, pgv_pga, toppled, alpha=None, p=None, g=MODEL_GRAVITY)
     With the block's alpha (rad) and p (1/s) the same surface is also given in
     Purvance's dimensionless groups, logit P = c0 + b1 ln(PGA / (g tan alpha)) +
     b2 ln(p PGV/PGA), c0 = b0 + b1 ln(g tan alpha) - b2 ln p (``dimensionless``).
-    Returns dict: form, coefficients {b0, b1, b2}, se, ci95, n, toppled, method,
-    separated, converged, log_likelihood[, dimensionless]; coefficients None when
+    Returns dict: form, coefficients {b0, b1, b2}, se, ci95, cov (3 x 3, b0-b2), n,
+    toppled, method, separated, converged, log_likelihood[, dimensionless]; coefficients None when
     every run has the same outcome or fewer than 3 runs.
     """
     pga = np.asarray(pga, float)
@@ -246,8 +246,8 @@ def logistic_surface(pga, pgv_pga, toppled, alpha=None, p=None, g=MODEL_GRAVITY)
     pga, ratio, y = pga[keep], ratio[keep], y[keep]
     out = {"form": LOGISTIC_SURFACE_FORM, "n": int(y.size), "toppled": int(y.sum())}
     if y.size < 3 or y.all() or not y.any():
-        return {**out, "coefficients": None, "se": None, "ci95": None, "method": None,
-                "separated": None, "converged": None, "log_likelihood": None,
+        return {**out, "coefficients": None, "se": None, "ci95": None, "cov": None,
+                "method": None, "separated": None, "converged": None, "log_likelihood": None,
                 "note": "every run has the same outcome (or fewer than 3 runs): not fitted"}
     X = np.column_stack([np.ones(y.size), np.log(pga), np.log(ratio)])
     note = None
@@ -264,8 +264,11 @@ def logistic_surface(pga, pgv_pga, toppled, alpha=None, p=None, g=MODEL_GRAVITY)
         note = ((note + "; ") if note else "") + (
             "the outcomes are separable in (ln PGA, ln PGV/PGA): the maximum-likelihood "
             "estimate does not exist; Firth-penalised estimate")
-    out.update(coefficients=coef, se=se, ci95=ci, method=fit["method"], separated=split,
-               converged=fit["converged"], log_likelihood=fit["log_likelihood"], note=note)
+    cov = np.zeros((3, 3))
+    cov[:X.shape[1], :X.shape[1]] = fit["cov"]      # b2 fixed at 0: no variance
+    out.update(coefficients=coef, se=se, ci95=ci, cov=cov.tolist(), method=fit["method"],
+               separated=split, converged=fit["converged"],
+               log_likelihood=fit["log_likelihood"], note=note)
     if alpha is not None and p is not None:
         c0 = coef["b0"] + coef["b1"] * math.log(g * math.tan(alpha)) - coef["b2"] * math.log(p)
         out["dimensionless"] = {

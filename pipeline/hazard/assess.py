@@ -1,0 +1,193 @@
+"""What survival says for one specimen or a set at one site: ``survival.json``'s content
+and the arrays its figure draws (:func:`assess`)."""
+import numpy as np
+
+from pipeline.constants import STANDARD_GRAVITY
+from pipeline.hazard.fragility import overturn_probability
+from pipeline.hazard.survival import (contribution_by_intensity, intensity_scale_bound,
+                                      overturning_rate, rate_density, rate_scale_bound,
+                                      survival_probability)
+from pipeline.provenance import software_versions
+
+FLOOR = 0.05                  # survival probability the bounds keep (5 %)
+INTERVAL = (2.5, 97.5)        # percentiles of the survival interval
+END_SHARE_WARNING = 0.1       # warn when a curve's end holds more of the rate than this
+
+ASSUMPTIONS = [
+    "Overturnings are a Poisson process in time: survival of age t is exp(-rate t).",
+    "The hazard curve is interpolated linearly in (ln PGA, ln rate); no extrapolation: "
+    "nothing below its first level, and every exceedance of its last level counted at the "
+    "last level (a lower bound on the rate; what it could add is reported).",
+    "An uncertain age is normal (mean, sd) truncated at 0 and integrated over: the "
+    "survival probability is its mean over the age, not an interval.",
+    "PGV/PGA at each PGA level is lognormal (from the user, or from the ground-motion "
+    "model at the stated magnitude and distance); the fragility is averaged over it.",
+    "survival_interval: 95 % of the survival probabilities of fragility parameters drawn "
+    "from the uncertainty of their estimate (parametric bootstrap); the hazard curve and "
+    "the PGV/PGA model are taken as exact.",
+    "A fragility fitted to a campaign's pooled members (campaign fragility) holds the "
+    "members' spread in its dispersion, as if each earthquake met another member; the rock "
+    "or column has one set of the unknown contact parameters in every earthquake.",
+    "PGA is taken as the hazard curve defines it; no conversion between horizontal "
+    "components: campaign fragility's PGA is the peak of the horizontal acceleration "
+    "vector, larger than the RotD50 or geometric-mean PGA of most hazard models, so a "
+    "campaign fragility read against such a curve overstates the survival.",
+    "A set of specimens shares one age and the site's earthquakes. common_shaking (the "
+    "headline for a set): the specimens overturn independently given the motion of one "
+    "event, P(all survive | PGA, PGV/PGA) = prod(1 - P_i); independent: each specimen meets "
+    "its own earthquakes (survival = prod exp(-rate_i t)); fully_correlated: in an event "
+    "the weakest specimen decides, P(any overturns) = max P_i.",
+]
+
+
+def assess(curve, specimens, ratio_model, age_ka, age_sd_ka=0.0, draws=400, seed=0):
+    """(summary dict for survival.json, figure data dict) for ``specimens`` (fragility
+    objects of :mod:`pipeline.hazard.fragility`) at the site of ``curve``
+    (:class:`~pipeline.hazard.curves.HazardCurve`); ``ratio_model``: the PGV/PGA model or
+    None; ages in ka (thousand years)."""
+    age, age_sd = age_ka * 1000.0, age_sd_ka * 1000.0
+    rng = np.random.default_rng(seed)
+    drawn = [f.draws(draws, rng) if draws else None for f in specimens]
+    warnings = list(curve.notes)
+    entries = []
+    for k, fragility in enumerate(specimens):
+        def probability(x, f=fragility):
+            return overturn_probability([f], ratio_model, x)[0]
+        members = None if drawn[k] is None else [
+            (lambda x, f=d: overturn_probability([f], ratio_model, x)[0]) for d in drawn[k]]
+        entry = _result(curve, probability, members, age, age_sd)
+        entry = {"fragility": fragility.describe(), **entry}
+        if drawn[k] is None:
+            entry["survival_interval_note"] = "no uncertainty stated for this fragility" \
+                if draws else "--draws 0"
+        entries.append(entry)
+        warnings += [f"specimen {k}: {w}" for w in entry.pop("warnings")]
+    if len(specimens) == 1:
+        headline, probability = entries[0], _combined(specimens, ratio_model, "each")
+    else:
+        probability = _combined(specimens, ratio_model, "any_common")
+        members = None
+        if all(d is not None for d in drawn):
+            members = [_combined(list(group), ratio_model, "any_common")
+                       for group in zip(*drawn)]
+        headline = _result(curve, probability, members, age, age_sd)
+        warnings += [f"set: {w}" for w in headline.pop("warnings")]
+    summary = {
+        "annual_overturning_rate_per_yr": headline["annual_overturning_rate_per_yr"],
+        "survival_probability": headline["survival_probability"],
+        "survival_interval": headline["survival_interval"],
+        **({} if headline["survival_interval"] is not None else {
+            "survival_interval_note": "no uncertainty stated for the fragility" if draws
+            else "--draws 0"}),
+        "rate_scale_bound_5pct": headline["rate_scale_bound_5pct"],
+        "intensity_scale_bound_5pct": headline["intensity_scale_bound_5pct"],
+        "contribution_by_intensity": headline["contribution_by_intensity"],
+        "curve_ends": headline["curve_ends"],
+        "headline": "the specimen" if len(specimens) == 1 else
+                    "the set under common shaking (all survive)",
+        "age_ka": age_ka, "age_sd_ka": age_sd_ka,
+        "age_distribution": "fixed" if age_sd_ka == 0 else "normal truncated at 0",
+        "definitions": {
+            "annual_overturning_rate_per_yr": "integral of P(overturn | PGA) |d lambda(PGA)| "
+            "over the hazard curve, 1/yr",
+            "survival_probability": "mean over the age of exp(-rate t)",
+            "survival_interval": f"{INTERVAL[0]:g}-{INTERVAL[1]:g} percentiles over "
+            f"{draws} fragility parameter draws (parametric bootstrap), or null",
+            "rate_scale_bound_5pct": "largest factor F on every rate of the hazard curve "
+            "with survival >= 0.05 (-ln 0.05 / (rate t) for a fixed age)",
+            "intensity_scale_bound_5pct": "largest factor c on the curve's PGA levels "
+            "(lambda_c(x) = lambda(x / c)) with survival >= 0.05; null with a note when "
+            "outside 0.001-1000",
+            "contribution_by_intensity": "the rate of overturning by PGA interval of the "
+            "curve (m/s^2; the last row: exceedances of the last level) and its share"},
+        "specimens": entries,
+        "hazard": {**curve.source, "levels_m_s2": curve.levels_m_s2.tolist(),
+                   "levels_g": (curve.levels_m_s2 / STANDARD_GRAVITY).tolist(),
+                   "rates_per_yr": curve.rates_per_yr.tolist(), "notes": list(curve.notes),
+                   "interpolation": "linear in (ln PGA, ln rate)"},
+        "pgv_pga": None if ratio_model is None else ratio_model.describe(),
+        "pgv_pga_used": any(f.uses_ratio for f in specimens),
+        "assumptions": ASSUMPTIONS, "warnings": warnings,
+        "draws": draws, "seed": seed, "software": software_versions()}
+    if len(specimens) > 1:
+        summary["site_set"] = _site_set(curve, specimens, ratio_model, entries, age, age_sd)
+    figure = _figure_data(curve, probability, headline, drawn, age, age_sd, specimens,
+                          ratio_model)
+    return summary, figure
+
+
+def _combined(specimens, ratio_model, combine):
+    def probability(x):
+        p = overturn_probability(specimens, ratio_model, x, combine)
+        return p[0] if combine == "each" else p
+    return probability
+
+
+def _result(curve, probability, members, age, age_sd):
+    """Rate, survival, interval, bounds and contributions of one probability function."""
+    zero = curve.zero_rate_from_m_s2
+    rate = overturning_rate(curve.levels_m_s2, curve.rates_per_yr, probability, zero)
+    total = rate["rate_per_yr"]
+    survival = float(survival_probability(total, age, age_sd))
+    interval = None
+    if members:
+        rates = np.array([overturning_rate(curve.levels_m_s2, curve.rates_per_yr, p,
+                                           zero)["rate_per_yr"] for p in members])
+        interval = np.percentile(survival_probability(rates, age, age_sd), INTERVAL).tolist()
+    bound_c, bound_note = intensity_scale_bound(curve.levels_m_s2, curve.rates_per_yr,
+                                                probability, age, age_sd, FLOOR, zero)
+    contribution = contribution_by_intensity(curve.levels_m_s2, curve.rates_per_yr,
+                                             probability)
+    for row in contribution:
+        row["lo_g"] = row["lo_m_s2"] / STANDARD_GRAVITY
+        row["hi_g"] = None if row["hi_m_s2"] is None else row["hi_m_s2"] / STANDARD_GRAVITY
+    warnings = []
+    for key, where in (("share_first_interval", "first interval"),
+                       ("share_at_last_level", "last level")):
+        if rate[key] is not None and rate[key] > END_SHARE_WARNING:
+            warnings.append(f"{100 * rate[key]:.0f} % of the overturning rate lies at the "
+                            f"curve's {where}: extend the hazard curve")
+    if rate["last_level_could_add_per_yr"] > END_SHARE_WARNING * max(total, 1e-300):
+        warnings.append("exceedances of the last level could add "
+                        f"{rate['last_level_could_add_per_yr']:.3g} /yr to the rate "
+                        f"{total:.3g} /yr: extend the hazard curve")
+    return {"annual_overturning_rate_per_yr": total, "survival_probability": survival,
+            "survival_interval": interval,
+            "rate_scale_bound_5pct": rate_scale_bound(total, age, age_sd, FLOOR),
+            "intensity_scale_bound_5pct": bound_c,
+            **({"intensity_scale_bound_note": bound_note} if bound_note else {}),
+            "contribution_by_intensity": contribution,
+            "curve_ends": {k: v for k, v in rate.items() if k != "rate_per_yr"},
+            "warnings": warnings}
+
+
+def _site_set(curve, specimens, ratio_model, entries, age, age_sd):
+    """Survival of all specimens of a set under the three assumptions of ASSUMPTIONS."""
+    zero = curve.zero_rate_from_m_s2
+    out = {}
+    rates = {"independent": sum(e["annual_overturning_rate_per_yr"] for e in entries)}
+    for name, combine in (("common_shaking", "any_common"),
+                          ("fully_correlated", "any_correlated")):
+        rates[name] = overturning_rate(curve.levels_m_s2, curve.rates_per_yr,
+                                       _combined(specimens, ratio_model, combine),
+                                       zero)["rate_per_yr"]
+    for name, rate in rates.items():
+        out[name] = {"annual_rate_any_overturns_per_yr": rate,
+                     "survival_probability_all": float(survival_probability(rate, age, age_sd)),
+                     "rate_scale_bound_5pct": rate_scale_bound(rate, age, age_sd, FLOOR)}
+    return out
+
+
+def _figure_data(curve, probability, headline, drawn, age, age_sd, specimens, ratio_model):
+    """Arrays for :func:`pipeline.figures.survival.plot_survival`."""
+    x, density = rate_density(curve.levels_m_s2, curve.rates_per_yr, probability)
+    ages = np.linspace(0.0, 2.0 * (age + 2.0 * age_sd), 200)
+    rate = headline["annual_overturning_rate_per_yr"]
+    survival = np.array([survival_probability(rate, a) for a in ages])
+    return {"levels_m_s2": curve.levels_m_s2, "rates_per_yr": curve.rates_per_yr,
+            "probability_x": x, "probability": probability(x), "density_x": x,
+            "density": density, "contribution": headline["contribution_by_intensity"],
+            "ages_yr": ages, "survival": survival, "age_yr": age, "age_sd_yr": age_sd,
+            "survival_probability": headline["survival_probability"],
+            "survival_interval": headline["survival_interval"],
+            "set": len(specimens) > 1, "pgv_pga_used": any(f.uses_ratio for f in specimens)}

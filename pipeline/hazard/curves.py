@@ -1,0 +1,283 @@
+"""The one loader of a site's hazard curve: annual rate of exceedance against PGA.
+
+Three formats: a second line ``lon,lat...`` is OpenQuake's, a first ``{`` the USGS
+web service's, anything else a plain table.
+
+- OpenQuake's hazard-curve CSV as the engine exports it: a first line starting with
+  ``#`` that states ``investigation_time`` (years) and ``imt`` (e.g. ``#,,,"generated_by=
+  'OpenQuake engine 3.7.0', ..., kind='mean', investigation_time=50.0, imt='PGA'"`` or the
+  older ``# ..., investigation_time=1.0, imt="PGA"``), a second line ``lon,lat[,depth],
+  poe-<level>,...`` (older files ``PGA-<level>:float32``), then one row per site with the
+  probability of exceedance (poe) over the investigation time T at each level (PGA in g).
+  Annual rate = -ln(1 - poe) / T (Poisson).
+- The USGS hazard web service's static-curve JSON (NSHM editions; the earthquake-hazard-tool
+  response ``{"response": [{"metadata": {"imt": {"value": "PGA"}, "xlabel": "Ground Motion
+  (g)", "ylabel": "Annual Frequency of Exceedence", "xvals": [...]}, "data": [{"yvals":
+  [...]}]}, ...]}``): the PGA curve, annual rates as given.
+- A plain table: comment lines starting with ``#`` anywhere, then the header
+  ``pga_<unit>,annual_rate_per_yr`` with unit ``g``, ``m_s2`` or ``cm_s2``, then one row
+  per level: PGA and the annual rate of exceeding it (1/yr).
+
+Checks (a one-line InputError each): an empty file, a missing IMT or investigation time,
+an IMT other than PGA, an unknown unit, unreadable numbers, negative levels, rates or
+probabilities, levels not increasing, rates rising with the level (non-monotonic), fewer
+than two levels with a positive rate.  Said in ``notes``, never silent: levels dropped
+because their poe is 1 (an unbounded rate) and the rates of 0 at the top (the curve ends
+at the last positive rate; the first level of rate 0 is kept as ``zero_rate_from_m_s2``).
+"""
+import json
+import math
+import re
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from pipeline.constants import STANDARD_GRAVITY
+from pipeline.files import InputError
+from pipeline.userfiles import Unreadable, json_int, read_text, show
+
+PLAIN_UNITS = {"g": STANDARD_GRAVITY, "m_s2": 1.0, "cm_s2": 0.01}    # factor to m/s^2
+PLAIN_RATE_COLUMN = "annual_rate_per_yr"
+OPENQUAKE_PGA_UNIT = "g"               # the engine's unit of PGA (and SA)
+_IMT = r"[A-Za-z]+(?:\([0-9.]+\))?"    # PGA, PGV, SA(0.1), ...
+_OQ_LEVEL = re.compile(rf"^(poe|{_IMT})-([^:]+)(?::\w+)?$")
+
+
+@dataclass(frozen=True)
+class HazardCurve:
+    """A site's hazard curve: ``levels_m_s2`` (PGA, m/s^2, increasing) and
+    ``rates_per_yr`` (annual rate of exceeding each level, 1/yr, positive and not
+    increasing); ``source`` (dict: format, file, imt, investigation_time_yr, site, ...);
+    ``notes``: what the loader dropped and why; ``zero_rate_from_m_s2``: the lowest level
+    the file gives a rate of 0 (None when every level has a positive rate)."""
+    levels_m_s2: np.ndarray
+    rates_per_yr: np.ndarray
+    source: dict
+    notes: tuple = ()
+    zero_rate_from_m_s2: float | None = None
+
+
+def load_hazard(path, site=None):
+    """The hazard curve in ``path`` (OpenQuake CSV, USGS JSON or plain table: see the module);
+    ``site``: the row (0-based) of an OpenQuake file with several sites."""
+    path = Path(path)
+    try:
+        text = read_text(path)
+    except FileNotFoundError:
+        raise InputError(f"hazard file not found: {path}") from None
+    except IsADirectoryError:
+        raise InputError(f"hazard file {path} is a directory") from None
+    except (OSError, Unreadable) as exc:
+        raise InputError(f"hazard file {path}: {exc}") from None
+    lines = [line.strip() for line in text.splitlines()]
+    while lines and not lines[-1]:
+        lines.pop()
+    if not any(lines):
+        raise InputError(f"hazard file {path} is empty")
+    if len(lines) > 1 and lines[1].lower().startswith("lon,lat"):
+        return _openquake(path, lines, site)
+    if site is not None:
+        raise InputError(f"--site applies to OpenQuake files with several sites; {path} is "
+                         "not one")
+    if text.lstrip().startswith("{"):
+        return _usgs(path, text)
+    return _plain(path, lines)
+
+
+def _openquake(path, lines, site):
+    header, columns = lines[0], [c.strip() for c in lines[1].split(",")]
+    if not header.startswith("#"):
+        raise InputError(f"{path}: an OpenQuake hazard curve starts with a '#' line stating "
+                         "investigation_time and imt")
+    found = re.search(r"investigation_time\s*=\s*([^,\"'\s]+)", header)
+    if not found:
+        raise InputError(f"{path}: no investigation_time in the first line")
+    time_yr = _float(found.group(1), f"{path}: investigation_time")
+    if not (math.isfinite(time_yr) and time_yr > 0):
+        raise InputError(f"{path}: investigation_time must be a positive number of years, "
+                         f"got {found.group(1)}")
+    found = re.search(rf"\bimt\s*=\s*['\"]?({_IMT})", header)
+    imt = found.group(1) if found else None
+    first = 3 if len(columns) > 2 and columns[2].lower() == "depth" else 2
+    levels = []
+    for name in columns[first:]:
+        match = _OQ_LEVEL.match(name)
+        if not match:
+            raise InputError(f"{path}: column {show(name)} is not poe-<level> or <IMT>-<level>")
+        if match.group(1) != "poe":
+            if imt is not None and match.group(1) != imt:
+                raise InputError(f"{path}: the first line says imt {imt}, column {name} "
+                                 f"says {match.group(1)}")
+            imt = match.group(1)
+        levels.append(_float(match.group(2), f"{path}: level of column {show(name)}"))
+    if imt is None:
+        raise InputError(f"{path}: missing IMT (no imt=... in the first line, poe-<level> "
+                         "columns)")
+    _check_imt(imt, path)
+    if not levels:
+        raise InputError(f"{path}: no poe-<level> columns")
+    rows = [line for line in lines[2:] if line]
+    if not rows:
+        raise InputError(f"{path}: no site rows below the header")
+    if site is None and len(rows) > 1:
+        raise InputError(f"{path} holds {len(rows)} sites: choose one with --site "
+                         f"(0 to {len(rows) - 1})")
+    site = 0 if site is None else site
+    if not (isinstance(site, int) and 0 <= site < len(rows)):
+        raise InputError(f"--site must be 0 to {len(rows) - 1} for {path}, got {site}")
+    cells = [c.strip() for c in rows[site].split(",")]
+    if len(cells) != len(columns):
+        raise InputError(f"{path}: site row {site} has {len(cells)} values for "
+                         f"{len(columns)} columns")
+    values = [_float(c, f"{path}: site row {site}, column {columns[k]}")
+              for k, c in enumerate(cells)]
+    poe = np.array(values[first:])
+    where = f"{path} (site {site})"
+    for level, p in zip(levels, poe):
+        if not math.isfinite(p):
+            raise InputError(f"{where}: poe at {level:g} g is {p}")
+        if p < 0:
+            raise InputError(f"{where}: negative probability of exceedance {p:g} at "
+                             f"{level:g} g")
+        if p > 1:
+            raise InputError(f"{where}: probability of exceedance {p:g} above 1 at "
+                             f"{level:g} g")
+    with np.errstate(divide="ignore"):
+        rates = -np.log1p(-poe) / time_yr
+    source = {"format": "OpenQuake hazard-curve CSV", "file": str(path), "imt": imt,
+              "unit_in_file": OPENQUAKE_PGA_UNIT, "investigation_time_yr": time_yr,
+              "site_index": site, "sites_in_file": len(rows),
+              "lon": values[0], "lat": values[1],
+              "rate_from_poe": "annual rate = -ln(1 - poe) / investigation_time (Poisson)"}
+    return _curve(np.array(levels), rates, STANDARD_GRAVITY, OPENQUAKE_PGA_UNIT, where, source)
+
+
+def _plain(path, lines):
+    body = [(k + 1, line) for k, line in enumerate(lines) if line and not line.startswith("#")]
+    if not body:
+        raise InputError(f"hazard file {path} is empty (comment lines only)")
+    names = [n.strip() for n in body[0][1].split(",")]
+    first = names[0].lower()
+    match = re.fullmatch(r"(pga|pgv|sa\([0-9.]+\)|sa)_(.+)", first)
+    if not match:
+        raise InputError(f"{path}: missing IMT: the first column must be pga_<unit> "
+                         f"(pga_g, pga_m_s2 or pga_cm_s2), got {show(names[0])}")
+    _check_imt(match.group(1).upper(), path)
+    unit = match.group(2)
+    if unit not in PLAIN_UNITS:
+        raise InputError(f"{path}: unknown unit {show(unit)} of column {show(names[0])} "
+                         f"(known: {', '.join(PLAIN_UNITS)})")
+    if len(names) != 2 or names[1].lower() != PLAIN_RATE_COLUMN:
+        raise InputError(f"{path}: expected the two columns pga_{unit},{PLAIN_RATE_COLUMN}, "
+                         f"got {show(body[0][1])}")
+    levels, rates = [], []
+    for number, line in body[1:]:
+        cells = line.split(",")
+        if len(cells) != 2:
+            raise InputError(f"{path}, line {number}: expected 2 values, got {len(cells)}")
+        levels.append(_float(cells[0], f"{path}, line {number}: level"))
+        rates.append(_float(cells[1], f"{path}, line {number}: rate"))
+    source = {"format": "plain table", "file": str(path), "imt": "PGA", "unit_in_file": unit}
+    return _curve(np.array(levels), np.array(rates), PLAIN_UNITS[unit],
+                  unit.replace("_s2", "/s^2"), str(path), source)
+
+
+def _usgs(path, text):
+    """The PGA curve of a USGS hazard web-service response (static curves: ``response``
+    a list of {metadata: {imt: {value}, xlabel "Ground Motion (g)", xvals, latitude,
+    longitude, edition, vs30}, data: [{yvals}]}, yvals annual frequencies of exceedance)."""
+    try:
+        data = json.loads(text, parse_int=json_int)
+    except (ValueError, Unreadable) as exc:
+        raise InputError(f"{path}: not JSON ({exc})") from None
+    curves = data.get("response") if isinstance(data, dict) else None
+    if not isinstance(curves, list) or not all(isinstance(c, dict) for c in curves):
+        raise InputError(f"{path}: not a USGS hazard-curve response (no 'response' list)")
+    imts = [((c.get("metadata") or {}).get("imt") or {}).get("value") for c in curves]
+    if None in imts:
+        raise InputError(f"{path}: missing IMT (a curve without metadata.imt.value)")
+    if "PGA" not in imts:
+        raise InputError(f"{path}: no PGA curve (IMTs: {', '.join(map(str, imts))}); survival "
+                         "uses PGA hazard curves")
+    curve = curves[imts.index("PGA")]
+    meta, rows = curve["metadata"], curve.get("data")
+    unit = re.search(r"\(([^)]*)\)\s*$", str(meta.get("xlabel", "")))
+    if not unit or unit.group(1) != "g":
+        raise InputError(f"{path}: unknown unit of PGA: xlabel {show(meta.get('xlabel'))} "
+                         "(expected 'Ground Motion (g)')")
+    if "annual" not in str(meta.get("ylabel", "")).lower():
+        raise InputError(f"{path}: ylabel {show(meta.get('ylabel'))} is not an annual "
+                         "frequency of exceedance")
+    if not isinstance(rows, list) or len(rows) != 1 or not isinstance(rows[0], dict):
+        raise InputError(f"{path}: expected one PGA data entry, got "
+                         f"{len(rows) if isinstance(rows, list) else show(rows)}")
+    x, y = meta.get("xvals"), rows[0].get("yvals")
+    if not (isinstance(x, list) and isinstance(y, list)) or len(x) != len(y):
+        raise InputError(f"{path}: xvals and yvals must be lists of one length")
+    for v in x + y:
+        if isinstance(v, bool) or not isinstance(v, (int, float)):
+            raise InputError(f"{path}: not a number: {show(v)}")
+    source = {"format": "USGS hazard web service (static curve)", "file": str(path),
+              "imt": "PGA", "unit_in_file": "g", "lat": meta.get("latitude"),
+              "lon": meta.get("longitude"),
+              "edition": (meta.get("edition") or {}).get("display"),
+              "vs30": (meta.get("vs30") or {}).get("display")}
+    return _curve(np.array(x, float), np.array(y, float), STANDARD_GRAVITY, "g", str(path),
+                  source)
+
+
+def _check_imt(imt, path):
+    if imt.upper() != "PGA":
+        raise InputError(f"{path}: IMT {imt}: survival uses PGA hazard curves (the "
+                         "fragility is over PGA and PGV/PGA)")
+
+
+def _float(text, what):
+    try:
+        return float(text)
+    except ValueError:
+        raise InputError(f"{what}: not a number: {show(text.strip())}") from None
+
+
+def _curve(levels, rates, to_m_s2, unit, where, source):
+    """HazardCurve from levels (file unit; ``to_m_s2`` converts) and annual rates: the
+    checks and repairs of the module docstring."""
+    if levels.size < 2:
+        raise InputError(f"{where}: {levels.size} level(s); a hazard curve needs at least 2")
+    for x in levels:
+        if not (math.isfinite(x) and x > 0):
+            raise InputError(f"{where}: level {x:g} {unit}: levels must be positive")
+    rising = np.flatnonzero(np.diff(levels) <= 0)
+    if rising.size:
+        k = rising[0]
+        raise InputError(f"{where}: levels not increasing: {levels[k]:g} then "
+                         f"{levels[k + 1]:g} {unit}")
+    for x, r in zip(levels, rates):
+        if math.isnan(r):
+            raise InputError(f"{where}: rate at {x:g} {unit} is not a number")
+        if r < 0:
+            raise InputError(f"{where}: negative annual rate {r:g} at {x:g} {unit}")
+    with np.errstate(invalid="ignore"):
+        up = np.flatnonzero(np.diff(rates) > 0)
+    if up.size:
+        k = up[0]
+        raise InputError(f"{where}: non-monotonic: the rate of exceedance rises from "
+                         f"{rates[k]:.6g} at {levels[k]:g} {unit} to {rates[k + 1]:.6g} at "
+                         f"{levels[k + 1]:g} {unit}")
+    notes = []
+    unbounded = ~np.isfinite(rates)
+    if unbounded.any():
+        notes.append(f"{int(unbounded.sum())} level(s) up to {levels[unbounded][-1]:g} {unit} "
+                     "dropped: probability of exceedance 1 (unbounded rate)")
+    zero = rates == 0
+    zero_from = None
+    if zero.any():
+        zero_from = float(levels[zero][0] * to_m_s2)
+        notes.append(f"rates are 0 from {levels[zero][0]:g} {unit} up: the curve ends at the "
+                     "last positive rate")
+    keep = np.isfinite(rates) & ~zero
+    if keep.sum() < 2:
+        raise InputError(f"{where}: fewer than 2 levels with a positive, finite rate")
+    return HazardCurve(levels[keep] * to_m_s2, rates[keep].astype(float), source, tuple(notes),
+                       zero_from)

@@ -1,0 +1,271 @@
+"""Fragility as survival needs it: P(overturn | PGA, PGV/PGA), and the PGV/PGA that goes
+with each PGA level.
+
+A fragility is either a :class:`Lognormal` over PGA (a stated median and beta, or the
+PGA fit of ``campaign fragility``) or the :class:`Logistic` surface of ``campaign
+fragility``, logit P = b0 + b1 ln(PGA / 1 m/s^2) + b2 ln(PGV/PGA / 1 s) (Purvance et al.
+2008).  Each can draw parameter sets from the uncertainty of its estimate (``draws``):
+ln median and ln beta normal with the spread of their 95 % intervals (independent: the
+campaign writes no covariance between them), the logistic coefficients multivariate
+normal with their covariance (each only its standard error when the file holds no
+covariance: ``note`` says so).
+
+PGV/PGA (s) at a PGA level is lognormal: :class:`RatioLognormal` (a median and sigma the
+user states, the same at every level) or :class:`RatioFromGmm` (the median and sigma of
+PGV and PGA from Boore et al. 2014 (pygmm) at a magnitude and distance, for example the
+mode of the hazard's disaggregation; ln PGV given ln PGA by their correlation).
+"""
+import importlib.metadata
+import json
+import math
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+
+import numpy as np
+from scipy import stats
+
+from pipeline.constants import STANDARD_GRAVITY
+from pipeline.files import InputError
+from pipeline.userfiles import Unreadable, number, read_text, show
+
+Z95 = stats.norm.ppf(0.975)
+RATIO_NODES = 24                  # Gauss-Hermite nodes over ln(PGV/PGA)
+PGA_PGV_CORRELATION = 0.733       # ln PGA, ln PGV residuals: Bradley (2012), Earthq. Spectra 28(1)
+GMM_MECHANISMS = ("SS", "NS", "RS")
+
+
+@dataclass(frozen=True)
+class Lognormal:
+    """P(overturn | PGA) = Phi(ln(PGA / median) / beta): ``median_m_s2`` (m/s^2), ``beta``
+    (natural log); optional 95 % intervals of each (same units) for :meth:`draws`."""
+    median_m_s2: float
+    beta: float
+    median_ci95: tuple | None = None
+    beta_ci95: tuple | None = None
+    label: str = "lognormal"
+    note: str | None = None
+    uses_ratio = False
+
+    def probability(self, pga_m_s2, pgv_pga_s=None):
+        """P(overturn) at PGA (m/s^2), the same at any PGV/PGA; shaped like both broadcast."""
+        pga = np.asarray(pga_m_s2, float)
+        if pgv_pga_s is not None:
+            pga = np.broadcast_to(pga, np.broadcast_shapes(pga.shape, np.shape(pgv_pga_s)))
+        return stats.norm.cdf(np.log(pga / self.median_m_s2) / self.beta)
+
+    def draws(self, n, rng):
+        """``n`` parameter sets drawn from the estimate's uncertainty; None without one."""
+        if self.median_ci95 is None and self.beta_ci95 is None:
+            return None
+        ln_m = _ln_normal(self.median_m_s2, self.median_ci95, n, rng)
+        ln_b = _ln_normal(self.beta, self.beta_ci95, n, rng)
+        return [replace(self, median_m_s2=float(np.exp(m)), beta=float(np.exp(b)))
+                for m, b in zip(ln_m, ln_b)]
+
+    def describe(self):
+        return {"form": "P = Phi(ln(PGA / median) / beta)", "label": self.label,
+                "median_m_s2": self.median_m_s2, "median_g": self.median_m_s2 / STANDARD_GRAVITY,
+                "beta": self.beta, "median_ci95_m_s2": self.median_ci95,
+                "beta_ci95": self.beta_ci95, "note": self.note}
+
+
+@dataclass(frozen=True)
+class Logistic:
+    """logit P = b0 + b1 ln(PGA / 1 m/s^2) + b2 ln(PGV/PGA / 1 s): ``coefficients``
+    (b0, b1, b2); ``cov`` (3 x 3) or ``se`` (3, None where fixed) for :meth:`draws`."""
+    coefficients: tuple
+    cov: tuple | None = None
+    se: tuple | None = None
+    label: str = "logistic surface"
+    note: str | None = None
+    uses_ratio = True
+
+    def probability(self, pga_m_s2, pgv_pga_s):
+        b0, b1, b2 = self.coefficients
+        eta = b0 + b1 * np.log(np.asarray(pga_m_s2, float)) + b2 * np.log(pgv_pga_s)
+        return 1.0 / (1.0 + np.exp(-eta))
+
+    def draws(self, n, rng):
+        b = np.array(self.coefficients, float)
+        if self.cov is not None:
+            sample = rng.multivariate_normal(b, np.array(self.cov, float), n)
+        elif self.se is not None:
+            se = np.array([0.0 if s is None else s for s in self.se], float)
+            sample = b + rng.standard_normal((n, 3)) * se
+        else:
+            return None
+        return [replace(self, coefficients=tuple(float(v) for v in row)) for row in sample]
+
+    def describe(self):
+        return {"form": "logit P = b0 + b1 ln(PGA / 1 m/s^2) + b2 ln(PGV/PGA / 1 s)",
+                "label": self.label, "coefficients": dict(zip(("b0", "b1", "b2"),
+                                                              self.coefficients)),
+                "covariance_used": self.cov is not None, "note": self.note}
+
+
+def _ln_normal(value, ci95, n, rng):
+    """n draws of ln(value) ~ N(ln value, s), s from a 95 % interval (0 without one)."""
+    s = 0.0 if ci95 is None else math.log(ci95[1] / ci95[0]) / (2.0 * Z95)
+    return math.log(value) + s * rng.standard_normal(n)
+
+
+def load_campaign_fragility(path, column=None, form="pga-pgv"):
+    """The fragility of one column entry of ``campaign fragility``'s ``fragility.json``:
+    ``form`` "pga" (its lognormal PGA fit) or "pga-pgv" (its logistic surface);
+    ``column``: monolithic, drums, block2d or block2d_worst (default: the first 3D one)."""
+    path = Path(path)
+    if path.is_dir():
+        path = path / "fragility.json"
+    try:
+        data = json.loads(read_text(path))
+    except FileNotFoundError:
+        raise InputError(f"fragility file not found: {path}") from None
+    except (OSError, ValueError, Unreadable) as exc:
+        raise InputError(f"{path}: not a fragility.json ({exc})") from None
+    columns = data.get("columns") if isinstance(data, dict) else None
+    if not isinstance(columns, dict) or not columns:
+        raise InputError(f"{path}: not a fragility.json of campaign fragility (no 'columns')")
+    if column is None:
+        column = next((c for c in ("monolithic", "drums") if c in columns), next(iter(columns)))
+    if column not in columns:
+        raise InputError(f"{path}: no column {column!r} (has {', '.join(columns)})")
+    entry = columns[column]
+    label = f"{column} ({entry.get('description', '')}) from {path.name}"
+    if form == "pga":
+        fit = entry.get("PGA") or {}
+        if fit.get("unit") != "m/s^2":
+            raise InputError(f"{path}: column {column}: PGA fit in unknown unit "
+                             f"{fit.get('unit')!r} (expected m/s^2)")
+        if fit.get("median") is None:
+            raise InputError(f"{path}: column {column}: PGA fragility not fitted "
+                             f"({fit.get('note') or 'no median'})")
+        where = f"{path}: column {column}: PGA"
+        return Lognormal(number(fit["median"], f"{where} median", 0, None, "m/s^2", True),
+                         number(fit.get("beta"), f"{where} beta", 0, None, "", True),
+                         _pair(fit.get("median_ci95"), f"{where} median_ci95"),
+                         _pair(fit.get("beta_ci95"), f"{where} beta_ci95"),
+                         label=label, note=fit.get("note"))
+    if form != "pga-pgv":
+        raise InputError(f"--fragility-form must be pga or pga-pgv, got {form!r}")
+    surface = entry.get("logistic") or {}
+    coefficients = surface.get("coefficients")
+    if coefficients is None:
+        raise InputError(f"{path}: column {column}: logistic surface not fitted "
+                         f"({surface.get('note') or 'no coefficients'})")
+    b = tuple(number(coefficients.get(k), f"{path}: column {column}: logistic {k}")
+              for k in ("b0", "b1", "b2"))
+    if not b[1] > 0:
+        raise InputError(f"{path}: column {column}: the logistic surface does not grow with "
+                         f"PGA (b1 = {b[1]:g})")
+    cov = surface.get("cov")
+    if cov is not None and not all(isinstance(v, (int, float)) for row in cov for v in row):
+        cov = None                       # a singular information matrix: written as nulls
+    se = surface.get("se") or {}
+    note = surface.get("note")
+    if cov is None:
+        note = "; ".join(filter(None, [note, "no covariance in the file: coefficients drawn "
+                                       "independently (their correlation ignored)"]))
+    return Logistic(b, tuple(map(tuple, cov)) if cov is not None else None,
+                    tuple(se.get(k) for k in ("b0", "b1", "b2")) if se else None,
+                    label=label, note=note)
+
+
+def _pair(value, what):
+    """A 95 % interval (lo, hi) from a file: positive numbers, lo <= hi; None stays None."""
+    if value is None:
+        return None
+    if not (isinstance(value, list) and len(value) == 2):
+        raise InputError(f"{what} must be a pair [lo, hi], got {show(value)}")
+    lo, hi = (number(v, what, 0, None, "", True) for v in value)
+    if lo > hi:
+        raise InputError(f"{what}: {lo:g} above {hi:g}")
+    return lo, hi
+
+
+# ---------------------------------------------------------------- PGV/PGA
+@dataclass(frozen=True)
+class RatioLognormal:
+    """PGV/PGA lognormal with ``median_s`` (s) and ``sigma_ln``, the same at every PGA."""
+    median_s: float
+    sigma_ln: float
+
+    def ln_mean_sd(self, pga_m_s2):
+        pga = np.asarray(pga_m_s2, float)
+        return np.full(pga.shape, math.log(self.median_s)), np.full(pga.shape, self.sigma_ln)
+
+    def describe(self):
+        return {"source": "user", "distribution": "lognormal, the same at every PGA",
+                "median_s": self.median_s, "sigma_ln": self.sigma_ln}
+
+
+@dataclass(frozen=True)
+class RatioFromGmm:
+    """PGV/PGA at a PGA level from a ground-motion model at a magnitude and distance:
+    ln PGV given ln PGA = a is normal with mean mu_v + rho (s_v / s_a)(a - mu_a) and
+    sd s_v sqrt(1 - rho^2); PGV/PGA = PGV / a."""
+    magnitude: float
+    distance_km: float
+    vs30_m_s: float = 760.0
+    mechanism: str = "SS"
+    correlation: float = PGA_PGV_CORRELATION
+    medians: dict = field(default=None, compare=False)
+
+    def __post_init__(self):
+        import pygmm  # noqa: PLC0415  (slow import, only needed here)
+        scenario = pygmm.Scenario(mag=self.magnitude, dist_jb=self.distance_km,
+                                  v_s30=self.vs30_m_s, mechanism=self.mechanism)
+        model = pygmm.BooreStewartSeyhanAtkinson2014(scenario)
+        object.__setattr__(self, "medians", {
+            "pga_m_s2": float(model.pga) * STANDARD_GRAVITY, "ln_std_pga": float(model.ln_std_pga),
+            "pgv_m_s": float(model.pgv) / 100.0, "ln_std_pgv": float(model.ln_std_pgv)})
+
+    def ln_mean_sd(self, pga_m_s2):
+        m, rho = self.medians, self.correlation
+        ln_a = np.log(np.asarray(pga_m_s2, float))
+        eps_a = (ln_a - math.log(m["pga_m_s2"])) / m["ln_std_pga"]
+        mean_v = math.log(m["pgv_m_s"]) + rho * m["ln_std_pgv"] * eps_a
+        sd = m["ln_std_pgv"] * math.sqrt(1.0 - rho ** 2)
+        return mean_v - ln_a, np.full(ln_a.shape, sd)
+
+    def describe(self):
+        return {"source": "ground-motion model",
+                "model": "Boore, Stewart, Seyhan & Atkinson (2014), pygmm "
+                         "BooreStewartSeyhanAtkinson2014 (RotD50)",
+                "magnitude": self.magnitude, "distance_jb_km": self.distance_km,
+                "vs30_m_s": self.vs30_m_s, "mechanism": self.mechanism,
+                "pga_pgv_correlation": self.correlation,
+                "median_pga_m_s2": self.medians["pga_m_s2"],
+                "median_pgv_m_s": self.medians["pgv_m_s"],
+                "ln_std_pga": self.medians["ln_std_pga"], "ln_std_pgv": self.medians["ln_std_pgv"],
+                "pygmm": importlib.metadata.version("pygmm"),
+                "distribution": "lognormal given PGA: ln PGV | ln PGA by their correlation"}
+
+
+def overturn_probability(fragilities, ratio_model, pga_m_s2, combine="each"):
+    """P(overturn) at PGA levels (m/s^2) averaged over PGV/PGA (Gauss-Hermite in ln PGV/PGA).
+
+    ``combine``: "each" (array n_specimens x n_levels), "any_common" (P that any overturns
+    in one event, the specimens independent given the motion they share: 1 - E[prod(1 -
+    P_i)]) or "any_correlated" (the specimens' capacities fully correlated: E[max P_i]).
+    """
+    pga = np.asarray(pga_m_s2, float)
+    if any(f.uses_ratio for f in fragilities):
+        if ratio_model is None:
+            raise InputError("the fragility depends on PGV/PGA: give its distribution "
+                             "(--pgv-pga-median and --pgv-pga-sigma, or --magnitude and "
+                             "--distance-km)")
+        nodes, weights = np.polynomial.hermite_e.hermegauss(RATIO_NODES)
+        weights = weights / weights.sum()
+        mean, sd = ratio_model.ln_mean_sd(pga)
+        ratio = np.exp(mean[:, None] + sd[:, None] * nodes[None, :])
+        each = np.array([f.probability(pga[:, None], ratio) for f in fragilities])
+    else:
+        weights = np.ones(1)
+        each = np.array([f.probability(pga)[:, None] for f in fragilities])
+    if combine == "each":
+        return each @ weights
+    if combine == "any_common":
+        return 1.0 - np.prod(1.0 - each, axis=0) @ weights
+    if combine == "any_correlated":
+        return each.max(axis=0) @ weights
+    raise ValueError(f"unknown combine {combine!r}")
