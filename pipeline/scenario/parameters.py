@@ -236,10 +236,12 @@ class Drive:
             raise InputError(f"--rotate must be a finite angle, got {self.rotate_deg!r}")
         if self.window is not None:
             window = tuple(self.window) if isinstance(self.window, (list, tuple)) else ()
-            if not (len(window) == 2 and all(
-                    isinstance(t, (int, float)) and not isinstance(t, bool)
-                    and math.isfinite(t) for t in window) and window[0] < window[1]):
-                raise InputError(f"--window needs START < END (finite), got {self.window!r}")
+            numbers = len(window) == 2 and all(
+                isinstance(t, (int, float)) and not isinstance(t, bool) for t in window)
+            if not (numbers and all(math.isfinite(t) for t in window)
+                    and window[0] < window[1]):
+                given = f"{window[0]:g} {window[1]:g}" if numbers else repr(self.window)
+                raise InputError(f"--window needs START < END (finite), got {given}")
             object.__setattr__(self, "window", window)
 
 
