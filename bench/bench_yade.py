@@ -318,13 +318,14 @@ def plot_convergence(rows, path):
 def parallel_run(spec, run_dir):
     """Campaign worker of the parallel bench: the twin model under the spec's pulse for
     exactly ``t_max`` s (no early stop); summary.json holds YADE's wall time."""
-    traj = run_yade(prepare(run_dir, "both", Motion.load(spec["motion_file"]), spec["t_max"]))
+    traj = run_yade(prepare(run_dir, "both", Motion.load(spec.motion_file),
+                            spec.tags["t_max"]))
     write_json(Path(run_dir) / "summary.json", {"wall_s": traj.wall_s})
 
 
 def noop_run(spec, run_dir):
     """A campaign worker that runs nothing: the executor's own cost per task."""
-    write_json(Path(run_dir) / "summary.json", {"run_id": spec["run_id"]})
+    write_json(Path(run_dir) / "summary.json", {"run_id": spec.run_id})
 
 
 def parallel(work, n_runs, t_max, n_noop=40):
@@ -345,13 +346,15 @@ def parallel(work, n_runs, t_max, n_noop=40):
     from pipeline.campaign.dask_client import close_dask, local_cluster
     from pipeline.campaign.dask_worker import run_task
     from pipeline.campaign.dask_worker import WORKER_CODE
+    from pipeline.campaign.spec import RunSpec
+    from pipeline.scenario import RunParams
     from pipeline.files import code_hash
     out = {"runs": n_runs, "t_max_s": t_max, "executor": "dask",
            "load_average_before": os.getloadavg()[0]}
     motions = [one_sine_pulse(30.0 * k, PULSE["amplitude"], PULSE["period"], t_max).save(
         work / f"parallel_motion_{k}.npz") for k in range(n_runs)]
-    specs = [{"run_id": f"parallel_{k}", "motion_file": str(m), "t_max": t_max}
-             for k, m in enumerate(motions)]
+    specs = [RunSpec(f"parallel_{k}", f"parallel_{k}", str(m), RunParams(), f"parallel_{k}",
+                     {"t_max": t_max}) for k, m in enumerate(motions)]
     code = code_hash(*WORKER_CODE)
     for jobs in (1, 2):
         start = time.perf_counter()
@@ -362,14 +365,15 @@ def parallel(work, n_runs, t_max, n_noop=40):
         try:
             if jobs == 1:
                 start = time.perf_counter()
-                client.gather([client.submit(run_task, noop_run, dict(specs[0], run_id=str(k)),
+                client.gather([client.submit(run_task, noop_run,
+                                             dataclasses.replace(specs[0], run_id=str(k)),
                                              motions[0].read_bytes(), "/bench", code, "bench",
                                              pure=False) for k in range(n_noop)])
                 out["task_overhead_ms"] = 1e3 * (time.perf_counter() - start) / n_noop
             start = time.perf_counter()
             results = client.gather([client.submit(run_task, parallel_run, spec,
-                                                   Path(spec["motion_file"]).read_bytes(),
-                                                   str(work / spec["run_id"]), code, "bench",
+                                                   Path(spec.motion_file).read_bytes(),
+                                                   str(work / spec.run_id), code, "bench",
                                                    pure=False) for spec in specs])
             wall = time.perf_counter() - start
         finally:

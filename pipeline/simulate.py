@@ -15,7 +15,9 @@ from pipeline.files import InputError, code_hash
 from pipeline.provenance import software_versions
 from pipeline.outcome.columns import summarise
 from pipeline.outcome.summary import RunSummary
-from pipeline.scenario import Column, Contact, Numerics, run_yade, scene_params, write_scenario
+from pipeline.scenario import (Column, Contact, Drive, Numerics, RunParams, run_yade,
+                               scene_params, write_scenario)
+from pipeline.scenario.parameters import MAX_SCALE
 
 
 # the code that turns a motion and parameters into an outcome: one list for the run ids,
@@ -26,9 +28,6 @@ RUN_CODE = ("scenario", "outcome", "motion", "simulate", "yade_scripts")
 def run_code_version():
     """Hash of the code that turns a motion and parameters into an outcome (RUN_CODE)."""
     return code_hash(*RUN_CODE)
-
-
-MAX_SCALE = 20.0        # the largest motion scale factor (run --scale, ensemble --vary scale)
 
 
 def check_scale(value, flag="--scale"):
@@ -111,8 +110,8 @@ def geometry_parameters(column):
     if g is None:
         return {}
     drums, _ = column.geometries()
-    return {"hd": round(g.height / g.base_width, 6), "height_m": g.height,
-            "n_drums": len(drums.bodies()), "density_kg_m3": g.density,
+    return {"hd": round(g.height / g.base_width, 6), "height": g.height,
+            "n_drums": len(drums.bodies()), "density": g.density,
             "column_file": (column.column_file if isinstance(column.column_file, str)
                             else g.name), "geometry": g.to_dict()}
 
@@ -128,6 +127,7 @@ def simulate(motion, out_dir, column=None, contact=None, numerics=None, window=N
     column, contact, numerics: parameter dataclasses (defaults: the paper's).
     """
     column, contact, numerics = column or Column(), contact or Contact(), numerics or Numerics()
+    run = RunParams(column, contact, numerics, Drive(window, rotate_deg, scale))
     if back_azimuth is not None:
         motion = dataclasses.replace(motion, meta=dict(motion.meta,
                                                        back_azimuth_deg=back_azimuth_of(
@@ -150,15 +150,10 @@ def simulate(motion, out_dir, column=None, contact=None, numerics=None, window=N
         params.update(start_s=window_s[0], quiet_after_s=window_s[1])
     write_scenario(out_dir, params, drive)
     trajectory = run_yade(out_dir, timeout_s=timeout_s) if window_s is not None else None
-    parameters = {"column": column.kind, "hd": column.hd, "height_m": column.height,
-                  "n_drums": column.n_drums, "density_kg_m3": column.density,
-                  **geometry_parameters(column),
-                  **dataclasses.asdict(contact), "window_s": list(window) if window else None,
-                  "rotate_deg": rotate_deg, "scale": scale,
+    parameters = {**run.to_dict(), **geometry_parameters(column),
+                  "dt_factor": params["dt_factor"],
                   "motion_file": None if motion_file is None else str(motion_file),
-                  "processing": motion.processing_mode,
-                  "dt_factor": params["dt_factor"], "rim_points": numerics.rim_points,
-                  "quiet_motion": numerics.quiet_motion}
+                  "processing": motion.processing_mode}
     provenance = {"software": software_versions(), "motion": motion.meta.get("processing"),
                   "code": {"scenario": run_code_version(), "packages": list(RUN_CODE)}}
     record = record or motion.record_id

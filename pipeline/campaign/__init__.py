@@ -108,7 +108,7 @@ def run_campaign(name, jobs=None, records=None, campaign_dir=None, animations=1,
         specs = campaign.specs(records, campaign_dir, **(options or {}))
         if allow_long is not None and jobs is not None:
             runs_dir = campaign_dir / "runs"
-            todo = sum(not (runs_dir / s["run_id"] / "summary.json").exists() for s in specs)
+            todo = sum(not (runs_dir / s.run_id / "summary.json").exists() for s in specs)
             check_long(f"campaign {name}", todo, campaign.run_core_s, jobs, allow_long,
                        "fewer records, members or parameter values")
         return _run_specs(campaign, name, specs, campaign_dir, jobs, animations, executor,
@@ -142,12 +142,12 @@ def reuse_finished(specs, campaign_dir, worker):
             sources.append(meta.parent / "runs")
     copied = 0
     for spec in specs:
-        target = here / "runs" / spec["run_id"]
+        target = here / "runs" / spec.run_id
         if not sources or (target / "summary.json").exists():
             continue
-        keep = spec.get("keep_trajectory", True)
+        keep = spec.keep_trajectory
         for runs in sources:
-            source = runs / spec["run_id"]
+            source = runs / spec.run_id
             if not (source / "summary.json").exists() or (
                     keep and not (source / "trajectory.npz").exists()):
                 continue
@@ -183,7 +183,7 @@ def _run_specs(campaign, name, specs, campaign_dir, jobs, animations, executor, 
                                   figures=not interrupted)
         write_json(campaign_dir / "campaign.json", {
             "campaign": name, "runs": len(specs), "interrupted": interrupted,
-            "failed": [{"run_id": s["run_id"], "record": s.get("record"), "error": str(e)}
+            "failed": [{"run_id": s.run_id, "record": s.record, "error": str(e)}
                        for s, e in failures], **result})
     if interrupted:
         raise KeyboardInterrupt

@@ -141,8 +141,8 @@ def mark(specs, data):
 def summary_entry(specs):
     """``{"column_file": description}`` for campaign.json when the specs carry one."""
     for spec in specs:
-        if spec.get("column_description") is not None:
-            return {"column_file": spec["column_description"]}
+        if spec.tags.get("column_description") is not None:
+            return {"column_file": spec.tags["column_description"]}
     return {}
 
 

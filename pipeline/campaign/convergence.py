@@ -78,7 +78,7 @@ def convergence_outputs(specs, campaign_dir, failures, animations, figures=True)
     runs, _ = collect(specs, "convergence", campaign_dir)
     if runs.empty:
         return {"code_version": run_code_version(), "figures": []}
-    variant_of = {s["run_id"]: s["variant"] for s in specs}
+    variant_of = {s.run_id: s.tags["variant"] for s in specs}
     runs.insert(1, "variant", runs["run_id"].map(variant_of))
     write_csv(campaign_dir / "members.csv", runs)
     result = compare_variants(runs, wall_per_member(specs, campaign_dir))
@@ -97,9 +97,9 @@ def wall_per_member(specs, campaign_dir):
     """{variant: mean wall time (s) of its finished YADE runs} from their summary.json."""
     times = {}
     for spec in specs:
-        summary = finished_summary(campaign_dir, spec["run_id"])
+        summary = finished_summary(campaign_dir, spec.run_id)
         if summary is not None:
-            times.setdefault(spec["variant"], []).append(summary.wall_s)
+            times.setdefault(spec.tags["variant"], []).append(summary.wall_s)
     return {name: float(np.mean(times[name])) for name in VARIANTS if name in times}
 
 

@@ -44,15 +44,15 @@ def execute_dask(todo, runs_dir, jobs, worker, bar, scheduler):
 
         def submit(spec):
             motion = None
-            if spec.get("motion_file"):
+            if spec.motion_file:
                 try:
-                    motion = _motion_future(client, motions, spec["motion_file"], token)
+                    motion = _motion_future(client, motions, spec.motion_file, token)
                 except OSError as exc:
                     book_finished(spec, exc, runs_dir, failures, bar)
                     return
             future = client.submit(run_task, worker, spec, motion,
-                                   str(runs_dir / spec["run_id"]), code, token,
-                                   key=f"{TASK_PREFIX}-run-{spec['run_id']}-{token}",
+                                   str(runs_dir / spec.run_id), code, token,
+                                   key=f"{TASK_PREFIX}-run-{spec.run_id}-{token}",
                                    pure=False)
             running[future.key] = (future, spec)
             completed.add(future)
@@ -111,7 +111,7 @@ def _motion_bytes(data):
 def _store_result(spec, future, result, runs_dir, failures, bar):
     """Write a task's files into its run directory (summary.json last), or book its
     failure."""
-    run_dir = runs_dir / spec["run_id"]
+    run_dir = runs_dir / spec.run_id
     if future.status != "finished":               # the task raised (KilledWorker, ...)
         if isinstance(result, tuple) and len(result) == 3:      # (type, exception, traceback)
             exc = result[1].with_traceback(result[2])

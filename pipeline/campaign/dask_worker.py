@@ -5,6 +5,7 @@ import json
 import socket
 import tempfile
 import traceback
+from dataclasses import replace
 from pathlib import Path
 
 from pipeline.files import ToolError, code_hash
@@ -43,14 +44,13 @@ def run_task(worker, spec, motion, client_run_dir, code, token):
     with tempfile.TemporaryDirectory(prefix=f"{TASK_PREFIX}-{token}-",
                                      dir=_scratch_directory()) as tmp:
         tmp = Path(tmp)
-        spec = dict(spec)        # a plain dict on the worker: its motion file is moved
         swaps = []
         if motion is not None:
-            path = tmp / "input" / Path(spec["motion_file"]).name
+            path = tmp / "input" / Path(spec.motion_file).name
             path.parent.mkdir()
             path.write_bytes(motion)
-            swaps.append((str(path), spec["motion_file"]))
-            spec["motion_file"] = str(path)
+            swaps.append((str(path), spec.motion_file))
+            spec = replace(spec, motion_file=str(path))     # the same run, its motion moved
         run_dir = tmp / "run"
         run_dir.mkdir()
         swaps.append((str(run_dir), client_run_dir))
@@ -68,7 +68,7 @@ def run_task(worker, spec, motion, client_run_dir, code, token):
             name = path.relative_to(run_dir).as_posix()
             if error is not None and path.suffix == ".npz":
                 continue                              # a failed run sends its logs only
-            if error is None and not spec.get("keep_trajectory", True) \
+            if error is None and not spec.keep_trajectory \
                     and name != "summary.json":
                 continue
             files[name] = path.read_bytes()

@@ -1,5 +1,4 @@
 """The campaigns: the paper's experiments and the verification, one definition each."""
-import dataclasses
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -18,7 +17,7 @@ from pipeline.files import (InputError, code_hash, content_hash, csv_true_column
 from pipeline.motion import Motion, synthetics
 from pipeline.records import catalog, catalog_row, processed_motion, resolve, sets
 from pipeline.records.processing import signal_end_s
-from pipeline.scenario import Column, Contact, Numerics
+from pipeline.scenario import RunParams
 from pipeline.scenario.parameters import param
 from pipeline.simulate import run_code_version, simulate
 from pipeline.stats.circular import direction_statistics, direction_table
@@ -28,8 +27,6 @@ from pipeline.scenario.column_format import example_names
 from pipeline.scenario.geometry import ColumnGeometry
 from pipeline import verification
 
-
-NUMERICS_FIELDS = {f.name for f in dataclasses.fields(Numerics)}
 
 # ---------------------------------------------------------------- column runs
 def motion_cache(campaign_dir):
@@ -72,15 +69,10 @@ def run_column_spec(spec, run_dir):
     """Worker: one twin-model (or single column) run of a spec; ``column_file`` in its
     parameters is a column description (dict, so that the run id covers its content) or
     a shipped example's name."""
-    p = dict(spec["params"])
-    column = Column(kind=p.pop("column", "both"), **{k: p.pop(k) for k in
-                                                     ("hd", "height", "n_drums", "density",
-                                                      "column_file")
-                                                     if k in p})
-    contact = Contact(**{k: p.pop(k) for k in ("kn", "damping", "mu_s", "mu_k") if k in p})
-    numerics = Numerics(**{k: p.pop(k) for k in list(p) if k in NUMERICS_FIELDS})
-    simulate(Motion.load(spec["motion_file"]), run_dir, column=column, contact=contact,
-             numerics=numerics, record=spec["record_id"], motion_file=spec["motion_file"], **p)
+    p = spec.params
+    simulate(Motion.load(spec.motion_file), run_dir, column=p.column, contact=p.contact,
+             numerics=p.numerics, window=p.drive.window, rotate_deg=p.drive.rotate_deg,
+             scale=p.drive.scale, record=spec.record_id, motion_file=spec.motion_file)
 
 
 @dataclass(frozen=True)
@@ -91,11 +83,11 @@ class SlendernessOptions(ColumnFileOptions):
 
 
 def twin(**params):
-    """Parameters of a twin-model run (paper defaults for what is not given); with
-    ``column_file`` (a description dict) the described column and a monolith of its
-    outline take the drums' and the monolith's places."""
-    return {"column": "both", "hd": paper.COLUMN_HD, "mu_s": paper.MU_STATIC,
-            "mu_k": paper.MU_KINETIC, **params}
+    """The flat parameters (:class:`~pipeline.scenario.parameters.RunParams` names) of a
+    twin-model run: the paper's for what is not given; with ``column_file`` (a
+    description dict) the described column and a monolith of its outline take the drums'
+    and the monolith's places."""
+    return RunParams.from_dict(params).to_dict()
 
 
 def pulse_record():
@@ -115,7 +107,7 @@ def column_outputs(name, size_by=None):
         runs, impacts = collect(specs, name, campaign_dir)
         described = summary_entry(specs)
         if described and not runs.empty:
-            names = {s["run_id"]: s["params"]["column_file"]["name"] for s in specs}
+            names = {s.run_id: s.params.column.column_file["name"] for s in specs}
             runs.insert(1, "description", runs["run_id"].map(names))
         write_tables(campaign_dir, runs, impacts)
         written = []
@@ -289,10 +281,10 @@ def columns_table(specs, campaign_dir):
 
     rows = []
     for spec in specs:
-        summary = finished_summary(campaign_dir, spec["run_id"])
+        summary = finished_summary(campaign_dir, spec.run_id)
         if summary is None:
             continue
-        geometry = ColumnGeometry.from_dict(spec["params"]["column_file"])
+        geometry = ColumnGeometry.from_dict(spec.params.column.column_file)
         shapes = {"drums": geometry, "monolithic": geometry.monolithic()}
         for col in summary.columns:
             g = shapes[col.column]
@@ -300,7 +292,7 @@ def columns_table(specs, campaign_dir):
                             key=lambda b: b["impact_time_s"])
             first = struck[0] if struck else None
             rows.append({
-                "description": geometry.name, "record_id": spec["record_id"],
+                "description": geometry.name, "record_id": spec.record_id,
                 "column": col.column, "toppled": col.toppled,
                 "downfall_azimuth_deg": col.downfall_azimuth_deg,
                 "impact_time_s": col.impact_time_s,
@@ -312,7 +304,7 @@ def columns_table(specs, campaign_dir):
                 "uplift_ratio": round(g.uplift_ratio(), 4), "height_m": g.height,
                 "mass_kg": round(sum(b.mass for b in g.bodies())),
                 "kn": summary.parameters["kn"],
-                "back_azimuth_deg": summary.back_azimuth_deg, "run_id": spec["run_id"]})
+                "back_azimuth_deg": summary.back_azimuth_deg, "run_id": spec.run_id})
     return pd.DataFrame(rows, columns=COLUMNS_TABLE)
 
 
@@ -322,7 +314,7 @@ def columns_outputs(specs, campaign_dir, failures, animations, figures=True):
     campaign_dir = Path(campaign_dir)
     runs, impacts = collect(specs, "columns", campaign_dir)
     if not runs.empty:
-        names = {s["run_id"]: s["description"] for s in specs}
+        names = {s.run_id: s.tags["description"] for s in specs}
         runs.insert(1, "description", runs["run_id"].map(names))
     write_tables(campaign_dir, runs, impacts)
     table = columns_table(specs, campaign_dir)
@@ -378,7 +370,7 @@ def verification_outputs(specs, campaign_dir, failures, animations, figures=True
     summary = verification.summarise_campaign(results)
     summary["figures"] = ([p.name for p in plot_verification(results, campaign_dir)]
                           if figures else [])
-    summary["failed_runs"] = [s["run_id"] for s, _ in failures]
+    summary["failed_runs"] = [s.run_id for s, _ in failures]
     write_json(Path(campaign_dir) / "verification.json", summary)
     for line in summary["lines"]:
         print(line)

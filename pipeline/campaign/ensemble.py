@@ -253,7 +253,7 @@ def ensemble_outputs(specs, campaign_dir, failures, animations, figures=True):
     runs, _ = collect(specs, "ensemble", campaign_dir)
     if runs.empty:
         return {"code_version": run_code_version(), **summary_entry(specs), "figures": []}
-    member_of = {s["run_id"]: s["member"] for s in specs}
+    member_of = {s.run_id: s.tags["member"] for s in specs}
     runs.insert(1, "member", runs["run_id"].map(member_of))
     described = summary_entry(specs)
     if described:
@@ -265,9 +265,9 @@ def ensemble_outputs(specs, campaign_dir, failures, animations, figures=True):
         sub = runs[runs["record_id"] == record_id].sort_values(["member", "column"])
         write_csv(out / "members.csv", sub)
         write_parquet(out / "members.parquet", sub)
-        summary = summarise(sub, record_id, specs[0]["seed"])
-        summary["record_input"] = next(sp["record"] for sp in specs
-                                       if sp["record_id"] == record_id)
+        summary = summarise(sub, record_id, specs[0].tags["seed"])
+        summary["record_input"] = next(sp.record for sp in specs
+                                       if sp.record_id == record_id)
         if described:
             summary["column_file"] = described["column_file"]["name"]
         summaries.append(summary)

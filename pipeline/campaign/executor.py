@@ -69,7 +69,7 @@ def execute(specs, campaign_dir, jobs, worker, label="runs", executor=None, sche
     if jobs is None and not scheduler:
         jobs = os.cpu_count() or 1
     runs_dir = Path(campaign_dir) / "runs"
-    todo = [s for s in specs if not (runs_dir / s["run_id"] / "summary.json").exists()]
+    todo = [s for s in specs if not (runs_dir / s.run_id / "summary.json").exists()]
     durations = {}
     todo.sort(key=lambda spec: motion_seconds(spec, durations), reverse=True)
     done = len(specs) - len(todo)
@@ -157,10 +157,11 @@ def motion_seconds(spec, durations):
     """Seconds of motion a run shakes (its window, else its motion file's length; 0 if
     unknown): campaigns start the longest first, so that no core idles at the end while
     one long run finishes.  ``durations`` caches file lengths by path."""
-    window = spec.get("params", {}).get("window")
+    params = getattr(spec, "params", None)       # a verification check has none
+    window = None if params is None else params.drive.window
     if window:
         return float(window[1]) - float(window[0])
-    path = spec.get("motion_file")
+    path = spec.motion_file
     if not path:
         return 0.0
     if path not in durations:
@@ -175,7 +176,7 @@ def motion_seconds(spec, durations):
 def _execute_threads(todo, runs_dir, jobs, worker, bar):
     failures = []
     pool = ThreadPoolExecutor(max_workers=jobs)
-    futures = {pool.submit(_guarded, worker, spec, runs_dir / spec["run_id"]): spec
+    futures = {pool.submit(_guarded, worker, spec, runs_dir / spec.run_id): spec
                for spec in todo}
     pending = set(futures)
     try:
@@ -204,5 +205,5 @@ def _guarded(worker, spec, run_dir):
     with DirectoryLock(run_dir, wait=False):
         (run_dir / "error.txt").unlink(missing_ok=True)
         worker(spec, run_dir)
-        if not spec.get("keep_trajectory", True):
+        if not spec.keep_trajectory:
             keep_only_summary(run_dir)

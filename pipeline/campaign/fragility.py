@@ -142,11 +142,13 @@ def fragility_specs(records, campaign_dir, levels=DEFAULT_LEVELS, members=DEFAUL
 
 
 def block_size(params):
-    """(height, width) in m of the 2D block of a run: the paper column's height and
+    """(height, width) in m of the 2D block of a run (``params``:
+    :class:`~pipeline.scenario.parameters.RunParams`): the paper column's height and
     diameter, or a description's overall height and base width."""
-    if "column_file" not in params:
-        return params["height"], params["height"] / params["hd"]
-    blocks = params["column_file"]["blocks"]     # as ColumnGeometry.height and .base_width
+    column = params.column
+    if column.column_file is None:
+        return column.height, column.height / column.hd
+    blocks = column.column_file["blocks"]        # as ColumnGeometry.height and .base_width
     bottom = blocks[0]
     width = (bottom["bottom_diameter"] if bottom["shape"] == "frustum"
              else min(bottom["width"], bottom["depth"]))
@@ -159,7 +161,7 @@ def scaled_runs(specs, campaign_dir):
     runs, _ = collect(specs, "fragility", campaign_dir)
     if runs.empty:
         return runs
-    by_id = {s["run_id"]: s for s in specs}
+    by_id = {s.run_id: s.tags for s in specs}
     for key in ("level_m_s2", "level_index", "member", "scale"):
         runs.insert(2, key, runs["run_id"].map(lambda r, k=key: by_id[r][k]))
     runs.insert(2, "model", "3D")
@@ -186,11 +188,11 @@ def block_runs(specs, azimuths=None, max_step=BLOCK_MAX_STEP_S, t_after=BLOCK_T_
     rows, cases = [], 0
     by_motion = {}
     for spec in specs:
-        by_motion.setdefault(spec["motion_file"], []).append(spec)
+        by_motion.setdefault(spec.motion_file, []).append(spec)
     for motion_file, specs_of_motion in by_motion.items():
         motion = Motion.load(motion_file)
         rp = record_parameters(motion)
-        n_az = int(azimuths or specs_of_motion[0].get("azimuths", DEFAULT_AZIMUTHS))
+        n_az = int(azimuths or specs_of_motion[0].tags.get("azimuths", DEFAULT_AZIMUTHS))
         strongest = float(rp["az_max_acc_deg"])
         directions = (strongest + np.arange(n_az) * 180.0 / n_az) % 360.0
         rad = np.radians(directions)
@@ -212,9 +214,9 @@ def _block_batch(group, motion_file, rp, along, directions, dt, max_step, t_afte
     times on the record's clock (the motion's + ``start_in_file_s``, s)."""
     n_az = len(directions)
     rows = []
-    sizes = np.array([block_size(s["params"]) for s in group], float)
+    sizes = np.array([block_size(s.params) for s in group], float)
     heights, widths = sizes[:, 0], sizes[:, 1]
-    scales = np.array([s["scale"] for s in group], float)
+    scales = np.array([s.params.drive.scale for s in group], float)
     acc = (along[:, None, :] * scales[None, :, None]).reshape(len(along), -1)
     out = rocking_response_sampled(np.repeat(heights, n_az), np.repeat(widths, n_az), acc,
                                    dt, t_after=t_after, max_step=max_step)
@@ -224,12 +226,12 @@ def _block_batch(group, motion_file, rp, along, directions, dt, max_step, t_afte
     side = out["overturn_direction"].reshape(shape)
     tilt = np.degrees(out["max_abs_theta"]).reshape(shape)
     for i, spec in enumerate(group):
-        s = spec["scale"]
-        base = {"campaign": "fragility", "run_id": spec["run_id"], "model": "2D",
-                "scale": s, "member": spec["member"], "level_index": spec["level_index"],
-                "level_m_s2": spec["level_m_s2"], "record_id": spec["record_id"],
-                "hd": round(heights[i] / widths[i], 6) if "column_file" in spec["params"]
-                else spec["params"]["hd"], "height_m": float(heights[i]),
+        s, tags, column = spec.params.drive.scale, spec.tags, spec.params.column
+        base = {"campaign": "fragility", "run_id": spec.run_id, "model": "2D",
+                "scale": s, "member": tags["member"], "level_index": tags["level_index"],
+                "level_m_s2": tags["level_m_s2"], "record_id": spec.record_id,
+                "hd": round(heights[i] / widths[i], 6) if column.column_file is not None
+                else column.hd, "height_m": float(heights[i]),
                 "pga_m_s2": rp["pga_h"] * s, "pgv_m_s": rp["pgv_h"] * s,
                 "pgv_pga_s": rp["pgv_pga_h"], "record_pga_h": rp["pga_h"],
                 "pga_h": rp["pga_h"] * s, "pgv_h": rp["pgv_h"] * s,
@@ -296,7 +298,7 @@ def summarise(table, specs, cost):
     dimensionless}}}, "comparison": [{column, block, im, median_3d, median_2d,
     ratio_3d_to_2d, ...}], "levels": [per record and level fractions],
     "block2d": {...}, "cost": {...}}"""
-    first = specs[0]
+    first = specs[0].tags
     alpha, p = _block_alpha_p(table, specs)
     described = summary_entry(specs)
     column_file = described["column_file"]["name"] if described else None
@@ -311,9 +313,9 @@ def summarise(table, specs, cost):
     comparison = _comparison(columns)
     levels = level_table(table)
     return _finite({
-        "records": list(dict.fromkeys(s["record_id"] for s in specs)),
-        "levels_m_s2": first["levels"], "members": 1 + max(s["member"] for s in specs),
-        "seed": first["seed"], "column": first["params"]["column"],
+        "records": list(dict.fromkeys(s.record_id for s in specs)),
+        "levels_m_s2": first["levels"], "members": 1 + max(s.tags["member"] for s in specs),
+        "seed": first["seed"], "column": specs[0].params.column.kind,
         **({"column_file": column_file} if column_file else {}),
         "azimuths": first["azimuths"],
         "intensity_measures": {im: {"column": key, "unit": unit,
@@ -336,7 +338,7 @@ def _block_alpha_p(table, specs):
     blocks = table[table["model"] == "2D"]
     if len(blocks):
         return float(blocks["alpha_rad"].median()), float(blocks["p_per_s"].median())
-    sizes = np.array([block_size(s["params"]) for s in specs], float)
+    sizes = np.array([block_size(s.params) for s in specs], float)
     hd = float(np.median(sizes[:, 0] / sizes[:, 1]))
     height = float(np.median(sizes[:, 0]))
     c = block_constants(height, height / hd)
@@ -427,7 +429,7 @@ def fragility_outputs(specs, campaign_dir, failures, animations, figures=True):
     if runs.empty:
         return {"code_version": run_code_version(), **summary_entry(specs), "figures": []}
     done = set(runs["run_id"])
-    blocks, cost = block_runs([s for s in specs if s["run_id"] in done])
+    blocks, cost = block_runs([s for s in specs if s.run_id in done])
     wall = [finished_summary(campaign_dir, r).wall_s for r in done]
     simulated = runs.drop_duplicates("run_id")["simulated"].astype(bool)
     cost.update({"yade_runs": int(simulated.sum()), "runs_not_simulated": int((~simulated).sum()),

@@ -20,8 +20,8 @@ def book_finished(spec, exc, runs_dir, failures, bar):
     if exc is not None:
         failures.append((spec, exc))
         if not isinstance(exc, RunError):          # a RunError's error.txt is written
-            write_error(runs_dir / spec["run_id"], exc)
-        tqdm.write(f"run {spec['run_id']} ({spec.get('record')}) failed: {exc}")
+            write_error(runs_dir / spec.run_id, exc)
+        tqdm.write(f"run {spec.run_id} ({spec.record}) failed: {exc}")
     bar.update()
 
 

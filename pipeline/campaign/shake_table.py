@@ -179,22 +179,22 @@ def outputs(specs_, campaign_dir, failures, animations, figures=True):
     campaign_dir = Path(campaign_dir)
     rows = []
     for spec in specs_:
-        summary = finished_summary(campaign_dir, spec["run_id"])
+        summary = finished_summary(campaign_dir, spec.run_id)
         if summary is None:
             continue
         column = summary.columns[0]
-        rows.append({"test": spec["test"], "stage": spec["stage"],
-                     "grid_point": spec["grid_point"], "observed": spec["observed"],
+        rows.append({"test": spec.tags["test"], "stage": spec.tags["stage"],
+                     "grid_point": spec.tags["grid_point"], "observed": spec.tags["observed"],
                      "predicted": column.toppled, "max_tilt_deg": column.max_tilt_deg,
-                     "run_id": spec["run_id"]})
+                     "run_id": spec.run_id})
     table = pd.DataFrame(rows)
     per_point = {}
     if len(table):
-        stage = specs_[0]["stage"]
+        stage = specs_[0].tags["stage"]
         write_csv(campaign_dir / f"{stage}.csv", table)
         for label, group in table.groupby("grid_point", sort=False):
             per_point[label] = scores(group["observed"], group["predicted"])
-    points = {spec["grid_point"]: spec["point"] for spec in specs_}
+    points = {spec.tags["grid_point"]: spec.tags["point"] for spec in specs_}
     return {"scores": per_point, "points": points, "runs_done": len(rows)}
 
 def best_point(result):

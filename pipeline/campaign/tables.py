@@ -55,19 +55,19 @@ def _tables(specs, campaign, campaign_dir):
     record_params = {}
     run_rows, impact_rows = [], []
     for spec in specs:
-        summary = finished_summary(campaign_dir, spec["run_id"])
+        summary = finished_summary(campaign_dir, spec.run_id)
         if summary is None:
             continue
-        if spec["motion_file"] not in record_params:
-            motion = Motion.load(spec["motion_file"])
+        if spec.motion_file not in record_params:
+            motion = Motion.load(spec.motion_file)
             site = {k: motion.meta[k] for k in SYNTHETIC_SITE_KEYS if k in motion.meta}
             if "station" in site:
                 site["site_id"] = site.pop("station")
-            record_params[spec["motion_file"]] = {**record_parameters(motion), **site}
-        rp = record_params[spec["motion_file"]]
+            record_params[spec.motion_file] = {**record_parameters(motion), **site}
+        rp = record_params[spec.motion_file]
         p = summary.parameters
-        base = {"campaign": campaign, "run_id": spec["run_id"], "record_id": spec["record_id"],
-                "hd": p["hd"], "height_m": p["height_m"], "n_drums": p["n_drums"],
+        base = {"campaign": campaign, "run_id": spec.run_id, "record_id": spec.record_id,
+                "hd": p["hd"], "height_m": p["height"], "n_drums": p["n_drums"],
                 "mu_s": p["mu_s"], "mu_k": p["mu_k"], "kn": p["kn"], "damping": p["damping"]}
         for col in summary.columns:
             point = col.impact_point_m or [math.nan, math.nan]
@@ -82,15 +82,15 @@ def _tables(specs, campaign, campaign_dir):
                 "start_in_file_s": summary.start_in_file_s,
                 **{k: v if isinstance(v, str) else _nan(v) for k, v in rp.items()},
                 "back_azimuth_deg": _nan(summary.back_azimuth_deg),
-                "motion_file": spec["motion_file"],
-                "run_dir": os.path.relpath(runs_dir / spec["run_id"], campaign_dir)})
+                "motion_file": spec.motion_file,
+                "run_dir": os.path.relpath(runs_dir / spec.run_id, campaign_dir)})
             for body in col.bodies:
                 if body["struck"]:
                     impact_rows.append({
-                        "run_id": spec["run_id"], "column": col.column,
+                        "run_id": spec.run_id, "column": col.column,
                         "body_index": body["index"], "impact_time_s": body["impact_time_s"],
                         "x_m": body["impact_point_m"][0], "y_m": body["impact_point_m"][1],
-                        "hd": p["hd"], "mu_s": p["mu_s"], "record_id": spec["record_id"]})
+                        "hd": p["hd"], "mu_s": p["mu_s"], "record_id": spec.record_id})
     return pd.DataFrame(run_rows), pd.DataFrame(impact_rows, columns=IMPACT_COLUMNS)
 
 

@@ -2,7 +2,6 @@
 
     python -m pipeline run --record GM20 --column both --hd 6 --out results/runs/GM20
 """
-import math
 from pathlib import Path
 
 from pipeline import RESULTS_DIR
@@ -10,11 +9,11 @@ from pipeline.constants import COLUMN_TYPES
 from pipeline.files import DirectoryLock, InputError
 from pipeline.motion import RECORD_CLOCK
 from pipeline.records import processed_motion, resolve
-from pipeline.scenario import Column, Contact, Numerics
+from pipeline.scenario import Column, Contact, Drive, Numerics
 from pipeline.cli._fields import add_arguments, add_column_file_argument, from_args
 from pipeline.scenario.parameters import check_cost, check_time_step, scene_params
 from pipeline.scenario.runner import wall_limit_s
-from pipeline.simulate import MAX_SCALE, back_azimuth_of, check_scale, simulate
+from pipeline.simulate import MAX_SCALE, back_azimuth_of, simulate
 
 NAME = "run"
 ORDER = 20
@@ -57,19 +56,13 @@ def check_run_options(args):
     """Validate the options that are not parameter dataclasses (one line each)."""
     if args.back_azimuth is not None:
         back_azimuth_of(None, args.back_azimuth)
-    if not math.isfinite(args.rotate):
-        raise InputError(f"--rotate must be a finite angle, got {args.rotate}")
-    check_scale(args.scale)
+    Drive(args.window, args.rotate, args.scale)       # --window, --rotate, --scale
     if getattr(args, "column_file", None) is not None:
         given = [flag for flag, name in (("--hd", "hd"), ("--height", "height"),
                                          ("--drums", "n_drums"), ("--density", "density"))
                  if getattr(args, name, None) is not None]
         if given:
             raise InputError(f"--column-file describes the column: drop {', '.join(given)}")
-    if args.window is not None:
-        start, end = args.window
-        if not (math.isfinite(start) and math.isfinite(end) and start < end):
-            raise InputError(f"--window needs START < END (finite), got {start:g} {end:g}")
 
 
 def run(args):

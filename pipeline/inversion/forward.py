@@ -91,7 +91,7 @@ def table_path(campaign_dir, grid):
 def forward_outputs(specs, campaign_dir, failures, animations, figures=True):
     """Collect the finished runs of ``specs`` into the table file (tables/forward_table_<grid
     key>.npz) and its per-node summary (tables/forward_cells_<grid key>.csv)."""
-    grid = TableGrid(**specs[0]["grid"])
+    grid = TableGrid(**specs[0].tags["grid"])
     table = ForwardTable.from_runs(specs, campaign_dir, grid)
     path = table_path(campaign_dir, grid)
     table.save(path)

@@ -76,23 +76,23 @@ class ForwardTable:
         wall, simulated = 0.0, 0
         na = len(grid.azimuths_deg)
         for spec in specs:
-            summary = finished_summary(campaign_dir, spec["run_id"])
+            summary = finished_summary(campaign_dir, spec.run_id)
             if summary is None:
                 continue
             wall += summary.wall_s
             simulated += summary.simulated
-            i, j = divmod(spec["node"], na)
+            i, j = divmod(spec.tags["node"], na)
             for col in summary.columns:
                 c = columns.index(col.column)
                 fell = col.toppled and col.downfall_azimuth_deg is not None
                 value = col.downfall_azimuth_deg if fell else np.nan
-                index = (spec["slice"], i, j, c)
-                if spec["member"] < 0:
+                index = (spec.tags["slice"], i, j, c)
+                if spec.tags["member"] < 0:
                     ntop[index], naz[index], nval[index] = fell, value, True
                 else:
-                    top[index + (spec["member"],)] = fell
-                    az[index + (spec["member"],)] = value
-                    valid[index + (spec["member"],)] = True
+                    top[index + (spec.tags["member"],)] = fell
+                    az[index + (spec.tags["member"],)] = value
+                    valid[index + (spec.tags["member"],)] = True
         slices = [{"mechanism": s[0], "dip_deg": s[1], "rake_deg": s[2], "depth_km": s[3],
                    "mw": s[4]} for s in sl]
         return cls(slices, grid.distances_km, grid.azimuths_deg, members, top, az, valid,

@@ -184,11 +184,11 @@ def truth_observations(specs, campaign_dir):
     """The observations dict of the finished runs: per site its columns fallen (downfall
     azimuth turned from the strike frame by the strike) or standing."""
     runs, _ = collect(specs, "inversion-truth", campaign_dir)
-    site_of = {s["run_id"]: s["site"] for s in specs}
-    strike = specs[0]["strike_deg"]
+    site_of = {s.run_id: s.tags["site"] for s in specs}
+    strike = specs[0].tags["strike_deg"]
     sites = {}
     for spec in specs:
-        sites.setdefault(spec["site"], [])
+        sites.setdefault(spec.tags["site"], [])
     for _, row in runs.iterrows():
         cols = sites[site_of[row["run_id"]]]
         if row["toppled"] and math.isfinite(row["downfall_azimuth_deg"]):

@@ -76,10 +76,18 @@ class ColumnOutcome:
         return cls(column=name, toppled=False, position_m=[x_m, y_m])
 
 
+# parameters' names in summaries written before they took the run parameters' spelling
+# (:class:`~pipeline.scenario.parameters.RunParams`): read under the new name
+OLD_PARAMETER_NAMES = {"height_m": "height", "density_kg_m3": "density", "window_s": "window"}
+
+
 @dataclass(frozen=True, kw_only=True)
 class RunSummary:
     """One run (``summary.json``): the record and its back azimuth (deg, None when
-    unknown), the run's parameters, one :class:`ColumnOutcome` per column, whether YADE
+    unknown), the run's parameters (the flat dict of
+    :class:`~pipeline.scenario.parameters.RunParams`, with what the run derived from them:
+    a description's sizes, ``geometry``, ``dt_factor``, ``motion_file``, ``processing``),
+    one :class:`ColumnOutcome` per column, whether YADE
     ran (``simulated``; ``note`` says why not), the simulated time (s) and window, the
     motion's end, whether the scene stopped early, the time step (s), wall time (s),
     provenance, ``quiet_after_s`` when the quiet tail was cut, and ``start_in_file_s``.
@@ -110,6 +118,10 @@ class RunSummary:
     def __post_init__(self):
         if not isinstance(self.record, str):
             raise InputError(f"run summary: record must be a name, got {self.record!r}")
+        if not isinstance(self.parameters, dict):
+            raise InputError("run summary: parameters must be a mapping")
+        object.__setattr__(self, "parameters", {OLD_PARAMETER_NAMES.get(k, k): v
+                                                for k, v in self.parameters.items()})
         back = self.back_azimuth_deg
         if back is not None and not math.isfinite(float(back)):
             back = None                         # an unknown back azimuth

@@ -7,11 +7,11 @@ A scenario directory holds ``params.json`` (every parameter), ``motion.npz``
 """
 from pipeline.scenario.bodies import ColumnSpec
 from pipeline.scenario.geometry import ColumnGeometry
-from pipeline.scenario.parameters import (PEDESTAL, Block, Column, Contact, Numerics,
-                                          scene_params)
+from pipeline.scenario.parameters import (PEDESTAL, Block, Column, Contact, Drive,
+                                          Numerics, RunParams, scene_params)
 from pipeline.scenario.runner import YadeError, run_yade
 from pipeline.scenario.writer import write_scenario
 
-__all__ = ["PEDESTAL", "Block", "Column", "ColumnGeometry", "ColumnSpec", "Contact", "Numerics",
-           "scene_params",
+__all__ = ["PEDESTAL", "Block", "Column", "ColumnGeometry", "ColumnSpec", "Contact", "Drive",
+           "Numerics", "RunParams", "scene_params",
            "write_scenario", "run_yade", "YadeError"]

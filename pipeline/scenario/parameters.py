@@ -217,6 +217,94 @@ class Block:
         check_fields(self)
 
 
+MAX_SCALE = 20.0        # the largest motion scale factor (run --scale, ensemble --vary scale)
+
+
+@dataclass(frozen=True)
+class Drive:
+    """How the record drives the pedestal: the part of it run (``window``: start and end,
+    s on the record's clock; None: all of it), turned clockwise by ``rotate_deg`` and
+    scaled by ``scale``."""
+    window: tuple = field(default=None, metadata={
+        "help": "[start, end] (s, record's clock) of the motion run; None: all of it"})
+    rotate_deg: float = param(0.0, "deg", "the motion turned clockwise by this angle",
+                              flag="--rotate")
+    scale: float = param(1.0, "", "motion scale factor", 0.0, MAX_SCALE, "--scale")
+
+    def __post_init__(self):
+        check_fields(self)
+        if not (isinstance(self.rotate_deg, (int, float)) and math.isfinite(self.rotate_deg)):
+            raise InputError(f"--rotate must be a finite angle, got {self.rotate_deg!r}")
+        if self.window is not None:
+            window = tuple(self.window) if isinstance(self.window, (list, tuple)) else ()
+            numbers = len(window) == 2 and all(
+                isinstance(t, (int, float)) and not isinstance(t, bool) for t in window)
+            if not (numbers and all(math.isfinite(t) for t in window)
+                    and window[0] < window[1]):
+                given = f"{window[0]:g} {window[1]:g}" if numbers else repr(self.window)
+                raise InputError(f"--window needs START < END (finite), got {given}")
+            object.__setattr__(self, "window", window)
+
+
+@dataclass(frozen=True)
+class RunParams:
+    """Everything that defines one run besides its motion: the column, the contact, the
+    numerics and the drive.  Written and read as one flat dict whose names are the
+    fields' names (the column's ``kind`` as ``column``): campaign specs, the run id's
+    hash and ``summary.json`` ``parameters`` spell every name the same way."""
+    column: Column = field(default_factory=Column)
+    contact: Contact = field(default_factory=Contact)
+    numerics: Numerics = field(default_factory=Numerics)
+    drive: Drive = field(default_factory=Drive)
+
+    GROUPS = ("column", "contact", "numerics", "drive")
+
+    def __post_init__(self):
+        for group in self.GROUPS:
+            if not isinstance(getattr(self, group), self.group_class(group)):
+                raise InputError(f"run parameters: {group} must be a "
+                                 f"{self.group_class(group).__name__}, got "
+                                 f"{type(getattr(self, group)).__name__}")
+
+    @staticmethod
+    def group_class(group):
+        """The parameter dataclass of one group (``group``: a GROUPS name)."""
+        return {"column": Column, "contact": Contact, "numerics": Numerics,
+                "drive": Drive}[group]
+
+    @classmethod
+    def names(cls, group):
+        """{flat name: field name} of one group's dataclass (``group``: a GROUPS name)."""
+        return {("column" if f.name == "kind" else f.name): f.name
+                for f in dataclasses.fields(cls.group_class(group)) if f.init}
+
+    @classmethod
+    def from_dict(cls, data):
+        """The run a flat dict describes (names of :meth:`to_dict`; a name left out takes
+        its default); InputError naming an unknown name or a value out of range."""
+        if not isinstance(data, dict):
+            raise InputError(f"run parameters must be a mapping, got {data!r}")
+        groups, known = {}, set()
+        for group in cls.GROUPS:
+            names = cls.names(group)
+            known |= set(names)
+            groups[group] = {names[k]: v for k, v in data.items() if k in names}
+        unknown = sorted(set(data) - known)
+        if unknown:
+            raise InputError(f"unknown run parameter(s): {', '.join(unknown)}")
+        return cls(*(cls.group_class(g)(**groups[g]) for g in cls.GROUPS))
+
+    def to_dict(self):
+        """The flat dict of every parameter (JSON-serialisable)."""
+        out = {}
+        for group in self.GROUPS:
+            obj = getattr(self, group)
+            for flat, name in self.names(group).items():
+                value = getattr(obj, name)
+                out[flat] = list(value) if isinstance(value, tuple) else value
+        return out
+
+
 PEDESTAL = {"size": paper.PEDESTAL_SIZE_M, "thickness": paper.PEDESTAL_THICKNESS_M,
             "mass": paper.PEDESTAL_MASS_KG,
             # the top face extends beyond the 5 m block so that a column falling over

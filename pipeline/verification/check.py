@@ -61,6 +61,9 @@ class Check(Mapping):
         """What campaign files name a run's record: the kind (a check has no motion)."""
         return self.kind
 
+    motion_file = None          # a check runs no recorded motion
+    keep_trajectory = True
+
     @classmethod
     def create(cls, kind, code_version, **setting):
         """The check whose run id is hash(code version, kind, setting)."""

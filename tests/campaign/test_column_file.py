@@ -25,13 +25,15 @@ DORIC_KN = 2.3e9                   # matched_kn (docs/columns-and-model.md, "Con
 CAMPAIGN_OPTIONS = {               # small but complete: every kind of run of each campaign
     "slenderness": {}, "friction": {}, "records": {}, "synthetic": {},
     "ensemble": {"members": 3}, "fragility": {"members": 2, "levels": (1.0, 4.0)}}
-# sha256 (first 16 hex) of the run parameters without --column-file on the pulse record,
-# computed before the option existed ("scale" dropped: it depends on the motion's PGA;
-# "window" too: synthetic runs have since been cut at their signal's end)
-# (commit 5b7b9e3; the run ids were equal too, at an unchanged model code hash)
-DEFAULT_PARAMS_SHA = {"slenderness": "e42a62714eaad8d6", "friction": "915100ca0ef786ec",
-                      "records": "43eb8fb2261ce585", "synthetic": "43eb8fb2261ce585",
-                      "ensemble": "ac83e6e32bb27c00", "fragility": "95245d1eb48f8e70"}
+# sha256 (first 16 hex) of the run parameters (RunParams.to_dict) without --column-file on
+# the pulse record ("scale" dropped: it depends on the motion's PGA; "window" too:
+# synthetic runs have since been cut at their signal's end).  First computed before the
+# option existed (commit 5b7b9e3, the run ids equal too); recomputed when the parameters
+# became RunParams (every name, defaults included), after checking that each campaign's
+# RunParams equal the parameters of the earlier specs read through RunParams.from_dict
+DEFAULT_PARAMS_SHA = {"slenderness": "d904b5004c5c9092", "friction": "e9e8404856fb90c7",
+                      "records": "ddef462ca301837f", "synthetic": "ddef462ca301837f",
+                      "ensemble": "adf0deaf07d0d55e", "fragility": "d2b3a55fc186c36c"}
 
 
 @pytest.fixture(scope="module")
@@ -49,7 +51,7 @@ def _specs(name, record, campaign_dir, **options):
 
 
 def _params_sha(specs):
-    params = [{k: v for k, v in s["params"].items() if k not in ("scale", "window")}
+    params = [{k: v for k, v in s.params.to_dict().items() if k not in ("scale", "window")}
               for s in specs]
     return hashlib.sha256(json.dumps(params, sort_keys=True).encode()).hexdigest()[:16]
 
@@ -58,11 +60,13 @@ def _params_sha(specs):
 def test_default_specs_are_unchanged(name, record, tmp_path):
     default = _specs(name, record, tmp_path / "a")
     explicit = _specs(name, record, tmp_path / "b", column_file=None)
-    assert [s["params"] for s in default] == [s["params"] for s in explicit]
-    assert [s["run_id"] for s in default] == [s["run_id"] for s in explicit]
-    assert not any("description" in s or "column_description" in s for s in default)
+    assert [s.params for s in default] == [s.params for s in explicit]
+    assert [s.run_id for s in default] == [s.run_id for s in explicit]
+    assert not any("description" in s.tags or "column_description" in s.tags
+                   for s in default)
     # only the ensemble's own drum columns (tilt, offsets) are descriptions by default
-    assert {s["params"]["column_file"]["name"] for s in default if "column_file" in s["params"]} \
+    assert {s.params.column.column_file["name"] for s in default
+            if s.params.column.column_file is not None} \
         <= {"drums (ensemble member)"}
     assert _params_sha(default) == DEFAULT_PARAMS_SHA[name]
 
@@ -72,26 +76,28 @@ def test_described_specs_carry_the_description(name, record, tmp_path):
     default = _specs(name, record, tmp_path / "default")
     described = _specs(name, record, tmp_path / "doric", column_file=DORIC)
     assert len(described) == len(default)
-    assert not {s["run_id"] for s in described} & {s["run_id"] for s in default}
+    assert not {s.run_id for s in described} & {s.run_id for s in default}
     for spec in described:
-        data = spec["params"]["column_file"]
+        data = spec.params.column.column_file
         assert isinstance(data, dict) and data["name"].startswith(DORIC)
         assert len(data["blocks"]) == 13
-        assert spec["description"] == DORIC
-        assert spec["column_description"] == ColumnGeometry.load(DORIC).to_dict()
-        assert spec["params"]["column"] == "both"
+        assert spec.tags["description"] == DORIC
+        assert spec.tags["column_description"] == ColumnGeometry.load(DORIC).to_dict()
+        assert spec.params.column.kind == "both"
     if name in ("friction", "records", "synthetic"):
-        assert all(s["params"]["column_file"] == ColumnGeometry.load(DORIC).to_dict()
-                   and s["params"]["kn"] == DORIC_KN for s in described)
+        assert all(s.params.column.column_file == ColumnGeometry.load(DORIC).to_dict()
+                   and s.params.contact.kn == DORIC_KN for s in described)
         # everything else as in the default run
         for a, b in zip(default, described):
-            rest = {k: v for k, v in b["params"].items() if k not in ("column_file", "kn")}
-            assert rest == a["params"]
+            def rest(spec):
+                return {k: v for k, v in spec.params.to_dict().items()
+                        if k not in ("column_file", "kn")}
+            assert rest(b) == rest(a)
     if name in ("ensemble", "fragility"):
-        kn = [s["params"]["kn"] for s in described]
+        kn = [s.params.contact.kn for s in described]
         assert all(0.5 * DORIC_KN <= k <= 2.0 * DORIC_KN for k in kn)
     paper_kn = _specs(name, record, tmp_path / "paper", column_file=DORIC, stiffness="paper")
-    assert all(s["params"]["kn"] <= 2.0 * paper.COLUMN_KN_N_M for s in paper_kn)
+    assert all(s.params.contact.kn <= 2.0 * paper.COLUMN_KN_N_M for s in paper_kn)
 
 
 @pytest.mark.parametrize("name", sorted(CAMPAIGN_OPTIONS))
@@ -157,11 +163,11 @@ def test_slenderness_scales_every_block_height_to_the_sweep():
 
 def test_slenderness_campaign_runs_the_scaled_column_with_its_own_kn(record, tmp_path):
     specs = _specs("slenderness", record, tmp_path, column_file=DORIC)
-    assert [s["params"]["hd"] for s in specs] == list(paper.SLENDERNESS_HD)
+    assert [s.params.column.hd for s in specs] == list(paper.SLENDERNESS_HD)
     for spec in specs:
-        g = ColumnGeometry.from_dict(spec["params"]["column_file"])
-        assert g.height / g.base_width == pytest.approx(spec["params"]["hd"], rel=1e-8)
-        assert spec["params"]["kn"] == matched_kn(g)
+        g = ColumnGeometry.from_dict(spec.params.column.column_file)
+        assert g.height / g.base_width == pytest.approx(spec.params.column.hd, rel=1e-8)
+        assert spec.params.contact.kn == matched_kn(g)
 
 
 def test_slenderness_too_tall_for_the_format_is_refused(tmp_path):
@@ -200,33 +206,33 @@ def test_perturbed_description_applies_tolerances_tilt_and_offsets():
 def test_ensemble_members_are_the_perturbed_described_column(record, tmp_path):
     specs = _specs("ensemble", record, tmp_path, column_file=DORIC, members=4)
     nominal, members = specs[0], specs[1:]
-    assert nominal["member"] == -1
-    assert nominal["params"]["column_file"] == ColumnGeometry.load(DORIC).to_dict()
-    assert nominal["params"]["kn"] == DORIC_KN
-    heights = {round(math.fsum(b["height"] for b in s["params"]["column_file"]["blocks"]), 6)
+    assert nominal.tags["member"] == -1
+    assert nominal.params.column.column_file == ColumnGeometry.load(DORIC).to_dict()
+    assert nominal.params.contact.kn == DORIC_KN
+    heights = {round(math.fsum(b["height"] for b in s.params.column.column_file["blocks"]), 6)
                for s in members}
     assert len(heights) == 4 and all(abs(h / 10.43 - 1) <= 0.01 + 1e-9 for h in heights)
     for spec in members:
-        blocks = spec["params"]["column_file"]["blocks"]
+        blocks = spec.params.column.column_file["blocks"]
         assert any("offset_m" in b for b in blocks[1:])
-        assert "hd" not in spec["params"] and "height" not in spec["params"]
+        assert spec.params.column.geometry.to_dict() == spec.params.column.column_file
     again = _specs("ensemble", record, tmp_path, column_file=DORIC, members=4)
-    assert [s["run_id"] for s in again] == [s["run_id"] for s in specs]   # seeded
+    assert [s.run_id for s in again] == [s.run_id for s in specs]   # seeded
 
 
 def test_fragility_block_takes_the_described_height_and_base_width(record, tmp_path):
     specs = _specs("fragility", record, tmp_path, column_file=DORIC, azimuths=4)
     for spec in specs:
-        data = spec["params"]["column_file"]
+        data = spec.params.column.column_file
         g = ColumnGeometry.from_dict(data)
-        height, width = fragility.block_size(spec["params"])
+        height, width = fragility.block_size(spec.params)
         assert height == pytest.approx(g.height) and width == pytest.approx(g.base_width)
         assert abs(height / 10.43 - 1) <= 0.01 + 1e-9 and abs(width / 1.905 - 1) <= 0.01 + 1e-9
         assert not any("offset_m" in b for b in data["blocks"])       # as described
     table, _ = fragility.block_runs(specs)
     for spec in specs:
-        rows = table[table["run_id"] == spec["run_id"]]
-        height, width = fragility.block_size(spec["params"])
+        rows = table[table["run_id"] == spec.run_id]
+        height, width = fragility.block_size(spec.params)
         assert rows["height_m"].tolist() == pytest.approx([height] * 2)
         assert rows["alpha_rad"].tolist() == pytest.approx([math.atan(width / height)] * 2)
 

@@ -50,14 +50,15 @@ def test_the_rim_phase_spans_one_spacing_of_each_setting():
 def test_specs_sample_each_setting_independently(tmp_path):
     from pipeline.campaign.convergence import convergence_specs
     specs = convergence_specs(["RSN126-GAZLI"], tmp_path, members=3)
-    assert len(specs) == 3 * len(VARIANTS) and len({s["run_id"] for s in specs}) == len(specs)
+    assert len(specs) == 3 * len(VARIANTS) and len({s.run_id for s in specs}) == len(specs)
     by = {}
     for s in specs:
-        by.setdefault(s["variant"], []).append(s["params"])
-    assert [p["rim_points"] for p in by["rim 64"]] == [64] * 3
-    assert [p["dt_factor"] for p in by["dt 0.15"]] == [0.15] * 3
-    assert all("rim_points" not in p and "dt_factor" not in p for p in by["default"])
-    assert [p["mu_s"] for p in by["default"]] != [p["mu_s"] for p in by["rim 32"]]
+        by.setdefault(s.tags["variant"], []).append(s.params)
+    assert [p.numerics.rim_points for p in by["rim 64"]] == [64] * 3
+    assert [p.numerics.dt_factor for p in by["dt 0.15"]] == [0.15] * 3
+    assert all(p.numerics.rim_points == 16 and p.numerics.dt_factor is None
+               for p in by["default"])                  # the model's defaults
+    assert [p.contact.mu_s for p in by["default"]] != [p.contact.mu_s for p in by["rim 32"]]
 
 
 def test_the_report_says_where_p_toppled_was_not_tested(tmp_path):

@@ -16,8 +16,10 @@ import pytest
 from pipeline import cli
 from pipeline.campaign.dask_worker import run_task, worker_code_version
 from pipeline.campaign.dask_worker import TASK_PREFIX
+from pipeline.campaign.spec import RunSpec
 from pipeline.motion import Motion
 from pipeline.motion.pulses import one_sine_pulse
+from pipeline.scenario import RunParams
 
 PROJECT = Path(__file__).resolve().parents[2]
 DASK = Path(sys.executable).parent / "dask"
@@ -32,19 +34,19 @@ def pulse_npz(path, azimuth_deg, amplitude=5.0, duration=5.0):
 # ---------------------------------------------------------------- the task, without YADE
 def fake_worker(spec, run_dir):
     """Stands in for run_column_spec: reads the motion, writes what a run writes."""
-    motion = Motion.load(spec["motion_file"])
+    motion = Motion.load(spec.motion_file)
     (run_dir / "trajectory.npz").write_bytes(b"trajectory")
     (run_dir / "yade.log").write_text(f"ran in {run_dir}\n")
-    if spec.get("fail"):
+    if spec.tags.get("fail"):
         raise RuntimeError(f"boom; see {run_dir / 'yade.log'}")
     (run_dir / "summary.json").write_text(json.dumps(
-        {"record": motion.record_id, "parameters": {"motion_file": spec["motion_file"]},
+        {"record": motion.record_id, "parameters": {"motion_file": spec.motion_file},
          "log": str(run_dir / "yade.log")}))
 
 
 def test_task_carries_its_motion_and_returns_files_with_client_paths(tmp_path):
     data = pulse_npz(tmp_path / "a.npz", 0.0).read_bytes()
-    spec = {"run_id": "r1", "record": "a", "motion_file": "/client/only/a.npz"}   # not here
+    spec = RunSpec("a", "a", "/client/only/a.npz", RunParams(), "r1")     # not here
     code, client_dir = worker_code_version(), "/client/camp/runs/r1"
     result = run_task(fake_worker, spec, data, client_dir, code, "t0")
     assert result["error"] is None
@@ -53,9 +55,9 @@ def test_task_carries_its_motion_and_returns_files_with_client_paths(tmp_path):
     assert summary["record"] == "a"
     assert summary["parameters"]["motion_file"] == "/client/only/a.npz"
     assert summary["log"] == client_dir + "/yade.log"
-    lean = run_task(fake_worker, dict(spec, keep_trajectory=False), data, client_dir, code, "t0")
+    lean = run_task(fake_worker, spec.tagged(keep_trajectory=False), data, client_dir, code, "t0")
     assert sorted(lean["files"]) == ["summary.json"]
-    failed = run_task(fake_worker, dict(spec, fail=True), data, client_dir, code, "t0")
+    failed = run_task(fake_worker, spec.tagged(fail=True), data, client_dir, code, "t0")
     assert failed["message"] == f"boom; see {client_dir}/yade.log"
     assert sorted(failed["files"]) == ["yade.log"]          # logs, no summary, no npz
     assert not list(Path(tempfile.gettempdir()).glob(f"{TASK_PREFIX}-t0-*"))

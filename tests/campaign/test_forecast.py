@@ -11,7 +11,9 @@ import pytest
 
 from pipeline.campaign import executor
 from pipeline.campaign.executor import duration_text, execute
+from pipeline.campaign.spec import RunSpec
 from pipeline.files import write_json
+from pipeline.scenario import RunParams
 
 
 def sleeper(seconds):
@@ -22,7 +24,8 @@ def sleeper(seconds):
 
 
 def specs(n):
-    return [{"run_id": f"r{k}"} for k in range(n)]
+    """``n`` runs without a motion file (their length unknown: 0 s)."""
+    return [RunSpec("r", "r", "/no/motion.npz", RunParams(), f"r{k}") for k in range(n)]
 
 
 @pytest.mark.parametrize("warn_from_s, head", [(1e9, ""), (0.5, "warning: ")])

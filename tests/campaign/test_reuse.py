@@ -4,6 +4,8 @@ import json
 
 from pipeline.campaign import reuse_finished
 from pipeline.campaign.definitions import run_column_spec
+from pipeline.campaign.spec import RunSpec
+from pipeline.scenario import RunParams
 
 
 def _campaign(root, name, runs):
@@ -24,9 +26,10 @@ def test_finished_runs_of_the_same_worker_are_copied_once(tmp_path):
     target = tmp_path / "ensemble"
     (target / "runs" / "b").mkdir(parents=True)
     (target / "runs" / "b" / "error.txt").write_text("an earlier attempt")
-    specs = [{"run_id": "a", "keep_trajectory": False}, {"run_id": "b"},
-             {"run_id": "c", "keep_trajectory": False}, {"run_id": "d"},
-             {"run_id": "e", "keep_trajectory": False}]
+    def spec(run_id, **tags):
+        return RunSpec("r", "r", "/m.npz", RunParams(), run_id, tags)
+    specs = [spec("a", keep_trajectory=False), spec("b"), spec("c", keep_trajectory=False),
+             spec("d"), spec("e", keep_trajectory=False)]
     assert reuse_finished(specs, target, run_column_spec) == 1
     assert sorted(p.name for p in (target / "runs" / "a").iterdir()) == ["summary.json"]
     assert json.loads((target / "runs" / "a" / "summary.json").read_text())["run"] == "a"

@@ -1,5 +1,6 @@
 """RunSpec: a run's id comes from what defines the run, never from a campaign's tags; a
 spec cannot be changed after it is made."""
+import json
 import pickle
 
 import numpy as np
@@ -7,6 +8,7 @@ import pytest
 
 from pipeline.campaign.spec import RunSpec
 from pipeline.files import InputError
+from pipeline.scenario import Column, Contact, RunParams
 
 
 def test_the_run_id_follows_motion_content_and_parameters_not_tags(tmp_path):
@@ -17,27 +19,40 @@ def test_the_run_id_follows_motion_content_and_parameters_not_tags(tmp_path):
     assert RunSpec.create("B", "B", b, {"hd": 6.0}, "code1").run_id == one.run_id
     assert RunSpec.create("A", "A", a, {"hd": 6.1}, "code1").run_id != one.run_id
     assert RunSpec.create("A", "A", a, {"hd": 6.0}, "code2").run_id != one.run_id
+    # a default given or left out is the same run
+    assert RunSpec.create("A", "A", a, {"hd": 6.0, "kn": Contact().kn}, "code1").run_id \
+        == one.run_id
+    assert RunSpec.create("A", "A", a, RunParams(Column(hd=6.0)), "code1").run_id == one.run_id
     tagged = one.tagged(member=4, seed=9)
-    assert tagged.run_id == one.run_id and tagged["member"] == 4 and one["member"] == 3
-    assert dict(tagged) == {"record": "A", "record_id": "A", "motion_file": str(a),
-                            "params": {"hd": 6.0}, "run_id": one.run_id, "member": 4, "seed": 9}
-    assert RunSpec.from_dict(tagged.to_dict()) == tagged
+    assert tagged.run_id == one.run_id and tagged.tags["member"] == 4
+    assert one.tags["member"] == 3
+    assert tagged.params.column.hd == 6.0 and tagged.params.contact == Contact()
+    assert tagged.to_dict() == {"record": "A", "record_id": "A", "motion_file": str(a),
+                                "params": RunParams(Column(hd=6.0)).to_dict(),
+                                "run_id": one.run_id, "member": 4, "seed": 9}
+    assert RunSpec.from_dict(json.loads(json.dumps(tagged.to_dict()))) == tagged
     assert pickle.loads(pickle.dumps(tagged)) == tagged        # to a Dask worker and back
 
 
 def test_a_spec_is_read_only_and_checked():
-    spec = RunSpec("A", "A", "/m.npz", {}, "id1")
+    spec = RunSpec("A", "A", "/m.npz", RunParams(), "id1")
     with pytest.raises(TypeError):
-        spec["member"] = 1
+        spec["member"]                                  # not a mapping: attributes
     with pytest.raises(AttributeError):
         spec.run_id = "other"
-    assert spec.get("member", -9) == -9 and "run_id" in spec
+    assert spec.keep_trajectory and not spec.tagged(keep_trajectory=False).keep_trajectory
     with pytest.raises(InputError, match="hide a field"):
-        RunSpec("A", "A", "/m.npz", {}, "id1", {"run_id": "x"})
+        RunSpec("A", "A", "/m.npz", RunParams(), "id1", {"run_id": "x"})
     with pytest.raises(InputError, match="run_id"):
-        RunSpec("A", "A", "/m.npz", {}, "")
+        RunSpec("A", "A", "/m.npz", RunParams(), "")
+    with pytest.raises(InputError, match="RunParams"):
+        RunSpec("A", "A", "/m.npz", {"hd": 6.0}, "id1")
     with pytest.raises(InputError, match="lacks params"):
         RunSpec.from_dict({"record": "A", "record_id": "A", "motion_file": "m", "run_id": "i"})
+    with pytest.raises(InputError, match="unknown run parameter.*height_m"):
+        RunSpec.create("A", "A", "/m.npz", {"height_m": 6.0}, "code1")
+    with pytest.raises(InputError, match="--scale 25 outside"):
+        RunSpec.create("A", "A", "/m.npz", {"scale": 25.0}, "code1")
 
 
 def test_every_campaign_is_found_without_importing_its_module_first():

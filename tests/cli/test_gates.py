@@ -10,7 +10,9 @@ import numpy as np
 import pytest
 
 from pipeline import campaign, cli
+from pipeline.campaign.spec import RunSpec
 from pipeline.files import LONG_RUN_S, InputError, check_long
+from pipeline.scenario import RunParams
 
 
 def one_line_error(capsys, code):
@@ -117,7 +119,7 @@ def test_an_experiment_table_without_rows_is_one_line(tmp_path, capsys):
 def still_worker(spec, run_dir):
     """Stands in for YADE: the specimen stands."""
     from pipeline.outcome.summary import RunSummary
-    RunSummary.still(spec["record_id"], [{"name": "monolithic", "x": 0.0, "y": 0.0}]).save(
+    RunSummary.still(spec.record_id, [{"name": "monolithic", "x": 0.0, "y": 0.0}]).save(
         run_dir / "summary.json")
 
 
@@ -207,7 +209,8 @@ def toy_campaign(run_core_s):
     from pipeline.outcome.summary import RunSummary
 
     def specs(records, campaign_dir):
-        return [{"run_id": f"run{k:03d}", "record": "toy"} for k in range(100)]
+        return [RunSpec("toy", "toy", "/toy.npz", RunParams(), f"run{k:03d}")
+                for k in range(100)]
 
     def worker(spec, run_dir):
         RunSummary.still("toy", []).save(run_dir / "summary.json")

@@ -27,7 +27,7 @@ def test_chain_on_pulse_excerpt(tmp_path, capsys):
     runs, impacts = collect(specs, "smoke", tmp_path)
     assert sorted(runs["column"]) == ["drums", "monolithic"]
 
-    motion = Motion.load(specs[0]["motion_file"])
+    motion = Motion.load(specs[0].motion_file)
     acc_h = np.hypot(motion.acc[:, 0], motion.acc[:, 1])
     peak_time = acc_h.argmax() * motion.dt + motion.meta["start_in_file_s"]   # record's clock
     assert window[0] < peak_time < window[1]
@@ -47,13 +47,13 @@ def test_chain_on_pulse_excerpt(tmp_path, capsys):
     assert len(drums) >= 4 and (drums["impact_time_s"] >= first).all()
 
     # a second campaign pass finds the run done and does not repeat it
-    summary = tmp_path / "runs" / specs[0]["run_id"] / "summary.json"
+    summary = tmp_path / "runs" / specs[0].run_id / "summary.json"
     stamp = summary.stat().st_mtime_ns
     capsys.readouterr()
     assert execute(specs, tmp_path, 1, run_column_spec) == ([], False)
     assert "1 already done, 0 to run" in capsys.readouterr().out
     assert summary.stat().st_mtime_ns == stamp
-    assert json.loads(summary.read_text())["parameters"]["window_s"] == window
+    assert json.loads(summary.read_text())["parameters"]["window"] == window
 
 
 @pytest.mark.parametrize("args, message", [
@@ -74,18 +74,19 @@ def test_campaign_runs_start_longest_motion_first(tmp_path):
     """One worker thread: runs start in order of decreasing motion length (a window's
     length when the run has one), equal lengths in the campaign's order."""
     from pipeline.files import write_json
+    from pipeline.campaign.spec import RunSpec
     from pipeline.motion.pulses import one_sine_pulse
+    from pipeline.scenario import Drive, RunParams
     specs = []
     for name, seconds, window in (("a", 4.0, None), ("b", 9.0, None), ("c", 9.0, [0.0, 2.0]),
                                   ("d", 6.0, None), ("e", 9.0, None)):
         path = tmp_path / f"{name}.npz"
         one_sine_pulse(duration=seconds).save(path)
-        specs.append({"run_id": name, "motion_file": str(path),
-                      "params": {"window": window} if window else {}})
+        specs.append(RunSpec(name, name, str(path), RunParams(drive=Drive(window)), name))
     started = []
 
     def worker(spec, run_dir):
-        started.append(spec["run_id"])
+        started.append(spec.run_id)
         write_json(Path(run_dir) / "summary.json", {})
 
     assert execute(specs, tmp_path, 1, worker) == ([], False)

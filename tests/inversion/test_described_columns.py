@@ -5,6 +5,7 @@ import json
 import numpy as np
 import pytest
 
+from pipeline.campaign.spec import RunSpec
 from pipeline.outcome.summary import RunSummary
 from pipeline import cli
 from pipeline.campaign.column_file import column_kn, description
@@ -12,6 +13,7 @@ from pipeline.files import InputError, write_json
 from pipeline.inversion.forward import member_parameters, table_path
 from pipeline.inversion.grid import GRIDS, TableGrid, node_positions
 from pipeline.inversion.table import ForwardTable
+from pipeline.scenario import RunParams
 
 
 def test_twin_grids_keep_their_keys_and_a_description_makes_another():
@@ -46,7 +48,8 @@ def test_from_runs_of_a_described_grid(tmp_path):
                 {"column": "drums", "toppled": node == 1,
                  "downfall_azimuth_deg": 33.0 if node else None}]).save(
                 tmp_path / "runs" / run_id / "summary.json")
-            specs.append({"run_id": run_id, "slice": 0, "node": node, "member": member})
+            specs.append(RunSpec(run_id, run_id, "/m.npz", RunParams(), run_id,
+                                 {"slice": 0, "node": node, "member": member}))
     table = ForwardTable.from_runs(specs, tmp_path, grid)
     assert table.columns == ("drums",) and table.toppled.shape == (1, 1, 2, 1, 1)
     assert table.toppled[0, 0, 1, 0, 0] and table.azimuth_deg[0, 0, 1, 0, 0] == 33.0

@@ -9,6 +9,7 @@ import pytest
 from scipy.integrate import cumulative_trapezoid
 
 from pipeline import simulate as simulate_module
+from pipeline.campaign.spec import RunSpec
 from pipeline.campaign.tables import collect, write_tables
 from pipeline.files import InputError
 from pipeline.motion import Motion
@@ -16,6 +17,7 @@ from pipeline.motion.pulses import raw_pulse
 from pipeline.outcome.columns import summarise
 from pipeline.outcome.summary import RunSummary
 from pipeline.report.campaigns import sweep_section
+from pipeline.scenario import RunParams
 from pipeline.simulate import drive_motion, simulate
 
 MOTION_START_S = -30.0     # record time of the motion's first sample: 30 s of margin
@@ -85,13 +87,13 @@ def test_a_run_on_a_padded_motion_reports_record_times_up_to_the_report(
     (col,) = summary.columns
     assert col.toppled and col.impact_time_s == pytest.approx(6.0, abs=1e-9)
     assert summary.start_in_file_s == pytest.approx(5.0, abs=1e-9)
-    assert summary.parameters["window_s"] == [5.0, 20.0]
+    assert summary.parameters["window"] == [5.0, 20.0]
     assert summary.motion_end_s == pytest.approx(20.0, abs=1e-9)
     # the quiet tail starts one sample after the pulse ends (10 + 1/0.75 s, record clock)
     assert summary.quiet_after_s == pytest.approx(10.0 + 1 / 0.75, abs=2 * DT)
     assert RunSummary.load(tmp_path / "runs" / "r1") == summary
 
-    specs = [{"run_id": "r1", "motion_file": str(motion_file), "record_id": "clock"}]
+    specs = [RunSpec("clock", "clock", str(motion_file), RunParams(), "r1")]
     runs, impacts = collect(specs, "slenderness", tmp_path)
     assert runs["impact_time_s"].tolist() == pytest.approx([6.0])
     assert runs["start_in_file_s"].tolist() == pytest.approx([5.0])
