@@ -8,12 +8,7 @@ import numpy as np
 
 from pipeline.constants import MODEL_GRAVITY
 from pipeline.files import InputError
-from pipeline.scenario.outline import (
-    Outline,
-    _edge_distances,
-    contact_outline,
-    perimeter_points,
-)
+from pipeline.scenario.outline import Outline, _edge_distances, contact_outline, perimeter_points
 from pipeline.scenario.scene_file import SceneBody, SceneColumn
 from pipeline.scenario.solids import ColumnBlock
 from pipeline.scenario.specimen import Specimen
