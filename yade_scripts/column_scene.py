@@ -27,7 +27,7 @@ import sys
 import time
 
 import numpy as np
-from yade import O, Quaternion, Vector3, utils
+from yade import Matrix3, O, Quaternion, Vector3, utils
 from yade.wrapper import (Bo1_Box_Aabb, Bo1_Sphere_Aabb, ForceResetter, Ig2_Box_Sphere_ScGeom,
                           Ig2_Sphere_Sphere_ScGeom, InsertionSortCollider, InteractionLoop,
                           Ip2_ViscElMat_ViscElMat_ViscElPhys, Law2_ScGeom_ViscElPhys_Basic,
@@ -91,12 +91,10 @@ def rotation_matrix(q):
 
 
 def yade_quaternion(R):
-    """YADE Quaternion from a 3x3 numpy rotation matrix (Shepperd's method)."""
-    w = math.sqrt(max(0.0, 1 + R[0, 0] + R[1, 1] + R[2, 2])) / 2
-    x = math.copysign(math.sqrt(max(0.0, 1 + R[0, 0] - R[1, 1] - R[2, 2])) / 2, R[2, 1] - R[1, 2])
-    y = math.copysign(math.sqrt(max(0.0, 1 - R[0, 0] + R[1, 1] - R[2, 2])) / 2, R[0, 2] - R[2, 0])
-    z = math.copysign(math.sqrt(max(0.0, 1 - R[0, 0] - R[1, 1] + R[2, 2])) / 2, R[1, 0] - R[0, 1])
-    return Quaternion(w, x, y, z)
+    """YADE Quaternion of a 3x3 numpy rotation matrix (minieigen's conversion), of the
+    sign with w >= 0 (q and -q are the same rotation)."""
+    q = Quaternion(Matrix3(*np.ravel(R)))
+    return q if q[3] >= 0 else Quaternion(-q[3], -q[0], -q[1], -q[2])
 
 
 def contact_material(mass, n_points):
