@@ -132,8 +132,7 @@ def rim_spheres(rim):
 
 
 def add_body(body, mask_base, mask_top, material):
-    """Add one rigid body (a params.json body) as a clump; return its clump id and the
-    number of its base contact points."""
+    """Add one rigid body (a params.json body) as a clump; return its clump id."""
     centre = np.asarray(body["centre"], float)
     R = np.asarray(body["rotation"], float)
     axes = R @ np.asarray(body["principal_axes"], float)          # world
@@ -145,11 +144,9 @@ def add_body(body, mask_base, mask_top, material):
         return tuple(centre + R @ np.asarray(p, float))
 
     def clump_members(frame_spheres):
-        members, n_base = [], 0
+        members = []
         for rim in body["rims"]:
             points = rim_spheres(rim)
-            if rim["role"] == "base":
-                n_base += len(points)
             for p in points:
                 members.append(utils.sphere(world(p), RIM_R, material=material,
                                             mask=mask_base if rim["role"] == "base"
@@ -170,13 +167,13 @@ def add_body(body, mask_base, mask_top, material):
                 for sign in (1, -1):
                     members.append(utils.sphere(tuple(centre + sign * FRAME_ARM * axis), radius,
                                                 material=CORE, mask=CORE_MASK))
-        return members, n_base
+        return members
 
     # mass and inertia of the solid body, expressed in the clump's principal frame
     i_world = R @ np.asarray(body["inertia"], float) @ R.T
     frame_spheres = not plain
     while True:
-        members, n_base = clump_members(frame_spheres)
+        members = clump_members(frame_spheres)
         clump_id, _ = O.bodies.appendClumped(members)
         clump = O.bodies[clump_id]
         Rc = rotation_matrix(clump.state.ori)
@@ -195,7 +192,7 @@ def add_body(body, mask_base, mask_top, material):
     # the clump frame is the members' principal frame (axes may be permuted):
     # body orientation = clump orientation * body_offset
     body_offset[clump_id] = yade_quaternion(Rc.T @ R)
-    return clump_id, n_base
+    return clump_id
 
 
 # ---------------------------------------------------------------- scene
@@ -203,7 +200,6 @@ bodies = []        # metadata for the trajectory file
 clumps = []        # clump ids in the same order
 body_offset = {}   # clump id -> Quaternion of the body frame in the clump frame
 pedestal_ids = []
-face_stiffness = []   # per body: (mass, kn x base contact points), for the time step
 
 
 def add_pedestal(mask, material):
@@ -236,17 +232,14 @@ for c, col in enumerate(COLUMNS):
     mask_base, mask_top = 1 << (2 * c), 1 << (2 * c + 1)
     add_pedestal(mask_base | mask_top, material_of(col["bodies"][0]))
     for body in col["bodies"]:
-        clump_id, n_base = add_body(body, mask_base, mask_top, material_of(body))
+        clump_id = add_body(body, mask_base, mask_top, material_of(body))
         clumps.append(clump_id)
-        face_stiffness.append((body["mass"], CONTACT["kn"] * max(n_base, RIM_POINTS)))
         meta = {k: v for k, v in body.items() if k not in ("centre", "rotation")}
         bodies.append(dict(meta, initial_pos=list(body["centre"]),
                            initial_rotation=body["rotation"]))
 
 # ---------------------------------------------------------------- time step
-# a body resting on its whole base rim: stiffness kn x its base points (at least
-# RIM_POINTS: a box on its four corners steps as finely as a drum on its rim)
-# (computed by pipeline.scenario.parameters.time_step_s)
+# from the lightest body resting on its whole base rim (pipeline.scenario.parameters.time_step_s)
 O.dt = P["time_step_s"]
 
 # ---------------------------------------------------------------- motion

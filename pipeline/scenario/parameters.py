@@ -245,8 +245,9 @@ US_PER_BODY_STEP = 8.0   # wall us per body and time step: twin model 4.5 (8 bod
 
 def time_step_s(columns, contact, rim_points, dt_factor):
     """The scene's time step (s): ``dt_factor`` sqrt(m / (kn x base points)) of its
-    lightest body on its base rim (at least ``rim_points`` points), as
-    yade_scripts/column_scene.py computes it (same operations, same value)."""
+    lightest body on its base rim (at least ``rim_points`` points: a box on its four
+    corners steps as finely as a drum on its rim); the scene takes it from the scene
+    file."""
     stiffness = []
     for column in columns:
         for body in column["bodies"]:
