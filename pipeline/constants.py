@@ -13,3 +13,5 @@ MODEL_GRAVITY = 9.81                   # m/s^2: gravity of the simulated world
 # +1.5 m) or one of its two columns (also the names of the columns in every output)
 COLUMN_TYPES = ("drums", "monolithic")
 COLUMN_KINDS = ("both", "monolithic", "drums")
+
+RIM_POINTS = 16       # contact spheres per circular rim (the default numerics)

@@ -36,6 +36,7 @@ from pipeline.campaign.definitions import column_specs, run_code_version, run_co
 from pipeline.campaign.ensemble import (DEFAULT_SEED, ENSEMBLE_RANGES, check_seed,
                                         sample_batches)
 from pipeline.campaign.tables import collect
+from pipeline.constants import RIM_POINTS
 from pipeline.files import InputError, write_csv, write_json
 from pipeline.stats.circular import circular_summary
 from pipeline.stats.ensemble import compare_ensembles, holm_reject, wilson_interval
@@ -54,7 +55,7 @@ ALPHA = 0.05                 # family-wise level of Holm's correction
 
 def variant_ranges(numerics):
     """The ensemble's ranges with the rim phase over one spacing of this variant's rim."""
-    points = numerics.get("rim_points", 16)
+    points = numerics.get("rim_points", RIM_POINTS)
     return dict(ENSEMBLE_RANGES, rim_phase_deg=(0.0, 360.0 / points, "uniform"))
 
 

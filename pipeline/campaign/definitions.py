@@ -15,7 +15,7 @@ from pipeline.campaign.tables import collect, write_tables
 from pipeline.files import (InputError, code_hash, content_hash, csv_true_column, write_csv,
                             write_json, write_text)
 from pipeline.motion import Motion, synthetics
-from pipeline.records import catalog, catalog_row, processed_motion, resolve, sets
+from pipeline.records import CACHE_DIR, catalog, catalog_row, processed_motion, resolve, sets
 from pipeline.records.processing import signal_end_s
 from pipeline.scenario import RunParams
 from pipeline.scenario.parameters import param
@@ -34,7 +34,7 @@ def motion_cache(campaign_dir):
     campaign directory when it lies outside results/."""
     campaign_dir = Path(campaign_dir).resolve()
     if RESULTS_DIR.resolve() in campaign_dir.parents:
-        return RESULTS_DIR / "cache" / "motions"
+        return CACHE_DIR
     return campaign_dir / "motions"
 
 
@@ -48,8 +48,8 @@ def column_specs(runs, campaign_dir, tags=None, **common):
     for record, _ in runs:
         if record in resolved:
             continue
-        _, path = processed_motion(record, cache_dir=cache)
         source = resolve(record)
+        _, path = processed_motion(source, cache_dir=cache)
         record_id = source.id
         if source.row is None and catalog_row(record_id) is not None:
             record_id = f"{record_id}-{path.stem[:6]}"      # a file named like a catalogue id

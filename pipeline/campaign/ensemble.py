@@ -57,6 +57,7 @@ from pipeline.files import InputError, write_csv, write_json
 from pipeline.scenario import Contact, Numerics
 from pipeline.simulate import check_scale
 from pipeline.scenario.column_format import MAX_OFFSET_M
+from pipeline.constants import RIM_POINTS
 from pipeline.scenario.geometry import ColumnGeometry
 from pipeline.stats.circular import angle_difference_deg, circular_summary
 from pipeline.stats.ensemble import (bootstrap_mean_azimuth_ci, direction_fractions, pooled_answer,
@@ -71,7 +72,7 @@ ENSEMBLE_RANGES = {            # name: (low, high, "uniform" | "log")
     "kn_factor": (0.5, 2.0, "log"),
     "height_tolerance": (-0.01, 0.01, "uniform"),
     "diameter_tolerance": (-0.01, 0.01, "uniform"),
-    "rim_phase_deg": (0.0, 360.0 / 16, "uniform"),
+    "rim_phase_deg": (0.0, 360.0 / RIM_POINTS, "uniform"),
     "tilt_deg": (0.0, 0.5, "uniform"),
     "tilt_azimuth_deg": (0.0, 360.0, "uniform"),
     "drum_offset_mm": (0.0, 3.0, "uniform"),

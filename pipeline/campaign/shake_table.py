@@ -16,6 +16,7 @@ F1, confusion) are reported per split beside the trivial baselines ("never overt
 ``experiments.csv`` (per test and parameter set), ``shake_table.json`` (scores), the
 figure ``shake_table_rates.png`` (observed and predicted rate per PGA x PGV/PGA bin).
 """
+import dataclasses
 from dataclasses import dataclass
 import itertools
 import math
@@ -29,7 +30,7 @@ from pipeline import RESULTS_DIR
 from pipeline.campaign import Campaign, register
 from pipeline.campaign.run_dirs import finished_summary
 from pipeline.campaign.options import CampaignOptions, column_file_param
-from pipeline.scenario.parameters import param
+from pipeline.scenario.parameters import Contact, param
 from pipeline.files import InputError, write_csv, write_json
 from pipeline.records import RECORDS_DIR
 from pipeline.stats.classification import scores
@@ -44,14 +45,16 @@ RUN_CPU_S = 1.6                  # CPU-s per run: 2,303 runs of SP1 took 62 CPU-
 VALIDATE_FROM = "2021-08-01"     # the issue's split: calibrate on June-July, validate August
 COLUMNS = ("test", "date", "pga_g", "pgv_pga_s", "motion_file")
 # what --grid may vary: contact parameters, and the specimen's footprint tolerance
-GRID_CONTACT = {"kn": (1e5, 1e11), "damping": (0.0, 1.0), "mu_s": (0.01, 2.0),
-                "mu_k": (0.01, 2.0)}
+# (the bounds of Contact's fields; mu_k within mu_s's, and mu_k <= mu_s per point)
+GRID_CONTACT = {f.name: (f.metadata["low"], f.metadata["high"])
+                for f in dataclasses.fields(Contact) if f.metadata["low"] is not None}
+GRID_CONTACT["mu_k"] = GRID_CONTACT["mu_s"]
 GRID_SPECIMEN = {"footprint_tolerance_m": (0.0, 0.05)}
 # and the motion: rotate_deg turns the table motion clockwise (180: the other sign of an
 # axis whose sign the laboratory does not state)
 GRID_MOTION = {"rotate_deg": (0.0, 360.0)}
 DEFAULT_GRID = "footprint_tolerance_m=0.001,0.003;damping=0.05,0.1;rotate_deg=0,180"
-DEFAULT_CONTACT = {"kn": 1.2e8, "damping": 0.36, "mu_s": 0.7, "mu_k": 0.6}
+DEFAULT_CONTACT = dataclasses.asdict(Contact())      # the paper's contact
 PGA_EDGES_G = np.array([0.0, 0.1, 0.2, 0.3, 0.4, 0.5, 0.7, 1.0, 2.0])
 PGV_PGA_EDGES_S = np.array([0.0, 0.05, 0.1, 0.2, 0.3, 0.5, 1.0])
 

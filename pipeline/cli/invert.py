@@ -348,7 +348,8 @@ def _say_reach(summary):
 
 def _run_demo(args, preset, grid, candidates):
     from pipeline.inversion import EXAMPLES_DIR, run_inversion
-    from pipeline.inversion.demo import DEFAULT_TRIALS, paper_grid, paper_nodes, run_demo
+    from pipeline.inversion.demo import (BOUND_ANSWER_KEY, BOUND_TEXT, DEFAULT_TRIALS, paper_grid,
+                                         paper_nodes, run_demo)
     from pipeline.inversion.forward import run_forward, table_path
     from pipeline.inversion.table import ForwardTable
     from pipeline.inversion.observations import load_observations
@@ -402,11 +403,11 @@ def _run_demo(args, preset, grid, candidates):
         print(f"truth tests, {kind} likelihood: {cov['trials']} inversions; the 95 % "
               f"back-azimuth arc holds the truth in {cov['back_azimuth_95']:.0%}, the 95 % "
               f"epicentre region in {cov['epicentre_95']:.0%}")
-    for row in summary["bound_30_deg"]:
+    for row in summary[BOUND_ANSWER_KEY]:
         k = row["fallen_per_site"]
         print(f"  {row['likelihood']}, {row['mechanism']}, {row['sites']} site(s): " +
-              (f"+-30 deg from {k} fallen column(s) per site" if k else
-               f"not within +-30 deg (median {row['largest_tested_width_median_deg']:.0f} deg "
+              (f"{BOUND_TEXT} from {k} fallen column(s) per site" if k else
+               f"not within {BOUND_TEXT} (median {row['largest_tested_width_median_deg']:.0f} deg "
                "at the most columns tried)"))
     print(f"wrote {out / 'demo_summary.json'} ({summary['elapsed_s']:.0f} s)")
     return 0

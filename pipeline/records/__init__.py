@@ -19,7 +19,7 @@ from obspy.geodetics import gps2dist_azimuth
 from pipeline import RECORDS_DIR, RESULTS_DIR
 from pipeline.files import InputError, code_hash, content_hash, display_path
 from pipeline.provenance import software_versions
-from pipeline.motion import Motion
+from pipeline.motion import NPZ_KEYS, Motion
 from pipeline.records import processing
 from pipeline.records.catalog import catalog, catalog_row
 from pipeline.records.readers import is_pattern, read_record
@@ -76,7 +76,7 @@ def resolve(record):
                     names = set(archive.files)
             except (ValueError, OSError, EOFError):
                 raise InputError(f"{path.name}: unreadable npz") from None
-            if {"dt", "acc", "vel", "disp", "meta"} <= names:
+            if set(NPZ_KEYS) <= names:
                 return Source(_sanitise(path.stem), path, processed=True)
         return Source(_sanitise(path.stem), path)
     row = catalog_row(str(record))
@@ -96,7 +96,8 @@ def _sanitise(stem):
 
 
 def processed_motion(record, back_azimuth=None, cache_dir=CACHE_DIR, mode="default"):
-    """The processed :class:`Motion` of ``record`` and the path of its cached npz.
+    """The processed :class:`Motion` of ``record`` (anything :func:`resolve` takes, or
+    its :class:`Source`) and the path of its cached npz.
 
     Cached in ``cache_dir/<key>.npz`` (``cache_dir`` None: not cached, path None).
     ``back_azimuth`` (deg) is used only when neither file nor catalogue gives one.
@@ -105,7 +106,7 @@ def processed_motion(record, back_azimuth=None, cache_dir=CACHE_DIR, mode="defau
     always taken as it is.
     """
     steps = processing.steps_for(mode)
-    source = resolve(record)
+    source = record if isinstance(record, Source) else resolve(record)
     if source.processed:
         return Motion.load(source.path), source.path
     key = source.key(back_azimuth, steps)

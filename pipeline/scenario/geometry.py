@@ -46,7 +46,7 @@ from pathlib import Path
 
 import numpy as np
 
-from pipeline.constants import MODEL_GRAVITY
+from pipeline.constants import MODEL_GRAVITY, RIM_POINTS
 from pipeline.files import InputError
 from pipeline.scenario.bodies import _build, _statics
 from pipeline.scenario.column_format import (DENSITY_RANGE, EXAMPLES_DIR, MAX_BLOCKS,
@@ -251,11 +251,12 @@ class ColumnGeometry:
         """Smallest energy (J) that tips any stack of bodies over its edge."""
         return min(j["barrier_j"] for j in self.statics(g))
 
-    def contact_rocking_hz(self, kn, rim_points=16):
+    def contact_rocking_hz(self, kn, rim_points=RIM_POINTS):
         """Frequency (Hz) of the whole column, as one stone, rocking on the contact springs
         of its base (kn N/m per contact point): sqrt(kn sum(x_i^2) / I_base) / 2 pi, the
         smaller about the two horizontal axes.  Rigid-block behaviour needs it well above
-        the frequencies of the shaking (the paper's column: 13.5 Hz)."""
+        the frequencies of the shaking (the paper's column:
+        :func:`pipeline.campaign.column_file.paper_rocking_hz`)."""
         (body,) = self.monolithic().bodies()
         contact = body.contact
         if contact.kind == "circle":

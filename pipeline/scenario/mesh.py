@@ -46,7 +46,7 @@ from pathlib import Path
 
 import numpy as np
 
-from pipeline.constants import MODEL_GRAVITY
+from pipeline.constants import MODEL_GRAVITY, RIM_POINTS
 from pipeline.files import InputError
 from pipeline.scenario.column_format import DENSITY_RANGE
 from pipeline.scenario.outline import perimeter_points
@@ -276,7 +276,7 @@ class MeshSpecimen:
     def check(self):
         return self.statics()
 
-    def contact_rocking_hz(self, kn, rim_points=16):
+    def contact_rocking_hz(self, kn, rim_points=RIM_POINTS):
         """Frequency (Hz) of the specimen rocking on the contact springs of its footprint
         outline (kn N/m per point), the smaller about the two horizontal axes."""
         pts = perimeter_points(self.footprint, rim_points) - self.com[:2]

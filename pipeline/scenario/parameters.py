@@ -9,7 +9,7 @@ import dataclasses
 import math
 from dataclasses import dataclass, field
 
-from pipeline.constants import COLUMN_KINDS, COLUMN_TYPES
+from pipeline.constants import COLUMN_KINDS, COLUMN_TYPES, RIM_POINTS
 from pipeline import paper
 from pipeline.files import InputError
 from pipeline.scenario.bodies import ColumnSpec
@@ -100,7 +100,7 @@ class Contact:
 @dataclass(frozen=True)
 class Numerics:
     """How the YADE model discretises and integrates the bodies."""
-    rim_points: int = param(16, "", "contact spheres per circular rim", 8, 128, "--rim-points")
+    rim_points: int = param(RIM_POINTS, "", "contact spheres per circular rim", 8, 128, "--rim-points")
     rim_sphere_radius: float = param(RIM_SPHERE_RADIUS_M, "m", "radius of the rim contact spheres",
                                      0.0, 0.05, low_open=True)
     rim_phase_deg: float = param(0.0, "deg", "angular phase of the rim contact points "
