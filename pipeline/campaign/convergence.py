@@ -32,7 +32,8 @@ from pipeline.campaign import Campaign, register
 from pipeline.campaign.options import CampaignOptions
 from pipeline.scenario.parameters import param
 from pipeline.campaign.run_dirs import finished_summary
-from pipeline.campaign.definitions import column_specs, run_code_version, run_column_spec
+from pipeline.campaign.runs import column_specs, run_column_spec
+from pipeline.simulate import run_code_version
 from pipeline.campaign.ensemble import (DEFAULT_SEED, ENSEMBLE_RANGES, check_seed,
                                         sample_batches)
 from pipeline.campaign.tables import collect

@@ -35,7 +35,7 @@ from pipeline.files import InputError, write_csv, write_json
 from pipeline.records import RECORDS_DIR
 from pipeline.stats.classification import scores
 from pipeline.scenario.geometry import ColumnGeometry
-from pipeline.campaign.definitions import column_specs, run_column_spec
+from pipeline.campaign.runs import column_specs, run_column_spec
 
 EXPERIMENTS = RECORDS_DIR / "shake_table" / "tests.csv"
 SPECIMEN = RECORDS_DIR / "shake_table" / "sp1.json"

@@ -33,7 +33,7 @@ from pipeline import RESULTS_DIR
 from pipeline.campaign import Campaign, register
 from pipeline.campaign.options import CampaignOptions
 from pipeline.scenario.parameters import param
-from pipeline.campaign.definitions import column_specs, run_column_spec
+from pipeline.campaign.runs import column_specs, run_column_spec
 from pipeline.files import InputError, write_csv
 from pipeline.inversion.grid import GRIDS, TableGrid, node_positions, slice_motions
 from pipeline.inversion.table import ForwardTable
