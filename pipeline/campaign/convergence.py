@@ -23,6 +23,7 @@ p-values, the verdict and the CPU time per member of each variant), ``convergenc
 and ``convergence.png``.
 """
 from dataclasses import dataclass
+import logging
 import math
 from pathlib import Path
 
@@ -41,6 +42,8 @@ from pipeline.constants import RIM_POINTS
 from pipeline.files import InputError, write_csv, write_json
 from pipeline.stats.circular import circular_summary
 from pipeline.stats.ensemble import compare_ensembles, holm_reject, wilson_interval
+
+log = logging.getLogger(__name__)
 
 DEFAULT_RECORDS = ("RC-CCC", "NF04", "RC-CLC")
 DEFAULT_MEMBERS = 32
@@ -86,7 +89,7 @@ def convergence_outputs(specs, campaign_dir, failures, animations, figures=True)
     result = compare_variants(runs, wall_per_member(specs, campaign_dir))
     write_csv(campaign_dir / "convergence.csv", _rows(result))
     write_json(campaign_dir / "convergence.json", result)
-    print(result["verdict"])
+    log.info(result["verdict"])
     written = []
     if figures:
         from pipeline.figures.ensemble import plot_convergence

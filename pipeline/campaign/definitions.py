@@ -1,5 +1,7 @@
 """The campaigns of the paper's experiments and the verification, one definition each (their
 runs: :mod:`pipeline.campaign.runs`)."""
+import logging
+
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -28,6 +30,8 @@ from pipeline.stats.location import locate_source_from_falls
 from pipeline.scenario.column_format import example_names
 from pipeline.scenario.geometry import ColumnGeometry
 from pipeline import verification
+
+log = logging.getLogger(__name__)
 
 
 @dataclass(frozen=True)
@@ -224,7 +228,7 @@ def columns_outputs(specs, campaign_dir, failures, animations, figures=True):
     write_text(campaign_dir / "columns.md", "# Real columns on the same records\n\n"
                "uplift_ratio: rocking threshold / g from statics (d/h for a cylinder).\n\n"
                + text + "\n")
-    print(text)
+    log.info(text)
     written = []
     if figures and animations and not runs.empty:
         from pipeline.figures import animate_examples
@@ -273,7 +277,7 @@ def verification_outputs(specs, campaign_dir, failures, animations, figures=True
     summary["failed_runs"] = [s.run_id for s, _ in failures]
     write_json(Path(campaign_dir) / "verification.json", summary)
     for line in summary["lines"]:
-        print(line)
+        log.info(line)
     return {"figures": summary["figures"]}
 
 

@@ -36,6 +36,7 @@ first that are not joined), and ``kn_factor`` multiplies the description's conta
 stiffness (``--stiffness``, as in ``campaign columns``).
 """
 from dataclasses import dataclass
+import logging
 import math
 from pathlib import Path
 
@@ -62,6 +63,8 @@ from pipeline.scenario.geometry import ColumnGeometry
 from pipeline.campaign.sizing import (DEFAULT_ARC_DEG, DEFAULT_MAX_MEMBERS, DEFAULT_PRECISION,
                                       run_sized, write_summaries)
 from pipeline.stats.ensemble import pooled_summary, record_summary
+
+log = logging.getLogger(__name__)
 
 DEFAULT_MEMBERS = 16
 KEPT_TRAJECTORIES = 2          # the nominal run and the first members keep trajectory.npz
@@ -276,9 +279,9 @@ def ensemble_outputs(specs, campaign_dir, failures, animations, figures=True):
             written += plot_ensemble(sub, summary, out)
         for col in summary["columns"]:
             az = col["mean_downfall_azimuth_deg"]
-            print(f"{record_id} {col['column']:>10}: P(toppled) {col['p_toppled']:.2f} "
-                  f"[{col['p_toppled_ci95'][0]:.2f}, {col['p_toppled_ci95'][1]:.2f}]"
-                  + ("" if az is None else f", mean downfall {az:.0f} deg "
+            log.info(f"{record_id} {col['column']:>10}: P(toppled) {col['p_toppled']:.2f} "
+                     f"[{col['p_toppled_ci95'][0]:.2f}, {col['p_toppled_ci95'][1]:.2f}]"
+                     + ("" if az is None else f", mean downfall {az:.0f} deg "
                      f"(R {col['resultant_length']:.2f})"))
     write_summaries(campaign_dir, summaries)
     if len(records) > 1:
@@ -294,8 +297,8 @@ def ensemble_outputs(specs, campaign_dir, failures, animations, figures=True):
                 errors = ", ".join(f"{name} +-{st[name]['mc_error']:.2f}" for name in
                                    ("p_toppled", "polarity", "radial_alignment")
                                    if st[name]["mc_error"] is not None)
-                print(f"over {pooled['records']} records, {col['column']}: {col['answer']} "
-                      f"(Monte Carlo error: {errors})")
+                log.info(f"over {pooled['records']} records, {col['column']}: {col['answer']} "
+                         f"(Monte Carlo error: {errors})")
     return {"code_version": run_code_version(), **described,
             "figures": [str(Path(p).relative_to(campaign_dir)) for p in written]}
 

@@ -1,6 +1,8 @@
 """The runs of one column that several campaigns share: run specs from (record,
 parameters) pairs (each record processed once, its motion cached), the worker that runs
 one, the twin model's parameters, the pulse record, the outputs of a column campaign."""
+import logging
+
 from pathlib import Path
 
 from pipeline import RESULTS_DIR
@@ -13,6 +15,8 @@ from pipeline.records import CACHE_DIR, catalog, catalog_row, processed_motion, 
 from pipeline.scenario import RunParams
 from pipeline.simulate import run_code_version, simulate
 from pipeline.stats.circular import direction_statistics
+
+log = logging.getLogger(__name__)
 
 
 # ---------------------------------------------------------------- column runs
@@ -99,7 +103,7 @@ def column_outputs(name, size_by=None):
                                                          size_by, animations)
         toppled = runs.groupby("column")["toppled"].agg(["sum", "count"]) if not runs.empty \
             else None
-        print(f"wrote {campaign_dir / 'runs.csv'}" + (
+        log.info(f"wrote {campaign_dir / 'runs.csv'}" + (
             "" if toppled is None else "; toppled: " + ", ".join(
                 f"{c} {int(r['sum'])}/{int(r['count'])}" for c, r in toppled.iterrows())))
         return {"code_version": run_code_version(), **described,

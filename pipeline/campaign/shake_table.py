@@ -19,6 +19,7 @@ figure ``shake_table_rates.png`` (observed and predicted rate per PGA x PGV/PGA 
 import dataclasses
 from dataclasses import dataclass
 import itertools
+import logging
 import math
 from datetime import date
 from pathlib import Path
@@ -36,6 +37,8 @@ from pipeline.records import RECORDS_DIR
 from pipeline.stats.classification import scores
 from pipeline.scenario.geometry import ColumnGeometry
 from pipeline.campaign.runs import column_specs, run_column_spec
+
+log = logging.getLogger(__name__)
 
 EXPERIMENTS = RECORDS_DIR / "shake_table" / "tests.csv"
 SPECIMEN = RECORDS_DIR / "shake_table" / "sp1.json"
@@ -227,21 +230,20 @@ def drive(run, records, campaign_dir, options, gate=None):
                          "all): nothing to calibrate on")
     points = len(parse_grid(options["grid"]))
     runs = points * early + late
-    print(f"shake-table: {points} parameter set(s) x {early} calibration tests, then the "
-          f"chosen set on {late} validation tests: at most {runs} YADE runs, about "
-          f"{runs * RUN_CPU_S / 60:.0f} CPU-min (finished runs are kept and not run again)",
-          flush=True)
+    log.info(f"shake-table: {points} parameter set(s) x {early} calibration tests, then the "
+             f"chosen set on {late} validation tests: at most {runs} YADE runs, about "
+             f"{runs * RUN_CPU_S / 60:.0f} CPU-min (finished runs are kept and not run again)")
     if gate is not None:
         gate("shake-table", runs, RUN_CPU_S, "a smaller --grid or --tests")
     calibration = run({**options, "stage": "calibration"})
     label, point = best_point(calibration)
-    print(f"calibration: best {label} (accuracy {calibration['scores'][label]['accuracy']:.3f} "
-          f"on {calibration['scores'][label]['n']} tests)", flush=True)
+    log.info(f"calibration: best {label} (accuracy {calibration['scores'][label]['accuracy']:.3f} "
+             f"on {calibration['scores'][label]['n']} tests)")
     if late:
         validation = run({**options, "stage": "validation", "chosen": point})
     else:
-        print(f"no test from {options['validate_from']} on: the calibration's scores alone, "
-              "no validation", flush=True)
+        log.info(f"no test from {options['validate_from']} on: the calibration's scores alone, "
+                 "no validation")
         validation = calibration
     specimen = ColumnGeometry.load(options["specimen"])
     table = _experiment_table(frame, campaign_dir, label, options["validate_from"])
@@ -252,7 +254,7 @@ def drive(run, records, campaign_dir, options, gate=None):
     plot_rates(table, campaign_dir / "shake_table_rates.png", result, PGA_EDGES_G,
                PGV_PGA_EDGES_S)
     for line in result["lines"]:
-        print(line)
+        log.info(line)
     return {**validation, "summary": result}
 
 

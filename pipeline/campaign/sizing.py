@@ -2,11 +2,14 @@
 records whose toppling probability (and, where falls gather, mean direction) is not yet
 as precise as asked (:func:`run_sized`, the ``ensemble`` campaign's driver)."""
 import json
+import logging
 import math
 from pathlib import Path
 
 from pipeline.files import write_json
 from pipeline.stats.ensemble import wilson_interval
+
+log = logging.getLogger(__name__)
 
 
 DEFAULT_PRECISION = 0.1       # half-width of P(toppled)'s 95 % interval
@@ -118,7 +121,7 @@ def run_sized(run, records, campaign_dir, options, gate=None):
         for rec, why in pending.items():
             summary = next(x for x in summaries if x["record_input"] == rec)
             more = members_needed(summary, precision, batch, cap, arc) - counts[rec]
-            print(f"{rec}: {why} after {counts[rec]} members: adding {more}", flush=True)
+            log.info(f"{rec}: {why} after {counts[rec]} members: adding {more}")
             counts[rec] += more
     write_summaries(campaign_dir, summaries)
     return {**result, "summaries": summaries}

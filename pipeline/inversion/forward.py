@@ -26,6 +26,7 @@ executor, so they are cached by content (run id = hash of motion, parameters and
 a second inversion reuses every finished run.
 """
 from dataclasses import dataclass
+import logging
 import time
 from pathlib import Path
 
@@ -40,6 +41,8 @@ from pipeline.inversion.table import ForwardTable
 from pipeline.campaign.column_file import column_kn
 from pipeline.campaign.ensemble import nominal, sample_members
 from pipeline.campaign import run_campaign
+
+log = logging.getLogger(__name__)
 
 DEFAULT_FORWARD_DIR = RESULTS_DIR / "inversion-forward"
 
@@ -98,8 +101,8 @@ def forward_outputs(specs, campaign_dir, failures, animations, figures=True):
     write_csv(path.with_name(f"forward_cells_{grid.key()}.csv"), table.cells())
     done = int(table.valid.any(axis=3).sum() + (table.nominal_valid.any(axis=3).sum()
                                                  if table.nominal_valid is not None else 0))
-    print(f"wrote {path} ({done} of {len(specs)} runs finished; YADE wall "
-          f"{table.info['yade_wall_s']:.0f} s in total)")
+    log.info(f"wrote {path} ({done} of {len(specs)} runs finished; YADE wall "
+             f"{table.info['yade_wall_s']:.0f} s in total)")
     return {"table": str(path), "grid": grid.as_dict(), "grid_key": grid.key(),
             "runs_finished": done}
 

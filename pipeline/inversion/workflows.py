@@ -2,6 +2,7 @@
 reused or read from a file, after a cost estimate and the long-run gate), then an
 inversion of an observations file, the demo, the member study or a hidden truth.  Each
 writes its files under ``options.out`` and returns the command's exit status."""
+import logging
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -10,6 +11,8 @@ from pipeline import RESULTS_DIR
 from pipeline.campaign.executor import RUN_CORE_S as FORWARD_RUN_CORE_S
 from pipeline.constants import COLUMN_TYPES
 from pipeline.files import InputError, check_jobs, check_long
+
+log = logging.getLogger(__name__)
 
 
 @dataclass(frozen=True)
@@ -76,9 +79,9 @@ def preflight(grid, forward_dir, jobs, allow_long, more_runs=0):
     done = finished_runs(forward_dir)
     needed = grid.n_runs()
     rest = max(0, needed - done)
-    print(f"forward table: {needed} YADE runs, up to {min(done, needed)} of them cached in "
-          f"{forward_dir}; the rest takes about {rest * FORWARD_RUN_CORE_S / jobs / 60:.0f} "
-          f"min on {jobs} core(s) ({FORWARD_RUN_CORE_S:g} s a run)", flush=True)
+    log.info(f"forward table: {needed} YADE runs, up to {min(done, needed)} of them cached in "
+             f"{forward_dir}; the rest takes about {rest * FORWARD_RUN_CORE_S / jobs / 60:.0f} "
+             f"min on {jobs} core(s) ({FORWARD_RUN_CORE_S:g} s a run)")
     what = "this forward table" + (" and the hidden truth's runs" if more_runs else "")
     return check_long(what, rest + more_runs, FORWARD_RUN_CORE_S, jobs, allow_long,
                       "choose --grid demo or quick, or give a computed --table")
@@ -114,12 +117,12 @@ def _say_reach(summary):
     """What the forward table's reach left out of the candidates asked for, and a warning
     line when the posterior piles against the edge of the reach."""
     if summary.get("beyond_table_fraction"):
-        print(f"candidates: within {summary['table_last_ring_km']:g} km of every site, where "
-              f"the forward table's rings end; {summary['beyond_table_fraction']:.0%} of the "
-              f"epicentres within --radius {summary['candidate_grid']['radius_km']:g} km of "
-              "a site lie beyond and are left out")
+        log.info(f"candidates: within {summary['table_last_ring_km']:g} km of every site, where "
+                 f"the forward table's rings end; {summary['beyond_table_fraction']:.0%} of the "
+                 f"epicentres within --radius {summary['candidate_grid']['radius_km']:g} km of "
+                 "a site lie beyond and are left out")
     if summary.get("reach_warning"):
-        print(f"warning: {summary['reach_warning']}")
+        log.warning(f"{summary['reach_warning']}")
 
 
 def demo(options, preset, grid, candidates):
@@ -152,7 +155,7 @@ def demo(options, preset, grid, candidates):
                                                 "yade_wall_s"),
                                             "runs": paper_tables[source].info.get("runs")}
             else:
-                print(f"paper scenario, {source}: no {sibling.name} beside --table: skipped")
+                log.info(f"paper scenario, {source}: no {sibling.name} beside --table: skipped")
             continue
         paper_tables[source], cost = run_forward(pgrid, options.forward_dir,
                                                  check_jobs(options.jobs), options.scheduler)
@@ -178,16 +181,16 @@ def demo(options, preset, grid, candidates):
     from pipeline.files import write_json
     write_json(out / "demo_summary.json", summary)
     for kind, cov in summary["coverage"].items():
-        print(f"truth tests, {kind} likelihood: {cov['trials']} inversions; the 95 % "
-              f"back-azimuth arc holds the truth in {cov['back_azimuth_95']:.0%}, the 95 % "
-              f"epicentre region in {cov['epicentre_95']:.0%}")
+        log.info(f"truth tests, {kind} likelihood: {cov['trials']} inversions; the 95 % "
+                 f"back-azimuth arc holds the truth in {cov['back_azimuth_95']:.0%}, the 95 % "
+                 f"epicentre region in {cov['epicentre_95']:.0%}")
     for row in summary[BOUND_ANSWER_KEY]:
         k = row["fallen_per_site"]
-        print(f"  {row['likelihood']}, {row['mechanism']}, {row['sites']} site(s): " +
-              (f"{BOUND_TEXT} from {k} fallen column(s) per site" if k else
+        log.info(f"  {row['likelihood']}, {row['mechanism']}, {row['sites']} site(s): " +
+                 (f"{BOUND_TEXT} from {k} fallen column(s) per site" if k else
                f"not within {BOUND_TEXT} (median {row['largest_tested_width_median_deg']:.0f} deg "
                "at the most columns tried)"))
-    print(f"wrote {out / 'demo_summary.json'} ({summary['elapsed_s']:.0f} s)")
+    log.info(f"wrote {out / 'demo_summary.json'} ({summary['elapsed_s']:.0f} s)")
     return 0
 
 
@@ -210,12 +213,11 @@ def member_study(options, grid, candidates):
     trials = STUDY_TRIALS if options.trials is None else options.trials
 
     jobs = check_jobs(options.jobs)
-    print(f"member study: {trials} trials per configuration on {jobs} process(es)",
-          flush=True)
+    log.info(f"member study: {trials} trials per configuration on {jobs} process(es)")
 
     def progress(kind, size):
-        print(f"  {kind} likelihood, {size} members: done "
-              f"({time.monotonic() - started:.0f} s)", flush=True)
+        log.info(f"  {kind} likelihood, {size} members: done "
+                 f"({time.monotonic() - started:.0f} s)")
 
     rows = member_study(table, candidates, trials=trials, kernel_deg=options.kernel_deg,
                         floor=options.floor, jobs=jobs, progress=progress)
@@ -237,8 +239,8 @@ def member_study(options, grid, candidates):
         "toppled_fraction_by_slice": table.toppled_fraction_by_slice(),
         "elapsed_s": round(time.monotonic() - started, 1)})
     for text in answer.values():
-        print(text)
-    print(f"wrote {out} ({time.monotonic() - started:.0f} s)")
+        log.info(text)
+    log.info(f"wrote {out} ({time.monotonic() - started:.0f} s)")
     return 0
 
 
@@ -266,8 +268,8 @@ def hidden_truth(truth_file, options, grid, candidates):
     check_hidden(truth, table_grid)
     from pipeline.inversion.posterior import check_reach
     check_reach(truth.sites, table.distances_km[-1], candidates)     # before any run
-    print(f"hidden truth: {sum(s[3] for s in truth.sites)} twin runs at "
-          f"{len(truth.sites)} site(s)", flush=True)
+    log.info(f"hidden truth: {sum(s[3] for s in truth.sites)} twin runs at "
+             f"{len(truth.sites)} site(s)")
     result = run_campaign("inversion-truth", jobs=check_jobs(options.jobs),
                           campaign_dir=out / "truth-runs", animations=0,
                           options={"truth": truth, "grid": table_grid, "jobs": options.jobs},
@@ -281,12 +283,12 @@ def hidden_truth(truth_file, options, grid, candidates):
                             forward_info=info, likelihood=options.likelihood,
                             truth=truth.as_truth())
     check = summary["truth"]["check"]
-    print(f"{observations.n_fallen} of {observations.n_columns} simulated columns fell; the "
-          f"95 % regions hold the true epicentre: {check['epicentre_in_95']}, back azimuth: "
-          f"{check['back_azimuth_in_95']}, distance: {check['distance_in_95']}, magnitude: "
-          f"{check['mw_in_95']}; MAP epicentre {check['map_epicentre_error_km']:.1f} km off")
+    log.info(f"{observations.n_fallen} of {observations.n_columns} simulated columns fell; the "
+             f"95 % regions hold the true epicentre: {check['epicentre_in_95']}, back azimuth: "
+             f"{check['back_azimuth_in_95']}, distance: {check['distance_in_95']}, magnitude: "
+             f"{check['mw_in_95']}; MAP epicentre {check['map_epicentre_error_km']:.1f} km off")
     _say_reach(summary)
-    print(f"wrote {out} ({time.monotonic() - started:.0f} s)")
+    log.info(f"wrote {out} ({time.monotonic() - started:.0f} s)")
     return 0
 
 
@@ -315,14 +317,14 @@ def invert_file(observations_file, options, grid, candidates):
                             options.floor, forward_info=info, likelihood=options.likelihood)
     lo, hi = summary["back_azimuth_ci95_deg"]
     mech = max(summary["mechanism_posterior"], key=summary["mechanism_posterior"].get)
-    print(f"{observations.n_fallen} fallen of {observations.n_columns} columns at "
-          f"{len(observations.sites)} site(s); {summary['candidates']} candidates")
-    print(f"back azimuth from {summary['first_site']}: MAP {summary['back_azimuth_map_deg']:.0f}"
-          f" deg, 95 % arc [{lo:.0f}, {hi:.0f}] ({summary['back_azimuth_ci95_width_deg']:.0f} "
-          f"deg); distance 95 % {summary['distance_ci95_km'][0]:.1f}-"
-          f"{summary['distance_ci95_km'][1]:.1f} km; 95 % area "
-          f"{summary['credible_area_95_km2']:.0f} km^2; most probable mechanism {mech} "
-          f"({summary['mechanism_posterior'][mech]:.2f})")
+    log.info(f"{observations.n_fallen} fallen of {observations.n_columns} columns at "
+             f"{len(observations.sites)} site(s); {summary['candidates']} candidates")
+    log.info(f"back azimuth from {summary['first_site']}: MAP {summary['back_azimuth_map_deg']:.0f}"
+             f" deg, 95 % arc [{lo:.0f}, {hi:.0f}] ({summary['back_azimuth_ci95_width_deg']:.0f} "
+             f"deg); distance 95 % {summary['distance_ci95_km'][0]:.1f}-"
+             f"{summary['distance_ci95_km'][1]:.1f} km; 95 % area "
+             f"{summary['credible_area_95_km2']:.0f} km^2; most probable mechanism {mech} "
+             f"({summary['mechanism_posterior'][mech]:.2f})")
     _say_reach(summary)
-    print(f"wrote {out} ({time.monotonic() - started:.0f} s)")
+    log.info(f"wrote {out} ({time.monotonic() - started:.0f} s)")
     return 0

@@ -8,6 +8,7 @@ the result by content: the input files' bytes, the catalogue row, the
 processing steps and the code of this package, never by name.
 """
 import glob
+import logging
 import re
 import sys
 from pathlib import Path
@@ -23,6 +24,8 @@ from pipeline.motion import NPZ_KEYS, Motion
 from pipeline.records import processing
 from pipeline.records.catalog import catalog, catalog_row
 from pipeline.records.readers import is_pattern, read_record
+
+log = logging.getLogger(__name__)
 
 CACHE_DIR = RESULTS_DIR / "cache" / "motions"
 SIDECARS = ("*.xml", "*.xml.gz", "event.json", "*.quakeml", "flatfile_rows.csv")
@@ -250,8 +253,8 @@ def _motion_meta(source, row, info, back_azimuth, has_vertical):
         meta["back_azimuth_source"] = ("gps2dist_azimuth of station and epicentre coordinates from "
                                        + (row.get("citation") or "the record file header"))
         if back_azimuth is not None:
-            print(f"note: {source.id}: coordinates give the back azimuth; "
-                  f"--back-azimuth {back_azimuth:g} ignored", file=sys.stderr)
+            log.info(f"note: {source.id}: coordinates give the back azimuth; "
+                     f"--back-azimuth {back_azimuth:g} ignored", extra={"stderr": True})
     elif row.get("back_azimuth_deg") is not None:
         meta["back_azimuth_deg"] = float(row["back_azimuth_deg"])
         meta["epicentral_distance_km"] = row.get("epicentral_distance_km")

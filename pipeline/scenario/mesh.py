@@ -36,11 +36,11 @@ land on), each sphere one radius inside the surface.
 """
 import functools
 import hashlib
+import logging
 import math
 import multiprocessing
 import re
 import struct
-import sys
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -51,6 +51,8 @@ from pipeline.files import InputError
 from pipeline.scenario.column_format import DENSITY_RANGE
 from pipeline.scenario.outline import perimeter_points
 from pipeline.userfiles import keys_text, number, show
+
+log = logging.getLogger(__name__)
 
 MESH_SUFFIXES = (".obj", ".ply", ".stl")   # the mesh files trimesh reads here
 
@@ -468,7 +470,7 @@ def _say(line):
     """Print a note or warning line on stderr, once per process (the process the user
     started: campaign workers load the specimen again and keep quiet)."""
     if line not in _SAID and multiprocessing.parent_process() is None:
-        print(line, file=sys.stderr)
+        log.info(line, extra={"stderr": True})
     _SAID.add(line)
 
 

@@ -6,6 +6,7 @@ represent and keep stable (docs/command-line.md); a value outside raises an
 :class:`~pipeline.files.InputError` naming the option and its range.
 """
 import dataclasses
+import logging
 import math
 from dataclasses import dataclass, field
 
@@ -15,6 +16,8 @@ from pipeline.files import InputError
 from pipeline.scenario.bodies import ColumnSpec
 from pipeline.scenario.column_format import DENSITY_RANGE
 from pipeline.scenario.geometry import ColumnGeometry
+
+log = logging.getLogger(__name__)
 
 RIM_SPHERE_RADIUS_M = 0.005   # rim contact spheres of the columns
 MIN_BODY_SIZE_M = 10 * RIM_SPHERE_RADIUS_M   # a drum must hold its two rims of spheres
@@ -357,7 +360,7 @@ def check_cost(params, wall_limit_s):
                          "min): use fewer or heavier blocks, a stiffer contact or a shorter "
                          "--window")
     if estimate > 300.0:
-        print(f"note: {what} at most (quiet parts are skipped)", flush=True)
+        log.info(f"note: {what} at most (quiet parts are skipped)")
     return estimate
 
 
