@@ -43,7 +43,7 @@ from scipy.integrate import cumulative_trapezoid
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))       # bench/mujoco_twin.py
 from pipeline import PROJECT_ROOT as PROJECT, RESULTS_DIR  # noqa: E402
-from pipeline.files import InputError, save_figure, write_json  # noqa: E402
+from pipeline.files import save_figure, write_json  # noqa: E402
 from pipeline.motion import Motion  # noqa: E402
 from pipeline.motion.pulses import one_sine_pulse  # noqa: E402
 from pipeline.outcome.columns import (column_outcomes, rotation_from_start_deg,  # noqa: E402
