@@ -27,7 +27,6 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from pipeline import RESULTS_DIR
 from pipeline.campaign import Campaign, register
 from pipeline.campaign.run_dirs import finished_summary
 from pipeline.campaign.options import CampaignOptions, column_file_param
@@ -373,5 +372,3 @@ register(Campaign(
     "experiments: calibrate on the early tests, validate on the held-out later ones",
     specs, _worker, outputs, label="experiments", options=ShakeTableOptions, driver=drive,
     run_core_s=RUN_CPU_S))
-
-RESULTS = RESULTS_DIR / "shake-table"

@@ -42,7 +42,6 @@ DEFAULT_TRIALS = 20
 OBS_UNCERTAINTY_DEG = 10.0
 DEMO_SEED = 2009
 PAPER_RINGS_KM = (5.0, 10.0, 20.0)
-PAPER_AZIMUTH_STEP_DEG = 30.0
 PAPER_MECHANISMS = {"strike_slip": "strike-slip", "thrust": "thrust"}
 # the paper's question: a 95 % back-azimuth arc no wider than BOUND_DEG (deg), and its
 # words and result keys
