@@ -490,7 +490,7 @@ MEMBER_SPACING_M = 10.0            # North of each other: a fallen column reache
 
 
 def members_per_scene(work, shaking):
-    """The issue's first idea for 2x members per CPU-hour, measured: n twin members
+    """One way to twice the members per CPU-hour, measured: n twin members
     (drums and monolith each) in one scene on one pedestal under one motion, spaced
     MEMBER_SPACING_M apart so that they never touch, for the motion's duration (no early
     stop).  Per n: the loop's wall s, wall s per member and members per wall hour
@@ -686,7 +686,7 @@ def print_peer(p):
               f"{m['sim_s']:.2f} s in {m['wall_s'] + m['setup_s']:.2f} s wall, "
               f"{m['sim_s_per_cpu_s']:.2f} s/CPU s (CPU {m['cpu_pct']:.0f} %); "
               f"CPU-time ratio YADE/MuJoCo {q['cpu_speed_ratio_yade_to_mujoco']:.3f}")
-    print("   note: the drum column at 5 m/s^2 is a marginal case in MuJoCo (its helper found "
+    print("   note: the drum column at 5 m/s^2 is a marginal case in MuJoCo (it was found with "
           "the drums 8.9 deg off the pulse axis with 4-point face contacts); the "
           f"{STRONG_AMPLITUDE:g} m/s^2 pulse is the case both engines should agree on")
 

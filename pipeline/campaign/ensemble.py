@@ -17,7 +17,7 @@ Ranges (``ENSEMBLE_RANGES``, all around the paper's values; override with
 - ``kn_factor`` 0.5-2 (log-uniform) on the paper's 1.2e8 N/m per point: the
   rocking response changes < 0.5 % for kn 1.2e7-1.2e9 (measured on the block);
 - ``height_tolerance`` and ``diameter_tolerance`` +-1 % of the nominal column
-  (masonry tolerances of cut drums; real geometry: issue "Real columns");
+  (masonry tolerances of cut drums; a real column's geometry: ``--column-file``);
 - ``rim_phase_deg`` 0 to one rim spacing: the rim discretisation moves a fall by
   up to ~12 deg (make bench); sampling its phase turns that bias into noise;
 - ``tilt_deg`` 0-0.5 deg toward ``tilt_azimuth_deg`` 0-360: a column already out

@@ -96,7 +96,7 @@ def execute(specs, campaign_dir, jobs, worker, label="runs", executor=None, sche
 
 
 class ForecastBar(tqdm):
-    """The campaign's progress bar.  Once the ``first`` runs of this session are done it
+    """The campaign's progress bar.  Once the ``first`` runs of this command are done it
     says how long the rest takes at the pace so far (wall time on this machine) when that
     is ``FORECAST_FROM_S`` or more, as a warning from ``WARN_FROM_S`` on.  It says it
     again when the pace of every run done so far puts the rest ``REVISE_FACTOR`` times

@@ -44,7 +44,7 @@ SPECIMEN = RECORDS_DIR / "shake_table" / "sp1.json"
 OUTCOME = "sp1_overturned"
 AXIS_DEG = 90.0                  # the shipped tests shake along East-West
 RUN_CPU_S = 1.6                  # CPU-s per run: 2,303 runs of SP1 took 62 CPU-min (2026-11-24)
-VALIDATE_FROM = "2021-08-01"     # the split: calibrate on June-July, validate August
+VALIDATE_FROM = "2021-08-01"     # calibrate on the June-July tests, validate on August's
 COLUMNS = ("test", "date", "pga_g", "pgv_pga_s", "motion_file")
 # what --grid may vary: contact parameters, and the specimen's footprint tolerance
 # (the bounds of Contact's fields; mu_k within mu_s's, and mu_k <= mu_s per point)
