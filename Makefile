@@ -19,13 +19,14 @@ setup: .venv/.installed
 	$(PY) -m pip install -q -e '.[test]'
 	touch $@
 
-# the layers of the stages (import-linter contract in pyproject.toml), the YADE physics
+# the layers of the stages (import-linter contract in pyproject.toml), ruff, the YADE physics
 # tests on glibc's second libm path (another CPU's last bits), then all; on every core
 # (pytest-xdist, a test file per worker at a time: its module fixtures are made once;
 # as many workers as nproc says, not xdist's "auto", which counts physical cores only)
 TEST_WORKERS ?= $(JOBS)
 test: setup
 	.venv/bin/lint-imports
+	$(PY) -m ruff check pipeline tests bench yade_scripts
 	$(PY) -m pytest -q -n $(TEST_WORKERS) --dist loadfile -m libm --second-libm tests
 	$(PY) -m pytest -q -n $(TEST_WORKERS) --dist loadfile tests
 

@@ -43,7 +43,7 @@ from scipy.integrate import cumulative_trapezoid
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))       # bench/mujoco_twin.py
 from pipeline import PROJECT_ROOT as PROJECT, RESULTS_DIR  # noqa: E402
-from pipeline.files import InputError, save_figure, write_json  # noqa: E402
+from pipeline.files import save_figure, write_json  # noqa: E402
 from pipeline.motion import Motion  # noqa: E402
 from pipeline.motion.pulses import one_sine_pulse  # noqa: E402
 from pipeline.outcome.columns import (column_outcomes, rotation_from_start_deg,  # noqa: E402
@@ -454,7 +454,7 @@ MEMBER_SPACING_M = 10.0            # North of each other: a fallen column reache
 
 
 def members_per_scene(work, shaking):
-    """The issue's first idea for 2x members per CPU-hour, measured: n twin members
+    """One way to twice the members per CPU-hour, measured: n twin members
     (drums and monolith each) in one scene on one pedestal under one motion, spaced
     MEMBER_SPACING_M apart so that they never touch, for the motion's duration (no early
     stop).  Per n: the loop's wall s, wall s per member and members per wall hour
@@ -650,7 +650,7 @@ def print_peer(p):
               f"{m['sim_s']:.2f} s in {m['wall_s'] + m['setup_s']:.2f} s wall, "
               f"{m['sim_s_per_cpu_s']:.2f} s/CPU s (CPU {m['cpu_pct']:.0f} %); "
               f"CPU-time ratio YADE/MuJoCo {q['cpu_speed_ratio_yade_to_mujoco']:.3f}")
-    print("   note: the drum column at 5 m/s^2 is a marginal case in MuJoCo (its helper found "
+    print("   note: the drum column at 5 m/s^2 is a marginal case in MuJoCo (it was found with "
           "the drums 8.9 deg off the pulse axis with 4-point face contacts); the "
           f"{STRONG_AMPLITUDE:g} m/s^2 pulse is the case both engines should agree on")
 

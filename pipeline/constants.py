@@ -14,6 +14,8 @@ MODEL_GRAVITY = 9.81                   # m/s^2: gravity of the simulated world
 COLUMN_TYPES = ("drums", "monolithic")
 COLUMN_KINDS = ("both", "monolithic", "drums")
 
+RIM_POINTS = 16       # contact spheres per circular rim (the default numerics)
+
 # what lying and standing mean, for the scene's stop checks and the outcome (one home):
 # a body's long axis points up at least STANDS_AXIS_Z while it stands (tilt below ~30
 # deg), below LIES_AXIS_Z = cos(LIES_TILT_DEG) once it lies; a mesh specimen (a rock)

@@ -8,6 +8,7 @@ import ctypes
 import hashlib
 import io
 import json
+import logging
 import os
 import signal
 import tempfile
@@ -16,6 +17,8 @@ from pathlib import Path
 
 import numpy as np
 from pipeline import PROJECT_ROOT
+
+log = logging.getLogger(__name__)
 
 
 class ToolError(Exception):
@@ -203,7 +206,7 @@ def check_long(what, runs, run_core_s, jobs, allow_long, advice="", unit="runs")
     if not allow_long:
         raise InputError(f"{said}, over {LONG_RUN_S / 3600:g} h: add --allow-long to start "
                          "it" + (f", or {advice}" if advice else ""))
-    print(f"warning: {said} (--allow-long)", flush=True)
+    log.warning(f"{said} (--allow-long)")
     return estimate
 
 

@@ -37,3 +37,5 @@ RECORDS_TOPPLED_DRUMS = (13, 29)      # 13 of 29 records toppled the drum column
 RECORDS_TOPPLED_MONOLITH = (7, 29)    # 7 of 29 toppled the monolith too
 SELECTION_MAX_DISTANCE_KM = 40.0      # record selection: epicentral distance < 40 km
 SELECTION_MIN_PGA_M_S2 = 2.0          # and horizontal PGA > 2 m/s^2
+# The question: can fallen columns bound the back azimuth of the source within +-30 deg?
+BACK_AZIMUTH_BOUND_DEG = 30.0

@@ -28,6 +28,10 @@ def pytest_configure(config):
         # started in the background (nohup, `make test &`): the Ctrl-C tests' commands
         # would inherit the ignored SIGINT and never see it
         signal.signal(signal.SIGINT, signal.default_int_handler)
+    # the stages' messages printed as the command line prints them (tests of a library
+    # function read them with capsys)
+    from pipeline.cli import setup_logging
+    setup_logging()
     if config.getoption("--second-libm"):
         from pipeline.scenario.runner import SECOND_LIBM_TUNABLES
         os.environ["GLIBC_TUNABLES"] = SECOND_LIBM_TUNABLES

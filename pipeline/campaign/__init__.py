@@ -11,6 +11,7 @@ of its inputs and of the code that turns them into an outcome); a finished run l
 :class:`~pipeline.outcome.summary.RunSummary`.
 """
 import importlib
+import logging
 import os
 import pkgutil
 import shutil
@@ -23,6 +24,8 @@ from pipeline import RESULTS_DIR
 from pipeline.files import (DirectoryLock, InputError, ToolError, check_jobs, check_long,
                             write_json)
 from pipeline.campaign.executor import EXECUTORS, RUN_CORE_S, execute
+
+log = logging.getLogger(__name__)
 
 CAMPAIGNS = {}
 
@@ -174,8 +177,8 @@ def _run_specs(campaign, name, specs, campaign_dir, jobs, animations, executor, 
         inside = RESULTS_DIR.resolve() in Path(campaign_dir).resolve().parents
         reused = reuse_finished(specs, campaign_dir, campaign.worker) if inside else 0
         if reused:
-            print(f"{Path(campaign_dir).name}: {reused} run(s) copied from campaigns beside it "
-                  "(same run id: same motion, parameters and model code)", flush=True)
+            log.info(f"{Path(campaign_dir).name}: {reused} run(s) copied from campaigns beside it "
+                     "(same run id: same motion, parameters and model code)")
         failures, interrupted = execute(specs, campaign_dir, jobs, campaign.worker,
                                         campaign.label, executor=executor,
                                         scheduler=scheduler)

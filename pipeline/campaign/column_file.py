@@ -146,15 +146,20 @@ def summary_entry(specs):
     return {}
 
 
-def matched_kn(geometry):
-    """Contact stiffness per point (N/m) that lets a column rock on its contact springs no
-    slower than the paper's column does with the paper's kn (13.5 Hz): the paper's kn for
-    columns of its size, more for heavier ones (kn scales with the square of the
-    frequency), rounded to two significant digits."""
+def paper_rocking_hz():
+    """Frequency (Hz) at which the paper's column, as one stone, rocks on its contact
+    springs with the paper's kn (:meth:`ColumnGeometry.contact_rocking_hz`)."""
     reference = ColumnGeometry.monolith(paper.COLUMN_HEIGHT_M,
                                         paper.COLUMN_HEIGHT_M / paper.COLUMN_HD,
                                         paper.MARBLE_DENSITY_KG_M3)
-    ratio = (reference.contact_rocking_hz(paper.COLUMN_KN_N_M)
-             / geometry.contact_rocking_hz(paper.COLUMN_KN_N_M)) ** 2
+    return reference.contact_rocking_hz(paper.COLUMN_KN_N_M)
+
+
+def matched_kn(geometry):
+    """Contact stiffness per point (N/m) that lets a column rock on its contact springs no
+    slower than the paper's column does with the paper's kn (:func:`paper_rocking_hz`):
+    the paper's kn for columns of its size, more for heavier ones (kn scales with the
+    square of the frequency), rounded to two significant digits."""
+    ratio = (paper_rocking_hz() / geometry.contact_rocking_hz(paper.COLUMN_KN_N_M)) ** 2
     kn = paper.COLUMN_KN_N_M * max(1.0, ratio)
     return float(f"{kn:.2g}")

@@ -23,6 +23,7 @@ p-values, the verdict and the CPU time per member of each variant), ``convergenc
 and ``convergence.png``.
 """
 from dataclasses import dataclass
+import logging
 import math
 from pathlib import Path
 
@@ -32,13 +33,17 @@ from pipeline.campaign import Campaign, register
 from pipeline.campaign.options import CampaignOptions
 from pipeline.scenario.parameters import param
 from pipeline.campaign.run_dirs import finished_summary
-from pipeline.campaign.definitions import column_specs, run_code_version, run_column_spec
+from pipeline.campaign.runs import column_specs, run_column_spec
+from pipeline.simulate import run_code_version
 from pipeline.campaign.ensemble import (DEFAULT_SEED, ENSEMBLE_RANGES, check_seed,
                                         sample_batches)
 from pipeline.campaign.tables import collect
+from pipeline.constants import RIM_POINTS
 from pipeline.files import InputError, write_csv, write_json
 from pipeline.stats.circular import circular_summary
 from pipeline.stats.ensemble import compare_ensembles, holm_reject, wilson_interval
+
+log = logging.getLogger(__name__)
 
 DEFAULT_RECORDS = ("RC-CCC", "NF04", "RC-CLC")
 DEFAULT_MEMBERS = 32
@@ -54,7 +59,7 @@ ALPHA = 0.05                 # family-wise level of Holm's correction
 
 def variant_ranges(numerics):
     """The ensemble's ranges with the rim phase over one spacing of this variant's rim."""
-    points = numerics.get("rim_points", 16)
+    points = numerics.get("rim_points", RIM_POINTS)
     return dict(ENSEMBLE_RANGES, rim_phase_deg=(0.0, 360.0 / points, "uniform"))
 
 
@@ -84,7 +89,7 @@ def convergence_outputs(specs, campaign_dir, failures, animations, figures=True)
     result = compare_variants(runs, wall_per_member(specs, campaign_dir))
     write_csv(campaign_dir / "convergence.csv", _rows(result))
     write_json(campaign_dir / "convergence.json", result)
-    print(result["verdict"])
+    log.info(result["verdict"])
     written = []
     if figures:
         from pipeline.figures.ensemble import plot_convergence

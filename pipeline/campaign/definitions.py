@@ -1,78 +1,37 @@
-"""The campaigns: the paper's experiments and the verification, one definition each."""
+"""The campaigns of the paper's experiments and the verification, one definition each (their
+runs: :mod:`pipeline.campaign.runs`)."""
+import logging
+
 from dataclasses import dataclass
 from pathlib import Path
 
 from pipeline.constants import COLUMN_KINDS
-from pipeline import RESULTS_DIR, paper
+from pipeline import paper
 from pipeline.campaign import Campaign, register
 from pipeline.campaign.options import (CAMPAIGN_NOTE, CampaignOptions, ColumnFileOptions,
                                        column_file_param, stiffness_param)
 from pipeline.campaign.run_dirs import finished_summary
-from pipeline.campaign.spec import RunSpec
 from pipeline.campaign.column_file import (at_slenderness, check_stiffness, column_kn,
-                                           description, mark, matched_kn, summary_entry)
+                                           description, mark, matched_kn)
+from pipeline.campaign.runs import (column_outputs, column_specs, described_twins,
+                                    motion_cache,  # noqa: F401 (fragility.py imports it here)
+                                    pulse_record, run_column_spec, twin)
 from pipeline.campaign.tables import collect, write_tables
-from pipeline.files import (InputError, code_hash, content_hash, csv_true_column, write_csv,
+from pipeline.files import (InputError, code_hash, content_hash, write_csv,
                             write_json, write_text)
 from pipeline.motion import Motion, synthetics
-from pipeline.records import catalog, catalog_row, processed_motion, resolve, sets
+from pipeline.records import resolve, sets
 from pipeline.records.processing import signal_end_s
-from pipeline.scenario import RunParams
 from pipeline.scenario.parameters import param
-from pipeline.simulate import run_code_version, simulate
-from pipeline.stats.circular import direction_statistics, direction_table
+from pipeline.simulate import run_code_version
+from pipeline.stats.circular import direction_table
 from pipeline.motion.synthetics import rupture_centre
 from pipeline.stats.location import locate_source_from_falls
 from pipeline.scenario.column_format import example_names
 from pipeline.scenario.geometry import ColumnGeometry
 from pipeline import verification
 
-
-# ---------------------------------------------------------------- column runs
-def motion_cache(campaign_dir):
-    """Where a campaign caches processed motions: results/cache/motions, or inside the
-    campaign directory when it lies outside results/."""
-    campaign_dir = Path(campaign_dir).resolve()
-    if RESULTS_DIR.resolve() in campaign_dir.parents:
-        return RESULTS_DIR / "cache" / "motions"
-    return campaign_dir / "motions"
-
-
-def column_specs(runs, campaign_dir, tags=None, **common):
-    """Resolve (record, parameters) pairs into :class:`~pipeline.campaign.spec.RunSpec`:
-    each record processed once, record ids unique, run id = hash(code, motion content,
-    parameters); ``tags``: one dict per run, ``common``: tags of every run."""
-    version = run_code_version()
-    cache = motion_cache(campaign_dir)
-    resolved, ids = {}, {}
-    for record, _ in runs:
-        if record in resolved:
-            continue
-        _, path = processed_motion(record, cache_dir=cache)
-        source = resolve(record)
-        record_id = source.id
-        if source.row is None and catalog_row(record_id) is not None:
-            record_id = f"{record_id}-{path.stem[:6]}"      # a file named like a catalogue id
-        if ids.get(record_id, path) != path:
-            record_id = f"{record_id}-{path.stem[:6]}"      # two files with one stem
-        ids[record_id] = path
-        resolved[record] = (record_id, path)
-    tags = [{}] * len(runs) if tags is None else list(tags)
-    if len(tags) != len(runs):
-        raise ValueError("column_specs: one tags dict per run")
-    return [RunSpec.create(record, resolved[record][0], resolved[record][1], params, version,
-                           **common, **more)
-            for (record, params), more in zip(runs, tags)]
-
-
-def run_column_spec(spec, run_dir):
-    """Worker: one twin-model (or single column) run of a spec; ``column_file`` in its
-    parameters is a column description (dict, so that the run id covers its content) or
-    a shipped example's name."""
-    p = spec.params
-    simulate(Motion.load(spec.motion_file), run_dir, column=p.column, contact=p.contact,
-             numerics=p.numerics, window=p.drive.window, rotate_deg=p.drive.rotate_deg,
-             scale=p.drive.scale, record=spec.record_id, motion_file=spec.motion_file)
+log = logging.getLogger(__name__)
 
 
 @dataclass(frozen=True)
@@ -82,63 +41,8 @@ class SlendernessOptions(ColumnFileOptions):
         "sweep (overall height over base width)")
 
 
-def twin(**params):
-    """The flat parameters (:class:`~pipeline.scenario.parameters.RunParams` names) of a
-    twin-model run: the paper's for what is not given; with ``column_file`` (a
-    description dict) the described column and a monolith of its outline take the drums'
-    and the monolith's places."""
-    return RunParams.from_dict(params).to_dict()
-
-
-def pulse_record():
-    """Catalogue id of the pulse-like record that stands in for the paper's GM23."""
-    table = catalog()
-    chosen = table[csv_true_column(table["replaces_gm23"].astype(str))]
-    if chosen.empty:
-        raise InputError("records/catalog.csv nominates no record with replaces_gm23 = True")
-    return str(chosen["id"].iloc[0])
-
-
-def column_outputs(name, size_by=None):
-    """Outputs of a column campaign: runs.csv, impacts.csv, direction statistics, figures."""
-
-    def outputs(specs, campaign_dir, failures, animations, figures=True):
-        campaign_dir = Path(campaign_dir)
-        runs, impacts = collect(specs, name, campaign_dir)
-        described = summary_entry(specs)
-        if described and not runs.empty:
-            names = {s.run_id: s.params.column.column_file["name"] for s in specs}
-            runs.insert(1, "description", runs["run_id"].map(names))
-        write_tables(campaign_dir, runs, impacts)
-        written = []
-        if not runs.empty:
-            write_csv(campaign_dir / "direction_statistics.csv", direction_statistics(runs))
-            if figures:
-                from pipeline import figures as figure_module   # matplotlib: not after Ctrl-C
-                written = figure_module.campaign_figures(name, runs, impacts, campaign_dir,
-                                                         size_by, animations)
-        toppled = runs.groupby("column")["toppled"].agg(["sum", "count"]) if not runs.empty \
-            else None
-        print(f"wrote {campaign_dir / 'runs.csv'}" + (
-            "" if toppled is None else "; toppled: " + ", ".join(
-                f"{c} {int(r['sum'])}/{int(r['count'])}" for c, r in toppled.iterrows())))
-        return {"code_version": run_code_version(), **described,
-                "figures": [str(p.relative_to(campaign_dir)) for p in written]}
-
-    return outputs
-
-
 def _records_or(records, default):
     return list(records) if records else list(default)
-
-
-def described_twins(runs, column_file, stiffness):
-    """(record, twin parameters) pairs with the description ``column_file`` (a dict) and
-    its contact stiffness added; unchanged without one."""
-    if column_file is None:
-        return runs
-    kn = column_kn(column_file, stiffness)
-    return [(r, {**p, "column_file": column_file, "kn": kn}) for r, p in runs]
 
 
 def slenderness_specs(records, campaign_dir, column_file=None, stiffness="matched"):
@@ -324,7 +228,7 @@ def columns_outputs(specs, campaign_dir, failures, animations, figures=True):
     write_text(campaign_dir / "columns.md", "# Real columns on the same records\n\n"
                "uplift_ratio: rocking threshold / g from statics (d/h for a cylinder).\n\n"
                + text + "\n")
-    print(text)
+    log.info(text)
     written = []
     if figures and animations and not runs.empty:
         from pipeline.figures import animate_examples
@@ -373,7 +277,7 @@ def verification_outputs(specs, campaign_dir, failures, animations, figures=True
     summary["failed_runs"] = [s.run_id for s, _ in failures]
     write_json(Path(campaign_dir) / "verification.json", summary)
     for line in summary["lines"]:
-        print(line)
+        log.info(line)
     return {"figures": summary["figures"]}
 
 

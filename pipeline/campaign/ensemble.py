@@ -17,7 +17,7 @@ Ranges (``ENSEMBLE_RANGES``, all around the paper's values; override with
 - ``kn_factor`` 0.5-2 (log-uniform) on the paper's 1.2e8 N/m per point: the
   rocking response changes < 0.5 % for kn 1.2e7-1.2e9 (measured on the block);
 - ``height_tolerance`` and ``diameter_tolerance`` +-1 % of the nominal column
-  (masonry tolerances of cut drums; real geometry: issue "Real columns");
+  (masonry tolerances of cut drums; a real column's geometry: ``--column-file``);
 - ``rim_phase_deg`` 0 to one rim spacing: the rim discretisation moves a fall by
   up to ~12 deg (make bench); sampling its phase turns that bias into noise;
 - ``tilt_deg`` 0-0.5 deg toward ``tilt_azimuth_deg`` 0-360: a column already out
@@ -36,6 +36,7 @@ first that are not joined), and ``kn_factor`` multiplies the description's conta
 stiffness (``--stiffness``, as in ``campaign columns``).
 """
 from dataclasses import dataclass
+import logging
 import math
 from pathlib import Path
 
@@ -50,17 +51,20 @@ from pipeline.campaign.column_file import (check_stiffness, column_kn, mark, per
 from pipeline.campaign.options import CampaignOptions, column_file_param, stiffness_param
 from pipeline.scenario.parameters import check_time_step, param
 from pipeline.campaign.column_file import description as column_file_description
-from pipeline.campaign.definitions import column_specs, run_code_version, run_column_spec
+from pipeline.campaign.runs import column_specs, run_column_spec
 from pipeline.campaign.run_dirs import finished_summary
 from pipeline.campaign.tables import collect, write_parquet
 from pipeline.files import InputError, write_csv, write_json
 from pipeline.scenario import Contact, Numerics
-from pipeline.simulate import check_scale
+from pipeline.simulate import check_scale, run_code_version
 from pipeline.scenario.column_format import MAX_OFFSET_M
+from pipeline.constants import RIM_POINTS
 from pipeline.scenario.geometry import ColumnGeometry
-from pipeline.stats.circular import angle_difference_deg, circular_summary
-from pipeline.stats.ensemble import (bootstrap_mean_azimuth_ci, direction_fractions, pooled_answer,
-                                     wilson_interval)
+from pipeline.campaign.sizing import (DEFAULT_ARC_DEG, DEFAULT_MAX_MEMBERS, DEFAULT_PRECISION,
+                                      run_sized, write_summaries)
+from pipeline.stats.ensemble import pooled_summary, record_summary
+
+log = logging.getLogger(__name__)
 
 DEFAULT_MEMBERS = 16
 KEPT_TRAJECTORIES = 2          # the nominal run and the first members keep trajectory.npz
@@ -71,7 +75,7 @@ ENSEMBLE_RANGES = {            # name: (low, high, "uniform" | "log")
     "kn_factor": (0.5, 2.0, "log"),
     "height_tolerance": (-0.01, 0.01, "uniform"),
     "diameter_tolerance": (-0.01, 0.01, "uniform"),
-    "rim_phase_deg": (0.0, 360.0 / 16, "uniform"),
+    "rim_phase_deg": (0.0, 360.0 / RIM_POINTS, "uniform"),
     "tilt_deg": (0.0, 0.5, "uniform"),
     "tilt_azimuth_deg": (0.0, 360.0, "uniform"),
     "drum_offset_mm": (0.0, 3.0, "uniform"),
@@ -265,7 +269,7 @@ def ensemble_outputs(specs, campaign_dir, failures, animations, figures=True):
         sub = runs[runs["record_id"] == record_id].sort_values(["member", "column"])
         write_csv(out / "members.csv", sub)
         write_parquet(out / "members.parquet", sub)
-        summary = summarise(sub, record_id, specs[0].tags["seed"])
+        summary = record_summary(sub, record_id, specs[0].tags["seed"])
         summary["record_input"] = next(sp.record for sp in specs
                                        if sp.record_id == record_id)
         if described:
@@ -275,9 +279,9 @@ def ensemble_outputs(specs, campaign_dir, failures, animations, figures=True):
             written += plot_ensemble(sub, summary, out)
         for col in summary["columns"]:
             az = col["mean_downfall_azimuth_deg"]
-            print(f"{record_id} {col['column']:>10}: P(toppled) {col['p_toppled']:.2f} "
-                  f"[{col['p_toppled_ci95'][0]:.2f}, {col['p_toppled_ci95'][1]:.2f}]"
-                  + ("" if az is None else f", mean downfall {az:.0f} deg "
+            log.info(f"{record_id} {col['column']:>10}: P(toppled) {col['p_toppled']:.2f} "
+                     f"[{col['p_toppled_ci95'][0]:.2f}, {col['p_toppled_ci95'][1]:.2f}]"
+                     + ("" if az is None else f", mean downfall {az:.0f} deg "
                      f"(R {col['resultant_length']:.2f})"))
     write_summaries(campaign_dir, summaries)
     if len(records) > 1:
@@ -293,44 +297,13 @@ def ensemble_outputs(specs, campaign_dir, failures, animations, figures=True):
                 errors = ", ".join(f"{name} +-{st[name]['mc_error']:.2f}" for name in
                                    ("p_toppled", "polarity", "radial_alignment")
                                    if st[name]["mc_error"] is not None)
-                print(f"over {pooled['records']} records, {col['column']}: {col['answer']} "
-                      f"(Monte Carlo error: {errors})")
+                log.info(f"over {pooled['records']} records, {col['column']}: {col['answer']} "
+                         f"(Monte Carlo error: {errors})")
     return {"code_version": run_code_version(), **described,
             "figures": [str(Path(p).relative_to(campaign_dir)) for p in written]}
 
 
 POOLED_FILE = "pooled_summary.json"
-QUESTION = ("Do the columns fall toward (or away from) the epicentre?  Hinzen (2009) asked it "
-            "of single runs; here every record's ensemble answers, pooled over the records.")
-
-
-def pooled_summary(runs, resamples=2000):
-    """The paper's question over the records of an ensemble campaign that have a back
-    azimuth (:func:`pipeline.stats.ensemble.pooled_answer` per column: every record
-    weighs alike; intervals hold the choice of records and the members' Monte Carlo
-    error); None for fewer than two such records."""
-    members = runs[(runs["member"] >= 0) & runs["back_azimuth_deg"].notna()]
-    records = list(dict.fromkeys(members["record_id"]))
-    if len(records) < 2:
-        return None
-    columns = []
-    for column, group in members.groupby("column", sort=True):
-        toppled, relative = [], []
-        for record_id in records:
-            sub = group[group["record_id"] == record_id].sort_values("member")
-            t = sub["toppled"].astype(bool).to_numpy()
-            toppled.append(t)
-            relative.append(np.where(t, angle_difference_deg(
-                sub["downfall_azimuth_deg"].to_numpy(float),
-                sub["back_azimuth_deg"].to_numpy(float)), np.nan))
-        answer = pooled_answer(toppled, relative, resamples=resamples)
-        columns.append({"column": column, **answer, "answer": pooled_sentence(answer)})
-    return {"question": QUESTION, "records": len(records), "record_ids": records,
-            "members_per_record": {r: int((members["record_id"] == r).sum()
-                                          / members["column"].nunique()) for r in records},
-            "columns": columns}
-
-
 def yade_cost(campaign_dir, run_ids):
     """What the finished runs ``run_ids`` of the campaign in ``campaign_dir`` cost: their
     number and their YADE processes' wall times summed (s); a campaign on ``--jobs`` N
@@ -338,195 +311,6 @@ def yade_cost(campaign_dir, run_ids):
     done = [finished_summary(campaign_dir, r) for r in dict.fromkeys(run_ids)]
     done = [s for s in done if s is not None]
     return {"runs": len(done), "yade_wall_s_total": round(float(sum(s.wall_s for s in done)), 1)}
-
-
-def pooled_sentence(answer):
-    """One sentence: what the pooled fall directions say of the epicentre's direction."""
-    st = answer["statistics"]
-
-    def value(name, digits=2):
-        s = st[name]
-        return (f"{s['estimate']:.{digits}f} [{s['ci95'][0]:.{digits}f}, "
-                f"{s['ci95'][1]:.{digits}f}]")
-
-    p = f"P(toppled) {value('p_toppled')} per record"
-    if answer["falls"] < 2 or st["polarity"]["ci95"] is None:
-        return f"{p}; too few falls to say where they point"
-    polar, radial = st["polarity"], st["radial_alignment"]
-    if polar["differs"]:
-        side = "toward" if polar["estimate"] > 0 else "away from"
-        finding = f"falls lean {side} the epicentre (polarity {value('polarity')}, 0: no relation)"
-    elif radial["differs"]:
-        side = "along" if radial["estimate"] > 0 else "across"
-        finding = (f"falls gather {side} the epicentre line, as often toward as away "
-                   f"(radial alignment {value('radial_alignment')}, 0: no relation)")
-    else:
-        finding = (f"the fall directions show no relation to the epicentre's direction "
-                   f"(polarity {value('polarity')}, radial alignment "
-                   f"{value('radial_alignment')}; 0: no relation)")
-    return (f"{p}; {finding}; toward {value('fraction_toward')}, away "
-            f"{value('fraction_away')} of the falls (0.25 each without a relation)")
-
-
-def mean_direction_error_deg(azimuths_deg):
-    """Standard error (deg) of the circular mean of ``azimuths_deg`` (Fisher 1993, eq.
-    4.21: sqrt((1 - R2) / (2 n R^2)), R2 the mean resultant of the doubled deviations);
-    None for fewer than 2 or a mean that is not defined."""
-    a = np.radians(np.asarray(azimuths_deg, float))
-    a = a[np.isfinite(a)]
-    if a.size < 2:
-        return None
-    c, s = np.cos(a).mean(), np.sin(a).mean()
-    r = math.hypot(c, s)
-    if r < 1e-9:
-        return None
-    r2 = float(np.cos(2 * (a - math.atan2(s, c))).mean())
-    return float(math.degrees(math.sqrt(max(0.0, 1 - r2) / (2 * a.size * r * r))))
-
-
-def summarise(runs, record_id, seed):
-    """``ensemble_summary.json`` content of one record (see the module docstring)."""
-    back = runs["back_azimuth_deg"].dropna()
-    back = float(back.iloc[0]) if len(back) else None
-    members = runs[runs["member"] >= 0]
-    columns = []
-    for column, group in members.groupby("column", sort=True):
-        fell = group[group["toppled"].astype(bool)]
-        az = fell["downfall_azimuth_deg"].to_numpy(float)
-        stats = circular_summary(az)
-        nominal_row = runs[(runs["member"] == -1) & (runs["column"] == column)]
-        nominal_az = (None if nominal_row.empty or not np.isfinite(
-            nominal_row["downfall_azimuth_deg"].iloc[0]) else
-            float(nominal_row["downfall_azimuth_deg"].iloc[0]))
-        columns.append({
-            "column": column, "members": int(len(group)), "toppled": int(len(fell)),
-            "p_toppled": float(len(fell) / len(group)),
-            "p_toppled_ci95": wilson_interval(len(fell), len(group)),
-            "p_toppled_mc_error": float(math.sqrt(len(fell) * (len(group) - len(fell))
-                                                  / len(group) ** 3)),
-            "mean_azimuth_mc_error_deg": mean_direction_error_deg(az),
-            "mean_downfall_azimuth_deg": None if not len(fell) or not np.isfinite(
-                stats["mean_deg"]) else stats["mean_deg"],
-            "resultant_length": None if not len(fell) else stats["resultant_length"],
-            "mean_azimuth_ci95_deg": bootstrap_mean_azimuth_ci(az),
-            **direction_fractions(az, back),
-            "nominal_toppled": None if nominal_row.empty else bool(
-                nominal_row["toppled"].iloc[0]),
-            "nominal_downfall_azimuth_deg": nominal_az,
-            "impact_time_s_median": None if not len(fell) else float(
-                np.median(fell["impact_time_s"]))})
-    return {"record": record_id, "members": int(members["member"].nunique()), "seed": seed,
-            "back_azimuth_deg": back, "columns": columns}
-
-
-DEFAULT_PRECISION = 0.1       # half-width of P(toppled)'s 95 % interval
-DEFAULT_ARC_DEG = 60.0        # width of the mean direction's 95 % interval, where falls gather
-DEFAULT_MAX_MEMBERS = 256
-CONCENTRATED = {"falls": 5, "resultant_length": 0.5}   # "falls concentrate"
-
-
-def converged(summary, precision, arc_deg):
-    """(bool, why) for one record's summary: every column's P(toppled) interval within
-    +-``precision`` and, where falls concentrate, its mean-direction interval under
-    ``arc_deg``."""
-    for col in summary["columns"]:
-        lo, hi = col["p_toppled_ci95"]
-        if (hi - lo) / 2 > precision:
-            return False, f"{col['column']}: P(toppled) +-{(hi - lo) / 2:.2f}"
-        ci = col.get("mean_azimuth_ci95_deg")
-        if (col["toppled"] >= CONCENTRATED["falls"] and ci is not None
-                and (col["resultant_length"] or 0) >= CONCENTRATED["resultant_length"]):
-            width = (ci[1] - ci[0]) % 360.0
-            if width > arc_deg:
-                return False, f"{col['column']}: mean direction arc {width:.0f} deg"
-    return True, "precision reached"
-
-
-def members_needed(summary, precision, batch, cap, arc_deg=None):
-    """Members (whole batches beyond the record's current ones, at most ``cap``, at least
-    one batch more) whose P(toppled) Wilson interval would be within +-``precision`` at the
-    fractions toppled so far: a record far from its precision gets several batches in one
-    round instead of a round per batch; likewise for a mean direction's interval wider
-    than ``arc_deg`` where falls gather (its width shrinks as 1 / sqrt(falls))."""
-    current = summary["columns"][0]["members"] if summary["columns"] else 0
-    need = min(cap, current + batch)
-    for col in summary["columns"]:
-        p = col["toppled"] / max(col["members"], 1)
-        n = current + batch
-        while n < cap:
-            lo, hi = wilson_interval(round(p * n), n)
-            if (hi - lo) / 2 <= precision:
-                break
-            n += batch
-        need = max(need, min(cap, n))
-        ci = col.get("mean_azimuth_ci95_deg")
-        if (arc_deg is not None and ci is not None and col["toppled"] >= CONCENTRATED["falls"]
-                and (col["resultant_length"] or 0) >= CONCENTRATED["resultant_length"]):
-            width = (ci[1] - ci[0]) % 360.0     # shrinks as 1 / sqrt(falls)
-            if width > arc_deg:
-                falls = col["toppled"] * (width / arc_deg) ** 2
-                n = current + batch * math.ceil(
-                    max(falls / max(p, 1e-9) - current, 1) / batch)
-                need = max(need, min(cap, n))
-    return need
-
-
-def write_summaries(campaign_dir, summaries):
-    """Each record's ensemble_summary.json (in ``campaign_dir``, or its record's folder when
-    there are several) and, for several records, ensemble_summaries.json with all."""
-    campaign_dir = Path(campaign_dir)
-    for summary in summaries:
-        out = campaign_dir if len(summaries) == 1 else campaign_dir / summary["record"]
-        write_json(out / "ensemble_summary.json", summary)
-    if len(summaries) > 1:
-        write_json(campaign_dir / "ensemble_summaries.json", summaries)
-
-
-def written_summaries(campaign_dir, n_records):
-    """The summaries :func:`write_summaries` wrote for a campaign of ``n_records`` records."""
-    import json
-    campaign_dir = Path(campaign_dir)
-    path = campaign_dir / ("ensemble_summaries.json" if n_records > 1 else
-                           "ensemble_summary.json")
-    if not path.exists():
-        return []
-    data = json.loads(path.read_text())
-    return data if n_records > 1 else [data]
-
-
-def run_sized(run, records, campaign_dir, options, gate=None):
-    """Add members in Latin-hypercube batches of ``options["members"]`` to the records not
-    yet converged (:func:`converged`) until all are or ``max_members`` is reached; each
-    record's ensemble_summary.json gets ``sizing`` (target, members, why it stopped).
-    ``run(options)`` runs the campaign once (its outputs write the summaries, read back
-    here with :func:`written_summaries`) and returns its outputs dict; it asks the
-    long-run gate before each batch (``gate``, for an estimate of the driver's own: not
-    used)."""
-    batch, cap = options["members"], options["max_members"]
-    precision, arc = options["precision"], options["arc_deg"]
-    counts = {rec: min(batch, cap) for rec in records}
-    while True:
-        result = run({**options, "batch": batch, "record_members": dict(counts)})
-        summaries = written_summaries(campaign_dir, len(counts))
-        pending = {}
-        for summary in summaries:
-            rec = summary["record_input"]
-            ok, why = converged(summary, precision, arc)
-            if not ok and counts[rec] < cap:
-                pending[rec] = why
-            summary["sizing"] = {"precision": precision, "arc_deg": arc, "batch": batch,
-                                 "max_members": cap, "members": counts[rec],
-                                 "stopped_by": "precision" if ok else "member cap",
-                                 "open": None if ok else why}
-        if not pending:
-            break
-        for rec, why in pending.items():
-            summary = next(x for x in summaries if x["record_input"] == rec)
-            more = members_needed(summary, precision, batch, cap, arc) - counts[rec]
-            print(f"{rec}: {why} after {counts[rec]} members: adding {more}", flush=True)
-            counts[rec] += more
-    write_summaries(campaign_dir, summaries)
-    return {**result, "summaries": summaries}
 
 
 @dataclass(frozen=True)

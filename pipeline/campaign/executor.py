@@ -28,6 +28,7 @@ Once the first runs are done (as many as run at once), a campaign whose rest tak
 ``WARN_FROM_S`` on; it says it again, a few times in hours at most, when the pace moves
 the rest by ``REVISE_FACTOR``.
 """
+import logging
 import os
 import time
 from concurrent.futures import FIRST_COMPLETED, ThreadPoolExecutor, wait
@@ -40,6 +41,8 @@ from pipeline.campaign.run_dirs import book_finished, keep_only_summary
 from pipeline.files import DirectoryLock, InputError, duration_text
 from pipeline.motion import Motion
 from pipeline.scenario.runner import kill_running, reuse_processes
+
+log = logging.getLogger(__name__)
 
 EXECUTORS = ("threads", "dask")
 DEFAULT_EXECUTOR = "threads"    # why: docs/campaigns.md, "On a cluster: Dask" (start-up, ports)
@@ -76,8 +79,8 @@ def execute(specs, campaign_dir, jobs, worker, label="runs", executor=None, sche
     where = (f"{jobs} parallel YADE process(es)" if executor == "threads" else
              f"{jobs} local Dask worker process(es)" if not scheduler else
              f"the Dask cluster at {scheduler}" + (f", {jobs} at a time" if jobs else ""))
-    print(f"{Path(campaign_dir).name}: {len(specs)} {label}, {done} already done, "
-          f"{len(todo)} to run with {where}", flush=True)
+    log.info(f"{Path(campaign_dir).name}: {len(specs)} {label}, {done} already done, "
+             f"{len(todo)} to run with {where}")
     if not todo:
         return [], False
     bar = ForecastBar(total=len(specs), initial=done, unit="run", dynamic_ncols=True,
@@ -93,7 +96,7 @@ def execute(specs, campaign_dir, jobs, worker, label="runs", executor=None, sche
 
 
 class ForecastBar(tqdm):
-    """The campaign's progress bar.  Once the ``first`` runs of this session are done it
+    """The campaign's progress bar.  Once the ``first`` runs of this command are done it
     says how long the rest takes at the pace so far (wall time on this machine) when that
     is ``FORECAST_FROM_S`` or more, as a warning from ``WARN_FROM_S`` on.  It says it
     again when the pace of every run done so far puts the rest ``REVISE_FACTOR`` times

@@ -5,14 +5,14 @@ fields of a frozen dataclass (the command line builds their flags:
 from dataclasses import dataclass, fields
 
 from pipeline import paper
-from pipeline.campaign.column_file import STIFFNESS_CHOICES, column_file_help
+from pipeline.campaign.column_file import STIFFNESS_CHOICES, column_file_help, paper_rocking_hz
 from pipeline.scenario.parameters import check_fields, param
 
 CAMPAIGN_NOTE = ("the described column stands in the drums' place and a monolith of its "
                  "outline in the monolith's")
 STIFFNESS_HELP = ("contact stiffness per point: matched raises the paper's kn for heavy "
                   "columns so that each rocks on its contact springs no slower than the "
-                  f"paper's column (13.5 Hz); paper: {paper.COLUMN_KN_N_M:g} N/m for all")
+                  f"paper's column ({paper_rocking_hz():.1f} Hz); paper: {paper.COLUMN_KN_N_M:g} N/m for all")
 
 
 def column_file_param(note="", many=False):

@@ -16,8 +16,10 @@ F1, confusion) are reported per split beside the trivial baselines ("never overt
 ``experiments.csv`` (per test and parameter set), ``shake_table.json`` (scores), the
 figure ``shake_table_rates.png`` (observed and predicted rate per PGA x PGV/PGA bin).
 """
+import dataclasses
 from dataclasses import dataclass
 import itertools
+import logging
 import math
 from datetime import date
 from pathlib import Path
@@ -25,33 +27,36 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from pipeline import RESULTS_DIR
 from pipeline.campaign import Campaign, register
 from pipeline.campaign.run_dirs import finished_summary
 from pipeline.campaign.options import CampaignOptions, column_file_param
-from pipeline.scenario.parameters import param
+from pipeline.scenario.parameters import Contact, param
 from pipeline.files import InputError, write_csv, write_json
 from pipeline.records import RECORDS_DIR
 from pipeline.stats.classification import scores
 from pipeline.scenario.geometry import ColumnGeometry
-from pipeline.campaign.definitions import column_specs, run_column_spec
+from pipeline.campaign.runs import column_specs, run_column_spec
+
+log = logging.getLogger(__name__)
 
 EXPERIMENTS = RECORDS_DIR / "shake_table" / "tests.csv"
 SPECIMEN = RECORDS_DIR / "shake_table" / "sp1.json"
 OUTCOME = "sp1_overturned"
 AXIS_DEG = 90.0                  # the shipped tests shake along East-West
 RUN_CPU_S = 1.6                  # CPU-s per run: 2,303 runs of SP1 took 62 CPU-min (2026-11-24)
-VALIDATE_FROM = "2021-08-01"     # the issue's split: calibrate on June-July, validate August
+VALIDATE_FROM = "2021-08-01"     # calibrate on the June-July tests, validate on August's
 COLUMNS = ("test", "date", "pga_g", "pgv_pga_s", "motion_file")
 # what --grid may vary: contact parameters, and the specimen's footprint tolerance
-GRID_CONTACT = {"kn": (1e5, 1e11), "damping": (0.0, 1.0), "mu_s": (0.01, 2.0),
-                "mu_k": (0.01, 2.0)}
+# (the bounds of Contact's fields; mu_k within mu_s's, and mu_k <= mu_s per point)
+GRID_CONTACT = {f.name: (f.metadata["low"], f.metadata["high"])
+                for f in dataclasses.fields(Contact) if f.metadata["low"] is not None}
+GRID_CONTACT["mu_k"] = GRID_CONTACT["mu_s"]
 GRID_SPECIMEN = {"footprint_tolerance_m": (0.0, 0.05)}
 # and the motion: rotate_deg turns the table motion clockwise (180: the other sign of an
 # axis whose sign the laboratory does not state)
 GRID_MOTION = {"rotate_deg": (0.0, 360.0)}
 DEFAULT_GRID = "footprint_tolerance_m=0.001,0.003;damping=0.05,0.1;rotate_deg=0,180"
-DEFAULT_CONTACT = {"kn": 1.2e8, "damping": 0.36, "mu_s": 0.7, "mu_k": 0.6}
+DEFAULT_CONTACT = dataclasses.asdict(Contact())      # the paper's contact
 PGA_EDGES_G = np.array([0.0, 0.1, 0.2, 0.3, 0.4, 0.5, 0.7, 1.0, 2.0])
 PGV_PGA_EDGES_S = np.array([0.0, 0.05, 0.1, 0.2, 0.3, 0.5, 1.0])
 
@@ -224,21 +229,20 @@ def drive(run, records, campaign_dir, options, gate=None):
                          "all): nothing to calibrate on")
     points = len(parse_grid(options["grid"]))
     runs = points * early + late
-    print(f"shake-table: {points} parameter set(s) x {early} calibration tests, then the "
-          f"chosen set on {late} validation tests: at most {runs} YADE runs, about "
-          f"{runs * RUN_CPU_S / 60:.0f} CPU-min (finished runs are kept and not run again)",
-          flush=True)
+    log.info(f"shake-table: {points} parameter set(s) x {early} calibration tests, then the "
+             f"chosen set on {late} validation tests: at most {runs} YADE runs, about "
+             f"{runs * RUN_CPU_S / 60:.0f} CPU-min (finished runs are kept and not run again)")
     if gate is not None:
         gate("shake-table", runs, RUN_CPU_S, "a smaller --grid or --tests")
     calibration = run({**options, "stage": "calibration"})
     label, point = best_point(calibration)
-    print(f"calibration: best {label} (accuracy {calibration['scores'][label]['accuracy']:.3f} "
-          f"on {calibration['scores'][label]['n']} tests)", flush=True)
+    log.info(f"calibration: best {label} (accuracy {calibration['scores'][label]['accuracy']:.3f} "
+             f"on {calibration['scores'][label]['n']} tests)")
     if late:
         validation = run({**options, "stage": "validation", "chosen": point})
     else:
-        print(f"no test from {options['validate_from']} on: the calibration's scores alone, "
-              "no validation", flush=True)
+        log.info(f"no test from {options['validate_from']} on: the calibration's scores alone, "
+                 "no validation")
         validation = calibration
     specimen = ColumnGeometry.load(options["specimen"])
     table = _experiment_table(frame, campaign_dir, label, options["validate_from"])
@@ -249,7 +253,7 @@ def drive(run, records, campaign_dir, options, gate=None):
     plot_rates(table, campaign_dir / "shake_table_rates.png", result, PGA_EDGES_G,
                PGV_PGA_EDGES_S)
     for line in result["lines"]:
-        print(line)
+        log.info(line)
     return {**validation, "summary": result}
 
 
@@ -366,5 +370,3 @@ register(Campaign(
     "experiments: calibrate on the early tests, validate on the held-out later ones",
     specs, _worker, outputs, label="experiments", options=ShakeTableOptions, driver=drive,
     run_core_s=RUN_CPU_S))
-
-RESULTS = RESULTS_DIR / "shake-table"

@@ -37,7 +37,7 @@ def write_parquet(path, frame):
     """Write a DataFrame atomically as Parquet (pyarrow, no index).  Object columns
     mixing types (a text value in one run, a number in another) are written as text."""
     frame = frame.copy()
-    for column in frame.columns[frame.dtypes == object]:
+    for column in frame.columns[frame.dtypes.eq(object)]:
         try:
             pa.array(frame[column], from_pandas=True)
         except (pa.ArrowInvalid, pa.ArrowTypeError):

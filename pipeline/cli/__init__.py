@@ -4,16 +4,44 @@ Each module of this package is one command and defines ``NAME``, ``HELP``,
 ``setup(parser)`` and ``run(args) -> int``; commands are found with pkgutil, so
 a new command is one new module.  A :class:`~pipeline.files.ToolError` becomes
 one line on stderr: exit status 2 for bad input, 1 for other failures; Ctrl-C
-exits 130 (SIGTERM 143) after finished results are written.
+exits 130 (SIGTERM 143) after finished results are written.  The stages say what they do
+through :mod:`logging` (logger ``pipeline``); :func:`setup_logging` prints it as lines.
 """
 import argparse
 import errno
 import importlib
+import logging
 import pkgutil
 import sys
 
 from pipeline import INTERRUPTED, interrupted_status
 from pipeline.files import InputError, ToolError
+
+
+class TerminalHandler(logging.Handler):
+    """The stages' log messages as plain lines: on stdout, or on stderr when logged with
+    ``extra={"stderr": True}``; a warning as ``warning: ...``.  The stream is looked up
+    at each message (a redirected ``sys.stdout`` is followed)."""
+
+    def emit(self, record):
+        try:
+            text = record.getMessage()
+            if record.levelno >= logging.WARNING:
+                text = f"warning: {text}"
+            stream = sys.stderr if getattr(record, "stderr", False) else sys.stdout
+            stream.write(text + "\n")
+            stream.flush()
+        except Exception:                   # logging's own convention: never raise
+            self.handleError(record)
+
+
+def setup_logging():
+    """Print the ``pipeline`` logger's messages (INFO and above) on the terminal, once."""
+    logger = logging.getLogger("pipeline")
+    logger.setLevel(logging.INFO)
+    logger.propagate = False
+    if not any(isinstance(h, TerminalHandler) for h in logger.handlers):
+        logger.addHandler(TerminalHandler())
 
 
 def commands():
@@ -50,6 +78,7 @@ def empty_path_option(argv):
 
 
 def main(argv=None):
+    setup_logging()
     parser = build_parser()
     empty = empty_path_option(argv)
     if empty:

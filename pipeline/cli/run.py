@@ -5,6 +5,7 @@
 from pathlib import Path
 
 from pipeline import RESULTS_DIR
+from pipeline.campaign.column_file import paper_rocking_hz
 from pipeline.constants import COLUMN_TYPES
 from pipeline.files import DirectoryLock, InputError
 from pipeline.motion import RECORD_CLOCK
@@ -119,7 +120,7 @@ def run(args):
         hz = column.geometry.contact_rocking_hz(contact.kn, numerics.rim_points)
         if hz < SOFT_CONTACT_HZ:
             print(f"note: with --kn {contact.kn:g} this column rocks on its contact springs "
-                  f"at {hz:.1f} Hz (the paper's column at 13.5 Hz): raise --kn (campaign "
+                  f"at {hz:.1f} Hz (the paper's column at {paper_rocking_hz():.1f} Hz): raise --kn (campaign "
                   "columns does) for rigid-block behaviour")
     if summary.start_in_file_s != 0.0:
         print(f"times in {RECORD_CLOCK} (the simulated motion, and trajectory.npz's clock, "

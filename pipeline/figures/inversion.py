@@ -6,6 +6,7 @@ import math
 import numpy as np
 from matplotlib.lines import Line2D
 
+from pipeline import paper
 from pipeline.figures.style import colour, new_figure
 from pipeline.files import save_figure
 
@@ -185,7 +186,8 @@ def plot_interval_widths(table, path):
                                group["coverage_back_azimuth_95"]):
                 ax.annotate(f"{100 * c:.0f}%", (x, y), xytext=(4, 4), fontsize=7,
                             textcoords="offset points", color=f"C{k}")
-        ax.axhline(60.0, color="k", lw=1, ls=":", label="±30°")
+        bound = paper.BACK_AZIMUTH_BOUND_DEG
+        ax.axhline(2 * bound, color="k", lw=1, ls=":", label=f"±{bound:g}°")
         ax.set_xscale("log")
         ax.set_xticks(ticks)
         ax.set_xticklabels([f"{v:g}" for v in ticks])

@@ -26,6 +26,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from pipeline import paper
 from pipeline.files import InputError, write_csv, write_json
 from pipeline.inversion.likelihood import (DEFAULT_FLOOR, DEFAULT_KERNEL_DEG, LIKELIHOODS,
                                            ForwardModel)
@@ -41,9 +42,14 @@ DEFAULT_TRIALS = 20
 OBS_UNCERTAINTY_DEG = 10.0
 DEMO_SEED = 2009
 PAPER_RINGS_KM = (5.0, 10.0, 20.0)
-PAPER_AZIMUTH_STEP_DEG = 30.0
 PAPER_MECHANISMS = {"strike_slip": "strike-slip", "thrust": "thrust"}
-BOUND_DEG = 60.0            # the paper's question: back azimuth within +-30 deg
+# the paper's question: a 95 % back-azimuth arc no wider than BOUND_DEG (deg), and its
+# words and result keys
+BOUND_DEG = 2 * paper.BACK_AZIMUTH_BOUND_DEG
+BOUND_TEXT = f"+-{paper.BACK_AZIMUTH_BOUND_DEG:g} deg"
+BOUNDED_FRACTION_KEY = f"bounded_{paper.BACK_AZIMUTH_BOUND_DEG:g}_fraction"
+BOUND_ANSWER_KEY = f"bound_{paper.BACK_AZIMUTH_BOUND_DEG:g}_deg"
+SITES_WITHIN_KEY = f"sites_within_{paper.BACK_AZIMUTH_BOUND_DEG:g}_deg"
 
 
 def split_members(table):
@@ -203,7 +209,7 @@ def narrowing(trials):
                          float(g["distance_in_95_or_warned"].mean()),
                      "reach_warning_fraction": float(g["reach_warning"].mean()),
                      "coverage_back_azimuth_68": float(g["back_azimuth_in_68"].mean()),
-                     "bounded_30_fraction": float((w <= BOUND_DEG).mean()),
+                     BOUNDED_FRACTION_KEY: float((w <= BOUND_DEG).mean()),
                      "median_abs_map_error_deg": float(
                          g["map_back_azimuth_error_deg"].abs().median()),
                      "credible_area_95_km2_median": float(g["credible_area_95_km2"].median()),
@@ -213,7 +219,7 @@ def narrowing(trials):
 
 def bound_answer(narrow):
     """The paper's question: per (mechanism, sites) the fewest fallen columns per site whose
-    median 95 % back-azimuth arc is within +-30 deg (None: not reached)."""
+    median 95 % back-azimuth arc is at most BOUND_DEG wide (None: not reached)."""
     out = []
     for (kind, mech, sites), g in narrow.groupby(["likelihood", "mechanism", "sites"]):
         g = g.sort_values("fallen_per_site")
@@ -357,7 +363,7 @@ def run_demo(table, out_dir, candidates, paper_tables=None, trials=DEFAULT_TRIAL
         "observation_uncertainty_deg": OBS_UNCERTAINTY_DEG,
         "trials_per_configuration": trials, "coverage": coverage,
         "narrowing": narrow.to_dict(orient="records"),
-        "bound_30_deg": bound_answer(narrow),
+        BOUND_ANSWER_KEY: bound_answer(narrow),
         "paper_scenario": {"joint": paper_joint,
                            "per_source": _paper_per_source(paper_sites)},
         "figures": [str(Path(f).relative_to(out_dir)) for f in figures],
@@ -463,7 +469,7 @@ def _paper_per_source(sites):
                         float(g[g["fallen"] == 0]["width95_deg"].median()),
                     "back_azimuth_in_95_sites_with_falls":
                         None if fell.empty else float(fell["back_azimuth_in_95"].mean()),
-                    "sites_within_30_deg": int((g["width95_deg"] <= BOUND_DEG).sum()),
+                    SITES_WITHIN_KEY: int((g["width95_deg"] <= BOUND_DEG).sum()),
                     "sites_reach_warning": int(g["reach_warning"].sum()),
                     "median_abs_map_error_deg_sites_with_falls":
                         None if fell.empty else float(fell["map_error_deg"].abs().median())})

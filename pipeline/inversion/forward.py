@@ -26,6 +26,7 @@ executor, so they are cached by content (run id = hash of motion, parameters and
 a second inversion reuses every finished run.
 """
 from dataclasses import dataclass
+import logging
 import time
 from pathlib import Path
 
@@ -33,13 +34,15 @@ from pipeline import RESULTS_DIR
 from pipeline.campaign import Campaign, register
 from pipeline.campaign.options import CampaignOptions
 from pipeline.scenario.parameters import param
-from pipeline.campaign.definitions import column_specs, run_column_spec
+from pipeline.campaign.runs import column_specs, run_column_spec
 from pipeline.files import InputError, write_csv
 from pipeline.inversion.grid import GRIDS, TableGrid, node_positions, slice_motions
 from pipeline.inversion.table import ForwardTable
 from pipeline.campaign.column_file import column_kn
 from pipeline.campaign.ensemble import nominal, sample_members
 from pipeline.campaign import run_campaign
+
+log = logging.getLogger(__name__)
 
 DEFAULT_FORWARD_DIR = RESULTS_DIR / "inversion-forward"
 
@@ -98,8 +101,8 @@ def forward_outputs(specs, campaign_dir, failures, animations, figures=True):
     write_csv(path.with_name(f"forward_cells_{grid.key()}.csv"), table.cells())
     done = int(table.valid.any(axis=3).sum() + (table.nominal_valid.any(axis=3).sum()
                                                  if table.nominal_valid is not None else 0))
-    print(f"wrote {path} ({done} of {len(specs)} runs finished; YADE wall "
-          f"{table.info['yade_wall_s']:.0f} s in total)")
+    log.info(f"wrote {path} ({done} of {len(specs)} runs finished; YADE wall "
+             f"{table.info['yade_wall_s']:.0f} s in total)")
     return {"table": str(path), "grid": grid.as_dict(), "grid_key": grid.key(),
             "runs_finished": done}
 

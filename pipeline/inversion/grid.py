@@ -3,6 +3,7 @@ around the epicentre (:class:`TableGrid`, presets ``GRIDS``), and the pyprop8 mo
 its nodes (:func:`slice_motions`).  Symmetries and sources: :mod:`pipeline.inversion.forward`."""
 import dataclasses
 import json
+import logging
 import math
 import os
 import time
@@ -18,6 +19,8 @@ from pipeline.motion import Motion
 from pipeline.motion.synthetics import CRUST_LAYERS, LEAD_TIME_S, SOURCES, moment_from_mw, numerics
 from pipeline.motion.synthetics.compute import _point_source_task
 from pipeline.campaign.column_file import description
+
+log = logging.getLogger(__name__)
 
 GENERATOR_VERSION = 1          # bump when the written motions change
 REFERENCE_MW = 6.5             # the paper scenario's magnitude: the sub-event template's
@@ -231,8 +234,8 @@ def slice_motions(grid, motion_dir, jobs=None, positions=None):
         return out
     jobs = max(1, min(jobs or os.cpu_count() or 1, len(tasks)))
     started = time.monotonic()
-    print(f"inversion-forward: pyprop8 for {len(todo)} source slice(s), {len(r)} receivers, "
-          f"{len(tasks)} sub-events on {jobs} process(es)", flush=True)
+    log.info(f"inversion-forward: pyprop8 for {len(todo)} source slice(s), {len(r)} receivers, "
+             f"{len(tasks)} sub-events on {jobs} process(es)")
     if jobs > 1:
         with Pool(jobs, initializer=die_with_parent, initargs=(os.getpid(),)) as pool:
             results = pool.map(_point_source_task, tasks)      # in order: reproducible sums

@@ -23,7 +23,7 @@ may lie farther).
 
 Per configuration: coverage of the 95 % back-azimuth arc (with its Wilson interval: a
 coverage is calibrated when the interval holds 0.95), its median width, the share of arcs
-within +-30 deg, the coverage of the distance's 95 % interval and of the epicentre's 95 %
+within the paper's bound (:data:`pipeline.paper.BACK_AZIMUTH_BOUND_DEG`), the coverage of the distance's 95 % interval and of the epicentre's 95 %
 credible area (and its median size), each also counting a warning that the source may lie
 beyond the reach as an answer (``*_or_warned``), per placement too, and the magnitude's:
 whether the true Mw lies in the smallest set of table magnitudes holding 95 % of the
@@ -38,8 +38,8 @@ import numpy as np
 import pandas as pd
 
 from pipeline.inversion import truth_check
-from pipeline.inversion.demo import BOUND_DEG, FALLEN_PER_SITE, REACH_KEYS, SITE_COUNTS, \
-    _frame, _site_position, draw_site_columns, out_of_reach_row
+from pipeline.inversion.demo import BOUND_DEG, BOUND_TEXT, BOUNDED_FRACTION_KEY, FALLEN_PER_SITE, \
+    REACH_KEYS, SITE_COUNTS, _frame, _site_position, draw_site_columns, out_of_reach_row
 from pipeline.inversion.likelihood import DEFAULT_FLOOR, DEFAULT_KERNEL_DEG, LIKELIHOODS, \
     ForwardModel
 from pipeline.inversion.posterior import OutOfReach, invert, magnitude_set
@@ -237,7 +237,7 @@ def study_summary(trials):
                      "coverage_back_azimuth_95": hit / n, "coverage_ci95": ci,
                      "calibrated": bool(ci[0] <= 0.95 <= ci[1]),
                      "width_median_deg": float(g["width95_deg"].median()),
-                     "bounded_30_fraction": float((g["width95_deg"] <= BOUND_DEG).mean()),
+                     BOUNDED_FRACTION_KEY: float((g["width95_deg"] <= BOUND_DEG).mean()),
                      "coverage_epicentre_95": float(g["epicentre_in_95"].mean()),
                      "coverage_epicentre_ci95": wilson_interval(int(g["epicentre_in_95"].sum()),
                                                                 n),
@@ -265,7 +265,7 @@ def study_summary(trials):
 
 def study_answer(summary):
     """The sentence per likelihood at its largest L: the fewest columns (S sites x K fallen
-    per site) whose median 95 % arc is within +-30 deg with calibrated coverage, or what
+    per site) whose median 95 % arc is at most BOUND_DEG wide with calibrated coverage, or what
     the largest configuration reaches instead."""
     out = {}
     for kind, g in summary.groupby("likelihood"):
@@ -280,12 +280,12 @@ def study_answer(summary):
             first = ok.iloc[0]
             text = (f"{kind} likelihood, {size} members per node: {int(first['sites'])} site(s) "
                     f"with {int(first['fallen_per_site'])} fallen column(s) each bound the back "
-                    f"azimuth to +-30 deg (median 95 % arc {first['width_median_deg']:.0f} deg, "
+                    f"azimuth to {BOUND_TEXT} (median 95 % arc {first['width_median_deg']:.0f} deg, "
                     f"coverage {first['coverage_back_azimuth_95']:.2f} "
                     f"[{first['coverage_ci95'][0]:.2f}, {first['coverage_ci95'][1]:.2f}])")
         else:
             text = (f"{kind} likelihood, {size} members per node: no tested configuration "
-                    f"bounds the back azimuth to +-30 deg with calibrated coverage")
+                    f"bounds the back azimuth to {BOUND_TEXT} with calibrated coverage")
             narrow = at[at["width_median_deg"] <= BOUND_DEG]
             if not narrow.empty:
                 first = narrow.iloc[0]

@@ -10,7 +10,7 @@ import numpy as np
 import pandas as pd
 
 from pipeline import files
-from pipeline.campaign.definitions import run_code_version
+from pipeline.simulate import run_code_version
 from pipeline.campaign.run_dirs import finished_summary
 from pipeline.constants import COLUMN_TYPES as COLUMNS
 from pipeline.files import InputError

@@ -28,7 +28,7 @@ from pathlib import Path
 import numpy as np
 
 from pipeline.campaign import Campaign, register
-from pipeline.campaign.definitions import column_specs, run_column_spec
+from pipeline.campaign.runs import column_specs, run_column_spec
 from pipeline.campaign.tables import collect
 from pipeline.files import InputError
 from pipeline.inversion.grid import MECHANISMS, slice_motions

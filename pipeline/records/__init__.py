@@ -8,6 +8,7 @@ the result by content: the input files' bytes, the catalogue row, the
 processing steps and the code of this package, never by name.
 """
 import glob
+import logging
 import re
 import sys
 from pathlib import Path
@@ -19,10 +20,12 @@ from obspy.geodetics import gps2dist_azimuth
 from pipeline import RECORDS_DIR, RESULTS_DIR
 from pipeline.files import InputError, code_hash, content_hash, display_path
 from pipeline.provenance import software_versions
-from pipeline.motion import Motion
+from pipeline.motion import NPZ_KEYS, Motion
 from pipeline.records import processing
 from pipeline.records.catalog import catalog, catalog_row
 from pipeline.records.readers import is_pattern, read_record
+
+log = logging.getLogger(__name__)
 
 CACHE_DIR = RESULTS_DIR / "cache" / "motions"
 SIDECARS = ("*.xml", "*.xml.gz", "event.json", "*.quakeml", "flatfile_rows.csv")
@@ -76,7 +79,7 @@ def resolve(record):
                     names = set(archive.files)
             except (ValueError, OSError, EOFError):
                 raise InputError(f"{path.name}: unreadable npz") from None
-            if {"dt", "acc", "vel", "disp", "meta"} <= names:
+            if set(NPZ_KEYS) <= names:
                 return Source(_sanitise(path.stem), path, processed=True)
         return Source(_sanitise(path.stem), path)
     row = catalog_row(str(record))
@@ -96,7 +99,8 @@ def _sanitise(stem):
 
 
 def processed_motion(record, back_azimuth=None, cache_dir=CACHE_DIR, mode="default"):
-    """The processed :class:`Motion` of ``record`` and the path of its cached npz.
+    """The processed :class:`Motion` of ``record`` (anything :func:`resolve` takes, or
+    its :class:`Source`) and the path of its cached npz.
 
     Cached in ``cache_dir/<key>.npz`` (``cache_dir`` None: not cached, path None).
     ``back_azimuth`` (deg) is used only when neither file nor catalogue gives one.
@@ -105,7 +109,7 @@ def processed_motion(record, back_azimuth=None, cache_dir=CACHE_DIR, mode="defau
     always taken as it is.
     """
     steps = processing.steps_for(mode)
-    source = resolve(record)
+    source = record if isinstance(record, Source) else resolve(record)
     if source.processed:
         return Motion.load(source.path), source.path
     key = source.key(back_azimuth, steps)
@@ -249,8 +253,8 @@ def _motion_meta(source, row, info, back_azimuth, has_vertical):
         meta["back_azimuth_source"] = ("gps2dist_azimuth of station and epicentre coordinates from "
                                        + (row.get("citation") or "the record file header"))
         if back_azimuth is not None:
-            print(f"note: {source.id}: coordinates give the back azimuth; "
-                  f"--back-azimuth {back_azimuth:g} ignored", file=sys.stderr)
+            log.info(f"note: {source.id}: coordinates give the back azimuth; "
+                     f"--back-azimuth {back_azimuth:g} ignored", extra={"stderr": True})
     elif row.get("back_azimuth_deg") is not None:
         meta["back_azimuth_deg"] = float(row["back_azimuth_deg"])
         meta["epicentral_distance_km"] = row.get("epicentral_distance_km")

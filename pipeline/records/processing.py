@@ -184,22 +184,6 @@ def remove_offset(work, trend="linear", min_quiet_s=1.0):
 
 
 @step
-def demean(work):
-    stream = work.stream()
-    stream.detrend("demean")
-    work.from_stream(stream)
-    return {}
-
-
-@step
-def detrend(work, type="linear"):
-    stream = work.stream()
-    stream.detrend(type)
-    work.from_stream(stream)
-    return {"type": type}
-
-
-@step
 def taper(work, max_percentage=0.05, type="hann", max_length_s=None):
     """obspy taper on both ends; records the length actually used (s)."""
     stream = work.stream()

@@ -5,6 +5,8 @@ from pathlib import Path
 import pandas as pd
 
 from pipeline.report.common import _figure, _fmt, _pct, _table
+from pipeline.inversion.demo import (BOUND_ANSWER_KEY, BOUND_DEG, BOUND_TEXT,
+                                     BOUNDED_FRACTION_KEY, SITES_WITHIN_KEY)
 from pipeline.inversion.grid import GRIDS
 from pipeline.simulate import run_code_version
 
@@ -121,7 +123,7 @@ def _narrowing_lines(demo):
                 f"{m:.0f} ({a:.0f}-{b:.0f})" for m, a, b in
                 zip(narrow["width_median_deg"], narrow["width_q25_deg"],
                     narrow["width_q75_deg"])],
-            "within +-30 deg": [_pct(v) for v in narrow["bounded_30_fraction"]],
+            f"within {BOUND_TEXT}": [_pct(v) for v in narrow[BOUNDED_FRACTION_KEY]],
             "truth in 95 % arc": [_pct(v) for v in narrow["coverage_back_azimuth_95"]],
             "truth in 95 % region": [_pct(v) for v in narrow["coverage_epicentre_95"]],
             "95 % area km^2": [f"{v:.0f}" for v in narrow["credible_area_95_km2_median"]],
@@ -129,7 +131,7 @@ def _narrowing_lines(demo):
         lines.append("**(b) How the back azimuth narrows** with the number of fallen columns "
                      "per site and of sites:\n\n" + _table(table) + "\n")
     answers = []
-    for row in demo.get("bound_30_deg", []):
+    for row in demo.get(BOUND_ANSWER_KEY, []):
         who = f"{row.get('likelihood', 'independent')} likelihood, {row['mechanism']}, " \
               f"{row['sites']} site(s)"
         if row["fallen_per_site"]:
@@ -143,7 +145,7 @@ def _narrowing_lines(demo):
                            "columns tried)")
     if answers:
         lines.append("**(c) The paper's question in numbers** - how many fallen columns bound "
-                     "the back azimuth to +-30 deg (median 95 % arc <= 60 deg)?\n\n"
+                     f"the back azimuth to {BOUND_TEXT} (median 95 % arc <= {BOUND_DEG:g} deg)?\n\n"
                      + "\n".join(f"- {a}" for a in answers) + "\n")
         lines.append(_inversion_findings(demo, narrow) + "\n")
     return lines
@@ -164,7 +166,7 @@ def _paper_scenario_lines(demo):
                              _fmt(p["width95_median_deg_sites_with_falls"]),
                          "truth in the 95 % arc": _pct(
                              p["back_azimuth_in_95_sites_with_falls"]),
-                         "sites within +-30 deg": p["sites_within_30_deg"],
+                         f"sites within {BOUND_TEXT}": p[SITES_WITHIN_KEY],
                          "MAP error (median deg)":
                              _fmt(p["median_abs_map_error_deg_sites_with_falls"]),
                          **({"warned: may lie farther": p["sites_reach_warning"]}

@@ -46,7 +46,7 @@ from pathlib import Path
 
 import numpy as np
 
-from pipeline.constants import MODEL_GRAVITY
+from pipeline.constants import MODEL_GRAVITY, RIM_POINTS
 from pipeline.files import InputError
 from pipeline.scenario.bodies import _build, _statics, column_scene
 from pipeline.scenario.column_format import (DENSITY_RANGE, EXAMPLES_DIR, MAX_BLOCKS,
@@ -252,11 +252,12 @@ class ColumnGeometry(Specimen):
                 raise InputError(f"{self.name}: block {k} is {min(sizes):g} m thin, less "
                                  f"than 4 contact sphere radii ({rim_sphere_radius:g} m)")
 
-    def contact_rocking_hz(self, kn, rim_points=16):
+    def contact_rocking_hz(self, kn, rim_points=RIM_POINTS):
         """Frequency (Hz) of the whole column, as one stone, rocking on the contact springs
         of its base (kn N/m per contact point): sqrt(kn sum(x_i^2) / I_base) / 2 pi, the
         smaller about the two horizontal axes.  Rigid-block behaviour needs it well above
-        the frequencies of the shaking (the paper's column: 13.5 Hz)."""
+        the frequencies of the shaking (the paper's column:
+        :func:`pipeline.campaign.column_file.paper_rocking_hz`)."""
         (body,) = self.monolithic().bodies()
         contact = body.contact
         if contact.kind == "circle":

@@ -36,23 +36,25 @@ land on), each sphere one radius inside the surface.
 """
 import functools
 import hashlib
+import logging
 import math
 import multiprocessing
 import re
 import struct
-import sys
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
-from pipeline.constants import MODEL_GRAVITY
+from pipeline.constants import MODEL_GRAVITY, RIM_POINTS
 from pipeline.files import InputError
 from pipeline.scenario.column_format import DENSITY_RANGE
 from pipeline.scenario.outline import perimeter_points
 from pipeline.scenario.scene_file import SceneBody, SceneColumn
 from pipeline.scenario.specimen import Specimen
 from pipeline.userfiles import keys_text, number, show
+
+log = logging.getLogger(__name__)
 
 MESH_SUFFIXES = (".obj", ".ply", ".stl")   # the mesh files trimesh reads here
 
@@ -266,7 +268,7 @@ class MeshSpecimen(Specimen):
     def check_rims(self, rim_sphere_radius):
         """Nothing to check: its contact spheres lie on its surface points."""
 
-    def contact_rocking_hz(self, kn, rim_points=16):
+    def contact_rocking_hz(self, kn, rim_points=RIM_POINTS):
         """Frequency (Hz) of the specimen rocking on the contact springs of its footprint
         outline (kn N/m per point), the smaller about the two horizontal axes."""
         pts = perimeter_points(self.footprint, rim_points) - self.com[:2]
@@ -458,7 +460,7 @@ def _say(line):
     """Print a note or warning line on stderr, once per process (the process the user
     started: campaign workers load the specimen again and keep quiet)."""
     if line not in _SAID and multiprocessing.parent_process() is None:
-        print(line, file=sys.stderr)
+        log.info(line, extra={"stderr": True})
     _SAID.add(line)
 
 

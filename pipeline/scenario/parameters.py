@@ -6,16 +6,19 @@ represent and keep stable (docs/command-line.md); a value outside raises an
 :class:`~pipeline.files.InputError` naming the option and its range.
 """
 import dataclasses
+import logging
 import math
 from dataclasses import dataclass, field
 
-from pipeline.constants import COLUMN_KINDS, COLUMN_TYPES
+from pipeline.constants import COLUMN_KINDS, COLUMN_TYPES, RIM_POINTS
 from pipeline import paper
 from pipeline.files import InputError
 from pipeline.scenario.bodies import ColumnSpec
 from pipeline.scenario.column_format import DENSITY_RANGE
 from pipeline.scenario.geometry import ColumnGeometry
 from pipeline.scenario.scene_file import SceneFile
+
+log = logging.getLogger(__name__)
 
 RIM_SPHERE_RADIUS_M = 0.005   # rim contact spheres of the columns
 MIN_BODY_SIZE_M = 10 * RIM_SPHERE_RADIUS_M   # a drum must hold its two rims of spheres
@@ -101,7 +104,7 @@ class Contact:
 @dataclass(frozen=True)
 class Numerics:
     """How the YADE model discretises and integrates the bodies."""
-    rim_points: int = param(16, "", "contact spheres per circular rim", 8, 128, "--rim-points")
+    rim_points: int = param(RIM_POINTS, "", "contact spheres per circular rim", 8, 128, "--rim-points")
     rim_sphere_radius: float = param(RIM_SPHERE_RADIUS_M, "m", "radius of the rim contact spheres",
                                      0.0, 0.05, low_open=True)
     rim_phase_deg: float = param(0.0, "deg", "angular phase of the rim contact points "
@@ -359,7 +362,7 @@ def check_cost(params, wall_limit_s):
                          "min): use fewer or heavier blocks, a stiffer contact or a shorter "
                          "--window")
     if estimate > 300.0:
-        print(f"note: {what} at most (quiet parts are skipped)", flush=True)
+        log.info(f"note: {what} at most (quiet parts are skipped)")
     return estimate
 
 

@@ -221,3 +221,19 @@ def direction_table(runs):
             row["axial_rayleigh_p"] = axial["rayleigh_p"]
         rows.append(row)
     return pd.DataFrame(rows)
+
+
+def mean_direction_error_deg(azimuths_deg):
+    """Standard error (deg) of the circular mean of ``azimuths_deg`` (Fisher 1993, eq.
+    4.21: sqrt((1 - R2) / (2 n R^2)), R2 the mean resultant of the doubled deviations);
+    None for fewer than 2 or a mean that is not defined."""
+    a = np.radians(np.asarray(azimuths_deg, float))
+    a = a[np.isfinite(a)]
+    if a.size < 2:
+        return None
+    c, s = np.cos(a).mean(), np.sin(a).mean()
+    r = math.hypot(c, s)
+    if r < 1e-9:
+        return None
+    r2 = float(np.cos(2 * (a - math.atan2(s, c))).mean())
+    return float(math.degrees(math.sqrt(max(0.0, 1 - r2) / (2 * a.size * r * r))))

@@ -8,7 +8,8 @@ from scipy import optimize, stats
 
 from pipeline.constants import MODEL_GRAVITY
 from pipeline.stats.circular import (AWAY_MIN_DEG as AWAY, TOWARD_MAX_DEG as TOWARD,
-                                     angle_difference_deg, circular_summary, direction_class)
+                                     angle_difference_deg, circular_summary, direction_class,
+                                     mean_direction_error_deg)
 
 
 def wilson_interval(successes, trials, confidence=0.95):
@@ -448,3 +449,98 @@ def pooled_answer(toppled, relative_deg, resamples=2000, seed=0, confidence=0.95
             "differs": None if reference is None or ci is None
             else bool(not ci[0] <= reference <= ci[1])}
     return out
+
+
+QUESTION = ("Do the columns fall toward (or away from) the epicentre?  Hinzen (2009) asked it "
+            "of single runs; here every record's ensemble answers, pooled over the records.")
+
+
+def pooled_summary(runs, resamples=2000):
+    """The paper's question over the records of an ensemble campaign that have a back
+    azimuth (:func:`pooled_answer` per column: every record
+    weighs alike; intervals hold the choice of records and the members' Monte Carlo
+    error); None for fewer than two such records."""
+    members = runs[(runs["member"] >= 0) & runs["back_azimuth_deg"].notna()]
+    records = list(dict.fromkeys(members["record_id"]))
+    if len(records) < 2:
+        return None
+    columns = []
+    for column, group in members.groupby("column", sort=True):
+        toppled, relative = [], []
+        for record_id in records:
+            sub = group[group["record_id"] == record_id].sort_values("member")
+            t = sub["toppled"].astype(bool).to_numpy()
+            toppled.append(t)
+            relative.append(np.where(t, angle_difference_deg(
+                sub["downfall_azimuth_deg"].to_numpy(float),
+                sub["back_azimuth_deg"].to_numpy(float)), np.nan))
+        answer = pooled_answer(toppled, relative, resamples=resamples)
+        columns.append({"column": column, **answer, "answer": pooled_sentence(answer)})
+    return {"question": QUESTION, "records": len(records), "record_ids": records,
+            "members_per_record": {r: int((members["record_id"] == r).sum()
+                                          / members["column"].nunique()) for r in records},
+            "columns": columns}
+
+
+def pooled_sentence(answer):
+    """One sentence: what the pooled fall directions say of the epicentre's direction."""
+    st = answer["statistics"]
+
+    def value(name, digits=2):
+        s = st[name]
+        return (f"{s['estimate']:.{digits}f} [{s['ci95'][0]:.{digits}f}, "
+                f"{s['ci95'][1]:.{digits}f}]")
+
+    p = f"P(toppled) {value('p_toppled')} per record"
+    if answer["falls"] < 2 or st["polarity"]["ci95"] is None:
+        return f"{p}; too few falls to say where they point"
+    polar, radial = st["polarity"], st["radial_alignment"]
+    if polar["differs"]:
+        side = "toward" if polar["estimate"] > 0 else "away from"
+        finding = f"falls lean {side} the epicentre (polarity {value('polarity')}, 0: no relation)"
+    elif radial["differs"]:
+        side = "along" if radial["estimate"] > 0 else "across"
+        finding = (f"falls gather {side} the epicentre line, as often toward as away "
+                   f"(radial alignment {value('radial_alignment')}, 0: no relation)")
+    else:
+        finding = (f"the fall directions show no relation to the epicentre's direction "
+                   f"(polarity {value('polarity')}, radial alignment "
+                   f"{value('radial_alignment')}; 0: no relation)")
+    return (f"{p}; {finding}; toward {value('fraction_toward')}, away "
+            f"{value('fraction_away')} of the falls (0.25 each without a relation)")
+
+
+def record_summary(runs, record_id, seed):
+    """An ensemble campaign's ``ensemble_summary.json`` content of one record (runs:
+    its runs table with ``member``, -1 the nominal run)."""
+    back = runs["back_azimuth_deg"].dropna()
+    back = float(back.iloc[0]) if len(back) else None
+    members = runs[runs["member"] >= 0]
+    columns = []
+    for column, group in members.groupby("column", sort=True):
+        fell = group[group["toppled"].astype(bool)]
+        az = fell["downfall_azimuth_deg"].to_numpy(float)
+        stats = circular_summary(az)
+        nominal_row = runs[(runs["member"] == -1) & (runs["column"] == column)]
+        nominal_az = (None if nominal_row.empty or not np.isfinite(
+            nominal_row["downfall_azimuth_deg"].iloc[0]) else
+            float(nominal_row["downfall_azimuth_deg"].iloc[0]))
+        columns.append({
+            "column": column, "members": int(len(group)), "toppled": int(len(fell)),
+            "p_toppled": float(len(fell) / len(group)),
+            "p_toppled_ci95": wilson_interval(len(fell), len(group)),
+            "p_toppled_mc_error": float(math.sqrt(len(fell) * (len(group) - len(fell))
+                                                  / len(group) ** 3)),
+            "mean_azimuth_mc_error_deg": mean_direction_error_deg(az),
+            "mean_downfall_azimuth_deg": None if not len(fell) or not np.isfinite(
+                stats["mean_deg"]) else stats["mean_deg"],
+            "resultant_length": None if not len(fell) else stats["resultant_length"],
+            "mean_azimuth_ci95_deg": bootstrap_mean_azimuth_ci(az),
+            **direction_fractions(az, back),
+            "nominal_toppled": None if nominal_row.empty else bool(
+                nominal_row["toppled"].iloc[0]),
+            "nominal_downfall_azimuth_deg": nominal_az,
+            "impact_time_s_median": None if not len(fell) else float(
+                np.median(fell["impact_time_s"]))})
+    return {"record": record_id, "members": int(members["member"].nunique()), "seed": seed,
+            "back_azimuth_deg": back, "columns": columns}

@@ -78,7 +78,7 @@ def test_sub_threshold_motion_never_topples_and_the_ensemble_grows_to_its_precis
 
 def fake_campaign(p_true, tmp_path):
     """A stand-in for run_campaign: per record, k = round(p n) of n members toppled."""
-    from pipeline.campaign import ensemble
+    from pipeline.campaign import sizing
     from pipeline.stats.ensemble import wilson_interval
     calls = []
 
@@ -92,21 +92,21 @@ def fake_campaign(p_true, tmp_path):
                 {"column": "drums", "members": n, "toppled": k, "p_toppled": k / n,
                  "p_toppled_ci95": wilson_interval(k, n), "mean_azimuth_ci95_deg": None,
                  "resultant_length": None}]})
-        ensemble.write_summaries(tmp_path, summaries)
+        sizing.write_summaries(tmp_path, summaries)
         return {"figures": []}
-    return ensemble, run, calls
+    return sizing, run, calls
 
 
 def test_members_are_added_until_the_interval_is_narrow_enough(tmp_path):
     """P = 0.5 needs about (1.96 / 0.1)^2 / 4 = 96 members for +-0.1, added in whole batches
     of 16 and in few rounds (as many batches at once as the fraction so far asks for);
     P = 0 is decided within two batches; each record stops by itself and says why."""
-    ensemble, run, calls = fake_campaign({"A": 0.5, "B": 0.0}, tmp_path)
+    sizing, run, calls = fake_campaign({"A": 0.5, "B": 0.0}, tmp_path)
     options = {"members": 16, "max_members": 256, "precision": 0.1, "arc_deg": 60.0}
-    result = ensemble.run_sized(run, ["A", "B"], tmp_path, options)
-    sizing = {s["record"]: s["sizing"] for s in result["summaries"]}
-    assert sizing["A"]["stopped_by"] == "precision" and 96 <= sizing["A"]["members"] <= 112
-    assert sizing["B"]["stopped_by"] == "precision" and sizing["B"]["members"] <= 32
+    result = sizing.run_sized(run, ["A", "B"], tmp_path, options)
+    sized = {s["record"]: s["sizing"] for s in result["summaries"]}
+    assert sized["A"]["stopped_by"] == "precision" and 96 <= sized["A"]["members"] <= 112
+    assert sized["B"]["stopped_by"] == "precision" and sized["B"]["members"] <= 32
     assert calls[0] == {"A": 16, "B": 16}
     assert all((c["A"] - p["A"]) % 16 == 0 for p, c in zip(calls, calls[1:]))
     assert len(calls) <= 3
@@ -115,9 +115,9 @@ def test_members_are_added_until_the_interval_is_narrow_enough(tmp_path):
 
 
 def test_the_member_cap_ends_the_sizing_and_says_so(tmp_path):
-    ensemble, run, _ = fake_campaign({"A": 0.5}, tmp_path)
+    sizing, run, _ = fake_campaign({"A": 0.5}, tmp_path)
     options = {"members": 8, "max_members": 24, "precision": 0.0, "arc_deg": 60.0}
-    (summary,) = ensemble.run_sized(run, ["A"], tmp_path, options)["summaries"]
+    (summary,) = sizing.run_sized(run, ["A"], tmp_path, options)["summaries"]
     assert summary["sizing"]["members"] == 24 and summary["sizing"]["stopped_by"] == "member cap"
     assert "P(toppled)" in summary["sizing"]["open"]
 
@@ -132,7 +132,7 @@ def test_batches_keep_the_members_that_ran():
 
 
 def test_mean_direction_error_is_the_circular_standard_error():
-    from pipeline.campaign.ensemble import mean_direction_error_deg
+    from pipeline.stats.circular import mean_direction_error_deg
     rng = np.random.default_rng(3)
     samples = rng.vonmises(0.0, 8.0, size=(400, 50))         # kappa 8: sigma ~ 20.7 deg
     means = np.degrees(np.angle(np.exp(1j * samples).mean(axis=1)))
@@ -145,7 +145,7 @@ def test_members_needed_follows_the_binomial_and_the_arc():
     """Wilson at the fraction so far (P = 0.5 of 16: 96 members for +-0.1), and a mean
     direction's interval shrinking as 1 / sqrt(falls): 120 deg from 16 falls needs 64
     falls for 60 deg; never past the cap, always one batch at least."""
-    from pipeline.campaign.ensemble import members_needed
+    from pipeline.campaign.sizing import members_needed
     half = {"columns": [{"members": 16, "toppled": 8, "mean_azimuth_ci95_deg": None,
                          "resultant_length": None}]}
     assert members_needed(half, 0.1, 16, 256) == 96

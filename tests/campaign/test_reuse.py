@@ -3,7 +3,7 @@ runs of the same run id and worker."""
 import json
 
 from pipeline.campaign import reuse_finished
-from pipeline.campaign.definitions import run_column_spec
+from pipeline.campaign.runs import run_column_spec
 from pipeline.campaign.spec import RunSpec
 from pipeline.scenario import RunParams
 

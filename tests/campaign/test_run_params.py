@@ -10,7 +10,7 @@ import pytest
 
 from pipeline import paper, simulate as simulate_module
 from pipeline.campaign.column_file import matched_kn
-from pipeline.campaign.definitions import column_specs, run_column_spec, twin
+from pipeline.campaign.runs import column_specs, run_column_spec, twin
 from pipeline.files import InputError
 from pipeline.motion import Motion
 from pipeline.motion.pulses import one_sine_pulse

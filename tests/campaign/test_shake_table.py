@@ -83,8 +83,8 @@ def test_sp1_specimen_has_the_mass_and_critical_angle_its_sources_state():
     rock = ColumnGeometry.load(SPECIMEN)
     assert rock.mass == pytest.approx(353.802)             # config/sp1.yaml
     assert rock.density == pytest.approx(2856, abs=5)      # 353.8 kg / 0.1239 m^3
-    # the rock's weak-side critical angle along the table's axis: 14.7 deg (the issue's
-    # equivalent box; pivot distance 0.302 m)
+    # the rock's weak-side critical angle along the table's axis: 14.7 deg (the
+    # specimen's equivalent box; pivot distance 0.302 m)
     assert rock.critical_angle_along_deg(90.0) == pytest.approx(14.7, abs=0.1)
     lever = rock.com[2] / math.cos(math.radians(14.7))
     assert lever == pytest.approx(0.302, abs=0.005)

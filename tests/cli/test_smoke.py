@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from pipeline.campaign.definitions import column_specs, pulse_record, run_column_spec, twin
+from pipeline.campaign.runs import column_specs, pulse_record, run_column_spec, twin
 from pipeline.campaign.executor import execute
 from pipeline.campaign.tables import collect
 from pipeline.motion import Motion

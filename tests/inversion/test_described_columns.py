@@ -118,7 +118,7 @@ def test_unknown_column_file_is_one_line_before_anything(tmp_path, capsys):
 
 
 def test_a_column_file_beside_the_observations(tmp_path):
-    from pipeline.cli.invert import described_columns
+    from pipeline.inversion.workflows import described_columns
     from pipeline.inversion.observations import load_observations
     data = description("roman-granite")
     write_json(tmp_path / "my_column.json", data)

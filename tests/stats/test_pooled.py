@@ -3,8 +3,7 @@ distributions, Holm's procedure by hand and the symmetry of turning every direct
 import numpy as np
 import pandas as pd
 
-from pipeline.campaign.ensemble import pooled_summary
-from pipeline.stats.ensemble import compare_ensembles, holm_reject, pooled_answer
+from pipeline.stats.ensemble import compare_ensembles, holm_reject, pooled_answer, pooled_summary
 
 
 def _records(rng, n_records, members, p, spread_deg=None, centre_deg=0.0):

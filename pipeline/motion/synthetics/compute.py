@@ -2,6 +2,7 @@
 import contextlib
 import importlib.metadata
 import json
+import logging
 import math
 import os
 import time
@@ -21,6 +22,8 @@ from pipeline.motion.synthetics.gmm import gmm_check, write_gmm_summary
 from pipeline.motion.synthetics.sites import AZIMUTH_STEP_DEG, RINGS_KM, settings, site_table
 from pipeline.motion.synthetics.sources import (CRUST_LAYERS, LEAD_TIME_S, source_parameters,
                                                 subevents)
+
+log = logging.getLogger(__name__)
 
 GENERATOR_VERSION = 2  # bump when the written motions change
 PYPROP8_VERSION = importlib.metadata.version("pyprop8")
@@ -215,8 +218,8 @@ def generate_sources(source_names, rings_km=RINGS_KM, azimuth_step_deg=AZIMUTH_S
     for name, plan in plans.items():
         if "shipped" in plan:
             origin = display_path(shipped_path(name))
-            print(f"{name}: pyprop8 displacements from {origin} (the same parameters and "
-                  "pyprop8 version; not recomputed)", flush=True)
+            log.info(f"{name}: pyprop8 displacements from {origin} (the same parameters and "
+                     "pyprop8 version; not recomputed)")
             _write_source(name, plan, plan["shipped"], cfg, num, 0.0, 0, origin=origin)
     write_gmm_summary(cfg["base"])
     return {name: plans[name]["paths"] for name in source_names}

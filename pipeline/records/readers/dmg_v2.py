@@ -46,7 +46,7 @@ def read(path, key=None):
     name = path.name
     lines = open_text(path).splitlines()
     starts = [i for i, line in enumerate(lines) if _START.match(line)]
-    if not starts or starts[0] != next((i for i, l in enumerate(lines) if l.strip()), None):
+    if not starts or starts[0] != next((i for i, text in enumerate(lines) if text.strip()), None):
         raise InputError(f"{name}: does not start with 'CORRECTED ACCELEROGRAM' "
                          "(not a DMG V2 file)")
     stream, info = Stream(), {}
