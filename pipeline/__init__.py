@@ -17,11 +17,16 @@ INTERRUPTED = "interrupted: finished results are kept"
 _STOPPED_BY = [signal.SIGINT]       # the signal that interrupted this process
 
 
+def stopped_by(signum):
+    """Note the signal that stops this process (its exit status is 128 + it)."""
+    _STOPPED_BY[0] = signum
+
+
 def stop_on_sigterm():
     """Make SIGTERM (a plain ``kill``) stop this process as Ctrl-C does: a
     KeyboardInterrupt in the main thread (children killed, finished results kept)."""
     def stop(signum, frame):
-        _STOPPED_BY[0] = signum
+        stopped_by(signum)
         raise KeyboardInterrupt
     signal.signal(signal.SIGTERM, stop)
 

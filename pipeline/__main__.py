@@ -4,15 +4,25 @@ Ctrl-C at any moment, during the imports of start-up too, ends with one line and
 status 130 (after finished results are written); SIGTERM (a plain ``kill``) the same way
 with exit status 143."""
 import os
+import signal
 import sys
 
-from pipeline import INTERRUPTED, interrupted_status, stop_on_sigterm
+from pipeline import INTERRUPTED, interrupted_status, stop_on_sigterm, stopped_by
 
 
 def console():
+    # a KeyboardInterrupt raised inside an extension module's import becomes an
+    # ImportError with a traceback: during the imports, a stop is noted and acted on after
+    pending = []
+    for signum in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(signum, lambda signum, frame: pending.append(signum))
+    from pipeline.cli import main
+    signal.signal(signal.SIGINT, signal.default_int_handler)
     stop_on_sigterm()
     try:
-        from pipeline.cli import main
+        if pending:
+            stopped_by(pending[0])
+            raise KeyboardInterrupt
         code = main()
     except KeyboardInterrupt:                  # during start-up, before main() handles it
         print(INTERRUPTED, file=sys.stderr)
