@@ -215,8 +215,8 @@ def plot_pulse_grid(summary, path):
                               vmin=0, vmax=1, s=[12 + 3 * b["n"] ** 0.5 * 4 for b in observed],
                               edgecolors="C1", linewidths=1.2, label="observed rate (tests)",
                               zorder=5)
-        ax.set_xlim(_edges(ratios)[0], _edges(ratios)[-1])
-        ax.set_ylim(_edges(pgas)[0], max(_edges(pgas)[-1], 1.2))
+        ax.set_xlim(0.0, max(_edges(ratios)[-1], 1.0 if observed else 0.0))
+        ax.set_ylim(0.0, max(_edges(pgas)[-1], 1.2 if observed else 0.0))
         ax.set_xlabel("PGV/PGA (s)")
         ax.set_ylabel("PGA (g)")
         ax.set_title(f"{summary['specimen']} ({name}): P(overturn), one-cosine pulses\n"
