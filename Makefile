@@ -5,7 +5,7 @@ PY := .venv/bin/python
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 JOBS ?= $(shell nproc)
 
-.PHONY: setup test run-all records campaigns bench clean invert-demo shake-table docs \
+.PHONY: setup test run-all records campaigns bench clean invert-demo shake-table rock-fragility docs \
 	convergence paper-question invert-study invert-study-table
 
 setup: .venv/.installed
@@ -74,6 +74,17 @@ bench: setup
 shake-table: setup
 	$(PY) -m pipeline campaign shake-table $(if $(SHAKE_GRID),--grid "$(SHAKE_GRID)") --jobs $(JOBS) \
 	  --allow-long
+	$(PY) -m pipeline report
+
+# the scanned rock SP1's fragility over one-cosine pulses in the range of its shake-table
+# tests (6 PGA x 4 PGV/PGA cells, 3 parameter sets, along the table's axis), checked against
+# the tests: a few minutes on 2 cores.  The full size: campaign fragility --column-file
+# records/shake_table/sp1.json (the vsr grid, 4 parameter sets x 4 sampled directions)
+ROCK_PULSES ?= pga_g=0.1:1.0:6;pgv_pga_s=0.02:0.29:4
+rock-fragility: setup
+	$(PY) -m pipeline campaign fragility --column-file records/shake_table/sp1.json \
+	  --pulses "$(ROCK_PULSES)" --members 3 --azimuth 90 --out results/rock-fragility \
+	  --jobs $(JOBS)
 	$(PY) -m pipeline report
 
 # the model's convergence judged on distributions: the twin model's ensembles of 3 records

@@ -82,7 +82,7 @@ def parse_pulses(text):
         if not 1 <= n <= MAX_AXIS_SIZE or (n == 1) != (lo == hi):
             raise InputError(f"--pulses {name}: N must be 1-{MAX_AXIS_SIZE}, and 1 exactly "
                              f"when LO = HI, got {value}")
-        axes[name] = np.linspace(lo, hi, n)
+        axes[name] = np.round(np.linspace(lo, hi, n), 9)
     missing = [a for a in PULSE_AXES if a not in axes]
     if missing:
         raise InputError(f"--pulses lacks {missing[0]} (give pga_g=LO:HI:N;pgv_pga_s=LO:HI:N, "
@@ -247,7 +247,8 @@ def block_outcomes(specs, t_after=30.0, max_step=1e-3):
         pulse = one_cosine_pulse(pga_g * G, ratio, 0.0, PULSE_DT_S, 0.0)
         sizes = np.array([block_of(specs[k].params, specs[k].tags["azimuth_deg"])
                           for k in idx], float)
-        result = rocking_response_sampled(sizes[:, 0], sizes[:, 1], pulse.acc[:, 1], pulse.dt,
+        acc = np.repeat(pulse.acc[:, 1:2], len(idx), axis=1)       # (n, cases)
+        result = rocking_response_sampled(sizes[:, 0], sizes[:, 1], acc, pulse.dt,
                                           t_after=t_after, max_step=max_step)
         out[idx] = result["overturned"]
     return out
