@@ -18,6 +18,7 @@ from scipy.interpolate import RegularGridInterpolator
 
 from pipeline.campaign.shake_table import (EXPERIMENTS, OUTCOME, PGA_EDGES_G, PGV_PGA_EDGES_S,
                                            load_experiments)
+from pipeline.constants import STANDARD_GRAVITY as G
 from pipeline.stats.ensemble import logistic_probability, logistic_surface, wilson_interval
 
 SPECIMENS_WITH_TESTS = {"SP1": OUTCOME}
@@ -68,10 +69,10 @@ def experiments_check(section, specimen, experiments=EXPERIMENTS):
            "note": "table records, not pulses: how far the pulse fragility carries over",
            "baselines": {f"PGA >= g tan alpha ({uplift:.3f} g)": scores(y, pga >= uplift)}}
     keep = (pga > 0) & (ratio > 0)
-    ceiling = logistic_surface(pga[keep] * 9.80665, ratio[keep], y[keep])
+    ceiling = logistic_surface(pga[keep] * G, ratio[keep], y[keep])
     if ceiling["coefficients"] is not None:
         out["baselines"]["logistic fit to the observations (ceiling)"] = scores(
-            y[keep], logistic_probability(ceiling["coefficients"], pga[keep] * 9.80665,
+            y[keep], logistic_probability(ceiling["coefficients"], pga[keep] * G,
                                           ratio[keep]))
     models = {}
     for model, entry in section["models"].items():
@@ -82,7 +83,7 @@ def experiments_check(section, specimen, experiments=EXPERIMENTS):
         coef = entry["logistic"].get("coefficients")
         if coef is not None:
             result["logistic"] = scores(y[keep], logistic_probability(
-                coef, pga[keep] * 9.80665, ratio[keep]))
+                coef, pga[keep] * G, ratio[keep]))
         result["bins"] = _bins(pga, ratio, y, p)
         models[model] = result
     out["models"] = models

@@ -27,13 +27,14 @@ from scipy.stats import qmc
 
 from pipeline.campaign.column_file import column_kn
 from pipeline.campaign.shake_table import DEFAULT_CONTACT, GRID_CONTACT, GRID_SPECIMEN
+from pipeline.constants import STANDARD_GRAVITY
 from pipeline.files import InputError
 from pipeline.motion.pulses import one_cosine_pulse
 from pipeline.rocking import block_constants, rocking_response_sampled
 from pipeline.scenario.geometry import ColumnGeometry
 from pipeline.stats.ensemble import logistic_surface, wilson_interval
 
-G = 9.80665                       # m/s^2 per g (the grid's PGA is in g)
+G = STANDARD_GRAVITY               # m/s^2 per g (the grid's PGA is in g)
 VSR_PULSES = "pga_g=0.2:1.1:10;pgv_pga_s=0.1:1.0:10"   # Chen et al. (2024)
 PULSE_PRESETS = {"vsr": VSR_PULSES}
 PULSE_AXES = {"pga_g": (0.01, 5.0), "pgv_pga_s": (0.01, 3.0)}
