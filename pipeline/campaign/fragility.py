@@ -176,14 +176,14 @@ def _pulse_specs(records, campaign_dir, data, column, pulses, members, headings,
     pairs, tags = [], []
     for pga, ratio, params, tag in runs:
         pairs.append((str(pulse_grid.pulse_file(cache, pga, ratio)), params))
-        tags.append({"mode": "pulses", **tag})
+        tags.append({"mode": "pulses", "core_s": round(pulse_grid.run_core_s(ratio), 3), **tag})
     n_cells = len(grid["pga_g"]) * len(grid["pgv_pga_s"])
-    per_cell = len(runs) // n_cells
-    core_s = pulse_grid.motion_seconds(grid) * per_cell * pulse_grid.RUN_CORE_S_PER_MOTION_S
+    core_s = sum(t["core_s"] for t in tags)
     print(f"fragility: {n_cells} pulse cells x {len(sets)} parameter sets x "
-          f"{azimuths.shape[1]} heading(s) = {len(runs)} YADE runs, about "
-          f"{duration_text(core_s / max(jobs or 1, 1))} on {jobs or 1} core(s) "
-          "(finished runs are kept and not run again)", flush=True)
+          f"{azimuths.shape[1]} heading(s) = {len(runs)} YADE runs, at most about "
+          f"{duration_text(core_s / max(jobs or 1, 1))} on {jobs or 1} core(s) (a run "
+          "stops early once the specimen has fallen or settled; finished runs are kept and "
+          "not run again)", flush=True)
     specs = column_specs(pairs, campaign_dir, tags, seed=seed, pulses=pulses,
                          ranges=ranges, azimuth=azimuth, headings=headings, members=members)
     return mark(specs, data)

@@ -49,7 +49,12 @@ DEFAULT_RANGES = "kn=4e7:1.2e8;damping=0.05:0.1;mu_s=0.6:0.8;footprint_tolerance
 MU_K_OVER_MU_S = DEFAULT_CONTACT["mu_k"] / DEFAULT_CONTACT["mu_s"]
 LOG_UNIFORM = ("kn",)
 CONTOUR_LEVELS = (0.16, 0.5, 0.84)
-RUN_CORE_S_PER_MOTION_S = 0.6     # core-s per simulated second of SP1 (3 s for a 5.3 s pulse)
+# the long-run gate's cost of a run, at most (it stops early once the specimen has fallen
+# or settled): SP1 over the vsr grid took 1,600 runs in 166 s on 2 cores (2026-11-27),
+# 0.09 s of YADE per simulated second (runs stop early: the bound takes twice that) and
+# about 0.1 s per run besides
+RUN_CORE_S_PER_MOTION_S = 0.2
+RUN_CORE_S_PER_RUN = 0.3
 
 
 def parse_pulses(text):
@@ -204,10 +209,10 @@ def pulse_runs(data, column, pulses, members, headings, azimuth, seed, ranges,
     return grid, sets, azimuths, runs
 
 
-def motion_seconds(grid):
-    """Simulated seconds of one run per cell summed over the grid (pulse + tail)."""
-    return float(sum(2 * math.pi * r + PULSE_TAIL_S for r in grid["pgv_pga_s"])
-                 * len(grid["pga_g"]))
+def run_core_s(pgv_pga_s):
+    """Core seconds of one run (the long-run gate's estimate): its pulse and tail at
+    RUN_CORE_S_PER_MOTION_S."""
+    return RUN_CORE_S_PER_RUN + (2 * math.pi * pgv_pga_s + PULSE_TAIL_S) * RUN_CORE_S_PER_MOTION_S
 
 
 # ---------------------------------------------------------------- 2D block

@@ -28,7 +28,8 @@ __all__ = ["build_report", "back_azimuth_table", "columns_section", "convergence
            "correlation_table", "paper_question_section",
            "ensemble_section", "fragility_section", "inversion_section",
            "member_study_section", "per_record_table",
-           "processing_section", "record_orientation", "records_section", "records_statements", "rock_fragility_section", "run_all_section",
+           "processing_section", "record_orientation", "records_section", "records_statements",
+           "rock_fragility_section", "run_all_section",
            "shake_table_section", "speed_section", "sweep_section", "synthetic_section",
            "toppled_fractions", "verification_section", "wilson_interval", "with_back_azimuth"]
 
@@ -58,6 +59,7 @@ def build_report(results=RESULTS_DIR):
                       "friction had a minor influence on downfall directions; with mu_s = 0.1 "
                       "neither column toppled (they slid instead)."),
         shake_table_section(results), rock_fragility_section(results),
+        rock_fragility_section(results, "rock-fragility-table"),
         paper_question_section(results), ensemble_section(results),
         convergence_section(results), fragility_section(results), columns_section(results),
         inversion_section(results), member_study_section(results),

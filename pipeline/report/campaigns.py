@@ -344,19 +344,28 @@ def run_all_section(results):
             + _table(frame[["step", "wall (min)", "exit"]]) + "\n")
 
 
+ROCK_FRAGILITY = {
+    "rock-fragility": ("Fragility of a scanned rock (pulse grid)",
+                       "SP1's P(overturn) over the pulse grid vsr, from directions sampled "
+                       "over 360 deg"),
+    "rock-fragility-table": ("Fragility of a scanned rock along the table",
+                             "SP1's P(overturn) over pulses in the range of its shake-table "
+                             "tests, along the table's axis, against the tests")}
+
+
 def rock_fragility_section(results, name="rock-fragility"):
     """A specimen's fragility over the pulse grid (campaign fragility --pulses; ``make
-    rock-fragility`` writes results/rock-fragility): contours, logistic surface, the 2D
-    block and the check against experiments, when it has run."""
+    rock-fragility`` writes results/rock-fragility and results/rock-fragility-table):
+    contours, logistic surface, the 2D block and the check against experiments, when it
+    has run."""
+    heading, what = ROCK_FRAGILITY.get(name, (f"Fragility over a pulse grid ({name})", ""))
     path = results / name / "fragility.json"
     summary = json.loads(path.read_text()) if path.exists() else {}
     section = summary.get("pulse_grid")
     if section is None:
-        return ("## Fragility of a scanned rock (pulse grid)\n\nNot run yet (`make "
-                "rock-fragility`: SP1's P(overturn) over one-cosine pulses, against its "
-                "shake-table tests).\n")
+        return f"## {heading}\n\nNot run yet (`make rock-fragility`: {what}).\n"
     block = section["block2d"]
-    lines = ["## Fragility of a scanned rock (pulse grid)\n",
+    lines = [f"## {heading}\n",
              f"{summary['specimen']}: one-cosine displacement pulses over PGA "
              f"{min(section['pga_g']):g}-{max(section['pga_g']):g} g x PGV/PGA "
              f"{min(section['pgv_pga_s']):g}-{max(section['pgv_pga_s']):g} s "
