@@ -155,3 +155,52 @@ def test_a_box_mesh_fragility_matches_the_2d_block_away_from_its_threshold(tmp_p
     for model in ("monolithic", "block2d"):
         p = {c["pga_g"]: c["P"] for c in section["models"][model]["cells"]}
         assert p == {0.15: 0.0, 1.0: 1.0}, model
+
+
+def test_the_long_run_gate_counts_each_pulse_run_by_its_length(tmp_path, monkeypatch):
+    """Before any run: refused in one line with the number of runs, nothing left behind."""
+    from pipeline import files
+    from pipeline.campaign import run_campaign
+    monkeypatch.setattr(files, "LONG_RUN_S", 1.0)
+    out = tmp_path / "frag"
+    with pytest.raises(InputError, match=r"campaign fragility \(8 runs") as error:
+        run_campaign("fragility", jobs=1, campaign_dir=out, allow_long=False, options={
+            "pulses": "pga_g=0.2:0.4:2;pgv_pga_s=0.1:1.0:2", "members": 2, "headings": 1,
+            "column": "monolithic"})
+    assert "\n" not in str(error.value)
+    # the estimate is each run's own: pulse and tail at the per-second cost, plus a start
+    per_run = [pulse_grid.run_core_s(r) for r in (0.1, 1.0)]
+    assert per_run[1] - per_run[0] == pytest.approx(
+        2 * math.pi * 0.9 * pulse_grid.RUN_CORE_S_PER_MOTION_S)
+    assert f"{sum(per_run) * 4 / 8:.3g} core-s each" in str(error.value)
+    assert not out.exists()
+
+
+def test_report_section_says_not_run_yet_then_quotes_the_file(tmp_path):
+    from pipeline.report import rock_fragility_section
+    assert "Not run yet" in rock_fragility_section(tmp_path)
+    cells = [{"pga_g": a, "pgv_pga_s": 0.5, "n": 4, "overturned": k, "P": k / 4,
+              "ci95": [0.0, 1.0], "P_per_set": [k / 4], "set_sd": 0.0, "set_spread_sd": None}
+             for a, k in ((0.2, 0), (0.4, 2), (0.6, 4))]
+    model = {"cells": cells, "contours": pulse_grid.contours(cells),
+             "logistic": {"coefficients": None}, "runs": 12, "overturned": 6}
+    section = {"pga_g": [0.2, 0.4, 0.6], "pgv_pga_s": [0.5], "members": 1, "headings": 4,
+               "ranges": "kn=1e8:1e8", "direction": "sampled", "runs_finished": 12, "runs": 12,
+               "block2d": {"alpha_rad": 0.2, "R_m": 0.3}, "models": {"monolithic": model}}
+    (tmp_path / "rock-fragility").mkdir()
+    (tmp_path / "rock-fragility" / "fragility.json").write_text(json.dumps(
+        {"mode": "pulses", "specimen": "box", "pulse_grid": section}))
+    text = rock_fragility_section(tmp_path)
+    assert text.startswith("## Fragility of a scanned rock") and "box:" in text
+    assert "0.40 [" in text            # P = 0.5 half-way between 0.2 g (0/4) and 0.6 g (4/4)
+
+
+def test_contours_interpolate_between_cells_and_say_none_beyond_the_grid():
+    cells = [{"pga_g": a, "pgv_pga_s": 0.3, "P": p, "ci95": [max(p - 0.2, 0), min(p + 0.2, 1)]}
+             for a, p in ((0.2, 0.0), (0.4, 0.25), (0.6, 0.75), (0.8, 1.0))]
+    (row,) = pulse_grid.contours(cells, levels=(0.5,))["0.5"]
+    assert row["pga_g"] == pytest.approx(0.5)
+    lo, hi = row["pga_g_band"]
+    assert lo < 0.5 < hi
+    (row,) = pulse_grid.contours([dict(c, P=0.0, ci95=[0, 0.1]) for c in cells], (0.5,))["0.5"]
+    assert row["pga_g"] is None
