@@ -345,10 +345,10 @@ def run_all_section(results):
 
 
 ROCK_FRAGILITY = {
-    "rock-fragility": ("Fragility of a scanned rock (pulse grid)",
+    "rock-fragility": ("Scanned rock fragility (pulse grid)",
                        "SP1's P(overturn) over the pulse grid vsr, from directions sampled "
                        "over 360 deg"),
-    "rock-fragility-table": ("Fragility of a scanned rock along the table",
+    "rock-fragility-table": ("Scanned rock fragility along the table",
                              "SP1's P(overturn) over pulses in the range of its shake-table "
                              "tests, along the table's axis, against the tests")}
 

@@ -191,7 +191,7 @@ def test_report_section_says_not_run_yet_then_quotes_the_file(tmp_path):
     (tmp_path / "rock-fragility" / "fragility.json").write_text(json.dumps(
         {"mode": "pulses", "specimen": "box", "pulse_grid": section}))
     text = rock_fragility_section(tmp_path)
-    assert text.startswith("## Fragility of a scanned rock") and "box:" in text
+    assert text.startswith("## Scanned rock fragility") and "box:" in text
     assert "0.40 [" in text            # P = 0.5 half-way between 0.2 g (0/4) and 0.6 g (4/4)
 
 
