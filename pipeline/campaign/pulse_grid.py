@@ -97,10 +97,12 @@ def parse_pulses(text):
 
 
 def parse_ranges(text, mesh=True):
-    """``name=LO:HI;...`` -> {name: (lo, hi)} over the defaults (:data:`DEFAULT_RANGES`);
-    LO = HI fixes a value; footprint_tolerance_m only for a mesh specimen."""
+    """``name=LO:HI;...`` -> {name: (lo, hi)}: for a mesh specimen over the defaults
+    (:data:`DEFAULT_RANGES`, from the shake-table calibration of a rock), for a column
+    over none (the paper's values, or a description's matched kn); LO = HI fixes a
+    value; footprint_tolerance_m only for a mesh specimen."""
     ranges = {}
-    for source in (DEFAULT_RANGES, text or ""):
+    for source in ((DEFAULT_RANGES,) if mesh else ()) + (text or "",):
         given = {}
         for item in source.split(";"):
             if not item.strip():
@@ -120,12 +122,10 @@ def parse_ranges(text, mesh=True):
                 raise InputError(f"--ranges {name}: need {low:g} <= LO <= HI <= {high:g}, "
                                  f"got {value}")
             given[name] = (lo, hi)
-        if source is not DEFAULT_RANGES and "footprint_tolerance_m" in given and not mesh:
+        if "footprint_tolerance_m" in given and not mesh:
             raise InputError("--ranges footprint_tolerance_m: only a mesh specimen has a "
                              "footprint tolerance")
         ranges.update(given)
-    if not mesh:
-        ranges.pop("footprint_tolerance_m", None)
     return ranges
 
 
@@ -133,6 +133,8 @@ def sample_sets(members, seed, ranges):
     """``members`` parameter sets: one Latin hypercube over ``ranges`` (kn log-uniform);
     mu_k = MU_K_OVER_MU_S mu_s."""
     names = sorted(ranges)
+    if not names:
+        return [{} for _ in range(members)]
     u = qmc.LatinHypercube(d=len(names), seed=seed).random(members)
     sets = []
     for row in u:
@@ -184,6 +186,9 @@ def pulse_runs(data, column, pulses, members, headings, azimuth, seed, ranges,
         if headings != 1:
             raise InputError("--azimuth fixes the direction: --headings must be 1")
     sets = sample_sets(members, seed, ranges)
+    if azimuth is not None and members > 1 and all(lo == hi for lo, hi in ranges.values()):
+        raise InputError(f"--members {members} with nothing drawn (no --ranges) and a fixed "
+                         "--azimuth would repeat one run: give --ranges or --members 1")
     if azimuth is None:
         heading = float(data.get("heading_deg", 0.0)) if mesh else 0.0
         azimuths = member_azimuths(members, headings, seed, heading)

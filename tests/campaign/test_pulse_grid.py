@@ -67,6 +67,7 @@ def test_bad_pulse_grids_are_refused_in_one_line(text, words):
 @pytest.mark.parametrize("text, mesh, words", [
     ("damping=0.1:2", True, "LO <= HI"), ("friction=0.5:0.6", True, "unknown parameter"),
     ("kn=1e8", True, "LO:HI"), ("footprint_tolerance_m=0.001:0.002", False, "only a mesh"),
+    ("damping=0.1:0.2;damping=0.1:0.2", False, "twice"),
 ])
 def test_bad_member_ranges_are_refused_in_one_line(text, mesh, words):
     with pytest.raises(InputError, match=words) as error:
@@ -204,3 +205,14 @@ def test_contours_interpolate_between_cells_and_say_none_beyond_the_grid():
     assert lo < 0.5 < hi
     (row,) = pulse_grid.contours([dict(c, P=0.0, ci95=[0, 0.1]) for c in cells], (0.5,))["0.5"]
     assert row["pga_g"] is None
+
+
+def test_a_column_draws_nothing_unless_told_and_a_mesh_draws_the_calibrated_ranges():
+    assert pulse_grid.parse_ranges(None, mesh=False) == {}
+    assert pulse_grid.parse_ranges("damping=0.1:0.2", mesh=False) == {"damping": (0.1, 0.2)}
+    rock = pulse_grid.parse_ranges(None, mesh=True)
+    assert set(rock) == {"kn", "damping", "mu_s", "footprint_tolerance_m"}
+    assert pulse_grid.parse_ranges("damping=0.2:0.2", mesh=True)["damping"] == (0.2, 0.2)
+    with pytest.raises(InputError, match="would repeat one run"):
+        pulse_grid.pulse_runs(None, "monolithic", "pga_g=0.2:0.2:1;pgv_pga_s=0.5:0.5:1", 2, 1,
+                              0.0, 1, None)
