@@ -105,7 +105,8 @@ def parse_levels(text):
 def fragility_specs(records, campaign_dir, levels=DEFAULT_LEVELS, members=DEFAULT_MEMBERS,
                     column="both", seed=None, azimuths=DEFAULT_AZIMUTHS, column_file=None,
                     stiffness="matched", pulses=None, azimuth=None,
-                    headings=DEFAULT_HEADINGS, ranges=None, jobs=None, **_):
+                    headings=DEFAULT_HEADINGS, ranges=None, jobs=None, only_runs=None,
+                    adaptive=False, **_):
     """Run specs: every record x level x member; ``scale`` = level / PGA of the record.
     With ``column_file`` every member is the described column with the sampled height
     and diameter tolerances (its own tilt and offsets as described), and the 2D block
@@ -119,8 +120,14 @@ def fragility_specs(records, campaign_dir, levels=DEFAULT_LEVELS, members=DEFAUL
         print("fragility: a mesh specimen: the pulse grid vsr (PGA 0.2-1.1 g x PGV/PGA "
               "0.1-1.0 s, 10 x 10; --pulses to change it)", flush=True)
     if pulses is not None:
-        return _pulse_specs(records, campaign_dir, data, column, pulses, members, headings,
-                            azimuth, seed, ranges, stiffness, jobs)
+        specs = _pulse_specs(records, campaign_dir, data, column, pulses, members, headings,
+                             azimuth, seed, ranges, stiffness, jobs, quiet=only_runs is not None)
+        if only_runs is not None:
+            keep = set(only_runs)
+            specs = [s.tagged(sampling="adaptive") for s in specs if s.run_id in keep]
+        return specs
+    if adaptive:
+        raise InputError("--adaptive belongs to the pulse grid: add --pulses")
     if mesh:
         raise InputError(f"--column-file {data['name']}: a mesh specimen takes the pulse grid "
                          "(--pulses), not scaled --records")
@@ -160,7 +167,7 @@ def fragility_specs(records, campaign_dir, levels=DEFAULT_LEVELS, members=DEFAUL
 
 
 def _pulse_specs(records, campaign_dir, data, column, pulses, members, headings, azimuth,
-                 seed, ranges, stiffness, jobs):
+                 seed, ranges, stiffness, jobs, quiet=False):
     """Run specs of the pulse grid (every cell x parameter set x heading), the cost said
     before any run."""
     if records:
@@ -179,11 +186,12 @@ def _pulse_specs(records, campaign_dir, data, column, pulses, members, headings,
         tags.append({"mode": "pulses", "core_s": round(pulse_grid.run_core_s(ratio), 3), **tag})
     n_cells = len(grid["pga_g"]) * len(grid["pgv_pga_s"])
     core_s = sum(t["core_s"] for t in tags)
-    print(f"fragility: {n_cells} pulse cells x {len(sets)} parameter sets x "
-          f"{azimuths.shape[1]} heading(s) = {len(runs)} YADE runs, at most about "
-          f"{duration_text(core_s / max(jobs or 1, 1))} on {jobs or 1} core(s) (a run "
-          "stops early once the specimen has fallen or settled; finished runs are kept and "
-          "not run again)", flush=True)
+    if not quiet:
+        print(f"fragility: {n_cells} pulse cells x {len(sets)} parameter sets x "
+              f"{azimuths.shape[1]} heading(s) = {len(runs)} YADE runs, at most about "
+              f"{duration_text(core_s / max(jobs or 1, 1))} on {jobs or 1} core(s) (a run "
+              "stops early once the specimen has fallen or settled; finished runs are kept "
+              "and not run again)", flush=True)
     specs = column_specs(pairs, campaign_dir, tags, seed=seed, pulses=pulses,
                          ranges=ranges, azimuth=azimuth, headings=headings, members=members)
     return mark(specs, data)
@@ -542,6 +550,9 @@ class FragilityOptions(CampaignOptions):
     ranges: str = param(None, "", "pulse grid: ranges the members' unknowns are drawn from "
                         f"(default {pulse_grid.DEFAULT_RANGES}; LO = HI fixes one)",
                         flag="--ranges", metavar="NAME=LO:HI;...")
+    adaptive: bool = param(False, "", "pulse grid: run every member only where P is uncertain "
+                           "(the 2D block as a guide, one probe run elsewhere, widened where a "
+                           "probe disagrees)", flag="--adaptive")
     TAKES_JOBS = True
 
     def check(self):
@@ -551,6 +562,8 @@ class FragilityOptions(CampaignOptions):
             pulse_grid.parse_pulses(self.pulses)
         if self.ranges is not None:
             pulse_grid.parse_ranges(self.ranges)
+        if self.adaptive and self.pulses is None and self.column_file is None:
+            raise InputError("--adaptive belongs to the pulse grid: add --pulses")
         if self.azimuth is not None and not (math.isfinite(self.azimuth)
                                              and 0 <= self.azimuth < 360):
             raise InputError(f"--azimuth must be in [0, 360) deg, got {self.azimuth:g}")
@@ -562,8 +575,46 @@ class FragilityOptions(CampaignOptions):
         return kwargs
 
 
+def drive(run, records, campaign_dir, options, gate=None):
+    """Run the campaign; with ``adaptive`` (pulse grid) in stages: every member where the
+    2D block of the same members and directions is uncertain (0 < P < 1) and one cell
+    either side in PGA, one probe run (first member, first direction) in every other
+    cell; a probe that disagrees with the block's certainty adds its cell and one either
+    side; until none does (at most :data:`pulse_grid.MAX_STAGES` stages)."""
+    if not options.get("adaptive"):
+        return run(options)
+    full = fragility_specs(records, campaign_dir, **options)
+    if gate is not None:
+        gate("campaign fragility (adaptive; at most the full grid)", len(full),
+             sum(s.tags["core_s"] for s in full) / len(full), "a smaller --pulses grid")
+    guide = pulse_grid.block_outcomes(full)
+    by_cell = {}
+    for spec, fell in zip(full, guide):
+        by_cell.setdefault(pulse_grid.cell_key(spec), []).append((spec, fell))
+    guide_p = {cell: float(np.mean([f for _, f in rows])) for cell, rows in by_cell.items()}
+    whole = pulse_grid.guide_cells(guide_p)
+    probes = {cell: rows[0][0] for cell, rows in by_cell.items()}
+    result = None
+    for stage in range(1, pulse_grid.MAX_STAGES + 1):
+        chosen = [s.run_id for cell, rows in by_cell.items() for s, _ in rows
+                  if cell in whole or s is probes[cell]]
+        print(f"fragility (adaptive), stage {stage}: {len(whole)} of {len(by_cell)} cells in "
+              f"full, a probe run in the others: {len(chosen)} of {len(full)} runs", flush=True)
+        result = run({**options, "only_runs": chosen})
+        outcomes = {}
+        for cell, spec in probes.items():
+            summary = finished_summary(campaign_dir, spec.run_id)
+            if summary is not None:
+                outcomes[cell] = any(c.toppled for c in summary.columns)
+        added = pulse_grid.expand(guide_p, whole, outcomes)
+        if not added:
+            break
+        whole |= added
+    return result
+
+
 register(Campaign("fragility", "P(toppled | PGA, PGV, PGV/PGA) by incremental dynamic analysis: "
                   "records scaled to a PGA ladder, a small ensemble per level, lognormal and "
                   "logistic fits, the 2D rigid block side by side (default records GM20, NF04)",
                   fragility_specs, run_column_spec, fragility_outputs, label="runs",
-                  options=FragilityOptions))
+                  options=FragilityOptions, driver=drive))

@@ -364,3 +364,40 @@ def summarise_grid(table, specs, grid, sets, azimuths, azimuth, ranges_text):
                                   "distance along each run's azimuth (Housner's equation "
                                   "and restitution, pipeline.rocking.rocking_response_sampled)"},
         "models": models}
+
+
+# ---------------------------------------------------------------- adaptive sampling
+MAX_STAGES = 6
+
+
+def cell_key(spec):
+    return tuple(spec.tags["cell"])
+
+
+def guide_cells(guide_p, margin=1):
+    """Cells (i ratio, j PGA) to run in full: where the guide's P (a dict cell -> P, e.g.
+    the 2D block over the same members and directions) is strictly between 0 and 1, and
+    ``margin`` cells either side in PGA (the specimen's threshold may lie beside the
+    guide's); a step of the guide between two cells counts as uncertain on both sides."""
+    chosen = set()
+    for (i, j), p in guide_p.items():
+        step = any(guide_p.get((i, j + d), p) != p for d in (-1, 1))
+        if 0.0 < p < 1.0 or step:
+            chosen.update((i, j + d) for d in range(-margin, margin + 1)
+                          if (i, j + d) in guide_p)
+    return chosen
+
+
+def expand(guide_p, full, probes, margin=1):
+    """Cells to add to ``full`` (the cells run in full): a probed cell whose one run
+    (``probes``: cell -> overturned) disagrees with the guide's certainty, with
+    ``margin`` cells either side in PGA."""
+    added = set()
+    for (i, j), overturned in probes.items():
+        if (i, j) in full:
+            continue
+        expected = guide_p[(i, j)] >= 0.5
+        if overturned != expected:
+            added.update((i, j + d) for d in range(-margin, margin + 1)
+                         if (i, j + d) in guide_p and (i, j + d) not in full)
+    return added

@@ -59,7 +59,7 @@ def pulse_outputs(specs, campaign_dir, figures=True):
     for spec in specs:
         sets[spec.tags["member"]] = spec.tags["point"]
         azimuths[(spec.tags["member"], spec.tags["heading"])] = spec.tags["azimuth_deg"]
-    azimuth_array = np.array([[azimuths[(m, h)] for h in range(first["headings"])]
+    azimuth_array = np.array([[azimuths.get((m, h), np.nan) for h in range(first["headings"])]
                               for m in range(first["members"])])
     section = pulse_grid.summarise_grid(table, done, grid, sets, azimuth_array,
                                         first["azimuth"], first["ranges"]
@@ -69,6 +69,12 @@ def pulse_outputs(specs, campaign_dir, figures=True):
     section["block2d"]["model"] = BLOCK_MODEL
     section["runs_finished"] = len(done)
     section["runs"] = len(specs)
+    section["full_grid_runs"] = (len(grid["pga_g"]) * len(grid["pgv_pga_s"]) * first["members"]
+                                 * first["headings"])
+    section["sampling"] = ("adaptive: every member only where P is uncertain (the 2D block "
+                           "as a guide, widened where a probe run disagreed), one probe run "
+                           "elsewhere" if first.get("sampling") == "adaptive"
+                           else "full grid: every cell x member x direction")
     observed = None
     from pipeline.campaign.pulse_check import experiments_check
     observed = experiments_check(section, name)

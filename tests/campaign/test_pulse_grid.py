@@ -216,3 +216,25 @@ def test_a_column_draws_nothing_unless_told_and_a_mesh_draws_the_calibrated_rang
     with pytest.raises(InputError, match="would repeat one run"):
         pulse_grid.pulse_runs(None, "monolithic", "pga_g=0.2:0.2:1;pgv_pga_s=0.5:0.5:1", 2, 1,
                               0.0, 1, None)
+
+
+def test_adaptive_sampling_runs_in_full_where_the_guide_is_uncertain_and_widens_on_surprise():
+    # one PGV/PGA row of 6 PGA cells: the guide certain below cell 2 and above cell 3
+    guide = {(0, j): p for j, p in enumerate((0.0, 0.0, 0.3, 0.8, 1.0, 1.0))}
+    full = pulse_grid.guide_cells(guide)
+    assert full == {(0, 1), (0, 2), (0, 3), (0, 4)}      # uncertain cells and one either side
+    # probes that agree with the guide add nothing
+    assert pulse_grid.expand(guide, full, {(0, 0): False, (0, 5): True}) == set()
+    # a probe that overturns where the guide is certain it stands: its cell and neighbours
+    assert pulse_grid.expand(guide, full, {(0, 0): True, (0, 5): True}) == {(0, 0)}
+    # a step of the guide from 0 to 1 between two cells: both sides and one beyond
+    guide = {(0, j): p for j, p in enumerate((0.0, 0.0, 0.0, 0.0, 1.0, 1.0))}
+    full = pulse_grid.guide_cells(guide)
+    assert full == {(0, 2), (0, 3), (0, 4), (0, 5)}
+    assert pulse_grid.expand(guide, full, {(0, 1): True}) == {(0, 0), (0, 1)}
+
+
+def test_adaptive_belongs_to_the_pulse_grid():
+    from pipeline.campaign.fragility import FragilityOptions
+    with pytest.raises(InputError, match="--adaptive belongs to the pulse grid"):
+        FragilityOptions(adaptive=True)
