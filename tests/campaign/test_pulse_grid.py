@@ -219,14 +219,16 @@ def test_a_column_draws_nothing_unless_told_and_a_mesh_draws_the_calibrated_rang
 
 
 def test_adaptive_sampling_runs_in_full_where_the_guide_is_uncertain_and_widens_on_surprise():
-    # one PGV/PGA row of 6 PGA cells: the guide certain below cell 2 and above cell 3
-    guide = {(0, j): p for j, p in enumerate((0.0, 0.0, 0.3, 0.8, 1.0, 1.0))}
+    # one PGV/PGA row of 8 PGA cells: the guide certain below cell 3 and above cell 4
+    guide = {(0, j): p for j, p in enumerate((0.0, 0.0, 0.0, 0.3, 0.8, 1.0, 1.0, 1.0))}
     full = pulse_grid.guide_cells(guide)
-    assert full == {(0, 1), (0, 2), (0, 3), (0, 4)}      # uncertain cells and one either side
+    # uncertain cells, the certain ones next to them (a step) and one beyond
+    assert full == {(0, j) for j in range(1, 7)}
     # probes that agree with the guide add nothing
-    assert pulse_grid.expand(guide, full, {(0, 0): False, (0, 5): True}) == set()
-    # a probe that overturns where the guide is certain it stands: its cell and neighbours
-    assert pulse_grid.expand(guide, full, {(0, 0): True, (0, 5): True}) == {(0, 0)}
+    assert pulse_grid.expand(guide, full, {(0, 0): False, (0, 7): True}) == set()
+    # a probe that overturns where the guide is certain it stands: its cell (its
+    # neighbours are run in full already)
+    assert pulse_grid.expand(guide, full, {(0, 0): True, (0, 7): True}) == {(0, 0)}
     # a step of the guide from 0 to 1 between two cells: both sides and one beyond
     guide = {(0, j): p for j, p in enumerate((0.0, 0.0, 0.0, 0.0, 1.0, 1.0))}
     full = pulse_grid.guide_cells(guide)
