@@ -283,6 +283,7 @@ def cell_table(table, model):
         cells.append({"pga_g": float(pga_g), "pgv_pga_s": float(ratio), "n": n,
                       "overturned": k, "P": k / n, "ci95": [lo, hi],
                       "P_per_set": [float(v) for v in p_sets],
+                      "sets": [int(m) for m in per_set.index],
                       "set_sd": math.sqrt(between),
                       "set_spread_sd": math.sqrt(max(between - within, 0.0))
                       if math.isfinite(within) else None})
@@ -292,7 +293,9 @@ def cell_table(table, model):
 def contours(cells, levels=CONTOUR_LEVELS):
     """Per level and PGV/PGA: the PGA (g) where P crosses the level (linear between the
     cells; P made non-decreasing in PGA first), with the PGAs where the Wilson upper and
-    lower bounds cross it (the Monte Carlo band: ``pga_g_band``); None beyond the grid."""
+    lower bounds cross it (the Monte Carlo band: ``pga_g_band``) and where each parameter
+    set's own P crosses it (``pga_g_per_set``, for the sets run in every cell of the row:
+    the members' spread); None beyond the grid."""
     out = {}
     ratios = sorted({c["pgv_pga_s"] for c in cells})
     for level in levels:
@@ -303,8 +306,15 @@ def contours(cells, levels=CONTOUR_LEVELS):
             crossing = [_crossing(pga, np.array([c[key] if key == "P" else c["ci95"][key]
                                                  for c in row]), level)
                         for key in ("P", 1, 0)]
-            rows.append({"pgv_pga_s": ratio, "pga_g": crossing[0],
-                         "pga_g_band": [crossing[1], crossing[2]]})
+            entry = {"pgv_pga_s": ratio, "pga_g": crossing[0],
+                     "pga_g_band": [crossing[1], crossing[2]]}
+            if all("sets" in c for c in row):
+                common = set.intersection(*(set(c["sets"]) for c in row))
+                entry["pga_g_per_set"] = {
+                    str(m): _crossing(pga, np.array([c["P_per_set"][c["sets"].index(m)]
+                                                     for c in row]), level)
+                    for m in sorted(common)}
+            rows.append(entry)
         out[f"{level:g}"] = rows
     return out
 

@@ -389,6 +389,14 @@ def rock_fragility_section(results, name="rock-fragility"):
                     f"{_fmt(r['pga_g'], 2)} [{_fmt(lo, 2)}, {_fmt(hi, 2)}]")
             rows.append(row)
     lines.append(_table(pd.DataFrame(rows)) + "\n")
+    for model, entry in section["models"].items():
+        per_set = [r for r in entry["contours"].get("0.5", []) if r.get("pga_g_per_set")]
+        shown = [f"{r['pgv_pga_s']:g} s: " + ", ".join(_fmt(v, 2) for v in
+                                                      r["pga_g_per_set"].values())
+                 for r in per_set]
+        if shown:
+            lines.append(f"P = 0.5 of each parameter set ({model}; the members' spread): "
+                         + "; ".join(shown) + ".\n")
     spread = [c["set_sd"] for e in section["models"].values() for c in e["cells"]
               if c["set_sd"] is not None]
     if spread:

@@ -240,3 +240,13 @@ def test_adaptive_belongs_to_the_pulse_grid():
     from pipeline.campaign.fragility import FragilityOptions
     with pytest.raises(InputError, match="--adaptive belongs to the pulse grid"):
         FragilityOptions(adaptive=True)
+
+
+def test_contours_per_parameter_set_show_the_members_spread():
+    # set 0 crosses P = 0.5 at 0.3 g, set 1 at 0.5 g; pooled half-way
+    cells = [{"pga_g": a, "pgv_pga_s": 0.3, "P": (p0 + p1) / 2, "ci95": [0, 1],
+              "P_per_set": [p0, p1], "sets": [0, 1]}
+             for a, p0, p1 in ((0.2, 0.0, 0.0), (0.4, 1.0, 0.0), (0.6, 1.0, 1.0))]
+    (row,) = pulse_grid.contours(cells, levels=(0.5,))["0.5"]
+    assert row["pga_g_per_set"] == {"0": pytest.approx(0.3), "1": pytest.approx(0.5)}
+    assert row["pga_g"] == pytest.approx(0.4)
