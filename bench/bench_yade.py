@@ -51,6 +51,7 @@ from pipeline.outcome.columns import (column_outcomes, rotation_from_start_deg, 
 from pipeline.scenario import (Column, Contact, Numerics, run_yade, scene_params,  # noqa: E402
                                write_scenario)
 from pipeline.scenario.runner import reuse_processes  # noqa: E402
+from pipeline.scenario.scene_file import Measurement, SceneFile  # noqa: E402
 from pipeline.simulate import can_move  # noqa: E402
 
 STARTUP_T_MAX_S = 1e-3          # a run this short measures YADE's start-up (s)
@@ -59,47 +60,8 @@ STRONG_AMPLITUDE = 8.0          # m/s^2: a pulse both engines topple the same wa
 SHAKING_PEAK = (3.0, 3.0, 1.5)  # m/s^2 E, N, U: ~0.3 g horizontal
 WEAK_PEAK = (1.5, 1.5, 0.75)    # m/s^2: rocks the drum column without toppling it
 
-# Patches of the copy of the scene in the bench's work directory (never the project's
-# file): a wall and CPU clock around the simulation loop (O.run() to the loop's end,
-# written to bench_loop.json); for runs of a fixed duration, the scene's stop checks see
-# the motion last until t_max (HOLD; RELEASE restores motion_end for the output); for
-# the timing run, O.timingEnabled and timing.stats().
-HOLD = "_bench_motion_end, motion_end = motion_end, T_MAX\nsignal_end = quiet_after = T_MAX\n"
-RELEASE = "motion_end = _bench_motion_end\n"
-LOOP_START = "_bench_t0 = (time.perf_counter(), time.process_time())\nO.run()\n"
-LOOP_END = ("_bench_t1 = (time.perf_counter(), time.process_time())\n"
-            "with open(os.path.join(HERE, 'bench_loop.json'), 'w') as _fh:\n"
-            "    json.dump({'loop_wall_s': _bench_t1[0] - _bench_t0[0],\n"
-            "               'loop_cpu_s': _bench_t1[1] - _bench_t0[1]}, _fh)\n"
-            "finish()\n")
-TIMING_PROLOGUE = "from yade import O\nO.timingEnabled = True\n"
-TIMING_EPILOGUE = '''
-# ---- bench/bench_yade.py: engine timing
-from yade import timing
-for _e in O.engines:
-    if isinstance(_e, PyRunner):
-        _e.label = _e.command.split("(")[0]
-print("ENGINE TIMING BEGIN")
-timing.stats()
-print("ENGINE TIMING END", flush=True)
-with open(os.path.join(HERE, "engine_timing.json"), "w") as _fh:
-    json.dump([{"engine": _e.label or type(_e).__name__, "exec_ns": _e.execTime,
-                "count": _e.execCount, "dead": _e.dead} for _e in O.engines], _fh)
-'''
-
-
-def patch_scene(scene, fixed=False, timing=False):
-    """Add the loop clock to a scene copy; ``fixed``: no early stop before t_max;
-    ``timing``: the engine timing."""
-    text = scene.read_text()
-    start, end = (HOLD + LOOP_START, RELEASE + LOOP_END) if fixed else (LOOP_START, LOOP_END)
-    for old, new in (("\nO.run()\n", "\n" + start), ("\nfinish()\n", "\n" + end)):
-        if text.count(old) != 1:
-            raise RuntimeError(f"{scene}: cannot patch {old.strip()!r} (scene changed?)")
-        text = text.replace(old, new)
-    if timing:
-        text = TIMING_PROLOGUE + text + TIMING_EPILOGUE
-    scene.write_text(text)
+LOOP_CLOCK_FILE = "bench_loop.json"        # the scene's simulation-loop clock (SceneFile.measure)
+ENGINE_TIMING_FILE = "engine_timing.json"  # YADE's engine timing, for the timing run
 
 
 def shaking_motion(duration_s, peak=SHAKING_PEAK, dt=0.005, seed=1):
@@ -123,22 +85,24 @@ def pulse(amplitude=PULSE["amplitude"]):
 def prepare(run_dir, kind="both", motion=None, t_max=None, timing=False, columns=None,
             **numerics):
     """Write a scenario directory; t_max None: motion + tail with the default early stop,
-    else exactly t_max simulated seconds (no early stop).  ``timing``: patch the copied
-    scene to record YADE's engine timing; ``columns``: the scene's column specs instead of
-    ``Column(kind)``'s."""
+    else exactly t_max simulated seconds (no early stop).  The scene clocks its simulation
+    loop; ``timing``: it records YADE's engine timing too; ``columns``: the scene's column
+    specs instead of ``Column(kind)``'s."""
     if t_max is not None:
         numerics.setdefault("rest_duration_s", 1e9)
     params = scene_params(columns=columns or Column(kind).specs(), numerics=Numerics(**numerics),
                           motion_duration=0.0 if motion is None else motion.duration,
                           t_max=t_max)
-    patch_scene(write_scenario(run_dir, params, motion), t_max is not None, timing)
+    params = dataclasses.replace(params, early_stop=t_max is None, measure=Measurement(
+        LOOP_CLOCK_FILE, ENGINE_TIMING_FILE if timing else None))
+    write_scenario(run_dir, params, motion)
     return Path(run_dir)
 
 
 def run_timed(run_dir):
     """run_yade; the simulation loop's wall and CPU time (s) in traj.extra."""
     traj = run_yade(run_dir)
-    traj.extra.update(json.loads((Path(run_dir) / "bench_loop.json").read_text()))
+    traj.extra.update(json.loads((Path(run_dir) / LOOP_CLOCK_FILE).read_text()))
     return traj
 
 
@@ -169,7 +133,7 @@ def engine_timing(work, duration_s):
     traj = run_timed(run_dir)
     log = (run_dir / "yade.log").read_text()
     table = log.split("ENGINE TIMING BEGIN\n")[1].split("ENGINE TIMING END")[0].rstrip()
-    engines = json.loads((run_dir / "engine_timing.json").read_text())
+    engines = json.loads((run_dir / ENGINE_TIMING_FILE).read_text())
     total_ns = sum(e["exec_ns"] for e in engines)
     rows = [{"engine": e["engine"], "exec_s": e["exec_ns"] * 1e-9, "calls": e["count"],
              "share_pct": 100.0 * e["exec_ns"] / total_ns, "dead": e["dead"]} for e in engines]
@@ -216,16 +180,16 @@ def after_motion(work, duration_s):
     k_end = np.searchsorted(traj.t, traj.motion_end)
     # body speed (m/s), angular speed x 1 m counting as a speed (the scene's rest check)
     body_speed = np.maximum(np.linalg.norm(traj.vel, axis=2), np.linalg.norm(traj.angvel, axis=2))
-    params = json.loads((run_dir / "params.json").read_text())
+    params = SceneFile.read(run_dir)
     return {"column": "drums", "peak_acc_m_s2": list(WEAK_PEAK), "motion_end_s": traj.motion_end,
-            "simulated_s": traj.simulated_s, "t_max_s": params["t_max"],
+            "simulated_s": traj.simulated_s, "t_max_s": params.t_max,
             "after_motion_s": after, "after_motion_pct": 100.0 * after / traj.simulated_s,
             "stopped_early": traj.stopped_early, "wall_s": traj.wall_s,
             "toppled": out["toppled"], "max_tilt_deg": out["max_tilt_deg"],
             "energy_at_motion_end_J": float(energy[k_end]), "energy_at_end_J": float(energy[-1]),
             "max_speed_last_s_m_s": float(body_speed[traj.t >= traj.t[-1] - 1.0].max()),
-            "campaign_would_run_yade": can_move(motion, params["columns"],
-                                                Contact(**params["contact"]))}
+            "campaign_would_run_yade": can_move(motion, params.columns,
+                                                Contact(**params.contact))}
 
 
 # ---------------------------------------------------------------- 4. MuJoCo peer
@@ -474,7 +438,7 @@ def two_x(work, shaking_s):
     params = scene_params(columns=Column("both", column_file=STILL_COLUMN).specs(),
                           motion_duration=0.0, t_max=STILL_S)
     write_scenario(run_dir, params, None)
-    accuracy = [{"dt_factor": params["dt_factor"], "housner_passed": h["passed"],
+    accuracy = [{"dt_factor": params.dt_factor, "housner_passed": h["passed"],
                  "housner_refused": None, "housner_tolerance": h["tolerance"],
                  "max_rel_error_impact_times": h["max_rel_error_impact_times"],
                  "max_rel_error_peaks": h["max_rel_error_peaks"],

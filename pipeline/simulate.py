@@ -140,18 +140,17 @@ def simulate(motion, out_dir, column=None, contact=None, numerics=None, window=N
     params = scene_params(columns=column.specs(), contact=contact, numerics=numerics,
                           motion_duration=drive.duration,
                           t_max=None if signal_end is None else signal_end + numerics.tail_s)
-    if signal_end is not None:
-        params["signal_end_s"] = signal_end
+    params = dataclasses.replace(params, signal_end_s=signal_end)
     out_dir = Path(out_dir)
     (out_dir / "summary.json").unlink(missing_ok=True)
     started = time.perf_counter()
-    window_s = quiet_window(drive, params["columns"], contact, numerics.quiet_lead_s)
+    window_s = quiet_window(drive, params.columns, contact, numerics.quiet_lead_s)
     if window_s is not None and numerics.quiet_motion == "skip":
-        params.update(start_s=window_s[0], quiet_after_s=window_s[1])
+        params = dataclasses.replace(params, start_s=window_s[0], quiet_after_s=window_s[1])
     write_scenario(out_dir, params, drive)
     trajectory = run_yade(out_dir, timeout_s=timeout_s) if window_s is not None else None
     parameters = {**run.to_dict(), **geometry_parameters(column),
-                  "dt_factor": params["dt_factor"],
+                  "dt_factor": params.dt_factor,
                   "motion_file": None if motion_file is None else str(motion_file),
                   "processing": motion.processing_mode}
     provenance = {"software": software_versions(), "motion": motion.meta.get("processing"),
@@ -159,7 +158,7 @@ def simulate(motion, out_dir, column=None, contact=None, numerics=None, window=N
     record = record or motion.record_id
     if trajectory is None:
         summary = RunSummary.still(
-            record, params["columns"], back_azimuth_deg=drive.back_azimuth,
+            record, params.columns, back_azimuth_deg=drive.back_azimuth,
             parameters=parameters,
             note="not simulated: the horizontal acceleration stays below the uplift and "
                  "sliding thresholds at every sample, so no body can move",
@@ -169,7 +168,7 @@ def simulate(motion, out_dir, column=None, contact=None, numerics=None, window=N
     else:
         summary = summarise(trajectory, record=record, back_azimuth_deg=drive.back_azimuth,
                             parameters=parameters, provenance=provenance,
-                            quiet_after_s=params.get("quiet_after_s"),
+                            quiet_after_s=params.quiet_after_s,
                             start_in_file_s=drive.start_in_file_s)
     summary.save(out_dir / "summary.json")
     return summary

@@ -27,19 +27,19 @@ import sys
 import time
 
 import numpy as np
-from yade import O, Quaternion, Vector3, utils
+from yade import Matrix3, O, Quaternion, Vector3, utils
 from yade.wrapper import (Bo1_Box_Aabb, Bo1_Sphere_Aabb, ForceResetter, Ig2_Box_Sphere_ScGeom,
                           Ig2_Sphere_Sphere_ScGeom, InsertionSortCollider, InteractionLoop,
                           Ip2_ViscElMat_ViscElMat_ViscElPhys, Law2_ScGeom_ViscElPhys_Basic,
                           NewtonIntegrator, PyRunner, ViscElMat)
 
 # ---------------------------------------------------------------- parameters
-# Every value comes from params.json beside this script (written by
-# pipeline/scenario/writer.py from the dataclasses of pipeline/scenario/parameters.py).
+# Every value comes from params.json beside this script: the scene file
+# (pipeline/scenario/scene_file.py, SceneFile; its field names are the keys read here).
 HERE = os.path.dirname(os.path.abspath(sys.argv[0]))
 with open(os.path.join(HERE, "params.json")) as fh:
     P = json.load(fh)
-G = 9.81                              # m/s^2, the model's gravity (pipeline.constants)
+G = P["gravity"]                      # m/s^2, the model's gravity
 COLUMNS = P["columns"]                # name, x, y (m), bodies (see below), settles,
 #                                       overturning_barrier_j (J); a test block is a column
 #   body: name, column, index, mass (kg), inertia (3x3, kg m^2, body frame about the
@@ -48,37 +48,40 @@ COLUMNS = P["columns"]                # name, x, y (m), bodies (see below), sett
 #   centre) | polygon (points)}], plate {centre, half_size} or null (body frame, m)
 CONTACT = P["contact"]                # kn (N/m per rim point), damping (ratio), mu_s, mu_k
 PEDESTAL = P["pedestal"]              # thickness (m), contact_half_size (m)
-RIM_POINTS = P["rim_points"]          # contact spheres per circular rim
-RIM_R = P["rim_sphere_radius"]        # m
-RIM_PHASE_DEG = P.get("rim_phase_deg", 0.0)  # angular phase of circular rims (deg)
-DT_FACTOR = P["dt_factor"]            # dt = DT_FACTOR sqrt(m / (kn x base points)), smallest
-DRIVE = P["drive"]                    # "inertial" (gravity table) or "kinematic"
-DRIVE_INTERVAL_S = P["drive_interval_s"]
-FRICTION = P["friction"]              # "switch" (mu_s sticking, mu_k sliding) or "static"
-FRICTION_INTERVAL_S = P["friction_interval_s"]
-RECORD_HZ = P["record_hz"]            # trajectory samples per second
-REST_VELOCITY = P["rest_velocity"]    # m/s
-REST_LENGTH = P["rest_length"]        # m
-REST_DURATION_S = P["rest_duration_s"]
+NUMERICS = P["numerics"]
+THRESHOLDS = P["thresholds"]          # the stop checks' (SceneFile.thresholds)
+CLUMP = P["clump"]                    # how a body becomes a clump (m, kg/m^3)
+RIM_POINTS = NUMERICS["rim_points"]   # contact spheres per circular rim
+RIM_R = NUMERICS["rim_sphere_radius"]  # m
+RIM_PHASE_DEG = NUMERICS["rim_phase_deg"]  # angular phase of circular rims (deg)
+DRIVE = NUMERICS["drive"]             # "inertial" (gravity table) or "kinematic"
+DRIVE_INTERVAL_S = NUMERICS["drive_interval_s"]
+FRICTION = NUMERICS["friction"]       # "switch" (mu_s sticking, mu_k sliding) or "static"
+FRICTION_INTERVAL_S = NUMERICS["friction_interval_s"]
+RECORD_HZ = NUMERICS["record_hz"]     # trajectory samples per second
+REST_VELOCITY = NUMERICS["rest_velocity"]  # m/s
+REST_LENGTH = NUMERICS["rest_length"]  # m
+REST_DURATION_S = NUMERICS["rest_duration_s"]
 T_MAX = P["t_max"]                    # s, simulated time at most
-VERLET_DISTANCE = P["verlet_distance"]  # m
-MOTION_FILE = P.get("motion_file")    # processed-motion npz (dt, acc, disp; East, North, Up)
+VERLET_DISTANCE = NUMERICS["verlet_distance"]  # m
+MOTION_FILE = P["motion_file"]        # processed-motion npz (dt, acc, disp; East, North, Up)
 # the motion's quiet parts (pipeline/simulate.py, quiet_window): the scene starts at START_S
 # on the motion's clock (no body can move before START_S + quiet_lead_s) and may stop once
 # every body rests seated after QUIET_AFTER_S (no later sample can set it moving)
-START_S = P.get("start_s", 0.0)       # s
-QUIET_AFTER_S = P.get("quiet_after_s")  # s, None: the motion's end
+START_S = P["start_s"]                # s
+QUIET_AFTER_S = P["quiet_after_s"]    # s, None: the motion's end
 OUTPUT = P["output"]                  # trajectory file name
-PLATE_HALF_THICKNESS = 0.005          # m, the top plate (a Box clump member)
+PLATE_HALF_THICKNESS = CLUMP["plate_half_thickness_m"]   # m, the top plate (a Box member)
 CORE_MASK = 1 << 29          # collides with nothing
 # the clump's reference point is its members' centre of mass: a tiny, very dense
 # core sphere at the body's centroid puts it there (mass set per density, not state.mass)
-CORE = O.materials.append(ViscElMat(density=1e20, kn=0, ks=0, cn=0, cs=0))
+CORE = O.materials.append(ViscElMat(density=CLUMP["core_density_kg_m3"], kn=0, ks=0, cn=0,
+                                    cs=0))
 # bodies other than an upright cylinder (whose members already have its principal axes)
 # get pairs of dense "frame" spheres along the body's principal axes (masses 1:2, none
 # on the third axis), so that the clump's principal frame, computed by YADE from its
 # members, is the body's; they collide with nothing
-FRAME_ARM, FRAME_RADIUS = 0.01, 2e-4   # m
+FRAME_ARM, FRAME_RADIUS = CLUMP["frame_arm_m"], CLUMP["frame_radius_m"]   # m
 
 
 def rotation_matrix(q):
@@ -88,12 +91,10 @@ def rotation_matrix(q):
 
 
 def yade_quaternion(R):
-    """YADE Quaternion from a 3x3 numpy rotation matrix (Shepperd's method)."""
-    w = math.sqrt(max(0.0, 1 + R[0, 0] + R[1, 1] + R[2, 2])) / 2
-    x = math.copysign(math.sqrt(max(0.0, 1 + R[0, 0] - R[1, 1] - R[2, 2])) / 2, R[2, 1] - R[1, 2])
-    y = math.copysign(math.sqrt(max(0.0, 1 - R[0, 0] + R[1, 1] - R[2, 2])) / 2, R[0, 2] - R[2, 0])
-    z = math.copysign(math.sqrt(max(0.0, 1 - R[0, 0] - R[1, 1] + R[2, 2])) / 2, R[1, 0] - R[0, 1])
-    return Quaternion(w, x, y, z)
+    """YADE Quaternion of a 3x3 numpy rotation matrix (minieigen's conversion), of the
+    sign with w >= 0 (q and -q are the same rotation)."""
+    q = Quaternion(Matrix3(*np.ravel(R)))
+    return q if q[3] >= 0 else Quaternion(-q[3], -q[0], -q[1], -q[2])
 
 
 def contact_material(mass, n_points):
@@ -106,7 +107,8 @@ def contact_material(mass, n_points):
     k_point = CONTACT["kn"]
     c_point = 2 * CONTACT["damping"] * math.sqrt(k_point * mass / n_points)
     return O.materials.append(ViscElMat(
-        density=1e-3, kn=2 * k_point, ks=2 * k_point, cn=2 * c_point, cs=2 * c_point,
+        density=CLUMP["member_density_kg_m3"], kn=2 * k_point, ks=2 * k_point,
+        cn=2 * c_point, cs=2 * c_point,
         frictionAngle=math.atan(CONTACT["mu_s"])))
 
 
@@ -130,8 +132,7 @@ def rim_spheres(rim):
 
 
 def add_body(body, mask_base, mask_top, material):
-    """Add one rigid body (a params.json body) as a clump; return its clump id and the
-    number of its base contact points."""
+    """Add one rigid body (a params.json body) as a clump; return its clump id."""
     centre = np.asarray(body["centre"], float)
     R = np.asarray(body["rotation"], float)
     axes = R @ np.asarray(body["principal_axes"], float)          # world
@@ -143,11 +144,9 @@ def add_body(body, mask_base, mask_top, material):
         return tuple(centre + R @ np.asarray(p, float))
 
     def clump_members(frame_spheres):
-        members, n_base = [], 0
+        members = []
         for rim in body["rims"]:
             points = rim_spheres(rim)
-            if rim["role"] == "base":
-                n_base += len(points)
             for p in points:
                 members.append(utils.sphere(world(p), RIM_R, material=material,
                                             mask=mask_base if rim["role"] == "base"
@@ -160,26 +159,27 @@ def add_body(body, mask_base, mask_top, material):
                                      (hx + RIM_R, hy + RIM_R, PLATE_HALF_THICKNESS),
                                      orientation=yade_quaternion(R), material=material,
                                      mask=mask_base))
-        members.append(utils.sphere(world((0, 0, 0)), 1e-3, material=CORE, mask=CORE_MASK))
+        members.append(utils.sphere(world((0, 0, 0)), CLUMP["core_radius_m"], material=CORE,
+                                    mask=CORE_MASK))
         if frame_spheres:
             for axis, radius in ((axes[:, 0], FRAME_RADIUS),
                                  (axes[:, 1], FRAME_RADIUS * 2 ** (1 / 3))):
                 for sign in (1, -1):
                     members.append(utils.sphere(tuple(centre + sign * FRAME_ARM * axis), radius,
                                                 material=CORE, mask=CORE_MASK))
-        return members, n_base
+        return members
 
     # mass and inertia of the solid body, expressed in the clump's principal frame
     i_world = R @ np.asarray(body["inertia"], float) @ R.T
     frame_spheres = not plain
     while True:
-        members, n_base = clump_members(frame_spheres)
+        members = clump_members(frame_spheres)
         clump_id, _ = O.bodies.appendClumped(members)
         clump = O.bodies[clump_id]
         Rc = rotation_matrix(clump.state.ori)
         i_clump = Rc.T @ i_world @ Rc
         off_diagonal = np.abs(i_clump - np.diag(np.diag(i_clump))).max()
-        if off_diagonal <= 1e-3 * np.abs(i_clump).max():
+        if off_diagonal <= CLUMP["principal_tolerance"] * np.abs(i_clump).max():
             break
         if frame_spheres:
             raise RuntimeError(f"body {body['name']}: the clump frame is not its principal "
@@ -192,7 +192,7 @@ def add_body(body, mask_base, mask_top, material):
     # the clump frame is the members' principal frame (axes may be permuted):
     # body orientation = clump orientation * body_offset
     body_offset[clump_id] = yade_quaternion(Rc.T @ R)
-    return clump_id, n_base
+    return clump_id
 
 
 # ---------------------------------------------------------------- scene
@@ -200,7 +200,6 @@ bodies = []        # metadata for the trajectory file
 clumps = []        # clump ids in the same order
 body_offset = {}   # clump id -> Quaternion of the body frame in the clump frame
 pedestal_ids = []
-face_stiffness = []   # per body: (mass, kn x base contact points), for the time step
 
 
 def add_pedestal(mask, material):
@@ -233,19 +232,15 @@ for c, col in enumerate(COLUMNS):
     mask_base, mask_top = 1 << (2 * c), 1 << (2 * c + 1)
     add_pedestal(mask_base | mask_top, material_of(col["bodies"][0]))
     for body in col["bodies"]:
-        clump_id, n_base = add_body(body, mask_base, mask_top, material_of(body))
+        clump_id = add_body(body, mask_base, mask_top, material_of(body))
         clumps.append(clump_id)
-        face_stiffness.append((body["mass"], CONTACT["kn"] * max(n_base, RIM_POINTS)))
         meta = {k: v for k, v in body.items() if k not in ("centre", "rotation")}
         bodies.append(dict(meta, initial_pos=list(body["centre"]),
                            initial_rotation=body["rotation"]))
 
 # ---------------------------------------------------------------- time step
-# a body resting on its whole base rim: stiffness kn x its base points (at least
-# RIM_POINTS: a box on its four corners steps as finely as a drum on its rim)
-# (computed by pipeline.scenario.parameters.time_step_s: the same operations on the same
-# bodies; the scene keeps the formula for scenes written without it)
-O.dt = P.get("time_step_s") or DT_FACTOR * math.sqrt(min(m / k for m, k in face_stiffness))
+# from the lightest body resting on its whole base rim (pipeline.scenario.parameters.time_step_s)
+O.dt = P["time_step_s"]
 
 # ---------------------------------------------------------------- motion
 motion = None
@@ -259,7 +254,7 @@ if MOTION_FILE:
 # the stop checks' end of the motion: the end of its signal when the processing gives one
 # (after it, the band-pass filter's transient only, far below anything that moves a body;
 # the pedestal is still driven by it while the run goes on)
-signal_end = motion_end if P.get("signal_end_s") is None else \
+signal_end = motion_end if P["signal_end_s"] is None else \
     min(motion_end, float(P["signal_end_s"]))
 quiet_after = signal_end if QUIET_AFTER_S is None else QUIET_AFTER_S
 
@@ -304,6 +299,7 @@ def drive_kinematic():
 
 # ---------------------------------------------------------------- friction
 TAN_S, TAN_K = CONTACT["mu_s"], CONTACT["mu_k"]
+STICK_FRACTION, SLIDE_FRACTION = THRESHOLDS["stick_fraction"], THRESHOLDS["slide_fraction"]
 
 
 def switch_friction():
@@ -315,9 +311,9 @@ def switch_friction():
             continue
         fs = ph.shearForce.norm()
         if ph.tangensOfFrictionAngle > TAN_K:        # sticking: switch at the static limit
-            if fs >= 0.999 * TAN_S * fn:
+            if fs >= STICK_FRACTION * TAN_S * fn:
                 ph.tangensOfFrictionAngle = TAN_K
-        elif fs < 0.99 * TAN_K * fn:                  # sliding stopped: back to static
+        elif fs < SLIDE_FRACTION * TAN_K * fn:        # sliding stopped: back to static
             ph.tangensOfFrictionAngle = TAN_S
 
 
@@ -340,14 +336,17 @@ def record_state():
 
 # smallest energy (J) that tips any stack of a column's bodies over its edge
 BARRIERS = {col["name"]: col["overturning_barrier_j"] for col in COLUMNS if col["settles"]}
-SETTLED_FRACTION = 0.9   # after the motion, energy below the barrier cannot tip a stack (10 % margin)
+# after the motion, energy below this fraction of the barrier cannot tip a stack
+SETTLED_FRACTION = THRESHOLDS["settled_fraction"]
 
-
-STANDS_UP, LIES_UP = 0.866, 0.5   # z of a body's axis: stands (tilt < 30 deg), lies (> 60 deg)
-# a mesh specimen (a rock) lies once tilted 30 deg past its critical angle (at most 60):
-# it has overturned, and may chatter on its landing points for long before it rests
-LIES_AT = [math.cos(math.radians(min(60.0, b["overturn_tilt_deg"] + 30.0)))
-           if b.get("overturn_tilt_deg") is not None else LIES_UP for b in bodies]
+# z of a body's axis: it stands (tilt below ~30 deg), lies (tilt past 60 deg)
+STANDS_UP, LIES_UP = THRESHOLDS["stands_axis_z"], THRESHOLDS["lies_axis_z"]
+# a mesh specimen (a rock) lies once tilted lies_past_critical_deg past its critical angle
+# (at most lies_tilt_deg): it has overturned, and may chatter on its landing points for
+# long before it rests
+LIES_AT = [math.cos(math.radians(min(THRESHOLDS["lies_tilt_deg"], b["overturn_tilt_deg"]
+                                     + THRESHOLDS["lies_past_critical_deg"])))
+           if b["overturn_tilt_deg"] is not None else LIES_UP for b in bodies]
 
 
 def up_axis(s, c):
@@ -382,11 +381,11 @@ def settled(rel):
 # tilted (times the column's height) by at most this fraction of the column's smallest
 # rocking lever: the levers then differ from the start's by a few per cent, inside the
 # pre-check's 10 % margin
-SEATED_FRACTION = 0.02
+SEATED_FRACTION = THRESHOLDS["seated_fraction"]
 SEATED = []      # per body: (index of its column's bottom body, shift tolerance m, tilt tol rad)
 for col in COLUMNS:
     bottom = len(SEATED)
-    tol = SEATED_FRACTION * col.get("rocking_lever_m", 0.0)
+    tol = SEATED_FRACTION * col["rocking_lever_m"]
     SEATED += [(bottom, tol, tol / col["height"])] * len(col["bodies"])
 INITIAL_AXES = [Vector3(*np.asarray(b["initial_rotation"], float)[:, 2]) for b in bodies]
 
@@ -478,7 +477,7 @@ def finish():
 
 # ---------------------------------------------------------------- engines
 friction_steps = max(1, int(round(FRICTION_INTERVAL_S / O.dt)))
-stop_steps = max(1, int(round(0.1 / O.dt)))
+stop_steps = max(1, int(round(THRESHOLDS["stop_interval_s"] / O.dt)))
 driven = motion is not None
 # recorders run before NewtonIntegrator so that O.time and positions agree
 O.engines = [
@@ -498,8 +497,28 @@ O.engines = [
 ]
 if driven and DRIVE == "inertial":
     drive_inertial()
+if not P["early_stop"]:          # simulate to T_MAX: the motion lasts until then for the checks
+    signal_end = quiet_after = T_MAX
+MEASURE = P["measure"]
+O.timingEnabled = MEASURE["engine_timing_file"] is not None
+loop_start = (time.perf_counter(), time.process_time())
 O.run()
 O.wait()
 while O.running:
     time.sleep(0.01)
+if MEASURE["loop_clock_file"] is not None:
+    with open(os.path.join(HERE, MEASURE["loop_clock_file"]), "w") as fh:
+        json.dump({"loop_wall_s": time.perf_counter() - loop_start[0],
+                   "loop_cpu_s": time.process_time() - loop_start[1]}, fh)
 finish()
+if MEASURE["engine_timing_file"] is not None:
+    from yade import timing
+    for engine in O.engines:
+        if isinstance(engine, PyRunner):
+            engine.label = engine.command.split("(")[0]
+    print("ENGINE TIMING BEGIN")
+    timing.stats()
+    print("ENGINE TIMING END", flush=True)
+    with open(os.path.join(HERE, MEASURE["engine_timing_file"]), "w") as fh:
+        json.dump([{"engine": e.label or type(e).__name__, "exec_ns": e.execTime,
+                    "count": e.execCount, "dead": e.dead} for e in O.engines], fh)

@@ -2,6 +2,7 @@
 carry the spec and the motion's bytes, results written atomically into ``runs/``."""
 import contextlib
 import hashlib
+import logging
 import os
 import shutil
 import signal
@@ -24,6 +25,7 @@ def execute_dask(todo, runs_dir, jobs, worker, bar, scheduler):
     except ImportError:
         raise ToolError("the dask executor needs dask.distributed: "
                         ".venv/bin/python -m pip install 'dask[distributed]'") from None
+    logging.getLogger("distributed").setLevel(logging.WARNING)   # its info is not for users
     failures, cluster, client, interrupted = [], None, None, False
     token = uuid.uuid4().hex[:8]
     running, motions = {}, {}                         # key -> (future, spec); file -> future
@@ -83,8 +85,6 @@ def local_cluster(jobs):
     dashboard is off) and per worker its nanny, its comm and its HTTP server:
     2 + 3 x jobs ports, closed with the cluster.
     """
-    import logging
-
     from distributed import LocalCluster
     return LocalCluster(n_workers=jobs, threads_per_worker=1, processes=True,
                         host="127.0.0.1", scheduler_port=0, dashboard_address=None,
@@ -165,6 +165,8 @@ def close_dask(client, cluster, token=None, interrupted=False, futures=()):
     and the client.  Best effort, bounded: Ctrl-C returns within about
     CONNECT_TIMEOUT_S on a cluster we don't own (its runs killed first: a busy worker may
     answer only after seconds) and CLOSE_TIMEOUT_S on a local one."""
+    if interrupted:     # comms closing under a stopped campaign are expected: one line
+        logging.getLogger("distributed").setLevel(logging.CRITICAL)
     if client is not None:
         def stop():
             if interrupted:

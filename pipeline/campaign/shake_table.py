@@ -272,9 +272,7 @@ def _experiment_table(frame, campaign_dir, label, validate_from):
 def summarise(table, specimen, calibration, label, point, options):
     """Scores per split for the model and the baselines, the calibration table, lines."""
     axis = options.get("axis_deg", AXIS_DEG)
-    critical = (specimen.critical_angle_along_deg(axis)
-                if hasattr(specimen, "critical_angle_along_deg")
-                else math.degrees(math.atan(specimen.uplift_ratio())))
+    critical = specimen.critical_angle_along_deg(axis)
     threshold_g = math.tan(math.radians(critical))
     splits = {}
     for split in ("calibration", "validation", "all"):

@@ -24,12 +24,11 @@ the struck bodies at their first strike (clockwise from North, degrees).
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from pipeline.constants import MODEL_GRAVITY
+from pipeline.constants import LIES_TILT_DEG, MODEL_GRAVITY
 from pipeline.motion import azimuth_deg
 from pipeline.outcome.summary import ColumnOutcome, RunSummary
 
 CONTACT_TOLERANCE_M = 0.02   # a rim this close to the pedestal top has struck it
-LIES_DEG = 60.0              # tilt past which the scene takes a body as lying (fallen)
 
 
 def body_axes(quat):
@@ -125,9 +124,9 @@ def column_outcomes(trajectory, start_in_file_s=0.0):
             else:
                 hits = stays_past(tilt, critical)
             over = np.flatnonzero(tilt > 90.0)
-            lying = not over.size and tilt[-1] > LIES_DEG    # the scene stopped it lying
+            lying = not over.size and tilt[-1] > LIES_TILT_DEG    # the scene stopped it lying
             if lying:
-                over = stays_past(tilt, LIES_DEG)
+                over = stays_past(tilt, LIES_TILT_DEG)
             entry = {"index": b["index"], **({"name": b["block_name"]} if b.get("block_name")
                                              else {}),
                      "mass_kg": b["mass"], "struck": bool(hits.size),

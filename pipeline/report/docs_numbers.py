@@ -155,7 +155,7 @@ def twin_time_step(fmt="factor {factor:.3f}, {step_us:.0f} us"):
     """The twin model's time step with the paper's contact, as ``run`` computes it."""
     params = scene_params(columns=Column("both").specs(), contact=Contact(),
                           motion_duration=1.0, t_max=1.0)
-    return fmt.format(factor=params["dt_factor"], step_us=1e6 * params["time_step_s"])
+    return fmt.format(factor=params.dt_factor, step_us=1e6 * params.time_step_s)
 
 
 def column_examples(names=None):

@@ -9,7 +9,9 @@ import numpy as np
 from pipeline.constants import MODEL_GRAVITY
 from pipeline.files import InputError
 from pipeline.scenario.outline import Outline, _edge_distances, contact_outline, perimeter_points
+from pipeline.scenario.scene_file import SceneBody, SceneColumn
 from pipeline.scenario.solids import ColumnBlock
+from pipeline.scenario.specimen import Specimen
 
 
 @dataclass
@@ -206,30 +208,31 @@ class ColumnSpec:
     kind: str
     x: float
     y: float
-    geometry: object               # a ColumnGeometry or MeshSpecimen
+    geometry: Specimen
 
     def scene(self, rim_points):
-        """The ``params.json`` entry of this column: bodies with placement, mass
-        properties, rims and plates (body frames centred on the centre of mass), its
-        rocking threshold (``uplift_ratio``), the smallest horizontal distance from a
-        rocking edge to the centre of mass of the stack above it (``rocking_lever_m``) and
-        the overturning energy barrier."""
-        if hasattr(self.geometry, "scene_column"):          # a mesh specimen
-            return self.geometry.scene_column(self, rim_points)
-        bodies = self.geometry.bodies(self.x, self.y)
-        statics = _statics(bodies, MODEL_GRAVITY)
-        n = len(bodies)
-        # a body released on its edge is not at rest at the start: no energy criterion
-        settles = self.geometry.settles and not any(b.edge_mode for b in bodies)
-        return {"name": self.name, "kind": self.kind, "x": self.x, "y": self.y,
-                "description": self.geometry.name,
-                "height": self.geometry.height, "n_bodies": n,
-                "uplift_ratio": min(j["ratio"] for j in statics),
-                "rocking_lever_m": min(j["lever_m"] for j in statics),
-                "overturning_barrier_j": (min(j["barrier_j"] for j in statics)
-                                          if settles else None),
-                "settles": settles,
-                "bodies": [_body_scene(self, b, n, rim_points) for b in bodies]}
+        """The ``params.json`` entry of this column
+        (:class:`~pipeline.scenario.scene_file.SceneColumn`, as a dict)."""
+        return self.geometry.scene_column(self, rim_points).to_dict()
+
+
+def column_scene(geometry, spec, rim_points):
+    """The :class:`~pipeline.scenario.scene_file.SceneColumn` of a column of blocks placed
+    as ``spec``: bodies with placement, mass properties, rims and plates (body frames
+    centred on the centre of mass), its rocking threshold (``uplift_ratio``), the smallest
+    horizontal distance from a rocking edge to the centre of mass of the stack above it
+    (``rocking_lever_m``) and the overturning energy barrier."""
+    bodies = geometry.bodies(spec.x, spec.y)
+    statics = _statics(bodies, MODEL_GRAVITY)
+    n = len(bodies)
+    # a body released on its edge is not at rest at the start: no energy criterion
+    settles = geometry.settles and not any(b.edge_mode for b in bodies)
+    return SceneColumn(
+        name=spec.name, kind=spec.kind, x=spec.x, y=spec.y, description=geometry.name,
+        height=geometry.height, n_bodies=n, uplift_ratio=min(j["ratio"] for j in statics),
+        rocking_lever_m=min(j["lever_m"] for j in statics),
+        overturning_barrier_j=min(j["barrier_j"] for j in statics) if settles else None,
+        settles=settles, bodies=[_body_scene(spec, b, n, rim_points) for b in bodies])
 
 
 def _body_scene(spec, body, n_bodies, rim_points):
@@ -268,9 +271,9 @@ def _body_scene(spec, body, n_bodies, rim_points):
     if np.array_equal(body.rotation, np.eye(3)):
         centre = body.base_world + com            # exact sums for an upright body
     shape = parts[0]["shape"] if len(parts) == 1 else "composite"
-    return {"name": f"{spec.name}[{body.index}]", "column": spec.name, "index": body.index,
-            "block_name": body.name, "blocks": [p.index for p in body.parts],
-            "shape": shape, "height": float(top[2]), "mass": body.mass,
-            "inertia": inertia.tolist(), "principal_axes": axes.tolist(),
-            "centre": centre.tolist(), "rotation": body.rotation.tolist(),
-            "column_position": [spec.x, spec.y], "parts": parts, "rims": rims, "plate": plate}
+    return SceneBody(name=f"{spec.name}[{body.index}]", column=spec.name, index=body.index,
+                     block_name=body.name, blocks=[p.index for p in body.parts], shape=shape,
+                     height=float(top[2]), mass=body.mass, inertia=inertia.tolist(),
+                     principal_axes=axes.tolist(), centre=centre.tolist(),
+                     rotation=body.rotation.tolist(), column_position=[spec.x, spec.y],
+                     parts=parts, rims=rims, plate=plate)

@@ -48,7 +48,7 @@ import numpy as np
 
 from pipeline.constants import MODEL_GRAVITY
 from pipeline.files import InputError
-from pipeline.scenario.bodies import _build, _statics
+from pipeline.scenario.bodies import _build, _statics, column_scene
 from pipeline.scenario.column_format import (DENSITY_RANGE, EXAMPLES_DIR, MAX_BLOCKS,
                                              MAX_COLUMN_HEIGHT_M, TOP_KEYS, _check_keys, _number,
                                              _one_line, _parse_block, _parse_json, _parse_yaml,
@@ -56,6 +56,7 @@ from pipeline.scenario.column_format import (DENSITY_RANGE, EXAMPLES_DIR, MAX_BL
 from pipeline.scenario.mesh import MESH_SUFFIXES, MeshSpecimen
 from pipeline.scenario.outline import perimeter_points
 from pipeline.scenario.solids import Box, ColumnBlock, Frustum
+from pipeline.scenario.specimen import Specimen
 from pipeline.userfiles import MAX_NESTING, read_text
 from pipeline.userfiles import Unreadable as _Unreadable
 from pipeline.userfiles import keys_text as _keys
@@ -64,7 +65,7 @@ from pipeline.userfiles import show as _show
 
 
 @dataclass(frozen=True)
-class ColumnGeometry:
+class ColumnGeometry(Specimen):
     """A column: blocks from the bottom, a density (kg/m^3) for blocks without their own.
 
     ``edge_rims``: contact spheres on the rims other than the base (they let a falling
@@ -200,12 +201,8 @@ class ColumnGeometry:
         return geometry
 
     def to_dict(self):
-        out = {"name": self.name, "density": self.density,
-               "blocks": [b.to_dict() for b in self.blocks]}
-        for key in ("source", "notes"):
-            if getattr(self, key):
-                out[key] = getattr(self, key)
-        return out
+        return self._described({"name": self.name, "density": self.density,
+                                "blocks": [b.to_dict() for b in self.blocks]})
 
     # ------------------------------------------------------------ derived
     @property
@@ -243,13 +240,17 @@ class ColumnGeometry:
         ``barrier_j``, the smallest energy that tips that stack over its edge."""
         return _statics(self.bodies(), g)
 
-    def uplift_ratio(self):
-        """Smallest rocking threshold of any stack / g (tan alpha of a single block)."""
-        return min(j["ratio"] for j in self.statics())
+    def scene_column(self, spec, rim_points):
+        return column_scene(self, spec, rim_points)
 
-    def overturning_barrier(self, g=MODEL_GRAVITY):
-        """Smallest energy (J) that tips any stack of bodies over its edge."""
-        return min(j["barrier_j"] for j in self.statics(g))
+    def check_rims(self, rim_sphere_radius):
+        for k, block in enumerate(self.blocks):
+            s = block.solid
+            sizes = [s.height] + ([s.bottom_diameter, s.top_diameter] if s.shape == "frustum"
+                                  else [s.width, s.depth])
+            if min(sizes) < 4 * rim_sphere_radius:
+                raise InputError(f"{self.name}: block {k} is {min(sizes):g} m thin, less "
+                                 f"than 4 contact sphere radii ({rim_sphere_radius:g} m)")
 
     def contact_rocking_hz(self, kn, rim_points=16):
         """Frequency (Hz) of the whole column, as one stone, rocking on the contact springs

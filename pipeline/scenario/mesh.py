@@ -50,6 +50,8 @@ from pipeline.constants import MODEL_GRAVITY
 from pipeline.files import InputError
 from pipeline.scenario.column_format import DENSITY_RANGE
 from pipeline.scenario.outline import perimeter_points
+from pipeline.scenario.scene_file import SceneBody, SceneColumn
+from pipeline.scenario.specimen import Specimen
 from pipeline.userfiles import keys_text, number, show
 
 MESH_SUFFIXES = (".obj", ".ply", ".stl")   # the mesh files trimesh reads here
@@ -74,7 +76,7 @@ KEYS = {"name", "mesh", "mass_kg", "density", "units", "rotation_wxyz", "rest_po
 
 
 @dataclass(frozen=True)
-class MeshSpecimen:
+class MeshSpecimen(Specimen):
     """A rigid specimen from a mesh, in its rest pose on the table (x East, y North, z
     up; the table at z = 0, the centre of mass above the origin).  Lengths m, mass kg."""
     name: str
@@ -92,9 +94,6 @@ class MeshSpecimen:
     source: str = None
     notes: str = None
     repairs: tuple = ()             # what was repaired to read the mesh (provenance)
-    settles = True
-    blocks = ()
-    edge_rims = True
 
     # ------------------------------------------------------------ loading
     @classmethod
@@ -201,11 +200,8 @@ class MeshSpecimen:
 
     def to_dict(self):
         """The description (absolute mesh path and its SHA-256: run ids follow the file)."""
-        out = {"name": self.name, "mesh": self.mesh_path, "mesh_sha256": self.mesh_sha256,
-               **self.options}
-        for key in ("source", "notes"):
-            if getattr(self, key):
-                out[key] = getattr(self, key)
+        out = self._described({"name": self.name, "mesh": self.mesh_path,
+                               "mesh_sha256": self.mesh_sha256, **self.options})
         if self.repairs:
             out["repairs"] = list(self.repairs)
         return out
@@ -253,9 +249,6 @@ class MeshSpecimen:
                  float((self.mass * g * (np.hypot(d, h) - h)).min()),
                  "mass_kg": self.mass, "com_m": self.com.tolist()}]
 
-    def uplift_ratio(self):
-        return self.statics()[0]["ratio"]
-
     def critical_angle_deg(self):
         """Smallest angle (deg) it must be tilted about a footprint edge to fall."""
         return math.degrees(math.atan(self.uplift_ratio()))
@@ -270,11 +263,8 @@ class MeshSpecimen:
         lever = min(along.max(), -along.min())
         return math.degrees(math.atan(lever / self.com[2]))
 
-    def overturning_barrier(self, g=MODEL_GRAVITY):
-        return self.statics(g)[0]["barrier_j"]
-
-    def check(self):
-        return self.statics()
+    def check_rims(self, rim_sphere_radius):
+        """Nothing to check: its contact spheres lie on its surface points."""
 
     def contact_rocking_hz(self, kn, rim_points=16):
         """Frequency (Hz) of the specimen rocking on the contact springs of its footprint
@@ -287,7 +277,7 @@ class MeshSpecimen:
         return min(out)
 
     def scene_column(self, spec, rim_points):
-        """The ``params.json`` column entry of this specimen placed as ``spec``
+        """The :class:`~pipeline.scenario.scene_file.SceneColumn` of this specimen placed as ``spec``
         (:class:`~pipeline.scenario.geometry.ColumnSpec`): one body whose rims are
         explicit points (body frame about the centre of mass) with inward normals."""
         com = self.com
@@ -299,24 +289,24 @@ class MeshSpecimen:
         joint = self.statics()[0]
         critical = math.degrees(math.atan(joint["ratio"]))
         _, axes = np.linalg.eigh(self.inertia)
-        body = {"name": f"{spec.name}[0]", "column": spec.name, "index": 0,
-                "block_name": self.name, "blocks": [0], "shape": "mesh",
-                "height": self.height, "mass": self.mass, "inertia": self.inertia.tolist(),
-                "principal_axes": axes.tolist(),
-                "centre": [spec.x + com[0], spec.y + com[1], float(com[2])],
-                "rotation": np.eye(3).tolist(), "column_position": [spec.x, spec.y],
-                "parts": [{"shape": "mesh", "block": 0, "name": self.name,
-                           "mesh_sha256": self.mesh_sha256}],
-                "rims": [{"role": "base", "kind": "points", "points": base3.tolist(),
-                          "normals": up.tolist()},
-                         {"role": "edge", "kind": "points", "points": landing.tolist(),
-                          "normals": inward.tolist()}],
-                "plate": None, "overturn_tilt_deg": critical}
-        return {"name": spec.name, "kind": spec.kind, "x": spec.x, "y": spec.y,
-                "description": self.name, "height": self.height, "n_bodies": 1,
-                "uplift_ratio": joint["ratio"], "rocking_lever_m": joint["lever_m"],
-                "overturning_barrier_j": joint["barrier_j"], "settles": True,
-                "bodies": [body]}
+        body = SceneBody(
+            name=f"{spec.name}[0]", column=spec.name, index=0, block_name=self.name,
+            blocks=[0], shape="mesh", height=self.height, mass=self.mass,
+            inertia=self.inertia.tolist(), principal_axes=axes.tolist(),
+            centre=[spec.x + com[0], spec.y + com[1], float(com[2])],
+            rotation=np.eye(3).tolist(), column_position=[spec.x, spec.y],
+            parts=[{"shape": "mesh", "block": 0, "name": self.name,
+                    "mesh_sha256": self.mesh_sha256}],
+            rims=[{"role": "base", "kind": "points", "points": base3.tolist(),
+                   "normals": up.tolist()},
+                  {"role": "edge", "kind": "points", "points": landing.tolist(),
+                   "normals": inward.tolist()}],
+            plate=None, overturn_tilt_deg=critical)
+        return SceneColumn(
+            name=spec.name, kind=spec.kind, x=spec.x, y=spec.y, description=self.name,
+            height=self.height, n_bodies=1, uplift_ratio=joint["ratio"],
+            rocking_lever_m=joint["lever_m"], overturning_barrier_j=joint["barrier_j"],
+            settles=True, bodies=[body])
 
 
 def _number(data, key, default, low, high, where):

@@ -15,6 +15,7 @@ from pipeline.files import InputError
 from pipeline.scenario.bodies import ColumnSpec
 from pipeline.scenario.column_format import DENSITY_RANGE
 from pipeline.scenario.geometry import ColumnGeometry
+from pipeline.scenario.scene_file import SceneFile
 
 RIM_SPHERE_RADIUS_M = 0.005   # rim contact spheres of the columns
 MIN_BODY_SIZE_M = 10 * RIM_SPHERE_RADIUS_M   # a drum must hold its two rims of spheres
@@ -332,8 +333,9 @@ US_PER_BODY_STEP = 8.0   # wall us per body and time step: twin model 4.5 (8 bod
 
 def time_step_s(columns, contact, rim_points, dt_factor):
     """The scene's time step (s): ``dt_factor`` sqrt(m / (kn x base points)) of its
-    lightest body on its base rim (at least ``rim_points`` points), as
-    yade_scripts/column_scene.py computes it (same operations, same value)."""
+    lightest body on its base rim (at least ``rim_points`` points: a box on its four
+    corners steps as finely as a drum on its rim); the scene takes it from the scene
+    file."""
     stiffness = []
     for column in columns:
         for body in column["bodies"]:
@@ -344,14 +346,14 @@ def time_step_s(columns, contact, rim_points, dt_factor):
 
 
 def check_cost(params, wall_limit_s):
-    """InputError when the scene ``params`` would need more wall time for its t_max than
+    """InputError when the scene file ``params`` would need more wall time for its t_max than
     ``wall_limit_s`` (the run's wall-clock limit would end it): say so before starting;
     a note on stdout when it takes over 5 minutes.  Returns the estimate (s): t_max /
     time step x bodies x US_PER_BODY_STEP."""
-    bodies = sum(len(c["bodies"]) for c in params["columns"])
-    estimate = params["t_max"] / params["time_step_s"] * bodies * US_PER_BODY_STEP * 1e-6
-    what = (f"{bodies} bodies stepping {params['time_step_s']:.2g} s for "
-            f"{params['t_max']:.0f} s simulated: about {estimate / 60:.0f} min")
+    bodies = sum(len(c["bodies"]) for c in params.columns)
+    estimate = params.t_max / params.time_step_s * bodies * US_PER_BODY_STEP * 1e-6
+    what = (f"{bodies} bodies stepping {params.time_step_s:.2g} s for "
+            f"{params.t_max:.0f} s simulated: about {estimate / 60:.0f} min")
     if estimate > wall_limit_s:
         raise InputError(f"{what}, beyond the run's wall-clock limit ({wall_limit_s / 60:.0f} "
                          "min): use fewer or heavier blocks, a stiffer contact or a shorter "
@@ -372,7 +374,7 @@ def check_time_step(contact, numerics):
 
 def scene_params(columns=(), block=None, contact=None, numerics=None, motion_duration=0.0,
                  t_max=None):
-    """The ``params.json`` content of a scene (JSON-serialisable dict).
+    """The scene file (:class:`~pipeline.scenario.scene_file.SceneFile`) of a scene.
 
     columns: list of :class:`~pipeline.scenario.geometry.ColumnSpec` (from
     :meth:`Column.specs`); block: a :class:`Block` (placed as a column named "block" at
@@ -394,31 +396,19 @@ def scene_params(columns=(), block=None, contact=None, numerics=None, motion_dur
             block.height, block.width, block.depth, block.density, block.theta0_rad)))
     pedestal = dict(PEDESTAL)
     for spec in specs:
-        check_rims(spec.geometry, numerics.rim_sphere_radius)
+        spec.geometry.check_rims(numerics.rim_sphere_radius)
         # a tall column falling over must still land at pedestal level
         reach = math.hypot(spec.x, spec.y) + 1.1 * spec.geometry.height + 2.0
         if reach > pedestal["contact_half_size"]:
             pedestal["contact_half_size"] = float(math.ceil(reach))
     scene_columns = [spec.scene(numerics.rim_points) for spec in specs]
     dt_factor = dt_factor_for(contact, numerics)
-    return {"columns": scene_columns,
-            "block": None if block is None else dataclasses.asdict(block),
-            "contact": dataclasses.asdict(contact), "pedestal": pedestal,
-            **dataclasses.asdict(numerics), "dt_factor": dt_factor,
-            "time_step_s": time_step_s(scene_columns, contact, numerics.rim_points, dt_factor),
-            "t_max": float(t_max),
-            "motion_file": None, "output": "trajectory.npz"}
-
-
-def check_rims(geometry, rim_sphere_radius):
-    """InputError when a block is too small for its rims of contact spheres."""
-    for k, block in enumerate(geometry.blocks):
-        s = block.solid
-        sizes = [s.height] + ([s.bottom_diameter, s.top_diameter] if s.shape == "frustum"
-                              else [s.width, s.depth])
-        if min(sizes) < 4 * rim_sphere_radius:
-            raise InputError(f"{geometry.name}: block {k} is {min(sizes):g} m thin, less "
-                             f"than 4 contact sphere radii ({rim_sphere_radius:g} m)")
+    return SceneFile(
+        columns=scene_columns, block=None if block is None else dataclasses.asdict(block),
+        contact=dataclasses.asdict(contact), numerics=dataclasses.asdict(numerics),
+        pedestal=pedestal, dt_factor=dt_factor,
+        time_step_s=time_step_s(scene_columns, contact, numerics.rim_points, dt_factor),
+        t_max=float(t_max))
 
 
 def split_options(options):

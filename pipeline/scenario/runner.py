@@ -22,7 +22,6 @@ paid once per thread instead of once per run.  That process dies with its thread
 itself after ``SERVE_IDLE_S`` without a scene.
 """
 import contextlib
-import json
 import os
 import re
 import select
@@ -39,6 +38,7 @@ from pipeline import YADE_SCRIPTS_DIR
 from pipeline.files import ToolError, die_with_parent
 from pipeline.outcome import Trajectory
 from pipeline.provenance import YADE_PY_PATH
+from pipeline.scenario.scene_file import SceneFile
 
 DEBIAN_PYTHON = "/usr/bin/python3"
 TMP_PREFIX = "toppling-yade-"     # a YADE process's note of its temporary directory
@@ -87,7 +87,7 @@ def run_yade(run_dir, timeout_s=None):
     out = run_dir / "trajectory.npz"
     out.unlink(missing_ok=True)
     if timeout_s is None:
-        timeout_s = wall_limit_s(json.loads((run_dir / "params.json").read_text())["t_max"])
+        timeout_s = wall_limit_s(SceneFile.read(run_dir).t_max)
     with _RUNNING_LOCK:
         _refuse_stopped(run_dir)     # before any file or process (checked again at the start)
     start = time.perf_counter()

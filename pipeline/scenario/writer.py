@@ -1,22 +1,22 @@
 """Write a scenario directory: params.json, motion.npz and scene.py (values never in code)."""
+import dataclasses
 import shutil
 from pathlib import Path
 
 from pipeline import YADE_SCRIPTS_DIR
-from pipeline.files import write_json
 
 SCENE_TEMPLATE = YADE_SCRIPTS_DIR / "column_scene.py"
 
 
 def write_scenario(run_dir, params, motion=None):
-    """Write params.json, motion.npz (if ``motion``, a :class:`~pipeline.motion.Motion`)
-    and scene.py into ``run_dir``; return the scene path."""
+    """Write params.json (``params``, a :class:`~pipeline.scenario.scene_file.SceneFile`),
+    motion.npz (if ``motion``, a :class:`~pipeline.motion.Motion`) and scene.py into
+    ``run_dir``; return the scene path."""
     run_dir = Path(run_dir)
     run_dir.mkdir(parents=True, exist_ok=True)
-    params = dict(params)
     if motion is not None:
         motion.save(run_dir / "motion.npz")
-        params["motion_file"] = "motion.npz"
-    write_json(run_dir / "params.json", params)
+        params = dataclasses.replace(params, motion_file="motion.npz")
+    params.write(run_dir)
     shutil.copyfile(SCENE_TEMPLATE, run_dir / "scene.py")
     return run_dir / "scene.py"

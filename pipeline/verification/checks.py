@@ -249,8 +249,7 @@ def still_rotation_deg(run_dir, model, damping, dt_factor, seconds=5.0):
     contact = Contact(damping=damping)
     params = scene_params(columns=column.specs(), contact=contact,
                           motion_duration=still.duration, t_max=still.duration)
-    params["dt_factor"] = dt_factor
-    params["time_step_s"] = time_step_s(params["columns"], contact, params["rim_points"],
-                                        dt_factor)
+    params = dataclasses.replace(params, dt_factor=dt_factor, time_step_s=time_step_s(
+        params.columns, contact, params.numerics["rim_points"], dt_factor))
     write_scenario(run_dir, params, still)
     return rotation_from_start_deg(run_yade(run_dir))

@@ -88,15 +88,17 @@ def test_the_scene_gets_every_key_it_reads_from_the_same_parameters(name, pulse,
     flat = spec.params.to_dict()
     assert RunParams.from_dict(json.loads(json.dumps(flat))) == spec.params   # via JSON
     params = _scene_params(spec, tmp_path / "run", monkeypatch)
-    text = SCENE.read_text()          # what the scene requires (P.get: optional keys)
-    read = set(re.findall(r'P\["(\w+)"\]', text)) - set(re.findall(r'P\.get\("(\w+)"', text))
-    assert {"columns", "contact", "rim_points", "t_max", "output"} <= read
+    text = SCENE.read_text()          # what the scene requires, at the top and in numerics
+    read = set(re.findall(r'\bP\["(\w+)"\]', text))
+    nested = set(re.findall(r'NUMERICS\["(\w+)"\]', text))
+    assert {"columns", "contact", "numerics", "t_max", "output"} <= read
     assert read <= set(params), sorted(read - set(params))
+    assert nested <= set(params["numerics"]), sorted(nested - set(params["numerics"]))
     p = spec.params
     assert params["contact"] == dataclasses.asdict(p.contact)
     for key, value in dataclasses.asdict(p.numerics).items():
         if key != "dt_factor" or value is not None:         # None: the stable default
-            assert params[key] == value, key
+            assert params["numerics"][key] == value, key
     assert [c["name"] for c in params["columns"]] == [s.name for s in p.column.specs()]
 
 

@@ -45,7 +45,7 @@ def test_paper_columns_from_files_give_the_outcomes_of_before(tmp_path):
     pulse = one_sine_pulse(0, 8)
     params, traj = run(tmp_path, "files", files, pulse)
     default, built_in = run(tmp_path, "built-in", Column("both").specs(), pulse)
-    for ours, theirs in zip(params["columns"], default["columns"]):
+    for ours, theirs in zip(params.columns, default.columns):
         assert ours["bodies"] == theirs["bodies"]
     assert np.array_equal(traj.quat, built_in.quat)
     assert np.array_equal(traj.pos, built_in.pos)

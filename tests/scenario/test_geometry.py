@@ -198,7 +198,7 @@ def test_out_of_plumb_column_rocks_earlier_toward_its_lean():
 
 def test_verification_block_is_placed_on_its_edge_as_before():
     h, w, d, th = 0.4, 0.08, 0.045, 0.1
-    (spec,) = [c for c in scene_params(block=Block(h, w, d, 2960.0, th))["columns"]]
+    (spec,) = [c for c in scene_params(block=Block(h, w, d, 2960.0, th)).columns]
     (body,) = spec["bodies"]
     Ry = np.array([[math.cos(th), 0, math.sin(th)], [0, 1, 0], [-math.sin(th), 0, math.cos(th)]])
     pivot = np.array([w / 2, 0, 0])
@@ -280,14 +280,14 @@ def test_default_columns_are_the_shipped_paper_columns():
 
 def test_default_scene_bodies_are_the_paper_columns():
     params = scene_params(columns=Column("both").specs())
-    drums, mono = params["columns"]
+    drums, mono = params.columns
     assert [b["centre"] for b in drums["bodies"]] == [[-1.5, 0.0, 0.25 + 0.5 * k]
                                                       for k in range(7)]
     d = 3.5 / 6
     assert drums["bodies"][0]["mass"] == 2960.0 * math.pi * (d / 2) ** 2 * 0.5
     assert mono["bodies"][0]["mass"] == pytest.approx(2772, rel=0.002)
     assert mono["uplift_ratio"] == pytest.approx(d / 3.5, rel=1e-15)      # tan(alpha)
-    assert params["pedestal"]["contact_half_size"] == 12.0
+    assert params.pedestal["contact_half_size"] == 12.0
 
 
 def test_column_file_with_both_places_a_monolith_of_its_outline_beside_it():

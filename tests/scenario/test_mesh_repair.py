@@ -55,7 +55,7 @@ def load(path, **options):
 
 def physics(rock):
     """The scene entry a specimen produces, without the file's own hash."""
-    column = rock.scene_column(ColumnSpec("monolithic", "monolithic", 0.0, 0.0, rock), 16)
+    column = ColumnSpec("monolithic", "monolithic", 0.0, 0.0, rock).scene(16)
     for part in column["bodies"][0]["parts"]:
         part.pop("mesh_sha256")
     return column

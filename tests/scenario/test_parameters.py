@@ -1,4 +1,6 @@
 """Scene parameters and the scene writer, without YADE."""
+import ast
+import dataclasses
 import json
 import math
 
@@ -43,9 +45,9 @@ def test_time_step_factor_limited_by_the_contact_damping():
     assert largest_stable_dt_factor(1.0) == pytest.approx(0.10399, abs=1e-5)
     assert largest_stable_dt_factor(0.36) == pytest.approx(0.23515, abs=1e-5)
     default = scene_params(columns=Column().specs(), contact=Contact(damping=1.0))
-    assert default["dt_factor"] == pytest.approx(0.10399, abs=1e-5)   # unset: the limit
+    assert default.dt_factor == pytest.approx(0.10399, abs=1e-5)   # unset: the limit
     assert scene_params(columns=Column().specs(),
-                        contact=Contact(damping=0.1))["dt_factor"] == 0.3   # converged cap
+                        contact=Contact(damping=0.1)).dt_factor == 0.3   # converged cap
     scene_params(columns=Column().specs(), numerics=Numerics(dt_factor=0.2))  # damping 0.36
     with pytest.raises(InputError) as info:
         scene_params(columns=Column().specs(), contact=Contact(damping=1.0),
@@ -79,12 +81,14 @@ def test_twin_model_geometry():
 def test_generated_scene_never_contains_values(tmp_path):
     evil = 'x"; import os; os.system("rm -rf /")  #\n\'\'\''
     params = scene_params(columns=Column("both").specs(), motion_duration=1.0)
-    params["record_name"] = evil
+    params = dataclasses.replace(params, columns=[dict(params.columns[0], description=evil),
+                                                  *params.columns[1:]])
     zeros = np.zeros((101, 3))
     script = write_scenario(tmp_path, params, Motion(0.01, zeros, zeros, zeros,
                                                      meta={"record_id": evil}))
     assert script.read_bytes() == SCENE_TEMPLATE.read_bytes()
-    assert json.loads((tmp_path / "params.json").read_text())["record_name"] == evil
+    assert json.loads((tmp_path / "params.json").read_text())["columns"][0]["description"] \
+        == evil
 
 
 def test_motion_with_nan_is_rejected_and_nothing_written(tmp_path):
@@ -93,3 +97,38 @@ def test_motion_with_nan_is_rejected_and_nothing_written(tmp_path):
     with pytest.raises(InputError, match="NaN"):
         Motion(0.01, acc, acc, acc)
     assert not (tmp_path / "run").exists()
+
+
+def test_the_scene_holds_no_physics_constant():
+    """Every number yade_scripts/column_scene.py computes with comes from params.json: its
+    code holds only small counts, indices and factors of formulas (0 to 4, 1/2), the bit of its
+    'collides with nothing' mask and the interval it polls YADE's loop at."""
+    tree = ast.parse(SCENE_TEMPLATE.read_text())
+    exempt = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.BinOp) and isinstance(node.op, ast.LShift):
+            exempt.add(id(node.right))                          # a mask bit
+        if isinstance(node, ast.Call) and ast.unparse(node.func) == "time.sleep":
+            exempt.update(id(a) for a in node.args)             # polling, not physics
+    constants = sorted({ast.unparse(node) for node in ast.walk(tree)
+                        if isinstance(node, ast.Constant) and id(node) not in exempt
+                        and isinstance(node.value, (int, float))
+                        and not isinstance(node.value, bool)
+                        and node.value not in (0, 1, 2, 3, 4, 0.5)})
+    assert constants == []
+
+
+def test_the_scene_file_reads_back_as_written(tmp_path):
+    """The one writer and the one reader of params.json: what is written reads back equal,
+    with gravity and the lying threshold of the outcome."""
+    from pipeline.constants import LIES_TILT_DEG, MODEL_GRAVITY
+    from pipeline.scenario.scene_file import SceneFile
+    params = scene_params(columns=Column("both", column_file="doric-peristyle").specs(),
+                          motion_duration=1.0)
+    params.write(tmp_path)
+    read = SceneFile.read(tmp_path)
+    assert read == SceneFile.from_dict(json.loads(json.dumps(params.to_dict())))
+    assert read.to_dict() == json.loads((tmp_path / "params.json").read_text())
+    assert read.gravity == MODEL_GRAVITY and read.thresholds.lies_tilt_deg == LIES_TILT_DEG
+    assert math.cos(math.radians(read.thresholds.lies_tilt_deg)) == \
+        pytest.approx(read.thresholds.lies_axis_z, abs=1e-15)
