@@ -196,10 +196,9 @@ def plot_pulse_grid(summary, path):
             for level, ls in zip(("0.16", "0.5", "0.84"), (":", "-", "--")):
                 rows = [r for r in contours.get(level, []) if r["pga_g"] is not None]
                 if rows:
+                    who = "2D rigid block (Housner integrator)" if model == block else name
                     ax.plot([r["pgv_pga_s"] for r in rows], [r["pga_g"] for r in rows],
-                            color=colour, ls=ls, lw=1.6,
-                            label=(f"{'2D rigid block (Housner integrator)' if model == block else name}"
-                                   f" P = {level}"))
+                            color=colour, ls=ls, lw=1.6, label=f"{who} P = {level}")
             band = [r for r in contours.get("0.5", [])
                     if None not in r["pga_g_band"]]
             if band and model == name:

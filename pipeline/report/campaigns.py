@@ -411,20 +411,17 @@ def rock_fragility_section(results, name="rock-fragility"):
                             if entry["logistic"].get("separated") else "") + ".\n")
     check = section.get("experiments")
     if check:
-        rows = [{"prediction": label, "log-likelihood per test": _fmt(s["log_likelihood_per_test"], 3),
-                 "Brier": _fmt(s["brier"], 3), "tests": s["n"]}
-                for label, s in check["baselines"].items()]
+        def score_row(label, score):
+            return {"prediction": label,
+                    "log-likelihood per test": _fmt(score["log_likelihood_per_test"], 3),
+                    "Brier": _fmt(score["brier"], 3), "tests": score["n"]}
+
+        rows = [score_row(label, s) for label, s in check["baselines"].items()]
         for model, result in check["models"].items():
-            rows.append({"prediction": f"{model}: pulse fragility (grid; "
-                                       f"{result['grid']['outside_grid']} tests outside it, "
-                                       "nearest edge)",
-                         "log-likelihood per test": _fmt(result["grid"]["log_likelihood_per_test"], 3),
-                         "Brier": _fmt(result["grid"]["brier"], 3), "tests": result["grid"]["n"]})
+            rows.append(score_row(f"{model}: pulse fragility (grid; {result['grid']['outside_grid']}"
+                                  " tests outside it, nearest edge)", result["grid"]))
             if "logistic" in result:
-                rows.append({"prediction": f"{model}: its logistic surface",
-                             "log-likelihood per test": _fmt(result["logistic"]["log_likelihood_per_test"], 3),
-                             "Brier": _fmt(result["logistic"]["brier"], 3),
-                             "tests": result["logistic"]["n"]})
+                rows.append(score_row(f"{model}: its logistic surface", result["logistic"]))
         lines.append(f"Against the {check['tests']} shake-table tests ({check['overturned']} "
                      f"overturned; {check['note']}):\n")
         lines.append(_table(pd.DataFrame(rows)) + "\n")
