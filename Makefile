@@ -5,7 +5,7 @@ PY := .venv/bin/python
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 JOBS ?= $(shell nproc)
 
-.PHONY: setup test run-all records campaigns bench clean invert-demo shake-table docs \
+.PHONY: setup test run-all records campaigns bench clean invert-demo shake-table rock-fragility docs \
 	convergence paper-question invert-study invert-study-table
 
 setup: .venv/.installed
@@ -75,6 +75,19 @@ bench: setup
 shake-table: setup
 	$(PY) -m pipeline campaign shake-table $(if $(SHAKE_GRID),--grid "$(SHAKE_GRID)") --jobs $(JOBS) \
 	  --allow-long
+	$(PY) -m pipeline report
+
+# the scanned rock SP1's fragility: over the Virtual Shake Robot's pulse grid (PGA 0.2-1.1 g x
+# PGV/PGA 0.1-1.0 s, 10 x 10) from directions sampled over 360 deg, 4 parameter sets x 4
+# directions (1,600 runs), and along the table's axis over the range of its shake-table
+# tests, checked against them (6 x 4 cells x 4 parameter sets): a few minutes on 2 cores
+ROCK_TABLE_PULSES ?= pga_g=0.1:1.0:6;pgv_pga_s=0.02:0.29:4
+rock-fragility: setup
+	$(PY) -m pipeline campaign fragility --column-file records/shake_table/sp1.json \
+	  --pulses vsr --out results/rock-fragility --jobs $(JOBS)
+	$(PY) -m pipeline campaign fragility --column-file records/shake_table/sp1.json \
+	  --pulses "$(ROCK_TABLE_PULSES)" --members 4 --azimuth 90 \
+	  --out results/rock-fragility-table --jobs $(JOBS)
 	$(PY) -m pipeline report
 
 # the model's convergence judged on distributions: the twin model's ensembles of 3 records

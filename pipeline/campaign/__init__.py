@@ -111,9 +111,10 @@ def run_campaign(name, jobs=None, records=None, campaign_dir=None, animations=1,
         specs = campaign.specs(records, campaign_dir, **(options or {}))
         if allow_long is not None and jobs is not None:
             runs_dir = campaign_dir / "runs"
-            todo = sum(not (runs_dir / s.run_id / "summary.json").exists() for s in specs)
-            check_long(f"campaign {name}", todo, campaign.run_core_s, jobs, allow_long,
-                       "fewer records, members or parameter values")
+            todo = [s for s in specs if not (runs_dir / s.run_id / "summary.json").exists()]
+            core_s = [s.tags.get("core_s", campaign.run_core_s) for s in todo]   # a run's own
+            check_long(f"campaign {name}", len(todo), sum(core_s) / max(len(todo), 1), jobs,
+                       allow_long, "fewer records, members or parameter values")
         return _run_specs(campaign, name, specs, campaign_dir, jobs, animations, executor,
                           scheduler)
     except (InputError, ToolError, OSError):

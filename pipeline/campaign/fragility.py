@@ -52,7 +52,8 @@ from pipeline.campaign.definitions import (column_specs, motion_cache, pulse_rec
 from pipeline.campaign import ensemble   # module: imported while ensemble may still load
 from pipeline.campaign.tables import collect
 from pipeline.constants import COLUMN_KINDS, MODEL_GRAVITY
-from pipeline.files import InputError, write_csv, write_json
+from pipeline.campaign import pulse_grid
+from pipeline.files import InputError, duration_text, write_csv, write_json
 from pipeline.motion import Motion
 from pipeline.motion.measures import horizontal_peak, record_parameters
 from pipeline.records import processed_motion
@@ -63,6 +64,7 @@ from pipeline.stats.ensemble import (binned_fractions, fragility_fit, logistic_s
 DEFAULT_LEVELS = tuple(round(float(v), 3) for v in np.geomspace(0.5, 8.0, 8))   # m/s^2
 DEFAULT_MEMBERS = 4
 DEFAULT_AZIMUTHS = 12
+DEFAULT_HEADINGS = 4            # pulse grid: shaking directions per parameter set
 BLOCK_T_AFTER_S = 30.0          # free rocking after the motion, at most (2D model)
 BLOCK_MAX_STEP_S = 1e-3         # 2D model integration step, at most
 BLOCK_CHUNK_SAMPLES = 10_000_000   # acceleration samples x cases integrated at once (memory)
@@ -102,12 +104,35 @@ def parse_levels(text):
 
 def fragility_specs(records, campaign_dir, levels=DEFAULT_LEVELS, members=DEFAULT_MEMBERS,
                     column="both", seed=None, azimuths=DEFAULT_AZIMUTHS, column_file=None,
-                    stiffness="matched", **_):
+                    stiffness="matched", pulses=None, azimuth=None,
+                    headings=DEFAULT_HEADINGS, ranges=None, jobs=None, only_runs=None,
+                    adaptive=False, **_):
     """Run specs: every record x level x member; ``scale`` = level / PGA of the record.
     With ``column_file`` every member is the described column with the sampled height
     and diameter tolerances (its own tilt and offsets as described), and the 2D block
-    has each member's overall height and base width."""
-    data = column_file_description(column_file)
+    has each member's overall height and base width.  With ``pulses`` (the default for
+    a mesh specimen: the preset vsr) the pulse grid of :mod:`pipeline.campaign.pulse_grid`
+    instead."""
+    data = column_file_description(column_file, meshes=True)
+    mesh = data is not None and "mesh" in data
+    if pulses is None and mesh and not records:
+        pulses = "vsr"
+        print("fragility: a mesh specimen: the pulse grid vsr (PGA 0.2-1.1 g x PGV/PGA "
+              "0.1-1.0 s, 10 x 10; --pulses to change it)", flush=True)
+    if pulses is not None:
+        specs = _pulse_specs(records, campaign_dir, data, column, pulses, members, headings,
+                             azimuth, seed, ranges, stiffness, jobs, quiet=only_runs is not None)
+        if only_runs is not None:
+            keep = set(only_runs)
+            specs = [s.tagged(sampling="adaptive") for s in specs if s.run_id in keep]
+        return specs
+    if adaptive:
+        raise InputError("--adaptive belongs to the pulse grid: add --pulses")
+    if mesh:
+        raise InputError(f"--column-file {data['name']}: a mesh specimen takes the pulse grid "
+                         "(--pulses), not scaled --records")
+    if azimuth is not None or ranges is not None:
+        raise InputError("--azimuth and --ranges belong to the pulse grid: add --pulses")
     check_stiffness(stiffness)
     records = list(records) if records else default_records()
     levels = parse_levels(levels)
@@ -139,6 +164,37 @@ def fragility_specs(records, campaign_dir, levels=DEFAULT_LEVELS, members=DEFAUL
                               "scale": scale})
     return mark(column_specs(runs, campaign_dir, extra, seed=seed, azimuths=azimuths,
                              levels=list(levels)), data)
+
+
+def _pulse_specs(records, campaign_dir, data, column, pulses, members, headings, azimuth,
+                 seed, ranges, stiffness, jobs, quiet=False):
+    """Run specs of the pulse grid (every cell x parameter set x heading), the cost said
+    before any run."""
+    if records:
+        raise InputError("--pulses shakes the specimen with pulses: drop --records (or "
+                         "--pulses to scale records)")
+    if column not in COLUMN_KINDS:
+        raise InputError(f"--column must be both, monolithic or drums, got {column!r}")
+    check_stiffness(stiffness)
+    seed = ensemble.DEFAULT_SEED if seed is None else seed
+    grid, sets, azimuths, runs = pulse_grid.pulse_runs(
+        data, column, pulses, members, headings, azimuth, seed, ranges, stiffness)
+    cache = motion_cache(campaign_dir)
+    pairs, tags = [], []
+    for pga, ratio, params, tag in runs:
+        pairs.append((str(pulse_grid.pulse_file(cache, pga, ratio)), params))
+        tags.append({"mode": "pulses", "core_s": round(pulse_grid.run_core_s(ratio), 3), **tag})
+    n_cells = len(grid["pga_g"]) * len(grid["pgv_pga_s"])
+    core_s = sum(t["core_s"] for t in tags)
+    if not quiet:
+        print(f"fragility: {n_cells} pulse cells x {len(sets)} parameter sets x "
+              f"{azimuths.shape[1]} heading(s) = {len(runs)} YADE runs, at most about "
+              f"{duration_text(core_s / max(jobs or 1, 1))} on {jobs or 1} core(s) (a run "
+              "stops early once the specimen has fallen or settled; finished runs are kept "
+              "and not run again)", flush=True)
+    specs = column_specs(pairs, campaign_dir, tags, seed=seed, pulses=pulses,
+                         ranges=ranges, azimuth=azimuth, headings=headings, members=members)
+    return mark(specs, data)
 
 
 def block_size(params):
@@ -425,6 +481,9 @@ def _finite(obj):
 
 def fragility_outputs(specs, campaign_dir, failures, animations, figures=True):
     campaign_dir = Path(campaign_dir)
+    if specs and specs[0].tags.get("mode") == "pulses":
+        from pipeline.campaign.pulse_outputs import pulse_outputs
+        return pulse_outputs(specs, campaign_dir, figures)
     runs = scaled_runs(specs, campaign_dir)
     if runs.empty:
         return {"code_version": run_code_version(), **summary_entry(specs), "figures": []}
@@ -479,17 +538,83 @@ class FragilityOptions(CampaignOptions):
         "tolerances (tilt and offsets as described); the 2D block has its overall height and "
         "base width")
     stiffness: str = stiffness_param("with --column-file, what kn_factor multiplies")
+    pulses: str = param(None, "", "shake with a grid of one-cosine pulses instead of scaled "
+                        "records: pga_g=LO:HI:N;pgv_pga_s=LO:HI:N, or the preset vsr (PGA "
+                        "0.2-1.1 g x PGV/PGA 0.1-1.0 s, 10 x 10; the default for a mesh "
+                        "specimen)", flag="--pulses", metavar="GRID")
+    azimuth: float = param(None, "deg", "pulse grid: shake along this fixed azimuth (a "
+                           "table); default: sampled per member over 360 deg (a field rock)",
+                           flag="--azimuth", metavar="DEG")
+    headings: int = param(DEFAULT_HEADINGS, "", "pulse grid: sampled shaking directions per "
+                          "parameter set (1 with --azimuth)", 1, 360, flag="--headings")
+    ranges: str = param(None, "", "pulse grid: ranges the members' unknowns are drawn from "
+                        f"(default {pulse_grid.DEFAULT_RANGES}; LO = HI fixes one)",
+                        flag="--ranges", metavar="NAME=LO:HI;...")
+    adaptive: bool = param(False, "", "pulse grid: run every member only where P is uncertain "
+                           "(the 2D block as a guide, one probe run elsewhere, widened where a "
+                           "probe disagrees)", flag="--adaptive")
+    TAKES_JOBS = True
 
     def check(self):
         parse_levels(self.levels)
         ensemble.check_seed(self.seed)
+        if self.pulses is not None:
+            pulse_grid.parse_pulses(self.pulses)
+        if self.ranges is not None:
+            pulse_grid.parse_ranges(self.ranges)
+        if self.adaptive and self.pulses is None and self.column_file is None:
+            raise InputError("--adaptive belongs to the pulse grid: add --pulses")
+        if self.azimuth is not None and not (math.isfinite(self.azimuth)
+                                             and 0 <= self.azimuth < 360):
+            raise InputError(f"--azimuth must be in [0, 360) deg, got {self.azimuth:g}")
 
     def kwargs(self):
-        return {**super().kwargs(), "levels": parse_levels(self.levels)}
+        kwargs = {**super().kwargs(), "levels": parse_levels(self.levels)}
+        if self.azimuth is not None and self.headings == DEFAULT_HEADINGS:
+            kwargs["headings"] = 1          # a fixed direction: one heading
+        return kwargs
+
+
+def drive(run, records, campaign_dir, options, gate=None):
+    """Run the campaign; with ``adaptive`` (pulse grid) in stages: every member where the
+    2D block of the same members and directions is uncertain (0 < P < 1) and one cell
+    either side in PGA, one probe run (first member, first direction) in every other
+    cell; a probe that disagrees with the block's certainty adds its cell and one either
+    side; until none does (at most :data:`pulse_grid.MAX_STAGES` stages)."""
+    if not options.get("adaptive"):
+        return run(options)
+    full = fragility_specs(records, campaign_dir, **options)
+    if gate is not None:
+        gate("campaign fragility (adaptive; at most the full grid)", len(full),
+             sum(s.tags["core_s"] for s in full) / len(full), "a smaller --pulses grid")
+    guide = pulse_grid.block_outcomes(full)
+    by_cell = {}
+    for spec, fell in zip(full, guide):
+        by_cell.setdefault(pulse_grid.cell_key(spec), []).append((spec, fell))
+    guide_p = {cell: float(np.mean([f for _, f in rows])) for cell, rows in by_cell.items()}
+    whole = pulse_grid.guide_cells(guide_p)
+    probes = {cell: rows[0][0] for cell, rows in by_cell.items()}
+    result = None
+    for stage in range(1, pulse_grid.MAX_STAGES + 1):
+        chosen = [s.run_id for cell, rows in by_cell.items() for s, _ in rows
+                  if cell in whole or s is probes[cell]]
+        print(f"fragility (adaptive), stage {stage}: {len(whole)} of {len(by_cell)} cells in "
+              f"full, a probe run in the others: {len(chosen)} of {len(full)} runs", flush=True)
+        result = run({**options, "only_runs": chosen})
+        outcomes = {}
+        for cell, spec in probes.items():
+            summary = finished_summary(campaign_dir, spec.run_id)
+            if summary is not None:
+                outcomes[cell] = any(c.toppled for c in summary.columns)
+        added = pulse_grid.expand(guide_p, whole, outcomes)
+        if not added:
+            break
+        whole |= added
+    return result
 
 
 register(Campaign("fragility", "P(toppled | PGA, PGV, PGV/PGA) by incremental dynamic analysis: "
                   "records scaled to a PGA ladder, a small ensemble per level, lognormal and "
                   "logistic fits, the 2D rigid block side by side (default records GM20, NF04)",
                   fragility_specs, run_column_spec, fragility_outputs, label="runs",
-                  options=FragilityOptions))
+                  options=FragilityOptions, driver=drive))

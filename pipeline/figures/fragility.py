@@ -171,3 +171,66 @@ def plot_surface(table, summary, path):
     fig.tight_layout()
     save_figure(fig, path, dpi=120)
     return path
+
+
+def plot_pulse_grid(summary, path):
+    """The pulse-grid fragility of each 3D specimen model: P per cell (colour), its
+    P = 0.16 / 0.5 / 0.84 contours (lines; the Monte Carlo band of the 0.5 contour
+    shaded), the 2D rigid block's (same critical angle and pivot distance; the toolkit's
+    Housner integrator) and, where experiments exist, the observed rate per bin."""
+    section = summary["pulse_grid"]
+    block = section["block2d"]["model"]
+    names = [m for m in section["models"] if m != block] or [block]
+    fig = figure(figsize=(5.2 * len(names), 4.4))
+    axes = fig.subplots(1, len(names), squeeze=False)[0]
+    ratios, pgas = np.array(section["pgv_pga_s"]), np.array(section["pga_g"])
+    for ax, name in zip(axes, names):
+        cells = section["models"][name]["cells"]
+        P = np.full((len(ratios), len(pgas)), np.nan)
+        for c in cells:
+            P[np.argmin(abs(ratios - c["pgv_pga_s"])), np.argmin(abs(pgas - c["pga_g"]))] = c["P"]
+        image = ax.pcolormesh(_edges(ratios), _edges(pgas), P.T, cmap="Greys", vmin=0, vmax=1,
+                              shading="flat")
+        for model, colour in ((name, "C3"), (block, "C0")):
+            contours = section["models"].get(model, {}).get("contours", {})
+            for level, ls in zip(("0.16", "0.5", "0.84"), (":", "-", "--")):
+                rows = [r for r in contours.get(level, []) if r["pga_g"] is not None]
+                if rows:
+                    who = "2D rigid block (Housner integrator)" if model == block else name
+                    ax.plot([r["pgv_pga_s"] for r in rows], [r["pga_g"] for r in rows],
+                            color=colour, ls=ls, lw=1.6, label=f"{who} P = {level}")
+            band = [r for r in contours.get("0.5", [])
+                    if None not in r["pga_g_band"]]
+            if band and model == name:
+                ax.fill_between([r["pgv_pga_s"] for r in band],
+                                [r["pga_g_band"][0] for r in band],
+                                [r["pga_g_band"][1] for r in band], color=colour, alpha=0.2,
+                                lw=0, label="P = 0.5, Monte Carlo 95 %")
+        observed = section.get("experiments", {}).get("models", {}).get(name, {}).get("bins")
+        if observed:
+            x = [np.mean(b["pgv_pga_s"]) for b in observed]
+            y = [np.mean(b["pga_g"]) for b in observed]
+            ax.scatter(x, y, c=[b["observed_rate"] for b in observed], cmap="Greys",
+                              vmin=0, vmax=1, s=[12 + 3 * b["n"] ** 0.5 * 4 for b in observed],
+                              edgecolors="C1", linewidths=1.2, label="observed rate (tests)",
+                              zorder=5)
+        ax.set_xlim(0.0, max(_edges(ratios)[-1], 1.0 if observed else 0.0))
+        ax.set_ylim(0.0, max(_edges(pgas)[-1], 1.2 if observed else 0.0))
+        ax.set_xlabel("PGV/PGA (s)")
+        ax.set_ylabel("PGA (g)")
+        ax.set_title(f"{summary['specimen']} ({name}): P(overturn), one-cosine pulses\n"
+                     f"direction: {section['direction'].split(' (')[0]}", fontsize=8)
+        ax.legend(fontsize=6, loc="upper right")
+        fig.colorbar(image, ax=ax, label="P(overturn)")
+    fig.tight_layout()
+    save_figure(fig, path, dpi=120)
+    return [Path(path)]
+
+
+def _edges(centres):
+    """Cell edges around grid centres (a single centre: +-10 %)."""
+    c = np.asarray(centres, float)
+    if c.size == 1:
+        return np.array([c[0] * 0.9, c[0] * 1.1])
+    mid = (c[1:] + c[:-1]) / 2
+    return np.concatenate([[c[0] - (mid[0] - c[0])], mid, [c[-1] + (c[-1] - mid[-1])]])

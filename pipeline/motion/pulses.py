@@ -54,3 +54,35 @@ def raw_pulse(kind="sine", amplitude=6.0, frequency=0.75, azimuth_deg=0.0, start
     acc = np.where(on, amplitude * shape(2 * math.pi * frequency * tau), 0.0)
     u = np.array([math.sin(math.radians(azimuth_deg)), math.cos(math.radians(azimuth_deg)), 0.0])
     return acc[:, None] * u
+
+
+def one_cosine_pulse(pga_m_s2, pgv_pga_s, azimuth_deg=0.0, dt=0.005, tail_s=4.0):
+    """One cycle of the one-cosine displacement pulse d(t) = A - A cos(2 pi F t) with
+    F = 1 / (2 pi PGV/PGA) (the Virtual Shake Robot's pulse: Chen et al. 2024), so that
+    PGA = A (2 pi F)^2 and PGV = A 2 pi F exactly, horizontal along ``azimuth_deg``
+    (deg clockwise from North), then ``tail_s`` s at rest for the body to settle.
+    Acceleration, velocity and displacement are the exact derivatives, sampled at most
+    every ``dt`` s (shortened so that a quarter period is a whole number of samples: the
+    samples hold the peaks); the displacement is back to zero at the end of the cycle."""
+    for name, value in (("pga_m_s2", pga_m_s2), ("pgv_pga_s", pgv_pga_s), ("dt", dt)):
+        if not (math.isfinite(value) and value > 0):
+            raise ValueError(f"one_cosine_pulse: {name} must be a positive number, got {value!r}")
+    w = 1.0 / pgv_pga_s                          # 2 pi F (rad/s)
+    amplitude = pga_m_s2 / w ** 2                # A (m)
+    period = 2 * math.pi / w
+    n_cycle = 4 * int(math.ceil(period / (4 * dt)))
+    dt = period / n_cycle
+    t = np.arange(n_cycle + 1 + int(math.ceil(tail_s / dt))) * dt
+    on = t <= period
+    phase = w * np.minimum(t, period)
+    disp = np.where(on, amplitude * (1 - np.cos(phase)), 0.0)
+    vel = np.where(on, amplitude * w * np.sin(phase), 0.0)
+    acc = np.where(on, amplitude * w ** 2 * np.cos(phase), 0.0)
+    u = np.array([math.sin(math.radians(azimuth_deg)), math.cos(math.radians(azimuth_deg)), 0.0])
+    meta = {"record_id": f"cosine_pulse_{pga_m_s2:.6g}ms2_{pgv_pga_s:.6g}s_{azimuth_deg:g}deg",
+            "back_azimuth_deg": None, "has_vertical": False,
+            "pulse": {"kind": "one-cosine displacement", "pga_m_s2": pga_m_s2,
+                      "pgv_m_s": pga_m_s2 * pgv_pga_s, "pgv_pga_s": pgv_pga_s,
+                      "amplitude_m": amplitude, "frequency_hz": 1 / period,
+                      "azimuth_deg": azimuth_deg, "tail_s": tail_s}}
+    return Motion(dt, acc[:, None] * u, vel[:, None] * u, disp[:, None] * u, meta=meta)

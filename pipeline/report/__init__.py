@@ -14,7 +14,8 @@ from pipeline import RESULTS_DIR, __version__
 from pipeline.files import write_text
 from pipeline.report.campaigns import (columns_section, convergence_section, ensemble_section,
                                        fragility_section, paper_question_section, run_all_section,
-                                       shake_table_section, speed_section, sweep_section,
+                                       rock_fragility_section, shake_table_section,
+                                       speed_section, sweep_section,
                                        verification_section)
 from pipeline.report.inversion import inversion_section, member_study_section
 from pipeline.report.records import (back_azimuth_table, correlation_table, per_record_table,
@@ -27,7 +28,8 @@ __all__ = ["build_report", "back_azimuth_table", "columns_section", "convergence
            "correlation_table", "paper_question_section",
            "ensemble_section", "fragility_section", "inversion_section",
            "member_study_section", "per_record_table",
-           "processing_section", "record_orientation", "records_section", "records_statements", "run_all_section",
+           "processing_section", "record_orientation", "records_section", "records_statements",
+           "rock_fragility_section", "run_all_section",
            "shake_table_section", "speed_section", "sweep_section", "synthetic_section",
            "toppled_fractions", "verification_section", "wilson_interval", "with_back_azimuth"]
 
@@ -56,7 +58,8 @@ def build_report(results=RESULTS_DIR):
         sweep_section(results, "friction", "mu_s",
                       "friction had a minor influence on downfall directions; with mu_s = 0.1 "
                       "neither column toppled (they slid instead)."),
-        shake_table_section(results),
+        shake_table_section(results), rock_fragility_section(results),
+        rock_fragility_section(results, "rock-fragility-table"),
         paper_question_section(results), ensemble_section(results),
         convergence_section(results), fragility_section(results), columns_section(results),
         inversion_section(results), member_study_section(results),
