@@ -53,7 +53,8 @@ from pipeline.campaign import ensemble   # module: imported while ensemble may s
 from pipeline.campaign.tables import collect
 from pipeline.constants import COLUMN_KINDS, MODEL_GRAVITY
 from pipeline.campaign import pulse_grid
-from pipeline.files import InputError, duration_text, write_csv, write_json
+from pipeline.campaign.pulse_grid import block_size
+from pipeline.files import InputError, duration_text, json_safe, write_csv, write_json
 from pipeline.motion import Motion
 from pipeline.motion.measures import horizontal_peak, record_parameters
 from pipeline.records import processed_motion
@@ -196,19 +197,6 @@ def _pulse_specs(records, campaign_dir, data, column, pulses, members, headings,
                          ranges=ranges, azimuth=azimuth, headings=headings, members=members)
     return mark(specs, data)
 
-
-def block_size(params):
-    """(height, width) in m of the 2D block of a run (``params``:
-    :class:`~pipeline.scenario.parameters.RunParams`): the paper column's height and
-    diameter, or a description's overall height and base width."""
-    column = params.column
-    if column.column_file is None:
-        return column.height, column.height / column.hd
-    blocks = column.column_file["blocks"]        # as ColumnGeometry.height and .base_width
-    bottom = blocks[0]
-    width = (bottom["bottom_diameter"] if bottom["shape"] == "frustum"
-             else min(bottom["width"], bottom["depth"]))
-    return math.fsum(b["height"] for b in blocks), width
 
 
 # ---------------------------------------------------------------- tables
@@ -368,7 +356,7 @@ def summarise(table, specs, cost):
     columns = _column_fits(table, descriptions, alpha, p)
     comparison = _comparison(columns)
     levels = level_table(table)
-    return _finite({
+    return json_safe({
         "records": list(dict.fromkeys(s.record_id for s in specs)),
         "levels_m_s2": first["levels"], "members": 1 + max(s.tags["member"] for s in specs),
         "seed": first["seed"], "column": specs[0].params.column.kind,
@@ -463,20 +451,6 @@ _IM_DEFINITIONS = {
     "PGV": "peak of the horizontal velocity vector of the scaled motion",
     "PGV/PGA": "PGV / PGA (s), unchanged by scaling: varies only between records"}
 
-
-def _finite(obj):
-    """JSON-safe copy: NaN / inf -> None, numpy scalars -> Python."""
-    if isinstance(obj, dict):
-        return {k: _finite(v) for k, v in obj.items()}
-    if isinstance(obj, (list, tuple)):
-        return [_finite(v) for v in obj]
-    if isinstance(obj, (np.bool_, bool)):
-        return bool(obj)
-    if isinstance(obj, (np.integer,)):
-        return int(obj)
-    if isinstance(obj, (float, np.floating)):
-        return float(obj) if math.isfinite(obj) else None
-    return obj
 
 
 def fragility_outputs(specs, campaign_dir, failures, animations, figures=True):

@@ -10,7 +10,7 @@ import pandas as pd
 from pipeline.campaign import pulse_grid
 from pipeline.campaign.column_file import summary_entry
 from pipeline.campaign.run_dirs import finished_summary
-from pipeline.files import write_csv, write_json
+from pipeline.files import json_safe, write_csv, write_json
 from pipeline.simulate import run_code_version
 
 BLOCK_MODEL = "block2d"
@@ -80,8 +80,7 @@ def pulse_outputs(specs, campaign_dir, figures=True):
     observed = experiments_check(section, name)
     if observed is not None:
         section["experiments"] = observed
-    from pipeline.campaign.fragility import _finite
-    summary = _finite({"mode": "pulses", "specimen": name, "seed": first["seed"],
+    summary = json_safe({"mode": "pulses", "specimen": name, "seed": first["seed"],
                                  "pulse_grid": section})
     write_json(campaign_dir / "fragility.json", summary)
     written = []
