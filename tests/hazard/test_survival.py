@@ -10,7 +10,7 @@ import pytest
 from scipy import integrate, stats
 
 from pipeline import RECORDS_DIR
-from pipeline.campaign.fragility import _column_fits
+from pipeline.campaign.fragility_tables import _column_fits
 from pipeline.files import json_safe
 from pipeline.cli import main
 from pipeline.files import InputError
