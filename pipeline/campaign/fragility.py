@@ -22,17 +22,23 @@ lognormal fragility (median and dispersion beta with 95 % intervals,
 :func:`pipeline.stats.ensemble.fragility_fit`) per column type, the binned
 fractions with Wilson intervals, and the two-parameter logistic surface
 logit P = b0 + b1 ln PGA + b2 ln(PGV/PGA) after Purvance et al. (2008)
-(:func:`pipeline.stats.ensemble.logistic_surface`).  Files (see ``fragility.json``
-keys in :func:`pipeline.campaign.fragility_tables.summarise`): ``fragility.json``, ``fragility_runs.csv`` (one row per
-run and column, 3D and 2D), ``fragility_levels.csv`` (fraction toppled per record
-and level, 3D columns beside the 2D block), figures ``fragility_curves.png``,
+(:func:`pipeline.stats.ensemble.logistic_surface`).  Files (see ``fragility.json`` keys in
+:func:`pipeline.campaign.fragility_tables.summarise`): ``fragility.json``,
+``fragility_runs.csv`` (one row per run and column, 3D and 2D), ``fragility_levels.csv``
+(fraction toppled per record and level, 3D columns beside the 2D block), figures
+``fragility_curves.png``,
 ``fragility_2d_vs_3d.png`` and ``fragility_surface.png``.
 
 With ``--column-file`` the members are the described column with the sampled height and
 diameter tolerances (its tilt and offsets as described, none sampled), and the 2D block
-has each member's overall height and base width (:func:`pipeline.campaign.pulse_grid.block_size`).
-The 2D block runs in :mod:`pipeline.campaign.fragility_block`, the tables and fits in
-:mod:`pipeline.campaign.fragility_tables`, the files in :mod:`pipeline.campaign.fragility_outputs`.
+has each member's overall height and base width
+(:func:`pipeline.campaign.pulse_grid.block_size`).
+
+This module is the campaign (specs, options, the adaptive driver); the 2D block batch is
+:mod:`pipeline.campaign.fragility_block`, the tables and fits
+:mod:`pipeline.campaign.fragility_tables`, the files
+:mod:`pipeline.campaign.fragility_outputs`, the pulse grid
+:mod:`pipeline.campaign.pulse_grid` (its files :mod:`pipeline.campaign.pulse_outputs`).
 """
 import logging
 import math
@@ -46,12 +52,11 @@ from pipeline.campaign import ensemble   # module: imported while ensemble may s
 from pipeline.campaign import pulse_grid
 from pipeline.campaign.column_file import check_stiffness, column_kn, mark
 from pipeline.campaign.column_file import description as column_file_description
-from pipeline.campaign.definitions import (column_specs, motion_cache, pulse_record,
-                                           run_column_spec)
 from pipeline.campaign.fragility_block import DEFAULT_AZIMUTHS
 from pipeline.campaign.fragility_outputs import fragility_outputs
 from pipeline.campaign.options import CampaignOptions, column_file_param, stiffness_param
 from pipeline.campaign.run_dirs import finished_summary
+from pipeline.campaign.runs import column_specs, motion_cache, pulse_record, run_column_spec
 from pipeline.constants import COLUMN_KINDS
 from pipeline.files import InputError, duration_text
 from pipeline.motion.measures import horizontal_peak

@@ -8,11 +8,11 @@ from pathlib import Path
 import pandas as pd
 
 from pipeline.campaign.column_file import summary_entry
-from pipeline.campaign.definitions import run_code_version
 from pipeline.campaign.fragility_block import block_runs
 from pipeline.campaign.fragility_tables import level_table, scaled_runs, summarise
 from pipeline.campaign.run_dirs import finished_summary
 from pipeline.files import write_csv, write_json
+from pipeline.simulate import run_code_version
 
 log = logging.getLogger(__name__)
 
