@@ -10,6 +10,7 @@ import pandas as pd
 from pipeline.campaign.column_file import summary_entry
 from pipeline.campaign.fragility_block import block_runs
 from pipeline.campaign.fragility_tables import level_table, scaled_runs, summarise
+from pipeline.campaign.pulse_outputs import pulse_outputs
 from pipeline.campaign.run_dirs import finished_summary
 from pipeline.files import write_csv, write_json
 from pipeline.simulate import run_code_version
@@ -18,9 +19,10 @@ log = logging.getLogger(__name__)
 
 
 def fragility_outputs(specs, campaign_dir, failures, animations, figures=True):
+    """Write the campaign's files from its finished runs (the pulse grid's:
+    :func:`pulse_outputs`) and say the fits; returns the campaign summary's entry."""
     campaign_dir = Path(campaign_dir)
     if specs and specs[0].tags.get("mode") == "pulses":
-        from pipeline.campaign.pulse_outputs import pulse_outputs
         return pulse_outputs(specs, campaign_dir, figures)
     runs = scaled_runs(specs, campaign_dir)
     if runs.empty:
