@@ -41,9 +41,11 @@ def setup(p):
                    "a set of specimens at the site")
     p.add_argument("--column", choices=COLUMNS, default=None,
                    help="which column entry of fragility.json (default: the first 3D one)")
-    p.add_argument("--fragility-form", choices=("pga", "pga-pgv"), default="pga-pgv",
-                   help="from fragility.json: pga (its lognormal PGA fit) or pga-pgv (its "
-                   "logistic surface in PGA and PGV/PGA; default)")
+    p.add_argument("--fragility-form", choices=("pga", "pga-pgv", "grid"), default=None,
+                   help="from fragility.json: pga (its lognormal PGA fit), pga-pgv (its "
+                   "logistic surface in PGA and PGV/PGA; default for columns) or grid (a "
+                   "pulse grid's cells, bilinear in ln PGA and ln PGV/PGA, the logistic "
+                   "surface outside; default for a pulse grid)")
     p.add_argument("--median-g", type=float, action="append", default=[], metavar="G",
                    help="a stated lognormal fragility over PGA: median PGA (g), 0-10; repeat "
                    "with --beta for a set")
