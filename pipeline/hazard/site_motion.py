@@ -55,8 +55,9 @@ def motion_bound(fragilities, fallen, pgv_pga_s=None):
     def excess(x):
         return -negative(x) - (ll_max - LR_DROP_95)
     ends = []
-    for side in (ln_a[ln_a < best_ln], ln_a[ln_a > best_ln][::-1]):
-        outside = side[[excess(x) < 0 for x in side]] if len(side) else side
+    low = ll < ll_max - LR_DROP_95
+    for side in (ln_a[(ln_a < best_ln) & low], ln_a[(ln_a > best_ln) & low][::-1]):
+        outside = side
         if not len(outside):
             ends.append(None)
             continue
