@@ -195,3 +195,23 @@ def test_site_motion_refuses_bad_input_in_one_line(tmp_path, capsys, extra, mess
     err = capsys.readouterr().err.strip()
     assert message in err and len(err.splitlines()) == 1
     assert not out.exists()
+
+
+def test_report_section_says_not_run_yet_then_quotes_the_file(tmp_path):
+    from pipeline.report import survival_section
+    assert "Not run yet" in survival_section(tmp_path)
+    path = _grid_json(tmp_path / "f.json", np.geomspace(0.05, 2.0, 12), [0.05, 0.2],
+                      lambda a, r: float(Lognormal(3.0, 0.4).probability(a)),
+                      p_set_of=lambda s, a, r: float(Lognormal(2.0 + 2 * s, 0.4).probability(a)),
+                      logistic=(-2.0, 3.0, 0.5))
+    out = tmp_path / "rock-survival"
+    assert main(["survival", "--hazard", str(_plain_curve(tmp_path / "curve.csv")),
+                 "--fragility", str(path), "--pgv-pga-median", "0.1", "--pgv-pga-sigma",
+                 "0.3", "--age-ka", "2", "--draws", "20", "--out", str(out)]) == 0
+    summary = json.loads((out / "survival.json").read_text())
+    text = survival_section(tmp_path)
+    assert "Not run yet" not in text
+    assert f"{summary['survival_probability']:.3g}" in text
+    lo, hi = summary["survival_parameter_set_range"]
+    assert f"per parameter set {lo:.3g}-{hi:.3g}" in text
+    assert "rock-survival/survival.png" in text
