@@ -30,6 +30,7 @@ SOURCES = {
     "shake-table/shake_table.json": "make shake-table",
     "inversion/demo_summary.json": "make run-all",
     "inversion/member-study/member_study.json": "make invert-study",
+    "rock-survival/survival.json": "make rock-survival",
 }
 FIGURE = re.compile(r"!\[([^\]]*)\]\(([^)\s]+)\)")     # ![alt](path)
 
