@@ -38,12 +38,8 @@ DEFAULT_PARAMS_SHA = {"slenderness": "d904b5004c5c9092", "friction": "e9e8404856
 
 
 @pytest.fixture(scope="module")
-def record(tmp_path_factory):
-    path = tmp_path_factory.mktemp("records") / "pulse.npz"
-    m = one_sine_pulse(30.0, 3.0, duration=4.0)
-    Motion(m.dt, m.acc, m.vel, m.disp,
-           meta={"record_id": "pulse", "back_azimuth_deg": 120.0}).save(path)
-    return str(path)
+def record(pulse_file):
+    return pulse_file
 
 
 def _specs(name, record, campaign_dir, **options):

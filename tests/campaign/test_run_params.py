@@ -12,8 +12,6 @@ from pipeline import paper, simulate as simulate_module
 from pipeline.campaign.column_file import matched_kn
 from pipeline.campaign.runs import column_specs, run_column_spec, twin
 from pipeline.files import InputError
-from pipeline.motion import Motion
-from pipeline.motion.pulses import one_sine_pulse
 from pipeline.outcome.summary import RunSummary
 from pipeline.scenario import Column, Drive, RunParams
 from pipeline.scenario.geometry import ColumnGeometry
@@ -40,12 +38,8 @@ def _cases():
 
 
 @pytest.fixture(scope="module")
-def pulse(tmp_path_factory):
-    path = tmp_path_factory.mktemp("motion") / "pulse.npz"
-    m = one_sine_pulse(30.0, 3.0, duration=4.0)
-    Motion(m.dt, m.acc, m.vel, m.disp,
-           meta={"record_id": "pulse", "back_azimuth_deg": 120.0}).save(path)
-    return str(path)
+def pulse(pulse_file):
+    return pulse_file
 
 
 class SceneWritten(Exception):
