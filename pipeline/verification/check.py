@@ -64,6 +64,11 @@ class Check(Mapping):
     motion_file = None          # a check runs no recorded motion
     keep_trajectory = True
 
+    @property
+    def tags(self):
+        """A campaign run's bookkeeping (:class:`~pipeline.campaign.spec.RunSpec`): none."""
+        return {}
+
     @classmethod
     def create(cls, kind, code_version, **setting):
         """The check whose run id is hash(code version, kind, setting)."""

@@ -313,3 +313,15 @@ def test_a_units_line_in_words_is_a_comment_beside_the_units(tmp_path):
                      n=200, pga_g=0.5)
     stream, _ = read_record(path)
     assert np.abs(stream[0].data).max() == pytest.approx(0.5 * STANDARD_GRAVITY, rel=1e-5)
+
+
+def test_every_campaign_without_records_passes_the_gate_before_its_runs(tmp_path, monkeypatch):
+    """The gate reads each run's cost from its spec: the verification campaign (runs that
+    are checks, not RunSpecs) and the paper's sweeps reach their runs (stood in for)."""
+    reached = []
+    monkeypatch.setattr(campaign, "_run_specs",
+                        lambda c, name, specs, *a, **k: reached.append((name, len(specs))))
+    for name in ("verification", "slenderness", "friction"):
+        campaign.run_campaign(name, campaign_dir=tmp_path / name, jobs=2, allow_long=False)
+    assert [name for name, _ in reached] == ["verification", "slenderness", "friction"]
+    assert all(n > 0 for _, n in reached)
