@@ -103,3 +103,33 @@ def test_decay_file_without_tilt_column_refused(tmp_path, capsys):
     code = cli.main(["contact", "--free-rocking", str(decay), "--block", "0.4,0.08",
                      "--out", str(tmp_path / "c.json")])
     assert code == 2 and "tilt_rad" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("text, message", [
+    ('{"restitution": 0.95}', "no kn and damping"),
+    ('{"kn": 1.2e7, "damping": 0.1, "stiffnes": 1}', "unknown key"),
+    ('[1, 2]', "JSON object"),
+    ('{"kn": 1.2e7,', "not readable JSON"),
+])
+def test_run_refuses_a_bad_contact_file(tmp_path, capsys, text, message):
+    contact = tmp_path / "contact.json"
+    contact.write_text(text)
+    out = tmp_path / "run"
+    code = cli.main(["run", "--record", "GM20", "--contact-file", str(contact),
+                     "--out", str(out)])
+    err = capsys.readouterr().err.strip()
+    assert code == 2 and len(err.splitlines()) == 1 and message in err
+    assert not out.exists()
+
+
+def test_contact_file_values_are_range_checked_and_not_doubled(tmp_path, capsys):
+    contact = tmp_path / "contact.json"
+    contact.write_text('{"kn": 1e3, "damping": 0.1}')
+    assert cli.main(["run", "--record", "GM20", "--contact-file", str(contact),
+                     "--out", str(tmp_path / "a")]) == 2
+    assert "--kn 1000 outside" in capsys.readouterr().err
+    contact.write_text('{"kn": 1.2e8, "damping": 0.1}')
+    assert cli.main(["run", "--record", "GM20", "--contact-file", str(contact), "--damping",
+                     "0.2", "--out", str(tmp_path / "b")]) == 2
+    assert "not both" in capsys.readouterr().err
+    assert not (tmp_path / "a").exists() and not (tmp_path / "b").exists()

@@ -13,6 +13,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from pipeline import paper
 from pipeline.files import InputError, write_json
 
 NAME = "contact"
@@ -32,6 +33,18 @@ def setup(p):
                    help="ratios of successive amplitudes (the next over the previous), in (0, 1)")
     p.add_argument("--block", required=True, metavar="HEIGHT,WIDTH",
                    help="the block's height and width in its rocking plane (m)")
+    p.add_argument("--damping-map", action="store_true",
+                   help="also find the contact damping ratio that gives this restitution in "
+                   "the YADE model of the block (free-rocking runs, bisection: about a "
+                   "minute), so that `run --contact-file` takes the file")
+    p.add_argument("--depth", type=float, default=None, metavar="M",
+                   help="the block's depth across the rocking plane (m; default its width)")
+    p.add_argument("--density", type=float, default=paper.MARBLE_DENSITY_KG_M3,
+                   metavar="KG_M3", help=f"the block's density (default "
+                   f"{paper.MARBLE_DENSITY_KG_M3:g} kg/m^3)")
+    p.add_argument("--kn", type=float, default=paper.MARBLE_BLOCK_KN_N_M, metavar="N_M",
+                   help=f"contact stiffness per point of the map (default the paper's block "
+                   f"{paper.MARBLE_BLOCK_KN_N_M:g} N/m)")
     p.add_argument("--out", type=Path, default=Path("contact.json"),
                    help="contact file written (JSON; default contact.json)")
 
@@ -76,6 +89,13 @@ def run(args):
     if not (0.01 <= height <= 30.0 and 0.005 <= width <= 30.0):
         raise InputError(f"--block: height in [0.01, 30] m and width in [0.005, 30] m needed, "
                          f"got {args.block!r}")
+    depth = width if args.depth is None else args.depth
+    if args.damping_map:
+        from pipeline.scenario import Block, Contact
+        Block(height=height, width=width, depth=depth, density=args.density)   # ranges
+        Contact(kn=args.kn)
+    elif args.depth is not None:
+        raise InputError("--depth goes with --damping-map")
     if (args.free_rocking is None) == (args.frequency_hz is None):
         raise InputError("give either --free-rocking CSV or --frequency-hz with "
                          "--amplitude-ratio")
@@ -106,6 +126,16 @@ def run(args):
               "restitution_per_impact": [float(e) for e in fit["restitution_per_impact"]],
               "housner_restitution": fit["housner_restitution"],
               "block": {"height_m": height, "width_m": width}, "source": source}
+    if args.damping_map:
+        from pipeline.verification.contact_map import (RESTITUTION_TOLERANCE,
+                                                       damping_for_restitution)
+        damping, measured, runs = damping_for_restitution(
+            fit["restitution"], height, width, depth, kn=args.kn, density=args.density)
+        result.update(kn=args.kn, damping=damping, damping_map={
+            "measured_restitution": measured, "tolerance": RESTITUTION_TOLERANCE,
+            "yade_runs": runs, "depth_m": depth, "density_kg_m3": args.density})
+        print(f"damping {damping:.3f} per contact at kn {args.kn:g} N/m gives this block a "
+              f"restitution of {measured:.4f} in YADE ({runs} free-rocking runs)")
     write_json(args.out, result)
     spread = "" if fit["restitution_sd"] is None else \
         f" +- {fit['restitution_se']:.3f} (standard error; single impacts scatter " \
