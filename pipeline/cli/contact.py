@@ -135,7 +135,8 @@ def run(args):
             "measured_restitution": measured, "tolerance": RESTITUTION_TOLERANCE,
             "yade_runs": runs, "depth_m": depth, "density_kg_m3": args.density})
         print(f"damping {damping:.3f} per contact at kn {args.kn:g} N/m gives this block a "
-              f"restitution of {measured:.4f} in YADE ({runs} free-rocking runs)")
+              f"restitution of {measured:.4f} in YADE ({runs} free-rocking run(s) made; "
+              "measured ones are kept in results/contact/restitution_map.json)")
     write_json(args.out, result)
     spread = "" if fit["restitution_sd"] is None else \
         f" +- {fit['restitution_se']:.3f} (standard error; single impacts scatter " \
