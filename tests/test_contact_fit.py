@@ -87,6 +87,10 @@ def test_command_writes_the_contact_file(tmp_path, capsys):
      "frequency-hz"),
     (["--block", "50,0.08", "--frequency-hz", "2", "--amplitude-ratio", "0.5"], "--block"),
     (["--block", "0.4,0.08", "--free-rocking", "missing.csv"], "not found"),
+    (["--block", "0.4,0.08", "--frequency-hz", "2", "--amplitude-ratio", "0.5", "--kn", "1e8"],
+     "go\\(es\\) with --damping-map"),
+    (["--block", "0.4,0.08", "--frequency-hz", "2", "--amplitude-ratio", "0.5", "--damping-map",
+      "--density", "5"], "density"),
 ])
 def test_command_refuses_bad_input(tmp_path, capsys, argv, message):
     target = tmp_path / "contact.json"

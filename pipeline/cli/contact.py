@@ -39,10 +39,10 @@ def setup(p):
                    "minute), so that `run --contact-file` takes the file")
     p.add_argument("--depth", type=float, default=None, metavar="M",
                    help="the block's depth across the rocking plane (m; default its width)")
-    p.add_argument("--density", type=float, default=paper.MARBLE_DENSITY_KG_M3,
+    p.add_argument("--density", type=float, default=None,
                    metavar="KG_M3", help=f"the block's density (default "
                    f"{paper.MARBLE_DENSITY_KG_M3:g} kg/m^3)")
-    p.add_argument("--kn", type=float, default=paper.MARBLE_BLOCK_KN_N_M, metavar="N_M",
+    p.add_argument("--kn", type=float, default=None, metavar="N_M",
                    help=f"contact stiffness per point of the map (default the paper's block "
                    f"{paper.MARBLE_BLOCK_KN_N_M:g} N/m)")
     p.add_argument("--out", type=Path, default=Path("contact.json"),
@@ -90,12 +90,16 @@ def run(args):
         raise InputError(f"--block: height in [0.01, 30] m and width in [0.005, 30] m needed, "
                          f"got {args.block!r}")
     depth = width if args.depth is None else args.depth
+    density = paper.MARBLE_DENSITY_KG_M3 if args.density is None else args.density
+    kn = paper.MARBLE_BLOCK_KN_N_M if args.kn is None else args.kn
     if args.damping_map:
         from pipeline.scenario import Block, Contact
-        Block(height=height, width=width, depth=depth, density=args.density)   # ranges
-        Contact(kn=args.kn)
-    elif args.depth is not None:
-        raise InputError("--depth goes with --damping-map")
+        Block(height=height, width=width, depth=depth, density=density)   # ranges
+        Contact(kn=kn)
+    else:
+        alone = [f"--{k}" for k in ("depth", "density", "kn") if getattr(args, k) is not None]
+        if alone:
+            raise InputError(f"{', '.join(alone)} go(es) with --damping-map")
     if (args.free_rocking is None) == (args.frequency_hz is None):
         raise InputError("give either --free-rocking CSV or --frequency-hz with "
                          "--amplitude-ratio")
@@ -130,11 +134,11 @@ def run(args):
         from pipeline.verification.contact_map import (RESTITUTION_TOLERANCE,
                                                        damping_for_restitution)
         damping, measured, runs = damping_for_restitution(
-            fit["restitution"], height, width, depth, kn=args.kn, density=args.density)
-        result.update(kn=args.kn, damping=damping, damping_map={
+            fit["restitution"], height, width, depth, kn=kn, density=density)
+        result.update(kn=kn, damping=damping, damping_map={
             "measured_restitution": measured, "tolerance": RESTITUTION_TOLERANCE,
-            "yade_runs": runs, "depth_m": depth, "density_kg_m3": args.density})
-        print(f"damping {damping:.3f} per contact at kn {args.kn:g} N/m gives this block a "
+            "yade_runs": runs, "depth_m": depth, "density_kg_m3": density})
+        print(f"damping {damping:.3f} per contact at kn {kn:g} N/m gives this block a "
               f"restitution of {measured:.4f} in YADE ({runs} free-rocking run(s) made; "
               "measured ones are kept in results/contact/restitution_map.json)")
     write_json(args.out, result)
