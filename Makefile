@@ -5,7 +5,7 @@ PY := .venv/bin/python
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 JOBS ?= $(shell nproc)
 
-.PHONY: setup test run-all records campaigns bench clean invert-demo shake-table rock-fragility docs \
+.PHONY: setup test run-all records campaigns bench clean invert-demo shake-table rock-fragility rock-survival docs \
 	convergence paper-question invert-study invert-study-table contact-convergence
 
 setup: .venv/.installed
@@ -100,6 +100,20 @@ rock-fragility: setup
 	  --pulses "$(ROCK_TABLE_PULSES)" --members 4 --azimuth 90 \
 	  --out results/rock-fragility-table --jobs $(JOBS)
 	$(PY) -m pipeline report
+
+# SP1's pulse-grid fragility (the first campaign of rock-fragility, run only when its
+# fragility.json is missing) under the USGS 2014 hazard curve shipped in records/hazard/,
+# PGV/PGA from the ground-motion model at M 6.5, 10 km; an age of 15 +- 3 ka
+ROCK_SURVIVAL_HAZARD ?= records/hazard/usgs_nshm2014r1_curves_-118_34_vs760.json
+rock-survival: results/rock-fragility/fragility.json
+	$(PY) -m pipeline survival --hazard $(ROCK_SURVIVAL_HAZARD) \
+	  --fragility results/rock-fragility/fragility.json --magnitude 6.5 --distance-km 10 \
+	  --age-ka 15 --age-sd-ka 3 --out results/rock-survival
+	$(PY) -m pipeline report
+
+results/rock-fragility/fragility.json: | setup
+	$(PY) -m pipeline campaign fragility --column-file records/shake_table/sp1.json \
+	  --pulses vsr --out results/rock-fragility --jobs $(JOBS)
 
 # the model's convergence judged on distributions: the twin model's ensembles of 3 records
 # at 16 (default), 32 and 64 rim points and time step factor 0.15, 32 members each

@@ -9,6 +9,7 @@ import hashlib
 import io
 import json
 import logging
+import math
 import os
 import signal
 import tempfile
@@ -244,3 +245,18 @@ def csv_true(value):
 def csv_true_column(series):
     """:func:`csv_true` of every cell of a pandas Series (a bool Series)."""
     return series.map(csv_true).astype(bool)
+
+
+def json_safe(obj):
+    """JSON-safe copy: NaN / inf -> None, numpy scalars -> Python."""
+    if isinstance(obj, dict):
+        return {k: json_safe(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [json_safe(v) for v in obj]
+    if isinstance(obj, (np.bool_, bool)):
+        return bool(obj)
+    if isinstance(obj, (np.integer,)):
+        return int(obj)
+    if isinstance(obj, (float, np.floating)):
+        return float(obj) if math.isfinite(obj) else None
+    return obj

@@ -14,7 +14,6 @@ from pipeline.campaign.run_dirs import finished_summary
 from pipeline.campaign.column_file import (at_slenderness, check_stiffness, column_kn,
                                            description, mark, matched_kn)
 from pipeline.campaign.runs import (column_outputs, column_specs, described_twins,
-                                    motion_cache,  # noqa: F401 (fragility.py imports it here)
                                     pulse_record, run_column_spec, twin)
 from pipeline.campaign.tables import collect, write_tables
 from pipeline.files import (InputError, code_hash, content_hash, write_csv,

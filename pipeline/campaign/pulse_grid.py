@@ -233,8 +233,20 @@ def block_of(params, azimuth_deg):
         angle = math.radians(specimen.critical_angle_along_deg(azimuth_deg))
         com_z = float(specimen.com[2])
         return 2 * com_z, 2 * com_z * math.tan(angle)
-    from pipeline.campaign.fragility import block_size
     return block_size(params)
+
+def block_size(params):
+    """(height, width) in m of the 2D block of a run (``params``:
+    :class:`~pipeline.scenario.parameters.RunParams`): the paper column's height and
+    diameter, or a description's overall height and base width."""
+    column = params.column
+    if column.column_file is None:
+        return column.height, column.height / column.hd
+    blocks = column.column_file["blocks"]        # as ColumnGeometry.height and .base_width
+    bottom = blocks[0]
+    width = (bottom["bottom_diameter"] if bottom["shape"] == "frustum"
+             else min(bottom["width"], bottom["depth"]))
+    return math.fsum(b["height"] for b in blocks), width
 
 
 _SPECIMENS = {}

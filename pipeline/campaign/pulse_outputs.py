@@ -2,6 +2,7 @@
 ``fragility_runs.csv`` (one row per run and model: the 3D specimen and the 2D block),
 ``fragility.json`` (``pulse_grid``: cells, contours, logistic surface, the 2D block, the
 check against experiments where they exist) and ``fragility_pulse_grid.png``."""
+import logging
 from pathlib import Path
 
 import numpy as np
@@ -10,9 +11,10 @@ import pandas as pd
 from pipeline.campaign import pulse_grid
 from pipeline.campaign.column_file import summary_entry
 from pipeline.campaign.run_dirs import finished_summary
-from pipeline.files import write_csv, write_json
+from pipeline.files import json_safe, write_csv, write_json
 from pipeline.simulate import run_code_version
 
+log = logging.getLogger(__name__)
 BLOCK_MODEL = "block2d"
 
 
@@ -80,8 +82,7 @@ def pulse_outputs(specs, campaign_dir, figures=True):
     observed = experiments_check(section, name)
     if observed is not None:
         section["experiments"] = observed
-    from pipeline.campaign.fragility import _finite
-    summary = _finite({"mode": "pulses", "specimen": name, "seed": first["seed"],
+    summary = json_safe({"mode": "pulses", "specimen": name, "seed": first["seed"],
                                  "pulse_grid": section})
     write_json(campaign_dir / "fragility.json", summary)
     written = []
@@ -91,7 +92,8 @@ def pulse_outputs(specs, campaign_dir, figures=True):
     for model, entry in section["models"].items():
         half = [c["pga_g"] for c in entry["contours"]["0.5"]]
         shown = ", ".join("-" if v is None else f"{v:.2f}" for v in half)
-        print(f"{model:>14}: {entry['overturned']}/{entry['runs']} overturned; P = 0.5 at PGA "
-              f"(g) {shown} for PGV/PGA {', '.join(f'{r:g}' for r in section['pgv_pga_s'])} s")
+        log.info(f"{model:>14}: {entry['overturned']}/{entry['runs']} overturned; P = 0.5 at "
+                 f"PGA (g) {shown} for PGV/PGA "
+                 f"{', '.join(f'{r:g}' for r in section['pgv_pga_s'])} s")
     return {"code_version": run_code_version(), **described,
             "figures": [str(Path(p).relative_to(campaign_dir)) for p in written]}

@@ -30,7 +30,7 @@ COLUMNS = ("monolithic", "drums", "block2d", "block2d_worst")
 
 
 def setup(p):
-    p.add_argument("--hazard", type=Path, required=True, metavar="FILE",
+    p.add_argument("--hazard", type=Path, default=None, metavar="FILE",
                    help="hazard curve: OpenQuake hazard-curve CSV, USGS hazard web service "
                    "JSON (static curves) or a plain table pga_<g|m_s2|cm_s2>,"
                    "annual_rate_per_yr")
@@ -41,9 +41,11 @@ def setup(p):
                    "a set of specimens at the site")
     p.add_argument("--column", choices=COLUMNS, default=None,
                    help="which column entry of fragility.json (default: the first 3D one)")
-    p.add_argument("--fragility-form", choices=("pga", "pga-pgv"), default="pga-pgv",
-                   help="from fragility.json: pga (its lognormal PGA fit) or pga-pgv (its "
-                   "logistic surface in PGA and PGV/PGA; default)")
+    p.add_argument("--fragility-form", choices=("pga", "pga-pgv", "grid"), default=None,
+                   help="from fragility.json: pga (its lognormal PGA fit), pga-pgv (its "
+                   "logistic surface in PGA and PGV/PGA; default for columns) or grid (a "
+                   "pulse grid's cells, bilinear in ln PGA and ln PGV/PGA, the logistic "
+                   "surface outside; default for a pulse grid)")
     p.add_argument("--median-g", type=float, action="append", default=[], metavar="G",
                    help="a stated lognormal fragility over PGA: median PGA (g), 0-10; repeat "
                    "with --beta for a set")
@@ -52,8 +54,9 @@ def setup(p):
     p.add_argument("--logistic", action="append", default=[], metavar="B0,B1,B2",
                    help="a stated logistic surface logit P = b0 + b1 ln(PGA / 1 m/s^2) + b2 "
                    "ln(PGV/PGA / 1 s) (b1 > 0); repeat for a set")
-    p.add_argument("--age-ka", type=float, required=True, metavar="KA",
-                   help="the specimen's age in thousand years (above 0, at most 10000)")
+    p.add_argument("--age-ka", type=float, default=None, metavar="KA",
+                   help="the specimen's age in thousand years (above 0, at most 10000); "
+                   "needed with --hazard")
     p.add_argument("--age-sd-ka", type=float, default=0.0, metavar="KA",
                    help="its standard deviation (ka; normal truncated at 0); default 0")
     g = p.add_argument_group("PGV/PGA at each PGA level (for a pga-pgv fragility)")
@@ -74,6 +77,17 @@ def setup(p):
     g.add_argument("--pga-pgv-correlation", type=float, default=None, metavar="RHO",
                    help="correlation of ln PGA and ln PGV residuals (0-0.99); default 0.733 "
                    "(Bradley 2012)")
+    o = p.add_argument_group("the motion at a site from its standing and fallen columns")
+    o.add_argument("--observations", type=Path, default=None, metavar="FILE",
+                   help="an observations file of invert (sites with fallen and standing "
+                   "columns): writes site_motion.json, the PGA range consistent with the "
+                   "site's outcome; fragility per column type from --fragility (a column "
+                   "fragility.json) or one stated --median-g/--beta or --logistic for all")
+    o.add_argument("--observation-site", default=None, metavar="NAME",
+                   help="the site's name in --observations (default: its only site)")
+    o.add_argument("--at-pgv-pga", type=float, default=None, metavar="S",
+                   help="the PGV/PGA (s, 0.001-10) at which the PGA range is stated (for a "
+                   "fragility over PGA and PGV/PGA)")
     p.add_argument("--draws", type=int, default=400, metavar="N",
                    help="fragility parameter draws for the survival interval (0-20000; 0: "
                    "none); default 400")
@@ -84,7 +98,24 @@ def setup(p):
 
 def check(args):
     """Every option range-checked before any work (InputError, one line)."""
-    number(args.age_ka, "--age-ka", 0, 10000, "ka", low_open=True)
+    if args.hazard is None and args.observations is None:
+        raise InputError("give --hazard (survival under a hazard curve) or --observations "
+                         "(the motion at a site from its columns), or both")
+    if args.hazard is not None and args.age_ka is None:
+        raise InputError("--hazard needs --age-ka (the specimen's age)")
+    if args.hazard is None and args.age_ka is not None:
+        raise InputError("--age-ka applies with --hazard")
+    if args.observations is None and (args.observation_site is not None
+                                      or args.at_pgv_pga is not None):
+        raise InputError("--observation-site and --at-pgv-pga apply with --observations")
+    if args.at_pgv_pga is not None:
+        number(args.at_pgv_pga, "--at-pgv-pga", 0.001, 10, "s")
+    if args.observations is not None and len(args.fragility) + len(args.median_g) \
+            + len(args.logistic) != 1:
+        raise InputError("--observations: give one fragility (--fragility, one "
+                         "--median-g/--beta or one --logistic), used by column type")
+    if args.age_ka is not None:
+        number(args.age_ka, "--age-ka", 0, 10000, "ka", low_open=True)
     number(args.age_sd_ka, "--age-sd-ka", 0, 10000, "ka")
     for v in args.median_g:
         number(v, "--median-g", 0, 10, "g", low_open=True)
@@ -97,6 +128,9 @@ def check(args):
         parse_logistic(text)
     if not args.median_g and not args.fragility and not args.logistic:
         raise InputError("no fragility: give --median-g and --beta, --logistic or --fragility")
+    if args.observations is not None and args.column is not None:
+        raise InputError("--column does not apply with --observations (each column's own "
+                         "type is read from the file)")
     if args.column is not None and not args.fragility:
         raise InputError("--column applies to --fragility files")
     if args.site is not None and args.site < 0:
@@ -131,6 +165,14 @@ def check(args):
 
 def run(args):
     check(args)
+    site_motion = None
+    if args.observations is not None:
+        site_motion = _site_motion(args)
+    if args.hazard is None:
+        write_json(args.out / "site_motion.json", site_motion)
+        _print_site_motion(site_motion)
+        print(f"wrote {display_path(args.out / 'site_motion.json')}")
+        return 0
     from pipeline.hazard import load_hazard
     from pipeline.hazard.assess import assess
     from pipeline.hazard.fragility import (PGA_PGV_CORRELATION, Logistic, Lognormal,
@@ -157,6 +199,8 @@ def run(args):
     summary, data = assess(curve, specimens, ratio, args.age_ka, args.age_sd_ka,
                            args.draws, args.seed)
     summary["figure"] = "survival.png"
+    if site_motion is not None:
+        summary["site_motion"] = site_motion
     from pipeline.figures.survival import plot_survival
     plot_survival(data, args.out / "survival.png")
     write_json(args.out / "survival.json", summary)
@@ -169,8 +213,49 @@ def run(args):
           + ("" if interval is None else f" [{interval[0]:.3g}, {interval[1]:.3g}]")
           + f"; hazard rates x {_g(summary['rate_scale_bound_5pct'])} or intensities x "
           f"{_g(bound)} leave 5 %")
+    if site_motion is not None:
+        write_json(args.out / "site_motion.json", site_motion)
+        _print_site_motion(site_motion)
     print(f"wrote {display_path(args.out / 'survival.json')} and survival.png")
     return 0
+
+
+def _site_motion(args):
+    """site_motion.json's content: the PGA range consistent with one site's columns."""
+    from pipeline.hazard.fragility import Logistic, Lognormal, load_campaign_fragility
+    from pipeline.hazard.site_motion import site_motion
+    from pipeline.inversion.observations import load_observations
+    observations = load_observations(args.observations)
+    name = args.observation_site
+    if name is None:
+        if len(observations.sites) != 1:
+            raise InputError(f"{args.observations.name}: {len(observations.sites)} sites: "
+                             "name one with --observation-site")
+        name = observations.sites[0].name
+    if args.fragility:
+        def fragility_for(column):
+            return load_campaign_fragility(args.fragility[0], column, args.fragility_form)
+    elif args.median_g:
+        stated = Lognormal(args.median_g[0] * STANDARD_GRAVITY, args.beta[0],
+                           label=f"stated lognormal: median {args.median_g[0]:g} g, "
+                           f"beta {args.beta[0]:g} (every column)")
+        def fragility_for(column):
+            return stated
+    else:
+        stated = Logistic(parse_logistic(args.logistic[0]),
+                          label=f"stated logistic surface {args.logistic[0]} (every column)")
+        def fragility_for(column):
+            return stated
+    return site_motion(observations, name, fragility_for, args.at_pgv_pga)
+
+
+def _print_site_motion(result):
+    lo, hi = result["pga_interval95_g"]
+    ml = result["pga_ml_g"]
+    print(f"site {result['site']}: {result['fallen']} of {result['columns']} columns fell; "
+          f"PGA {'-' if ml is None else f'{ml:.3g}'} g, 95 % [{_g(lo)}, {_g(hi)}] g"
+          + ("" if result["pgv_pga_s"] is None else f" at PGV/PGA {result['pgv_pga_s']:g} s")
+          + ("" if result["note"] is None else f" ({result['note']})"))
 
 
 def parse_logistic(text):

@@ -25,6 +25,10 @@ ASSUMPTIONS = [
     "survival_interval: 95 % of the survival probabilities of fragility parameters drawn "
     "from the uncertainty of their estimate (parametric bootstrap); the hazard curve and "
     "the PGV/PGA model are taken as exact.",
+    "A pulse grid (campaign fragility --pulses) is read as its cells: P bilinear in (ln "
+    "PGA, ln PGV/PGA) inside the grid, the logistic surface fitted to the same runs outside "
+    "it; its survival_interval is the cells' Monte Carlo error and survival_per_parameter_set "
+    "the members' spread, reported apart.",
     "A fragility fitted to a campaign's pooled members (campaign fragility) holds the "
     "members' spread in its dispersion, as if each earthquake met another member; the rock "
     "or column has one set of the unknown contact parameters in every earthquake.",
@@ -56,7 +60,8 @@ def assess(curve, specimens, ratio_model, age_ka, age_sd_ka=0.0, draws=400, seed
         members = None if drawn[k] is None else [
             (lambda x, f=d: overturn_probability([f], ratio_model, x)[0]) for d in drawn[k]]
         entry = _result(curve, probability, members, age, age_sd)
-        entry = {"fragility": fragility.describe(), **entry}
+        entry = {"fragility": fragility.describe(), **entry,
+                 **_per_parameter_set(curve, fragility, ratio_model, age, age_sd)}
         if drawn[k] is None:
             entry["survival_interval_note"] = "no uncertainty stated for this fragility" \
                 if draws else "--draws 0"
@@ -79,6 +84,9 @@ def assess(curve, specimens, ratio_model, age_ka, age_sd_ka=0.0, draws=400, seed
         **({} if headline["survival_interval"] is not None else {
             "survival_interval_note": "no uncertainty stated for the fragility" if draws
             else "--draws 0"}),
+        **({k: entries[0][k] for k in ("survival_per_parameter_set",
+                                       "survival_parameter_set_range")
+            if k in entries[0]} if len(specimens) == 1 else {}),
         "rate_scale_bound_5pct": headline["rate_scale_bound_5pct"],
         "intensity_scale_bound_5pct": headline["intensity_scale_bound_5pct"],
         "contribution_by_intensity": headline["contribution_by_intensity"],
@@ -92,7 +100,14 @@ def assess(curve, specimens, ratio_model, age_ka, age_sd_ka=0.0, draws=400, seed
             "over the hazard curve, 1/yr",
             "survival_probability": "mean over the age of exp(-rate t)",
             "survival_interval": f"{INTERVAL[0]:g}-{INTERVAL[1]:g} percentiles over "
-            f"{draws} fragility parameter draws (parametric bootstrap), or null",
+            f"{draws} draws of the fragility's estimate (parametric bootstrap: of its "
+            "fitted parameters, or for a pulse grid of every cell's count, Binomial(n, P): "
+            "the Monte Carlo error), or null",
+            "survival_per_parameter_set": "a pulse grid only: the survival probability "
+            "with each parameter set's own P in every cell (the rock has one set of the "
+            "unknown contact parameters in every earthquake)",
+            "survival_parameter_set_range": "min and max of survival_per_parameter_set: "
+            "the members' spread, reported apart from the Monte Carlo error",
             "rate_scale_bound_5pct": "largest factor F on every rate of the hazard curve "
             "with survival >= 0.05 (-ln 0.05 / (rate t) for a fixed age)",
             "intensity_scale_bound_5pct": "largest factor c on the curve's PGA levels "
@@ -159,6 +174,19 @@ def _result(curve, probability, members, age, age_sd):
             "contribution_by_intensity": contribution,
             "curve_ends": {k: v for k, v in rate.items() if k != "rate_per_yr"},
             "warnings": warnings}
+
+
+def _per_parameter_set(curve, fragility, ratio_model, age, age_sd):
+    """Survival with each parameter set's own fragility (a pulse grid), else nothing."""
+    if not hasattr(fragility, "members"):
+        return {}
+    zero = curve.zero_rate_from_m_s2
+    rates = [overturning_rate(curve.levels_m_s2, curve.rates_per_yr,
+                              lambda x, f=m: overturn_probability([f], ratio_model, x)[0],
+                              zero)["rate_per_yr"] for m in fragility.members()]
+    survival = survival_probability(np.array(rates), age, age_sd).tolist()
+    return {"rate_per_parameter_set_per_yr": rates, "survival_per_parameter_set": survival,
+            "survival_parameter_set_range": [min(survival), max(survival)]}
 
 
 def _site_set(curve, specimens, ratio_model, entries, age, age_sd):

@@ -109,10 +109,11 @@ def _ln_normal(value, ci95, n, rng):
     return math.log(value) + s * rng.standard_normal(n)
 
 
-def load_campaign_fragility(path, column=None, form="pga-pgv"):
+def load_campaign_fragility(path, column=None, form=None):
     """The fragility of one column entry of ``campaign fragility``'s ``fragility.json``:
-    ``form`` "pga" (its lognormal PGA fit) or "pga-pgv" (its logistic surface);
-    ``column``: monolithic, drums, block2d or block2d_worst (default: the first 3D one)."""
+    ``form`` "pga" (its lognormal PGA fit) or "pga-pgv" (its logistic surface; default);
+    ``column``: monolithic, drums, block2d or block2d_worst (default: the first 3D one).
+    A pulse-grid file (``--pulses``): :func:`load_pulse_grid` (``form`` default "grid")."""
     path = Path(path)
     if path.is_dir():
         path = path / "fragility.json"
@@ -122,6 +123,9 @@ def load_campaign_fragility(path, column=None, form="pga-pgv"):
         raise InputError(f"fragility file not found: {path}") from None
     except (OSError, ValueError, Unreadable) as exc:
         raise InputError(f"{path}: not a fragility.json ({exc})") from None
+    if isinstance(data, dict) and "pulse_grid" in data:
+        return load_pulse_grid(path, data, column, form or "grid")
+    form = form or "pga-pgv"
     columns = data.get("columns") if isinstance(data, dict) else None
     if not isinstance(columns, dict) or not columns:
         raise InputError(f"{path}: not a fragility.json of campaign fragility (no 'columns')")
@@ -147,16 +151,19 @@ def load_campaign_fragility(path, column=None, form="pga-pgv"):
                          label=label, note=fit.get("note"))
     if form != "pga-pgv":
         raise InputError(f"--fragility-form must be pga or pga-pgv, got {form!r}")
-    surface = entry.get("logistic") or {}
+    return _logistic(entry.get("logistic") or {}, f"{path}: column {column}", label)
+
+
+def _logistic(surface, where, label):
+    """The :class:`Logistic` of a fragility.json's ``logistic`` entry."""
     coefficients = surface.get("coefficients")
     if coefficients is None:
-        raise InputError(f"{path}: column {column}: logistic surface not fitted "
+        raise InputError(f"{where}: logistic surface not fitted "
                          f"({surface.get('note') or 'no coefficients'})")
-    b = tuple(number(coefficients.get(k), f"{path}: column {column}: logistic {k}")
-              for k in ("b0", "b1", "b2"))
+    b = tuple(number(coefficients.get(k), f"{where}: logistic {k}") for k in ("b0", "b1", "b2"))
     if not b[1] > 0:
-        raise InputError(f"{path}: column {column}: the logistic surface does not grow with "
-                         f"PGA (b1 = {b[1]:g})")
+        raise InputError(f"{where}: the logistic surface does not grow with PGA "
+                         f"(b1 = {b[1]:g})")
     cov = surface.get("cov")
     if cov is not None and not all(isinstance(v, (int, float)) for row in cov for v in row):
         cov = None                       # a singular information matrix: written as nulls
@@ -269,3 +276,159 @@ def overturn_probability(fragilities, ratio_model, pga_m_s2, combine="each"):
     if combine == "any_correlated":
         return each.max(axis=0) @ weights
     raise ValueError(f"unknown combine {combine!r}")
+
+
+# ---------------------------------------------------------------- the pulse grid
+@dataclass(frozen=True)
+class PulseGrid:
+    """P(overturn | PGA, PGV/PGA) from the cells of ``campaign fragility --pulses``:
+    ``pga_m_s2`` (m/s^2) x ``pgv_pga_s`` (s) axes, ``n`` runs and ``overturned`` per cell
+    (arrays n_pga x n_ratio), ``p_per_set`` (n_sets x n_pga x n_ratio, NaN where a set has
+    no run) and ``outside``: the fitted logistic surface (or None).
+
+    Inside the grid P is interpolated bilinearly in (ln PGA, ln PGV/PGA) between the
+    cells' fractions: no functional form is imposed, and the cells are where the runs are.
+    Outside it P is the logistic surface fitted to the same runs (its smooth trend carries
+    the grid's edge outwards); without one, the nearest edge cell's P."""
+    pga_m_s2: tuple
+    pgv_pga_s: tuple
+    n: np.ndarray = field(compare=False)
+    overturned: np.ndarray = field(compare=False)
+    p_per_set: np.ndarray = field(compare=False)
+    outside: Logistic | None = None
+    label: str = "pulse grid"
+    note: str | None = None
+    uses_ratio = True
+
+    @property
+    def p(self):
+        with np.errstate(invalid="ignore", divide="ignore"):
+            return np.where(self.n > 0, self.overturned / np.maximum(self.n, 1), np.nan)
+
+    def probability(self, pga_m_s2, pgv_pga_s):
+        return self._interpolate(self.p, pga_m_s2, pgv_pga_s)
+
+    def _interpolate(self, cells, pga_m_s2, pgv_pga_s):
+        from scipy.interpolate import RegularGridInterpolator  # noqa: PLC0415
+        pga, ratio = np.broadcast_arrays(np.asarray(pga_m_s2, float),
+                                         np.asarray(pgv_pga_s, float))
+        points = np.stack([np.log(pga), np.log(ratio)], axis=-1)
+        inside = RegularGridInterpolator((np.log(self.pga_m_s2), np.log(self.pgv_pga_s)),
+                                         _fill_empty(cells), bounds_error=False,
+                                         fill_value=None)
+        ln_a, ln_r = np.log(self.pga_m_s2), np.log(self.pgv_pga_s)
+        within = ((points[..., 0] >= ln_a[0]) & (points[..., 0] <= ln_a[-1])
+                  & (points[..., 1] >= ln_r[0]) & (points[..., 1] <= ln_r[-1]))
+        held = inside(_clip_points(points, ln_a, ln_r))     # the edge cell's P outside
+        out = held if self.outside is None else self.outside.probability(pga, ratio)
+        return np.clip(np.where(within, held, out), 0.0, 1.0)
+
+    def draws(self, n, rng):
+        """``n`` grids with every cell's count redrawn Binomial(n_cell, P_cell): the Monte
+        Carlo error of the cells (parametric bootstrap); the outside surface kept."""
+        return [replace(self, overturned=rng.binomial(self.n, np.nan_to_num(self.p)))
+                for _ in range(n)]
+
+    def members(self):
+        """One grid per parameter set (its own P in every cell; a cell the set did not run
+        takes the pooled P): the spread of the unknown contact parameters."""
+        out = []
+        for p_set in self.p_per_set:
+            p = np.where(np.isnan(p_set), self.p, p_set)
+            out.append(replace(self, n=np.ones_like(self.n), overturned=p))
+        return out
+
+    def describe(self):
+        return {"form": "P(overturn | PGA, PGV/PGA) from the pulse grid's cells",
+                "label": self.label,
+                "inside": "bilinear in (ln PGA, ln PGV/PGA) between the cells' fractions",
+                "outside": "the logistic surface fitted to the same runs"
+                if self.outside is not None else "the nearest edge cell's P",
+                "pga_range_g": [self.pga_m_s2[0] / STANDARD_GRAVITY,
+                                self.pga_m_s2[-1] / STANDARD_GRAVITY],
+                "pgv_pga_range_s": [self.pgv_pga_s[0], self.pgv_pga_s[-1]],
+                "cells": int(self.n.size), "runs": int(self.n.sum()),
+                "parameter_sets": int(len(self.p_per_set)),
+                "outside_surface": None if self.outside is None else self.outside.describe(),
+                "note": self.note}
+
+
+def _clip_points(points, ln_a, ln_r):
+    """Points held inside the grid's box (the interpolator is only asked inside)."""
+    return np.stack([np.clip(points[..., 0], ln_a[0], ln_a[-1]),
+                     np.clip(points[..., 1], ln_r[0], ln_r[-1])], axis=-1)
+
+
+def _fill_empty(cells):
+    """A grid's NaN cells (no run) filled from the nearest cell with runs (along PGA)."""
+    cells = np.array(cells, float)
+    if not np.isnan(cells).any():
+        return cells
+    for j in range(cells.shape[1]):
+        column = cells[:, j]
+        good = ~np.isnan(column)
+        if good.any():
+            idx = np.arange(len(column))
+            cells[:, j] = np.interp(idx, idx[good], column[good])
+    return np.where(np.isnan(cells), np.nanmean(cells), cells)
+
+
+def load_pulse_grid(path, data, model=None, form="grid"):
+    """One model of a pulse-grid ``fragility.json`` (``models``: monolithic, block2d):
+    ``form`` "grid" (:class:`PulseGrid`) or "pga-pgv" (its logistic surface)."""
+    section = data["pulse_grid"]
+    models = section.get("models") if isinstance(section, dict) else None
+    if not isinstance(models, dict) or not models:
+        raise InputError(f"{path}: pulse_grid has no 'models'")
+    if model is None:
+        model = "monolithic" if "monolithic" in models else next(iter(models))
+    if model not in models:
+        raise InputError(f"{path}: pulse_grid has no model {model!r} (has {', '.join(models)})")
+    entry = models[model]
+    where = f"{path}: pulse_grid model {model}"
+    label = f"{data.get('specimen', 'specimen')} {model} pulse grid from {path.name}"
+    logistic = None
+    surface = entry.get("logistic") or {}
+    if surface.get("coefficients") is not None:
+        logistic = _logistic(surface, where, label)
+    if form == "pga-pgv":
+        if logistic is None:
+            raise InputError(f"{where}: logistic surface not fitted "
+                             f"({surface.get('note') or 'no coefficients'})")
+        return logistic
+    if form != "grid":
+        raise InputError(f"--fragility-form for a pulse grid must be grid or pga-pgv, got "
+                         f"{form!r}")
+    try:
+        pga_g = [number(v, f"{where}: pga_g", 0, None, "g", True) for v in section["pga_g"]]
+        ratios = [number(v, f"{where}: pgv_pga_s", 0, None, "s", True)
+                  for v in section["pgv_pga_s"]]
+        cells = entry["cells"]
+    except (KeyError, TypeError):
+        raise InputError(f"{where}: no pga_g / pgv_pga_s axes or cells") from None
+    if len(pga_g) < 2 or len(ratios) < 2 or np.any(np.diff(pga_g) <= 0) \
+            or np.any(np.diff(ratios) <= 0):
+        raise InputError(f"{where}: the grid's axes must hold 2 or more increasing values")
+    n_sets = int(number(section.get("members"), f"{where}: members", 1, None))
+    n = np.zeros((len(pga_g), len(ratios)), int)
+    overturned = np.zeros_like(n)
+    per_set = np.full((n_sets, len(pga_g), len(ratios)), np.nan)
+    index_a = {round(v, 9): i for i, v in enumerate(pga_g)}
+    index_r = {round(v, 9): j for j, v in enumerate(ratios)}
+    for cell in cells:
+        try:
+            i, j = index_a[round(cell["pga_g"], 9)], index_r[round(cell["pgv_pga_s"], 9)]
+            n[i, j], overturned[i, j] = int(cell["n"]), int(cell["overturned"])
+            for s, p in zip(cell.get("sets") or [], cell.get("P_per_set") or []):
+                if p is not None:
+                    per_set[int(s), i, j] = float(p)
+        except (KeyError, TypeError, ValueError, IndexError):
+            raise InputError(f"{where}: a cell off the grid or without n/overturned: "
+                             f"{show(cell)}") from None
+    if not (0 <= overturned).all() or not (overturned <= n).all():
+        raise InputError(f"{where}: a cell with overturned outside 0..n")
+    empty = int((n == 0).sum())
+    note = None if not empty else (f"{empty} of {n.size} cells without runs: filled from the "
+                                   "nearest cell along PGA")
+    return PulseGrid(tuple(v * STANDARD_GRAVITY for v in pga_g), tuple(ratios), n,
+                     overturned, per_set, logistic, label, note)

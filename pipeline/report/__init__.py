@@ -17,6 +17,7 @@ from pipeline.report.campaigns import (columns_section, convergence_section, ens
                                        rock_fragility_section, shake_table_section,
                                        speed_section, sweep_section,
                                        verification_section)
+from pipeline.report.hazard import survival_section
 from pipeline.report.inversion import inversion_section, member_study_section
 from pipeline.report.records import (back_azimuth_table, correlation_table, per_record_table,
                                      processing_section, record_orientation, records_section,
@@ -30,7 +31,8 @@ __all__ = ["build_report", "back_azimuth_table", "columns_section", "convergence
            "member_study_section", "per_record_table",
            "processing_section", "record_orientation", "records_section", "records_statements",
            "rock_fragility_section", "run_all_section",
-           "shake_table_section", "speed_section", "sweep_section", "synthetic_section",
+           "shake_table_section", "speed_section", "survival_section", "sweep_section",
+           "synthetic_section",
            "toppled_fractions", "verification_section", "wilson_interval", "with_back_azimuth"]
 
 
@@ -59,7 +61,7 @@ def build_report(results=RESULTS_DIR):
                       "friction had a minor influence on downfall directions; with mu_s = 0.1 "
                       "neither column toppled (they slid instead)."),
         shake_table_section(results), rock_fragility_section(results),
-        rock_fragility_section(results, "rock-fragility-table"),
+        rock_fragility_section(results, "rock-fragility-table"), survival_section(results),
         paper_question_section(results), ensemble_section(results),
         convergence_section(results), fragility_section(results), columns_section(results),
         inversion_section(results), member_study_section(results),

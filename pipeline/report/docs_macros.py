@@ -1,6 +1,7 @@
 """mkdocs-macros hook (``mkdocs.yml``: ``module_name``): the docs pages' measured numbers
 and tables from :mod:`pipeline.report.docs_numbers`; the REPORT's figures that a page
 shows are copied beside the page in the built site."""
+import html
 import shutil
 from pathlib import Path
 
@@ -25,7 +26,10 @@ def define_env(env):
             page_url = env.page.url if env.page is not None else ""
             env.variables["_figures"].update(
                 (page_url, figure) for figure in docs_numbers.figures(text))
-            return text
+            # as HTML: mkdocs checks Markdown links against the docs' own files, and
+            # these figures are copied beside the page only after the build
+            return docs_numbers.FIGURE.sub(
+                lambda m: f'<img alt="{html.escape(m[1])}" src="{m[2]}">', text)
         macro.__doc__ = function.__doc__
         return macro
 

@@ -31,8 +31,9 @@ SOURCES = {
     "contact-convergence/convergence.json": "make contact-convergence",
     "inversion/demo_summary.json": "make run-all",
     "inversion/member-study/member_study.json": "make invert-study",
+    "rock-survival/survival.json": "make rock-survival",
 }
-FIGURE = re.compile(r"!\[[^\]]*\]\(([^)\s]+)\)")
+FIGURE = re.compile(r"!\[([^\]]*)\]\(([^)\s]+)\)")     # ![alt](path)
 
 
 def _not_yet(command):
@@ -262,4 +263,4 @@ def report_section(heading, path=REPORT, command="make run-all"):
 
 def figures(text):
     """The figure paths (relative to ``results/``) a piece of the REPORT shows."""
-    return FIGURE.findall(text)
+    return [path for _, path in FIGURE.findall(text)]

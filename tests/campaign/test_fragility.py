@@ -10,6 +10,8 @@ import pytest
 
 from pipeline import cli, rocking
 from pipeline.campaign import fragility as fr
+from pipeline.campaign import fragility_block
+from pipeline.campaign.fragility_tables import MODELS_2D, level_table
 from pipeline.files import InputError
 from pipeline.motion import Motion
 from pipeline.motion.measures import horizontal_peak
@@ -113,10 +115,10 @@ def test_block_never_topples_below_g_tan_alpha_and_always_under_a_huge_pulse(tmp
     for spec in specs:
         pga = horizontal_peak(motion.scale(spec.params.drive.scale).acc)[0]
         assert pga == pytest.approx(spec.tags["level_m_s2"], rel=1e-5)
-    table, cost = fr.block_runs(specs)
+    table, cost = fragility_block.block_runs(specs)
     assert cost["block2d_cases"] == 6 * 6
-    levels = fr.level_table(table).set_index(["record_id", "level_m_s2"])
-    for block in fr.MODELS_2D:
+    levels = level_table(table).set_index(["record_id", "level_m_s2"])
+    for block in MODELS_2D:
         assert levels.loc[("pulse", 1.6), f"p_{block}"] == 0.0
         assert levels.loc[("pulse", 60.0), f"p_{block}"] == 1.0
     low = table[table["level_m_s2"] == 1.6]
@@ -125,8 +127,8 @@ def test_block_never_topples_below_g_tan_alpha_and_always_under_a_huge_pulse(tmp
     # a pulse toward 30 deg pushes the block over toward 210 deg at its first half cycle
     assert np.allclose(high["downfall_azimuth_deg"], 210.0)
     # integrated in small batches (memory bound): the same table
-    monkeypatch.setattr(fr, "BLOCK_CHUNK_SAMPLES", 1)
-    chunked, _ = fr.block_runs(specs)
+    monkeypatch.setattr(fragility_block, "BLOCK_CHUNK_SAMPLES", 1)
+    chunked, _ = fragility_block.block_runs(specs)
     assert chunked.equals(table)
 
 

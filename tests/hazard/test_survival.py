@@ -10,7 +10,8 @@ import pytest
 from scipy import integrate, stats
 
 from pipeline import RECORDS_DIR
-from pipeline.campaign.fragility import _column_fits, _finite
+from pipeline.campaign.fragility_tables import _column_fits
+from pipeline.files import json_safe
 from pipeline.cli import main
 from pipeline.files import InputError
 from pipeline.hazard import load_hazard
@@ -280,7 +281,7 @@ def test_reads_what_campaign_fragility_writes(tmp_path):
                           "level_m_s2": pga})
     columns = _column_fits(table, {"monolithic": "3D YADE monolithic column"}, 0.165, 2.0)
     path = tmp_path / "fragility.json"
-    path.write_text(json.dumps(_finite({"columns": columns})))
+    path.write_text(json.dumps(json_safe({"columns": columns})))
     surface = load_campaign_fragility(tmp_path)
     written = columns["monolithic"]["logistic"]
     assert surface.coefficients == tuple(written["coefficients"][k] for k in ("b0", "b1", "b2"))

@@ -1,0 +1,201 @@
+"""Tables and fits over the runs of the ``fragility`` campaign (scaled records): the 3D
+runs table with the record parameters of the scaled motions (:func:`scaled_runs`), the
+fraction toppled per record and level (:func:`level_table`) and ``fragility.json``
+(:func:`summarise`: per column type the lognormal fit and binned fractions per intensity
+measure and the logistic surface, the 3D columns against the 2D block)."""
+import math
+
+import numpy as np
+import pandas as pd
+
+from pipeline.campaign.column_file import summary_entry
+from pipeline.campaign.pulse_grid import block_size
+from pipeline.campaign.tables import collect
+from pipeline.constants import MODEL_GRAVITY
+from pipeline.files import json_safe
+from pipeline.rocking import block_constants
+from pipeline.stats.ensemble import (binned_fractions, fragility_fit, logistic_surface,
+                                     wilson_interval)
+
+# intensity measures: name -> (runs-table column, unit, label)
+INTENSITY_MEASURES = {"PGA": ("pga_m_s2", "m/s^2", "PGA (m/s$^2$)"),
+                      "PGV": ("pgv_m_s", "m/s", "PGV (m/s)"),
+                      "PGV/PGA": ("pgv_pga_s", "s", "PGV/PGA (s)")}
+MODELS_3D = ("monolithic", "drums")
+MODELS_2D = ("block2d", "block2d_worst")
+# amplitude-dependent record parameters, rescaled to the scaled motion in the runs table
+SCALED_LINEAR = ("pga", "pgv", "pgd")
+SCALED_SQUARE = ("arias",)
+
+
+def scaled_runs(specs, campaign_dir):
+    """The 3D runs table with the record parameters of the scaled motions and the IMs."""
+    runs, _ = collect(specs, "fragility", campaign_dir)
+    if runs.empty:
+        return runs
+    by_id = {s.run_id: s.tags for s in specs}
+    for key in ("level_m_s2", "level_index", "member", "scale"):
+        runs.insert(2, key, runs["run_id"].map(lambda r, k=key: by_id[r][k]))
+    runs.insert(2, "model", "3D")
+    scale = runs["scale"].astype(float)
+    runs["record_pga_h"] = runs["pga_h"]
+    for column in list(runs.columns):
+        stem = column.rsplit("_", 1)[0]
+        if stem in SCALED_LINEAR and column.rsplit("_", 1)[1] in ("e", "n", "z", "h"):
+            runs[column] = pd.to_numeric(runs[column], errors="coerce") * scale
+        elif stem in SCALED_SQUARE and column.rsplit("_", 1)[1] in ("e", "n", "z", "h"):
+            runs[column] = pd.to_numeric(runs[column], errors="coerce") * scale ** 2
+    runs["pga_m_s2"] = runs["pga_h"]
+    runs["pgv_m_s"] = runs["pgv_h"]
+    runs["pgv_pga_s"] = runs["pgv_pga_h"]
+    runs["toppled"] = runs["toppled"].astype(bool)
+    return runs
+
+
+
+def level_table(table):
+    """Fraction toppled per record and level (and over all records), one column per model."""
+    rows = []
+    pooled = table.assign(record_id="all records")
+    for (record, level), group in pd.concat([table, pooled]).groupby(
+            ["record_id", "level_m_s2"], sort=True):
+        row = {"record_id": record, "level_m_s2": level,
+               "pgv_m_s": float(np.exp(np.log(group["pgv_m_s"].astype(float)).mean()))}
+        for column, sub in group.groupby("column"):
+            k, n = int(sub["toppled"].sum()), len(sub)
+            lo, hi = wilson_interval(k, n)
+            row.update({f"p_{column}": k / n, f"p_{column}_lo": lo, f"p_{column}_hi": hi,
+                        f"n_{column}": n})
+        rows.append(row)
+    out = pd.DataFrame(rows)
+    for column in MODELS_3D:
+        if f"p_{column}" in out:
+            for block in MODELS_2D:
+                if f"p_{block}" in out:
+                    out[f"diff_{column}_{block}"] = out[f"p_{column}"] - out[f"p_{block}"]
+    return out
+
+
+
+def summarise(table, specs, cost):
+    """``fragility.json``: {"records", "levels_m_s2", "members", "seed", "column",
+    "azimuths", "intensity_measures", "columns": {name: {"model": "3D"|"2D",
+    "description", "runs", "toppled", "all_stood_up_to_m_s2" (highest PGA level below
+    which no run toppled), "all_toppled_from_m_s2" (lowest level from which every run
+    toppled), "PGA"|"PGV"|"PGV/PGA": {median, beta,
+    median_ci95, beta_ci95, n, toppled, n_distinct, method, separated, note, unit,
+    bins: [{lo, hi, im, n, toppled, fraction, ci95}]}, "logistic": {form,
+    coefficients {b0, b1, b2}, se, ci95, n, toppled, method, separated, note,
+    dimensionless}}}, "comparison": [{column, block, im, median_3d, median_2d,
+    ratio_3d_to_2d, ...}], "levels": [per record and level fractions],
+    "block2d": {...}, "cost": {...}}"""
+    first = specs[0].tags
+    alpha, p = _block_alpha_p(table, specs)
+    described = summary_entry(specs)
+    column_file = described["column_file"]["name"] if described else None
+    descriptions = {
+        "monolithic": "3D YADE monolithic column" if column_file is None
+        else f"3D YADE monolith of the outline of {column_file}",
+        "drums": "3D YADE multi-drum column" if column_file is None
+        else f"3D YADE column as described in {column_file}",
+        "block2d": "2D rigid block (Housner), shaken along the strongest azimuth",
+        "block2d_worst": f"2D rigid block, worst of {first['azimuths']} azimuths over 180 deg"}
+    columns = _column_fits(table, descriptions, alpha, p)
+    comparison = _comparison(columns)
+    levels = level_table(table)
+    return json_safe({
+        "records": list(dict.fromkeys(s.record_id for s in specs)),
+        "levels_m_s2": first["levels"], "members": 1 + max(s.tags["member"] for s in specs),
+        "seed": first["seed"], "column": specs[0].params.column.kind,
+        **({"column_file": column_file} if column_file else {}),
+        "azimuths": first["azimuths"],
+        "intensity_measures": {im: {"column": key, "unit": unit,
+                                    "definition": _IM_DEFINITIONS[im]}
+                               for im, (key, unit, _) in INTENSITY_MEASURES.items()},
+        "columns": columns, "comparison": comparison,
+        "levels": levels.to_dict(orient="records"),
+        "block2d": {"alpha_rad": alpha, "p_per_s": p,
+                    "uplift_acc_m_s2": MODEL_GRAVITY * math.tan(alpha),
+                    "restitution": "Housner, 1 - 1.5 sin^2 alpha",
+                    "excitation": "horizontal acceleration projected on an azimuth; no "
+                                  "vertical motion, no sliding",
+                    "integrator": "pipeline.rocking.rocking_response_sampled"},
+        "cost": cost})
+
+
+def _block_alpha_p(table, specs):
+    """The 2D block's slenderness angle alpha (rad) and frequency parameter p (1/s): the
+    medians of its runs, or from the members' sizes when no block ran."""
+    blocks = table[table["model"] == "2D"]
+    if len(blocks):
+        return float(blocks["alpha_rad"].median()), float(blocks["p_per_s"].median())
+    sizes = np.array([block_size(s.params) for s in specs], float)
+    hd = float(np.median(sizes[:, 0] / sizes[:, 1]))
+    height = float(np.median(sizes[:, 0]))
+    c = block_constants(height, height / hd)
+    return c["alpha"], c["p"]
+
+
+def _column_fits(table, descriptions, alpha, p):
+    """Per column type present: counts, the bracketing levels, a lognormal fit and binned
+    fractions per intensity measure, and the logistic surface in (PGA, PGV/PGA)."""
+    columns = {}
+    for name in [c for c in (*MODELS_3D, *MODELS_2D) if c in set(table["column"])]:
+        sub = table[table["column"] == name]
+        y = sub["toppled"].astype(bool).to_numpy()
+        stood_to, toppled_from = _brackets(sub.groupby("level_m_s2")["toppled"].mean())
+        entry = {"model": "3D" if name in MODELS_3D else "2D", "description": descriptions[name],
+                 "runs": len(sub), "toppled": int(y.sum()),
+                 "all_stood_up_to_m_s2": stood_to, "all_toppled_from_m_s2": toppled_from}
+        for im, (key, unit, _) in INTENSITY_MEASURES.items():
+            values = sub[key].astype(float).to_numpy()
+            entry[im] = {**fragility_fit(values, y), "unit": unit,
+                         "bins": binned_fractions(values, y)}
+        entry["logistic"] = logistic_surface(sub["pga_m_s2"].astype(float),
+                                             sub["pgv_pga_s"].astype(float), y, alpha=alpha, p=p)
+        columns[name] = entry
+    return columns
+
+
+def _comparison(columns):
+    """3D column against 2D block per intensity measure: medians, their ratio, betas,
+    P(toppled) and (PGA) the bracketing levels."""
+    comparison = []
+    for column in MODELS_3D:
+        for block in MODELS_2D:
+            if column not in columns or block not in columns:
+                continue
+            for im in INTENSITY_MEASURES:
+                m3, m2 = columns[column][im]["median"], columns[block][im]["median"]
+                comparison.append({
+                    "column": column, "block": block, "im": im, "median_3d": m3,
+                    "median_2d": m2, "ratio_3d_to_2d": None if m3 is None or m2 is None
+                    else m3 / m2, "beta_3d": columns[column][im]["beta"],
+                    "beta_2d": columns[block][im]["beta"],
+                    "p_toppled_3d": columns[column]["toppled"] / columns[column]["runs"],
+                    "p_toppled_2d": columns[block]["toppled"] / columns[block]["runs"],
+                    **({"all_stood_up_to_3d": columns[column]["all_stood_up_to_m_s2"],
+                        "all_stood_up_to_2d": columns[block]["all_stood_up_to_m_s2"],
+                        "all_toppled_from_3d": columns[column]["all_toppled_from_m_s2"],
+                        "all_toppled_from_2d": columns[block]["all_toppled_from_m_s2"]}
+                       if im == "PGA" else {})})
+    return comparison
+
+
+def _brackets(fraction_by_level):
+    """(highest level up to which no run toppled at any level, lowest level from which
+    every run toppled at every level); None where there is none."""
+    fraction = fraction_by_level.sort_index()
+    levels, values = fraction.index.to_numpy(float), fraction.to_numpy(float)
+    none = np.cumprod(values == 0).astype(bool)               # all stood up to here
+    every = np.cumprod((values == 1)[::-1]).astype(bool)[::-1]   # all toppled from here
+    return (float(levels[none][-1]) if none.any() else None,
+            float(levels[every][0]) if every.any() else None)
+
+
+_IM_DEFINITIONS = {
+    "PGA": "peak of the horizontal acceleration vector of the scaled motion",
+    "PGV": "peak of the horizontal velocity vector of the scaled motion",
+    "PGV/PGA": "PGV / PGA (s), unchanged by scaling: varies only between records"}
+
+

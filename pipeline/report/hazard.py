@@ -1,0 +1,55 @@
+"""REPORT section of ``survival`` (``make rock-survival`` writes results/rock-survival)."""
+import json
+
+import pandas as pd
+
+from pipeline.report.common import _figure, _fmt, _table
+
+ROCK_SURVIVAL = "rock-survival"
+
+
+def survival_section(results, name=ROCK_SURVIVAL):
+    """The scanned rock under an example hazard curve: rate, survival with its Monte Carlo
+    interval and the parameter sets' spread, bounds, contribution by PGA, figure."""
+    heading = "Scanned rock survival under an example hazard curve"
+    path = results / name / "survival.json"
+    if not path.is_file():
+        return (f"## {heading}\n\nNot run yet (`make rock-survival`: SP1's pulse-grid "
+                "fragility under the USGS 2014 hazard curve at 34 N, 118 W).\n")
+    s = json.loads(path.read_text())
+    specimen = s["specimens"][0]
+    fragility, hazard, ratio = specimen["fragility"], s["hazard"], s["pgv_pga"] or {}
+    interval = s["survival_interval"]
+    sets = s.get("survival_parameter_set_range")
+    lines = [f"## {heading}\n",
+             f"Fragility: {fragility['label']} ({fragility.get('inside', fragility['form'])}"
+             f"; outside the grid: {fragility.get('outside', '-')}). Hazard: "
+             f"{hazard.get('format', '')} `{hazard.get('file', '')}`"
+             + ("" if hazard.get("lat") is None else
+                f" at {abs(hazard['lat']):g} {'N' if hazard['lat'] >= 0 else 'S'}, "
+                f"{abs(hazard['lon']):g} {'E' if hazard['lon'] >= 0 else 'W'}")
+             + (f"; PGV/PGA from {ratio.get('model', ratio.get('source'))} at M "
+                f"{ratio['magnitude']:g}, {ratio['distance_jb_km']:g} km"
+                if "magnitude" in ratio else "")
+             + f". Age {s['age_ka']:g} +- {s['age_sd_ka']:g} ka.\n",
+             f"Annual overturning rate {s['annual_overturning_rate_per_yr']:.3g} /yr; "
+             f"survival probability {s['survival_probability']:.3g}"
+             + ("" if interval is None else
+                f" (Monte Carlo 95 %: {interval[0]:.3g}-{interval[1]:.3g})")
+             + ("" if sets is None else
+                f"; per parameter set {sets[0]:.3g}-{sets[1]:.3g} (the members' spread)")
+             + f". Hazard rates x {_fmt(s['rate_scale_bound_5pct'], 3)} or PGA levels x "
+             f"{_fmt(s['intensity_scale_bound_5pct'], 3)} leave survival at 5 %.\n"]
+    rows = [{"PGA (g)": f"{r['lo_g']:.3g}-" + ("" if r["hi_g"] is None else f"{r['hi_g']:.3g}"),
+             "rate (1/yr)": f"{r['rate_per_yr']:.3g}",
+             "share": "-" if r["share"] is None else f"{100 * r['share']:.1f} %"}
+            for r in s["contribution_by_intensity"] if (r["share"] or 0) >= 0.01]
+    if rows:
+        lines.append("Contribution by PGA (intervals holding 1 % or more of the rate):\n")
+        lines.append(_table(pd.DataFrame(rows)) + "\n")
+    for w in s["warnings"]:
+        lines.append(f"Warning: {w}\n")
+    lines.append(_figure(results, results / name / s.get("figure", "survival.png"),
+                         "hazard curve and fragility, fragility-weighted rate density, "
+                         "survival against age"))
+    return "\n".join(lines)
