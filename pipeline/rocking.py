@@ -691,3 +691,71 @@ def _below_barrier(theta, omega, alpha, R, I0, g):
     less energy than the barrier's top (energy only decreases without ground motion)."""
     energy = 0.5 * I0 * omega ** 2 + g * R * np.cos(alpha - np.abs(theta))
     return (np.abs(theta) < alpha) & (energy < g * R)
+
+
+def free_rocking_peaks(t, theta):
+    """Impacts and amplitudes of a recorded free-rocking decay: ``t`` (s, increasing) and
+    ``theta`` (rad, signed tilt).  An impact is a change of sign of theta (linear
+    interpolation between samples); the amplitude of a swing is the largest |theta|
+    between two impacts (the first swing: from the start to the first impact).  Returns
+    dict: impact_times (s), peaks (rad, index k = amplitude after k impacts), swing_s
+    (s, durations between successive impacts)."""
+    t = np.asarray(t, float)
+    theta = np.asarray(theta, float)
+    if t.ndim != 1 or t.shape != theta.shape or t.size < 3:
+        raise InputError("free rocking: time and tilt need the same length, at least 3 samples")
+    if not (np.all(np.isfinite(t)) and np.all(np.isfinite(theta))):
+        raise InputError("free rocking: time and tilt must be finite numbers")
+    if np.any(np.diff(t) <= 0):
+        raise InputError("free rocking: time must increase from sample to sample")
+    crossing = np.flatnonzero(np.sign(theta[1:]) * np.sign(theta[:-1]) < 0)
+    impacts = t[crossing] - theta[crossing] * (t[crossing + 1] - t[crossing]) / \
+        (theta[crossing + 1] - theta[crossing])
+    bounds = np.concatenate([[0], crossing + 1, [t.size]])
+    peaks = np.array([np.max(np.abs(theta[a:b])) for a, b in zip(bounds[:-1], bounds[1:])
+                      if b > a])
+    # the swing after the last impact counts only when it has turned back (a peak inside)
+    if crossing.size and np.argmax(np.abs(theta[bounds[-2]:])) == t.size - 1 - bounds[-2]:
+        peaks = peaks[:-1]
+    return dict(impact_times=impacts, peaks=peaks, swing_s=np.diff(impacts))
+
+
+def fit_free_rocking(height, width, t=None, theta=None, frequency_hz=None,
+                     amplitude_ratios=None, g=MODEL_GRAVITY):
+    """The rocking coefficient of restitution (eta: angular velocity after / before an
+    impact) that reproduces a free-rocking decay of a block of ``height`` and ``width``
+    (m, width in the rocking plane), from either a tilt record (``t`` s, ``theta`` rad:
+    successive amplitudes, :func:`restitution_from_peaks`, exact for the rigid block) or
+    the rocking frequency (Hz, full cycle, at the amplitudes measured) and the ratios of
+    successive amplitudes (the amplitude from the frequency by Housner's linearised
+    period, eq 7: theta / alpha = 1 - 1 / cosh(p T / 4)).  Returns dict: restitution
+    (mean over impacts), restitution_sd (scatter of single impacts; None for one),
+    restitution_se (standard error of the mean; None for one), restitution_per_impact,
+    impacts, housner_restitution (1 - 1.5 sin^2 alpha), alpha (rad), p (1/s)."""
+    c = block_constants(height, width, g)
+    alpha = c["alpha"]
+    if t is not None:
+        found = free_rocking_peaks(t, theta)
+        peaks = found["peaks"]
+        if peaks.size < 2:
+            raise InputError("free rocking: at least one impact with amplitudes before and "
+                             "after it is needed")
+        if np.any(peaks >= alpha):
+            raise InputError(f"free rocking: an amplitude of {np.max(peaks):.4g} rad is at or "
+                             f"beyond the block's overturning angle alpha {alpha:.4g} rad "
+                             "(wrong block size, or tilt in degrees given as radians?)")
+        eta = restitution_from_peaks(peaks, alpha)["eta_per_impact"]
+    else:
+        if frequency_hz is None or not amplitude_ratios:
+            raise InputError("free rocking: give a tilt record, or the rocking frequency and "
+                             "the ratios of successive amplitudes")
+        amplitude = 1.0 - 1.0 / math.cosh(c["p"] / (4.0 * frequency_hz))
+        ratios = np.asarray(amplitude_ratios, float)
+        energy = lambda ratio: np.cos(alpha - ratio * alpha) - math.cos(alpha)  # noqa: E731
+        eta = np.sqrt(energy(amplitude * ratios) / energy(amplitude))
+    n = eta.size
+    sd = float(np.std(eta, ddof=1)) if n > 1 else None
+    return dict(restitution=float(np.mean(eta)), restitution_sd=sd,
+                restitution_se=None if sd is None else sd / math.sqrt(n),
+                restitution_per_impact=eta, impacts=int(n),
+                housner_restitution=c["restitution"], alpha=alpha, p=c["p"])

@@ -112,14 +112,23 @@ def contact_material(mass, n_points):
         frictionAngle=math.atan(CONTACT["mu_s"])))
 
 
-def rim_spheres(rim):
+def rim_spheres(rim, floor_z=None):
     """Centres (n x 3, body frame) of a rim's contact spheres: circles get RIM_POINTS
     points from the phase on, polygons their given points, point sets (a mesh specimen's
     footprint and hull) theirs one radius along their inward normals; each point lies in the rim's
     face (the plane through z with the rim's normal, e.g. a wedge joint) and its sphere
-    one radius inside the body along that normal."""
+    one radius inside the body along that normal.  ``floor_z``: the base plane (body
+    frame) no point-set sphere may reach below."""
     if rim["kind"] == "points":              # a mesh specimen: surface points, inward normals
-        return np.asarray(rim["points"], float) + RIM_R * np.asarray(rim["normals"], float)
+        points = np.asarray(rim["points"], float)
+        centres = points + RIM_R * np.asarray(rim["normals"], float)
+        if floor_z is not None:
+            # a sphere one radius in along a slanted normal reaches below its point: one
+            # that would start inside the table (below the base) sits straight above its
+            # point instead, touching it from above (no spring loaded at the start)
+            below = centres[:, 2] - RIM_R < floor_z
+            centres[below] = points[below] + [0.0, 0.0, RIM_R]
+        return centres
     if rim["kind"] == "circle":
         ang = 2 * math.pi * np.arange(RIM_POINTS) / RIM_POINTS + math.radians(RIM_PHASE_DEG)
         xy = np.column_stack([rim["radius"] * np.cos(ang), rim["radius"] * np.sin(ang)])
@@ -145,8 +154,10 @@ def add_body(body, mask_base, mask_top, material):
 
     def clump_members(frame_spheres):
         members = []
+        floor_z = min((min(p[2] for p in rim["points"]) for rim in body["rims"]
+                       if rim["role"] == "base" and rim["kind"] == "points"), default=None)
         for rim in body["rims"]:
-            points = rim_spheres(rim)
+            points = rim_spheres(rim, floor_z)
             for p in points:
                 members.append(utils.sphere(world(p), RIM_R, material=material,
                                             mask=mask_base if rim["role"] == "base"

@@ -32,6 +32,9 @@ def setup(p):
     add_column_file_argument(p, "with --column both a monolith of the same outline stands "
                              "beside it; excludes --hd, --height, --drums, --density")
     add_arguments(p, Contact)
+    p.add_argument("--contact-file", type=Path, default=None, metavar="JSON",
+                   help="contact parameters (kn, damping; mu_s, mu_k) from a file `contact` "
+                   "wrote (a free-rocking test)")
     add_arguments(p, Numerics)
     p.add_argument("--back-azimuth", type=float, default=None, metavar="DEG",
                    help="back azimuth to the epicentre when the record does not give it, [0, 360)")
@@ -70,6 +73,14 @@ def run(args):
     check_run_options(args)
     column = from_args(Column, args, centred=True if args.centred else None)
     contact, numerics = from_args(Contact, args), from_args(Numerics, args)
+    if args.contact_file is not None:
+        from pipeline.scenario.contact_file import load_contact_file
+        from_file = load_contact_file(args.contact_file)
+        both = [f"--{k.replace('_', '-')}" for k in from_file if getattr(args, k) is not None]
+        if both:
+            raise InputError(f"--contact-file sets {', '.join(both)}: give it there or on the "
+                             "command line, not both")
+        contact = from_args(Contact, args, **from_file)
     check_time_step(contact, numerics)
     out = args.out
     if out is None:

@@ -28,6 +28,7 @@ SOURCES = {
     "bench/bench.json": "make bench",
     "verification/verification.json": "make run-all",
     "shake-table/shake_table.json": "make shake-table",
+    "contact-convergence/convergence.json": "make contact-convergence",
     "inversion/demo_summary.json": "make run-all",
     "inversion/member-study/member_study.json": "make invert-study",
     "rock-survival/survival.json": "make rock-survival",

@@ -192,3 +192,37 @@ def test_campaign_calibrates_on_early_tests_and_validates_the_chosen_set_only(tm
     assert summary["splits"]["validation"]["model"]["n"] == 2
     assert summary["splits"]["all"]["tests"] == 4
     assert (tmp_path / "st" / "shake_table_rates.png").stat().st_size > 10_000
+
+
+@pytest.mark.yade
+def test_sp1_starts_at_rest_at_any_contact_stiffness(tmp_path):
+    """SP1 on its lowest asperities (footprint 1 mm) starts at rest on the table: no
+    contact sphere starts inside the table, so no spring is loaded at the start, whatever
+    its stiffness (a sphere 0.6 mm inside at kn 1.2e9 launched the rock at 0.5 m/s and
+    overturned it).  Shaken gently (a fifth of its weakest uplift threshold: it cannot
+    move as a rigid body) until a pulse past the threshold at 1.5 s, its bodies stay
+    slower than 1 cm/s before the pulse, at kn x1 and x10."""
+    from pipeline import cli
+    rock = ColumnGeometry.load(SPECIMEN).to_dict()
+    rock["footprint_tolerance_m"] = 0.001
+    rock["mesh"] = str(SPECIMEN.parent / rock["mesh"])
+    specimen = tmp_path / "sp1.json"
+    specimen.write_text(json.dumps(rock))
+    t = np.arange(0.0, 2.0, 0.005)
+    uplift = ColumnGeometry.load(specimen).uplift_ratio()
+    accel_g = np.where((t >= 1.5) & (t < 1.6), 1.2 * uplift,
+                       0.2 * uplift * np.sin(2 * np.pi * 2.0 * t))
+    table = tmp_path / "gentle.txt"
+    table.write_text("# lab-table: test\n# units: g\n# axes: 90\n" + "\n".join(
+        f"{a:.4f} {b:.6f}" for a, b in zip(t, accel_g)) + "\n")
+    for kn in ("1.2e8", "1.2e9"):
+        out = tmp_path / kn
+        assert cli.main(["run", "--record", str(table), "--column", "monolithic",
+                         "--column-file", str(specimen), "--kn", kn, "--damping", "0.05",
+                         "--quiet-motion", "simulate", "--out", str(out)]) == 0
+        trajectory = np.load(out / "trajectory.npz")
+        quiet = trajectory["t"] < 1.45
+        assert quiet.sum() > 20                     # the quiet lead was simulated
+        speed = np.linalg.norm(trajectory["vel"][quiet, 0], axis=1)
+        spin = np.linalg.norm(trajectory["angvel"][quiet, 0], axis=1)
+        assert speed.max() < 0.01 and spin.max() < 0.05, (kn, speed.max(), spin.max())

@@ -1,0 +1,151 @@
+"""``contact``: the rocking coefficient of restitution that reproduces a recorded
+free-rocking decay of a block, written to a contact file (JSON).
+
+    python -m pipeline contact --free-rocking decay.csv --block 0.40,0.08 --out contact.json
+    python -m pipeline contact --frequency-hz 2.5 --amplitude-ratio 0.62,0.60 --block 0.40,0.08
+
+The decay file is a CSV with a header: ``time_s`` and ``tilt_rad`` or ``tilt_deg`` (the
+block's tilt in its rocking plane, signed).
+"""
+import math
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from pipeline import paper
+from pipeline.files import InputError, write_json
+
+NAME = "contact"
+ORDER = 60
+HELP = "contact parameters from a free-rocking test of a block (restitution, its uncertainty)"
+MAX_ROWS = 1_000_000
+TILT_COLUMNS = {"tilt_rad": 1.0, "tilt_deg": math.pi / 180.0}
+
+
+def setup(p):
+    p.add_argument("--free-rocking", type=Path, default=None, metavar="CSV",
+                   help="recorded decay: columns time_s and tilt_rad or tilt_deg")
+    p.add_argument("--frequency-hz", type=float, default=None, metavar="HZ",
+                   help="instead of a record: the rocking frequency (full cycles per s) at "
+                   "the amplitudes whose ratios --amplitude-ratio gives")
+    p.add_argument("--amplitude-ratio", default=None, metavar="R,R",
+                   help="ratios of successive amplitudes (the next over the previous), in (0, 1)")
+    p.add_argument("--block", required=True, metavar="HEIGHT,WIDTH",
+                   help="the block's height and width in its rocking plane (m)")
+    p.add_argument("--damping-map", action="store_true",
+                   help="also find the contact damping ratio that gives this restitution in "
+                   "the YADE model of the block (free-rocking runs, bisection: about a "
+                   "minute), so that `run --contact-file` takes the file")
+    p.add_argument("--depth", type=float, default=None, metavar="M",
+                   help="the block's depth across the rocking plane (m; default its width)")
+    p.add_argument("--density", type=float, default=None,
+                   metavar="KG_M3", help=f"the block's density (default "
+                   f"{paper.MARBLE_DENSITY_KG_M3:g} kg/m^3)")
+    p.add_argument("--kn", type=float, default=None, metavar="N_M",
+                   help=f"contact stiffness per point of the map (default the paper's block "
+                   f"{paper.MARBLE_BLOCK_KN_N_M:g} N/m)")
+    p.add_argument("--out", type=Path, default=Path("contact.json"),
+                   help="contact file written (JSON; default contact.json)")
+
+
+def _numbers(text, what, count=None):
+    try:
+        values = [float(v) for v in text.split(",") if v.strip()]
+    except ValueError:
+        raise InputError(f"{what}: numbers separated by commas needed, got {text!r}") from None
+    if count is not None and len(values) != count:
+        raise InputError(f"{what}: {count} numbers needed, got {text!r}")
+    if not values or not all(math.isfinite(v) for v in values):
+        raise InputError(f"{what}: finite numbers needed, got {text!r}")
+    return values
+
+
+def load_free_rocking(path):
+    """(time s, tilt rad) arrays of a decay CSV; one-line InputError otherwise."""
+    path = Path(path)
+    if not path.is_file():
+        raise InputError(f"--free-rocking {path}: file not found")
+    try:
+        frame = pd.read_csv(path, nrows=MAX_ROWS + 1)
+    except (OSError, ValueError, UnicodeDecodeError, pd.errors.ParserError) as exc:
+        raise InputError(f"{path.name}: not a readable CSV ({str(exc).splitlines()[0][:100]})"
+                         ) from None
+    tilt = [c for c in TILT_COLUMNS if c in frame.columns]
+    if "time_s" not in frame.columns or len(tilt) != 1:
+        raise InputError(f"{path.name}: columns time_s and one of tilt_rad, tilt_deg needed "
+                         f"(found {', '.join(map(str, frame.columns))})")
+    if len(frame) > MAX_ROWS:
+        raise InputError(f"{path.name}: more than {MAX_ROWS:,} rows")
+    values = frame[["time_s", tilt[0]]].apply(pd.to_numeric, errors="coerce").to_numpy(float)
+    if not np.all(np.isfinite(values)):
+        raise InputError(f"{path.name}: time_s and {tilt[0]} must hold numbers in every row")
+    return values[:, 0], values[:, 1] * TILT_COLUMNS[tilt[0]]
+
+
+def run(args):
+    from pipeline.rocking import fit_free_rocking
+    height, width = _numbers(args.block, "--block HEIGHT,WIDTH", 2)
+    if not (0.01 <= height <= 30.0 and 0.005 <= width <= 30.0):
+        raise InputError(f"--block: height in [0.01, 30] m and width in [0.005, 30] m needed, "
+                         f"got {args.block!r}")
+    depth = width if args.depth is None else args.depth
+    density = paper.MARBLE_DENSITY_KG_M3 if args.density is None else args.density
+    kn = paper.MARBLE_BLOCK_KN_N_M if args.kn is None else args.kn
+    if args.damping_map:
+        from pipeline.scenario import Block, Contact
+        Block(height=height, width=width, depth=depth, density=density)   # ranges
+        Contact(kn=kn)
+    else:
+        alone = [f"--{k}" for k in ("depth", "density", "kn") if getattr(args, k) is not None]
+        if alone:
+            raise InputError(f"{', '.join(alone)} go(es) with --damping-map")
+    if (args.free_rocking is None) == (args.frequency_hz is None):
+        raise InputError("give either --free-rocking CSV or --frequency-hz with "
+                         "--amplitude-ratio")
+    if args.frequency_hz is not None:
+        if not (math.isfinite(args.frequency_hz) and 0.01 <= args.frequency_hz <= 100.0):
+            raise InputError(f"--frequency-hz must be in [0.01, 100] Hz, got "
+                             f"{args.frequency_hz:g}")
+        if args.amplitude_ratio is None:
+            raise InputError("--frequency-hz needs --amplitude-ratio")
+        ratios = _numbers(args.amplitude_ratio, "--amplitude-ratio")
+        if not all(0.0 < r < 1.0 for r in ratios):
+            raise InputError(f"--amplitude-ratio: ratios in (0, 1) needed (a free-rocking "
+                             f"amplitude decays), got {args.amplitude_ratio!r}")
+        fit = fit_free_rocking(height, width, frequency_hz=args.frequency_hz,
+                               amplitude_ratios=ratios)
+        source = {"frequency_hz": args.frequency_hz, "amplitude_ratios": ratios}
+    else:
+        if args.amplitude_ratio is not None:
+            raise InputError("--amplitude-ratio goes with --frequency-hz, not --free-rocking")
+        t, theta = load_free_rocking(args.free_rocking)
+        fit = fit_free_rocking(height, width, t=t, theta=theta)
+        source = {"free_rocking": str(args.free_rocking)}
+    if not 0.0 < fit["restitution"] <= 1.0:
+        raise InputError(f"the decay gives a restitution of {fit['restitution']:.3f}, outside "
+                         "(0, 1]: amplitudes that grow are not a free-rocking decay")
+    result = {"restitution": fit["restitution"], "restitution_sd": fit["restitution_sd"],
+              "restitution_se": fit["restitution_se"], "impacts": fit["impacts"],
+              "restitution_per_impact": [float(e) for e in fit["restitution_per_impact"]],
+              "housner_restitution": fit["housner_restitution"],
+              "block": {"height_m": height, "width_m": width}, "source": source}
+    if args.damping_map:
+        from pipeline.verification.contact_map import (RESTITUTION_TOLERANCE,
+                                                       damping_for_restitution)
+        damping, measured, runs = damping_for_restitution(
+            fit["restitution"], height, width, depth, kn=kn, density=density)
+        result.update(kn=kn, damping=damping, damping_map={
+            "measured_restitution": measured, "tolerance": RESTITUTION_TOLERANCE,
+            "yade_runs": runs, "depth_m": depth, "density_kg_m3": density})
+        print(f"damping {damping:.3f} per contact at kn {kn:g} N/m gives this block a "
+              f"restitution of {measured:.4f} in YADE ({runs} free-rocking run(s) made; "
+              "measured ones are kept in results/contact/restitution_map.json)")
+    write_json(args.out, result)
+    spread = "" if fit["restitution_sd"] is None else \
+        f" +- {fit['restitution_se']:.3f} (standard error; single impacts scatter " \
+        f"{fit['restitution_sd']:.3f})"
+    print(f"restitution {fit['restitution']:.3f}{spread} from {fit['impacts']} impact(s); "
+          f"a rigid block of this shape: {fit['housner_restitution']:.3f} (Housner)")
+    print(f"wrote {args.out}")
+    return 0

@@ -1,0 +1,38 @@
+"""The contact file (JSON) that ``contact`` writes and ``run --contact-file`` reads: the
+contact parameters a free-rocking test gave (``kn`` N/m per point, ``damping``; also
+``mu_s``, ``mu_k`` when stated) beside what they came from (``restitution`` and its
+uncertainty, the block, the source: informational keys, not read)."""
+import json
+from pathlib import Path
+
+from pipeline.files import InputError
+from pipeline.userfiles import keys_text
+
+CONTACT_KEYS = ("kn", "damping", "mu_s", "mu_k")
+INFORMATION_KEYS = ("restitution", "restitution_sd", "restitution_se", "impacts",
+                    "restitution_per_impact", "housner_restitution", "block", "source",
+                    "damping_map")
+
+
+def load_contact_file(path):
+    """{Contact field: value} of a contact file (values range-checked by
+    :class:`~pipeline.scenario.parameters.Contact` where used); one-line InputError for a
+    missing or unreadable file, an unknown key, or a file without kn and damping."""
+    path = Path(path)
+    if not path.is_file():
+        raise InputError(f"--contact-file {path}: file not found")
+    try:
+        data = json.loads(path.read_text())
+    except (OSError, UnicodeDecodeError, ValueError) as exc:
+        raise InputError(f"--contact-file {path.name}: not readable JSON ({exc})") from None
+    if not isinstance(data, dict):
+        raise InputError(f"--contact-file {path.name}: a JSON object needed")
+    unknown = set(data) - set(CONTACT_KEYS) - set(INFORMATION_KEYS)
+    if unknown:
+        raise InputError(f"--contact-file {path.name}: unknown key(s) {keys_text(unknown)} "
+                         f"(known: {', '.join(CONTACT_KEYS + INFORMATION_KEYS)})")
+    values = {k: data[k] for k in CONTACT_KEYS if data.get(k) is not None}
+    if "damping" not in values or "kn" not in values:
+        raise InputError(f"--contact-file {path.name}: no kn and damping (a restitution "
+                         "alone: give `contact` --damping-map to map it onto the contact law)")
+    return values
