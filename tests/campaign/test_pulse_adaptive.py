@@ -15,7 +15,7 @@ from pipeline.outcome.summary import ColumnOutcome, RunSummary
 from pipeline.rocking import rocking_response_sampled
 from tests.campaign.test_pulse_grid import box_description
 
-WIDER = 1.25        # the model's base is this much wider than the guide's: a stabler rock
+WIDER = 2.0         # the model's base is this much wider than the guide's: a stabler rock
 
 
 def stabler_block_worker(spec, run_dir):
@@ -58,6 +58,7 @@ def test_the_adaptive_surface_matches_the_full_grid_with_fewer_runs(tmp_path, mo
     difference = pulse_grid.contour_difference(summaries["full"], summaries["adaptive"])
     crossing = [r for r in difference["rows"] if r["pga_g_reference"] is not None]
     assert len(crossing) == 2                      # the threshold lies inside the grid
+    print(difference, adaptive["runs_finished"])
     assert difference["within_band"]
     assert difference["max_abs_diff_g"] == pytest.approx(0.0, abs=1e-9)
 
