@@ -222,7 +222,8 @@ class FragilityOptions(CampaignOptions):
                         flag="--ranges", metavar="NAME=LO:HI;...")
     adaptive: bool = param(False, "", "pulse grid: run every member only where P is uncertain "
                            "(the 2D block as a guide, one probe run elsewhere, widened where a "
-                           "probe disagrees)", flag="--adaptive")
+                           "probe disagrees or the specimen's own P is uncertain)",
+                           flag="--adaptive")
     TAKES_JOBS = True
 
     def check(self):

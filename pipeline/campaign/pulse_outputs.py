@@ -76,8 +76,9 @@ def pulse_outputs(specs, campaign_dir, figures=True):
     section["full_grid_runs"] = (len(grid["pga_g"]) * len(grid["pgv_pga_s"]) * first["members"]
                                  * first["headings"])
     section["sampling"] = ("adaptive: every member only where P is uncertain (the 2D block "
-                           "as a guide, widened where a probe run disagreed), one probe run "
-                           "elsewhere" if first.get("sampling") == "adaptive"
+                           "as a guide, widened where a probe run disagreed or the specimen's "
+                           "own P was uncertain), one probe run elsewhere"
+                           if first.get("sampling") == "adaptive"
                            else "full grid: every cell x member x direction")
     observed = None
     from pipeline.campaign.pulse_check import experiments_check
