@@ -22,16 +22,22 @@ One run prints, and writes to results/bench/bench.json (+ convergence.png):
    Doric column for 5 s at the largest allowed factor and 1.3x it, several dampings,
    on this machine's libm and on the second libm path;
 10. ctrl_c: seconds from Ctrl-C to the exit of a running campaign and of a command
-   interrupted during its start-up.
+   interrupted during its start-up;
+11. rock_fragility_adaptive: SP1's pulse-grid fragility on a small grid, the adaptive
+   surface (``--adaptive``) beside the full grid of the same resolution, each in a fresh
+   directory: runs, YADE wall time (the runs' own wall times summed), and the largest
+   difference of their P = 0.5 contours (g) beside the full grid's Monte Carlo band.
 
 Units: seconds (s), metres, m/s^2; azimuths in degrees clockwise from North.
-``--quick`` shortens every run and skips the convergence table (for development).
+``--quick`` shortens every run and skips the convergence table (for development);
+``--only-rock-fragility`` runs section 11 alone and adds it to an existing bench.json.
 """
 import argparse
 import contextlib
 import dataclasses
 import json
 import os
+import subprocess
 import sys
 import tempfile
 import time
@@ -43,6 +49,7 @@ from scipy.integrate import cumulative_trapezoid
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))       # bench/mujoco_twin.py
 from pipeline import PROJECT_ROOT as PROJECT, RESULTS_DIR  # noqa: E402
+from pipeline.campaign.pulse_grid import contour_difference  # noqa: E402
 from pipeline.files import save_figure, write_json  # noqa: E402
 from pipeline.motion import Motion  # noqa: E402
 from pipeline.motion.pulses import one_sine_pulse  # noqa: E402
@@ -532,7 +539,6 @@ def ctrl_c(work, trials=3):
     going), and of a command interrupted 0.3 s into its start-up; exit status and the
     last line it printed."""
     import signal
-    import subprocess
     from pipeline.motion.pulses import one_sine_pulse as pulse
 
     def yade_running(under):
@@ -737,6 +743,59 @@ def print_two_x(t):
               f"{'passed' if still_ok else 'FAILED'}")
 
 
+ROCK_SPECIMEN = "records/shake_table/sp1.json"
+ROCK_PULSES = "pga_g=0.1:1.5:15;pgv_pga_s=0.1:0.7:3"    # 45 cells
+ROCK_MEMBERS, ROCK_HEADINGS = 2, 2
+
+
+def rock_fragility_adaptive(work, jobs=2):
+    """The adaptive pulse-grid surface of SP1 beside the full grid of the same cells,
+    members and headings, each campaign in a fresh directory (nothing shared)."""
+    result = {"specimen": ROCK_SPECIMEN, "pulses": ROCK_PULSES, "members": ROCK_MEMBERS,
+              "headings": ROCK_HEADINGS, "jobs": jobs}
+    summaries = {}
+    for mode in ("full", "adaptive"):
+        out = work / f"rock_fragility_{mode}"
+        command = [sys.executable, "-m", "pipeline", "campaign", "fragility",
+                   "--column-file", str(PROJECT / ROCK_SPECIMEN), "--pulses", ROCK_PULSES,
+                   "--members", str(ROCK_MEMBERS), "--headings", str(ROCK_HEADINGS),
+                   "--jobs", str(jobs), "--out", str(out)]
+        started = time.perf_counter()
+        subprocess.run(command + (["--adaptive"] if mode == "adaptive" else []), cwd=PROJECT,
+                       check=True, capture_output=True, text=True)
+        wall = time.perf_counter() - started
+        summaries[mode] = json.loads((out / "fragility.json").read_text())
+        grid = summaries[mode]["pulse_grid"]
+        result[mode] = {"runs": grid["runs_finished"], "full_grid_runs": grid["full_grid_runs"],
+                        "yade_wall_s": grid["yade_wall_s_total"], "campaign_wall_s": wall}
+    result["runs_ratio"] = result["full"]["runs"] / max(result["adaptive"]["runs"], 1)
+    result["yade_wall_ratio"] = (result["full"]["yade_wall_s"]
+                                 / max(result["adaptive"]["yade_wall_s"], 1e-9))
+    result["contour_0_5"] = contour_difference(summaries["full"], summaries["adaptive"])
+    return result
+
+
+def print_rock_fragility(r):
+    print(f"\n11. Adaptive pulse grid against the full grid: {r['specimen']}, {r['pulses']}, "
+          f"{r['members']} members x {r['headings']} headings, --jobs {r['jobs']}")
+    print(f"   {'sampling':<10}{'runs':>6}{'YADE wall s':>13}{'campaign wall s':>17}")
+    for mode in ("full", "adaptive"):
+        m = r[mode]
+        print(f"   {mode:<10}{m['runs']:6d}{m['yade_wall_s']:13.1f}{m['campaign_wall_s']:17.1f}")
+    print(f"   full / adaptive: {r['runs_ratio']:.2f}x runs, {r['yade_wall_ratio']:.2f}x YADE "
+          "wall time")
+    c = r["contour_0_5"]
+    print(f"   P = 0.5 contour (PGA g) {'PGV/PGA s':>10}{'full':>7}{'adaptive':>10}"
+          f"{'diff':>7}   full grid's Monte Carlo band")
+    for row in c["rows"]:
+        band = " - ".join(fmt(v, ".2f") for v in row["reference_band_g"])
+        print(f"   {'':<23}{row['pgv_pga_s']:10.2f}{fmt(row['pga_g_reference'], '.2f'):>7}"
+              f"{fmt(row['pga_g_other'], '.2f'):>10}{fmt(row['diff_g'], '+.2f'):>7}   {band}")
+    print(f"   largest difference {fmt(c['max_abs_diff_g'], '.2f')} g; "
+          f"{'every' if c['within_band'] else 'NOT every'} adaptive crossing inside the full "
+          "grid's band")
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true",
@@ -747,7 +806,18 @@ def main(argv=None):
     parser.add_argument("--skip-peer", action="store_true", help="no MuJoCo comparison")
     parser.add_argument("--skip-convergence", action="store_true")
     parser.add_argument("--out", type=Path, default=RESULTS_DIR / "bench")
+    parser.add_argument("--only-rock-fragility", action="store_true",
+                        help="run only section 11 (adaptive against full pulse grid) and add "
+                        "it to the bench.json in --out")
     args = parser.parse_args(argv)
+    if args.only_rock_fragility:
+        path = args.out / "bench.json"
+        result = json.loads(path.read_text()) if path.is_file() else {}
+        with tempfile.TemporaryDirectory(prefix="bench_yade_") as tmp:
+            result["rock_fragility_adaptive"] = rock_fragility_adaptive(Path(tmp))
+        print_rock_fragility(result["rock_fragility_adaptive"])
+        write_json(path, result)
+        return 0
     shaking_s = args.duration or (3.0 if args.quick else 20.0)
     started = time.perf_counter()
     result = {"quick": args.quick}
@@ -787,6 +857,8 @@ def main(argv=None):
         print_time_step_limit(result["time_step_limit"])
         result["ctrl_c"] = ctrl_c(work, 1 if args.quick else 3)
         print_ctrl_c(result["ctrl_c"])
+        result["rock_fragility_adaptive"] = rock_fragility_adaptive(work)
+        print_rock_fragility(result["rock_fragility_adaptive"])
     result["bench_wall_s"] = time.perf_counter() - started
     write_json(args.out / "bench.json", result)
     print(f"\nbench: {result['bench_wall_s']:.0f} s wall; wrote {args.out / 'bench.json'}")

@@ -222,7 +222,8 @@ class FragilityOptions(CampaignOptions):
                         flag="--ranges", metavar="NAME=LO:HI;...")
     adaptive: bool = param(False, "", "pulse grid: run every member only where P is uncertain "
                            "(the 2D block as a guide, one probe run elsewhere, widened where a "
-                           "probe disagrees)", flag="--adaptive")
+                           "probe disagrees or the specimen's own P is uncertain)",
+                           flag="--adaptive")
     TAKES_JOBS = True
 
     def check(self):
@@ -250,7 +251,9 @@ def drive(run, records, campaign_dir, options, gate=None):
     2D block of the same members and directions is uncertain (0 < P < 1) and one cell
     either side in PGA, one probe run (first member, first direction) in every other
     cell; a probe that disagrees with the block's certainty adds its cell and one either
-    side; until none does (at most :data:`pulse_grid.MAX_STAGES` stages)."""
+    side, and so does, read on the specimen's own P (a probe as 0 or 1), a cell where that
+    P is uncertain or steps (the specimen's threshold beyond the block's); until nothing
+    is added (at most :data:`pulse_grid.MAX_STAGES` stages)."""
     if not options.get("adaptive"):
         return run(options)
     full = fragility_specs(records, campaign_dir, **options)
@@ -271,12 +274,17 @@ def drive(run, records, campaign_dir, options, gate=None):
         log.info(f"fragility (adaptive), stage {stage}: {len(whole)} of {len(by_cell)} cells "
                  f"in full, a probe run in the others: {len(chosen)} of {len(full)} runs")
         result = run({**options, "only_runs": chosen})
-        outcomes = {}
-        for cell, spec in probes.items():
-            summary = finished_summary(campaign_dir, spec.run_id)
-            if summary is not None:
-                outcomes[cell] = any(c.toppled for c in summary.columns)
-        added = pulse_grid.expand(guide_p, whole, outcomes)
+        outcomes, measured = {}, {}
+        for cell, rows in by_cell.items():
+            fell = {spec.run_id: any(c.toppled for c in summary.columns)
+                    for spec, _ in rows
+                    if (summary := finished_summary(campaign_dir, spec.run_id)) is not None}
+            if fell:
+                measured[cell] = float(np.mean(list(fell.values())))
+            if probes[cell].run_id in fell:
+                outcomes[cell] = fell[probes[cell].run_id]
+        added = (pulse_grid.expand(guide_p, whole, outcomes)
+                 | (pulse_grid.guide_cells(measured) - whole))
         if not added:
             break
         whole |= added

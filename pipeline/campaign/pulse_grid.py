@@ -423,3 +423,38 @@ def expand(guide_p, full, probes, margin=1):
             added.update((i, j + d) for d in range(-margin, margin + 1)
                          if (i, j + d) in guide_p and (i, j + d) not in full)
     return added
+
+
+def contour_difference(reference, other, level="0.5"):
+    """How far the P = ``level`` contour of ``other`` lies from that of ``reference`` (two
+    fragility.json dicts of the same pulse grid, e.g. the adaptive surface and the full
+    grid): per PGV/PGA of the specimen model (not the 2D block) both PGAs (g), their
+    difference and the reference's Monte Carlo band (the PGAs where its Wilson bounds
+    cross the level); ``max_abs_diff_g`` over the rows where both cross (None if none),
+    ``one_sided`` the rows where only one does, ``within_band`` whether every crossing of
+    ``other`` lies inside the reference's band (an open side counts as open)."""
+    def rows(summary):
+        models = summary["pulse_grid"]["models"]
+        specimen = [m for m in models if m != "block2d"]
+        if len(specimen) != 1:
+            raise ValueError(f"expected one specimen model beside block2d, got {specimen}")
+        return {r["pgv_pga_s"]: r for r in models[specimen[0]]["contours"][level]}
+    ref, oth = rows(reference), rows(other)
+    if set(ref) != set(oth):
+        raise ValueError("the two fragility.json files are not of the same pulse grid")
+    table, diffs, one_sided, within = [], [], 0, True
+    for ratio in sorted(ref):
+        a, b = ref[ratio]["pga_g"], oth[ratio]["pga_g"]
+        lo, hi = ref[ratio]["pga_g_band"]
+        diff = None if a is None or b is None else b - a
+        if diff is not None:
+            diffs.append(abs(diff))
+        elif (a is None) != (b is None):
+            one_sided += 1
+        if b is not None and not ((lo is None or lo <= b) and (hi is None or b <= hi)):
+            within = False
+        table.append({"pgv_pga_s": ratio, "pga_g_reference": a, "pga_g_other": b,
+                      "diff_g": diff, "reference_band_g": [lo, hi]})
+    return {"level": float(level), "rows": table,
+            "max_abs_diff_g": max(diffs) if diffs else None,
+            "one_sided": one_sided, "within_band": within and one_sided == 0}

@@ -70,12 +70,15 @@ def pulse_outputs(specs, campaign_dir, figures=True):
     name = described["column_file"]["name"] if described else "the paper's column"
     section["block2d"]["model"] = BLOCK_MODEL
     section["runs_finished"] = len(done)
+    section["yade_wall_s_total"] = round(float(sum(
+        finished_summary(campaign_dir, s.run_id).wall_s or 0.0 for s in done)), 1)
     section["runs"] = len(specs)
     section["full_grid_runs"] = (len(grid["pga_g"]) * len(grid["pgv_pga_s"]) * first["members"]
                                  * first["headings"])
     section["sampling"] = ("adaptive: every member only where P is uncertain (the 2D block "
-                           "as a guide, widened where a probe run disagreed), one probe run "
-                           "elsewhere" if first.get("sampling") == "adaptive"
+                           "as a guide, widened where a probe run disagreed or the specimen's "
+                           "own P was uncertain), one probe run elsewhere"
+                           if first.get("sampling") == "adaptive"
                            else "full grid: every cell x member x direction")
     observed = None
     from pipeline.campaign.pulse_check import experiments_check

@@ -1,0 +1,90 @@
+"""The adaptive pulse grid of campaign fragility end to end against the full grid of the
+same cells, members and directions, on a cheap model (the run worker replaced by the 2D
+rigid block of a stabler rock than the guide, so that the guide is wrong near its
+threshold and the adaptive stages must widen), and the contour difference ``make bench``
+reports, on constructed fragility.json dicts."""
+import dataclasses
+import json
+
+import pytest
+
+from pipeline.campaign import CAMPAIGNS, get, pulse_grid, run_campaign
+from pipeline.campaign.fragility import FragilityOptions, drive
+from pipeline.motion.pulses import one_cosine_pulse
+from pipeline.outcome.summary import ColumnOutcome, RunSummary
+from pipeline.rocking import rocking_response_sampled
+from tests.campaign.test_pulse_grid import box_description
+
+WIDER = 2.0         # the model's base is this much wider than the guide's: a stabler rock
+
+
+def stabler_block_worker(spec, run_dir):
+    """Worker: the 2D block of the run's height and WIDER x its width under the run's
+    pulse, written as the run's summary (the specimen's one column)."""
+    height, width = pulse_grid.block_of(spec.params, spec.tags["azimuth_deg"])
+    pulse = one_cosine_pulse(spec.tags["pga_g"] * pulse_grid.G, spec.tags["pgv_pga_s"], 0.0,
+                             pulse_grid.PULSE_DT_S, 0.0)
+    fell = bool(rocking_response_sampled(height, WIDER * width, pulse.acc[:, 1], pulse.dt,
+                                         t_after=30.0, max_step=1e-3)["overturned"][0])
+    column = ColumnOutcome(column="box", toppled=fell,
+                           downfall_azimuth_deg=spec.tags["azimuth_deg"] if fell else None)
+    RunSummary(record=spec.record_id, columns=[column]).save(run_dir / "summary.json")
+
+
+def test_the_adaptive_surface_matches_the_full_grid_with_fewer_runs(tmp_path, monkeypatch):
+    monkeypatch.setitem(CAMPAIGNS, "fragility", dataclasses.replace(
+        get("fragility"), worker=stabler_block_worker))
+    (tmp_path / "box.json").write_text(json.dumps(box_description(tmp_path)))
+    given = {"column_file": str(tmp_path / "box.json"),
+             "pulses": "pga_g=0.1:1.0:10;pgv_pga_s=0.2:0.6:2", "members": 2, "headings": 2,
+             "ranges": "kn=1e8:1e8;damping=0.1:0.1;mu_s=0.8:0.8;"
+                       "footprint_tolerance_m=0.001:0.004"}
+    summaries = {}
+    for mode in ("full", "adaptive"):       # as the command line runs them
+        out = tmp_path / mode
+        options = FragilityOptions(**given, adaptive=mode == "adaptive").kwargs()
+        drive(lambda opts, out=out: run_campaign("fragility", jobs=1, campaign_dir=out,
+                                                 options=opts), [], out, options)
+        summaries[mode] = json.loads((out / "fragility.json").read_text())
+    full, adaptive = (summaries[m]["pulse_grid"] for m in ("full", "adaptive"))
+    assert full["runs_finished"] == full["full_grid_runs"] == 10 * 2 * 2 * 2
+    assert adaptive["runs_finished"] < full["runs_finished"]
+    # the model is stabler than the guide: somewhere a probe disagreed and a cell the guide
+    # called certain was run in full (the driver's widening, not only its first stage)
+    guide = {(c["pgv_pga_s"], c["pga_g"]): c["P"] for c in full["models"]["block2d"]["cells"]}
+    rock = {(c["pgv_pga_s"], c["pga_g"]): c for c in adaptive["models"]["box"]["cells"]}
+    assert any(guide[k] in (0.0, 1.0) and c["n"] > 1 and c["P"] != guide[k]
+               for k, c in rock.items())
+    difference = pulse_grid.contour_difference(summaries["full"], summaries["adaptive"])
+    crossing = [r for r in difference["rows"] if r["pga_g_reference"] is not None]
+    assert len(crossing) == 2                      # the threshold lies inside the grid
+    print(difference, adaptive["runs_finished"])
+    assert difference["within_band"]
+    assert difference["max_abs_diff_g"] == pytest.approx(0.0, abs=1e-9)
+
+
+def fragility(rows):
+    """A fragility.json dict of one specimen model with the given P = 0.5 contour rows
+    (pgv_pga_s, pga_g, band lo, band hi)."""
+    contour = [{"pgv_pga_s": r, "pga_g": a, "pga_g_band": [lo, hi]} for r, a, lo, hi in rows]
+    return {"pulse_grid": {"models": {"block2d": {"contours": {"0.5": []}},
+                                      "rock": {"contours": {"0.5": contour}}}}}
+
+
+def test_contour_difference_on_constructed_contours():
+    full = fragility([(0.1, 0.40, 0.35, 0.45), (0.3, 0.25, 0.20, None), (0.5, None, 0.5, None)])
+    same = pulse_grid.contour_difference(full, full)
+    assert same["max_abs_diff_g"] == 0.0 and same["within_band"] and same["one_sided"] == 0
+    other = fragility([(0.1, 0.43, 0, 1), (0.3, 0.19, 0, 1), (0.5, None, 0, 1)])
+    d = pulse_grid.contour_difference(full, other)
+    assert [r["diff_g"] for r in d["rows"][:2]] == [pytest.approx(0.03), pytest.approx(-0.06)]
+    assert d["rows"][2]["diff_g"] is None
+    assert d["max_abs_diff_g"] == pytest.approx(0.06)
+    assert not d["within_band"]                    # 0.19 g lies below the band 0.20 g - open
+    inside = fragility([(0.1, 0.43, 0, 1), (0.3, 0.9, 0, 1), (0.5, None, 0, 1)])
+    assert pulse_grid.contour_difference(full, inside)["within_band"]   # an open upper side
+    one_sided = fragility([(0.1, 0.43, 0, 1), (0.3, 0.25, 0, 1), (0.5, 0.7, 0, 1)])
+    d = pulse_grid.contour_difference(full, one_sided)
+    assert d["one_sided"] == 1 and not d["within_band"]
+    with pytest.raises(ValueError, match="same pulse grid"):
+        pulse_grid.contour_difference(full, fragility([(0.1, 0.4, 0, 1)]))
