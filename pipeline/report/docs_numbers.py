@@ -53,6 +53,8 @@ def _json_value(path, key, fmt, times, command):
                        key.split("."), data)
     except (KeyError, IndexError, ValueError, TypeError):
         return _not_yet(command)
+    if found is None:               # a file's null: nothing to quote (e.g. no crossing)
+        return "none"
     return fmt.format(found * times if isinstance(found, (int, float))
                       and not isinstance(found, bool) else found)
 

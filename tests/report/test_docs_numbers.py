@@ -214,3 +214,10 @@ def test_every_macro_the_docs_call_exists():
     env = Env()
     docs_macros.define_env(env)
     assert set(env.macros) == set(MACROS)
+
+
+def test_a_null_in_a_quoted_file_is_said_as_none(tmp_path):
+    bench = tmp_path / "bench.json"
+    bench.write_text(json.dumps({"section": {"diff_g": None, "runs": 3}}))
+    assert docs_numbers.bench_value("section.diff_g", "{:.2f}", path=bench) == "none"
+    assert docs_numbers.bench_value("section.runs", "{:d}", path=bench) == "3"
