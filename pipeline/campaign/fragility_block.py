@@ -11,14 +11,12 @@ import time
 import numpy as np
 import pandas as pd
 
-from pipeline.campaign.pulse_grid import block_size
+from pipeline.campaign.pulse_grid import BLOCK_MAX_STEP_S, BLOCK_T_AFTER_S, block_size
 from pipeline.motion import Motion
 from pipeline.motion.measures import record_parameters
 from pipeline.rocking import rocking_response_sampled
 
 DEFAULT_AZIMUTHS = 12
-BLOCK_T_AFTER_S = 30.0          # free rocking after the motion, at most (2D model)
-BLOCK_MAX_STEP_S = 1e-3         # 2D model integration step, at most
 BLOCK_CHUNK_SAMPLES = 10_000_000   # acceleration samples x cases integrated at once (memory)
 
 

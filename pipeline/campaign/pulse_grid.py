@@ -235,6 +235,10 @@ def block_of(params, azimuth_deg):
         return 2 * com_z, 2 * com_z * math.tan(angle)
     return block_size(params)
 
+BLOCK_T_AFTER_S = 30.0          # the 2D block's free rocking after the motion, at most
+BLOCK_MAX_STEP_S = 1e-3         # the 2D block's integration step, at most
+
+
 def block_size(params):
     """(height, width) in m of the 2D block of a run (``params``:
     :class:`~pipeline.scenario.parameters.RunParams`): the paper column's height and
@@ -259,7 +263,7 @@ def _specimen(described):
     return _SPECIMENS[key]
 
 
-def block_outcomes(specs, t_after=30.0, max_step=1e-3):
+def block_outcomes(specs, t_after=BLOCK_T_AFTER_S, max_step=BLOCK_MAX_STEP_S):
     """Overturned (bool array, one per spec) of the 2D block of each run under its pulse:
     the pulse along the run's azimuth is the same scalar series for every direction."""
     out = np.zeros(len(specs), bool)
