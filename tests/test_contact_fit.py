@@ -114,6 +114,7 @@ def test_decay_file_without_tilt_column_refused(tmp_path, capsys):
     ('{"kn": 1.2e7, "damping": 0.1, "stiffnes": 1}', "unknown key"),
     ('[1, 2]', "JSON object"),
     ('{"kn": 1.2e7,', "not readable JSON"),
+    ('{"kn": true, "damping": 0.1}', "'kn' must be a finite number"),
 ])
 def test_run_refuses_a_bad_contact_file(tmp_path, capsys, text, message):
     contact = tmp_path / "contact.json"

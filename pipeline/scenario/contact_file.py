@@ -6,7 +6,7 @@ import json
 from pathlib import Path
 
 from pipeline.files import InputError
-from pipeline.userfiles import keys_text
+from pipeline.userfiles import Unreadable, keys_text, number, read_text
 
 CONTACT_KEYS = ("kn", "damping", "mu_s", "mu_k")
 INFORMATION_KEYS = ("restitution", "restitution_sd", "restitution_se", "impacts",
@@ -22,8 +22,8 @@ def load_contact_file(path):
     if not path.is_file():
         raise InputError(f"--contact-file {path}: file not found")
     try:
-        data = json.loads(path.read_text())
-    except (OSError, UnicodeDecodeError, ValueError) as exc:
+        data = json.loads(read_text(path))
+    except (OSError, Unreadable, ValueError) as exc:
         raise InputError(f"--contact-file {path.name}: not readable JSON ({exc})") from None
     if not isinstance(data, dict):
         raise InputError(f"--contact-file {path.name}: a JSON object needed")
@@ -31,7 +31,8 @@ def load_contact_file(path):
     if unknown:
         raise InputError(f"--contact-file {path.name}: unknown key(s) {keys_text(unknown)} "
                          f"(known: {', '.join(CONTACT_KEYS + INFORMATION_KEYS)})")
-    values = {k: data[k] for k in CONTACT_KEYS if data.get(k) is not None}
+    values = {k: number(data[k], f"--contact-file {path.name}: '{k}'")
+              for k in CONTACT_KEYS if data.get(k) is not None}
     if "damping" not in values or "kn" not in values:
         raise InputError(f"--contact-file {path.name}: no kn and damping (a restitution "
                          "alone: give `contact` --damping-map to map it onto the contact law)")
