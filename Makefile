@@ -71,7 +71,8 @@ bench: setup
 	$(PY) bench/bench_yade.py
 
 # the scanned granite rock SP1 against 490 shake-table tests (calibrate June-July 2021,
-# validate August; 8 parameter sets): about 45 min on 2 cores
+# validate August; 16 parameter sets over footprint, damping, friction and the axis's
+# sign): about 1 h on 2 cores
 shake-table: setup
 	$(PY) -m pipeline campaign shake-table $(if $(SHAKE_GRID),--grid "$(SHAKE_GRID)") --jobs $(JOBS) \
 	  --allow-long

@@ -55,7 +55,8 @@ GRID_SPECIMEN = {"footprint_tolerance_m": (0.0, 0.05)}
 # and the motion: rotate_deg turns the table motion clockwise (180: the other sign of an
 # axis whose sign the laboratory does not state)
 GRID_MOTION = {"rotate_deg": (0.0, 360.0)}
-DEFAULT_GRID = "footprint_tolerance_m=0.001,0.003;damping=0.05,0.1;rotate_deg=0,180"
+DEFAULT_GRID = ("footprint_tolerance_m=0.001,0.003;damping=0.05,0.1;mu_s=0.3,0.7;"
+                "rotate_deg=0,180")
 DEFAULT_CONTACT = dataclasses.asdict(Contact())      # the paper's contact
 PGA_EDGES_G = np.array([0.0, 0.1, 0.2, 0.3, 0.4, 0.5, 0.7, 1.0, 2.0])
 PGV_PGA_EDGES_S = np.array([0.0, 0.05, 0.1, 0.2, 0.3, 0.5, 1.0])
@@ -131,14 +132,24 @@ def parse_grid(text):
     names = list(axes)
     points = [dict(zip(names, combo)) for combo in itertools.product(*axes.values())] or [{}]
     for point in points:
-        mu_s = point.get("mu_s", DEFAULT_CONTACT["mu_s"])
-        mu_k = point.get("mu_k", DEFAULT_CONTACT["mu_k"])
-        if mu_k > mu_s:
+        contact = grid_contact(point)
+        if contact["mu_k"] > contact["mu_s"]:
             said = {k: "" if k in point else " (default)" for k in ("mu_s", "mu_k")}
-            raise InputError(f"--grid: mu_k {mu_k:g}{said['mu_k']} above mu_s "
-                             f"{mu_s:g}{said['mu_s']}: kinetic friction must not exceed "
-                             "static (mu_k <= mu_s)")
+            raise InputError(f"--grid: mu_k {contact['mu_k']:g}{said['mu_k']} above mu_s "
+                             f"{contact['mu_s']:g}{said['mu_s']}: kinetic friction must not "
+                             "exceed static (mu_k <= mu_s)")
     return points
+
+
+def grid_contact(point):
+    """The contact fields of a grid point: its values over the paper's; a point that
+    gives mu_s without mu_k gets Contact's kinetic friction for that mu_s."""
+    given = {k: v for k, v in point.items() if k in GRID_CONTACT}
+    out = {**DEFAULT_CONTACT, **given}
+    if "mu_s" in given and "mu_k" not in given:
+        out["mu_k"] = Contact(mu_s=given["mu_s"]).mu_k
+    return out
+
 
 def _label(point):
     return ", ".join(f"{k}={v:g}" for k, v in point.items()) or "defaults"
@@ -150,7 +161,7 @@ def _run_params(specimen, point):
         if key in point:
             description[key] = point[key]
     ColumnGeometry.from_dict(description)          # refuse a bad point before any run
-    contact = {**DEFAULT_CONTACT, **{k: v for k, v in point.items() if k in GRID_CONTACT}}
+    contact = grid_contact(point)
     motion = {k: v for k, v in point.items() if k in GRID_MOTION and v}
     return {"column": "monolithic", "column_file": description, **contact, **motion}
 

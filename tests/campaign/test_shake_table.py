@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from pipeline.campaign.shake_table import (EXPERIMENTS, SPECIMEN, load_experiments,
-                                           parse_grid)
+                                           grid_contact, parse_grid)
 from pipeline.files import InputError
 from pipeline.records import build_motion, resolve
 from pipeline.scenario import ColumnGeometry
@@ -48,6 +48,15 @@ def test_grid_is_the_cartesian_product_and_checks_its_ranges():
                        ("damping=a", "numbers"), ("damping=0.1;damping=0.2", "twice")):
         with pytest.raises(InputError, match=words):
             parse_grid(bad)
+
+
+def test_grid_friction_alone_takes_the_kinetic_friction_a_run_takes():
+    """A point giving mu_s alone runs with the mu_k that Contact gives that mu_s (the
+    paper's ratio 0.6 / 0.7 rounded), not the paper's 0.6, which exceeds a low mu_s."""
+    low, paper_value = parse_grid("mu_s=0.3,0.7")
+    assert grid_contact(low)["mu_k"] == pytest.approx(0.84 * 0.3, abs=1e-4)
+    assert grid_contact(paper_value)["mu_k"] == pytest.approx(0.6)
+    assert grid_contact({"mu_s": 0.5, "mu_k": 0.5})["mu_k"] == 0.5
 
 
 def test_experiment_table_errors_are_one_line(tmp_path):

@@ -93,7 +93,7 @@ def experiments(tmp_path, rows, motions=True):
     (["--tests", "A,A"], "--tests names A twice"),
     (["--grid", "damping=0.1,0.1"], "damping: value 0.1 given twice"),
     (["--grid", "mu_s=0.3;mu_k=0.9"], "mu_k 0.9 above mu_s 0.3"),
-    (["--grid", "mu_s=0.3"], "mu_k 0.6 (default) above mu_s 0.3"),
+    (["--grid", "mu_k=0.8"], "mu_k 0.8 above mu_s 0.7 (default)"),
     (["--validate-from", "2000-01-01"], "nothing to calibrate on"),
     (["--tests", "B"], "nothing to calibrate on"),
 ])
