@@ -98,6 +98,7 @@ contact-convergence: setup
 	    --max-members $(CONTACT_MEMBERS) --vary kn_factor=$$f,$$f --animations 0 \
 	    --out results/contact-convergence/twin-x$$f --jobs $(JOBS) || exit 1; done
 	$(PY) -m pipeline.campaign.contact_convergence results/contact-convergence --free-rocking
+	$(PY) -m pipeline report
 
 # the scanned rock SP1's fragility: over the Virtual Shake Robot's pulse grid (PGA 0.2-1.1 g x
 # PGV/PGA 0.1-1.0 s, 10 x 10) from directions sampled over 360 deg, 4 parameter sets x 4

@@ -2,6 +2,7 @@
 columns, the shake-table check, speed."""
 import json
 import math
+import re
 from pathlib import Path
 
 import pandas as pd
@@ -133,7 +134,8 @@ def contact_stiffness_section(results):
                  "predicted overturned (observed)": f"{r['predicted_overturned']} "
                  f"({r['observed_overturned']})", "as at x1": r["same_as_x1"],
                  **cost(r)} for k, r in conv["factors"].items()]
-        lines += [f"The rock SP1 on fixed shake-table tests (`{conv['grid_point']}`):\n",
+        fixed = re.sub(r"kn=[^;]*;?", "", conv["grid_point"]).strip(";")
+        lines += [f"The rock SP1 on {len(conv['tests'])} fixed shake-table tests (`{fixed}`):\n",
                   _table(pd.DataFrame(rows)) + "\n"]
     for body, table in conv.get("free_rocking", {}).items():
         rows = [{"kn": f"{k} ({r['kn']:g} N/m)",
@@ -144,7 +146,8 @@ def contact_stiffness_section(results):
                  "impact times vs x1 (ms)": _fmt(1e3 * r["max_abs_impact_time_minus_x1_s"], 1),
                  **cost(r, "wall_s")} for k, r in table["factors"].items()]
         size = f"{table['height_m']:g} m x {table['width_m']:.3g} m"
-        lines += [f"Housner free rocking of the {body} ({table['shape']}, {size}, released at "
+        lines += [f"Housner free rocking of {table.get('body', body)} ({table['shape']}, "
+                  f"{size}, released at "
                   f"{table['theta0_ratio']:g} alpha, damping ratio "
                   f"{table['contact']['damping']:g}); Housner's restitution "
                   f"{table['housner_restitution']:.4f}:\n", _table(pd.DataFrame(rows)) + "\n"]

@@ -25,10 +25,11 @@ from pipeline.verification.checks import (HOUSNER_DAMPING, MARBLE_BLOCK, MARBLE_
 FACTORS = (1, 3, 10)
 THETA0_RATIO = 0.5
 IMPACTS = 5
-BODIES = {   # name: shape, sizes (m; width: the diameter of a cylinder), contact
-    "block": {"shape": "block", **MARBLE_BLOCK,
+BODIES = {   # name: what it is, shape, sizes (m; width: a cylinder's diameter), contact
+    "block": {"label": "the paper's marble block", "shape": "block", **MARBLE_BLOCK,
               "contact": {**MARBLE_CONTACT, "damping": HOUSNER_DAMPING}},
-    "column": {"shape": "cylinder", "height": paper.COLUMN_HEIGHT_M,
+    "column": {"label": "the paper's monolithic column", "shape": "cylinder",
+               "height": paper.COLUMN_HEIGHT_M,
                "width": paper.COLUMN_HEIGHT_M / paper.COLUMN_HD,
                "contact": {"kn": paper.COLUMN_KN_N_M, "damping": HOUSNER_DAMPING,
                            "mu_s": paper.MU_STATIC, "mu_k": paper.MU_KINETIC}},
@@ -114,7 +115,8 @@ def summarise(name, runs, theta0_ratio=THETA0_RATIO, impacts=IMPACTS):
                 times[:k] - np.asarray(base["impact_times_s"][:k])))) if k else None,
             "time_step_vs_x1": run["time_step_s"] / base["time_step_s"],
             "wall_vs_x1": run["wall_s"] / base["wall_s"] if base["wall_s"] > 0 else None}
-    return {"shape": body["shape"], "height_m": body["height"], "width_m": body["width"],
+    return {"body": body["label"], "shape": body["shape"], "height_m": body["height"],
+            "width_m": body["width"],
             **({"depth_m": body["depth"]} if "depth" in body else {}),
             "contact": body["contact"], "theta0_ratio": theta0_ratio,
             "alpha_rad": constants["alpha"], "housner_restitution": constants["restitution"],

@@ -2,6 +2,7 @@
 synthetic inputs, the restitution measured from a free-rocking trajectory against
 Housner's, and one short YADE check that a stiffer contact keeps the block's restitution."""
 import math
+import re
 
 import numpy as np
 import pandas as pd
@@ -110,3 +111,18 @@ def test_a_stiffer_contact_keeps_the_blocks_restitution(tmp_path):
     assert np.allclose(x1["restitution_per_impact"], x3["restitution_per_impact"], atol=2e-3)
     assert np.allclose(x3["restitution_per_impact"], housner, atol=2e-3)
     assert x3["time_step_s"] / x1["time_step_s"] == pytest.approx(3 ** -0.5, rel=1e-6)
+
+
+def test_report_section_from_the_file(tmp_path):
+    from pipeline.report import contact_stiffness_section
+    assert "Not run yet" in contact_stiffness_section(tmp_path)
+    nan = math.nan
+    twin = cc.twin_summary(pd.concat([
+        members(1.0, [True, False], [90.0, nan], 1e-4, 10.0),
+        members(3.0, [True, True], [100.0, 200.0], 6e-5, 15.0)]), "R")
+    (tmp_path / "contact-convergence").mkdir()
+    (tmp_path / "contact-convergence" / "convergence.json").write_text(
+        __import__("json").dumps({"twin": twin}))
+    text = contact_stiffness_section(tmp_path)
+    # x3: both members fell, one of them stood at x1
+    assert re.search(r"\| x3 +\| monolithic +\| +2 \| 1\.00 \[[^|]*\| 150, [^|]*\| 1/2 ", text)
