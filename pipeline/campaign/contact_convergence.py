@@ -31,7 +31,7 @@ import pandas as pd
 
 from pipeline.campaign.run_dirs import finished_summary
 from pipeline.campaign.shake_table import EXPERIMENTS, load_experiments
-from pipeline.files import InputError, write_json
+from pipeline.files import InputError, ToolError, write_json
 from pipeline.outcome.summary import RunSummary
 from pipeline.stats.circular import circular_summary
 from pipeline.stats.classification import scores
@@ -271,7 +271,7 @@ def main(argv=None):
         return 2
     try:
         summary = summarise_all(rest[0], free_rocking=free_rocking)
-    except InputError as exc:
+    except ToolError as exc:              # bad input, or a YADE run that failed
         print(f"error: {exc}", file=sys.stderr)
         return 1
     write_json(Path(rest[0]) / "convergence.json", summary)
