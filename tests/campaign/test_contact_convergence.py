@@ -126,3 +126,31 @@ def test_report_section_from_the_file(tmp_path):
     text = contact_stiffness_section(tmp_path)
     # x3: both members fell, one of them stood at x1
     assert re.search(r"\| x3 +\| monolithic +\| +2 \| 1\.00 \[[^|]*\| 150, [^|]*\| 1/2 ", text)
+
+
+def fake_ensemble(directory, record, toppled, time_step, wall):
+    """An ensemble campaign's members.csv and its runs' summary.json (no YADE)."""
+    from pipeline.outcome.summary import RunSummary
+    rows = []
+    for member, fell in enumerate(toppled):
+        run_dir = f"runs/m{member}"
+        RunSummary(record=record, time_step_s=time_step, wall_s=wall).save(
+            directory / run_dir / "summary.json")
+        rows.append({"run_id": f"m{member}", "member": member, "record_id": record,
+                     "column": "drums", "toppled": fell,
+                     "downfall_azimuth_deg": 45.0 if fell else math.nan, "run_dir": run_dir})
+    pd.DataFrame(rows).to_csv(directory / "members.csv", index=False)
+
+
+def test_twin_ensembles_read_from_their_campaign_directories(tmp_path):
+    fake_ensemble(tmp_path / "twin-x1", "R", [True, False], 1e-4, 4.0)
+    fake_ensemble(tmp_path / "twin-x10", "R", [True, True], 1e-4 / 10 ** 0.5, 12.0)
+    said = []
+    out = cc.summarise_all(tmp_path, log=said.append)
+    assert set(out) == {"twin"} and len(said) == 2          # rock and free rocking: said
+    x10 = out["twin"]["factors"]["x10"]
+    assert out["twin"]["record"] == "R" and x10["columns"]["drums"]["same_outcome_as_x1"] == 1
+    assert x10["time_step_s"] == pytest.approx(1e-4 / 10 ** 0.5) and x10["wall_vs_x1"] == 3.0
+    fake_ensemble(tmp_path / "twin-x3", "Q", [True, True], 1e-4, 4.0)
+    with pytest.raises(InputError, match="different records"):
+        cc.summarise_all(tmp_path, log=said.append)
