@@ -237,6 +237,10 @@ def table_lines(summary):
                          f"{100 * row['max_rel_error_impact_times_housner']:.1f} % of Housner's, "
                          f"{row['max_abs_impact_time_minus_x1_s'] * 1e3:.1f} ms of x1's"
                          + _cost_text({**row, "wall_s_per_run": row["wall_s"]}))
+        for entry in table.get("at_damping", []):
+            lines.append(f"free rocking {body} at damping {entry['damping']:g}: restitution "
+                         + ", ".join(f"{factor} {row['restitution']:.4f}"
+                                     for factor, row in entry["factors"].items()))
     twin = summary.get("twin")
     for factor, row in (twin or {}).get("factors", {}).items():
         parts = []

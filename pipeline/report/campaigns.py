@@ -136,7 +136,7 @@ def contact_stiffness_section(results):
                  **cost(r)} for k, r in conv["factors"].items()]
         fixed = re.sub(r"kn=[^;]*;?", "", conv["grid_point"]).strip(";")
         lines += [f"The rock SP1 on {len(conv['tests'])} fixed shake-table tests (`{fixed}`):\n",
-                  _table(pd.DataFrame(rows)) + "\n"]
+                  _text_table(rows) + "\n"]
     for body, table in conv.get("free_rocking", {}).items():
         rows = [{"kn": f"{k} ({r['kn']:g} N/m)",
                  "restitution per impact": " ".join(f"{e:.4f}" for e in
@@ -150,7 +150,17 @@ def contact_stiffness_section(results):
                   f"{size}, released at "
                   f"{table['theta0_ratio']:g} alpha, damping ratio "
                   f"{table['contact']['damping']:g}); Housner's restitution "
-                  f"{table['housner_restitution']:.4f}:\n", _table(pd.DataFrame(rows)) + "\n"]
+                  f"{table['housner_restitution']:.4f}:\n", _text_table(rows) + "\n"]
+        other = [{"damping ratio": f"{entry['damping']:g}",
+                  **{f"restitution {k}": f"{r['restitution']:.4f}"
+                     for k, r in entry["factors"].items()},
+                  "largest diff. of an impact's from x1": _fmt(max(
+                      r["max_abs_restitution_minus_x1"] or 0.0
+                      for r in entry["factors"].values()), 4)}
+                 for entry in table.get("at_damping", [])]
+        if other:
+            lines += ["The same body at other damping ratios (restitution, mean over the "
+                      "impacts):\n", _text_table(other) + "\n"]
     twin = conv.get("twin")
     if twin:
         rows = []
@@ -168,8 +178,13 @@ def contact_stiffness_section(results):
                              "median turn vs x1 (deg)": _fmt(c["median_turn_vs_x1_deg"]),
                              **cost(r)})
         lines += [f"The twin model's ensembles on {twin['record']} (the same sampled members "
-                  "at every factor):\n", _table(pd.DataFrame(rows)) + "\n"]
+                  "at every factor):\n", _text_table(rows) + "\n"]
     return "\n".join(lines)
+
+
+def _text_table(rows):
+    """A Markdown table of rows whose cells are written as given (0.9450 keeps its 0)."""
+    return pd.DataFrame(rows).to_markdown(index=False, disable_numparse=True)
 
 
 def fragility_section(results):

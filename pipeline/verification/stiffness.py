@@ -10,7 +10,10 @@ perfectly inelastic impact: :func:`pipeline.rocking.block_constants`,
 :func:`pipeline.rocking.cylinder_constants`; the impact times from his equation
 integrated with that restitution) and against x1; the time step (s) the scene used and the
 wall time (s) of the YADE run.  The damping ratio is ``HOUSNER_DAMPING`` (critical): the
-setting whose impact is Housner's (docs/campaigns.md, Verification).
+setting whose impact is Housner's (docs/campaigns.md, Verification).  The same runs at the
+other ``DAMPINGS`` (the paper's 0.36, the middle of the twin ensembles' range, and the
+rock's calibrated 0.05: impacts that keep more) give the restitution against the
+stiffness where the model is used (``at_damping``).
 """
 import math
 from pathlib import Path
@@ -25,6 +28,7 @@ from pipeline.verification.checks import (HOUSNER_DAMPING, MARBLE_BLOCK, MARBLE_
 FACTORS = (1, 3, 10)
 THETA0_RATIO = 0.5
 IMPACTS = 5
+DAMPINGS = (HOUSNER_DAMPING, paper.DAMPING_RATIO, 0.05)
 BODIES = {   # name: what it is, shape, sizes (m; width: a cylinder's diameter), contact
     "block": {"label": "the paper's marble block", "shape": "block", **MARBLE_BLOCK,
               "contact": {**MARBLE_CONTACT, "damping": HOUSNER_DAMPING}},
@@ -67,12 +71,14 @@ def measure(t, theta, alpha, impacts=IMPACTS):
             "restitution_per_impact": eta.tolist(), "restitution": float(np.mean(eta))}
 
 
-def run_body(name, factor, run_dir, theta0_ratio=THETA0_RATIO, impacts=IMPACTS):
-    """One YADE free-rocking run of BODIES[name] at kn x ``factor``: its measure, time step
-    (s), wall time (s) and simulated time (s)."""
+def run_body(name, factor, run_dir, theta0_ratio=THETA0_RATIO, impacts=IMPACTS, damping=None):
+    """One YADE free-rocking run of BODIES[name] at kn x ``factor`` (and ``damping``, else
+    the body's): its measure, time step (s), wall time (s) and simulated time (s)."""
     body = BODIES[name]
     constants, free = reference(body, theta0_ratio, impacts)
     contact = {**body["contact"], "kn": body["contact"]["kn"] * factor}
+    if damping is not None:
+        contact["damping"] = damping
     # a body whose impacts keep more than Housner's swings longer: 25 % more time
     duration = 1.25 * float(free["peak_times"][impacts]) + 0.05
     theta0 = theta0_ratio * constants["alpha"]
@@ -123,9 +129,12 @@ def summarise(name, runs, theta0_ratio=THETA0_RATIO, impacts=IMPACTS):
             "housner_impact_times_s": housner_times.tolist(), "factors": factors}
 
 
-def free_rocking_table(out_dir, factors=FACTORS, bodies=tuple(BODIES), log=print):
-    """Run every body of ``bodies`` at every factor (run directories under ``out_dir``)
-    and return {body: :func:`summarise`}."""
+def free_rocking_table(out_dir, factors=FACTORS, bodies=tuple(BODIES), dampings=DAMPINGS,
+                       log=print):
+    """Run every body of ``bodies`` at every factor and damping ratio (run directories
+    under ``out_dir``) and return {body: :func:`summarise` at the body's own (critical)
+    damping, with ``at_damping``: [{damping, factors: :func:`other_damping`}, ...] for the
+    other dampings}."""
     factors = check_factors(factors)
     unknown = set(bodies) - set(BODIES)
     if unknown:
@@ -133,11 +142,35 @@ def free_rocking_table(out_dir, factors=FACTORS, bodies=tuple(BODIES), log=print
                          f"{', '.join(BODIES)})")
     table = {}
     for name in bodies:
-        runs = {}
-        for factor in factors:
-            runs[factor] = run_body(name, factor, Path(out_dir) / f"{name}-x{factor:g}")
-            r = runs[factor]
-            log(f"free rocking, {name} kn x{factor:g}: restitution {r['restitution']:.4f}, "
-                f"time step {r['time_step_s']:.3g} s, wall {r['wall_s']:.1f} s")
-        table[name] = summarise(name, runs)
+        own = BODIES[name]["contact"]["damping"]
+        by_damping = {}
+        for damping in dict.fromkeys((own, *dampings)):
+            runs = by_damping[damping] = {}
+            for factor in factors:
+                runs[factor] = run_body(name, factor, Path(out_dir) /
+                                        f"{name}-damping{damping:g}-x{factor:g}",
+                                        damping=damping)
+                r = runs[factor]
+                log(f"free rocking, {name} damping {damping:g} kn x{factor:g}: restitution "
+                    f"{r['restitution']:.4f}, time step {r['time_step_s']:.3g} s, wall "
+                    f"{r['wall_s']:.1f} s")
+        table[name] = {**summarise(name, by_damping[own]),
+                       "at_damping": [{"damping": d, "factors": other_damping(runs)}
+                                      for d, runs in by_damping.items() if d != own]}
     return table
+
+
+def other_damping(runs):
+    """{x1: ..., x3: ...}: restitution (mean and per impact), time step (s), wall time (s)
+    and the largest difference of an impact's restitution from x1's (``runs``: {factor:
+    :func:`run_body` result})."""
+    base = np.asarray(runs[1]["restitution_per_impact"])
+    out = {}
+    for factor in sorted(runs):
+        eta = np.asarray(runs[factor]["restitution_per_impact"])
+        n = min(eta.size, base.size)
+        out[f"x{factor:g}"] = {key: runs[factor][key] for key in (
+            "kn", "restitution", "restitution_per_impact", "time_step_s", "wall_s")}
+        out[f"x{factor:g}"]["max_abs_restitution_minus_x1"] = float(
+            np.max(np.abs(eta[:n] - base[:n]))) if n else None
+    return out

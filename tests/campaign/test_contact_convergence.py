@@ -97,6 +97,9 @@ def test_free_rocking_summary_against_housner_and_x1():
     assert x10["time_step_vs_x1"] == pytest.approx(10 ** -0.5) and x10["wall_vs_x1"] == 2.5
     with pytest.raises(InputError, match="factors"):
         stiffness.check_factors((3, 10))
+    other = stiffness.other_damping(runs)
+    assert other["x10"]["max_abs_restitution_minus_x1"] == pytest.approx(0.001)
+    assert other["x1"]["restitution"] == eta and "impact_times_s" not in other["x1"]
 
 
 @pytest.mark.yade
@@ -125,7 +128,7 @@ def test_report_section_from_the_file(tmp_path):
         __import__("json").dumps({"twin": twin}))
     text = contact_stiffness_section(tmp_path)
     # x3: both members fell, one of them stood at x1
-    assert re.search(r"\| x3 +\| monolithic +\| +2 \| 1\.00 \[[^|]*\| 150, [^|]*\| 1/2 ", text)
+    assert re.search(r"\| x3 +\| monolithic +\| 2 +\| 1\.00 \[[^|]*\| 150, [^|]*\| 1/2 ", text)
 
 
 def fake_ensemble(directory, record, toppled, time_step, wall):
