@@ -1,5 +1,6 @@
-"""The rock's predictions against the contact stiffness: a shake-table campaign whose grid
-varies ``kn`` alone (``make contact-convergence``) summarised per stiffness factor.
+"""The model against the contact stiffness alone (``make contact-convergence``): the rock's
+predictions from a shake-table campaign whose grid varies ``kn`` alone, Housner free
+rocking of a block and a column, and the twin model's ensembles, per stiffness factor.
 
 ``python -m pipeline.campaign.contact_convergence DIR`` reads ``DIR/calibration.csv`` (the
 campaign's runs) and the experiment table, and writes ``DIR/convergence.json``: per
@@ -20,7 +21,6 @@ resultant length and spread, how many members keep their outcome of x1 and how f
 the falls of those that fell at both turn, the time step and the wall time.  A part that
 has not run is said and left out.
 """
-import json
 import math
 import re
 import sys
@@ -31,7 +31,7 @@ import pandas as pd
 
 from pipeline.campaign.run_dirs import finished_summary
 from pipeline.campaign.shake_table import EXPERIMENTS, load_experiments
-from pipeline.files import InputError, ToolError, write_json
+from pipeline.files import InputError, ToolError, read_run_json, write_json
 from pipeline.outcome.summary import RunSummary
 from pipeline.stats.circular import circular_summary
 from pipeline.stats.classification import scores
@@ -202,7 +202,7 @@ def summarise_all(campaign_dir, free_rocking=False, experiments=EXPERIMENTS, log
         out["free_rocking"] = free_rocking_table(kept.parent, log=log)
         write_json(kept, out["free_rocking"])
     elif kept.is_file():
-        out["free_rocking"] = json.loads(kept.read_text())
+        out["free_rocking"] = read_run_json(kept, "free-rocking table")[1]
     else:
         log(f"free rocking: not run (--free-rocking runs it into {kept.parent})")
     members, record = load_twin(campaign_dir)
