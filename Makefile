@@ -78,16 +78,27 @@ shake-table: setup
 	  --allow-long
 	$(PY) -m pipeline report
 
-# the rock SP1's predictions against the contact stiffness alone: kn x1, x3, x10 at the
+# the contact stiffness alone, kn x1, x3, x10, side by side in
+# results/contact-convergence/convergence.json: the rock SP1's predictions at the
 # calibrated footprint, damping and sign on 27 fixed June-July tests (13 of PGA < 0.15 g,
-# 14 from 0.15 g; every 8th and 12th by name), summarised in
-# results/contact-convergence/convergence.json: a few minutes on 2 cores
+# 14 from 0.15 g; every 8th and 12th by name); the twin model's ensembles of
+# CONTACT_MEMBERS members on CONTACT_RECORD (the same sampled members at every factor;
+# CONTACT_MEMBERS=32 for intervals half as wide); Housner free rocking of the paper's
+# marble block and monolithic column.  About 15 min on 2 cores (8 members)
 CONTACT_TESTS := Test011,Test019,Test034,Test051,Test259,Test318,Test330,Test339,Test350,Test371,Test383,Test397,Test408,Test027,Test060,Test087,Test101,Test117,Test135,Test167,Test183,Test201,Test227,Test241,Test284,Test304,Test361
 CONTACT_GRID := footprint_tolerance_m=0.001;damping=0.05;rotate_deg=180;kn=1.2e8,3.6e8,1.2e9
+CONTACT_RECORD ?= RC-CLC
+CONTACT_MEMBERS ?= 8
+CONTACT_FACTORS := 1 3 10
 contact-convergence: setup
 	$(PY) -m pipeline campaign shake-table --tests $(CONTACT_TESTS) --grid "$(CONTACT_GRID)" \
 	  --out results/contact-convergence --animations 0 --jobs $(JOBS)
-	$(PY) -m pipeline.campaign.contact_convergence results/contact-convergence
+	for f in $(CONTACT_FACTORS); do \
+	  $(PY) -m pipeline campaign ensemble --record $(CONTACT_RECORD) --members $(CONTACT_MEMBERS) \
+	    --max-members $(CONTACT_MEMBERS) --vary kn_factor=$$f,$$f --animations 0 \
+	    --out results/contact-convergence/twin-x$$f --jobs $(JOBS) || exit 1; done
+	$(PY) -m pipeline.campaign.contact_convergence results/contact-convergence --free-rocking
+	$(PY) -m pipeline report
 
 # the scanned rock SP1's fragility: over the Virtual Shake Robot's pulse grid (PGA 0.2-1.1 g x
 # PGV/PGA 0.1-1.0 s, 10 x 10) from directions sampled over 360 deg, 4 parameter sets x 4

@@ -72,6 +72,27 @@ def block_constants(height, width, g=MODEL_GRAVITY):
                 energy_ratio=eta ** 2, uplift_acc=g * math.tan(alpha))
 
 
+def cylinder_constants(height, diameter, g=MODEL_GRAVITY):
+    """Housner's constants of a homogeneous solid cylinder (h, d in m) rocking in a plane
+    about a point of its base rim: the block's equation with alpha = atan(d / h), R the
+    distance from that point to the centre of mass, I0 = m (d^2 / 16 + h^2 / 12) + m R^2
+    about it, p = sqrt(g R / (I0 / m)) (1/s) and the restitution of a perfectly inelastic
+    impact on the opposite rim point, eta = 1 - 2 R^2 sin^2(alpha) / (I0 / m) (angular
+    momentum conserved about it).  Same keys as :func:`block_constants`."""
+    if not (height > 0 and diameter > 0 and g > 0):
+        raise InputError(f"cylinder height {height}, diameter {diameter} and g {g} must be "
+                         "positive")
+    alpha = math.atan(diameter / height)
+    R = 0.5 * math.hypot(height, diameter)
+    i0 = diameter ** 2 / 16.0 + height ** 2 / 12.0 + R ** 2
+    eta = 1.0 - 2.0 * R ** 2 * math.sin(alpha) ** 2 / i0
+    return dict(alpha=alpha, R=R, p=math.sqrt(g * R / i0), I0_per_mass=i0, restitution=eta,
+                energy_ratio=eta ** 2, uplift_acc=g * math.tan(alpha))
+
+
+SHAPES = {"block": block_constants, "cylinder": cylinder_constants}
+
+
 def housner_closed_form(theta0_ratio, r, n):
     """Paper eq 6 (Housner 1963, linearised block): amplitudes theta_k / alpha.
 
@@ -97,8 +118,10 @@ def housner_half_periods(height, width, theta0_ratio, n, r=None, g=MODEL_GRAVITY
 
 
 def housner_free_rocking(height, width, theta0, n_impacts=10, restitution=None, g=MODEL_GRAVITY,
-                         linearised=False, dt_out=0.001):
-    """Free rocking released from rest at theta0 (rad, != 0), Housner's equation.
+                         linearised=False, dt_out=0.001, shape="block"):
+    """Free rocking released from rest at theta0 (rad, != 0), Housner's equation; of a
+    block, or with ``shape`` "cylinder" of a cylinder of diameter ``width``
+    (:func:`cylinder_constants`).
 
     ``linearised`` uses theta'' = p^2 (theta - alpha sgn theta) instead of the
     full nonlinear equation.  Integrates up to the peak after impact n_impacts.
@@ -108,7 +131,9 @@ def housner_free_rocking(height, width, theta0, n_impacts=10, restitution=None, 
     (rad, signed; index k = amplitude after k impacts, index 0 = theta0),
     peak_ratio (|peak| / alpha); alpha, p, restitution, overturned (bool).
     """
-    c = block_constants(height, width, g)
+    if shape not in SHAPES:
+        raise InputError(f"rocking shape must be one of {', '.join(SHAPES)}, got {shape!r}")
+    c = SHAPES[shape](height, width, g)
     if theta0 == 0:
         raise InputError("free rocking needs a non-zero initial tilt theta0")
     out = _integrate(c, None, _FREE_ROCKING_T_MAX, theta0, 0.0, _restitution(c, restitution), g,

@@ -228,3 +228,43 @@ def test_bad_input_raises():
         rk.housner_free_rocking(PAPER_H, PAPER_B, 0.1, restitution=1.5)
     with pytest.raises(InputError):
         rk.restitution_from_peaks([0.3, 0.2], alpha=0.25)
+
+
+def test_cylinder_constants_from_its_mass_properties_and_an_impact_balance():
+    """The cylinder's I0 from the solid's own closed forms (parallel axes), and its
+    restitution from angular momentum about the new pivot written out as vectors."""
+    from pipeline.scenario.solids import Frustum
+    h, d = 3.5, 3.5 / 6
+    c = rk.cylinder_constants(h, d)
+    m, zc, (ixx, _, _) = Frustum(h, d, d).mass_properties(1.0)
+    R = math.hypot(zc, d / 2)
+    assert c["R"] == pytest.approx(R) and c["alpha"] == pytest.approx(math.atan(d / h))
+    assert c["I0_per_mass"] == pytest.approx((ixx + m * R ** 2) / m)
+    assert c["p"] == pytest.approx(math.sqrt(G * R * m / (ixx + m * R ** 2)))
+    # at theta = 0 rocking about A = (+r, 0) with omega about North (y): the centre of mass
+    # G = (0, zc) moves with v = omega x (G - A); after the impact about B = (-r, 0),
+    # H_B = I_G omega + m (G - B) x v is kept
+    omega = 1.0
+    g_minus_a = np.array([-d / 2, 0.0, zc])
+    v = np.cross([0.0, omega, 0.0], g_minus_a)
+    h_b = ixx * omega + m * np.cross(np.array([d / 2, 0.0, zc]), v)[1]
+    assert c["restitution"] == pytest.approx(h_b / (ixx + m * R ** 2))
+    # the block's constants through the same balance (its I_G = m (b^2 + h^2) / 12)
+    b = rk.block_constants(h, d)
+    i_block = (d ** 2 + h ** 2) / 12
+    h_block = i_block + np.cross([d / 2, 0.0, h / 2], np.cross([0, 1.0, 0],
+                                                                [-d / 2, 0, h / 2]))[1]
+    assert b["restitution"] == pytest.approx(h_block / b["I0_per_mass"])
+
+
+def test_cylinder_free_rocking_keeps_its_energy_between_impacts():
+    h, d = 3.5, 3.5 / 6
+    c = rk.cylinder_constants(h, d)
+    out = rk.housner_free_rocking(h, d, 0.5 * c["alpha"], n_impacts=3, shape="cylinder")
+    before = out["t"] < out["impact_times"][0]
+    energy = energy_per_mass(c, out["theta"][before], out["omega"][before])
+    assert np.ptp(energy) < 1e-8 * G * c["R"]
+    assert out["impact_omega_after"][0] == pytest.approx(
+        c["restitution"] * out["impact_omega_before"][0])
+    with pytest.raises(InputError, match="shape"):
+        rk.housner_free_rocking(h, d, 0.1, shape="sphere")

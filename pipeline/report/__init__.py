@@ -12,7 +12,8 @@ from pathlib import Path
 
 from pipeline import RESULTS_DIR, __version__
 from pipeline.files import write_text
-from pipeline.report.campaigns import (columns_section, convergence_section, ensemble_section,
+from pipeline.report.campaigns import (columns_section, contact_stiffness_section,
+                                       convergence_section, ensemble_section,
                                        fragility_section, paper_question_section, run_all_section,
                                        rock_fragility_section, shake_table_section,
                                        speed_section, sweep_section,
@@ -25,7 +26,8 @@ from pipeline.report.records import (back_azimuth_table, correlation_table, per_
                                      with_back_azimuth)
 from pipeline.stats.ensemble import wilson_interval
 
-__all__ = ["build_report", "back_azimuth_table", "columns_section", "convergence_section",
+__all__ = ["build_report", "back_azimuth_table", "columns_section",
+           "contact_stiffness_section", "convergence_section",
            "correlation_table", "paper_question_section",
            "ensemble_section", "fragility_section", "inversion_section",
            "member_study_section", "per_record_table",
@@ -60,7 +62,8 @@ def build_report(results=RESULTS_DIR):
         sweep_section(results, "friction", "mu_s",
                       "friction had a minor influence on downfall directions; with mu_s = 0.1 "
                       "neither column toppled (they slid instead)."),
-        shake_table_section(results), rock_fragility_section(results),
+        shake_table_section(results), contact_stiffness_section(results),
+        rock_fragility_section(results),
         rock_fragility_section(results, "rock-fragility-table"), survival_section(results),
         paper_question_section(results), ensemble_section(results),
         convergence_section(results), fragility_section(results), columns_section(results),

@@ -16,8 +16,9 @@ from pipeline.files import InputError
 from pipeline.motion import Motion
 from pipeline.motion.pulses import phased_sine_pulse
 from pipeline.outcome.columns import body_axes, rotation_from_start_deg
-from pipeline.scenario import (Block, Column, Contact, Numerics, run_yade, scene_params,
-                               write_scenario)
+from pipeline.scenario import (Block, Column, ColumnGeometry, ColumnSpec, Contact, Numerics,
+                               run_yade, scene_params, write_scenario)
+from pipeline.scenario.solids import ColumnBlock, Frustum
 from pipeline.scenario.parameters import split_options, time_step_s
 
 MARBLE_BLOCK = paper.MARBLE_BLOCK_M
@@ -55,8 +56,30 @@ def run_block(run_dir, height, width, depth, theta0=0.0, motion=None, duration=5
     options: Contact and Numerics fields (kn, damping, mu_s, mu_k, rim_sphere_radius, ...).
     """
     block = Block(height=height, width=width, depth=depth, density=density, theta0_rad=theta0)
+    return run_released(run_dir, block=block, motion=motion, duration=duration,
+                        record_hz=record_hz, **options)
+
+
+def run_cylinder(run_dir, height, diameter, theta0, duration=5.0,
+                 density=paper.MARBLE_DENSITY_KG_M3, record_hz=1000.0, **options):
+    """Run a monolithic cylinder (the paper's column: ``height``, ``diameter`` m) released
+    from rest on the East (theta0 > 0, rad) or West point of its base rim; return (t,
+    theta, trajectory) as :func:`run_block`."""
+    geometry = ColumnGeometry("column", density, (ColumnBlock(
+        Frustum(height, diameter, diameter), tilt_deg=math.degrees(abs(theta0)),
+        tilt_azimuth_deg=90.0 if theta0 >= 0 else 270.0, tilt_mode="edge"),),
+        edge_rims=False, settles=False)
+    return run_released(run_dir, columns=[ColumnSpec("column", "monolithic", 0.0, 0.0,
+                                                     geometry)],
+                        duration=duration, record_hz=record_hz, **options)
+
+
+def run_released(run_dir, columns=(), block=None, motion=None, duration=5.0, record_hz=1000.0,
+                 **options):
+    """Run one body (a :class:`Block` or one column spec) and return (t, theta,
+    trajectory), theta (rad) the tilt of its long axis about North (+ = leaning East)."""
     contact, numerics = split_options(options)
-    params = scene_params(block=block, contact=Contact(**contact),
+    params = scene_params(columns=columns, block=block, contact=Contact(**contact),
                           numerics=Numerics(**{"record_hz": record_hz, "rest_duration_s": 0.3,
                                                **numerics}), t_max=duration)
     write_scenario(run_dir, params, motion)
