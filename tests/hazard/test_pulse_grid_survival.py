@@ -18,9 +18,11 @@ from pipeline.hazard.survival import overturning_rate
 G = STANDARD_GRAVITY
 
 
-def _grid_json(path, pga_g, ratios, p_of, n=16, sets=2, p_set_of=None, logistic=None):
+def _grid_json(path, pga_g, ratios, p_of, n=16, sets=2, p_set_of=None, logistic=None,
+               uplift_g=None):
     """A pulse-grid fragility.json as campaign fragility --pulses writes it, with cell
-    fractions p_of(pga_m_s2, ratio) (rounded to counts of n) and per-set P."""
+    fractions p_of(pga_m_s2, ratio) (rounded to counts of n), per-set P and (``uplift_g``)
+    the 2D block's uplift acceleration."""
     cells = []
     for a in pga_g:
         for r in ratios:
@@ -35,6 +37,9 @@ def _grid_json(path, pga_g, ratios, p_of, n=16, sets=2, p_set_of=None, logistic=
     data = {"mode": "pulses", "specimen": "test rock",
             "pulse_grid": {"pga_g": list(pga_g), "pgv_pga_s": list(ratios), "members": sets,
                            "models": {"monolithic": model}}}
+    if uplift_g is not None:
+        data["pulse_grid"]["block2d"] = {"alpha_rad": math.atan(uplift_g),
+                                         "uplift_g": uplift_g}
     path.write_text(json.dumps(data))
     return path
 
@@ -46,7 +51,7 @@ def test_grid_is_bilinear_in_log_space_and_the_surface_outside(tmp_path):
         return 0.5 + 0.2 * math.log(a / (0.2 * G)) + 0.1 * math.log(r / 0.1)
     path = _grid_json(tmp_path / "f.json", pga_g, ratios, p_of, n=100000,
                       logistic=(-2.0, 3.0, 0.5))
-    grid = load_campaign_fragility(path)
+    grid = load_campaign_fragility(path, below="logistic")
     a = np.array([0.13, 0.3, 0.55, 0.79]) * G
     r = np.array([0.06, 0.15, 0.11, 0.19])
     expected = [p_of(x, y) for x, y in zip(a, r)]
