@@ -105,7 +105,8 @@ def test_parameter_sets_and_monte_carlo_error_reported_apart(tmp_path):
         out = tmp_path / f"out{n}"
         assert main(["survival", "--hazard", str(curve), "--fragility", str(path),
                      "--pgv-pga-median", "0.1", "--pgv-pga-sigma", "0.3", "--age-ka", "2",
-                     "--draws", "120", "--out", str(out)]) == 0
+                     "--draws", "120", "--hazard-component", "rotd100",
+                     "--out", str(out)]) == 0
         runs[n] = json.loads((out / "survival.json").read_text())
     wide, narrow = (r["survival_interval"] for r in (runs[8], runs[800]))
     assert narrow[1] - narrow[0] < 0.3 * (wide[1] - wide[0])     # MC error ~ 1/sqrt(n)
@@ -116,6 +117,19 @@ def test_parameter_sets_and_monte_carlo_error_reported_apart(tmp_path):
     assert runs[800]["survival_per_parameter_set"] == pytest.approx(expected, rel=0.02)
     assert runs[800]["survival_parameter_set_range"] == pytest.approx(
         [min(expected), max(expected)], rel=0.02)
+    # on a RotD50 hazard curve: pulses along one line have RotD50 = PGA cos 45 deg, so each
+    # set's median on the curve's PGA is its median x cos 45 deg
+    out = tmp_path / "rotd50"
+    assert main(["survival", "--hazard", str(curve), "--fragility", str(tmp_path / "f800.json"),
+                 "--pgv-pga-median", "0.1", "--pgv-pga-sigma", "0.3", "--age-ka", "2",
+                 "--draws", "0", "--out", str(out)]) == 0
+    rotd50 = json.loads((out / "survival.json").read_text())
+    c45 = math.cos(math.radians(45.0))
+    expected = [math.exp(-2000.0 * 1e-4 * (c45 * f.median_m_s2) ** -2.5
+                         * math.exp(0.5 * (2.5 * 0.4) ** 2)) for f in sets]
+    assert rotd50["survival_per_parameter_set"] == pytest.approx(expected, rel=0.02)
+    assert rotd50["specimens"][0]["fragility"]["pga_measure"]["fraction"] == pytest.approx(c45)
+    assert rotd50["hazard_component"] == "rotd50"
 
 
 def test_bad_pulse_grid_files_one_line(tmp_path):
