@@ -409,12 +409,20 @@ class PulseGrid:
     def _interpolate(self, cells, pga_m_s2, pgv_pga_s):
         pga, ratio = np.broadcast_arrays(np.asarray(pga_m_s2, float),
                                          np.asarray(pgv_pga_s, float))
-        p = self._surface(cells, pga, ratio)
         low = pga < self.pga_m_s2[0]
         if self.below == "logistic" or not low.any():
-            return p
-        edge = self._surface(cells, np.full(pga.shape, self.pga_m_s2[0]), ratio)
-        return np.where(low, edge * self.below_weight(pga), p)
+            return self._surface(cells, pga, ratio)
+        p = np.zeros(pga.shape)
+        if not low.all():
+            p[~low] = self._surface(cells, pga[~low], ratio[~low])
+        weight = self.below_weight(pga[low])
+        ramp = weight > 0                # only where P is not 0 is the edge's P needed
+        if ramp.any():
+            below = np.zeros(weight.shape)
+            below[ramp] = weight[ramp] * self._surface(
+                cells, np.full(int(ramp.sum()), self.pga_m_s2[0]), ratio[low][ramp])
+            p[low] = below
+        return p
 
     def below_weight(self, pga_m_s2):
         """w(a) of the class docstring below the grid's first PGA (1 at a_1)."""

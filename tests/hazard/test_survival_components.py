@@ -283,3 +283,13 @@ def test_quantile_curves_of_one_calculation_order_the_survival(tmp_path):
     single = json.loads((alone / "survival.json").read_text())
     assert single["survival_probability"] == pytest.approx(s["quantile-0.84"], rel=1e-12)
     assert "hazard_curves" not in single
+
+
+def test_below_grid_without_a_grid_is_refused_in_one_line(tmp_path, capsys):
+    out = tmp_path / "out"
+    assert main(["survival", "--hazard", str(CASE_37["mean"]), "--site", "0", "--median-g",
+                 "0.2", "--beta", "0.4", "--age-ka", "1", "--below-grid", "zero",
+                 "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "--below-grid applies to a pulse-grid" in err and len(err.splitlines()) == 1
+    assert not out.exists()
