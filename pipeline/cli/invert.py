@@ -20,7 +20,8 @@ DESCRIPTION = (
     "toward an azimuth, or standing) from a forward table of twin-model ensembles shaken by "
     "pyprop8 synthetics (campaign inversion-forward, cached by content: a second inversion "
     "reuses every run). Writes posterior.csv, inversion_summary.json, posterior_map.png and "
-    "marginals.png. Observations schema: docs/inversion.md.")
+    "marginals.png (and with --site-fragility site_motion.json, the PGA range each site's "
+    "columns allow). Observations schema: docs/inversion.md.")
 
 
 def _floats(name):
