@@ -9,6 +9,7 @@ import math
 from pathlib import Path
 
 from pipeline.files import LONG_RUN_S, InputError, check_jobs
+from pipeline.userfiles import number
 
 NAME = "invert"
 ORDER = 45
@@ -19,7 +20,8 @@ DESCRIPTION = (
     "toward an azimuth, or standing) from a forward table of twin-model ensembles shaken by "
     "pyprop8 synthetics (campaign inversion-forward, cached by content: a second inversion "
     "reuses every run). Writes posterior.csv, inversion_summary.json, posterior_map.png and "
-    "marginals.png. Observations schema: docs/inversion.md.")
+    "marginals.png (and with --site-fragility site_motion.json, the PGA range each site's "
+    "columns allow). Observations schema: docs/inversion.md.")
 
 
 def _floats(name):
@@ -58,6 +60,22 @@ def setup(p):
                   GRIDS["full"], MECHANISMS)
     _candidates(p.add_argument_group("candidates and prior"), DEFAULT_KERNEL_DEG,
                 DEFAULT_FLOOR)
+    _site_motion(p.add_argument_group("the motion at each site from its standing and fallen "
+                                      "columns (with an OBSERVATIONS.json)"))
+
+
+def _site_motion(g):
+    g.add_argument("--site-fragility", type=Path, default=None, metavar="FILE",
+                   help="a column fragility.json of campaign fragility (or its directory), "
+                   "one entry per column type of the observations: writes site_motion.json "
+                   "beside the posterior, the PGA range (RotD50) each site's outcome allows "
+                   "(docs/survival.md)")
+    g.add_argument("--site-fragility-form", choices=("pga", "pga-pgv"), default="pga",
+                   help="its lognormal PGA fit (pga, default) or its logistic surface in PGA "
+                   "and PGV/PGA (pga-pgv, with --at-pgv-pga)")
+    g.add_argument("--at-pgv-pga", type=float, default=None, metavar="S",
+                   help="the PGV/PGA (s, 0.001-10) at which the PGA range is stated for "
+                   "--site-fragility-form pga-pgv")
 
 
 def _what_to_run(p, grids):
@@ -208,6 +226,7 @@ def run(args):
     from pipeline.inversion.likelihood import check_model_options
     check_model_options(args.kernel_deg, args.floor, getattr(args, "likelihood", "independent"))
     check_jobs(args.jobs)
+    site_fragility = _check_site_motion(args)
     preset, grid, candidates = build_grids(args)
     if args.demo:
         return workflows.demo(inversion_options(args), preset, grid, candidates)
@@ -217,7 +236,41 @@ def run(args):
         return workflows.hidden_truth(args.hidden_truth, inversion_options(args), grid,
                                       candidates)
     return workflows.invert_file(args.observations, inversion_options(args), grid,
-                                 candidates)
+                                 candidates, site_fragility)
+
+
+def _check_site_motion(args):
+    """The site-motion options checked before any work: (fragility_for(column type),
+    at_pgv_pga) or None."""
+    given = (args.site_fragility is not None, args.at_pgv_pga is not None,
+             args.site_fragility_form != "pga")
+    if not any(given):
+        return None
+    if args.site_fragility is None:
+        raise InputError("--site-fragility-form and --at-pgv-pga go with --site-fragility")
+    if args.observations is None:
+        raise InputError("--site-fragility goes with an OBSERVATIONS.json file")
+    if args.at_pgv_pga is not None:
+        number(args.at_pgv_pga, "--at-pgv-pga", 0.001, 10, "s")
+    if args.site_fragility_form == "pga-pgv" and args.at_pgv_pga is None:
+        raise InputError("--site-fragility-form pga-pgv needs --at-pgv-pga (the PGV/PGA at "
+                         "which the PGA range is stated)")
+    if args.site_fragility_form == "pga" and args.at_pgv_pga is not None:
+        raise InputError("--at-pgv-pga goes with --site-fragility-form pga-pgv")
+    from pipeline.hazard.fragility import load_campaign_fragility
+    from pipeline.inversion.observations import load_observations
+    from pipeline.records import rotd50_fraction
+    cache = {}
+
+    def fragility_for(column):
+        if column not in cache:
+            cache[column] = load_campaign_fragility(
+                args.site_fragility, column, args.site_fragility_form, component="rotd50",
+                record_fraction=rotd50_fraction)
+        return cache[column]
+    for column in load_observations(args.observations).column_types():
+        fragility_for(column)                  # a missing column type refused before work
+    return fragility_for, args.at_pgv_pga
 
 
 def inversion_options(args):

@@ -13,6 +13,8 @@ from pathlib import Path
 from pipeline import RESULTS_DIR
 from pipeline.constants import STANDARD_GRAVITY
 from pipeline.files import InputError, display_path, write_json
+from pipeline.hazard.components import COMPONENTS
+from pipeline.hazard.fragility import BELOW_GRID
 from pipeline.userfiles import number
 
 NAME = "survival"
@@ -30,10 +32,17 @@ COLUMNS = ("monolithic", "drums", "block2d", "block2d_worst")
 
 
 def setup(p):
-    p.add_argument("--hazard", type=Path, default=None, metavar="FILE",
+    p.add_argument("--hazard", type=Path, action="append", default=[], metavar="FILE",
                    help="hazard curve: OpenQuake hazard-curve CSV, USGS hazard web service "
                    "JSON (static curves) or a plain table pga_<g|m_s2|cm_s2>,"
-                   "annual_rate_per_yr")
+                   "annual_rate_per_yr; repeat for several curves of the site (e.g. an "
+                   "engine's mean and quantile curves): the first gives the headline, "
+                   "survival.json's hazard_curves the result under each")
+    p.add_argument("--hazard-component", choices=COMPONENTS, default="rotd50",
+                   help="the horizontal component of the hazard curve's PGA: rotd50 (NGA-West2 "
+                   "models, the USGS 2014 model; default) or rotd100 (the peak of the "
+                   "horizontal vector, campaign fragility's PGA); a campaign's fragility is "
+                   "put on it")
     p.add_argument("--site", type=int, default=None, metavar="N",
                    help="row (0-based) of an OpenQuake file with several sites")
     p.add_argument("--fragility", type=Path, action="append", default=[], metavar="FILE",
@@ -46,6 +55,11 @@ def setup(p):
                    "logistic surface in PGA and PGV/PGA; default for columns) or grid (a "
                    "pulse grid's cells, bilinear in ln PGA and ln PGV/PGA, the logistic "
                    "surface outside; default for a pulse grid)")
+    p.add_argument("--below-grid", choices=BELOW_GRID, default="ramp",
+                   help="a pulse grid's P below its first PGA: ramp (0 at the uplift "
+                   "acceleration g tan(alpha), rising linearly in ln PGA to the edge's P; "
+                   "default), zero, edge (the edge's P held down to the uplift acceleration) "
+                   "or logistic (the fitted surface)")
     p.add_argument("--median-g", type=float, action="append", default=[], metavar="G",
                    help="a stated lognormal fragility over PGA: median PGA (g), 0-10; repeat "
                    "with --beta for a set")
@@ -98,12 +112,12 @@ def setup(p):
 
 def check(args):
     """Every option range-checked before any work (InputError, one line)."""
-    if args.hazard is None and args.observations is None:
+    if not args.hazard and args.observations is None:
         raise InputError("give --hazard (survival under a hazard curve) or --observations "
                          "(the motion at a site from its columns), or both")
-    if args.hazard is not None and args.age_ka is None:
+    if args.hazard and args.age_ka is None:
         raise InputError("--hazard needs --age-ka (the specimen's age)")
-    if args.hazard is None and args.age_ka is not None:
+    if not args.hazard and args.age_ka is not None:
         raise InputError("--age-ka applies with --hazard")
     if args.observations is None and (args.observation_site is not None
                                       or args.at_pgv_pga is not None):
@@ -168,7 +182,7 @@ def run(args):
     site_motion = None
     if args.observations is not None:
         site_motion = _site_motion(args)
-    if args.hazard is None:
+    if not args.hazard:
         write_json(args.out / "site_motion.json", site_motion)
         _print_site_motion(site_motion)
         print(f"wrote {display_path(args.out / 'site_motion.json')}")
@@ -178,9 +192,16 @@ def run(args):
     from pipeline.hazard.fragility import (PGA_PGV_CORRELATION, Logistic, Lognormal,
                                            RatioFromGmm, RatioLognormal,
                                            load_campaign_fragility)
-    curve = load_hazard(args.hazard, args.site)
-    specimens = [load_campaign_fragility(path, args.column, args.fragility_form)
+    from pipeline.records import rotd50_fraction
+    curves = [load_hazard(path, args.site) for path in args.hazard]
+    specimens = [load_campaign_fragility(path, args.column, args.fragility_form,
+                                         args.below_grid, args.hazard_component,
+                                         args.magnitude, args.distance_km, rotd50_fraction)
                  for path in args.fragility]
+    if args.below_grid != "ramp" and not any(getattr(f, "grid_range", lambda: None)()
+                                             for f in specimens):
+        raise InputError("--below-grid applies to a pulse-grid fragility (--fragility of "
+                         "campaign fragility --pulses, --fragility-form grid)")
     specimens += [Lognormal(m * STANDARD_GRAVITY, b, label=f"stated lognormal: median "
                             f"{m:g} g, beta {b:g}") for m, b in zip(args.median_g, args.beta)]
     specimens += [Logistic(parse_logistic(text), label=f"stated logistic surface {text}")
@@ -196,8 +217,9 @@ def run(args):
         raise InputError("the fragility is over PGA and PGV/PGA: give --pgv-pga-median and "
                          "--pgv-pga-sigma, or --magnitude and --distance-km (or "
                          "--fragility-form pga)")
-    summary, data = assess(curve, specimens, ratio, args.age_ka, args.age_sd_ka,
-                           args.draws, args.seed)
+    summary, data = assess(curves[0], specimens, ratio, args.age_ka, args.age_sd_ka,
+                           args.draws, args.seed, curves[1:])
+    summary["hazard_component"] = args.hazard_component
     summary["figure"] = "survival.png"
     if site_motion is not None:
         summary["site_motion"] = site_motion
@@ -213,6 +235,9 @@ def run(args):
           + ("" if interval is None else f" [{interval[0]:.3g}, {interval[1]:.3g}]")
           + f"; hazard rates x {_g(summary['rate_scale_bound_5pct'])} or intensities x "
           f"{_g(bound)} leave 5 %")
+    for row in summary.get("hazard_curves", [])[1:]:
+        print(f"under {row['kind'] or row['file']}: rate {row['annual_overturning_rate_per_yr']:.3g}"
+              f" /yr, survival P = {row['survival_probability']:.3g}")
     if site_motion is not None:
         write_json(args.out / "site_motion.json", site_motion)
         _print_site_motion(site_motion)
@@ -225,6 +250,7 @@ def _site_motion(args):
     from pipeline.hazard.fragility import Logistic, Lognormal, load_campaign_fragility
     from pipeline.hazard.site_motion import site_motion
     from pipeline.inversion.observations import load_observations
+    from pipeline.records import rotd50_fraction
     observations = load_observations(args.observations)
     name = args.observation_site
     if name is None:
@@ -234,7 +260,9 @@ def _site_motion(args):
         name = observations.sites[0].name
     if args.fragility:
         def fragility_for(column):
-            return load_campaign_fragility(args.fragility[0], column, args.fragility_form)
+            return load_campaign_fragility(args.fragility[0], column, args.fragility_form,
+                                           args.below_grid, args.hazard_component,
+                                           args.magnitude, args.distance_km, rotd50_fraction)
     elif args.median_g:
         stated = Lognormal(args.median_g[0] * STANDARD_GRAVITY, args.beta[0],
                            label=f"stated lognormal: median {args.median_g[0]:g} g, "
@@ -246,7 +274,11 @@ def _site_motion(args):
                           label=f"stated logistic surface {args.logistic[0]} (every column)")
         def fragility_for(column):
             return stated
-    return site_motion(observations, name, fragility_for, args.at_pgv_pga)
+    result = site_motion(observations, name, fragility_for, args.at_pgv_pga)
+    result["pga_measure"] = (f"{args.hazard_component}: a campaign's fragility put on it "
+                             "(fragilities.*.pga_measure)" if args.fragility else
+                             "the stated fragility's own PGA")
+    return result
 
 
 def _print_site_motion(result):

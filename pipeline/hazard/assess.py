@@ -5,8 +5,8 @@ import numpy as np
 from pipeline.constants import STANDARD_GRAVITY
 from pipeline.hazard.fragility import overturn_probability
 from pipeline.hazard.survival import (contribution_by_intensity, intensity_scale_bound,
-                                      overturning_rate, rate_density, rate_scale_bound,
-                                      survival_probability)
+                                      overturning_rate, rate_density, rate_outside,
+                                      rate_scale_bound, survival_probability)
 from pipeline.provenance import software_versions
 
 FLOOR = 0.05                  # survival probability the bounds keep (5 %)
@@ -23,19 +23,25 @@ ASSUMPTIONS = [
     "PGV/PGA at each PGA level is lognormal (from the user, or from the ground-motion "
     "model at the stated magnitude and distance); the fragility is averaged over it.",
     "survival_interval: 95 % of the survival probabilities of fragility parameters drawn "
-    "from the uncertainty of their estimate (parametric bootstrap); the hazard curve and "
-    "the PGV/PGA model are taken as exact.",
+    "from the uncertainty of their estimate (parametric bootstrap); the PGV/PGA model is "
+    "taken as exact, and each hazard curve too: the hazard's own uncertainty is the spread "
+    "over the curves given (hazard_curves: e.g. an engine's mean and quantile curves).",
     "A pulse grid (campaign fragility --pulses) is read as its cells: P bilinear in (ln "
-    "PGA, ln PGV/PGA) inside the grid, the logistic surface fitted to the same runs outside "
-    "it; its survival_interval is the cells' Monte Carlo error and survival_per_parameter_set "
-    "the members' spread, reported apart.",
+    "PGA, ln PGV/PGA) inside the grid, the logistic surface fitted to the same runs above "
+    "and beside it, and below its first PGA the choice of --below-grid (fragility."
+    "below_grid; default: P rising linearly in ln PGA from 0 at the uplift acceleration g "
+    "tan(alpha) to the edge's P); its survival_interval is the cells' Monte Carlo error and "
+    "survival_per_parameter_set the members' spread, reported apart.",
     "A fragility fitted to a campaign's pooled members (campaign fragility) holds the "
     "members' spread in its dispersion, as if each earthquake met another member; the rock "
-    "or column has one set of the unknown contact parameters in every earthquake.",
-    "PGA is taken as the hazard curve defines it; no conversion between horizontal "
-    "components: campaign fragility's PGA is the peak of the horizontal acceleration "
-    "vector, larger than the RotD50 or geometric-mean PGA of most hazard models, so a "
-    "campaign fragility read against such a curve overstates the survival.",
+    "or column has one set of the unknown contact parameters in every earthquake: "
+    "survival_per_parameter_set gives the survival with each member's own fit (from the "
+    "campaign's fragility_runs.csv) where it is determined.",
+    "The fragility is read on the hazard curve's PGA (--hazard-component, RotD50 by "
+    "default): a campaign's PGA (the horizontal vector peak, = RotD100) is converted with "
+    "the ratio RotD50 / vector peak of its motions (fragility.pga_measure says which and "
+    "where it comes from); PGV/PGA is taken as the same on both measures.  A stated "
+    "fragility (--median-g, --logistic) is taken on the hazard's measure.",
     "A set of specimens shares one age and the site's earthquakes. common_shaking (the "
     "headline for a set): the specimens overturn independently given the motion of one "
     "event, P(all survive | PGA, PGV/PGA) = prod(1 - P_i); independent: each specimen meets "
@@ -44,11 +50,13 @@ ASSUMPTIONS = [
 ]
 
 
-def assess(curve, specimens, ratio_model, age_ka, age_sd_ka=0.0, draws=400, seed=0):
+def assess(curve, specimens, ratio_model, age_ka, age_sd_ka=0.0, draws=400, seed=0,
+           more_curves=()):
     """(summary dict for survival.json, figure data dict) for ``specimens`` (fragility
     objects of :mod:`pipeline.hazard.fragility`) at the site of ``curve``
     (:class:`~pipeline.hazard.curves.HazardCurve`); ``ratio_model``: the PGV/PGA model or
-    None; ages in ka (thousand years)."""
+    None; ages in ka (thousand years).  ``more_curves``: further hazard curves of the
+    site (e.g. quantiles): the headline again under each (``hazard_curves``)."""
     age, age_sd = age_ka * 1000.0, age_sd_ka * 1000.0
     rng = np.random.default_rng(seed)
     drawn = [f.draws(draws, rng) if draws else None for f in specimens]
@@ -61,14 +69,28 @@ def assess(curve, specimens, ratio_model, age_ka, age_sd_ka=0.0, draws=400, seed
             (lambda x, f=d: overturn_probability([f], ratio_model, x)[0]) for d in drawn[k]]
         entry = _result(curve, probability, members, age, age_sd)
         entry = {"fragility": fragility.describe(), **entry,
-                 **_per_parameter_set(curve, fragility, ratio_model, age, age_sd)}
+                 **_per_parameter_set(curve, fragility, ratio_model, age, age_sd),
+                 **_outside_grid(curve, fragility, ratio_model, probability,
+                                 entry["annual_overturning_rate_per_yr"])}
         if drawn[k] is None:
             entry["survival_interval_note"] = "no uncertainty stated for this fragility" \
                 if draws else "--draws 0"
         entries.append(entry)
+        outside = entry.get("outside_grid") or {}
+        for side in ("below", "above"):
+            share = outside.get(f"share_{side}_grid")
+            if share is not None and share > END_SHARE_WARNING:
+                entry["warnings"].append(
+                    f"{100 * share:.0f} % of the overturning rate comes from PGA {side} the "
+                    "fragility's grid" + (f" (rate {outside['rate_per_yr_zero_below_grid']:.3g}"
+                                          f" to {outside['rate_per_yr_edge_held_below_grid']:.3g}"
+                                          " /yr with P = 0 or the edge's P below it)"
+                                          if side == "below" else ""))
         warnings += [f"specimen {k}: {w}" for w in entry.pop("warnings")]
     if len(specimens) == 1:
         headline, probability = entries[0], _combined(specimens, ratio_model, "each")
+        members = None if drawn[0] is None else [_combined([d], ratio_model, "each")
+                                                 for d in drawn[0]]
     else:
         probability = _combined(specimens, ratio_model, "any_common")
         members = None
@@ -77,6 +99,12 @@ def assess(curve, specimens, ratio_model, age_ka, age_sd_ka=0.0, draws=400, seed
                        for group in zip(*drawn)]
         headline = _result(curve, probability, members, age, age_sd)
         warnings += [f"set: {w}" for w in headline.pop("warnings")]
+    curves = [_curve_row(curve, headline, specimens, ratio_model, age, age_sd)] \
+        if more_curves else []
+    for k, other in enumerate(more_curves, start=1):
+        result = _result(other, probability, members, age, age_sd)
+        warnings += [f"hazard curve {k}: {w}" for w in list(other.notes) + result["warnings"]]
+        curves.append(_curve_row(other, result, specimens, ratio_model, age, age_sd))
     summary = {
         "annual_overturning_rate_per_yr": headline["annual_overturning_rate_per_yr"],
         "survival_probability": headline["survival_probability"],
@@ -85,7 +113,7 @@ def assess(curve, specimens, ratio_model, age_ka, age_sd_ka=0.0, draws=400, seed
             "survival_interval_note": "no uncertainty stated for the fragility" if draws
             else "--draws 0"}),
         **({k: entries[0][k] for k in ("survival_per_parameter_set",
-                                       "survival_parameter_set_range")
+                                       "survival_parameter_set_range", "outside_grid")
             if k in entries[0]} if len(specimens) == 1 else {}),
         "rate_scale_bound_5pct": headline["rate_scale_bound_5pct"],
         "intensity_scale_bound_5pct": headline["intensity_scale_bound_5pct"],
@@ -103,9 +131,17 @@ def assess(curve, specimens, ratio_model, age_ka, age_sd_ka=0.0, draws=400, seed
             f"{draws} draws of the fragility's estimate (parametric bootstrap: of its "
             "fitted parameters, or for a pulse grid of every cell's count, Binomial(n, P): "
             "the Monte Carlo error), or null",
-            "survival_per_parameter_set": "a pulse grid only: the survival probability "
-            "with each parameter set's own P in every cell (the rock has one set of the "
-            "unknown contact parameters in every earthquake)",
+            "survival_per_parameter_set": "the survival probability with each parameter "
+            "set's own fragility: a pulse grid's P per set in every cell, or a column "
+            "campaign member's own fit (the specimen has one set of the unknown contact "
+            "parameters in every earthquake)",
+            "outside_grid": "a pulse grid: the rate of overturning from PGA below the "
+            "grid's first PGA and above its last (on the hazard's PGA), their shares, and "
+            "the rate with P = 0 below the grid (lower bound) and with the edge's P held "
+            "down to the uplift acceleration (upper bound)",
+            "hazard_curves": "the headline under each hazard curve given (--hazard "
+            "repeated), the first being the headline's; survival_range_over_curves: min "
+            "and max of their survival probabilities",
             "survival_parameter_set_range": "min and max of survival_per_parameter_set: "
             "the members' spread, reported apart from the Monte Carlo error",
             "rate_scale_bound_5pct": "largest factor F on every rate of the hazard curve "
@@ -124,6 +160,10 @@ def assess(curve, specimens, ratio_model, age_ka, age_sd_ka=0.0, draws=400, seed
         "pgv_pga_used": any(f.uses_ratio for f in specimens),
         "assumptions": ASSUMPTIONS, "warnings": warnings,
         "draws": draws, "seed": seed, "software": software_versions()}
+    if more_curves:
+        survivals = [row["survival_probability"] for row in curves]
+        summary["hazard_curves"] = curves
+        summary["survival_range_over_curves"] = [min(survivals), max(survivals)]
     if len(specimens) > 1:
         summary["site_set"] = _site_set(curve, specimens, ratio_model, entries, age, age_sd)
     figure = _figure_data(curve, probability, headline, drawn, age, age_sd, specimens,
@@ -176,17 +216,62 @@ def _result(curve, probability, members, age, age_sd):
             "warnings": warnings}
 
 
+def _curve_row(curve, result, specimens, ratio_model, age, age_sd):
+    """One hazard curve's row of ``hazard_curves``: the curve and the headline under it."""
+    source = curve.source
+    row = {"file": source.get("file"), "format": source.get("format"),
+           "kind": source.get("kind"), "site_index": source.get("site_index"),
+           **{k: result[k] for k in ("annual_overturning_rate_per_yr", "survival_probability",
+                                     "survival_interval", "rate_scale_bound_5pct",
+                                     "intensity_scale_bound_5pct")}}
+    if len(specimens) == 1:
+        sets = _per_parameter_set(curve, specimens[0], ratio_model, age, age_sd)
+        if sets:
+            row["survival_parameter_set_range"] = sets["survival_parameter_set_range"]
+    return row
+
+
+def _members(fragility):
+    """The fragility's per-parameter-set fragilities, or None."""
+    members = getattr(fragility, "members", None)
+    return None if members is None else members()
+
+
 def _per_parameter_set(curve, fragility, ratio_model, age, age_sd):
-    """Survival with each parameter set's own fragility (a pulse grid), else nothing."""
-    if not hasattr(fragility, "members"):
+    """Survival with each parameter set's own fragility (a pulse grid's sets, a column
+    campaign's members), else nothing."""
+    members = _members(fragility)
+    if not members:
         return {}
     zero = curve.zero_rate_from_m_s2
     rates = [overturning_rate(curve.levels_m_s2, curve.rates_per_yr,
                               lambda x, f=m: overturn_probability([f], ratio_model, x)[0],
-                              zero)["rate_per_yr"] for m in fragility.members()]
+                              zero)["rate_per_yr"] for m in members]
     survival = survival_probability(np.array(rates), age, age_sd).tolist()
     return {"rate_per_parameter_set_per_yr": rates, "survival_per_parameter_set": survival,
             "survival_parameter_set_range": [min(survival), max(survival)]}
+
+
+def _outside_grid(curve, fragility, ratio_model, probability, rate):
+    """How much of the rate comes from outside a pulse grid's PGA range, and the rate
+    with P = 0 below it and with the edge's P held below it; nothing for other forms."""
+    grid = getattr(fragility, "grid_range", None)
+    if grid is None or grid() is None:
+        return {}
+    lo, hi = grid()
+    below, above = rate_outside(curve.levels_m_s2, curve.rates_per_yr, probability, lo, hi)
+    zero = curve.zero_rate_from_m_s2
+    bounds = {name: overturning_rate(
+        curve.levels_m_s2, curve.rates_per_yr,
+        lambda x, f=variant: overturn_probability([f], ratio_model, x)[0], zero)["rate_per_yr"]
+        for name, variant in fragility.variants().items()}
+    return {"outside_grid": {
+        "pga_range_m_s2": [lo, hi], "pga_range_g": [lo / STANDARD_GRAVITY, hi / STANDARD_GRAVITY],
+        "rate_below_grid_per_yr": below, "rate_above_grid_per_yr": above,
+        "share_below_grid": below / rate if rate > 0 else None,
+        "share_above_grid": above / rate if rate > 0 else None,
+        "rate_per_yr_zero_below_grid": bounds["zero"],
+        "rate_per_yr_edge_held_below_grid": bounds["edge"]}}
 
 
 def _site_set(curve, specimens, ratio_model, entries, age, age_sd):

@@ -9,7 +9,8 @@ web service's, anything else a plain table.
   older ``# ..., investigation_time=1.0, imt="PGA"``), a second line ``lon,lat[,depth],
   poe-<level>,...`` (older files ``PGA-<level>:float32``), then one row per site with the
   probability of exceedance (poe) over the investigation time T at each level (PGA in g).
-  Annual rate = -ln(1 - poe) / T (Poisson).
+  Annual rate = -ln(1 - poe) / T (Poisson).  The header's ``kind`` (mean, quantile-0.16,
+  rlz-001, ...) is kept in ``source``.
 - The USGS hazard web service's static-curve JSON (NSHM editions; the earthquake-hazard-tool
   response ``{"response": [{"metadata": {"imt": {"value": "PGA"}, "xlabel": "Ground Motion
   (g)", "ylabel": "Annual Frequency of Exceedence", "xvals": [...]}, "data": [{"yvals":
@@ -145,7 +146,9 @@ def _openquake(path, lines, site):
                              f"{level:g} g")
     with np.errstate(divide="ignore"):
         rates = -np.log1p(-poe) / time_yr
+    kind = re.search(r"\bkind\s*=\s*['\"]?([\w.\-]+)", header)
     source = {"format": "OpenQuake hazard-curve CSV", "file": str(path), "imt": imt,
+              "kind": kind.group(1) if kind else None,
               "unit_in_file": OPENQUAKE_PGA_UNIT, "investigation_time_yr": time_yr,
               "site_index": site, "sites_in_file": len(rows),
               "lon": values[0], "lat": values[1],

@@ -30,6 +30,7 @@ from pipeline.userfiles import Unreadable, number, read_text, show
 
 Z95 = stats.norm.ppf(0.975)
 RATIO_NODES = 24                  # Gauss-Hermite nodes over ln(PGV/PGA)
+BELOW_GRID = ("ramp", "zero", "edge", "logistic")   # P below a pulse grid: see PulseGrid
 PGA_PGV_CORRELATION = 0.733       # ln PGA, ln PGV residuals: Bradley (2012), Earthq. Spectra 28(1)
 GMM_MECHANISMS = ("SS", "NS", "RS")
 
@@ -44,6 +45,7 @@ class Lognormal:
     beta_ci95: tuple | None = None
     label: str = "lognormal"
     note: str | None = None
+    member_fits: tuple | None = field(default=None, compare=False)
     uses_ratio = False
 
     def probability(self, pga_m_s2, pgv_pga_s=None):
@@ -59,8 +61,12 @@ class Lognormal:
             return None
         ln_m = _ln_normal(self.median_m_s2, self.median_ci95, n, rng)
         ln_b = _ln_normal(self.beta, self.beta_ci95, n, rng)
-        return [replace(self, median_m_s2=float(np.exp(m)), beta=float(np.exp(b)))
-                for m, b in zip(ln_m, ln_b)]
+        return [replace(self, median_m_s2=float(np.exp(m)), beta=float(np.exp(b)),
+                        member_fits=None) for m, b in zip(ln_m, ln_b)]
+
+    def members(self):
+        """One fragility per member (parameter set) of the campaign, or None."""
+        return None if not self.member_fits else list(self.member_fits)
 
     def describe(self):
         return {"form": "P = Phi(ln(PGA / median) / beta)", "label": self.label,
@@ -78,6 +84,7 @@ class Logistic:
     se: tuple | None = None
     label: str = "logistic surface"
     note: str | None = None
+    member_fits: tuple | None = field(default=None, compare=False)
     uses_ratio = True
 
     def probability(self, pga_m_s2, pgv_pga_s):
@@ -94,7 +101,12 @@ class Logistic:
             sample = b + rng.standard_normal((n, 3)) * se
         else:
             return None
-        return [replace(self, coefficients=tuple(float(v) for v in row)) for row in sample]
+        return [replace(self, coefficients=tuple(float(v) for v in row), member_fits=None)
+                for row in sample]
+
+    def members(self):
+        """One fragility per member (parameter set) of the campaign, or None."""
+        return None if not self.member_fits else list(self.member_fits)
 
     def describe(self):
         return {"form": "logit P = b0 + b1 ln(PGA / 1 m/s^2) + b2 ln(PGV/PGA / 1 s)",
@@ -109,11 +121,27 @@ def _ln_normal(value, ci95, n, rng):
     return math.log(value) + s * rng.standard_normal(n)
 
 
-def load_campaign_fragility(path, column=None, form=None):
+def load_campaign_fragility(path, column=None, form=None, below="ramp", component=None,
+                            magnitude=None, distance_km=None, record_fraction=None):
     """The fragility of one column entry of ``campaign fragility``'s ``fragility.json``:
     ``form`` "pga" (its lognormal PGA fit) or "pga-pgv" (its logistic surface; default);
     ``column``: monolithic, drums, block2d or block2d_worst (default: the first 3D one).
-    A pulse-grid file (``--pulses``): :func:`load_pulse_grid` (``form`` default "grid")."""
+    A pulse-grid file (``--pulses``): :func:`load_pulse_grid` (``form`` default "grid";
+    ``below``: P below the grid, :class:`PulseGrid`).  Each member's own fit of the same
+    form (from ``fragility_runs.csv`` beside the file, when there) in ``member_fits``.
+    ``component`` (rotd50 or rotd100, the hazard curve's PGA): the fragility put on it
+    (:func:`pipeline.hazard.components.on_hazard_measure`, ``record_fraction(record)``
+    the RotD50 / vector peak of a record's motion); None: as in the file."""
+    fragility, kind, records = _load_campaign_fragility(path, column, form, below)
+    if component is None:
+        return fragility
+    from pipeline.hazard.components import on_hazard_measure  # noqa: PLC0415
+    return on_hazard_measure(fragility, kind, component, records, record_fraction,
+                             magnitude, distance_km)
+
+
+def _load_campaign_fragility(path, column, form, below):
+    """(fragility, "line" | "records", record ids) of :func:`load_campaign_fragility`."""
     path = Path(path)
     if path.is_dir():
         path = path / "fragility.json"
@@ -124,7 +152,7 @@ def load_campaign_fragility(path, column=None, form=None):
     except (OSError, ValueError, Unreadable) as exc:
         raise InputError(f"{path}: not a fragility.json ({exc})") from None
     if isinstance(data, dict) and "pulse_grid" in data:
-        return load_pulse_grid(path, data, column, form or "grid")
+        return load_pulse_grid(path, data, column, form or "grid", below), "line", ()
     form = form or "pga-pgv"
     columns = data.get("columns") if isinstance(data, dict) else None
     if not isinstance(columns, dict) or not columns:
@@ -144,14 +172,69 @@ def load_campaign_fragility(path, column=None, form=None):
             raise InputError(f"{path}: column {column}: PGA fragility not fitted "
                              f"({fit.get('note') or 'no median'})")
         where = f"{path}: column {column}: PGA"
-        return Lognormal(number(fit["median"], f"{where} median", 0, None, "m/s^2", True),
-                         number(fit.get("beta"), f"{where} beta", 0, None, "", True),
-                         _pair(fit.get("median_ci95"), f"{where} median_ci95"),
-                         _pair(fit.get("beta_ci95"), f"{where} beta_ci95"),
-                         label=label, note=fit.get("note"))
-    if form != "pga-pgv":
+        pooled = Lognormal(number(fit["median"], f"{where} median", 0, None, "m/s^2", True),
+                           number(fit.get("beta"), f"{where} beta", 0, None, "", True),
+                           _pair(fit.get("median_ci95"), f"{where} median_ci95"),
+                           _pair(fit.get("beta_ci95"), f"{where} beta_ci95"),
+                           label=label, note=fit.get("note"))
+    elif form == "pga-pgv":
+        pooled = _logistic(entry.get("logistic") or {}, f"{path}: column {column}", label)
+    else:
         raise InputError(f"--fragility-form must be pga or pga-pgv, got {form!r}")
-    return _logistic(entry.get("logistic") or {}, f"{path}: column {column}", label)
+    fits, note = member_fits(path.parent / "fragility_runs.csv", column, form, data)
+    pooled = replace(pooled, member_fits=fits,
+                     note="; ".join(filter(None, [pooled.note, note])) or None)
+    return pooled, "records", tuple(data.get("records") or ())
+
+
+def member_fits(runs_path, column, form, data):
+    """(one fragility per member of a column campaign fitted to its own runs, note): the
+    lognormal PGA fit (form "pga") or the logistic surface ("pga-pgv") of
+    :mod:`pipeline.stats.ensemble`, as the campaign fits the pooled runs; (None, note)
+    when the runs table is absent or no member's fit is determined."""
+    import io  # noqa: PLC0415
+
+    import pandas as pd  # noqa: PLC0415
+
+    from pipeline.stats.ensemble import fragility_fit, logistic_surface  # noqa: PLC0415
+    if not runs_path.is_file():
+        return None, f"no {runs_path.name} beside the file: the members' spread not available"
+    try:
+        table = pd.read_csv(io.StringIO(read_text(runs_path)))
+        sub = table[table["column"] == column]
+        groups = sorted(sub.groupby("member"), key=lambda item: item[0])
+    except (OSError, Unreadable, ValueError, KeyError, pd.errors.ParserError) as exc:
+        raise InputError(f"{runs_path}: not a fragility_runs.csv of campaign fragility "
+                         f"({exc})") from None
+    block = data.get("block2d") or {}
+    fits, skipped = [], []
+    for member, rows in groups:
+        try:
+            y = rows["toppled"].astype(str).str.lower().isin(("true", "1")).to_numpy()
+            pga = rows["pga_m_s2"].astype(float).to_numpy()
+            ratio = rows["pgv_pga_s"].astype(float).to_numpy()
+        except (KeyError, ValueError):
+            raise InputError(f"{runs_path}: member {member}: no readable toppled, pga_m_s2 "
+                             "and pgv_pga_s") from None
+        label = f"member {member}"
+        if form == "pga":
+            fit = fragility_fit(pga, y)
+            if fit["median"] is None:
+                skipped.append(f"{member} ({fit['note']})")
+                continue
+            fits.append(Lognormal(float(fit["median"]), float(fit["beta"]), label=label))
+        else:
+            fit = logistic_surface(pga, ratio, y, alpha=block.get("alpha_rad"),
+                                   p=block.get("p_per_s"))
+            b = fit["coefficients"]
+            if b is None or not b["b1"] > 0:
+                skipped.append(f"{member} ({fit.get('note') or 'does not grow with PGA'})")
+                continue
+            fits.append(Logistic((b["b0"], b["b1"], b["b2"]), label=label))
+    note = None if not skipped else (f"{len(skipped)} of {len(groups)} member(s) not fitted "
+                                     f"alone, left out of the members' spread: "
+                                     f"{'; '.join(skipped)}")
+    return (tuple(fits) or None), note
 
 
 def _logistic(surface, where, label):
@@ -288,8 +371,21 @@ class PulseGrid:
 
     Inside the grid P is interpolated bilinearly in (ln PGA, ln PGV/PGA) between the
     cells' fractions: no functional form is imposed, and the cells are where the runs are.
-    Outside it P is the logistic surface fitted to the same runs (its smooth trend carries
-    the grid's edge outwards); without one, the nearest edge cell's P."""
+    Above the grid's PGA and beside its PGV/PGA P is the logistic surface fitted to the
+    same runs (its smooth trend carries the grid's edge outwards); without one, the
+    nearest edge cell's P.  Below the grid's first PGA a_1, ``below`` (:data:`BELOW_GRID`):
+    the edge P at a_1 times w(a), continuous at a_1, with ``uplift_m_s2`` = g tan(alpha)
+    (a rigid body does not leave its rest below it, Housner 1963):
+
+    - "ramp": w = ln(a / a_u) / ln(a_1 / a_u) between a_u and a_1, 0 below a_u (P rises
+      linearly in ln PGA from 0 at the uplift acceleration to the edge P);
+    - "zero": w = 0 (nothing below the grid: a lower bound on the rate);
+    - "edge": w = 1 above a_u, 0 below (the edge P held: an upper bound, P growing with
+      PGA);
+    - "logistic": the surface, as above and beside the grid (not continuous at a_1).
+
+    Without an uplift acceleration "ramp" and "edge" take a_u = 0 ("ramp" then is
+    "zero", and "edge" holds the edge P down to any PGA), said in ``describe``."""
     pga_m_s2: tuple
     pgv_pga_s: tuple
     n: np.ndarray = field(compare=False)
@@ -298,6 +394,8 @@ class PulseGrid:
     outside: Logistic | None = None
     label: str = "pulse grid"
     note: str | None = None
+    uplift_m_s2: float | None = None
+    below: str = "ramp"
     uses_ratio = True
 
     @property
@@ -309,9 +407,45 @@ class PulseGrid:
         return self._interpolate(self.p, pga_m_s2, pgv_pga_s)
 
     def _interpolate(self, cells, pga_m_s2, pgv_pga_s):
-        from scipy.interpolate import RegularGridInterpolator  # noqa: PLC0415
         pga, ratio = np.broadcast_arrays(np.asarray(pga_m_s2, float),
                                          np.asarray(pgv_pga_s, float))
+        low = pga < self.pga_m_s2[0]
+        if self.below == "logistic" or not low.any():
+            return self._surface(cells, pga, ratio)
+        p = np.zeros(pga.shape)
+        if not low.all():
+            p[~low] = self._surface(cells, pga[~low], ratio[~low])
+        weight = self.below_weight(pga[low])
+        ramp = weight > 0                # only where P is not 0 is the edge's P needed
+        if ramp.any():
+            below = np.zeros(weight.shape)
+            below[ramp] = weight[ramp] * self._surface(
+                cells, np.full(int(ramp.sum()), self.pga_m_s2[0]), ratio[low][ramp])
+            p[low] = below
+        return p
+
+    def below_weight(self, pga_m_s2):
+        """w(a) of the class docstring below the grid's first PGA (1 at a_1)."""
+        pga = np.asarray(pga_m_s2, float)
+        a_1, a_u = self.pga_m_s2[0], self.uplift_m_s2
+        if self.below == "zero" or (self.below == "ramp" and (a_u is None or a_u >= a_1)):
+            return np.zeros(pga.shape)
+        if self.below == "edge":
+            return (pga > (a_u or 0.0)).astype(float)
+        return np.clip(np.log(pga / a_u) / math.log(a_1 / a_u), 0.0, 1.0)
+
+    def variants(self):
+        """The grid with P = 0 below it ("zero", a lower bound on the rate) and with the
+        edge P held down to the uplift acceleration ("edge", an upper bound)."""
+        return {name: replace(self, below=name) for name in ("zero", "edge")}
+
+    def grid_range(self):
+        """(first, last) PGA of the grid, m/s^2."""
+        return self.pga_m_s2[0], self.pga_m_s2[-1]
+
+    def _surface(self, cells, pga, ratio):
+        """Bilinear inside the grid, the logistic surface (or the edge cell) outside."""
+        from scipy.interpolate import RegularGridInterpolator  # noqa: PLC0415
         points = np.stack([np.log(pga), np.log(ratio)], axis=-1)
         inside = RegularGridInterpolator((np.log(self.pga_m_s2), np.log(self.pgv_pga_s)),
                                          _fill_empty(cells), bounds_error=False,
@@ -344,6 +478,7 @@ class PulseGrid:
                 "inside": "bilinear in (ln PGA, ln PGV/PGA) between the cells' fractions",
                 "outside": "the logistic surface fitted to the same runs"
                 if self.outside is not None else "the nearest edge cell's P",
+                "below_grid": self.describe_below(),
                 "pga_range_g": [self.pga_m_s2[0] / STANDARD_GRAVITY,
                                 self.pga_m_s2[-1] / STANDARD_GRAVITY],
                 "pgv_pga_range_s": [self.pgv_pga_s[0], self.pgv_pga_s[-1]],
@@ -351,6 +486,37 @@ class PulseGrid:
                 "parameter_sets": int(len(self.p_per_set)),
                 "outside_surface": None if self.outside is None else self.outside.describe(),
                 "note": self.note}
+
+
+    def describe_below(self):
+        """What P is below the grid's first PGA: the choice and its definition."""
+        a_u = self.uplift_m_s2
+        applied = self.below
+        if self.below == "ramp" and (a_u is None or a_u >= self.pga_m_s2[0]):
+            applied = "zero"
+        definitions = {
+            "ramp": "P = P(a_1) ln(a / a_u) / ln(a_1 / a_u) between the uplift acceleration "
+                    "a_u = g tan(alpha) and the grid's first PGA a_1, 0 below a_u (a rigid "
+                    "body does not leave its rest below a_u)",
+            "zero": "P = 0 below the grid's first PGA (a lower bound on the rate)",
+            "edge": "P = P(a_1), the edge's P, held down to the uplift acceleration, 0 below "
+                    "(an upper bound on the rate, P growing with PGA)",
+            "logistic": "the logistic surface fitted to the same runs (not continuous at "
+                        "a_1)"}
+        note = None
+        if applied != self.below:
+            note = ("no uplift acceleration in the file: P = 0 below the grid" if a_u is None
+                    else "the uplift acceleration is not below the grid's first PGA: P = 0 "
+                         "below the grid")
+        elif self.below == "edge" and a_u is None:
+            note = "no uplift acceleration in the file: the edge's P held down to any PGA"
+        return {"choice": self.below, "applied": applied, "definition": definitions[applied],
+                "first_pga_g": self.pga_m_s2[0] / STANDARD_GRAVITY,
+                "uplift_pga_g": None if a_u is None else a_u / STANDARD_GRAVITY,
+                "uplift_source": None if a_u is None else
+                "the 2D block's critical angle alpha in the file (median over the runs' "
+                "directions): a_u = g tan(alpha)",
+                "note": note}
 
 
 def _clip_points(points, ln_a, ln_r):
@@ -373,9 +539,12 @@ def _fill_empty(cells):
     return np.where(np.isnan(cells), np.nanmean(cells), cells)
 
 
-def load_pulse_grid(path, data, model=None, form="grid"):
+def load_pulse_grid(path, data, model=None, form="grid", below="ramp"):
     """One model of a pulse-grid ``fragility.json`` (``models``: monolithic, block2d):
-    ``form`` "grid" (:class:`PulseGrid`) or "pga-pgv" (its logistic surface)."""
+    ``form`` "grid" (:class:`PulseGrid`, ``below`` what P is below it) or "pga-pgv" (its
+    logistic surface)."""
+    if below not in BELOW_GRID:
+        raise InputError(f"--below-grid must be one of {', '.join(BELOW_GRID)}, got {below!r}")
     section = data["pulse_grid"]
     models = section.get("models") if isinstance(section, dict) else None
     if not isinstance(models, dict) or not models:
@@ -430,5 +599,20 @@ def load_pulse_grid(path, data, model=None, form="grid"):
     empty = int((n == 0).sum())
     note = None if not empty else (f"{empty} of {n.size} cells without runs: filled from the "
                                    "nearest cell along PGA")
+    uplift = _uplift(section, where)
     return PulseGrid(tuple(v * STANDARD_GRAVITY for v in pga_g), tuple(ratios), n,
-                     overturned, per_set, logistic, label, note)
+                     overturned, per_set, logistic, label, note, uplift, below)
+
+
+def _uplift(section, where):
+    """g tan(alpha) (m/s^2) of a pulse grid's 2D block (``block2d``: uplift_g or alpha_rad),
+    or None when the file has neither."""
+    block = section.get("block2d") or {}
+    if block.get("uplift_g") is not None:
+        return number(block["uplift_g"], f"{where}: block2d uplift_g", 0, None, "g",
+                      True) * STANDARD_GRAVITY
+    if block.get("alpha_rad") is not None:
+        alpha = number(block["alpha_rad"], f"{where}: block2d alpha_rad", 0, math.pi / 2,
+                       "rad", True)
+        return STANDARD_GRAVITY * math.tan(alpha)
+    return None

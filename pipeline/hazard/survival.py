@@ -143,3 +143,17 @@ def intensity_scale_bound(levels_m_s2, rates_per_yr, probability, age_yr, age_sd
     if excess(lo) < 0:
         return None, f"survival is below {floor:g} even at {limits[0]:g} x the intensities"
     return math.exp(optimize.brentq(excess, lo, hi, xtol=1e-8)), None
+
+
+def rate_outside(levels_m_s2, rates_per_yr, probability, lo_m_s2, hi_m_s2,
+                 cells=CELLS_PER_INTERVAL):
+    """The parts of the rate of overturning (1/yr) from PGA below ``lo_m_s2`` and above
+    ``hi_m_s2`` (e.g. outside a fragility's grid): (below, above), the exceedances of the
+    curve's last level counted above when that level lies above ``hi_m_s2``."""
+    levels = np.asarray(levels_m_s2, float)
+    rates = np.asarray(rates_per_yr, float)
+    x_mid, d_rate, _, _ = hazard_cells(levels, rates, cells)
+    part = probability(x_mid) * d_rate
+    top = float(probability(levels[-1:])[0]) * rates[-1]
+    above = float(part[x_mid > hi_m_s2].sum()) + (top if levels[-1] > hi_m_s2 else 0.0)
+    return float(part[x_mid < lo_m_s2].sum()), above

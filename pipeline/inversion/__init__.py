@@ -24,9 +24,11 @@ from pipeline.inversion.posterior import in_arc, invert, magnitude_set
 EXAMPLES_DIR = Path(__file__).resolve().parent / "examples"
 
 
-def write_outputs(post, observations, out_dir, forward_info=None, truth=None, title=None):
+def write_outputs(post, observations, out_dir, forward_info=None, truth=None, title=None,
+                  site_motion=None):
     """posterior.csv, inversion_summary.json, posterior_map.png and marginals.png in
-    ``out_dir``; returns the summary dict."""
+    ``out_dir`` (and site_motion.json with ``site_motion``, also under the summary's
+    ``site_motion``); returns the summary dict."""
     from pipeline.figures.inversion import plot_marginals, plot_posterior_map
     out_dir = Path(out_dir)
     write_csv(out_dir / "posterior.csv", post.frame())
@@ -54,12 +56,16 @@ def write_outputs(post, observations, out_dir, forward_info=None, truth=None, ti
                + [Path(f).name for f in figures]}
     if truth is not None:
         summary["truth"] = truth
+    if site_motion is not None:
+        write_json(out_dir / "site_motion.json", site_motion)
+        summary["site_motion"] = site_motion
+        summary["outputs"].append("site_motion.json")
     write_json(out_dir / "inversion_summary.json", summary)
     return summary
 
 
 def run_inversion(observations, out_dir, table, candidates, kernel_deg=None, floor=None,
-                  forward_info=None, likelihood="independent", truth=None):
+                  forward_info=None, likelihood="independent", truth=None, site_motion=None):
     """Invert ``observations`` with the forward ``table`` over ``candidates`` and write the
     outputs into ``out_dir`` (locked while writing); return the summary dict.  ``truth``
     (a hidden-truth test's source: :meth:`pipeline.inversion.truth.HiddenTruth.as_truth`)
@@ -72,7 +78,8 @@ def run_inversion(observations, out_dir, table, candidates, kernel_deg=None, flo
     if truth is not None:
         truth = {**truth, "check": truth_check(post, truth)}
     with DirectoryLock(out_dir, wait=False):
-        summary = write_outputs(post, observations, out_dir, forward_info, truth=truth)
+        summary = write_outputs(post, observations, out_dir, forward_info, truth=truth,
+                                site_motion=site_motion)
     summary["inversion_s"] = round(time.monotonic() - started, 2)
     return summary
 

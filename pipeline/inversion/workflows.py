@@ -292,13 +292,29 @@ def hidden_truth(truth_file, options, grid, candidates):
     return 0
 
 
-def invert_file(observations_file, options, grid, candidates):
+def site_motions(observations, fragility_for, pgv_pga_s=None):
+    """site_motion.json's content: the PGA range each site's standing and fallen columns
+    allow (:func:`pipeline.hazard.site_motion.site_motion`), every site with columns."""
+    from pipeline.hazard.site_motion import site_motion
+    sites = [site_motion(observations, site.name, fragility_for, pgv_pga_s)
+             for site in observations.sites if site.columns]
+    return {"sites": sites,
+            "pga_measure": "RotD50: each column type's fragility put on it "
+                           "(sites.*.fragilities.*.pga_measure)",
+            "assumption": "each site's columns decided by one event, independent given its "
+                          "motion; the sites' bounds are separate (the source's posterior "
+                          "ties them together)"}
+
+
+def invert_file(observations_file, options, grid, candidates, site_fragility=None):
     """invert OBSERVATIONS.json: the forward table (run, reused or ``options.table``) and
     the described columns' tables, then the inversion (``options.out``, default
-    results/inversion/<file stem>)."""
+    results/inversion/<file stem>).  ``site_fragility`` ((fragility_for(column type),
+    PGV/PGA) or None): the PGA range at each site too (site_motion.json)."""
     from pipeline.inversion import run_inversion
     from pipeline.inversion.observations import load_observations
     observations = load_observations(observations_file)
+    motions = None if site_fragility is None else site_motions(observations, *site_fragility)
     described = described_columns(observations, observations_file.parent)
     out = options.out or RESULTS_DIR / "inversion" / observations_file.stem
     if out.exists() and not out.is_dir():
@@ -314,7 +330,8 @@ def invert_file(observations_file, options, grid, candidates):
         table = table.with_column(name, column_table)
         info.setdefault("described_columns", {})[name] = column_info
     summary = run_inversion(observations, out, table, candidates, options.kernel_deg,
-                            options.floor, forward_info=info, likelihood=options.likelihood)
+                            options.floor, forward_info=info, likelihood=options.likelihood,
+                            site_motion=motions)
     lo, hi = summary["back_azimuth_ci95_deg"]
     mech = max(summary["mechanism_posterior"], key=summary["mechanism_posterior"].get)
     log.info(f"{observations.n_fallen} fallen of {observations.n_columns} columns at "
@@ -326,5 +343,11 @@ def invert_file(observations_file, options, grid, candidates):
              f"{summary['credible_area_95_km2']:.0f} km^2; most probable mechanism {mech} "
              f"({summary['mechanism_posterior'][mech]:.2f})")
     _say_reach(summary)
+    for site in (motions or {}).get("sites", []):
+        lo_g, hi_g = site["pga_interval95_g"]
+        log.info(f"site {site['site']}: {site['fallen']} of {site['columns']} columns fell; "
+                 f"PGA (RotD50) 95 % [{'-' if lo_g is None else f'{lo_g:.3g}'}, "
+                 f"{'-' if hi_g is None else f'{hi_g:.3g}'}] g"
+                 + ("" if site["note"] is None else f" ({site['note']})"))
     log.info(f"wrote {out} ({time.monotonic() - started:.0f} s)")
     return 0

@@ -93,6 +93,18 @@ def horizontal_peak(series):
     return float(length[index]), azimuth, index
 
 
+def rotd_peak(series, percentile=50.0, step_deg=1.0):
+    """RotDnn of the horizontal components (columns 0 = East, 1 = North) of an (n, >=2)
+    array (Boore 2010, BSSA 100(4)): the ``percentile`` over rotation angles theta in
+    [0, 180) deg, in steps of ``step_deg``, of the peak |x cos theta + y sin theta|.
+    RotD100 is the peak of the horizontal vector (to within cos(step / 2)); for a
+    motion along one line RotD50 = peak cos 45 deg."""
+    theta = np.radians(np.arange(0.0, 180.0, step_deg))
+    xy = np.asarray(series, float)[:, :2]
+    peaks = np.abs(xy @ np.vstack([np.cos(theta), np.sin(theta)])).max(axis=0)
+    return float(np.percentile(peaks, percentile))
+
+
 def displacement_directionality(disp):
     """Peak displacement along the azimuth of the horizontal peak over the peak
     perpendicular to it (``disp_perp_ratio``), and the number of half cycles

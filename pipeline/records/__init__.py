@@ -127,6 +127,18 @@ def processed_motion(record, back_azimuth=None, cache_dir=CACHE_DIR, mode="defau
     return motion, path
 
 
+def rotd50_fraction(record):
+    """RotD50 / RotD100 of the horizontal PGA of ``record``'s processed motion (RotD100 =
+    the peak of the horizontal vector; :func:`pipeline.motion.measures.rotd_peak`, 0.5 deg
+    steps); unchanged by scaling the record."""
+    from pipeline.motion.measures import rotd_peak  # noqa: PLC0415
+    motion, _ = processed_motion(record, cache_dir=None)
+    peak = rotd_peak(motion.acc, 100.0, 0.5)
+    if not peak > 0:
+        raise InputError(f"record {record}: no horizontal acceleration")
+    return rotd_peak(motion.acc, 50.0, 0.5) / peak
+
+
 def read_east_north_up(source):
     """Read a :class:`Source` and rotate it: (acc (n, 3) m/s^2 East/North/Up, dt s, info,
     has_vertical), with the catalogue's orientation and time window applied."""

@@ -40,6 +40,21 @@ def survival_section(results, name=ROCK_SURVIVAL):
                 f"; per parameter set {sets[0]:.3g}-{sets[1]:.3g} (the members' spread)")
              + f". Hazard rates x {_fmt(s['rate_scale_bound_5pct'], 3)} or PGA levels x "
              f"{_fmt(s['intensity_scale_bound_5pct'], 3)} leave survival at 5 %.\n"]
+    measure, below = fragility.get("pga_measure"), fragility.get("below_grid")
+    outside = s.get("outside_grid")
+    if measure is not None:
+        lines.append(f"PGA on the hazard curve's {measure['hazard']}: the fragility's PGA "
+                     f"({measure['fragility']}) times {measure['fraction']:.3f} "
+                     f"({measure['source']}).\n")
+    if below is not None and outside is not None:
+        share = outside["share_below_grid"]
+        lines.append(f"Below the grid's first PGA ({below['first_pga_g']:.3g} g): "
+                     f"{below['definition']}; "
+                     + ("" if share is None else f"{100 * share:.1f} % of the rate comes "
+                        "from there, ")
+                     + f"the rate {outside['rate_per_yr_zero_below_grid']:.3g} to "
+                     f"{outside['rate_per_yr_edge_held_below_grid']:.3g} /yr with P = 0 or "
+                     "the edge's P held there.\n")
     rows = [{"PGA (g)": f"{r['lo_g']:.3g}-" + ("" if r["hi_g"] is None else f"{r['hi_g']:.3g}"),
              "rate (1/yr)": f"{r['rate_per_yr']:.3g}",
              "share": "-" if r["share"] is None else f"{100 * r['share']:.1f} %"}

@@ -18,9 +18,11 @@ from pipeline.hazard.survival import overturning_rate
 G = STANDARD_GRAVITY
 
 
-def _grid_json(path, pga_g, ratios, p_of, n=16, sets=2, p_set_of=None, logistic=None):
+def _grid_json(path, pga_g, ratios, p_of, n=16, sets=2, p_set_of=None, logistic=None,
+               uplift_g=None):
     """A pulse-grid fragility.json as campaign fragility --pulses writes it, with cell
-    fractions p_of(pga_m_s2, ratio) (rounded to counts of n) and per-set P."""
+    fractions p_of(pga_m_s2, ratio) (rounded to counts of n), per-set P and (``uplift_g``)
+    the 2D block's uplift acceleration."""
     cells = []
     for a in pga_g:
         for r in ratios:
@@ -35,6 +37,9 @@ def _grid_json(path, pga_g, ratios, p_of, n=16, sets=2, p_set_of=None, logistic=
     data = {"mode": "pulses", "specimen": "test rock",
             "pulse_grid": {"pga_g": list(pga_g), "pgv_pga_s": list(ratios), "members": sets,
                            "models": {"monolithic": model}}}
+    if uplift_g is not None:
+        data["pulse_grid"]["block2d"] = {"alpha_rad": math.atan(uplift_g),
+                                         "uplift_g": uplift_g}
     path.write_text(json.dumps(data))
     return path
 
@@ -46,7 +51,7 @@ def test_grid_is_bilinear_in_log_space_and_the_surface_outside(tmp_path):
         return 0.5 + 0.2 * math.log(a / (0.2 * G)) + 0.1 * math.log(r / 0.1)
     path = _grid_json(tmp_path / "f.json", pga_g, ratios, p_of, n=100000,
                       logistic=(-2.0, 3.0, 0.5))
-    grid = load_campaign_fragility(path)
+    grid = load_campaign_fragility(path, below="logistic")
     a = np.array([0.13, 0.3, 0.55, 0.79]) * G
     r = np.array([0.06, 0.15, 0.11, 0.19])
     expected = [p_of(x, y) for x, y in zip(a, r)]
@@ -100,7 +105,8 @@ def test_parameter_sets_and_monte_carlo_error_reported_apart(tmp_path):
         out = tmp_path / f"out{n}"
         assert main(["survival", "--hazard", str(curve), "--fragility", str(path),
                      "--pgv-pga-median", "0.1", "--pgv-pga-sigma", "0.3", "--age-ka", "2",
-                     "--draws", "120", "--out", str(out)]) == 0
+                     "--draws", "120", "--hazard-component", "rotd100",
+                     "--out", str(out)]) == 0
         runs[n] = json.loads((out / "survival.json").read_text())
     wide, narrow = (r["survival_interval"] for r in (runs[8], runs[800]))
     assert narrow[1] - narrow[0] < 0.3 * (wide[1] - wide[0])     # MC error ~ 1/sqrt(n)
@@ -111,6 +117,19 @@ def test_parameter_sets_and_monte_carlo_error_reported_apart(tmp_path):
     assert runs[800]["survival_per_parameter_set"] == pytest.approx(expected, rel=0.02)
     assert runs[800]["survival_parameter_set_range"] == pytest.approx(
         [min(expected), max(expected)], rel=0.02)
+    # on a RotD50 hazard curve: pulses along one line have RotD50 = PGA cos 45 deg, so each
+    # set's median on the curve's PGA is its median x cos 45 deg
+    out = tmp_path / "rotd50"
+    assert main(["survival", "--hazard", str(curve), "--fragility", str(tmp_path / "f800.json"),
+                 "--pgv-pga-median", "0.1", "--pgv-pga-sigma", "0.3", "--age-ka", "2",
+                 "--draws", "0", "--out", str(out)]) == 0
+    rotd50 = json.loads((out / "survival.json").read_text())
+    c45 = math.cos(math.radians(45.0))
+    expected = [math.exp(-2000.0 * 1e-4 * (c45 * f.median_m_s2) ** -2.5
+                         * math.exp(0.5 * (2.5 * 0.4) ** 2)) for f in sets]
+    assert rotd50["survival_per_parameter_set"] == pytest.approx(expected, rel=0.02)
+    assert rotd50["specimens"][0]["fragility"]["pga_measure"]["fraction"] == pytest.approx(c45)
+    assert rotd50["hazard_component"] == "rotd50"
 
 
 def test_bad_pulse_grid_files_one_line(tmp_path):

@@ -1,6 +1,7 @@
 """`invert` end to end on a toy forward table file (no YADE): outputs and their keys; the
 demo machinery on a toy table; one YADE smoke run of two forward runs."""
 import json
+import math
 
 import numpy as np
 import pandas as pd
@@ -112,3 +113,58 @@ def test_demo_outputs_feed_the_report(tmp_path, make_away_table):
     assert [j["sites"] for j in summary["paper_scenario"]["joint"]] == [2 * 12]
     assert "the 24 sites within 10 km (half the forward table's last ring" in text
     assert "or the inversion warned that it may lie farther in" in text
+
+
+def _column_fragility(directory, columns=("monolithic", "drums"), median=3.0, beta=0.4):
+    """A column fragility.json of campaign fragility: the same lognormal PGA fit (m/s^2, the
+    horizontal vector peak) for each column type, scaled records the project does not hold
+    (so RotD50 comes from Boore & Kishida 2017 at their reference M 5.5, 50 km)."""
+    directory.mkdir()
+    fit = {"unit": "m/s^2", "median": median, "beta": beta}
+    (directory / "fragility.json").write_text(json.dumps(
+        {"records": ["not-a-record"], "columns": {c: {"PGA": fit} for c in columns}}))
+    return directory
+
+
+def test_invert_reports_each_sites_motion_beside_the_source(tmp_path, capsys, make_away_table):
+    from scipy import stats
+    table = make_away_table().save(tmp_path / "toy.npz")
+    out = tmp_path / "out"
+    code = cli.main(["invert", str(EXAMPLES_DIR / "two_sites.json"), "--table", str(table),
+                     "--out", str(out), "--radius", "10", "--step", "2",
+                     "--site-fragility", str(_column_fragility(tmp_path / "fragility"))])
+    assert code == 0, capsys.readouterr().err
+    motion = json.loads((out / "site_motion.json").read_text())
+    summary = json.loads((out / "inversion_summary.json").read_text())
+    assert summary["site_motion"] == motion and "site_motion.json" in summary["outputs"]
+    assert SUMMARY_KEYS <= set(summary)
+    # identical lognormal columns, k of n fallen: the most likely PGA is median
+    # exp(beta Phi^-1(k/n)) on the campaign's PGA; on RotD50 times 1 / exp(0.18577), the
+    # RotD100/RotD50 of PGA of Boore & Kishida (2017) at M 5.5, 50 km
+    to_rotd50 = math.exp(-0.185774509)
+    sites = {s["site"]: s for s in motion["sites"]}
+    assert (sites["A"]["fallen"], sites["A"]["columns"]) == (1, 2)
+    assert sites["A"]["pga_ml_m_s2"] == pytest.approx(3.0 * to_rotd50, rel=1e-5)
+    assert (sites["B"]["fallen"], sites["B"]["columns"]) == (2, 3)
+    assert sites["B"]["pga_ml_m_s2"] == pytest.approx(
+        3.0 * math.exp(0.4 * stats.norm.ppf(2 / 3)) * to_rotd50, rel=1e-5)
+
+
+@pytest.mark.parametrize("extra, message", [
+    (["--at-pgv-pga", "0.1"], "go with --site-fragility"),
+    (["--site-fragility", "FRAG", "--site-fragility-form", "pga-pgv"], "needs --at-pgv-pga"),
+    (["--site-fragility", "FRAG", "--at-pgv-pga", "0.1"], "goes with --site-fragility-form"),
+    (["--site-fragility", "MONO"], "no column 'drums'"),
+])
+def test_invert_site_motion_refuses_in_one_line(tmp_path, capsys, extra, message,
+                                                 make_away_table):
+    table = make_away_table().save(tmp_path / "toy.npz")
+    paths = {"FRAG": str(_column_fragility(tmp_path / "f")),
+             "MONO": str(_column_fragility(tmp_path / "m", columns=("monolithic",)))}
+    out = tmp_path / "out"
+    argv = ["invert", str(EXAMPLES_DIR / "two_sites.json"), "--table", str(table),
+            "--out", str(out)] + [paths.get(a, a) for a in extra]
+    assert cli.main(argv) == 2
+    err = capsys.readouterr().err.strip()
+    assert message in err and len(err.splitlines()) == 1
+    assert not out.exists()
