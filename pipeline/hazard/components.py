@@ -7,9 +7,12 @@ the horizontal acceleration vector, which is RotD100 (the largest rotated peak).
 fragility read against a hazard curve is put on the curve's measure:
 P_hazard(x) = P_fragility(x / f), f = RotD50 / (vector peak) of the campaign's motions:
 
-- a pulse grid's one-cosine pulses act along one line: the projection at angle theta has
-  peak PGA |cos theta|, whose median over theta in [0, 180) is PGA cos 45 deg, so
-  f = cos 45 deg = 0.7071 exactly;
+- a pulse grid: a one-cosine pulse along one line stands for the field motion along its
+  strongest direction (the rock's heading is sampled, the motion's peak is not), so its
+  PGA is the field motion's RotD100 and f = 1 / (RotD100 / RotD50) of Boore & Kishida
+  (below).  A field motion that is itself along one line would have f = cos 45 deg
+  (0.7071: the median over theta in [0, 180) of |cos theta|), the lowest any motion has;
+  it is kept beside as ``polarised_fraction`` (the survival it gives is the lower bound);
 - a campaign of scaled records: f of each record computed from its motion
   (:func:`pipeline.motion.measures.rotd_peak`), their geometric mean (scaling leaves f
   unchanged);
@@ -135,10 +138,13 @@ def on_hazard_measure(fragility, kind, component, records=(), fraction_of=None,
         return OnHazardMeasure(fragility, 1.0, {**described, "fraction": 1.0,
                                                 "source": "the same measure: no conversion"})
     if kind == "line":
-        fraction = LINE_ROTD50_FRACTION
-        source = ("motions along one line: RotD50 = vector peak x cos 45 deg (the median "
-                  "over theta of |cos theta|)")
-        extra = {}
+        fraction = 1.0 / bk17_rotd100_over_rotd50(magnitude, distance_km)
+        source = (f"a pulse is the field motion's strongest direction (RotD100): f = 1 / "
+                  f"(RotD100 / RotD50 of PGA, Boore & Kishida 2017, at M "
+                  f"{5.5 if magnitude is None else magnitude:g}, "
+                  f"{50 if distance_km is None else distance_km:g} km) = {fraction:.4f}; a "
+                  "field motion along one line would have cos 45 deg")
+        extra = {"polarised_fraction": LINE_ROTD50_FRACTION}
     else:
         found = records_fraction(records, fraction_of, magnitude, distance_km)
         fraction, source = found["fraction"], found["source"]

@@ -117,18 +117,22 @@ def test_parameter_sets_and_monte_carlo_error_reported_apart(tmp_path):
     assert runs[800]["survival_per_parameter_set"] == pytest.approx(expected, rel=0.02)
     assert runs[800]["survival_parameter_set_range"] == pytest.approx(
         [min(expected), max(expected)], rel=0.02)
-    # on a RotD50 hazard curve: pulses along one line have RotD50 = PGA cos 45 deg, so each
-    # set's median on the curve's PGA is its median x cos 45 deg
+    # on a RotD50 hazard curve: a pulse is the field motion's strongest direction, so each
+    # set's median on the curve's PGA is its median / (RotD100 / RotD50), Boore & Kishida
+    # (2017) at their reference M 5.5, 50 km: exp(c0) = exp(0.185774509)
     out = tmp_path / "rotd50"
     assert main(["survival", "--hazard", str(curve), "--fragility", str(tmp_path / "f800.json"),
                  "--pgv-pga-median", "0.1", "--pgv-pga-sigma", "0.3", "--age-ka", "2",
                  "--draws", "0", "--out", str(out)]) == 0
     rotd50 = json.loads((out / "survival.json").read_text())
     c45 = math.cos(math.radians(45.0))
-    expected = [math.exp(-2000.0 * 1e-4 * (c45 * f.median_m_s2) ** -2.5
+    bk = math.exp(-0.185774509051029)
+    expected = [math.exp(-2000.0 * 1e-4 * (bk * f.median_m_s2) ** -2.5
                          * math.exp(0.5 * (2.5 * 0.4) ** 2)) for f in sets]
     assert rotd50["survival_per_parameter_set"] == pytest.approx(expected, rel=0.02)
-    assert rotd50["specimens"][0]["fragility"]["pga_measure"]["fraction"] == pytest.approx(c45)
+    measure = rotd50["specimens"][0]["fragility"]["pga_measure"]
+    assert measure["fraction"] == pytest.approx(bk)
+    assert measure["polarised_fraction"] == pytest.approx(c45)
     assert rotd50["hazard_component"] == "rotd50"
 
 
