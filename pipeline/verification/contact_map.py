@@ -43,33 +43,40 @@ def rocking_restitution(height, width, depth, damping, kn=paper.MARBLE_BLOCK_KN_
     return rocking.fit_free_rocking(height, width, t=t, theta=theta)["restitution"]
 
 
-def damping_for_restitution(restitution, height, width, depth, kn=paper.MARBLE_BLOCK_KN_N_M,
-                            density=paper.MARBLE_DENSITY_KG_M3, log=print, cache=CACHE):
-    """(damping, measured restitution, YADE runs made) for the stated ``restitution`` of
-    this block at ``kn``: bisection on the damping ratio in [0, 1], each step one YADE
-    free-rocking run unless ``cache`` (a JSON file, or None) holds it.  InputError (one line, naming the reachable range) when the restitution lies
-    outside what damping 0-1 gives."""
+def cached_measure(measure, key, cache=CACHE):
+    """(measured, runs): ``measured(damping)`` is ``measure(damping)`` (one YADE run) unless
+    ``cache`` (a JSON file, or None) holds it under ``key`` (what was run), the damping
+    and the model's code; ``runs()`` counts the runs made."""
     cached = json.loads(cache.read_text()) if cache is not None and cache.is_file() else {}
     model = code_hash("scenario", "verification", "yade_scripts")
-    runs = 0
+    runs = [0]
 
     def measured(damping):
-        nonlocal runs
-        key = f"{height:.6g},{width:.6g},{depth:.6g},{density:.6g},{kn:.6g},{damping:.6g},{model}"
-        if key not in cached:
-            cached[key] = rocking_restitution(height, width, depth, damping, kn, density)
-            runs += 1
+        name = f"{key},{damping:.6g},{model}"
+        if name not in cached:
+            cached[name] = measure(damping)
+            runs[0] += 1
             if cache is not None:
                 write_json(cache, cached)
-        return cached[key]
+        return cached[name]
 
+    return measured, lambda: runs[0]
+
+
+def bisect_damping(restitution, measured, what, log=print, clip=False):
+    """(damping, measured restitution): the damping ratio in [0, 1] whose ``measured``
+    restitution (a function falling with the damping) is ``restitution``, by bisection.
+    Outside the reachable range: InputError (one line naming the range of ``what``), or
+    with ``clip`` the end of the range nearest to it."""
     low, high = 0.0, 1.0
     r_low, r_high = measured(low), measured(high)
     if not r_high - RESTITUTION_TOLERANCE <= restitution <= r_low + RESTITUTION_TOLERANCE:
-        raise InputError(f"restitution {restitution:.3f}: this block reaches "
-                         f"{r_high:.3f}-{r_low:.3f} with contact damping 1-0 in YADE "
-                         f"(kn {kn:g} N/m); a lower one needs a lossier contact than the "
-                         "perfectly inelastic impact of Housner's")
+        if clip:
+            return (low, r_low) if restitution > r_low else (high, r_high)
+        raise InputError(f"restitution {restitution:.3f}: {what} reaches "
+                         f"{r_high:.3f}-{r_low:.3f} with contact damping 1-0 in YADE; a "
+                         "lower one needs a lossier contact than the perfectly inelastic "
+                         "impact of Housner's")
     best = min(((abs(r_low - restitution), low, r_low), (abs(r_high - restitution), high, r_high)))
     while best[0] > RESTITUTION_TOLERANCE and high - low > DAMPING_TOLERANCE:
         middle = 0.5 * (low + high)
@@ -80,4 +87,145 @@ def damping_for_restitution(restitution, height, width, depth, kn=paper.MARBLE_B
             low = middle
         else:
             high = middle
-    return best[1], best[2], runs
+    return best[1], best[2]
+
+
+INTERVAL_MEANING = ("damping ratios whose restitution in YADE is the stated restitution plus "
+                    "(low) and minus (high) its standard error; an end of the reachable "
+                    "range (0 or 1) where that restitution lies beyond it")
+
+
+def damping_interval(restitution, restitution_se, measured, what, log=print):
+    """The damping interval of a restitution +- its standard error (dict low, high,
+    restitution_low, restitution_high, clipped: which ends lie beyond the reachable range,
+    meaning); None without a standard error."""
+    if restitution_se is None:
+        return None
+    upper, lower = restitution + restitution_se, restitution - restitution_se
+    low, r_upper = bisect_damping(upper, measured, what, log, clip=True)
+    high, r_lower = bisect_damping(lower, measured, what, log, clip=True)
+    clipped = [name for name, r, m in (("low", upper, r_upper), ("high", lower, r_lower))
+               if abs(r - m) > RESTITUTION_TOLERANCE]
+    return {"low": low, "high": high, "restitution_low": lower, "restitution_high": upper,
+            "clipped": clipped, "meaning": INTERVAL_MEANING}
+
+
+def block_measure(height, width, depth, kn=paper.MARBLE_BLOCK_KN_N_M,
+                  density=paper.MARBLE_DENSITY_KG_M3, cache=CACHE):
+    """:func:`cached_measure` of the block's :func:`rocking_restitution`."""
+    return cached_measure(
+        lambda damping: rocking_restitution(height, width, depth, damping, kn, density),
+        f"{height:.6g},{width:.6g},{depth:.6g},{density:.6g},{kn:.6g}", cache)
+
+
+def damping_for_restitution(restitution, height, width, depth, kn=paper.MARBLE_BLOCK_KN_N_M,
+                            density=paper.MARBLE_DENSITY_KG_M3, log=print, cache=CACHE):
+    """(damping, measured restitution, YADE runs made) for the stated ``restitution`` of
+    this block at ``kn``: bisection on the damping ratio in [0, 1], each step one YADE
+    free-rocking run unless ``cache`` (a JSON file, or None) holds it.  InputError (one
+    line, naming the reachable range) when the restitution lies outside what damping 0-1
+    gives."""
+    measured, runs = block_measure(height, width, depth, kn, density, cache)
+    damping, found = bisect_damping(restitution, measured,
+                                    f"this block (kn {kn:g} N/m)", log)
+    return damping, found, runs()
+
+
+# ---------------------------------------------------------------- any specimen
+def _scene(geometry, contact, numerics):
+    """(scene file, its one column dict) of the specimen (a column description as the
+    monolith of its outline) alone at the table's centre, at rest."""
+    from pipeline.scenario import ColumnSpec, scene_params
+    spec = ColumnSpec("specimen", "monolithic", 0.0, 0.0, geometry.monolithic())
+    scene = scene_params(columns=[spec], contact=contact, numerics=numerics, t_max=1.0)
+    return scene, scene.columns[0]
+
+
+def weakest_azimuth(column, step_deg=1.0):
+    """Azimuth (deg) toward which a scene column's critical angle is smallest (the weak
+    side), on a grid of ``step_deg``."""
+    from pipeline.scenario.scene_file import support_line
+    azimuths = [k * step_deg for k in range(int(round(360.0 / step_deg)))]
+    return min(azimuths, key=lambda a: support_line(column, a)["critical_angle_rad"])
+
+
+def specimen_rocking(geometry, damping, kn, azimuth_deg=None, release_ratio=RELEASE_RATIO,
+                     impacts=IMPACTS, **options):
+    """Free rocking of any specimen in YADE (a mesh specimen, or a column description as
+    the monolith of its outline): released from rest, turned about its footprint's
+    support line toward ``azimuth_deg`` (default the weak side, :func:`weakest_azimuth`)
+    by ``release_ratio`` of its critical angle that way
+    (:func:`pipeline.scenario.scene_file.released`).  The restitution of each impact
+    from the successive highest rises z_k of the centre of mass above its rest height:
+    the kinetic energy at an impact is the potential energy of the swing before, so
+    eta_k^2 = z_k+1 / z_k (for a rigid block Housner's amplitude formula, exactly).  The
+    rise is the rigid body's (the centre of mass above the lowest point of its base
+    outline, from its orientation), so the springs' static sink does not enter.
+    ``options``: other Contact and Numerics fields.  Returns dict restitution (mean over
+    the first ``impacts``), restitution_per_impact, impacts, azimuth_deg,
+    critical_angle_deg, release_deg."""
+    import dataclasses
+
+    import numpy as np
+    from scipy.spatial.transform import Rotation
+
+    from pipeline.outcome.columns import rotations
+    from pipeline.scenario import Contact, Numerics, run_yade
+    from pipeline.scenario.parameters import split_options
+    from pipeline.scenario.scene_file import base_points, released, support_line
+    from pipeline.scenario.writer import write_scenario
+
+    contact, numerics = split_options(options)
+    scene, column = _scene(geometry, Contact(**{**contact, "kn": kn, "damping": damping}),
+                           Numerics(**{"record_hz": 1000.0, "rest_duration_s": 0.3,
+                                       **numerics}))
+    azimuth = weakest_azimuth(column) if azimuth_deg is None else float(azimuth_deg)
+    line = support_line(column, azimuth)
+    alpha = line["critical_angle_rad"]
+    if not alpha > 0:
+        raise InputError(f"{geometry.name}: its centre of mass is not above its footprint "
+                         f"toward {azimuth:g} deg")
+    tilt = release_ratio * alpha
+    body = column["bodies"][0]
+    # duration: Housner's block of the same lever and height, its swings scaled by the
+    # specimen's own rocking frequency about the line (p^2 = m g R / I_pivot)
+    lever_height = line["pivot"] - line["com"]
+    radius = float(np.linalg.norm(lever_height - (lever_height @ line["axis"]) * line["axis"]))
+    rotation = np.asarray(body["rotation"], float)
+    inertia = line["axis"] @ rotation @ np.asarray(body["inertia"], float) @ rotation.T @ \
+        line["axis"] + body["mass"] * radius ** 2
+    p_specimen = math.sqrt(body["mass"] * scene.gravity * radius / inertia)
+    p_block = math.sqrt(0.75 * scene.gravity / radius)
+    h, b = 2 * radius * math.cos(alpha), 2 * radius * math.sin(alpha)
+    reference = rocking.housner_free_rocking(h, b, tilt, n_impacts=impacts)
+    duration = 1.5 * float(reference["peak_times"][impacts]) * p_block / p_specimen + 0.1
+    scene = dataclasses.replace(scene, columns=[released(column, azimuth, tilt)],
+                                t_max=duration)
+    with tempfile.TemporaryDirectory(prefix="toppling-contact-") as run_dir:
+        write_scenario(run_dir, scene)
+        trajectory = run_yade(run_dir)
+    turns = rotations(trajectory.quat[:, 0])
+    start = Rotation.from_matrix(rotation)
+    theta = (turns * start.inv()).as_rotvec() @ line["axis"]
+    points = base_points(body)
+    lowest = lambda r: (r.as_matrix()[..., 2, :] @ points.T).min(axis=-1)   # noqa: E731
+    rise = float(lowest(start)) - lowest(turns)
+    found = rocking.free_rocking_peaks(trajectory.t, theta, rise=rise)
+    z = found["rise_peaks"][:impacts + 1]
+    if z.size < 2 or not np.all(z > 0):
+        raise InputError(f"{geometry.name}: no impact with swings before and after it in "
+                         f"{duration:.2f} s of free rocking")
+    eta = np.sqrt(z[1:] / z[:-1])
+    return {"restitution": float(np.mean(eta)),
+            "restitution_per_impact": [float(e) for e in eta], "impacts": int(eta.size),
+            "azimuth_deg": azimuth, "critical_angle_deg": math.degrees(alpha),
+            "release_deg": math.degrees(tilt)}
+
+
+def specimen_measure(geometry, kn, azimuth_deg, cache=CACHE, **options):
+    """:func:`cached_measure` of the specimen's :func:`specimen_rocking` restitution (key:
+    the description's content, azimuth, kn, options)."""
+    from pipeline.files import content_hash
+    key = content_hash(geometry.to_dict(), azimuth_deg, kn, RELEASE_RATIO, IMPACTS, options)
+    return cached_measure(lambda damping: specimen_rocking(
+        geometry, damping, kn, azimuth_deg, **options)["restitution"], f"specimen {key}", cache)
