@@ -11,7 +11,7 @@ from pipeline.userfiles import Unreadable, keys_text, number, read_text
 CONTACT_KEYS = ("kn", "damping", "mu_s", "mu_k")
 INFORMATION_KEYS = ("restitution", "restitution_sd", "restitution_se", "impacts",
                     "restitution_per_impact", "housner_restitution", "block", "source",
-                    "damping_map")
+                    "damping_map", "damping_interval", "specimen")
 
 
 def load_contact_file(path):

@@ -24,6 +24,7 @@ RESTITUTION_TOLERANCE = 0.0005   # |measured - stated| restitution the bisection
 DAMPING_TOLERANCE = 0.002        # or the damping interval below this
 RELEASE_RATIO = 0.5              # released from rest at this fraction of alpha
 IMPACTS = 6
+SETTLING_IMPACTS = 1             # a specimen's first impacts not counted (see specimen_rocking)
 CACHE = RESULTS_DIR / "contact" / "restitution_map.json"
 
 
@@ -150,7 +151,7 @@ def weakest_azimuth(column, step_deg=1.0):
 
 
 def specimen_rocking(geometry, damping, kn, azimuth_deg=None, release_ratio=RELEASE_RATIO,
-                     impacts=IMPACTS, **options):
+                     impacts=IMPACTS, run_dir=None, **options):
     """Free rocking of any specimen in YADE (a mesh specimen, or a column description as
     the monolith of its outline): released from rest, turned about its footprint's
     support line toward ``azimuth_deg`` (default the weak side, :func:`weakest_azimuth`)
@@ -160,10 +161,21 @@ def specimen_rocking(geometry, damping, kn, azimuth_deg=None, release_ratio=RELE
     the kinetic energy at an impact is the potential energy of the swing before, so
     eta_k^2 = z_k+1 / z_k (for a rigid block Housner's amplitude formula, exactly).  The
     rise is the rigid body's (the centre of mass above the lowest point of its base
-    outline, from its orientation), so the springs' static sink does not enter.
-    ``options``: other Contact and Numerics fields.  Returns dict restitution (mean over
-    the first ``impacts``), restitution_per_impact, impacts, azimuth_deg,
-    critical_angle_deg, release_deg."""
+    outline, from its orientation), so the springs' static sink does not enter.  A rock
+    rocks in 3D: its swings to either side differ and part of its energy wobbles about
+    the other axis, so its peak rises scatter from impact to impact
+    (``restitution_from_rises``); the restitution is taken from its whole energy instead
+    (kinetic, of translation and rotation, and the rise; the median over the middle half
+    of each swing), E_k+1 / E_k = eta_k^2, which for a block is the same as the rises.
+    The first SETTLING_IMPACTS impacts are not counted (released about one point of its
+    footprint, a rock settles onto the edge it rocks about there), and the restitution
+    is the geometric mean of the next ``impacts`` (E_n / E_0)^(1 / 2n): the mean decay of
+    its energy per impact (for a block, the mean of its impacts').  ``options``: other Contact and Numerics fields.  Returns dict
+    restitution (over the first ``impacts``, an even number: whole cycles),
+    restitution_per_impact, impacts, azimuth_deg,
+    critical_angle_deg, release_deg, and the record (t s, tilt rad about the support
+    line, rise m).  ``run_dir``: keep the run there (default: a temporary directory)."""
+    import contextlib
     import dataclasses
 
     import numpy as np
@@ -197,13 +209,15 @@ def specimen_rocking(geometry, damping, kn, azimuth_deg=None, release_ratio=RELE
     p_specimen = math.sqrt(body["mass"] * scene.gravity * radius / inertia)
     p_block = math.sqrt(0.75 * scene.gravity / radius)
     h, b = 2 * radius * math.cos(alpha), 2 * radius * math.sin(alpha)
-    reference = rocking.housner_free_rocking(h, b, tilt, n_impacts=impacts)
-    duration = 1.5 * float(reference["peak_times"][impacts]) * p_block / p_specimen + 0.1
+    counted = impacts + SETTLING_IMPACTS
+    reference = rocking.housner_free_rocking(h, b, tilt, n_impacts=counted)
+    duration = 1.5 * float(reference["peak_times"][counted]) * p_block / p_specimen + 0.1
     scene = dataclasses.replace(scene, columns=[released(column, azimuth, tilt)],
                                 t_max=duration)
-    with tempfile.TemporaryDirectory(prefix="toppling-contact-") as run_dir:
-        write_scenario(run_dir, scene)
-        trajectory = run_yade(run_dir)
+    with contextlib.nullcontext(run_dir) if run_dir is not None else \
+            tempfile.TemporaryDirectory(prefix="toppling-contact-") as where:
+        write_scenario(where, scene)
+        trajectory = run_yade(where)
     turns = rotations(trajectory.quat[:, 0])
     start = Rotation.from_matrix(rotation)
     theta = (turns * start.inv()).as_rotvec() @ line["axis"]
@@ -211,15 +225,29 @@ def specimen_rocking(geometry, damping, kn, azimuth_deg=None, release_ratio=RELE
     lowest = lambda r: (r.as_matrix()[..., 2, :] @ points.T).min(axis=-1)   # noqa: E731
     rise = float(lowest(start)) - lowest(turns)
     found = rocking.free_rocking_peaks(trajectory.t, theta, rise=rise)
-    z = found["rise_peaks"][:impacts + 1]
+    z = found["rise_peaks"][SETTLING_IMPACTS:counted + 1]
     if z.size < 2 or not np.all(z > 0):
         raise InputError(f"{geometry.name}: no impact with swings before and after it in "
                          f"{duration:.2f} s of free rocking")
-    eta = np.sqrt(z[1:] / z[:-1])
-    return {"restitution": float(np.mean(eta)),
+    # its whole energy above rest (J): translation, rotation, rise
+    inertia_world = turns.as_matrix() @ np.asarray(body["inertia"], float) @ \
+        turns.as_matrix().transpose(0, 2, 1)
+    w = trajectory.angvel[:, 0]
+    energy = body["mass"] * (0.5 * (trajectory.vel[:, 0] ** 2).sum(axis=1) +
+                             scene.gravity * rise) + \
+        0.5 * np.einsum("ti,tij,tj->t", w, inertia_world, w)
+    times = np.concatenate([[trajectory.t[0]], found["impact_times"]])
+    swings = [np.median(energy[(trajectory.t > a + 0.25 * (b - a)) &
+                               (trajectory.t < b - 0.25 * (b - a))])
+              for a, b in zip(times[:-1], times[1:])][SETTLING_IMPACTS:counted + 1]
+    eta = np.sqrt(np.asarray(swings[1:]) / swings[:-1])
+    eta_rise = np.sqrt(z[1:] / z[:-1])
+    return {"restitution": float((swings[-1] / swings[0]) ** (0.5 / eta.size)),
             "restitution_per_impact": [float(e) for e in eta], "impacts": int(eta.size),
+            "restitution_from_rises": float((z[-1] / z[0]) ** (0.5 / eta_rise.size)),
+            "restitution_per_impact_from_rises": [float(e) for e in eta_rise],
             "azimuth_deg": azimuth, "critical_angle_deg": math.degrees(alpha),
-            "release_deg": math.degrees(tilt)}
+            "release_deg": math.degrees(tilt), "t": trajectory.t, "tilt": theta, "rise": rise}
 
 
 def specimen_measure(geometry, kn, azimuth_deg, cache=CACHE, **options):
