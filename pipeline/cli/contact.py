@@ -195,7 +195,8 @@ def run(args):
             extra = {"depth_m": depth, "density_kg_m3": density}
         else:
             measured_at, runs = contact_map.specimen_measure(geometry, kn, azimuth)
-            extra = {"azimuth_deg": azimuth, "release_ratio": contact_map.RELEASE_RATIO}
+            extra = {"azimuth_deg": azimuth,
+                     "release_ratios": list(contact_map.SPECIMEN_RELEASES)}
         reach = f"{what} (kn {kn:g} N/m)"
         damping, measured = contact_map.bisect_damping(fit["restitution"], measured_at, reach)
         interval = contact_map.damping_interval(fit["restitution"], fit["restitution_se"],

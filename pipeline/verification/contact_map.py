@@ -24,6 +24,7 @@ RESTITUTION_TOLERANCE = 0.0005   # |measured - stated| restitution the bisection
 DAMPING_TOLERANCE = 0.002        # or the damping interval below this
 RELEASE_RATIO = 0.5              # released from rest at this fraction of alpha
 IMPACTS = 6
+SPECIMEN_RELEASES = (0.3, 0.4, 0.5)   # a specimen's map: the median over these releases
 SETTLING_IMPACTS = 1             # a specimen's first impacts not counted (see specimen_rocking)
 CACHE = RESULTS_DIR / "contact" / "restitution_map.json"
 
@@ -88,6 +89,10 @@ def bisect_damping(restitution, measured, what, log=print, clip=False):
             low = middle
         else:
             high = middle
+    if best[0] > RESTITUTION_TOLERANCE:
+        log(f"warning: {what}: restitution {restitution:.4f} not met within "
+            f"{RESTITUTION_TOLERANCE:g}: the nearest measured is {best[2]:.4f} at damping "
+            f"{best[1]:.4f} (the restitution does not fall smoothly with the damping there)")
     return best[1], best[2]
 
 
@@ -103,10 +108,10 @@ def damping_interval(restitution, restitution_se, measured, what, log=print):
     if restitution_se is None:
         return None
     upper, lower = restitution + restitution_se, restitution - restitution_se
-    low, r_upper = bisect_damping(upper, measured, what, log, clip=True)
-    high, r_lower = bisect_damping(lower, measured, what, log, clip=True)
-    clipped = [name for name, r, m in (("low", upper, r_upper), ("high", lower, r_lower))
-               if abs(r - m) > RESTITUTION_TOLERANCE]
+    low, _ = bisect_damping(upper, measured, what, log, clip=True)
+    high, _ = bisect_damping(lower, measured, what, log, clip=True)
+    clipped = [name for name, r, end in (("low", upper, 0.0), ("high", lower, 1.0))
+               if (r > measured(end) if end == 0.0 else r < measured(end))]
     return {"low": low, "high": high, "restitution_low": lower, "restitution_high": upper,
             "clipped": clipped, "meaning": INTERVAL_MEANING}
 
@@ -251,9 +256,15 @@ def specimen_rocking(geometry, damping, kn, azimuth_deg=None, release_ratio=RELE
 
 
 def specimen_measure(geometry, kn, azimuth_deg, cache=CACHE, **options):
-    """:func:`cached_measure` of the specimen's :func:`specimen_rocking` restitution (key:
-    the description's content, azimuth, kn, options)."""
+    """:func:`cached_measure` of the specimen's restitution: the median of
+    :func:`specimen_rocking` over the releases SPECIMEN_RELEASES (a rock's single
+    releases scatter; key: the description's content, azimuth, kn, options)."""
+    import statistics
+
     from pipeline.files import content_hash
-    key = content_hash(geometry.to_dict(), azimuth_deg, kn, RELEASE_RATIO, IMPACTS, options)
-    return cached_measure(lambda damping: specimen_rocking(
-        geometry, damping, kn, azimuth_deg, **options)["restitution"], f"specimen {key}", cache)
+    key = content_hash(geometry.to_dict(), azimuth_deg, kn, SPECIMEN_RELEASES, IMPACTS,
+                       options)
+    return cached_measure(lambda damping: statistics.median(
+        specimen_rocking(geometry, damping, kn, azimuth_deg, release_ratio=ratio,
+                         **options)["restitution"] for ratio in SPECIMEN_RELEASES),
+        f"specimen {key}", cache)

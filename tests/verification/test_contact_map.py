@@ -116,3 +116,14 @@ def test_specimen_path_equals_the_block_path_on_the_marble_block():
     from pipeline.verification.contact_map import _scene, weakest_azimuth
     from pipeline.scenario import Contact, Numerics
     assert weakest_azimuth(_scene(block, Contact(), Numerics())[1]) % 180.0 == 0.0
+
+
+def test_a_restitution_the_bisection_cannot_meet_is_said():
+    """A measure with a step (as a rock's scattered restitution can have) leaves the
+    stated value unmet: the nearest is returned and a warning line says so."""
+    from pipeline.verification.contact_map import bisect_damping
+    lines = []
+    damping, found = bisect_damping(0.965, lambda d: 0.99 if d < 0.3 else 0.94, "a step",
+                                     log=lines.append)
+    assert found in (0.99, 0.94) and (damping < 0.3) == (found == 0.99)
+    assert "not met" in lines[-1] and "a step" in lines[-1]
