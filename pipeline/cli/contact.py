@@ -194,7 +194,8 @@ def run(args):
             measured_at, runs = contact_map.block_measure(height, width, depth, kn, density)
             extra = {"depth_m": depth, "density_kg_m3": density}
         else:
-            measured_at, runs = contact_map.specimen_measure(geometry, kn, azimuth)
+            measured_at, measures = contact_map.specimen_measure(geometry, kn, azimuth)
+            runs = lambda: measures() * len(contact_map.SPECIMEN_RELEASES)   # noqa: E731
             extra = {"azimuth_deg": azimuth,
                      "release_ratios": list(contact_map.SPECIMEN_RELEASES)}
         reach = f"{what} (kn {kn:g} N/m)"
