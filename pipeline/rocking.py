@@ -718,9 +718,10 @@ def _below_barrier(theta, omega, alpha, R, I0, g):
     return (np.abs(theta) < alpha) & (energy < g * R)
 
 
-def free_rocking_peaks(t, theta):
+def free_rocking_peaks(t, theta, rise=None):
     """Impacts and amplitudes of a recorded free-rocking decay: ``t`` (s, increasing) and
-    ``theta`` (rad, signed tilt).  An impact is a change of sign of theta (linear
+    ``theta`` (rad, signed tilt); with ``rise`` (m, the centre of mass above its rest
+    height, one per sample) also the highest rise of each swing (``rise_peaks``).  An impact is a change of sign of theta (linear
     interpolation between samples); the amplitude of a swing is the largest |theta|
     between two impacts (the first swing: from the start to the first impact).  Returns
     dict: impact_times (s), peaks (rad, index k = amplitude after k impacts), swing_s
@@ -740,9 +741,16 @@ def free_rocking_peaks(t, theta):
     peaks = np.array([np.max(np.abs(theta[a:b])) for a, b in zip(bounds[:-1], bounds[1:])
                       if b > a])
     # the swing after the last impact counts only when it has turned back (a peak inside)
-    if crossing.size and np.argmax(np.abs(theta[bounds[-2]:])) == t.size - 1 - bounds[-2]:
+    turned = not (crossing.size and
+                  np.argmax(np.abs(theta[bounds[-2]:])) == t.size - 1 - bounds[-2])
+    if not turned:
         peaks = peaks[:-1]
-    return dict(impact_times=impacts, peaks=peaks, swing_s=np.diff(impacts))
+    out = dict(impact_times=impacts, peaks=peaks, swing_s=np.diff(impacts))
+    if rise is not None:
+        rise = np.asarray(rise, float)
+        out["rise_peaks"] = np.array([np.max(rise[a:b]) for a, b in
+                                      zip(bounds[:-1], bounds[1:]) if b > a])[:peaks.size]
+    return out
 
 
 def fit_free_rocking(height, width, t=None, theta=None, frequency_hz=None,

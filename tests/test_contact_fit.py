@@ -91,6 +91,15 @@ def test_command_writes_the_contact_file(tmp_path, capsys):
      "go\\(es\\) with --damping-map"),
     (["--block", "0.4,0.08", "--frequency-hz", "2", "--amplitude-ratio", "0.5", "--damping-map",
       "--density", "5"], "density"),
+    (["--frequency-hz", "2", "--amplitude-ratio", "0.5"], "either --block"),
+    (["--block", "0.4,0.08", "--column-file", "doric-peristyle", "--frequency-hz", "2",
+      "--amplitude-ratio", "0.5"], "either --block"),
+    (["--block", "0.4,0.08", "--azimuth", "90", "--frequency-hz", "2",
+      "--amplitude-ratio", "0.5"], "--azimuth goes with --column-file"),
+    (["--column-file", "doric-peristyle", "--azimuth", "360", "--frequency-hz", "2",
+      "--amplitude-ratio", "0.5"], "--azimuth must be in"),
+    (["--column-file", "doric-peristyle", "--depth", "0.1", "--frequency-hz", "2",
+      "--amplitude-ratio", "0.5"], "go\\(es\\) with --block"),
 ])
 def test_command_refuses_bad_input(tmp_path, capsys, argv, message):
     target = tmp_path / "contact.json"
@@ -138,3 +147,25 @@ def test_contact_file_values_are_range_checked_and_not_doubled(tmp_path, capsys)
                      "0.2", "--out", str(tmp_path / "b")]) == 2
     assert "not both" in capsys.readouterr().err
     assert not (tmp_path / "a").exists() and not (tmp_path / "b").exists()
+
+
+def test_a_column_file_is_read_as_its_equivalent_block(tmp_path, capsys):
+    """A column description's decay is read with the block of its critical angle toward
+    the azimuth: a box column's equivalent block is the box itself (Housner's value of
+    its width over height)."""
+    box = tmp_path / "box.json"
+    box.write_text(json.dumps({"name": "box", "density": 2700, "blocks": [
+        {"shape": "box", "height": H, "width": B, "depth": 0.2}]}))
+    target = tmp_path / "contact.json"
+    assert cli.main(["contact", "--frequency-hz", "2.4", "--amplitude-ratio", "0.74,0.73",
+                     "--column-file", str(box), "--azimuth", "90", "--out", str(target)]) == 0
+    written = json.loads(target.read_text())
+    alpha = math.atan(B / H)
+    assert written["specimen"]["critical_angle_deg"] == pytest.approx(math.degrees(alpha),
+                                                                       abs=1e-6)
+    assert written["housner_restitution"] == pytest.approx(1 - 1.5 * math.sin(alpha) ** 2)
+    by_block = tmp_path / "block.json"
+    assert cli.main(["contact", "--frequency-hz", "2.4", "--amplitude-ratio", "0.74,0.73",
+                     "--block", f"{H},{B}", "--out", str(by_block)]) == 0
+    assert written["restitution"] == pytest.approx(
+        json.loads(by_block.read_text())["restitution"], abs=1e-9)

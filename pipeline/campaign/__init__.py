@@ -115,8 +115,12 @@ def run_campaign(name, jobs=None, records=None, campaign_dir=None, animations=1,
             core_s = [s.tags.get("core_s", campaign.run_core_s) for s in todo]   # a run's own
             check_long(f"campaign {name}", len(todo), sum(core_s) / max(len(todo), 1), jobs,
                        allow_long, "fewer records, members or parameter values")
+        provenance = {}
+        if (options or {}).get("contact_file") is not None:     # which file, its values
+            from pipeline.scenario.contact_file import contact_provenance
+            provenance["contact_file"] = contact_provenance(options["contact_file"])
         return _run_specs(campaign, name, specs, campaign_dir, jobs, animations, executor,
-                          scheduler)
+                          scheduler, provenance)
     except (InputError, ToolError, OSError):
         if not existed and not (campaign_dir / "campaign.json").exists() and \
                 not any(campaign_dir.glob("runs/*/summary.json")):
@@ -172,8 +176,10 @@ def reuse_finished(specs, campaign_dir, worker):
     return copied
 
 
-def _run_specs(campaign, name, specs, campaign_dir, jobs, animations, executor, scheduler):
-    """Execute the specs and write the campaign's outputs (see :func:`run_campaign`)."""
+def _run_specs(campaign, name, specs, campaign_dir, jobs, animations, executor, scheduler,
+               provenance=None):
+    """Execute the specs and write the campaign's outputs (see :func:`run_campaign`);
+    ``provenance``: more entries of campaign.json (the contact file run with)."""
     with DirectoryLock(campaign_dir, wait=False):
         inside = RESULTS_DIR.resolve() in Path(campaign_dir).resolve().parents
         reused = reuse_finished(specs, campaign_dir, campaign.worker) if inside else 0
@@ -188,7 +194,7 @@ def _run_specs(campaign, name, specs, campaign_dir, jobs, animations, executor, 
         write_json(campaign_dir / "campaign.json", {
             "campaign": name, "runs": len(specs), "interrupted": interrupted,
             "failed": [{"run_id": s.run_id, "record": s.record, "error": str(e)}
-                       for s, e in failures], **result})
+                       for s, e in failures], **result, **(provenance or {})})
     if interrupted:
         raise KeyboardInterrupt
     if failures:

@@ -9,7 +9,9 @@ from pipeline.constants import COLUMN_KINDS
 from pipeline import paper
 from pipeline.campaign import Campaign, register
 from pipeline.campaign.options import (CAMPAIGN_NOTE, CampaignOptions, ColumnFileOptions,
-                                       column_file_param, stiffness_param)
+                                       column_file_param, contact_file_param, contact_of,
+                                       stiffness_param)
+from pipeline.scenario.contact_file import contact_values, refuse_set_twice, with_contact
 from pipeline.campaign.run_dirs import finished_summary
 from pipeline.campaign.column_file import (at_slenderness, check_stiffness, column_kn,
                                            description, mark, matched_kn)
@@ -44,29 +46,42 @@ def _records_or(records, default):
     return list(records) if records else list(default)
 
 
-def slenderness_specs(records, campaign_dir, column_file=None, stiffness="matched"):
+def _contact(contact_file):
+    """The contact values of ``--contact-file`` (None without one)."""
+    return None if contact_file is None else contact_values(contact_file)
+
+
+def slenderness_specs(records, campaign_dir, column_file=None, stiffness="matched",
+                      contact_file=None):
     """h/d sweep of the twin model; with a description, the described column's block
     heights scaled to each h/d (:func:`pipeline.campaign.column_file.at_slenderness`)."""
     data = description(column_file)
     check_stiffness(stiffness)
+    contact = _contact(contact_file)
     recs = _records_or(records, [paper.SWEEP_RECORD, pulse_record()])
     if data is None:
-        return column_specs([(r, twin(hd=hd)) for r in recs for hd in paper.SLENDERNESS_HD],
+        return column_specs(with_contact([(r, twin(hd=hd)) for r in recs
+                                          for hd in paper.SLENDERNESS_HD], contact),
                             campaign_dir)
     sweep = []
     for hd in paper.SLENDERNESS_HD:
         scaled = at_slenderness(data, hd)
         sweep.append(twin(hd=hd, column_file=scaled, kn=column_kn(scaled, stiffness)))
-    return mark(column_specs([(r, p) for r in recs for p in sweep], campaign_dir), data)
+    return mark(column_specs(with_contact([(r, p) for r in recs for p in sweep], contact),
+                             campaign_dir), data)
 
 
-def friction_specs(records, campaign_dir, column_file=None, stiffness="matched"):
+def friction_specs(records, campaign_dir, column_file=None, stiffness="matched",
+                   contact_file=None):
     data = description(column_file, meshes=True)
     check_stiffness(stiffness)
+    contact = _contact(contact_file)
+    refuse_set_twice(contact, ("mu_s", "mu_k"), "the friction campaign's sweep")
     runs = [(r, twin(mu_s=mu, mu_k=round(paper.MU_K_OVER_MU_S * mu, 4)))
             for r in _records_or(records, [paper.SWEEP_RECORD, pulse_record()])
             for mu in paper.FRICTION_MU_S]
-    return mark(column_specs(described_twins(runs, data, stiffness), campaign_dir), data)
+    return mark(column_specs(with_contact(described_twins(runs, data, stiffness), contact),
+                             campaign_dir), data)
 
 
 register(Campaign(
@@ -86,11 +101,13 @@ def _nearsource_records():
     return sets.record_ids("nearsource")
 
 
-def records_specs(records, campaign_dir, column_file=None, stiffness="matched"):
+def records_specs(records, campaign_dir, column_file=None, stiffness="matched",
+                  contact_file=None):
     data = description(column_file, meshes=True)
     check_stiffness(stiffness)
     runs = [(r, twin()) for r in (list(records) if records else _nearsource_records())]
-    return mark(column_specs(described_twins(runs, data, stiffness), campaign_dir), data)
+    return mark(column_specs(with_contact(described_twins(runs, data, stiffness),
+                                          _contact(contact_file)), campaign_dir), data)
 
 
 register(Campaign(
@@ -113,9 +130,11 @@ def signal_window(record):
     return [start, round(start + float(signal_end_s(motion.acc, motion.dt)), 6)]
 
 
-def synthetic_specs(records, campaign_dir, column_file=None, stiffness="matched"):
+def synthetic_specs(records, campaign_dir, column_file=None, stiffness="matched",
+                    contact_file=None):
     data = description(column_file, meshes=True)
     check_stiffness(stiffness)
+    contact = _contact(contact_file)
     paths = list(records) if records else [
         p for source_paths in synthetics.generate_sources(synthetics.SOURCES).values()
         for p in source_paths]
@@ -123,7 +142,8 @@ def synthetic_specs(records, campaign_dir, column_file=None, stiffness="matched"
     for path in paths:
         window = signal_window(path)
         runs.append((str(path), twin(window=window) if window else twin()))
-    return mark(column_specs(described_twins(runs, data, stiffness), campaign_dir), data)
+    return mark(column_specs(with_contact(described_twins(runs, data, stiffness), contact),
+                             campaign_dir), data)
 
 
 def synthetic_outputs(specs, campaign_dir, failures, animations, figures=True):
@@ -150,11 +170,12 @@ register(Campaign("synthetic", "the twin model at synthetic sites around two sou
 
 # ---------------------------------------------------------------- real columns
 def columns_specs(records, campaign_dir, column_files=None, column="both",
-                  stiffness="matched"):
+                  stiffness="matched", contact_file=None):
     """Every column description (default: the shipped examples) on the same records
     (default: the sweep record and the pulse record), each with a monolith of its
     outline beside it (``column`` both); ``stiffness`` "matched" gives each column the
-    contact stiffness of :func:`matched_kn`, "paper" the paper's kn for all."""
+    contact stiffness of :func:`matched_kn`, "paper" the paper's kn for all; a contact
+    file's values (its kn too) go over them."""
     names = list(column_files) if column_files else example_names()
     geometries = [ColumnGeometry.load(name) for name in names]
     if column not in COLUMN_KINDS:
@@ -166,6 +187,7 @@ def columns_specs(records, campaign_dir, column_files=None, column="both",
     for g in geometries:
         kn = matched_kn(g) if stiffness == "matched" else paper.COLUMN_KN_N_M
         runs += [(r, twin(column=column, column_file=g.to_dict(), kn=kn)) for r in recs]
+    runs = with_contact(runs, _contact(contact_file))
     return column_specs(runs, campaign_dir,
                         tags=[{"description": p["column_file"]["name"]} for _, p in runs])
 
@@ -243,11 +265,15 @@ class ColumnsOptions(CampaignOptions):
                         "drums: the description only; monolithic: the monolith only",
                         flag="--column", choices=COLUMN_KINDS)
     stiffness: str = stiffness_param("")
+    contact_file: str = contact_file_param("its kn replaces --stiffness's")
+
+    def check(self):
+        contact_of(self)
 
     def kwargs(self):
         files = [f for f in (self.column_files or "").split(",") if f]
         return {"column_files": files or None, "column": self.column,
-                "stiffness": self.stiffness}
+                "stiffness": self.stiffness, "contact_file": self.contact_file}
 
 
 register(Campaign(

@@ -48,7 +48,9 @@ from pipeline import paper
 from pipeline.campaign import Campaign, register
 from pipeline.campaign.column_file import (check_stiffness, column_kn, mark, perturbed,
                                            summary_entry)
-from pipeline.campaign.options import CampaignOptions, column_file_param, stiffness_param
+from pipeline.campaign.options import (CampaignOptions, column_file_param, contact_file_param,
+                                       contact_of, stiffness_param)
+from pipeline.scenario.contact_file import contact_values, refuse_set_twice
 from pipeline.scenario.parameters import check_time_step, param
 from pipeline.campaign.column_file import description as column_file_description
 from pipeline.campaign.runs import column_specs, run_column_spec
@@ -208,6 +210,28 @@ def paper_drums(height, diameter):
             "blocks": [dict(drum) for _ in range(paper.N_DRUMS)]}
 
 
+SAMPLED_CONTACT = {"mu_s": ("mu_s", "mu_k"), "damping": ("damping",)}   # range: file fields
+
+
+def contact_ranges(ranges, contact, vary=None):
+    """The ranges without those a contact file fixes (``contact``: its values, or None):
+    its damping and friction replace the sampled ones; its kn is what kn_factor
+    multiplies.  A ``vary`` range of a field the file sets is refused (one line)."""
+    if not contact:
+        return ranges
+    refuse_set_twice(contact, [f for name in (vary or {}) for f in SAMPLED_CONTACT.get(name, ())
+                               if name in SAMPLED_CONTACT], "--vary")
+    return {k: v for k, v in ranges.items()
+            if not any(f in contact for f in SAMPLED_CONTACT.get(k, ()))}
+
+
+def with_fixed_contact(rows, contact):
+    """Member parameters with a contact file's damping and friction (its kn is the base
+    of their kn, given to the sampling)."""
+    fixed = {k: v for k, v in (contact or {}).items() if k != "kn"}
+    return [{**row, **fixed} for row in rows]
+
+
 def nominal(column="both", description=None, kn=None):
     """The nominal run: the paper's values (and a description as described, with ``kn``)."""
     params = {"column": column, "hd": paper.COLUMN_HD, "mu_s": paper.MU_STATIC,
@@ -219,9 +243,10 @@ def nominal(column="both", description=None, kn=None):
 
 def ensemble_specs(records, campaign_dir, record=None, column="both", members=DEFAULT_MEMBERS,
                    seed=DEFAULT_SEED, vary=None, column_file=None, stiffness="matched",
-                   batch=None, record_members=None, **_):
+                   batch=None, record_members=None, contact_file=None, **_):
     """Specs of the nominal run and ``members`` members per record (``record_members``:
-    {record: members} overrides it per record), sampled in batches of ``batch``."""
+    {record: members} overrides it per record), sampled in batches of ``batch``; a
+    contact file fixes what it sets (:func:`contact_ranges`)."""
     data = column_file_description(column_file)
     records = list(records or []) + ([record] if record else [])
     if not records:
@@ -229,18 +254,22 @@ def ensemble_specs(records, campaign_dir, record=None, column="both", members=DE
     if column not in COLUMN_KINDS:
         raise InputError(f"--column must be both, monolithic or drums, got {column!r}")
     check_stiffness(stiffness)
-    ranges = dict(ENSEMBLE_RANGES, **(vary or {}))
+    contact = None if contact_file is None else contact_values(contact_file)
+    ranges = contact_ranges(dict(ENSEMBLE_RANGES, **(vary or {})), contact, vary)
     batch = batch or members
     counts = {rec: (record_members or {}).get(rec, members) for rec in records}
     most = max(counts.values())
     if data is None:
-        member_params = sample_batches(most, batch, seed, ranges, column)
+        member_params = sample_batches(most, batch, seed, ranges, column,
+                                       kn=(contact or {}).get("kn", paper.COLUMN_KN_N_M))
         nominal_params = nominal(column)
     else:
-        kn = column_kn(data, stiffness)
+        kn = (contact or {}).get("kn") or column_kn(data, stiffness)
         member_params = sample_batches(most, batch, seed, ranges, column, description=data,
                                        kn=kn)
         nominal_params = nominal(column, data, kn)
+    member_params = with_fixed_contact(member_params, contact)
+    nominal_params = {**nominal_params, **(contact or {})}
     runs, member_numbers = [], []
     for rec in records:
         runs.append((rec, nominal_params))
@@ -338,8 +367,12 @@ class EnsembleOptions(CampaignOptions):
         "blocks above the first (joined blocks keep theirs); with --column both a monolith "
         "of its outline stands beside it")
     stiffness: str = stiffness_param("with --column-file, what kn_factor multiplies")
+    contact_file: str = contact_file_param(
+        "its damping and friction for every member (not sampled), its kn what kn_factor "
+        "multiplies (replacing --stiffness's)")
 
     def check(self):
+        contact_ranges(ENSEMBLE_RANGES, contact_of(self), parse_vary(self.vary))
         if not self.members <= self.max_members:
             raise InputError(f"--max-members must lie in [--members, 10000], got "
                              f"{self.max_members}")

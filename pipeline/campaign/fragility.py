@@ -54,7 +54,9 @@ from pipeline.campaign.column_file import check_stiffness, column_kn, mark
 from pipeline.campaign.column_file import description as column_file_description
 from pipeline.campaign.fragility_block import DEFAULT_AZIMUTHS
 from pipeline.campaign.fragility_outputs import fragility_outputs
-from pipeline.campaign.options import CampaignOptions, column_file_param, stiffness_param
+from pipeline.campaign.options import (CampaignOptions, column_file_param, contact_file_param,
+                                       contact_of, stiffness_param)
+from pipeline.scenario.contact_file import contact_values
 from pipeline.campaign.run_dirs import finished_summary
 from pipeline.campaign.runs import column_specs, motion_cache, pulse_record, run_column_spec
 from pipeline.constants import COLUMN_KINDS
@@ -97,14 +99,17 @@ def fragility_specs(records, campaign_dir, levels=DEFAULT_LEVELS, members=DEFAUL
                     column="both", seed=None, azimuths=DEFAULT_AZIMUTHS, column_file=None,
                     stiffness="matched", pulses=None, azimuth=None,
                     headings=DEFAULT_HEADINGS, ranges=None, jobs=None, only_runs=None,
-                    adaptive=False, **_):
+                    adaptive=False, contact_file=None, **_):
     """Run specs: every record x level x member; ``scale`` = level / PGA of the record.
     With ``column_file`` every member is the described column with the sampled height
     and diameter tolerances (its own tilt and offsets as described), and the 2D block
     has each member's overall height and base width.  With ``pulses`` (the default for
     a mesh specimen: the preset vsr) the pulse grid of :mod:`pipeline.campaign.pulse_grid`
-    instead."""
+    instead.  A contact file fixes what it sets for every member
+    (:func:`pipeline.campaign.ensemble.contact_ranges`; on the pulse grid,
+    :func:`pipeline.campaign.pulse_grid.pulse_runs`)."""
     data = column_file_description(column_file, meshes=True)
+    contact = None if contact_file is None else contact_values(contact_file)
     mesh = data is not None and "mesh" in data
     if pulses is None and mesh and not records:
         pulses = "vsr"
@@ -112,7 +117,8 @@ def fragility_specs(records, campaign_dir, levels=DEFAULT_LEVELS, members=DEFAUL
                  "0.1-1.0 s, 10 x 10; --pulses to change it)")
     if pulses is not None:
         specs = _pulse_specs(records, campaign_dir, data, column, pulses, members, headings,
-                             azimuth, seed, ranges, stiffness, jobs, quiet=only_runs is not None)
+                             azimuth, seed, ranges, stiffness, jobs, quiet=only_runs is not None,
+                             contact=contact)
         if only_runs is not None:
             keep = set(only_runs)
             specs = [s.tagged(sampling="adaptive") for s in specs if s.run_id in keep]
@@ -133,13 +139,17 @@ def fragility_specs(records, campaign_dir, levels=DEFAULT_LEVELS, members=DEFAUL
         raise InputError(f"--azimuths must be an integer in [1, 360], got {azimuths!r}")
     seed = ensemble.DEFAULT_SEED if seed is None else seed
     # the 2D block needs each member's height and h/d: no tilt or offset descriptions here
-    ranges = {k: v for k, v in ensemble.ENSEMBLE_RANGES.items()
-              if k not in ensemble.GEOMETRY_KEYS}
+    ranges = ensemble.contact_ranges({k: v for k, v in ensemble.ENSEMBLE_RANGES.items()
+                                      if k not in ensemble.GEOMETRY_KEYS}, contact)
+    base_kn = (contact or {}).get("kn")
     if data is None:
-        member_params = ensemble.sample_members(members, seed, ranges, column=column)
+        member_params = ensemble.sample_members(members, seed, ranges, column=column,
+                                                kn=base_kn or paper.COLUMN_KN_N_M)
     else:
         member_params = ensemble.sample_members(members, seed, ranges, column=column,
-                                                description=data, kn=column_kn(data, stiffness))
+                                                description=data,
+                                                kn=base_kn or column_kn(data, stiffness))
+    member_params = ensemble.with_fixed_contact(member_params, contact)
     cache = motion_cache(campaign_dir)
     runs, extra = [], []
     for record in records:
@@ -158,7 +168,7 @@ def fragility_specs(records, campaign_dir, levels=DEFAULT_LEVELS, members=DEFAUL
 
 
 def _pulse_specs(records, campaign_dir, data, column, pulses, members, headings, azimuth,
-                 seed, ranges, stiffness, jobs, quiet=False):
+                 seed, ranges, stiffness, jobs, quiet=False, contact=None):
     """Run specs of the pulse grid (every cell x parameter set x heading), the cost said
     before any run."""
     if records:
@@ -169,7 +179,7 @@ def _pulse_specs(records, campaign_dir, data, column, pulses, members, headings,
     check_stiffness(stiffness)
     seed = ensemble.DEFAULT_SEED if seed is None else seed
     grid, sets, azimuths, runs = pulse_grid.pulse_runs(
-        data, column, pulses, members, headings, azimuth, seed, ranges, stiffness)
+        data, column, pulses, members, headings, azimuth, seed, ranges, stiffness, contact)
     cache = motion_cache(campaign_dir)
     pairs, tags = [], []
     for pga, ratio, params, tag in runs:
@@ -224,9 +234,14 @@ class FragilityOptions(CampaignOptions):
                            "(the 2D block as a guide, one probe run elsewhere, widened where a "
                            "probe disagrees or the specimen's own P is uncertain)",
                            flag="--adaptive")
+    contact_file: str = contact_file_param(
+        "its damping and friction for every member (not sampled or drawn), its kn what "
+        "kn_factor multiplies (scaled records, replacing --stiffness's) or every run's kn "
+        "(pulse grid); a --ranges of a field it sets is refused")
     TAKES_JOBS = True
 
     def check(self):
+        contact_of(self)
         parse_levels(self.levels)
         ensemble.check_seed(self.seed)
         if self.pulses is not None:

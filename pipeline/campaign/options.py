@@ -26,6 +26,24 @@ def stiffness_param(note="with --column-file"):
                  flag="--stiffness", choices=STIFFNESS_CHOICES)
 
 
+def contact_file_param(note=""):
+    """The ``--contact-file JSON`` field (a file ``contact`` writes); ``note``: how the
+    campaign uses it beside its own parameters."""
+    return param(None, "", "contact parameters (kn, damping; mu_s, mu_k) from a file "
+                 "`contact` writes, for every run" + (f"; {note}" if note else ""),
+                 flag="--contact-file", metavar="JSON")
+
+
+def contact_of(options):
+    """The contact values of an options object's ``contact_file`` (None without one),
+    checked before any run."""
+    if options.contact_file is None:
+        return None
+    from pipeline.scenario.contact_file import contact_values
+    return contact_values(options.contact_file)
+
+
+
 @dataclass(frozen=True)
 class CampaignOptions:
     """No options of its own.  Subclasses declare fields and may add :meth:`check`."""
@@ -48,3 +66,9 @@ class ColumnFileOptions(CampaignOptions):
     """A campaign of the twin model that can shake a described column instead."""
     column_file: str = column_file_param(CAMPAIGN_NOTE)
     stiffness: str = stiffness_param()
+    contact_file: str = contact_file_param(
+        "with --column-file its kn replaces --stiffness's")
+
+    def check(self):
+        contact_of(self)
+

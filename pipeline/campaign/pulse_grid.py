@@ -172,12 +172,22 @@ def pulse_file(cache_dir, pga_m_s2, pgv_pga_s):
 
 
 def pulse_runs(data, column, pulses, members, headings, azimuth, seed, ranges,
-               stiffness="matched"):
+               stiffness="matched", contact=None):
     """(pulse cells, [(pga, ratio, params, tags)]): every cell x parameter set x heading.
-    ``data``: the description dict (None: the paper's column)."""
+    ``data``: the description dict (None: the paper's column); ``contact``: a contact
+    file's values, fixed for every run (not drawn; a --ranges of a field it sets is
+    refused)."""
     mesh = data is not None and "mesh" in data
     grid = parse_pulses(pulses)
-    ranges = parse_ranges(ranges, mesh)
+    if contact:
+        from pipeline.scenario.contact_file import refuse_set_twice
+        given = parse_ranges(ranges, mesh=False)           # those --ranges names
+        refuse_set_twice(contact, [f for name in given
+                                   for f in ((name, "mu_k") if name == "mu_s" else (name,))],
+                         "--ranges")
+    ranges = {k: v for k, v in parse_ranges(ranges, mesh).items()
+              if not (contact and (k in contact or (k == "mu_s" and "mu_k" in contact)))}
+
     if not (isinstance(headings, int) and 1 <= headings <= 360):
         raise InputError(f"--headings must be an integer in [1, 360], got {headings!r}")
     if azimuth is not None:
@@ -199,13 +209,13 @@ def pulse_runs(data, column, pulses, members, headings, azimuth, seed, ranges,
         for j, pga_g in enumerate(grid["pga_g"]):
             for m, point in enumerate(sets):
                 for h in range(azimuths.shape[1]):
-                    params = {"column": "monolithic" if mesh else column,
+                    params = {"column": "monolithic" if mesh else column, **(contact or {}),
                               **{k: v for k, v in point.items() if k in GRID_CONTACT},
                               "rotate_deg": float(azimuths[m, h])}
                     if data is not None:
                         params["column_file"] = {**data, **{k: v for k, v in point.items()
                                                             if k in GRID_SPECIMEN}}
-                    if "kn" not in point and data is not None:
+                    if "kn" not in point and "kn" not in (contact or {}) and data is not None:
                         params["kn"] = column_kn(data, stiffness)
                     runs.append((round(float(pga_g) * G, 6), round(float(ratio), 6), params,
                                  {"cell": [i, j], "pga_g": float(pga_g),

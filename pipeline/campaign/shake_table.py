@@ -29,7 +29,9 @@ import pandas as pd
 
 from pipeline.campaign import Campaign, register
 from pipeline.campaign.run_dirs import finished_summary
-from pipeline.campaign.options import CampaignOptions, column_file_param
+from pipeline.campaign.options import (CampaignOptions, column_file_param, contact_file_param,
+                                       contact_of)
+from pipeline.scenario.contact_file import contact_values
 from pipeline.scenario.parameters import Contact, param
 from pipeline.files import InputError, write_csv, write_json
 from pipeline.records import RECORDS_DIR
@@ -141,11 +143,12 @@ def parse_grid(text):
     return points
 
 
-def grid_contact(point):
-    """The contact fields of a grid point: its values over the paper's; a point that
-    gives mu_s without mu_k gets Contact's kinetic friction for that mu_s."""
+def grid_contact(point, base=None):
+    """The contact fields of a grid point: its values over ``base`` (a contact file's
+    values) over the paper's; a point that gives mu_s without mu_k gets Contact's
+    kinetic friction for that mu_s."""
     given = {k: v for k, v in point.items() if k in GRID_CONTACT}
-    out = {**DEFAULT_CONTACT, **given}
+    out = {**DEFAULT_CONTACT, **(base or {}), **given}
     if "mu_s" in given and "mu_k" not in given:
         out["mu_k"] = Contact(mu_s=given["mu_s"]).mu_k
     return out
@@ -154,22 +157,24 @@ def grid_contact(point):
 def _label(point):
     return ", ".join(f"{k}={v:g}" for k, v in point.items()) or "defaults"
 
-def _run_params(specimen, point):
-    """Run parameters of one grid point: the specimen alone at the table's centre."""
+def _run_params(specimen, point, base=None):
+    """Run parameters of one grid point: the specimen alone at the table's centre
+    (``base``: a contact file's values, which the point's override)."""
     description = dict(specimen)
     for key in GRID_SPECIMEN:
         if key in point:
             description[key] = point[key]
     ColumnGeometry.from_dict(description)          # refuse a bad point before any run
-    contact = grid_contact(point)
+    contact = grid_contact(point, base)
     motion = {k: v for k, v in point.items() if k in GRID_MOTION and v}
     return {"column": "monolithic", "column_file": description, **contact, **motion}
 
 def specs(records, campaign_dir, experiments=EXPERIMENTS, specimen=SPECIMEN, outcome=OUTCOME,
           validate_from=VALIDATE_FROM, grid=DEFAULT_GRID, stage="calibration", chosen=None,
-          tests=None, axis_deg=AXIS_DEG):
+          tests=None, axis_deg=AXIS_DEG, contact_file=None):
     """Run specs of one stage: every grid point on the calibration tests, or the chosen
-    point on the validation tests."""
+    point on the validation tests; a contact file's values are the base the points
+    override."""
     if records:
         raise InputError("the shake-table campaign takes its motions from --experiments, "
                          "not --records")
@@ -180,10 +185,11 @@ def specs(records, campaign_dir, experiments=EXPERIMENTS, specimen=SPECIMEN, out
     split = date.fromisoformat(validate_from)
     frame = frame[(frame["day"] < split) if stage == "calibration" else (frame["day"] >= split)]
     description = ColumnGeometry.load(specimen).to_dict()
+    base = None if contact_file is None else contact_values(contact_file)
     points = parse_grid(grid) if stage == "calibration" else [chosen or {}]
     runs, meta = [], []
     for point in points:
-        params = _run_params(description, point)
+        params = _run_params(description, point, base)
         for row in frame.itertuples():
             runs.append((str(row.motion_path), params))
             meta.append({"test": row.test, "observed": bool(row.observed), "stage": stage,
@@ -313,7 +319,8 @@ def summarise(table, specimen, calibration, label, point, options):
                      f"{threshold_g:.2f} g {s['pga_threshold']['accuracy']:.3f}")
     return {"specimen": specimen.to_dict(), "critical_angle_deg": critical, "axis_deg": axis,
             "pga_threshold_g": threshold_g, "validate_from": options["validate_from"],
-            "grid": options["grid"], "chosen": {"label": label, "parameters": point},
+            "grid": options["grid"], "contact_file": options.get("contact_file"),
+            "chosen": {"label": label, "parameters": point},
             "calibration_scores": calibration["scores"], "splits": splits, "lines": lines}
 
 def _f(value):
@@ -341,8 +348,12 @@ class ShakeTableOptions(CampaignOptions):
                             0.0, 360.0, flag="--axis-deg", metavar="DEG")
     tests: str = param(None, "", "only these tests (a quick look; default all)",
                        flag="--tests", metavar="TEST,TEST")
+    contact_file: str = contact_file_param(
+        "its values are the base every --grid point starts from: a point's own values "
+        "override them")
 
     def check(self):
+        contact_of(self)
         try:
             date.fromisoformat(self.validate_from)
         except (TypeError, ValueError):
@@ -370,7 +381,8 @@ class ShakeTableOptions(CampaignOptions):
         return {"experiments": self.experiments, "outcome": self.outcome,
                 "specimen": self.column_file or SPECIMEN,
                 "validate_from": self.validate_from, "grid": self.grid,
-                "tests": self.test_names() or None, "axis_deg": self.axis_deg}
+                "tests": self.test_names() or None, "axis_deg": self.axis_deg,
+                "contact_file": self.contact_file}
 
 
 def _worker(spec, run_dir):

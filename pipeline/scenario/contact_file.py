@@ -11,7 +11,7 @@ from pipeline.userfiles import Unreadable, keys_text, number, read_text
 CONTACT_KEYS = ("kn", "damping", "mu_s", "mu_k")
 INFORMATION_KEYS = ("restitution", "restitution_sd", "restitution_se", "impacts",
                     "restitution_per_impact", "housner_restitution", "block", "source",
-                    "damping_map")
+                    "damping_map", "damping_interval", "specimen")
 
 
 def load_contact_file(path):
@@ -37,3 +37,41 @@ def load_contact_file(path):
         raise InputError(f"--contact-file {path.name}: no kn and damping (a restitution "
                          "alone: give `contact` --damping-map to map it onto the contact law)")
     return values
+
+
+def contact_values(path):
+    """The contact fields a contact file sets, range-checked by
+    :class:`~pipeline.scenario.parameters.Contact` (one-line InputError); a file that sets
+    mu_s without mu_k gets the kinetic friction a run gives that mu_s."""
+    from pipeline.scenario.parameters import Contact
+    values = load_contact_file(path)
+    contact = Contact(**values)
+    if "mu_s" in values and "mu_k" not in values:
+        values["mu_k"] = contact.mu_k
+    return values
+
+
+def contact_provenance(path):
+    """What a campaign records of the contact file it ran with: the file, its SHA-256
+    and the contact values taken from it."""
+    import hashlib
+    path = Path(path)
+    return {"file": str(path), "sha256": hashlib.sha256(path.read_bytes()).hexdigest(),
+            "values": contact_values(path)}
+
+
+def with_contact(runs, values):
+    """(record, parameters) pairs with a contact file's ``values`` over each run's
+    contact fields (unchanged for None)."""
+    if not values:
+        return list(runs)
+    return [(record, {**params, **values}) for record, params in runs]
+
+
+def refuse_set_twice(values, fields, what):
+    """One-line InputError when the contact file sets a field that ``what`` (a flag or
+    the campaign's own sweep) sets too."""
+    both = [k for k in fields if k in (values or {})]
+    if both:
+        raise InputError(f"--contact-file sets {', '.join(both)}, which {what} sets too: "
+                         "give it in one place, not both")

@@ -172,3 +172,56 @@ class SceneFile:
     def read(cls, run_dir):
         """The scene file of ``run_dir``."""
         return cls.from_dict(json.loads((run_dir / FILE_NAME).read_text()))
+
+
+def base_points(body, circle_points=720):
+    """Points (n, 3; m, body frame about the centre of mass) of the outline a scene body
+    (a :class:`SceneBody` as a dict) stands on: its base rim, in the rim's face."""
+    import numpy as np
+    rim = next(r for r in body["rims"] if r["role"] == "base")
+    if rim["kind"] == "points":
+        return np.asarray(rim["points"], float)
+    if rim["kind"] == "circle":
+        angle = 2 * np.pi * np.arange(circle_points) / circle_points
+        xy = rim["radius"] * np.column_stack([np.cos(angle), np.sin(angle)]) + rim["centre"]
+    else:
+        xy = np.asarray(rim["points"], float)
+    n = np.asarray(rim["normal"], float)
+    return np.column_stack([xy, rim["z"] - (n[0] * xy[:, 0] + n[1] * xy[:, 1]) / n[2]])
+
+
+def support_line(column, azimuth_deg):
+    """Where a scene column (a :class:`SceneColumn` as a dict) tips toward ``azimuth_deg``
+    (deg clockwise from North): dict pivot (3,) (the point of its bottom body's base
+    outline farthest that way, world m), axis (3,) (horizontal, across the azimuth: a
+    positive rotation about it leans the column that way), com (3,) (the column's centre
+    of mass, world m), critical_angle_rad (the tilt about that line at which the centre
+    of mass stands above it)."""
+    import numpy as np
+    a = np.radians(azimuth_deg)
+    u = np.array([np.sin(a), np.cos(a), 0.0])
+    bottom = column["bodies"][0]
+    world = np.asarray(bottom["centre"], float) + \
+        base_points(bottom) @ np.asarray(bottom["rotation"], float).T
+    pivot = world[np.argmax(world @ u)]
+    masses = np.array([b["mass"] for b in column["bodies"]])
+    com = masses @ np.array([b["centre"] for b in column["bodies"]], float) / masses.sum()
+    lever, height = float((pivot - com) @ u), float(com[2] - pivot[2])
+    return {"pivot": pivot, "axis": np.cross([0.0, 0.0, 1.0], u), "com": com,
+            "critical_angle_rad": float(np.arctan2(lever, height))}
+
+
+def released(column, azimuth_deg, tilt_rad):
+    """The scene column (dict) turned rigidly by ``tilt_rad`` about its support line
+    toward ``azimuth_deg`` (:func:`support_line`): a free-rocking release from rest, on
+    the edge of its footprint.  It never stops on energy (``settles`` False: it is
+    raised above its rest)."""
+    import numpy as np
+    from scipy.spatial.transform import Rotation
+    line = support_line(column, azimuth_deg)
+    turn = Rotation.from_rotvec(line["axis"] * tilt_rad).as_matrix()
+    pivot = line["pivot"]
+    bodies = [dict(b, centre=(pivot + turn @ (np.asarray(b["centre"], float) - pivot)).tolist(),
+                   rotation=(turn @ np.asarray(b["rotation"], float)).tolist())
+              for b in column["bodies"]]
+    return dict(column, bodies=bodies, settles=False)
