@@ -18,8 +18,14 @@ and ``twin``, the twin model's ensembles on one record at each factor
 same seed, so member m has the same sampled friction, damping, geometry and rim phase at
 every factor): P(toppled) with its Wilson interval, the fall directions' circular mean,
 resultant length and spread, how many members keep their outcome of x1 and how far
-the falls of those that fell at both turn, the time step and the wall time.  A part that
-has not run is said and left out.
+the falls of those that fell at both turn, the time step and the wall time; and
+``rock_restitution`` (with ``--free-rocking``, kept in ``DIR/free-rocking/rock.json``):
+the rock of the shake-table part rocking freely in YADE
+(:func:`pipeline.verification.contact_map.specimen_measure`: released toward
+``ROCK_AZIMUTH_DEG``, the median over three releases) at the part's footprint and
+damping per stiffness factor, and at its kn per damping ratio of ``ROCK_DAMPINGS``:
+the rocking restitution a damping ratio stands for.  A part that has not run is said and
+left out.
 """
 import math
 import re
@@ -42,6 +48,9 @@ PGA_SPLIT_G = 0.15
 KN = re.compile(r"kn=([0-9.eE+-]+)")
 TWIN_DIR = re.compile(r"twin-x([0-9.]+)$")
 FREE_ROCKING_FILE = Path("free-rocking") / "free_rocking.json"
+ROCK_FILE = Path("free-rocking") / "rock.json"
+ROCK_AZIMUTH_DEG = 90.0          # along the table's axis (+x, East), toward the weak side
+ROCK_DAMPINGS = (0.0, 0.05, 0.1, 0.36, 1.0)
 
 
 def _band(rows, reference):
@@ -186,6 +195,47 @@ def load_twin(campaign_dir):
     return pd.concat(frames, ignore_index=True), records.pop()
 
 
+def _grid_point(label):
+    """{name: value} of a campaign's grid-point label ("name=v, name=v")."""
+    return {name.strip(): float(value) for name, _, value in
+            (item.partition("=") for item in label.split(",")) if name.strip()}
+
+
+def rock_restitution(rock, specimen=None, log=print):
+    """The rock's rocking restitution in YADE at the rock part's footprint and damping
+    per stiffness factor, and at its x1 kn per damping ratio (ROCK_DAMPINGS and its
+    own); Housner's for a block of its critical angle beside (1 - 1.5 sin^2 alpha)."""
+    from pipeline.campaign.shake_table import SPECIMEN
+    from pipeline.scenario import ColumnGeometry
+    from pipeline.verification.contact_map import specimen_measure
+
+    point = {k: v for k, v in _grid_point(rock["grid_point"]).items()
+             if k not in ("kn", "rotate_deg")}
+    description = ColumnGeometry.load(specimen or SPECIMEN).to_dict()
+    if "footprint_tolerance_m" in point:
+        description["footprint_tolerance_m"] = point.pop("footprint_tolerance_m")
+    geometry = ColumnGeometry.from_dict(description)
+    damping = point.pop("damping")
+    options = {k: v for k, v in point.items() if k in ("mu_s", "mu_k")}
+
+    def measured(kn, d):
+        value = specimen_measure(geometry, kn, ROCK_AZIMUTH_DEG, **options)(d)
+        log(f"rock free rocking: kn {kn:g}, damping {d:g}: restitution {value:.4f}")
+        return value
+
+    first = min(r["kn"] for r in rock["factors"].values())
+    alpha = math.radians(geometry.critical_angle_along_deg(ROCK_AZIMUTH_DEG))
+    return {"specimen": geometry.name, "azimuth_deg": ROCK_AZIMUTH_DEG,
+            "footprint_tolerance_m": description.get("footprint_tolerance_m"),
+            "damping": damping, "friction": options,
+            "housner_block_restitution": 1.0 - 1.5 * math.sin(alpha) ** 2,
+            "critical_angle_along_deg": math.degrees(alpha),
+            "factors": {f: {"kn": r["kn"], "restitution": measured(r["kn"], damping)}
+                        for f, r in rock["factors"].items()},
+            "by_damping": [{"damping": d, "restitution": measured(first, d)}
+                           for d in sorted({*ROCK_DAMPINGS, damping})]}
+
+
 def summarise_all(campaign_dir, free_rocking=False, experiments=EXPERIMENTS, log=print):
     """convergence.json's content: the rock's part (:func:`summarise`, when
     ``calibration.csv`` is there), ``free_rocking`` (run now when ``free_rocking``, else
@@ -205,6 +255,12 @@ def summarise_all(campaign_dir, free_rocking=False, experiments=EXPERIMENTS, log
         out["free_rocking"] = read_run_json(kept, "free-rocking table")[1]
     else:
         log(f"free rocking: not run (--free-rocking runs it into {kept.parent})")
+    kept_rock = campaign_dir / ROCK_FILE
+    if free_rocking and "factors" in out:
+        out["rock_restitution"] = rock_restitution(out, log=log)
+        write_json(kept_rock, out["rock_restitution"])
+    elif kept_rock.is_file():
+        out["rock_restitution"] = read_run_json(kept_rock, "rock free-rocking table")[1]
     members, record = load_twin(campaign_dir)
     if members is not None:
         out["twin"] = twin_summary(members, record)
@@ -241,6 +297,14 @@ def table_lines(summary):
             lines.append(f"free rocking {body} at damping {entry['damping']:g}: restitution "
                          + ", ".join(f"{factor} {row['restitution']:.4f}"
                                      for factor, row in entry["factors"].items()))
+    rock = summary.get("rock_restitution")
+    if rock:
+        lines.append(f"free rocking {rock['specimen']} (damping {rock['damping']:g}): restitution "
+                     + ", ".join(f"{f} {r['restitution']:.4f}" for f, r in rock["factors"].items())
+                     + "; at x1 by damping " + ", ".join(
+                         f"{r['damping']:g}: {r['restitution']:.4f}" for r in rock["by_damping"])
+                     + f" (Housner's block of {rock['critical_angle_along_deg']:.1f} deg: "
+                     f"{rock['housner_block_restitution']:.4f})")
     twin = summary.get("twin")
     for factor, row in (twin or {}).get("factors", {}).items():
         parts = []

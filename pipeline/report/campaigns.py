@@ -179,6 +179,18 @@ def contact_stiffness_section(results):
                              **cost(r)})
         lines += [f"The twin model's ensembles on {twin['record']} (the same sampled members "
                   "at every factor):\n", _text_table(rows) + "\n"]
+    rock = conv.get("rock_restitution")
+    if rock:
+        rows = [{"kn": f"{k} ({r['kn']:g} N/m)", "damping ratio": f"{rock['damping']:g}",
+                 "restitution": f"{r['restitution']:.4f}"} for k, r in rock["factors"].items()]
+        rows += [{"kn": "x1", "damping ratio": f"{r['damping']:g}",
+                  "restitution": f"{r['restitution']:.4f}"} for r in rock["by_damping"]]
+        lines += [f"The rock {rock['specimen']} rocking freely in the same model (footprint "
+                  f"tolerance {rock['footprint_tolerance_m']:g} m, released toward "
+                  f"{rock['azimuth_deg']:g} deg; median over three releases): the rocking "
+                  "restitution a damping ratio stands for.  Housner's restitution for a "
+                  f"block of its critical angle that way ({rock['critical_angle_along_deg']:.1f} "
+                  f"deg) is {rock['housner_block_restitution']:.4f}.\n", _text_table(rows) + "\n"]
     return "\n".join(lines)
 
 

@@ -157,3 +157,31 @@ def test_twin_ensembles_read_from_their_campaign_directories(tmp_path):
     fake_ensemble(tmp_path / "twin-x3", "Q", [True, True], 1e-4, 4.0)
     with pytest.raises(InputError, match="different records"):
         cc.summarise_all(tmp_path, log=said.append)
+
+
+def test_rock_restitution_runs_the_rock_parts_point(monkeypatch):
+    """The rock's free rocking takes the shake-table part's footprint, damping and
+    friction, each factor's kn, and every damping of ROCK_DAMPINGS with its own at x1;
+    Housner's block value is 1 - 1.5 sin^2 of the critical angle toward the azimuth."""
+    from pipeline.scenario import ColumnGeometry
+    from pipeline.verification import contact_map
+    calls = []
+
+    def measure(geometry, kn, azimuth_deg, **options):
+        calls.append((geometry.to_dict()["footprint_tolerance_m"], kn, azimuth_deg, options))
+        return lambda damping: 0.9 + 0.01 * damping + kn * 1e-12
+    monkeypatch.setattr(contact_map, "specimen_measure", measure)
+    rock = {"grid_point": "footprint_tolerance_m=0.002, damping=0.07, mu_s=0.3, "
+                          "rotate_deg=180, kn=1e+08",
+            "factors": {"x1": {"kn": 1e8}, "x3": {"kn": 3e8}}}
+    out = cc.rock_restitution(rock, log=lambda line: None)
+    assert {c[0] for c in calls} == {0.002} and {c[2] for c in calls} == {90.0}
+    assert all(c[3] == {"mu_s": 0.3} for c in calls)
+    assert out["factors"]["x3"]["restitution"] == pytest.approx(0.9 + 0.0007 + 3e-4)
+    assert [r["damping"] for r in out["by_damping"]] == sorted({*cc.ROCK_DAMPINGS, 0.07})
+    from pipeline.campaign.shake_table import SPECIMEN
+    geometry = ColumnGeometry.load(SPECIMEN).to_dict()
+    geometry["footprint_tolerance_m"] = 0.002
+    alpha = math.radians(ColumnGeometry.from_dict(geometry).critical_angle_along_deg(90.0))
+    assert out["housner_block_restitution"] == pytest.approx(1 - 1.5 * math.sin(alpha) ** 2)
+    assert 0 < alpha < math.radians(45)
