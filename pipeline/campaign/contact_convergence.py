@@ -219,7 +219,7 @@ def rock_restitution(rock, specimen=None, log=print):
     options = {k: v for k, v in point.items() if k in ("mu_s", "mu_k")}
 
     def measured(kn, d):
-        value = specimen_measure(geometry, kn, ROCK_AZIMUTH_DEG, **options)(d)
+        value = specimen_measure(geometry, kn, ROCK_AZIMUTH_DEG, **options)[0](d)
         log(f"rock free rocking: kn {kn:g}, damping {d:g}: restitution {value:.4f}")
         return value
 

@@ -169,7 +169,7 @@ def test_rock_restitution_runs_the_rock_parts_point(monkeypatch):
 
     def measure(geometry, kn, azimuth_deg, **options):
         calls.append((geometry.to_dict()["footprint_tolerance_m"], kn, azimuth_deg, options))
-        return lambda damping: 0.9 + 0.01 * damping + kn * 1e-12
+        return (lambda damping: 0.9 + 0.01 * damping + kn * 1e-12), (lambda: 0)  # (measured, runs)
     monkeypatch.setattr(contact_map, "specimen_measure", measure)
     rock = {"grid_point": "footprint_tolerance_m=0.002, damping=0.07, mu_s=0.3, "
                           "rotate_deg=180, kn=1e+08",
