@@ -220,9 +220,10 @@ class FragilityOptions(CampaignOptions):
     ranges: str = param(None, "", "pulse grid: ranges the members' unknowns are drawn from "
                         f"(default {pulse_grid.DEFAULT_RANGES}; LO = HI fixes one)",
                         flag="--ranges", metavar="NAME=LO:HI;...")
-    adaptive: bool = param(False, "", "pulse grid: run every member only where P is uncertain "
-                           "(the 2D block as a guide, one probe run elsewhere, widened where a "
-                           "probe disagrees or the specimen's own P is uncertain)",
+    adaptive: bool = param(False, "", "pulse grid: run each cell only until it is decided "
+                           "on which side of P = 0.5 it lies (the 2D block as a guide: a few "
+                           "runs near its threshold, one probe run elsewhere; more where a "
+                           "cell's Wilson interval still holds 0.5 or a probe disagrees)",
                            flag="--adaptive")
     TAKES_JOBS = True
 
@@ -247,13 +248,14 @@ class FragilityOptions(CampaignOptions):
 
 
 def drive(run, records, campaign_dir, options, gate=None):
-    """Run the campaign; with ``adaptive`` (pulse grid) in stages: every member where the
-    2D block of the same members and directions is uncertain (0 < P < 1) and one cell
-    either side in PGA, one probe run (first member, first direction) in every other
-    cell; a probe that disagrees with the block's certainty adds its cell and one either
-    side, and so does, read on the specimen's own P (a probe as 0 or 1), a cell where that
-    P is uncertain or steps (the specimen's threshold beyond the block's); until nothing
-    is added (at most :data:`pulse_grid.MAX_STAGES` stages)."""
+    """Run the campaign; with ``adaptive`` (pulse grid) in stages that decide, cell by
+    cell, on which side of P = 0.5 it lies (:func:`pulse_grid.next_targets`): first
+    :data:`pulse_grid.ADAPTIVE_FIRST_RUNS` runs where the 2D block of the same members and
+    directions is uncertain or steps (and one cell either side in PGA), one probe run
+    elsewhere; then a cell whose Wilson interval still holds 0.5 doubles its runs (up to
+    the full grid's), and a probe goes to the first count where it disagrees with the
+    block or a neighbour; until nothing changes (at most :data:`pulse_grid.MAX_STAGES`
+    stages). A cell's runs are taken in :func:`pulse_grid.run_order`."""
     if not options.get("adaptive"):
         return run(options)
     full = fragility_specs(records, campaign_dir, **options)
@@ -261,33 +263,38 @@ def drive(run, records, campaign_dir, options, gate=None):
         gate("campaign fragility (adaptive; at most the full grid)", len(full),
              sum(s.tags["core_s"] for s in full) / len(full), "a smaller --pulses grid")
     guide = pulse_grid.block_outcomes(full)
-    by_cell = {}
+    by_cell, guide_by_cell = {}, {}
     for spec, fell in zip(full, guide):
-        by_cell.setdefault(pulse_grid.cell_key(spec), []).append((spec, fell))
-    guide_p = {cell: float(np.mean([f for _, f in rows])) for cell, rows in by_cell.items()}
-    whole = pulse_grid.guide_cells(guide_p)
-    probes = {cell: rows[0][0] for cell, rows in by_cell.items()}
+        by_cell.setdefault(pulse_grid.cell_key(spec), []).append(spec)
+        guide_by_cell.setdefault(pulse_grid.cell_key(spec), []).append(fell)
+    headings = full[0].tags["headings"]
+    for rows in by_cell.values():
+        rows.sort(key=lambda s: pulse_grid.run_order(s.tags["member"], s.tags["heading"],
+                                                     headings))
+    guide_p = {cell: float(np.mean(fell)) for cell, fell in guide_by_cell.items()}
+    per_cell = len(full) // len(by_cell)
+    targets = pulse_grid.first_targets(guide_p, per_cell)
     result = None
     for stage in range(1, pulse_grid.MAX_STAGES + 1):
-        chosen = [s.run_id for cell, rows in by_cell.items() for s, _ in rows
-                  if cell in whole or s is probes[cell]]
-        log.info(f"fragility (adaptive), stage {stage}: {len(whole)} of {len(by_cell)} cells "
-                 f"in full, a probe run in the others: {len(chosen)} of {len(full)} runs")
+        chosen = [s.run_id for cell, rows in by_cell.items() for s in rows[:targets[cell]]]
+        counts = sorted(set(targets.values()))
+        log.info(f"fragility (adaptive), stage {stage}: {len(chosen)} of {len(full)} runs "
+                 "(runs per cell: " + ", ".join(
+                     f"{n} in {sum(t == n for t in targets.values())}" for n in counts) + ")")
         result = run({**options, "only_runs": chosen})
-        outcomes, measured = {}, {}
+        outcomes = {}
         for cell, rows in by_cell.items():
-            fell = {spec.run_id: any(c.toppled for c in summary.columns)
-                    for spec, _ in rows
-                    if (summary := finished_summary(campaign_dir, spec.run_id)) is not None}
-            if fell:
-                measured[cell] = float(np.mean(list(fell.values())))
-            if probes[cell].run_id in fell:
-                outcomes[cell] = fell[probes[cell].run_id]
-        added = (pulse_grid.expand(guide_p, whole, outcomes)
-                 | (pulse_grid.guide_cells(measured) - whole))
-        if not added:
+            outcomes[cell] = [any(c.toppled for c in summary.columns)
+                              for spec in rows[:targets[cell]]
+                              if (summary := finished_summary(campaign_dir, spec.run_id))
+                              is not None]
+        new = pulse_grid.next_targets(guide_p, outcomes, targets, per_cell)
+        if new == targets:
             break
-        whole |= added
+        targets = new
+    else:
+        log.warning(f"fragility (adaptive): stopped after {pulse_grid.MAX_STAGES} stages with "
+                    "cells still undecided (their Wilson intervals say so)")
     return result
 
 

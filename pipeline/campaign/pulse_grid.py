@@ -309,7 +309,9 @@ def cell_table(table, model):
 def contours(cells, levels=CONTOUR_LEVELS):
     """Per level and PGV/PGA: the PGA (g) where P crosses the level (linear between the
     cells; P made non-decreasing in PGA first), with the PGAs where the Wilson upper and
-    lower bounds cross it (the Monte Carlo band: ``pga_g_band``) and where each parameter
+    lower bounds cross it (the Monte Carlo band: ``pga_g_band``; the bounds made
+    monotone as P is: a cell's lower bound holds every cell above it, its upper bound
+    every cell below, so a cell of few runs beside a cell of many does not open the band) and where each parameter
     set's own P crosses it (``pga_g_per_set``, for the sets run in every cell of the row:
     the members' spread); None beyond the grid."""
     out = {}
@@ -319,9 +321,11 @@ def contours(cells, levels=CONTOUR_LEVELS):
         for ratio in ratios:
             row = sorted((c for c in cells if c["pgv_pga_s"] == ratio), key=lambda c: c["pga_g"])
             pga = np.array([c["pga_g"] for c in row])
-            crossing = [_crossing(pga, np.array([c[key] if key == "P" else c["ci95"][key]
-                                                 for c in row]), level)
-                        for key in ("P", 1, 0)]
+            upper = np.array([c["ci95"][1] for c in row])
+            upper = np.minimum.accumulate(upper[::-1])[::-1]     # holds every cell below
+            crossing = [_crossing(pga, values, level) for values in (
+                np.array([c["P"] for c in row]), upper,
+                np.array([c["ci95"][0] for c in row]))]
             entry = {"pgv_pga_s": ratio, "pga_g": crossing[0],
                      "pga_g_band": [crossing[1], crossing[2]]}
             if all("sets" in c for c in row):
@@ -393,18 +397,29 @@ def summarise_grid(table, specs, grid, sets, azimuths, azimuth, ranges_text):
 
 
 # ---------------------------------------------------------------- adaptive sampling
-MAX_STAGES = 6
+MAX_STAGES = 12
+ADAPTIVE_LEVEL = 0.5        # the contour whose side every cell is decided on
+# a cell near a change runs this many first: all alike, its Wilson interval excludes
+# ADAPTIVE_LEVEL (0 of 4 overturned: upper bound 0.49)
+ADAPTIVE_FIRST_RUNS = 4
 
 
 def cell_key(spec):
     return tuple(spec.tags["cell"])
 
 
+def run_order(member, heading, headings):
+    """Sort key of a cell's runs: its first runs are distinct parameter sets shaken from
+    distinct direction sectors (the diagonals of the members x headings square)."""
+    return ((heading - member) % headings, member)
+
+
 def guide_cells(guide_p, margin=1):
-    """Cells (i ratio, j PGA) to run in full: where the guide's P (a dict cell -> P, e.g.
-    the 2D block over the same members and directions) is strictly between 0 and 1, and
-    ``margin`` cells either side in PGA (the specimen's threshold may lie beside the
-    guide's); a step of the guide between two cells counts as uncertain on both sides."""
+    """Cells (i ratio, j PGA) near the guide's threshold: where the guide's P (a dict
+    cell -> P, e.g. the 2D block over the same members and directions) is strictly
+    between 0 and 1, and ``margin`` cells either side in PGA (the specimen's threshold
+    may lie beside the guide's); a step of the guide between two cells counts as
+    uncertain on both sides."""
     chosen = set()
     for (i, j), p in guide_p.items():
         step = any(guide_p.get((i, j + d), p) != p for d in (-1, 1))
@@ -414,19 +429,39 @@ def guide_cells(guide_p, margin=1):
     return chosen
 
 
-def expand(guide_p, full, probes, margin=1):
-    """Cells to add to ``full`` (the cells run in full): a probed cell whose one run
-    (``probes``: cell -> overturned) disagrees with the guide's certainty, with
-    ``margin`` cells either side in PGA."""
-    added = set()
-    for (i, j), overturned in probes.items():
-        if (i, j) in full:
+def first_targets(guide_p, per_cell, first=ADAPTIVE_FIRST_RUNS):
+    """Runs per cell of the first stage: ``first`` near the guide's threshold
+    (:func:`guide_cells`), one probe run elsewhere (at most ``per_cell``)."""
+    near = guide_cells(guide_p)
+    return {cell: min(per_cell, first if cell in near else 1) for cell in guide_p}
+
+
+def next_targets(guide_p, outcomes, targets, per_cell, first=ADAPTIVE_FIRST_RUNS,
+                 level=ADAPTIVE_LEVEL):
+    """Runs per cell of the next stage (never fewer than ``targets``), from the outcomes
+    so far (cell -> overturned per finished run, in :func:`run_order`). A cell whose
+    Wilson 95 % interval excludes ``level`` is decided and stops. Otherwise: a cell of
+    mixed outcomes, or of ``first`` runs or more, doubles (up to ``per_cell``, the full
+    grid's count); a cell of fewer runs all alike (a probe) goes to ``first`` only next
+    to a change: a neighbour in PGA with another outcome, or its outcome against the
+    guide's (P >= 0.5); elsewhere it stays a probe."""
+    new = dict(targets)
+    for (i, j), fell in outcomes.items():
+        m, k = len(fell), int(sum(fell))
+        lo, hi = wilson_interval(k, m)
+        if m == 0 or not lo <= level <= hi:
             continue
-        expected = guide_p[(i, j)] >= 0.5
-        if overturned != expected:
-            added.update((i, j + d) for d in range(-margin, margin + 1)
-                         if (i, j + d) in guide_p and (i, j + d) not in full)
-    return added
+        if 0 < k < m or m >= first:
+            want = max(first, 2 * m)
+        else:
+            alike = k == m
+            beside = [outcomes.get((i, j + d)) or [] for d in (-1, 1)]
+            if not (any(v != alike for row in beside for v in row)
+                    or (guide_p[(i, j)] >= 0.5) != alike):
+                continue
+            want = first
+        new[(i, j)] = max(new[(i, j)], min(per_cell, want))
+    return new
 
 
 def contour_difference(reference, other, level="0.5"):

@@ -218,22 +218,39 @@ def test_a_column_draws_nothing_unless_told_and_a_mesh_draws_the_calibrated_rang
                               0.0, 1, None)
 
 
-def test_adaptive_sampling_runs_in_full_where_the_guide_is_uncertain_and_widens_on_surprise():
+def test_adaptive_stages_run_cells_until_their_side_of_one_half_is_decided():
     # one PGV/PGA row of 8 PGA cells: the guide certain below cell 3 and above cell 4
     guide = {(0, j): p for j, p in enumerate((0.0, 0.0, 0.0, 0.3, 0.8, 1.0, 1.0, 1.0))}
-    full = pulse_grid.guide_cells(guide)
     # uncertain cells, the certain ones next to them (a step) and one beyond
-    assert full == {(0, j) for j in range(1, 7)}
-    # probes that agree with the guide add nothing
-    assert pulse_grid.expand(guide, full, {(0, 0): False, (0, 7): True}) == set()
-    # a probe that overturns where the guide is certain it stands: its cell (its
-    # neighbours are run in full already)
-    assert pulse_grid.expand(guide, full, {(0, 0): True, (0, 7): True}) == {(0, 0)}
-    # a step of the guide from 0 to 1 between two cells: both sides and one beyond
+    assert pulse_grid.guide_cells(guide) == {(0, j) for j in range(1, 7)}
+    first = pulse_grid.first_targets(guide, per_cell=16)
+    assert [first[(0, j)] for j in range(8)] == [1, 4, 4, 4, 4, 4, 4, 1]
+    F, T = False, True
+    seen = {(0, 0): [F], (0, 1): [F] * 4, (0, 2): [F] * 4, (0, 3): [F, T, F, F],
+            (0, 4): [T, T, T, F], (0, 5): [T] * 4, (0, 6): [T] * 4, (0, 7): [T]}
+    after = pulse_grid.next_targets(guide, seen, first, per_cell=16)
+    # 0 of 4 or 4 of 4: the Wilson interval excludes 0.5 (upper 0.49): decided; probes
+    # that agree with the guide and their neighbours stay probes; 1 of 4 and 3 of 4 double
+    assert [after[(0, j)] for j in range(8)] == [1, 4, 4, 8, 8, 4, 4, 1]
+    # a probe that overturns where the guide is certain it stands: the first count
+    assert pulse_grid.next_targets(guide, {**seen, (0, 0): [T]}, first, 16)[(0, 0)] == 4
+    # doubling stops at the full grid's count, and where the interval excludes 0.5
+    grown = pulse_grid.next_targets(guide, {**seen, (0, 3): [F, T] * 4,
+                                            (0, 4): [T] * 7 + [F]}, after, per_cell=10)
+    assert grown[(0, 3)] == 10 and grown[(0, 4)] == 8
+    # a probe that agrees with the guide but not with its neighbour: both to the first
+    # count (the specimen's threshold beyond the guide's)
     guide = {(0, j): p for j, p in enumerate((0.0, 0.0, 0.0, 0.0, 1.0, 1.0))}
-    full = pulse_grid.guide_cells(guide)
-    assert full == {(0, 2), (0, 3), (0, 4), (0, 5)}
-    assert pulse_grid.expand(guide, full, {(0, 1): True}) == {(0, 0), (0, 1)}
+    assert pulse_grid.guide_cells(guide) == {(0, 2), (0, 3), (0, 4), (0, 5)}
+    first = pulse_grid.first_targets(guide, per_cell=16)
+    seen = {(0, 0): [F], (0, 1): [T], (0, 2): [T] * 4, (0, 3): [T] * 4, (0, 4): [T] * 4,
+            (0, 5): [T] * 4}
+    after = pulse_grid.next_targets(guide, seen, first, per_cell=16)
+    assert [after[(0, j)] for j in range(6)] == [4, 4, 4, 4, 4, 4]
+    # the first runs of a cell are distinct members from distinct direction sectors
+    order = sorted(((m, h) for m in range(4) for h in range(4)),
+                   key=lambda mh: pulse_grid.run_order(*mh, headings=4))
+    assert order[:4] == [(0, 0), (1, 1), (2, 2), (3, 3)]
 
 
 def test_adaptive_belongs_to_the_pulse_grid():
