@@ -273,26 +273,23 @@ def drive(run, records, campaign_dir, options, gate=None):
                                                      headings))
     guide_p = {cell: float(np.mean(fell)) for cell, fell in guide_by_cell.items()}
     per_cell = len(full) // len(by_cell)
-    targets = pulse_grid.first_targets(guide_p, per_cell)
     result = None
-    for stage in range(1, pulse_grid.MAX_STAGES + 1):
+
+    def run_stage(stage, targets):
+        nonlocal result
         chosen = [s.run_id for cell, rows in by_cell.items() for s in rows[:targets[cell]]]
         counts = sorted(set(targets.values()))
         log.info(f"fragility (adaptive), stage {stage}: {len(chosen)} of {len(full)} runs "
                  "(runs per cell: " + ", ".join(
                      f"{n} in {sum(t == n for t in targets.values())}" for n in counts) + ")")
         result = run({**options, "only_runs": chosen})
-        outcomes = {}
-        for cell, rows in by_cell.items():
-            outcomes[cell] = [any(c.toppled for c in summary.columns)
-                              for spec in rows[:targets[cell]]
-                              if (summary := finished_summary(campaign_dir, spec.run_id))
-                              is not None]
-        new = pulse_grid.next_targets(guide_p, outcomes, targets, per_cell)
-        if new == targets:
-            break
-        targets = new
-    else:
+        return {cell: [any(c.toppled for c in summary.columns)
+                       for spec in rows[:targets[cell]]
+                       if (summary := finished_summary(campaign_dir, spec.run_id)) is not None]
+                for cell, rows in by_cell.items()}
+
+    _, settled = pulse_grid.adaptive_sampling(guide_p, per_cell, run_stage)
+    if not settled:
         log.warning(f"fragility (adaptive): stopped after {pulse_grid.MAX_STAGES} stages with "
                     "cells still undecided (their Wilson intervals say so)")
     return result

@@ -439,19 +439,26 @@ def first_targets(guide_p, per_cell, first=ADAPTIVE_FIRST_RUNS):
 def next_targets(guide_p, outcomes, targets, per_cell, first=ADAPTIVE_FIRST_RUNS,
                  level=ADAPTIVE_LEVEL):
     """Runs per cell of the next stage (never fewer than ``targets``), from the outcomes
-    so far (cell -> overturned per finished run, in :func:`run_order`). A cell whose
-    Wilson 95 % interval excludes ``level`` is decided and stops. Otherwise: a cell of
-    mixed outcomes, or of ``first`` runs or more, doubles (up to ``per_cell``, the full
-    grid's count); a cell of fewer runs all alike (a probe) goes to ``first`` only next
+    so far (cell -> overturned per finished run, in :func:`run_order`). The two cells the
+    ``level`` contour lies between (neighbours in PGA with P on either side of it) run
+    all ``per_cell`` runs, the full grid's count: the contour's position rests on them.
+    Any other cell whose Wilson 95 % interval excludes ``level`` is decided and stops.
+    Otherwise a cell of mixed outcomes, or of ``first`` runs or more, doubles (up to
+    ``per_cell``); a cell of fewer runs all alike (a probe) goes to ``first`` only next
     to a change: a neighbour in PGA with another outcome, or its outcome against the
     guide's (P >= 0.5); elsewhere it stays a probe."""
     new = dict(targets)
+    above = {cell: np.mean(fell) >= level for cell, fell in outcomes.items() if fell}
     for (i, j), fell in outcomes.items():
         m, k = len(fell), int(sum(fell))
         lo, hi = wilson_interval(k, m)
-        if m == 0 or not lo <= level <= hi:
+        bracket = any(above.get((i, j + d), above.get((i, j))) != above.get((i, j))
+                      for d in (-1, 1))
+        if m >= first and bracket:
+            want = per_cell
+        elif m == 0 or not lo <= level <= hi:
             continue
-        if 0 < k < m or m >= first:
+        elif 0 < k < m or m >= first:
             want = max(first, 2 * m)
         else:
             alike = k == m
@@ -462,6 +469,21 @@ def next_targets(guide_p, outcomes, targets, per_cell, first=ADAPTIVE_FIRST_RUNS
             want = first
         new[(i, j)] = max(new[(i, j)], min(per_cell, want))
     return new
+
+
+def adaptive_sampling(guide_p, per_cell, run_stage, max_stages=MAX_STAGES):
+    """The stages of the adaptive pulse grid: ``run_stage(stage, targets)`` runs the first
+    ``targets[cell]`` runs of every cell (in :func:`run_order`) and returns their outcomes
+    (cell -> overturned per finished run); from :func:`first_targets` until
+    :func:`next_targets` changes nothing. Returns (targets, settled: False when
+    ``max_stages`` ran out first)."""
+    targets = first_targets(guide_p, per_cell)
+    for stage in range(1, max_stages + 1):
+        new = next_targets(guide_p, run_stage(stage, targets), targets, per_cell)
+        if new == targets:
+            return targets, True
+        targets = new
+    return targets, False
 
 
 def contour_difference(reference, other, level="0.5"):

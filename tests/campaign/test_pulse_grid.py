@@ -229,15 +229,19 @@ def test_adaptive_stages_run_cells_until_their_side_of_one_half_is_decided():
     seen = {(0, 0): [F], (0, 1): [F] * 4, (0, 2): [F] * 4, (0, 3): [F, T, F, F],
             (0, 4): [T, T, T, F], (0, 5): [T] * 4, (0, 6): [T] * 4, (0, 7): [T]}
     after = pulse_grid.next_targets(guide, seen, first, per_cell=16)
-    # 0 of 4 or 4 of 4: the Wilson interval excludes 0.5 (upper 0.49): decided; probes
-    # that agree with the guide and their neighbours stay probes; 1 of 4 and 3 of 4 double
-    assert [after[(0, j)] for j in range(8)] == [1, 4, 4, 8, 8, 4, 4, 1]
+    # the contour lies between cells 3 (1 of 4) and 4 (3 of 4): both run in full; 0 of 4
+    # or 4 of 4 elsewhere: the Wilson interval excludes 0.5 (upper 0.49): decided; probes
+    # that agree with the guide and their neighbours stay probes
+    assert [after[(0, j)] for j in range(8)] == [1, 4, 4, 16, 16, 4, 4, 1]
     # a probe that overturns where the guide is certain it stands: the first count
     assert pulse_grid.next_targets(guide, {**seen, (0, 0): [T]}, first, 16)[(0, 0)] == 4
-    # doubling stops at the full grid's count, and where the interval excludes 0.5
-    grown = pulse_grid.next_targets(guide, {**seen, (0, 3): [F, T] * 4,
-                                            (0, 4): [T] * 7 + [F]}, after, per_cell=10)
-    assert grown[(0, 3)] == 10 and grown[(0, 4)] == 8
+    # away from the contour a mixed cell doubles until its interval excludes 0.5, and
+    # no cell passes the full grid's count
+    seen = {**seen, (0, 3): [F] * 4, (0, 4): [F, T, T, F], (0, 5): [T, T, T, F]}
+    after = pulse_grid.next_targets(guide, seen, first, per_cell=10)
+    assert [after[(0, j)] for j in range(3, 6)] == [10, 10, 8]
+    seen = {**seen, (0, 5): [T] * 7 + [F]}         # 7 of 8: [0.53, 0.98], decided
+    assert pulse_grid.next_targets(guide, seen, after, per_cell=10)[(0, 5)] == 8
     # a probe that agrees with the guide but not with its neighbour: both to the first
     # count (the specimen's threshold beyond the guide's)
     guide = {(0, j): p for j, p in enumerate((0.0, 0.0, 0.0, 0.0, 1.0, 1.0))}
