@@ -439,24 +439,27 @@ def first_targets(guide_p, per_cell, first=ADAPTIVE_FIRST_RUNS):
 def next_targets(guide_p, outcomes, targets, per_cell, first=ADAPTIVE_FIRST_RUNS,
                  level=ADAPTIVE_LEVEL):
     """Runs per cell of the next stage (never fewer than ``targets``), from the outcomes
-    so far (cell -> overturned per finished run, in :func:`run_order`). The two cells the
-    ``level`` contour lies between (neighbours in PGA with P on either side of it) run
-    all ``per_cell`` runs, the full grid's count: the contour's position rests on them.
-    Any other cell whose Wilson 95 % interval excludes ``level`` is decided and stops.
-    Otherwise a cell of mixed outcomes, or of ``first`` runs or more, doubles (up to
-    ``per_cell``); a cell of fewer runs all alike (a probe) goes to ``first`` only next
-    to a change: a neighbour in PGA with another outcome, or its outcome against the
-    guide's (P >= 0.5); elsewhere it stays a probe."""
+    so far (cell -> overturned per finished run, in :func:`run_order`), row by row (a
+    PGV/PGA) as :func:`contours` reads them: the ``level`` contour lies below the first
+    cell whose P reaches ``level``. That cell and the one below it run all ``per_cell``
+    runs, the full grid's count: the contour's position rests on them. The cells above
+    them do not move it and stop. A cell below them whose Wilson 95 % interval excludes
+    ``level`` is decided and stops; otherwise, with mixed outcomes or ``first`` runs or
+    more, it doubles (up to ``per_cell``); with fewer runs all alike (a probe) it goes to
+    ``first`` only next to a change: a neighbour in PGA with another outcome, or its
+    outcome against the guide's (P >= 0.5); elsewhere it stays a probe."""
     new = dict(targets)
-    above = {cell: np.mean(fell) >= level for cell, fell in outcomes.items() if fell}
+    crossing = {}
+    for (i, j), fell in sorted(outcomes.items()):
+        if fell and i not in crossing and np.mean(fell) >= level:
+            crossing[i] = j
     for (i, j), fell in outcomes.items():
         m, k = len(fell), int(sum(fell))
         lo, hi = wilson_interval(k, m)
-        bracket = any(above.get((i, j + d), above.get((i, j))) != above.get((i, j))
-                      for d in (-1, 1))
-        if m >= first and bracket:
-            want = per_cell
-        elif m == 0 or not lo <= level <= hi:
+        top = crossing.get(i)
+        if top is not None and top > 0 and j in (top - 1, top):
+            want = per_cell if m >= first else first
+        elif top is not None and j > top or m == 0 or not lo <= level <= hi:
             continue
         elif 0 < k < m or m >= first:
             want = max(first, 2 * m)

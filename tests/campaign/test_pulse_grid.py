@@ -235,13 +235,13 @@ def test_adaptive_stages_run_cells_until_their_side_of_one_half_is_decided():
     assert [after[(0, j)] for j in range(8)] == [1, 4, 4, 16, 16, 4, 4, 1]
     # a probe that overturns where the guide is certain it stands: the first count
     assert pulse_grid.next_targets(guide, {**seen, (0, 0): [T]}, first, 16)[(0, 0)] == 4
-    # away from the contour a mixed cell doubles until its interval excludes 0.5, and
-    # no cell passes the full grid's count
-    seen = {**seen, (0, 3): [F] * 4, (0, 4): [F, T, T, F], (0, 5): [T, T, T, F]}
+    # below the contour a mixed cell doubles until its interval excludes 0.5; above it a
+    # cell does not move the contour and stops; no cell passes the full grid's count
+    seen = {**seen, (0, 2): [F, T, F, F], (0, 3): [F] * 4, (0, 4): [F, T, T, F]}
     after = pulse_grid.next_targets(guide, seen, first, per_cell=10)
-    assert [after[(0, j)] for j in range(3, 6)] == [10, 10, 8]
-    seen = {**seen, (0, 5): [T] * 7 + [F]}         # 7 of 8: [0.53, 0.98], decided
-    assert pulse_grid.next_targets(guide, seen, after, per_cell=10)[(0, 5)] == 8
+    assert [after[(0, j)] for j in range(2, 6)] == [8, 10, 10, 4]
+    seen = {**seen, (0, 2): [F, T] + [F] * 6}         # 1 of 8: [0.02, 0.47], decided
+    assert pulse_grid.next_targets(guide, seen, after, per_cell=10)[(0, 2)] == 8
     # a probe that agrees with the guide but not with its neighbour: both to the first
     # count (the specimen's threshold beyond the guide's)
     guide = {(0, j): p for j, p in enumerate((0.0, 0.0, 0.0, 0.0, 1.0, 1.0))}
