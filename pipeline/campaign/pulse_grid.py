@@ -429,11 +429,26 @@ def guide_cells(guide_p, margin=1):
     return chosen
 
 
-def first_targets(guide_p, per_cell, first=ADAPTIVE_FIRST_RUNS):
+def first_crossings(p_by_cell, level=ADAPTIVE_LEVEL):
+    """Per row i (a PGV/PGA): the first cell j (lowest PGA) whose P reaches ``level``,
+    where :func:`contours` finds the ``level`` contour (P made non-decreasing in PGA)."""
+    crossing = {}
+    for (i, j), p in sorted(p_by_cell.items()):
+        if i not in crossing and p >= level:
+            crossing[i] = j
+    return crossing
+
+
+def first_targets(guide_p, per_cell, first=ADAPTIVE_FIRST_RUNS, margin=1):
     """Runs per cell of the first stage: ``first`` near the guide's threshold
-    (:func:`guide_cells`), one probe run elsewhere (at most ``per_cell``)."""
-    near = guide_cells(guide_p)
-    return {cell: min(per_cell, first if cell in near else 1) for cell in guide_p}
+    (:func:`guide_cells`) up to ``margin`` cells above the first cell where the guide's P
+    reaches 0.5 (the cells above do not move the 0.5 contour), one probe run elsewhere
+    (at most ``per_cell``)."""
+    near = guide_cells(guide_p, margin)
+    top = first_crossings(guide_p)
+    return {(i, j): min(per_cell, first if (i, j) in near and j <= top.get(i, j) + margin
+                        else 1)
+            for (i, j) in guide_p}
 
 
 def next_targets(guide_p, outcomes, targets, per_cell, first=ADAPTIVE_FIRST_RUNS,
@@ -449,10 +464,8 @@ def next_targets(guide_p, outcomes, targets, per_cell, first=ADAPTIVE_FIRST_RUNS
     ``first`` only next to a change: a neighbour in PGA with another outcome, or its
     outcome against the guide's (P >= 0.5); elsewhere it stays a probe."""
     new = dict(targets)
-    crossing = {}
-    for (i, j), fell in sorted(outcomes.items()):
-        if fell and i not in crossing and np.mean(fell) >= level:
-            crossing[i] = j
+    crossing = first_crossings({cell: np.mean(fell) for cell, fell in outcomes.items() if fell},
+                               level)
     for (i, j), fell in outcomes.items():
         m, k = len(fell), int(sum(fell))
         lo, hi = wilson_interval(k, m)

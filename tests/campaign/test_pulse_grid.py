@@ -223,16 +223,17 @@ def test_adaptive_stages_run_cells_until_their_side_of_one_half_is_decided():
     guide = {(0, j): p for j, p in enumerate((0.0, 0.0, 0.0, 0.3, 0.8, 1.0, 1.0, 1.0))}
     # uncertain cells, the certain ones next to them (a step) and one beyond
     assert pulse_grid.guide_cells(guide) == {(0, j) for j in range(1, 7)}
+    # the first counts near it, up to one cell above where the guide reaches 0.5
     first = pulse_grid.first_targets(guide, per_cell=16)
-    assert [first[(0, j)] for j in range(8)] == [1, 4, 4, 4, 4, 4, 4, 1]
+    assert [first[(0, j)] for j in range(8)] == [1, 4, 4, 4, 4, 4, 1, 1]
     F, T = False, True
     seen = {(0, 0): [F], (0, 1): [F] * 4, (0, 2): [F] * 4, (0, 3): [F, T, F, F],
-            (0, 4): [T, T, T, F], (0, 5): [T] * 4, (0, 6): [T] * 4, (0, 7): [T]}
+            (0, 4): [T, T, T, F], (0, 5): [T] * 4, (0, 6): [T], (0, 7): [T]}
     after = pulse_grid.next_targets(guide, seen, first, per_cell=16)
     # the contour lies between cells 3 (1 of 4) and 4 (3 of 4): both run in full; 0 of 4
     # or 4 of 4 elsewhere: the Wilson interval excludes 0.5 (upper 0.49): decided; probes
     # that agree with the guide and their neighbours stay probes
-    assert [after[(0, j)] for j in range(8)] == [1, 4, 4, 16, 16, 4, 4, 1]
+    assert [after[(0, j)] for j in range(8)] == [1, 4, 4, 16, 16, 4, 1, 1]
     # a probe that overturns where the guide is certain it stands: the first count
     assert pulse_grid.next_targets(guide, {**seen, (0, 0): [T]}, first, 16)[(0, 0)] == 4
     # below the contour a mixed cell doubles until its interval excludes 0.5; above it a
