@@ -158,6 +158,46 @@ def test_a_box_mesh_fragility_matches_the_2d_block_away_from_its_threshold(tmp_p
         assert p == {0.15: 0.0, 1.0: 1.0}, model
 
 
+@pytest.mark.yade
+def test_turning_a_field_rock_turns_nothing_in_its_fragility(tmp_path):
+    """A box wider one way than the other (0.15 m East x 0.3 m North x 0.6 m: tipping
+    across its thin side at 14.0 deg, across its wide side at 26.6 deg), in the field
+    default (directions sampled relative to the specimen), as scanned and turned by
+    90 deg: run for run the same outcome, its fall turned by 90 deg, so the same P per
+    cell. At 0.45 g (the two sides' uplift: 0.25 g and 0.5 g) the 2D block of the same
+    runs falls in some directions and not in others, so a direction not turned with the
+    specimen would show; at 0.85 g it falls in all, so the falls' directions compare."""
+    import pandas as pd
+
+    from pipeline.campaign import run_campaign
+    path = tmp_path / "slab.obj"
+    trimesh.creation.box(extents=(0.15, 0.3, 0.6)).export(path)
+    options = {"pulses": "pga_g=0.45:0.85:2;pgv_pga_s=0.5:0.5:1", "members": 1, "headings": 4,
+               "ranges": "kn=1.2e8:1.2e8;damping=0.1:0.1;mu_s=0.8:0.8;"
+                         "footprint_tolerance_m=0.001:0.001"}
+    runs = {}
+    for heading in (0.0, 90.0):
+        (tmp_path / f"slab{heading:g}.json").write_text(json.dumps(
+            {"name": "slab", "mesh": str(path), "density": 2700.0, "heading_deg": heading}))
+        out = tmp_path / f"frag{heading:g}"
+        run_campaign("fragility", jobs=2, campaign_dir=out, options={
+            **options, "column_file": str(tmp_path / f"slab{heading:g}.json")})
+        table = pd.read_csv(out / "fragility_runs.csv")
+        runs[heading] = table.set_index(["model", "pga_g", "member", "heading"]).sort_index()
+    turned, scanned = runs[90.0], runs[0.0]
+    assert np.allclose((turned["azimuth_deg"] - scanned["azimuth_deg"]) % 360.0, 90.0)
+    block = scanned.loc["block2d"]
+    assert block.loc[0.45, "toppled"].nunique() == 2       # the direction matters here
+    assert block.loc[0.85, "toppled"].all()
+    rock = "monolithic"
+    assert (turned.loc[rock, "toppled"] == scanned.loc[rock, "toppled"]).all()
+    fell = scanned.loc[rock, "toppled"].astype(bool)
+    assert fell.any()
+    turn = (turned.loc[rock, "downfall_azimuth_deg"][fell]
+            - scanned.loc[rock, "downfall_azimuth_deg"][fell] - 90.0 + 180.0) % 360.0 - 180.0
+    assert np.abs(turn).max() < 5.0
+
+
 def test_the_long_run_gate_counts_each_pulse_run_by_its_length(tmp_path, monkeypatch):
     """Before any run: refused in one line with the number of runs, nothing left behind."""
     from pipeline import files
