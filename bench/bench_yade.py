@@ -50,6 +50,7 @@ import numpy as np
 from scipy.integrate import cumulative_trapezoid
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))       # bench/mujoco_twin.py
+sys.path.insert(1, str(Path(__file__).resolve().parent.parent))  # this checkout's pipeline
 from pipeline import PROJECT_ROOT as PROJECT, RESULTS_DIR  # noqa: E402
 from pipeline.campaign.pulse_grid import contour_difference  # noqa: E402
 from pipeline.files import save_figure, write_json  # noqa: E402
