@@ -97,13 +97,14 @@ def fragility_specs(records, campaign_dir, levels=DEFAULT_LEVELS, members=DEFAUL
                     column="both", seed=None, azimuths=DEFAULT_AZIMUTHS, column_file=None,
                     stiffness="matched", pulses=None, azimuth=None,
                     headings=DEFAULT_HEADINGS, ranges=None, jobs=None, only_runs=None,
-                    adaptive=False, **_):
+                    adaptive=False, grid_specs=None, **_):
     """Run specs: every record x level x member; ``scale`` = level / PGA of the record.
     With ``column_file`` every member is the described column with the sampled height
     and diameter tolerances (its own tilt and offsets as described), and the 2D block
     has each member's overall height and base width.  With ``pulses`` (the default for
     a mesh specimen: the preset vsr) the pulse grid of :mod:`pipeline.campaign.pulse_grid`
-    instead."""
+    instead; ``only_runs`` (run ids) keeps those of its runs, taken from ``grid_specs``
+    when the adaptive driver has made the grid's specs already."""
     data = column_file_description(column_file, meshes=True)
     mesh = data is not None and "mesh" in data
     if pulses is None and mesh and not records:
@@ -111,8 +112,9 @@ def fragility_specs(records, campaign_dir, levels=DEFAULT_LEVELS, members=DEFAUL
         log.info("fragility: a mesh specimen: the pulse grid vsr (PGA 0.2-1.1 g x PGV/PGA "
                  "0.1-1.0 s, 10 x 10; --pulses to change it)")
     if pulses is not None:
-        specs = _pulse_specs(records, campaign_dir, data, column, pulses, members, headings,
-                             azimuth, seed, ranges, stiffness, jobs, quiet=only_runs is not None)
+        specs = grid_specs if grid_specs is not None else _pulse_specs(
+            records, campaign_dir, data, column, pulses, members, headings, azimuth, seed,
+            ranges, stiffness, jobs, quiet=only_runs is not None)
         if only_runs is not None:
             keep = set(only_runs)
             specs = [s.tagged(sampling="adaptive") for s in specs if s.run_id in keep]
@@ -282,7 +284,7 @@ def drive(run, records, campaign_dir, options, gate=None):
         log.info(f"fragility (adaptive), stage {stage}: {len(chosen)} of {len(full)} runs "
                  "(runs per cell: " + ", ".join(
                      f"{n} in {sum(t == n for t in targets.values())}" for n in counts) + ")")
-        result = run({**options, "only_runs": chosen})
+        result = run({**options, "only_runs": chosen, "grid_specs": full})
         return {cell: [any(c.toppled for c in summary.columns)
                        for spec in rows[:targets[cell]]
                        if (summary := finished_summary(campaign_dir, spec.run_id)) is not None]
