@@ -23,10 +23,12 @@ One run prints, and writes to results/bench/bench.json (+ convergence.png):
    on this machine's libm and on the second libm path;
 10. ctrl_c: seconds from Ctrl-C to the exit of a running campaign and of a command
    interrupted during its start-up;
-11. rock_fragility_adaptive: SP1's pulse-grid fragility on a small grid, the adaptive
-   surface (``--adaptive``) beside the full grid of the same resolution, each in a fresh
-   directory: runs, YADE wall time (the runs' own wall times summed), and the largest
-   difference of their P = 0.5 contours (g) beside the full grid's Monte Carlo band.
+11. rock_fragility_adaptive: SP1's pulse-grid fragility on a grid 0.05 g fine in PGA, the
+   adaptive surface (``--adaptive``) beside the full grid of the same cells, members and
+   directions, each in a fresh directory: runs (and the adaptive cells by their runs),
+   YADE wall time (the runs' own wall times summed), campaign wall time, and their
+   P = 0.5 contours (g) side by side with the full grid's Monte Carlo band; the load
+   average at the start (wall times grow with what else the machine runs).
 
 Units: seconds (s), metres, m/s^2; azimuths in degrees clockwise from North.
 ``--quick`` shortens every run and skips the convergence table (for development);
@@ -48,6 +50,7 @@ import numpy as np
 from scipy.integrate import cumulative_trapezoid
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))       # bench/mujoco_twin.py
+sys.path.insert(1, str(Path(__file__).resolve().parent.parent))  # this checkout's pipeline
 from pipeline import PROJECT_ROOT as PROJECT, RESULTS_DIR  # noqa: E402
 from pipeline.campaign.pulse_grid import contour_difference  # noqa: E402
 from pipeline.files import save_figure, write_json  # noqa: E402
@@ -744,15 +747,15 @@ def print_two_x(t):
 
 
 ROCK_SPECIMEN = "records/shake_table/sp1.json"
-ROCK_PULSES = "pga_g=0.1:1.5:15;pgv_pga_s=0.1:0.7:3"    # 45 cells
-ROCK_MEMBERS, ROCK_HEADINGS = 2, 2
+ROCK_PULSES = "pga_g=0.05:1.5:30;pgv_pga_s=0.1:0.7:3"    # 90 cells, PGA 0.05 g apart
+ROCK_MEMBERS, ROCK_HEADINGS = 4, 4                      # 16 runs per cell in the full grid
 
 
 def rock_fragility_adaptive(work, jobs=2):
     """The adaptive pulse-grid surface of SP1 beside the full grid of the same cells,
     members and headings, each campaign in a fresh directory (nothing shared)."""
     result = {"specimen": ROCK_SPECIMEN, "pulses": ROCK_PULSES, "members": ROCK_MEMBERS,
-              "headings": ROCK_HEADINGS, "jobs": jobs}
+              "headings": ROCK_HEADINGS, "jobs": jobs, "load_average_1min": os.getloadavg()[0]}
     summaries = {}
     for mode in ("full", "adaptive"):
         out = work / f"rock_fragility_{mode}"
@@ -766,24 +769,32 @@ def rock_fragility_adaptive(work, jobs=2):
         wall = time.perf_counter() - started
         summaries[mode] = json.loads((out / "fragility.json").read_text())
         grid = summaries[mode]["pulse_grid"]
+        runs_per_cell = [c["n"] for c in grid["models"]["block2d"]["cells"]]
         result[mode] = {"runs": grid["runs_finished"], "full_grid_runs": grid["full_grid_runs"],
-                        "yade_wall_s": grid["yade_wall_s_total"], "campaign_wall_s": wall}
+                        "yade_wall_s": grid["yade_wall_s_total"], "campaign_wall_s": wall,
+                        "cells_by_runs": {str(n): runs_per_cell.count(n)
+                                          for n in sorted(set(runs_per_cell))}}
     result["runs_ratio"] = result["full"]["runs"] / max(result["adaptive"]["runs"], 1)
     result["yade_wall_ratio"] = (result["full"]["yade_wall_s"]
                                  / max(result["adaptive"]["yade_wall_s"], 1e-9))
+    result["campaign_wall_ratio"] = (result["full"]["campaign_wall_s"]
+                                     / max(result["adaptive"]["campaign_wall_s"], 1e-9))
     result["contour_0_5"] = contour_difference(summaries["full"], summaries["adaptive"])
     return result
 
 
 def print_rock_fragility(r):
     print(f"\n11. Adaptive pulse grid against the full grid: {r['specimen']}, {r['pulses']}, "
-          f"{r['members']} members x {r['headings']} headings, --jobs {r['jobs']}")
+          f"{r['members']} members x {r['headings']} headings, --jobs {r['jobs']} (load "
+          f"average {r['load_average_1min']:.1f} at the start: wall times grow with it)")
     print(f"   {'sampling':<10}{'runs':>6}{'YADE wall s':>13}{'campaign wall s':>17}")
     for mode in ("full", "adaptive"):
         m = r[mode]
         print(f"   {mode:<10}{m['runs']:6d}{m['yade_wall_s']:13.1f}{m['campaign_wall_s']:17.1f}")
     print(f"   full / adaptive: {r['runs_ratio']:.2f}x runs, {r['yade_wall_ratio']:.2f}x YADE "
-          "wall time")
+          f"wall time, {r['campaign_wall_ratio']:.2f}x campaign wall time")
+    print("   adaptive cells by their runs: " + ", ".join(
+        f"{count} with {n}" for n, count in r["adaptive"]["cells_by_runs"].items()))
     c = r["contour_0_5"]
     print(f"   P = 0.5 contour (PGA g) {'PGV/PGA s':>10}{'full':>7}{'adaptive':>10}"
           f"{'diff':>7}   full grid's Monte Carlo band")

@@ -99,15 +99,16 @@ def fragility_specs(records, campaign_dir, levels=DEFAULT_LEVELS, members=DEFAUL
                     column="both", seed=None, azimuths=DEFAULT_AZIMUTHS, column_file=None,
                     stiffness="matched", pulses=None, azimuth=None,
                     headings=DEFAULT_HEADINGS, ranges=None, jobs=None, only_runs=None,
-                    adaptive=False, contact_file=None, **_):
+                    adaptive=False, contact_file=None, grid_specs=None, **_):
     """Run specs: every record x level x member; ``scale`` = level / PGA of the record.
     With ``column_file`` every member is the described column with the sampled height
     and diameter tolerances (its own tilt and offsets as described), and the 2D block
     has each member's overall height and base width.  With ``pulses`` (the default for
     a mesh specimen: the preset vsr) the pulse grid of :mod:`pipeline.campaign.pulse_grid`
-    instead.  A contact file fixes what it sets for every member
-    (:func:`pipeline.campaign.ensemble.contact_ranges`; on the pulse grid,
-    :func:`pipeline.campaign.pulse_grid.pulse_runs`)."""
+    instead; ``only_runs`` (run ids) keeps those of its runs, taken from ``grid_specs``
+    when the adaptive driver has made the grid's specs already.  A contact file fixes what
+    it sets for every member (:func:`pipeline.campaign.ensemble.contact_ranges`; on the
+    pulse grid, :func:`pipeline.campaign.pulse_grid.pulse_runs`)."""
     data = column_file_description(column_file, meshes=True)
     contact = None if contact_file is None else contact_values(contact_file)
     mesh = data is not None and "mesh" in data
@@ -116,9 +117,9 @@ def fragility_specs(records, campaign_dir, levels=DEFAULT_LEVELS, members=DEFAUL
         log.info("fragility: a mesh specimen: the pulse grid vsr (PGA 0.2-1.1 g x PGV/PGA "
                  "0.1-1.0 s, 10 x 10; --pulses to change it)")
     if pulses is not None:
-        specs = _pulse_specs(records, campaign_dir, data, column, pulses, members, headings,
-                             azimuth, seed, ranges, stiffness, jobs, quiet=only_runs is not None,
-                             contact=contact)
+        specs = grid_specs if grid_specs is not None else _pulse_specs(
+            records, campaign_dir, data, column, pulses, members, headings, azimuth, seed,
+            ranges, stiffness, jobs, quiet=only_runs is not None, contact=contact)
         if only_runs is not None:
             keep = set(only_runs)
             specs = [s.tagged(sampling="adaptive") for s in specs if s.run_id in keep]
@@ -230,9 +231,10 @@ class FragilityOptions(CampaignOptions):
     ranges: str = param(None, "", "pulse grid: ranges the members' unknowns are drawn from "
                         f"(default {pulse_grid.DEFAULT_RANGES}; LO = HI fixes one)",
                         flag="--ranges", metavar="NAME=LO:HI;...")
-    adaptive: bool = param(False, "", "pulse grid: run every member only where P is uncertain "
-                           "(the 2D block as a guide, one probe run elsewhere, widened where a "
-                           "probe disagrees or the specimen's own P is uncertain)",
+    adaptive: bool = param(False, "", "pulse grid: run each cell only until it is decided "
+                           "on which side of P = 0.5 it lies (the 2D block as a guide: a few "
+                           "runs near its threshold, one probe run elsewhere; more where a "
+                           "cell's Wilson interval still holds 0.5 or a probe disagrees)",
                            flag="--adaptive")
     contact_file: str = contact_file_param(
         "its damping and friction for every member (not sampled or drawn), its kn what "
@@ -262,13 +264,14 @@ class FragilityOptions(CampaignOptions):
 
 
 def drive(run, records, campaign_dir, options, gate=None):
-    """Run the campaign; with ``adaptive`` (pulse grid) in stages: every member where the
-    2D block of the same members and directions is uncertain (0 < P < 1) and one cell
-    either side in PGA, one probe run (first member, first direction) in every other
-    cell; a probe that disagrees with the block's certainty adds its cell and one either
-    side, and so does, read on the specimen's own P (a probe as 0 or 1), a cell where that
-    P is uncertain or steps (the specimen's threshold beyond the block's); until nothing
-    is added (at most :data:`pulse_grid.MAX_STAGES` stages)."""
+    """Run the campaign; with ``adaptive`` (pulse grid) in stages that decide, cell by
+    cell, on which side of P = 0.5 it lies (:func:`pulse_grid.next_targets`): first
+    :data:`pulse_grid.ADAPTIVE_FIRST_RUNS` runs where the 2D block of the same members and
+    directions is uncertain or steps (and one cell either side in PGA), one probe run
+    elsewhere; then a cell whose Wilson interval still holds 0.5 doubles its runs (up to
+    the full grid's), and a probe goes to the first count where it disagrees with the
+    block or a neighbour; until nothing changes (at most :data:`pulse_grid.MAX_STAGES`
+    stages). A cell's runs are taken in :func:`pulse_grid.run_order`."""
     if not options.get("adaptive"):
         return run(options)
     full = fragility_specs(records, campaign_dir, **options)
@@ -276,33 +279,35 @@ def drive(run, records, campaign_dir, options, gate=None):
         gate("campaign fragility (adaptive; at most the full grid)", len(full),
              sum(s.tags["core_s"] for s in full) / len(full), "a smaller --pulses grid")
     guide = pulse_grid.block_outcomes(full)
-    by_cell = {}
+    by_cell, guide_by_cell = {}, {}
     for spec, fell in zip(full, guide):
-        by_cell.setdefault(pulse_grid.cell_key(spec), []).append((spec, fell))
-    guide_p = {cell: float(np.mean([f for _, f in rows])) for cell, rows in by_cell.items()}
-    whole = pulse_grid.guide_cells(guide_p)
-    probes = {cell: rows[0][0] for cell, rows in by_cell.items()}
+        by_cell.setdefault(pulse_grid.cell_key(spec), []).append(spec)
+        guide_by_cell.setdefault(pulse_grid.cell_key(spec), []).append(fell)
+    headings = full[0].tags["headings"]
+    for rows in by_cell.values():
+        rows.sort(key=lambda s: pulse_grid.run_order(s.tags["member"], s.tags["heading"],
+                                                     headings))
+    guide_p = {cell: float(np.mean(fell)) for cell, fell in guide_by_cell.items()}
+    per_cell = len(full) // len(by_cell)
     result = None
-    for stage in range(1, pulse_grid.MAX_STAGES + 1):
-        chosen = [s.run_id for cell, rows in by_cell.items() for s, _ in rows
-                  if cell in whole or s is probes[cell]]
-        log.info(f"fragility (adaptive), stage {stage}: {len(whole)} of {len(by_cell)} cells "
-                 f"in full, a probe run in the others: {len(chosen)} of {len(full)} runs")
-        result = run({**options, "only_runs": chosen})
-        outcomes, measured = {}, {}
-        for cell, rows in by_cell.items():
-            fell = {spec.run_id: any(c.toppled for c in summary.columns)
-                    for spec, _ in rows
-                    if (summary := finished_summary(campaign_dir, spec.run_id)) is not None}
-            if fell:
-                measured[cell] = float(np.mean(list(fell.values())))
-            if probes[cell].run_id in fell:
-                outcomes[cell] = fell[probes[cell].run_id]
-        added = (pulse_grid.expand(guide_p, whole, outcomes)
-                 | (pulse_grid.guide_cells(measured) - whole))
-        if not added:
-            break
-        whole |= added
+
+    def run_stage(stage, targets):
+        nonlocal result
+        chosen = [s.run_id for cell, rows in by_cell.items() for s in rows[:targets[cell]]]
+        counts = sorted(set(targets.values()))
+        log.info(f"fragility (adaptive), stage {stage}: {len(chosen)} of {len(full)} runs "
+                 "(runs per cell: " + ", ".join(
+                     f"{n} in {sum(t == n for t in targets.values())}" for n in counts) + ")")
+        result = run({**options, "only_runs": chosen, "grid_specs": full})
+        return {cell: [any(c.toppled for c in summary.columns)
+                       for spec in rows[:targets[cell]]
+                       if (summary := finished_summary(campaign_dir, spec.run_id)) is not None]
+                for cell, rows in by_cell.items()}
+
+    _, settled = pulse_grid.adaptive_sampling(guide_p, per_cell, run_stage)
+    if not settled:
+        log.warning(f"fragility (adaptive): stopped after {pulse_grid.MAX_STAGES} stages with "
+                    "cells still undecided (their Wilson intervals say so)")
     return result
 
 

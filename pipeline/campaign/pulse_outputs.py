@@ -75,9 +75,11 @@ def pulse_outputs(specs, campaign_dir, figures=True):
     section["runs"] = len(specs)
     section["full_grid_runs"] = (len(grid["pga_g"]) * len(grid["pgv_pga_s"]) * first["members"]
                                  * first["headings"])
-    section["sampling"] = ("adaptive: every member only where P is uncertain (the 2D block "
-                           "as a guide, widened where a probe run disagreed or the specimen's "
-                           "own P was uncertain), one probe run elsewhere"
+    section["sampling"] = ("adaptive: each cell run until its Wilson interval excludes "
+                           "P = 0.5 (up to the full grid's runs), starting from a few runs "
+                           "near the 2D block's threshold and one probe run elsewhere, "
+                           "more where a probe disagreed with the block or a neighbour; "
+                           "a cell's n is the runs it had"
                            if first.get("sampling") == "adaptive"
                            else "full grid: every cell x member x direction")
     observed = None

@@ -158,6 +158,46 @@ def test_a_box_mesh_fragility_matches_the_2d_block_away_from_its_threshold(tmp_p
         assert p == {0.15: 0.0, 1.0: 1.0}, model
 
 
+@pytest.mark.yade
+def test_turning_a_field_rock_turns_nothing_in_its_fragility(tmp_path):
+    """A box wider one way than the other (0.15 m East x 0.3 m North x 0.6 m: tipping
+    across its thin side at 14.0 deg, across its wide side at 26.6 deg), in the field
+    default (directions sampled relative to the specimen), as scanned and turned by
+    90 deg: run for run the same outcome, its fall turned by 90 deg, so the same P per
+    cell. At 0.45 g (the two sides' uplift: 0.25 g and 0.5 g) the 2D block of the same
+    runs falls in some directions and not in others, so a direction not turned with the
+    specimen would show; at 0.85 g it falls in all, so the falls' directions compare."""
+    import pandas as pd
+
+    from pipeline.campaign import run_campaign
+    path = tmp_path / "slab.obj"
+    trimesh.creation.box(extents=(0.15, 0.3, 0.6)).export(path)
+    options = {"pulses": "pga_g=0.45:0.85:2;pgv_pga_s=0.5:0.5:1", "members": 1, "headings": 4,
+               "ranges": "kn=1.2e8:1.2e8;damping=0.1:0.1;mu_s=0.8:0.8;"
+                         "footprint_tolerance_m=0.001:0.001"}
+    runs = {}
+    for heading in (0.0, 90.0):
+        (tmp_path / f"slab{heading:g}.json").write_text(json.dumps(
+            {"name": "slab", "mesh": str(path), "density": 2700.0, "heading_deg": heading}))
+        out = tmp_path / f"frag{heading:g}"
+        run_campaign("fragility", jobs=2, campaign_dir=out, options={
+            **options, "column_file": str(tmp_path / f"slab{heading:g}.json")})
+        table = pd.read_csv(out / "fragility_runs.csv")
+        runs[heading] = table.set_index(["model", "pga_g", "member", "heading"]).sort_index()
+    turned, scanned = runs[90.0], runs[0.0]
+    assert np.allclose((turned["azimuth_deg"] - scanned["azimuth_deg"]) % 360.0, 90.0)
+    block = scanned.loc["block2d"]
+    assert block.loc[0.45, "toppled"].nunique() == 2       # the direction matters here
+    assert block.loc[0.85, "toppled"].all()
+    rock = "monolithic"
+    assert (turned.loc[rock, "toppled"] == scanned.loc[rock, "toppled"]).all()
+    fell = scanned.loc[rock, "toppled"].astype(bool)
+    assert fell.any()
+    turn = (turned.loc[rock, "downfall_azimuth_deg"][fell]
+            - scanned.loc[rock, "downfall_azimuth_deg"][fell] - 90.0 + 180.0) % 360.0 - 180.0
+    assert np.abs(turn).max() < 5.0
+
+
 def test_the_long_run_gate_counts_each_pulse_run_by_its_length(tmp_path, monkeypatch):
     """Before any run: refused in one line with the number of runs, nothing left behind."""
     from pipeline import files
@@ -218,22 +258,44 @@ def test_a_column_draws_nothing_unless_told_and_a_mesh_draws_the_calibrated_rang
                               0.0, 1, None)
 
 
-def test_adaptive_sampling_runs_in_full_where_the_guide_is_uncertain_and_widens_on_surprise():
+def test_adaptive_stages_run_cells_until_their_side_of_one_half_is_decided():
     # one PGV/PGA row of 8 PGA cells: the guide certain below cell 3 and above cell 4
     guide = {(0, j): p for j, p in enumerate((0.0, 0.0, 0.0, 0.3, 0.8, 1.0, 1.0, 1.0))}
-    full = pulse_grid.guide_cells(guide)
     # uncertain cells, the certain ones next to them (a step) and one beyond
-    assert full == {(0, j) for j in range(1, 7)}
-    # probes that agree with the guide add nothing
-    assert pulse_grid.expand(guide, full, {(0, 0): False, (0, 7): True}) == set()
-    # a probe that overturns where the guide is certain it stands: its cell (its
-    # neighbours are run in full already)
-    assert pulse_grid.expand(guide, full, {(0, 0): True, (0, 7): True}) == {(0, 0)}
-    # a step of the guide from 0 to 1 between two cells: both sides and one beyond
+    assert pulse_grid.guide_cells(guide) == {(0, j) for j in range(1, 7)}
+    # the first counts near it, up to one cell above where the guide reaches 0.5
+    first = pulse_grid.first_targets(guide, per_cell=16)
+    assert [first[(0, j)] for j in range(8)] == [1, 4, 4, 4, 4, 4, 1, 1]
+    F, T = False, True
+    seen = {(0, 0): [F], (0, 1): [F] * 4, (0, 2): [F] * 4, (0, 3): [F, T, F, F],
+            (0, 4): [T, T, T, F], (0, 5): [T] * 4, (0, 6): [T], (0, 7): [T]}
+    after = pulse_grid.next_targets(guide, seen, first, per_cell=16)
+    # the contour lies between cells 3 (1 of 4) and 4 (3 of 4): both run in full; 0 of 4
+    # or 4 of 4 elsewhere: the Wilson interval excludes 0.5 (upper 0.49): decided; probes
+    # that agree with the guide and their neighbours stay probes
+    assert [after[(0, j)] for j in range(8)] == [1, 4, 4, 16, 16, 4, 1, 1]
+    # a probe that overturns where the guide is certain it stands: the first count
+    assert pulse_grid.next_targets(guide, {**seen, (0, 0): [T]}, first, 16)[(0, 0)] == 4
+    # below the contour a mixed cell doubles until its interval excludes 0.5; above it a
+    # cell does not move the contour and stops; no cell passes the full grid's count
+    seen = {**seen, (0, 2): [F, T, F, F], (0, 3): [F] * 4, (0, 4): [F, T, T, F]}
+    after = pulse_grid.next_targets(guide, seen, first, per_cell=10)
+    assert [after[(0, j)] for j in range(2, 6)] == [8, 10, 10, 4]
+    seen = {**seen, (0, 2): [F, T] + [F] * 6}         # 1 of 8: [0.02, 0.47], decided
+    assert pulse_grid.next_targets(guide, seen, after, per_cell=10)[(0, 2)] == 8
+    # a probe that agrees with the guide but not with its neighbour: both to the first
+    # count (the specimen's threshold beyond the guide's)
     guide = {(0, j): p for j, p in enumerate((0.0, 0.0, 0.0, 0.0, 1.0, 1.0))}
-    full = pulse_grid.guide_cells(guide)
-    assert full == {(0, 2), (0, 3), (0, 4), (0, 5)}
-    assert pulse_grid.expand(guide, full, {(0, 1): True}) == {(0, 0), (0, 1)}
+    assert pulse_grid.guide_cells(guide) == {(0, 2), (0, 3), (0, 4), (0, 5)}
+    first = pulse_grid.first_targets(guide, per_cell=16)
+    seen = {(0, 0): [F], (0, 1): [T], (0, 2): [T] * 4, (0, 3): [T] * 4, (0, 4): [T] * 4,
+            (0, 5): [T] * 4}
+    after = pulse_grid.next_targets(guide, seen, first, per_cell=16)
+    assert [after[(0, j)] for j in range(6)] == [4, 4, 4, 4, 4, 4]
+    # the first runs of a cell are distinct members from distinct direction sectors
+    order = sorted(((m, h) for m in range(4) for h in range(4)),
+                   key=lambda mh: pulse_grid.run_order(*mh, headings=4))
+    assert order[:4] == [(0, 0), (1, 1), (2, 2), (3, 3)]
 
 
 def test_adaptive_belongs_to_the_pulse_grid():
