@@ -141,7 +141,7 @@ def contact_stiffness_section(results):
                  "predicted overturned (observed)": f"{r['predicted_overturned']} "
                  f"({r['observed_overturned']})", "as at x1": r["same_as_x1"],
                  **cost(r)} for k, r in conv["factors"].items()]
-        fixed = re.sub(r"kn=[^;]*;?", "", conv["grid_point"]).strip(";")
+        fixed = re.sub(r"[,;]?\s*kn=[^,;]*", "", conv["grid_point"]).strip(",; ")
         lines += [f"The rock SP1 on {len(conv['tests'])} fixed shake-table tests (`{fixed}`):\n",
                   _text_table(rows) + "\n"]
     for body, table in conv.get("free_rocking", {}).items():
