@@ -34,6 +34,7 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
+from scipy.stats import binomtest
 
 from pipeline.campaign.run_dirs import finished_summary
 from pipeline.campaign.shake_table import EXPERIMENTS, load_experiments
@@ -125,8 +126,10 @@ def twin_summary(members, record=None):
     every factor), column, toppled, downfall_azimuth_deg, time_step_s and wall_s (of the
     member's run).  Per factor (x1, x3, ...): per column P(toppled) with its Wilson
     interval, the falls' circular mean, resultant length and spread (deg), members with
-    the outcome of x1, the median and largest turn (deg) of the falls of members that fell
-    at both; and the runs' cost with ratios to x1."""
+    the outcome of x1, the exact McNemar test of P against x1's on the same members
+    (``p_value_vs_x1``: two-sided binomial on the members that changed, toppling only at
+    one factor; 1 when none changed), the median and largest turn (deg) of the falls of
+    members that fell at both; and the runs' cost with ratios to x1."""
     members = members[members["member"] >= 0]
     factors = sorted(members["factor"].unique())
     if not factors or factors[0] != 1:
@@ -148,6 +151,9 @@ def twin_summary(members, record=None):
             turn = np.abs((az[both] - paired["downfall_azimuth_deg"].to_numpy(float)[both]
                            + 180.0) % 360.0 - 180.0)
             fell = bool(toppled.any()) and math.isfinite(stats["mean_deg"])
+            only_here = int((known & toppled & ~base_toppled).sum())
+            only_x1 = int((known & ~toppled & base_toppled).sum())
+            changed = only_here + only_x1
             columns[column] = {
                 "members": int(toppled.size), "toppled": int(toppled.sum()),
                 "p_toppled": float(toppled.mean()),
@@ -159,6 +165,9 @@ def twin_summary(members, record=None):
                 else None,
                 "same_outcome_as_x1": int((toppled[known] == base_toppled[known]).sum()),
                 "paired_with_x1": int(known.sum()),
+                "toppled_only_here": only_here, "toppled_only_at_x1": only_x1,
+                "p_value_vs_x1": float(binomtest(min(only_here, only_x1), changed).pvalue)
+                if changed else 1.0,
                 "fell_at_both": int(both.sum()),
                 "median_turn_vs_x1_deg": float(np.median(turn)) if turn.size else None,
                 "max_turn_vs_x1_deg": float(turn.max()) if turn.size else None}
@@ -314,7 +323,8 @@ def table_lines(summary):
                 f", falls {c['mean_downfall_azimuth_deg']:.0f} deg (R "
                 f"{c['resultant_length']:.2f})")
             parts.append(f"{column} P {c['p_toppled']:.2f} [{ci[0]:.2f}, {ci[1]:.2f}]"
-                         f"{direction}, {c['same_outcome_as_x1']}/{c['paired_with_x1']} as x1")
+                         f"{direction}, {c['same_outcome_as_x1']}/{c['paired_with_x1']} as x1"
+                         f" (McNemar p {c['p_value_vs_x1']:.2f})")
         lines.append(f"twin {twin['record']} {factor} ({row['members']} members): "
                      + "; ".join(parts) + _cost_text(row))
     return lines

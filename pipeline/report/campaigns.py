@@ -182,6 +182,7 @@ def contact_stiffness_section(results):
                              f"{c['resultant_length']:.2f}",
                              "outcome as at x1": f"{c['same_outcome_as_x1']}/"
                              f"{c['paired_with_x1']}",
+                             "P vs x1 (McNemar p)": _fmt(c.get("p_value_vs_x1"), 2),
                              "median turn vs x1 (deg)": _fmt(c["median_turn_vs_x1_deg"]),
                              **cost(r)})
         lines += [f"The twin model's ensembles on {twin['record']} (the same sampled members "

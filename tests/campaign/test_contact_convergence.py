@@ -37,6 +37,10 @@ def test_twin_summary_pairs_members_across_factors():
     # member 0 fell at 350 deg at x1 and 10 deg at x10: 20 deg across North, member 1 0
     assert col["fell_at_both"] == 2 and col["max_turn_vs_x1_deg"] == pytest.approx(20.0)
     assert col["median_turn_vs_x1_deg"] == pytest.approx(10.0)
+    # one member changed (stood at x1, fell at x10): McNemar's exact p = 2 * 0.5^1 = 1
+    assert (col["toppled_only_here"], col["toppled_only_at_x1"]) == (1, 0)
+    assert col["p_value_vs_x1"] == pytest.approx(1.0)
+    assert x1["columns"]["monolithic"]["p_value_vs_x1"] == 1.0
     # 10, 90, 180 deg: the mean direction of three unit vectors
     east, north = np.sin(np.radians([10, 90, 180])).sum(), np.cos(np.radians([10, 90, 180])).sum()
     assert col["mean_downfall_azimuth_deg"] == pytest.approx(
@@ -114,6 +118,14 @@ def test_a_stiffer_contact_keeps_the_blocks_restitution(tmp_path):
     assert np.allclose(x1["restitution_per_impact"], x3["restitution_per_impact"], atol=2e-3)
     assert np.allclose(x3["restitution_per_impact"], housner, atol=2e-3)
     assert x3["time_step_s"] / x1["time_step_s"] == pytest.approx(3 ** -0.5, rel=1e-6)
+
+
+def test_mcnemar_p_of_members_that_all_changed_one_way():
+    """Six members standing at x1 all fall at x3: exact two-sided p = 2 * 0.5^6."""
+    table = pd.concat([members(1.0, [False] * 6, [math.nan] * 6, 1e-4, 1.0),
+                       members(3.0, [True] * 6, [0.0] * 6, 1e-4, 1.0)])
+    col = cc.twin_summary(table)["factors"]["x3"]["columns"]["monolithic"]
+    assert col["p_value_vs_x1"] == pytest.approx(2 * 0.5 ** 6)
 
 
 def test_report_section_from_the_file(tmp_path):
