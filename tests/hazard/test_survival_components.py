@@ -46,6 +46,14 @@ def _grid_file(path, pga_g, ratios, p_of, uplift_g=None, n=10 ** 6):
 
 
 # ---------------------------------------------------------------- below the grid
+
+def _power_law_curve(path, low_m_s2, high_m_s2):
+    """A plain hazard table of the rate 1e-4 x^-2.5 per year at 60 PGA levels (m/s^2)."""
+    levels = np.geomspace(low_m_s2, high_m_s2, 60)
+    path.write_text("pga_m_s2,annual_rate_per_yr\n" + "".join(
+        f"{float(x)!r},{float(1e-4 * x ** -2.5)!r}\n" for x in levels))
+    return path
+
 def test_below_the_grid_p_is_continuous_and_zero_below_the_uplift(tmp_path):
     # P = 0.25 at the grid's first PGA (0.2 g), the uplift acceleration 0.1 g
     path = _grid_file(tmp_path / "f.json", [0.2, 0.4, 0.8], [0.05, 0.2],
@@ -109,10 +117,7 @@ def test_survival_json_reports_the_rate_outside_the_grid(tmp_path):
     path = _grid_file(tmp_path / "f.json", np.geomspace(0.2, 2.0, 8), [0.05, 0.2],
                       lambda a: min(1.0, 0.3 + 0.5 * math.log(a / (0.2 * G)))
                       , uplift_g=0.1)
-    curve = tmp_path / "curve.csv"
-    levels = np.geomspace(0.02, 40.0, 60)
-    curve.write_text("pga_m_s2,annual_rate_per_yr\n" + "".join(
-        f"{float(x)!r},{float(1e-4 * x ** -2.5)!r}\n" for x in levels))
+    curve = _power_law_curve(tmp_path / "curve.csv", 0.02, 40.0)
     out = tmp_path / "out"
     assert main(["survival", "--hazard", str(curve), "--fragility", str(path),
                  "--pgv-pga-median", "0.1", "--pgv-pga-sigma", "0.3", "--age-ka", "1",
@@ -209,10 +214,7 @@ def test_column_members_spread_meets_each_members_closed_form(tmp_path):
     fragility = load_campaign_fragility(campaign, "monolithic", "pga")
     fits = fragility.members()
     assert [f.median_m_s2 for f in fits] == pytest.approx(MEMBERS, rel=0.03)
-    curve = tmp_path / "curve.csv"
-    levels = np.geomspace(0.05, 300.0, 60)
-    curve.write_text("pga_m_s2,annual_rate_per_yr\n" + "".join(
-        f"{float(x)!r},{float(1e-4 * x ** -2.5)!r}\n" for x in levels))
+    curve = _power_law_curve(tmp_path / "curve.csv", 0.05, 300.0)
     out = tmp_path / "out"
     assert main(["survival", "--hazard", str(curve), "--fragility", str(campaign),
                  "--column", "monolithic", "--fragility-form", "pga", "--age-ka", "2",
