@@ -748,7 +748,7 @@ def print_two_x(t):
 
 ROCK_SPECIMEN = "records/shake_table/sp1.json"
 ROCK_PULSES = "pga_g=0.05:1.5:30;pgv_pga_s=0.1:0.7:3"    # 90 cells, PGA 0.05 g apart
-ROCK_MEMBERS, ROCK_HEADINGS = 4, 4                      # 16 runs per cell in the full grid
+ROCK_MEMBERS, ROCK_HEADINGS = 8, 4                      # 32 runs per cell in the full grid
 
 
 def rock_fragility_adaptive(work, jobs=2):
