@@ -361,10 +361,11 @@ def _crossing(x, p, level):
 
 
 def block_reference(specs):
-    """alpha (rad), R (m), p (1/s) of the 2D block: medians over the runs."""
+    """alpha (rad), R (m), p (1/s) of the 2D block: medians over the runs; and
+    ``alpha_smallest`` (rad), the smallest critical angle of any run's block."""
     sizes = np.array([block_of(s.params, s.tags["azimuth_deg"]) for s in specs], float)
     c = block_constants(float(np.median(sizes[:, 0])), float(np.median(sizes[:, 1])))
-    return c
+    return {**c, "alpha_smallest": float(np.min(np.arctan2(sizes[:, 1], sizes[:, 0])))}
 
 
 def summarise_grid(table, specs, grid, sets, azimuths, azimuth, ranges_text):
@@ -400,9 +401,13 @@ def summarise_grid(table, specs, grid, sets, azimuths, azimuth, ranges_text):
                        "removed (the spread the unknown parameters carry)",
         "block2d": {"alpha_rad": block["alpha"], "R_m": block["R"], "p_per_s": block["p"],
                     "uplift_g": math.tan(block["alpha"]),
+                    "uplift_g_smallest": math.tan(block["alpha_smallest"]),
                     "definition": "2D rigid block of the specimen's critical angle and pivot "
                                   "distance along each run's azimuth (Housner's equation "
-                                  "and restitution, pipeline.rocking.rocking_response_sampled)"},
+                                  "and restitution, pipeline.rocking.rocking_response_sampled); "
+                                  "its constants the runs' medians; uplift_g_smallest: g tan "
+                                  "of the smallest critical angle of any run (no run's rigid "
+                                  "block leaves rest below it)"},
         "models": models}
 
 

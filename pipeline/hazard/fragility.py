@@ -514,8 +514,9 @@ class PulseGrid:
                 "first_pga_g": self.pga_m_s2[0] / STANDARD_GRAVITY,
                 "uplift_pga_g": None if a_u is None else a_u / STANDARD_GRAVITY,
                 "uplift_source": None if a_u is None else
-                "the 2D block's critical angle alpha in the file (median over the runs' "
-                "directions): a_u = g tan(alpha)",
+                "the 2D block in the file: a_u = g tan(alpha), alpha the smallest critical "
+                "angle of its runs (block2d uplift_g_smallest) or, in a file without it, "
+                "their median",
                 "note": note}
 
 
@@ -605,9 +606,13 @@ def load_pulse_grid(path, data, model=None, form="grid", below="ramp"):
 
 
 def _uplift(section, where):
-    """g tan(alpha) (m/s^2) of a pulse grid's 2D block (``block2d``: uplift_g or alpha_rad),
-    or None when the file has neither."""
+    """g tan(alpha) (m/s^2) of a pulse grid's 2D block (``block2d``: the smallest over its
+    runs, uplift_g_smallest, where written; else uplift_g or alpha_rad, the runs' median),
+    or None when the file has none."""
     block = section.get("block2d") or {}
+    if block.get("uplift_g_smallest") is not None:
+        return number(block["uplift_g_smallest"], f"{where}: block2d uplift_g_smallest", 0,
+                      None, "g", True) * STANDARD_GRAVITY
     if block.get("uplift_g") is not None:
         return number(block["uplift_g"], f"{where}: block2d uplift_g", 0, None, "g",
                       True) * STANDARD_GRAVITY

@@ -153,6 +153,8 @@ def test_a_box_mesh_fragility_matches_the_2d_block_away_from_its_threshold(tmp_p
     section = summary["pulse_grid"]
     assert section["block2d"]["alpha_rad"] == pytest.approx(block["alpha"], rel=1e-3)
     assert section["block2d"]["R_m"] == pytest.approx(block["R"], rel=1e-3)
+    # one footprint, one direction: the smallest uplift is the block's g tan(alpha) = 0.25 g
+    assert section["block2d"]["uplift_g_smallest"] == pytest.approx(0.25, rel=1e-3)
     for model in ("monolithic", "block2d"):
         p = {c["pga_g"]: c["P"] for c in section["models"][model]["cells"]}
         assert p == {0.15: 0.0, 1.0: 1.0}, model

@@ -79,6 +79,14 @@ def test_below_the_grid_p_is_continuous_and_zero_below_the_uplift(tmp_path):
                                               lambda a: 0.25))
     assert bare.describe()["below_grid"]["applied"] == "zero"
     assert "no uplift acceleration" in bare.describe()["below_grid"]["note"]
+    # a file with the smallest uplift of its runs ramps from that one, not their median
+    data = json.loads(path.read_text())
+    data["pulse_grid"]["block2d"]["uplift_g_smallest"] = 0.05
+    path.write_text(json.dumps(data))
+    smallest = load_campaign_fragility(path)
+    assert smallest.describe()["below_grid"]["uplift_pga_g"] == pytest.approx(0.05)
+    assert smallest.probability(np.array([0.049, 0.1]) * G, np.full(2, 0.1)) == pytest.approx(
+        [0.0, 0.25 * math.log(2) / math.log(4)], abs=1e-4)
 
 
 def test_rate_below_the_grid_against_its_closed_form(tmp_path):
