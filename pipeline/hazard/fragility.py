@@ -371,9 +371,10 @@ class PulseGrid:
 
     Inside the grid P is interpolated bilinearly in (ln PGA, ln PGV/PGA) between the
     cells' fractions: no functional form is imposed, and the cells are where the runs are.
-    Above the grid's PGA and beside its PGV/PGA P is the logistic surface fitted to the
-    same runs (its smooth trend carries the grid's edge outwards); without one, the
-    nearest edge cell's P.  Below the grid's first PGA a_1, ``below`` (:data:`BELOW_GRID`):
+    Above the grid's PGA and beside its PGV/PGA P follows the logistic surface fitted to
+    the same runs from the nearest edge cell: its log-odds shifted to meet that cell's P
+    (continuous at the edge; the surface's trend carries it outwards); without a surface,
+    the nearest edge cell's P.  Below the grid's first PGA a_1, ``below`` (:data:`BELOW_GRID`):
     the edge P at a_1 times w(a), continuous at a_1, with ``uplift_m_s2`` = g tan(alpha)
     (a rigid body does not leave its rest below it, Housner 1963):
 
@@ -444,7 +445,10 @@ class PulseGrid:
         return self.pga_m_s2[0], self.pga_m_s2[-1]
 
     def _surface(self, cells, pga, ratio):
-        """Bilinear inside the grid, the logistic surface (or the edge cell) outside."""
+        """Bilinear inside the grid; outside, the logistic surface's trend carried from the
+        nearest edge cell (its log-odds shifted to meet that cell's P, so P is continuous
+        at the edge and a cell of P 0 or 1 stays so; the raw surface, with its steps, for
+        ``below`` "logistic"), or without a surface the edge cell's P."""
         from scipy.interpolate import RegularGridInterpolator  # noqa: PLC0415
         points = np.stack([np.log(pga), np.log(ratio)], axis=-1)
         inside = RegularGridInterpolator((np.log(self.pga_m_s2), np.log(self.pgv_pga_s)),
@@ -453,8 +457,15 @@ class PulseGrid:
         ln_a, ln_r = np.log(self.pga_m_s2), np.log(self.pgv_pga_s)
         within = ((points[..., 0] >= ln_a[0]) & (points[..., 0] <= ln_a[-1])
                   & (points[..., 1] >= ln_r[0]) & (points[..., 1] <= ln_r[-1]))
-        held = inside(_clip_points(points, ln_a, ln_r))     # the edge cell's P outside
-        out = held if self.outside is None else self.outside.probability(pga, ratio)
+        edge = _clip_points(points, ln_a, ln_r)
+        held = inside(edge)                                   # the edge cell's P outside
+        if self.outside is None:
+            out = held
+        elif self.below == "logistic":
+            out = self.outside.probability(pga, ratio)
+        else:
+            out = _carried(held, self.outside.probability(pga, ratio),
+                           self.outside.probability(np.exp(edge[..., 0]), np.exp(edge[..., 1])))
         return np.clip(np.where(within, held, out), 0.0, 1.0)
 
     def draws(self, n, rng):
@@ -518,6 +529,16 @@ class PulseGrid:
                 "angle of its runs (block2d uplift_g_smallest) or, in a file without it, "
                 "their median",
                 "note": note}
+
+
+def _carried(p_edge, surface, surface_at_edge):
+    """P outside a grid: logit P = logit p_edge + logit surface - logit surface_at_edge."""
+    from scipy.special import expit, logit  # noqa: PLC0415
+    tiny = 1e-12
+    shift = (logit(np.clip(surface, tiny, 1 - tiny))
+             - logit(np.clip(surface_at_edge, tiny, 1 - tiny)))
+    with np.errstate(divide="ignore"):
+        return expit(logit(np.clip(p_edge, 0.0, 1.0)) + shift)
 
 
 def _clip_points(points, ln_a, ln_r):

@@ -303,3 +303,38 @@ def test_below_grid_without_a_grid_is_refused_in_one_line(tmp_path, capsys):
     err = capsys.readouterr().err.strip()
     assert "--below-grid applies to a pulse-grid" in err and len(err.splitlines()) == 1
     assert not out.exists()
+
+
+def test_beside_and_above_the_grid_p_carries_the_surface_from_the_edge(tmp_path):
+    """Outside the grid's PGV/PGA range and above its PGA, P follows the logistic surface
+    from the nearest edge cell: continuous there, and its log-odds differ from the
+    surface's by the same shift as at the edge cell (closed form); --below-grid logistic
+    keeps the raw surface."""
+    from scipy.special import logit
+
+    from pipeline.hazard.fragility import Logistic
+    coefficients = (1.0, 3.0, 2.0)
+    path = _grid_file(tmp_path / "f.json", [0.2, 0.4, 0.8], [0.1, 0.3],
+                      lambda a: {0.2: 0.25, 0.4: 0.6, 0.8: 0.9}[round(a / G, 6)], uplift_g=0.1)
+    data = json.loads(path.read_text())
+    data["pulse_grid"]["models"]["monolithic"]["logistic"]["coefficients"] = dict(
+        zip(("b0", "b1", "b2"), coefficients))
+    path.write_text(json.dumps(data))
+    grid = load_campaign_fragility(path)
+    surface = Logistic(coefficients)
+    a = np.full(3, 0.4 * G)
+    # beside: PGV/PGA just inside and just outside the lower edge 0.1 s meet
+    inside, outside = grid.probability(a[:2], np.array([0.1, 0.0999]))
+    assert outside == pytest.approx(inside, abs=1e-3)
+    # far beside: the edge cell's log-odds plus the surface's change from the edge
+    for ratio in (0.03, 1.0):
+        edge_ratio = 0.1 if ratio < 0.1 else 0.3
+        expected = logit(0.6) + (logit(surface.probability(0.4 * G, ratio))
+                                 - logit(surface.probability(0.4 * G, edge_ratio)))
+        assert logit(grid.probability(0.4 * G, ratio)) == pytest.approx(expected, abs=1e-6)
+    # above the grid's last PGA, from the 0.8 g cell
+    expected = logit(0.9) + (logit(surface.probability(1.6 * G, 0.2))
+                             - logit(surface.probability(0.8 * G, 0.2)))
+    assert logit(grid.probability(1.6 * G, 0.2)) == pytest.approx(expected, abs=1e-6)
+    raw = load_campaign_fragility(path, below="logistic")
+    assert raw.probability(0.4 * G, 0.03) == pytest.approx(surface.probability(0.4 * G, 0.03))
