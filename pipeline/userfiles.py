@@ -37,6 +37,20 @@ def read_text(path):
                          content[at]) from None
 
 
+def read_json(path, what):
+    """The parsed JSON of a user's file (read by :func:`read_text`); InputError (one line)
+    "``what`` not found: path" or "name: not readable JSON (why)"."""
+    import json
+    from pathlib import Path
+    path = Path(path)
+    if not path.is_file():
+        raise InputError(f"{what} not found: {path}")
+    try:
+        return json.loads(read_text(path))
+    except (OSError, ValueError, RecursionError) as exc:      # Unreadable is a ValueError
+        raise InputError(f"{path.name}: not readable JSON ({exc})") from None
+
+
 _REPR = reprlib.Repr()
 _REPR.maxlevel, _REPR.maxlist, _REPR.maxdict, _REPR.maxset = 2, 4, 4, 4
 _REPR.maxstring, _REPR.maxother, _REPR.maxlong = 60, 60, 40

@@ -16,7 +16,6 @@ PGV and PGA from Boore et al. 2014 (pygmm) at a magnitude and distance, for exam
 mode of the hazard's disaggregation; ln PGV given ln PGA by their correlation).
 """
 import importlib.metadata
-import json
 import math
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -26,7 +25,7 @@ from scipy import stats
 
 from pipeline.constants import STANDARD_GRAVITY
 from pipeline.files import InputError
-from pipeline.userfiles import Unreadable, number, read_text, show
+from pipeline.userfiles import Unreadable, number, read_json, read_text, show
 
 Z95 = stats.norm.ppf(0.975)
 RATIO_NODES = 24                  # Gauss-Hermite nodes over ln(PGV/PGA)
@@ -145,12 +144,7 @@ def _load_campaign_fragility(path, column, form, below):
     path = Path(path)
     if path.is_dir():
         path = path / "fragility.json"
-    try:
-        data = json.loads(read_text(path))
-    except FileNotFoundError:
-        raise InputError(f"fragility file not found: {path}") from None
-    except (OSError, ValueError, Unreadable) as exc:
-        raise InputError(f"{path}: not a fragility.json ({exc})") from None
+    data = read_json(path, "fragility file")
     if isinstance(data, dict) and "pulse_grid" in data:
         return load_pulse_grid(path, data, column, form or "grid", below), "line", ()
     form = form or "pga-pgv"

@@ -20,7 +20,6 @@ azimuths (turned by the strike into geographic ones) and the standing columns be
 observations file (``observations.json``, the schema of
 :mod:`pipeline.inversion.observations`), which ``invert`` inverts as any other.
 """
-import json
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -33,7 +32,7 @@ from pipeline.campaign.tables import collect
 from pipeline.files import InputError
 from pipeline.inversion.grid import MECHANISMS, slice_motions
 from pipeline.stats.circular import azimuth_deg
-from pipeline.userfiles import read_text
+from pipeline.userfiles import read_json
 from pipeline.userfiles import keys_text as _keys
 from pipeline.userfiles import number as _number
 from pipeline.inversion.forward import MEMBER_BATCH, member_parameters
@@ -133,13 +132,7 @@ def parse_truth(data, source="truth"):
 def load_truth(path):
     """Read a truth file; InputError (one line) for any problem."""
     path = Path(path)
-    if not path.is_file():
-        raise InputError(f"truth file not found: {path}")
-    try:
-        data = json.loads(read_text(path))
-    except (OSError, ValueError, RecursionError) as exc:
-        raise InputError(f"{path.name}: not a readable JSON truth file ({exc})") from None
-    return parse_truth(data, path.name)
+    return parse_truth(read_json(path, "truth file"), path.name)
 
 
 def truth_grid(truth, grid):

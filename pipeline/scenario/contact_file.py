@@ -2,11 +2,10 @@
 contact parameters a free-rocking test gave (``kn`` N/m per point, ``damping``; also
 ``mu_s``, ``mu_k`` when stated) beside what they came from (``restitution`` and its
 uncertainty, the block, the source: informational keys, not read)."""
-import json
 from pathlib import Path
 
 from pipeline.files import InputError
-from pipeline.userfiles import Unreadable, keys_text, number, read_text
+from pipeline.userfiles import keys_text, number, read_json
 
 CONTACT_KEYS = ("kn", "damping", "mu_s", "mu_k")
 INFORMATION_KEYS = ("restitution", "restitution_sd", "restitution_se", "impacts",
@@ -19,12 +18,7 @@ def load_contact_file(path):
     :class:`~pipeline.scenario.parameters.Contact` where used); one-line InputError for a
     missing or unreadable file, an unknown key, or a file without kn and damping."""
     path = Path(path)
-    if not path.is_file():
-        raise InputError(f"--contact-file {path}: file not found")
-    try:
-        data = json.loads(read_text(path))
-    except (OSError, Unreadable, ValueError) as exc:
-        raise InputError(f"--contact-file {path.name}: not readable JSON ({exc})") from None
+    data = read_json(path, "--contact-file")
     if not isinstance(data, dict):
         raise InputError(f"--contact-file {path.name}: a JSON object needed")
     unknown = set(data) - set(CONTACT_KEYS) - set(INFORMATION_KEYS)
