@@ -43,7 +43,6 @@ def contact_of(options):
     return contact_values(options.contact_file)
 
 
-
 @dataclass(frozen=True)
 class CampaignOptions:
     """No options of its own.  Subclasses declare fields and may add :meth:`check`."""
@@ -71,4 +70,3 @@ class ColumnFileOptions(CampaignOptions):
 
     def check(self):
         contact_of(self)
-
