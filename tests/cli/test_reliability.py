@@ -388,16 +388,38 @@ def test_kill_9_leaves_no_yade_behind_and_resume_completes(tmp_path):
 
 # YADE makes /tmp/yade-XXXXXX per process, at that fixed path (not TMPDIR): a command run
 # by private_tmp_cli sees a /tmp of its own (``tmp_path/tmp``, in a mount namespace), so
-# that a test sees only its own YADE directories, not those of tests running beside it;
-# tmp_path is seen at its own path
+# that a test sees only its own YADE directories, not those of tests running beside it.
+# What lives under /tmp and the command needs is bound back at its own path: tmp_path,
+# the checkout and the virtual environment (a clone under /tmp, as CI systems make).
+# Arguments: private_tmp, N, N directories to keep, then the command.
 PRIVATE_TMP = """
-exec 3<"$2"
-mount --bind "$1" /tmp && mkdir -p "$2" && mount --no-canonicalize --bind /proc/self/fd/3 "$2" \
-  || exit 99
-exec 3<&-
-shift 2
+private=$1; count=$2; shift 2
+fd=3; i=0
+for dir; do
+  [ "$i" -lt "$count" ] || break
+  eval "exec $fd<\"\$dir\"" || exit 99
+  fd=$((fd + 1)); i=$((i + 1))
+done
+mount --bind "$private" /tmp || exit 99
+fd=3; i=0
+while [ "$i" -lt "$count" ]; do
+  mkdir -p "$1" && mount --no-canonicalize --bind "/proc/self/fd/$fd" "$1" || exit 99
+  eval "exec $fd<&-"
+  fd=$((fd + 1)); i=$((i + 1)); shift
+done
 exec "$@"
 """
+
+
+def kept_under_tmp(tmp_path):
+    """The directories a private-/tmp command must still see: tmp_path, and the checkout,
+    the virtual environment and the interpreter's installation where they lie under /tmp
+    (outermost only, so a bind never hides another)."""
+    tmp = Path("/tmp").resolve()
+    wanted = [Path(p).resolve() for p in (tmp_path, PROJECT, sys.prefix, sys.base_prefix)]
+    under = [p for p in wanted if p == tmp_path.resolve() or tmp in p.parents]
+    outer = [p for p in under if not any(q in p.parents for q in under)]
+    return list(dict.fromkeys(str(p) for p in outer))
 
 
 def private_tmp_cli(tmp_path, *args):
@@ -406,9 +428,10 @@ def private_tmp_cli(tmp_path, *args):
     if subprocess.run(["unshare", "-Urm", "true"], capture_output=True).returncode != 0:
         pytest.skip("no unprivileged mount namespace (unshare -Urm) for a private /tmp")
     (tmp_path / "tmp").mkdir(exist_ok=True)
+    kept = kept_under_tmp(tmp_path)
     return subprocess.Popen(["unshare", "-Urm", "sh", "-c", PRIVATE_TMP, "sh",
-                             str(tmp_path / "tmp"), str(tmp_path), sys.executable, "-m",
-                             "pipeline", *args], cwd=PROJECT, stdout=subprocess.PIPE,
+                             str(tmp_path / "tmp"), str(len(kept)), *kept, sys.executable,
+                             "-m", "pipeline", *args], cwd=PROJECT, stdout=subprocess.PIPE,
                             stderr=subprocess.PIPE, text=True)
 
 
