@@ -1,0 +1,291 @@
+"""What ``constrain`` says for a logic tree and the specimens standing at its site:
+``constrain.json``'s content, the tables and the arrays of its figure
+(:func:`constrain_tree`)."""
+import numpy as np
+
+from pipeline.constants import STANDARD_GRAVITY
+from pipeline.hazard.constrain import (FLOOR, FRACTILES, TARGET_RATES, bayes, branch_rates,
+                                       cell_matrix, change_percent, eliminate,
+                                       log_survival_fixed, log_survival_sampled,
+                                       motion_at_rate, truncated_ages, weighted_mean,
+                                       weighted_quantile)
+from pipeline.hazard.fragility import overturn_probability
+from pipeline.hazard.survival import survival_probability
+from pipeline.provenance import software_versions
+
+RULES = ("bayes", "eliminate")
+AGE_SAMPLES = 2000           # Monte Carlo samples of differing, uncertain ages
+INTERVAL = (2.5, 97.5)       # percentiles of the intervals over fragility draws
+END_SHARE_WARNING = 0.1
+
+WHY_BAYES = ("Bayes is the headline: each branch's weight is multiplied by the probability "
+             "that the specimens survived under it (the likelihood), so all of what the "
+             "survival says is used, and no threshold is chosen; elimination keeps or drops a "
+             "branch by an arbitrary floor and forgets how far above it a branch lies.")
+
+ASSUMPTIONS = [
+    "Earthquakes are a Poisson process in time; a specimen's age is the time it has stood "
+    "exposed in its present state.",
+    "Specimens at one site share every earthquake and overturn independently given its "
+    "shaking (P(any overturns) = 1 - prod(1 - P_j), averaged over PGV/PGA).  With differing "
+    "ages the joint survival is the product over the age intervals (youngest first) of the "
+    "survival of the specimens standing through each interval: exact for a Poisson process.",
+    "An uncertain age is normal (mean, sd) truncated at 0.  One age for all specimens: "
+    "integrated in closed form.  Differing ages, some uncertain: Monte Carlo over "
+    f"independent ages ({AGE_SAMPLES} samples; the standard error is reported), and for the "
+    "fragility draws the ages at their means.",
+    "Each branch's curve is interpolated linearly in (ln PGA, ln rate), nothing counted "
+    "below its first level and every exceedance of its last level counted at it (a lower "
+    "bound on the rate), as in survival.",
+    "The mean hazard curve is the weighted mean of the branches' annual rates (OpenQuake "
+    "averages probabilities of exceedance unless use_rates is set: at small probabilities "
+    "the two agree); fractiles are OpenQuake's weighted quantile (values sorted, cumulative "
+    "weights interpolated linearly), branches of weight 0 left out.",
+    "Ground motion at an annual rate: the curve interpolated linearly in (ln rate, ln PGA), "
+    "never extrapolated (null outside the curve's rates).",
+    "The fragility's members (its parameter sets) are possible specimens: the weights under "
+    "each member and under their mixture (the mean over members of P_s per branch) are "
+    "reported apart from the Monte Carlo error of the fragility (its draws).  In a set, "
+    "member m takes every specimen's m-th member (specimens without members their own "
+    "fragility).",
+]
+
+
+def constrain_tree(tree, specimens, ratio_model, ages_ka, age_sds_ka, rule="bayes",
+                   floor=FLOOR, draws=400, seed=0):
+    """(summary dict, branch rows, figure data) for the
+    :class:`~pipeline.hazard.logictree.LogicTree` ``tree`` and ``specimens`` (fragility
+    objects, one per specimen) of ages ``ages_ka`` (ka, one per specimen) with sds
+    ``age_sds_ka``."""
+    ages = np.asarray(ages_ka, float) * 1000.0
+    sds = np.asarray(age_sds_ka, float) * 1000.0
+    rng = np.random.default_rng(seed)
+    cells = cell_matrix(tree.levels_m_s2, tree.rates_per_yr)
+    mode, samples = _age_mode(ages, sds, rng)
+    warnings = list(tree.notes)
+
+    def survival_of(fragilities, sampled=True):
+        return _log_survival(tree, cells, fragilities, ratio_model, ages, sds, mode,
+                             samples if sampled else None)
+
+    log_p, age_se = survival_of(specimens)
+    p = np.exp(log_p)
+    posterior = {"bayes": bayes(tree.weights, log_p), "eliminate": eliminate(tree.weights, p,
+                                                                           floor)}
+    for name, w in posterior.items():
+        if w is None:
+            warnings.append(_none_left(name, floor))
+    members = _members(tree, specimens, survival_of, floor, warnings)
+    carlo = _draws(tree, specimens, survival_of, draws, rng, floor)
+    warnings += _end_warnings(tree, cells, specimens, ratio_model, posterior[rule])
+    prior_stats = _statistics(tree, tree.weights)
+    post_stats = None if posterior[rule] is None else _statistics(tree, posterior[rule])
+    other = "eliminate" if rule == "bayes" else "bayes"
+    summary = {
+        "rule": rule, "headline": WHY_BAYES, "floor": floor,
+        "branch_count": tree.size, "specimen_count": len(specimens),
+        "specimens": [{"fragility": f.describe(), "age_ka": float(a), "age_sd_ka": float(s)}
+                      for f, a, s in zip(specimens, ages_ka, age_sds_ka)],
+        "age_model": mode,
+        "age_integration_se_max": None if age_se is None else float(np.nanmax(age_se)),
+        "branches": _branch_rows(tree, p, posterior, carlo, age_se),
+        "levels_m_s2": tree.levels_m_s2.tolist(),
+        "levels_g": (tree.levels_m_s2 / STANDARD_GRAVITY).tolist(),
+        "prior": prior_stats,
+        "posterior": post_stats,
+        f"posterior_{other}": None if posterior[other] is None
+        else _statistics(tree, posterior[other]),
+        "ground_motion_at_rates": _motions(tree, prior_stats, post_stats),
+        "members": members, "monte_carlo": carlo,
+        "hazard": {**tree.source, "notes": list(tree.notes),
+                   "interpolation": "linear in (ln PGA, ln rate)",
+                   "cells_per_interval": cells[2]},
+        "pgv_pga": None if ratio_model is None else ratio_model.describe(),
+        "warnings": warnings, "assumptions": ASSUMPTIONS,
+        "draws": draws, "seed": seed, "software": software_versions()}
+    figure = {"levels_m_s2": tree.levels_m_s2, "rates_per_yr": tree.rates_per_yr,
+              "prior_weights": tree.weights, "posterior_weights": posterior[rule],
+              "prior": prior_stats, "posterior": post_stats, "rule": rule,
+              "ages_ka": list(ages_ka), "age_sds_ka": list(age_sds_ka),
+              "target_rates": TARGET_RATES}
+    return summary, summary["branches"], figure
+
+
+def _age_mode(ages, sds, rng):
+    """(how ages are treated, age samples or None)."""
+    if not (sds > 0).any():
+        return "known ages", None
+    if np.all(ages == ages[0]) and np.all(sds == sds[0]):
+        return "one uncertain age for all: integrated in closed form", None
+    return (f"differing uncertain ages: Monte Carlo over {AGE_SAMPLES} samples",
+            truncated_ages(ages, sds, AGE_SAMPLES, rng))
+
+
+def _log_survival(tree, cells, fragilities, ratio_model, ages, sds, mode, samples):
+    """(ln P_s per branch, its relative standard error per branch or None)."""
+    def set_rates(members):
+        chosen = [fragilities[j] for j in members]
+        return branch_rates(cells, tree.levels_m_s2, tree.rates_per_yr,
+                            lambda x: overturn_probability(chosen, ratio_model, x,
+                                                           "any_common"))
+    if mode.startswith("one uncertain age"):
+        rate = set_rates(tuple(range(len(fragilities))))
+        with np.errstate(divide="ignore"):
+            return np.log(survival_probability(rate, ages[0], sds[0])), None
+    if samples is None:
+        return log_survival_fixed(set_rates, ages), None
+    return log_survival_sampled(set_rates, samples)
+
+
+def _none_left(rule, floor):
+    if rule == "bayes":
+        return ("every branch gives the specimens a survival probability of 0: no Bayesian "
+                "update (check the ages and the fragility)")
+    return (f"every branch gives a survival probability below {floor:g}: elimination drops "
+            "them all, no constrained curve under that rule")
+
+
+def _statistics(tree, weights):
+    """Mean and fractile curves (annual rates) under ``weights``."""
+    rates = tree.rates_per_yr
+    return {"mean_rates_per_yr": weighted_mean(rates, weights).tolist(),
+            "fractiles": {f"{q:g}": weighted_quantile(rates, weights, q).tolist()
+                          for q in FRACTILES}}
+
+
+def _motions(tree, prior, posterior):
+    """PGA at TARGET_RATES on the mean and each fractile curve, before and after."""
+    rows = []
+    curves = [("mean", "mean_rates_per_yr", None)] + \
+        [(f"fractile {q:g}", "fractiles", f"{q:g}") for q in FRACTILES]
+    for rate in TARGET_RATES:
+        for name, key, q in curves:
+            before = _pga(tree, prior, key, q, rate)
+            after = None if posterior is None else _pga(tree, posterior, key, q, rate)
+            rows.append({"annual_rate_per_yr": rate, "curve": name,
+                         "prior_m_s2": before, "posterior_m_s2": after,
+                         "prior_g": _g(before), "posterior_g": _g(after),
+                         "change_percent": change_percent(before, after)})
+        lo_b, hi_b = (_pga(tree, prior, "fractiles", q, rate) for q in ("0.05", "0.95"))
+        lo_a, hi_a = (None, None) if posterior is None else \
+            (_pga(tree, posterior, "fractiles", q, rate) for q in ("0.05", "0.95"))
+        width_b = None if None in (lo_b, hi_b) else hi_b - lo_b
+        width_a = None if None in (lo_a, hi_a) else hi_a - lo_a
+        rows.append({"annual_rate_per_yr": rate, "curve": "range 0.05-0.95",
+                     "prior_m_s2": width_b, "posterior_m_s2": width_a,
+                     "prior_g": _g(width_b), "posterior_g": _g(width_a),
+                     "change_percent": change_percent(width_b, width_a)})
+    return rows
+
+
+def _pga(tree, stats, key, q, rate):
+    curve = stats[key] if q is None else stats[key][q]
+    return motion_at_rate(tree.levels_m_s2, np.asarray(curve), rate)
+
+
+def _g(value):
+    return None if value is None else value / STANDARD_GRAVITY
+
+
+def _members(tree, specimens, survival_of, floor, warnings):
+    """The weights under each member of the fragility and under their mixture, or None."""
+    lists = [None if getattr(f, "members", None) is None else f.members() for f in specimens]
+    counts = {len(m) for m in lists if m}
+    if not counts:
+        return None
+    if len(counts) > 1:
+        warnings.append(f"the specimens' fragilities have different numbers of members "
+                        f"({sorted(counts)}): the members' spread not reported")
+        return None
+    count = counts.pop()
+    log_ps = np.array([survival_of([m[k] if m else f for m, f in zip(lists, specimens)])[0]
+                       for k in range(count)])
+    ps = np.exp(log_ps)
+    mixture = ps.mean(axis=0)
+    posteriors = [bayes(tree.weights, lp) for lp in log_ps]
+    with np.errstate(divide="ignore"):
+        mixed = bayes(tree.weights, np.log(mixture))
+    at = {}
+    for rate in TARGET_RATES:
+        per = [None if w is None else motion_at_rate(tree.levels_m_s2,
+                                                     weighted_mean(tree.rates_per_yr, w), rate)
+               for w in posteriors]
+        mix = None if mixed is None else motion_at_rate(
+            tree.levels_m_s2, weighted_mean(tree.rates_per_yr, mixed), rate)
+        known = [v for v in per if v is not None]
+        at[f"{rate:g}"] = {"mixture_g": _g(mix), "per_member_g": [_g(v) for v in per],
+                           "member_range_g": [_g(min(known)), _g(max(known))] if known
+                           else None}
+    return {"count": count,
+            "survival_per_member": ps.tolist(),
+            "posterior_bayes_per_member": [None if w is None else w.tolist()
+                                           for w in posteriors],
+            "mixture": {"survival_probability": mixture.tolist(),
+                        "posterior_bayes": None if mixed is None else mixed.tolist(),
+                        "posterior_eliminate": _list(eliminate(tree.weights, mixture, floor))},
+            "mean_ground_motion_at_rates": at}
+
+
+def _draws(tree, specimens, survival_of, draws, rng, floor):
+    """The Monte Carlo error of the fragility: P_s, posterior weights and the posterior
+    mean's PGA at TARGET_RATES over fragility draws (intervals), or None."""
+    drawn = [f.draws(draws, rng) if draws else None for f in specimens]
+    if all(d is None for d in drawn):
+        return None
+    log_ps = np.array([survival_of([d[k] if d is not None else f
+                                    for d, f in zip(drawn, specimens)], sampled=False)[0]
+                       for k in range(draws)])
+    ps = np.exp(log_ps)
+    posteriors = [bayes(tree.weights, lp) for lp in log_ps]
+    usable = np.array([w for w in posteriors if w is not None])
+    motion = {}
+    for rate in TARGET_RATES:
+        values = [motion_at_rate(tree.levels_m_s2, weighted_mean(tree.rates_per_yr, w), rate)
+                  for w in usable]
+        values = [v for v in values if v is not None]
+        motion[f"{rate:g}"] = None if not values else \
+            (np.percentile(values, INTERVAL) / STANDARD_GRAVITY).tolist()
+    return {"draws": draws,
+            "survival_interval": np.percentile(ps, INTERVAL, axis=0).T.tolist(),
+            "posterior_bayes_interval": None if not len(usable) else
+            np.percentile(usable, INTERVAL, axis=0).T.tolist(),
+            "posterior_mean_pga_g_interval_at_rates": motion,
+            "definition": f"{INTERVAL[0]:g}-{INTERVAL[1]:g} percentiles over {draws} draws of "
+                          "the fragility's estimate (its Monte Carlo or fitting error)"}
+
+
+def _end_warnings(tree, cells, specimens, ratio_model, weights):
+    """A warning when, for branches of weight, the last level holds much of the rate."""
+    def probability(x):
+        return overturn_probability(specimens, ratio_model, x, "any_common")
+    total = branch_rates(cells, tree.levels_m_s2, tree.rates_per_yr, probability)
+    top = float(probability(tree.levels_m_s2[-1:])[0]) * tree.rates_per_yr[:, -1]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        share = np.where(total > 0, top / total, 0.0)
+    w = tree.weights if weights is None else weights
+    held = float(w @ share)
+    if held > END_SHARE_WARNING:
+        return [f"{100 * held:.0f} % of the overturning rate (weighted over branches) lies at "
+                "the curves' last level: extend the hazard curves (a lower bound on the rate)"]
+    return []
+
+
+def _list(array):
+    return None if array is None else array.tolist()
+
+
+def _branch_rows(tree, p, posterior, carlo, age_se):
+    rows = []
+    for k in range(tree.size):
+        row = {"branch": tree.branch_ids[k], "path": tree.branch_paths[k],
+               "prior_weight": float(tree.weights[k]), "survival_probability": float(p[k]),
+               "posterior_bayes": None if posterior["bayes"] is None
+               else float(posterior["bayes"][k]),
+               "posterior_eliminate": None if posterior["eliminate"] is None
+               else float(posterior["eliminate"][k])}
+        if age_se is not None:
+            row["survival_age_se_relative"] = float(age_se[k])
+        if carlo is not None:
+            row["survival_interval"] = carlo["survival_interval"][k]
+        rows.append(row)
+    return rows
