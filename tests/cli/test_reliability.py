@@ -392,7 +392,7 @@ def test_kill_9_leaves_no_yade_behind_and_resume_completes(tmp_path):
 # What lives under /tmp and the command needs is bound back at its own path: tmp_path,
 # the checkout and the virtual environment (a clone under /tmp, as CI systems make).
 # Arguments: private_tmp, N, N directories to keep, then the command.
-PRIVATE_TMP = """
+PRIVATE_TMP = r"""
 private=$1; count=$2; shift 2
 fd=3; i=0
 for dir; do
