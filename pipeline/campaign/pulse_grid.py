@@ -323,7 +323,8 @@ def contours(cells, levels=CONTOUR_LEVELS):
     monotone as P is: a cell's lower bound holds every cell above it, its upper bound
     every cell below, so a cell of few runs beside a cell of many does not open the band) and where each parameter
     set's own P crosses it (``pga_g_per_set``, for the sets run in every cell of the row:
-    the members' spread); None beyond the grid."""
+    the members' spread); None beyond the grid, and ``outside_grid`` says on which side
+    (:func:`_outside`)."""
     out = {}
     ratios = sorted({c["pgv_pga_s"] for c in cells})
     for level in levels:
@@ -337,7 +338,8 @@ def contours(cells, levels=CONTOUR_LEVELS):
                 np.array([c["P"] for c in row]), upper,
                 np.array([c["ci95"][0] for c in row]))]
             entry = {"pgv_pga_s": ratio, "pga_g": crossing[0],
-                     "pga_g_band": [crossing[1], crossing[2]]}
+                     "pga_g_band": [crossing[1], crossing[2]],
+                     "outside_grid": _outside(np.array([c["P"] for c in row]), level)}
             if all("sets" in c for c in row):
                 common = set.intersection(*(set(c["sets"]) for c in row))
                 entry["pga_g_per_set"] = {
@@ -358,6 +360,38 @@ def _crossing(x, p, level):
     if k == 0:
         return None if p[0] > level else float(x[0])
     return float(x[k - 1] + (level - p[k - 1]) * (x[k] - x[k - 1]) / (p[k] - p[k - 1]))
+
+
+def _outside(p, level):
+    """Where the ``level`` contour of a row lies when the grid does not hold it: "below"
+    (P, made non-decreasing in PGA, is above the level already at the grid's first PGA),
+    "above" (P never reaches it) or None (it crosses inside, or one PGA only)."""
+    p = np.maximum.accumulate(np.asarray(p, float))
+    if len(p) < 2:
+        return None
+    if p[0] > level:
+        return "below"
+    return "above" if p[-1] < level else None
+
+
+def contour_warnings(models, pga_g):
+    """One line per model, level and side where a contour leaves the grid (``outside_grid``
+    of :func:`contours`), naming the PGV/PGA rows and the grid's edge: the surface there
+    is not measured, and whatever integrates over it (survival) extrapolates."""
+    out = []
+    for model, entry in models.items():
+        for level, rows in entry["contours"].items():
+            for side, edge in (("below", min(pga_g)), ("above", max(pga_g))):
+                ratios = [r["pgv_pga_s"] for r in rows if r.get("outside_grid") == side]
+                if ratios:
+                    out.append(
+                        f"{model}: the P = {level} contour lies {side} the grid's "
+                        f"{'lowest' if side == 'below' else 'highest'} PGA ({edge:g} g) for "
+                        f"PGV/PGA {', '.join(f'{v:g}' for v in ratios)} s (P is "
+                        f"{'above' if side == 'below' else 'below'} {level} at the edge): the "
+                        f"grid does not hold it; extend --pulses to "
+                        f"{'lower' if side == 'below' else 'higher'} PGA")
+    return out
 
 
 def block_reference(specs):
@@ -395,6 +429,7 @@ def summarise_grid(table, specs, grid, sets, azimuths, azimuth, ranges_text):
         "members": len(sets), "headings": int(azimuths.shape[1]),
         "ranges": ranges_text, "parameter_sets": sets,
         "contour_levels": list(CONTOUR_LEVELS),
+        "warnings": contour_warnings(models, grid["pga_g"]),
         "uncertainty": "ci95: Wilson 95 % interval of the pooled P (Monte Carlo error); "
                        "P_per_set: P of each parameter set over its headings; set_sd: their "
                        "standard deviation; set_spread_sd: with each set's binomial variance "

@@ -100,5 +100,7 @@ def pulse_outputs(specs, campaign_dir, figures=True):
         log.info(f"{model:>14}: {entry['overturned']}/{entry['runs']} overturned; P = 0.5 at "
                  f"PGA (g) {shown} for PGV/PGA "
                  f"{', '.join(f'{r:g}' for r in section['pgv_pga_s'])} s")
+    for warning in section["warnings"]:
+        log.warning(f"warning: {warning}")
     return {"code_version": run_code_version(), **described,
             "figures": [str(Path(p).relative_to(campaign_dir)) for p in written]}

@@ -206,6 +206,7 @@ def plot_pulse_grid(summary, path):
                                 [r["pga_g_band"][0] for r in band],
                                 [r["pga_g_band"][1] for r in band], color=colour, alpha=0.2,
                                 lw=0, label="P = 0.5, Monte Carlo 95 %")
+        _mark_outside(ax, section, name, ratios, pgas)
         observed = section.get("experiments", {}).get("models", {}).get(name, {}).get("bins")
         if observed:
             x = [np.mean(b["pgv_pga_s"]) for b in observed]
@@ -225,6 +226,24 @@ def plot_pulse_grid(summary, path):
     fig.tight_layout()
     save_figure(fig, path, dpi=120)
     return [Path(path)]
+
+
+def _mark_outside(ax, section, name, ratios, pgas):
+    """Where the specimen's P = 0.5 contour leaves the grid: a red arrow at the edge it
+    leaves by, per PGV/PGA, and the warnings of fragility.json written on the axes."""
+    edges = _edges(pgas)
+    for side, y, marker in (("below", edges[0], "v"), ("above", edges[-1], "^")):
+        rows = [r["pgv_pga_s"] for r in section["models"][name]["contours"].get("0.5", [])
+                if r.get("outside_grid") == side]
+        if rows:
+            ax.plot(rows, [y] * len(rows), ls="none", marker=marker, color="C3", ms=7,
+                    clip_on=False, zorder=6, label=f"P = 0.5 {side} the grid")
+    said = [w.split(": ", 1)[1].split(": the grid")[0]
+            for w in section.get("warnings", []) if w.startswith(f"{name}: ")]
+    if said:
+        ax.text(0.02, 0.02, "warning: contour outside the grid\n" + "\n".join(said),
+                transform=ax.transAxes, fontsize=5, color="C3", va="bottom", wrap=True,
+                bbox={"facecolor": "white", "alpha": 0.8, "lw": 0})
 
 
 def _edges(centres):

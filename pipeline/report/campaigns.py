@@ -490,6 +490,7 @@ def rock_fragility_section(results, name="rock-fragility"):
                     f"{_fmt(r['pga_g'], 2)} [{_fmt(lo, 2)}, {_fmt(hi, 2)}]")
             rows.append(row)
     lines.append(_table(pd.DataFrame(rows)) + "\n")
+    lines += [f"Warning: {w}.\n" for w in section.get("warnings", [])]
     for model, entry in section["models"].items():
         per_set = [r for r in entry["contours"].get("0.5", []) if r.get("pga_g_per_set")]
         shown = [f"{r['pgv_pga_s']:g} s: " + ", ".join(_fmt(v, 2) for v in

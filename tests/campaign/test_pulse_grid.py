@@ -314,3 +314,30 @@ def test_contours_per_parameter_set_show_the_members_spread():
     (row,) = pulse_grid.contours(cells, levels=(0.5,))["0.5"]
     assert row["pga_g_per_set"] == {"0": pytest.approx(0.3), "1": pytest.approx(0.5)}
     assert row["pga_g"] == pytest.approx(0.4)
+
+
+def test_a_contour_that_leaves_the_grid_is_said_on_its_side_with_its_rows():
+    """A synthetic grid (PGA 0.2-0.8 g): at PGV/PGA 0.1 s P never reaches 0.5 (the contour
+    lies above the grid), at 0.3 s it crosses half-way between 0.4 and 0.6 g, at 0.5 and
+    0.7 s P is already 0.75 at 0.2 g (below the grid)."""
+    rows = {0.1: (0.0, 0.0, 0.25, 0.25), 0.3: (0.0, 0.25, 0.75, 1.0),
+            0.5: (0.75, 1.0, 1.0, 1.0), 0.7: (0.75, 0.75, 1.0, 1.0)}
+    cells = [{"pga_g": a, "pgv_pga_s": ratio, "P": p, "ci95": [max(p - 0.3, 0), min(p + 0.3, 1)]}
+             for ratio, ps in rows.items() for a, p in zip((0.2, 0.4, 0.6, 0.8), ps)]
+    contour = pulse_grid.contours(cells, levels=(0.5,))["0.5"]
+    assert [r["outside_grid"] for r in contour] == ["above", None, "below", "below"]
+    assert [r["pga_g"] for r in contour] == [None, pytest.approx(0.5), None, None]
+    warnings = pulse_grid.contour_warnings({"monolithic": {"contours": {"0.5": contour}}},
+                                           [0.2, 0.4, 0.6, 0.8])
+    assert len(warnings) == 2
+    below, above = warnings
+    assert below.startswith("monolithic: the P = 0.5 contour lies below the grid's lowest "
+                            "PGA (0.2 g) for PGV/PGA 0.5, 0.7 s")
+    assert above.startswith("monolithic: the P = 0.5 contour lies above the grid's highest "
+                            "PGA (0.8 g) for PGV/PGA 0.1 s")
+    inside = [dict(c, P=min(1.0, (c["pga_g"] - 0.2) / 0.6)) for c in cells]
+    held = pulse_grid.contours(inside, levels=(0.16, 0.5, 0.84))
+    assert pulse_grid.contour_warnings({"m": {"contours": held}}, [0.2, 0.4, 0.6, 0.8]) == []
+    (one,) = pulse_grid.contours([c for c in cells if c["pgv_pga_s"] == 0.5
+                                  and c["pga_g"] == 0.2], levels=(0.5,))["0.5"]
+    assert one["outside_grid"] is None        # a single PGA has no contour to leave
