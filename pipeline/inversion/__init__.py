@@ -19,7 +19,7 @@ from pathlib import Path
 
 from pipeline.files import DirectoryLock, write_csv, write_json
 from pipeline.inversion.likelihood import DEFAULT_FLOOR, DEFAULT_KERNEL_DEG, ForwardModel
-from pipeline.inversion.posterior import in_arc, invert, magnitude_set
+from pipeline.inversion.posterior import in_arc, invert
 
 EXAMPLES_DIR = Path(__file__).resolve().parent / "examples"
 
@@ -88,13 +88,18 @@ def truth_check(post, truth, summary=None):
     """Whether the posterior's credible regions hold a known source (``truth``: epicentre_km
     in the inversion's frame, back_azimuth_deg, distance_km, mechanism, mw), whether the
     source lies within the inversion's reach, and whether the outputs warn that it may lie
-    beyond (``*_or_warned``: the region holds the truth or the warning is there).
+    beyond (``*_or_warned``: the region holds the truth or the warning is there).  The
+    magnitude: in the 95 % interval (``mw_in_95``), a table slice's (``mw_in_table``),
+    within the table's range of magnitudes (``mw_in_table_range``: beyond it the
+    inversion cannot answer).
     ``summary``: ``post.summary()`` when computed already."""
     summary = post.summary() if summary is None else summary
     east, north = truth["epicentre_km"]
     lo, hi = summary["distance_ci95_km"]
     map_e, map_n = summary["map_epicentre_km"]
-    mw = f"{truth['mw']:g}"
+    mw = float(truth["mw"])
+    mw_lo, mw_hi = summary["magnitude_ci95"]
+    low, high = summary["magnitude_range"]
     warned = summary["reach_warning"] is not None
     epicentre_in_95 = post.contains(east, north, level=0.95)
     distance_in_95 = bool(lo <= truth["distance_km"] <= hi)
@@ -109,6 +114,9 @@ def truth_check(post, truth, summary=None):
             "distance_in_95": distance_in_95,
             "map_epicentre_error_km": float(math.hypot(map_e - east, map_n - north)),
             "reach_edge_fraction": summary["reach_edge_fraction"],
-            "mw_in_95": mw in magnitude_set(summary["magnitude_posterior"]),
-            "mw_in_table": mw in summary["magnitude_posterior"],
+            "reach_edge_bayes_factor": summary["reach_edge_bayes_factor"],
+            "mw_in_95": bool(mw_lo - 1e-9 <= mw <= mw_hi + 1e-9),
+            "mw_in_table": f"{mw:g}" in {f"{s['mw']:g}" for s in post.info.get(
+                "table_slices", post.slices)},
+            "mw_in_table_range": bool(low - 1e-9 <= mw <= high + 1e-9),
             "p_true_mechanism": summary["mechanism_posterior"].get(truth["mechanism"], 0.0)}

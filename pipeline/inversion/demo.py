@@ -125,7 +125,7 @@ def truth_trial(model, pool, mechanism, n_sites, fallen, candidates, rng):
     except OutOfReach:
         return {**row, **out_of_reach_row(truth, observations, table, candidates)}, None
     summary = post.summary()
-    map_error = angle_difference_deg(summary["back_azimuth_map_deg"], true_baz)
+    map_error = map_azimuth_error(summary, true_baz)
     check = truth_check(post, {"epicentre_km": truth, "back_azimuth_deg": true_baz,
                                "distance_km": d, "mechanism": mechanism,
                                "mw": table.slices[s]["mw"]}, summary)
@@ -146,6 +146,14 @@ def truth_trial(model, pool, mechanism, n_sites, fallen, candidates, rng):
             "credible_area_95_km2": summary["credible_area_95_km2"],
             "p_true_mechanism": summary["mechanism_posterior"].get(mechanism, 0.0)}, \
         (post, observations, truth)
+
+
+def map_azimuth_error(summary, true_baz):
+    """The MAP back azimuth's error (deg); NaN when the summary gives no direction (the
+    source may lie beyond the reach)."""
+    if summary["back_azimuth_map_deg"] is None:
+        return np.nan
+    return angle_difference_deg(summary["back_azimuth_map_deg"], true_baz)
 
 
 REACH_KEYS = ("within_reach", "reach_warning", "reach_edge_fraction",
@@ -304,8 +312,7 @@ def paper_scenario(model, obs_table, source_name, candidates):
                          "width95_deg": summary["back_azimuth_ci95_width_deg"],
                          "back_azimuth_in_95": in_arc(true_baz, summary["back_azimuth_ci95_deg"]),
                          "map_back_azimuth_deg": summary["back_azimuth_map_deg"],
-                         "map_error_deg": angle_difference_deg(summary["back_azimuth_map_deg"],
-                                                               true_baz),
+                         "map_error_deg": map_azimuth_error(summary, true_baz),
                          "epicentre_in_95": post.contains(*truth, level=0.95),
                          "credible_area_95_km2": summary["credible_area_95_km2"],
                          "reach_warning": summary["reach_warning"] is not None,

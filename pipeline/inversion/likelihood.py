@@ -20,8 +20,28 @@ standing are interpolated as mixtures of the four surrounding nodes, bilinearly 
 log distance (clamped at the first and last ring: the inversion's candidates never lie
 beyond the last ring of a site, :func:`pipeline.inversion.posterior.invert`) and in node
 azimuth (periodic).  Interpolating in the site frame moves a fall direction that is fixed
-relative to the source-to-site direction smoothly between nodes.  Log-likelihood = sum
-over columns (``likelihood="independent"``, the default).  Densities are per radian.
+relative to the source-to-site direction smoothly between nodes.
+
+Between spokes (node azimuths ``h`` deg apart) the table cannot tell whether the falls
+keep their direction relative to the source-to-site direction (the site frame, in which
+it is interpolated) or relative to the fault (the strike frame): read at an azimuth
+delta from a node, the two differ by delta.  So a node's direction density read delta
+away is spread uniformly over the rotations between its site-frame and its strike-frame
+reading (a box of width |delta|; nothing at the node, 30 deg for each neighbour halfway
+between 60-deg spokes).  The spread densities are tabulated on virtual azimuths every
+``h / refine`` deg (at most :data:`VIRTUAL_STEP_DEG`), between which the interpolation
+is linear.
+
+Between magnitude slices (same mechanism and depth) the candidates' magnitudes run every
+``mw_step`` (0.1) from the table's smallest to its largest: a candidate at weight w between
+slices m0 and m1 takes P and P d (and 1 - P) as (1 - w) x slice m0's + w x slice m1's,
+per column before the product (a mixture: the columns of a magnitude between slices fall
+like those of either slice in proportion).  :attr:`ForwardModel.sources` lists these
+candidates, :attr:`ForwardModel.mix` their weights over the table's slices.  Magnitudes
+beyond the table's range are not candidates: the table cannot answer for them.
+
+Log-likelihood = sum over columns (``likelihood="independent"``, the default).
+Densities are per radian.
 
 ``likelihood="predictive"`` accounts for the ensemble's own sampling error, which the
 product above ignores: columns at one site share one ground motion, and the node's fall
@@ -50,6 +70,8 @@ DEFAULT_KERNEL_DEG = 20.0
 DEFAULT_FLOOR = 0.05
 PSI_STEP_DEG = 0.5
 OBS_CHUNK = 8                  # observations per vectorised block (memory)
+VIRTUAL_STEP_DEG = 7.5         # the largest spacing of the virtual azimuths between spokes
+MW_STEP = 0.1                  # the candidates' magnitude step between the table's slices
 
 
 def mean_resultant_length(kappa):
@@ -98,18 +120,31 @@ class ForwardModel:
     """Per-node toppling probabilities and direction densities of a forward table."""
 
     def __init__(self, table, kernel_deg=DEFAULT_KERNEL_DEG, floor=DEFAULT_FLOOR,
-                 likelihood="independent"):
+                 likelihood="independent", mw_step=MW_STEP):
         check_model_options(kernel_deg, floor, likelihood)
-        self.likelihood = likelihood
+        if not (math.isfinite(mw_step) and 0 < mw_step <= 1):
+            raise InputError(f"magnitude step must lie in (0, 1], got {mw_step:g}")
+        self.likelihood, self.mw_step = likelihood, float(mw_step)
         self.table, self.kernel_deg, self.floor = table, float(kernel_deg), float(floor)
         self.k = table.toppled.sum(axis=-1)
         self.n = table.valid.sum(axis=-1)
-        self.p = p_toppled(self.k, self.n)                       # (ns, nr, na, nc)
+        self.p_nodes = p_toppled(self.k, self.n)                 # (ns, nr, na, nc)
         theta = table.azimuths_deg[None, None, :, None, None]
         self.relative = np.where(table.toppled, np.mod(table.azimuth_deg - theta, 360.0),
                                  np.nan)                         # site frame, deg
         self.psi = np.arange(0.0, 360.0, PSI_STEP_DEG)
+        self.spacing_deg = 360.0 / len(table.azimuths_deg)
+        self.refine = max(1, math.ceil(self.spacing_deg / VIRTUAL_STEP_DEG - 1e-9))
+        j, w = self._virtual_nodes()
+        self.p = ((1 - w)[:, None] * self.p_nodes[:, :, j, :]
+                  + w[:, None] * self.p_nodes[:, :, (j + 1) % len(table.azimuths_deg), :])
+        self.sources, self.mix = magnitude_sources(table.slices, self.mw_step)
         self._fallen_cache = {}
+
+    def _virtual_nodes(self):
+        """(node index j, weight w of node j + 1) of each virtual azimuth."""
+        v = np.arange(len(self.table.azimuths_deg) * self.refine)
+        return v // self.refine, (v % self.refine) / self.refine
 
     # ------------------------------------------------------------------ node tables
     def direction_density(self, sigma_deg):
@@ -129,10 +164,21 @@ class ForwardModel:
         return (1.0 - self.floor) * density + self.floor / (2 * math.pi)
 
     def fallen_table(self, sigma_deg):
-        """P_n d_n(psi): (ns, nr, na, nc, npsi), cached per uncertainty."""
+        """P d(psi) on the virtual azimuths: (ns, nr, n_virtual, nc, npsi), cached per
+        uncertainty; between spokes each neighbour's density spread by :func:`spread`."""
         key = round(float(sigma_deg), 9)
         if key not in self._fallen_cache:
-            self._fallen_cache[key] = self.p[..., None] * self.direction_density(sigma_deg)
+            fallen = self.p_nodes[..., None] * self.direction_density(sigma_deg)
+            na = len(self.table.azimuths_deg)
+            levels = []
+            for level in range(self.refine):
+                w = level / self.refine
+                here = spread(fallen, w * self.spacing_deg)
+                there = spread(np.roll(fallen, -1, axis=2), -(1 - w) * self.spacing_deg)
+                levels.append(here if level == 0 else (1 - w) * here + w * there)
+            stacked = np.stack(levels, axis=3)            # (ns, nr, na, refine, nc, npsi)
+            self._fallen_cache[key] = stacked.reshape(
+                fallen.shape[:2] + (na * self.refine,) + fallen.shape[3:])
         return self._fallen_cache[key]
 
     def column_index(self, column):
@@ -157,8 +203,8 @@ class ForwardModel:
         return i0, i1, w1
 
     def azimuth_weights(self, theta_deg):
-        """(i0, i1, w1): node azimuths around theta (periodic), weight of i1."""
-        na = len(self.table.azimuths_deg)
+        """(i0, i1, w1): virtual azimuths around theta (periodic), weight of i1."""
+        na = self.p.shape[2]
         x = np.mod(np.asarray(theta_deg, float), 360.0) / (360.0 / na)
         i0 = np.floor(x).astype(int)
         w1 = x - i0
@@ -170,8 +216,15 @@ class ForwardModel:
         return j0 % len(self.psi), (j0 + 1) % len(self.psi), x - j0
 
     # ------------------------------------------------------------------ likelihood
+    def _mixed(self, values):
+        """Per-slice values (ns, ...) as the candidate sources' (n_sources, ...)."""
+        if self.mix.shape[0] == self.mix.shape[1] and np.array_equal(
+                self.mix, np.eye(len(self.mix))):
+            return values
+        return np.tensordot(self.mix, values, axes=(1, 0))
+
     def site_log_likelihood(self, site, east_km, north_km, strikes_deg):
-        """Log-likelihood of one site's columns: (ns, n_strikes, n_epicentres)."""
+        """Log-likelihood of one site's columns: (n_sources, n_strikes, n_epicentres)."""
         east, north = np.asarray(east_km, float), np.asarray(north_km, float)
         strikes = np.asarray(strikes_deg, float)
         dx, dy = site.east_km - east, site.north_km - north
@@ -179,14 +232,14 @@ class ForwardModel:
         alpha = np.mod(np.degrees(np.arctan2(dx, dy)), 360.0)     # epicentre -> site
         rings = self.distance_weights(r)
         ai0, ai1, aw = self.azimuth_weights(alpha[None, :] - strikes[:, None])   # (nphi, ne)
-        ns, ne, nphi = self.p.shape[0], east.size, strikes.size
+        ns, ne, nphi = len(self.sources), east.size, strikes.size
         out = np.zeros((ns, nphi, ne))
         by_type = {}
         for obs in site.columns:
             by_type.setdefault(self.column_index(obs.column), []).append(obs)
         for c, group in by_type.items():
             standing = sum(not o.fallen for o in group)
-            q = self._standing(c, rings, ai0, ai1, aw) if standing else None  # (ns, nphi, ne)
+            q = self._mixed(self._standing(c, rings, ai0, ai1, aw)) if standing else None
             fallen = [k for k, o in enumerate(group) if o.fallen]
             if self.likelihood == "independent":
                 if standing:
@@ -194,15 +247,15 @@ class ForwardModel:
                 for start in range(0, len(fallen), OBS_CHUNK):
                     chunk = [group[k] for k in fallen[start:start + OBS_CHUNK]]
                     for value in self._fallen(c, chunk, alpha, rings, ai0, ai1, aw):
-                        out += np.log(value)
+                        out += np.log(self._mixed(value))
                 continue
             # predictive: a Polya urn per site and column type, in the file's order
             weight = float(np.mean(self.n[..., c])) + 1.0
             values = {}
             for start in range(0, len(fallen), OBS_CHUNK):
                 ks = fallen[start:start + OBS_CHUNK]
-                values.update(zip(ks, self._fallen(c, [group[k] for k in ks], alpha, rings,
-                                                   ai0, ai1, aw)))
+                values.update(zip(ks, map(self._mixed, self._fallen(
+                    c, [group[k] for k in ks], alpha, rings, ai0, ai1, aw))))
             earlier, s_prev = [], 0
             for j, obs in enumerate(group):
                 if not obs.fallen:
@@ -257,6 +310,48 @@ class ForwardModel:
         for site in observations.sites:
             total = total + self.site_log_likelihood(site, east_km, north_km, strikes_deg)
         return total
+
+
+def spread(density, delta_deg):
+    """``density`` (last axis: psi every PSI_STEP_DEG) read ``delta_deg`` away from its
+    node: the mean of density(psi + t delta) over t in [0, 1] (trapezoid rule on the psi
+    grid), the rotations between the site-frame reading (t = 0) and the strike-frame
+    reading (t = 1)."""
+    m = int(round(abs(delta_deg) / PSI_STEP_DEG))
+    if m == 0:
+        return density
+    n = density.shape[-1]
+    ext = np.concatenate([density, density[..., :m]], axis=-1)
+    c = np.concatenate([np.zeros(density.shape[:-1] + (1,)), np.cumsum(ext, axis=-1)],
+                       axis=-1)
+    ends = density + np.roll(density, -m, axis=-1)
+    forward = (c[..., m + 1:m + 1 + n] - c[..., :n] - ends / 2) / m   # psi .. psi + m steps
+    return forward if delta_deg > 0 else np.roll(forward, m, axis=-1)
+
+
+def magnitude_sources(slices, mw_step=MW_STEP):
+    """(candidate sources: slice dicts with the magnitude every ``mw_step`` between the
+    table's slices of one mechanism and depth, weights (n_sources, n_slices): each
+    source's mixture of its two neighbouring slices, linear in magnitude)."""
+    groups = {}
+    for k, s in enumerate(slices):
+        key = (s["mechanism"], s["dip_deg"], s["rake_deg"], s["depth_km"])
+        groups.setdefault(key, []).append(k)
+    sources, rows = [], []
+    for members in groups.values():
+        members = sorted(members, key=lambda k: slices[k]["mw"])
+        for a, b in zip(members[:-1], members[1:]):
+            m0, m1 = slices[a]["mw"], slices[b]["mw"]
+            steps = max(1, int(round((m1 - m0) / mw_step)))
+            for i in range(steps):
+                w = i / steps
+                sources.append({**slices[a], "mw": round(m0 + w * (m1 - m0), 4)})
+                row = np.zeros(len(slices))
+                row[a], row[b] = 1 - w, w
+                rows.append(row)
+        sources.append(dict(slices[members[-1]]))
+        rows.append(np.eye(len(slices))[members[-1]])
+    return sources, np.array(rows)
 
 
 def _pick(values, i0, i1, w1):

@@ -7,11 +7,17 @@ lattice maps onto itself when turned by 90 deg about the first site), every latt
 within ``radius_km`` of some site and within the forward table's last ring of every site:
 the table speaks for every candidate, none takes the last ring's values for a farther
 site (the inversion's reach).  The posterior's mass in the outermost cells of the
-candidates (``reach_edge_fraction``) says when the answer is "farther than the candidates
-reach": above ``EDGE_WARNING_FRACTION`` the summary holds a ``reach_warning``.  The prior
-is uniform over epicentre area, strike and depth; mechanisms uniform unless
-``mechanism_prior`` gives weights; magnitudes uniform unless ``gr_b`` gives a
-Gutenberg-Richter b value (prior proportional to 10^(-b M)).
+candidates (``reach_edge_fraction``, f) against the prior's there (p) says when the answer
+is "farther than the candidates reach": the Bayes factor of "the source lies in the
+outermost cells" against "inside them", (f / (1 - f)) / (p / (1 - p))
+(``reach_edge_bayes_factor``), above ``EDGE_BAYES_FACTOR`` puts a ``reach_warning`` in
+the summary, and then the back azimuth, which the reach's edge would decide, is given
+as unknown (the whole circle; the arcs within the reach are kept apart).  The magnitudes
+are the likelihood's sources (:func:`pipeline.inversion.likelihood.magnitude_sources`:
+every 0.1 between the table's slices).  The prior is uniform over epicentre area, strike,
+depth and the candidates' magnitudes; mechanisms uniform unless ``mechanism_prior`` gives
+weights; magnitudes uniform unless ``gr_b`` gives a Gutenberg-Richter b value (prior
+proportional to 10^(-b M)).
 
 Frames: km East/North of the first site; the back azimuth is the azimuth from the first
 site to the epicentre.  Credible regions are highest-posterior-density (HPD) sets: for the
@@ -36,8 +42,9 @@ from pipeline.inversion.observations import Observations, Site
 BAZ_BIN_DEG = 2.0
 SUBGRID = 5
 LEVELS = (0.68, 0.95)
-EDGE_WARNING_FRACTION = 0.05   # posterior mass in the outermost cells that the 95 % regions
-#                                cannot leave out: the source may lie beyond the reach
+EDGE_BAYES_FACTOR = 3.0   # the outermost cells' posterior odds over their prior odds above
+#                           which the source may lie beyond the reach (the member study
+#                           measures the false alarms and the hits of this threshold)
 
 
 class OutOfReach(InputError):
@@ -266,6 +273,9 @@ class Posterior:
         out["mechanism_posterior"] = self.marginal("mechanism")
         out["depth_posterior"] = {f"{k:g}": v for k, v in self.marginal("depth_km").items()}
         out["magnitude_posterior"] = {f"{k:g}": v for k, v in self.marginal("mw").items()}
+        out["magnitude_ci95"] = magnitude_interval(self.marginal("mw"), 0.95)
+        mws = [s["mw"] for s in self.slices]
+        out["magnitude_range"] = [float(min(mws)), float(max(mws))]
         strikes, pstrike = self.strike_marginal()
         out["strike_posterior"] = {f"{k:g}": float(v) for k, v in zip(strikes, pstrike)}
         for level in LEVELS:
@@ -278,30 +288,44 @@ class Posterior:
                                 "epicentre_km": [float(self.east_km[joint[2]]),
                                                  float(self.north_km[joint[2]])]}
         out.update(self.reach_summary())
+        out["direction_reliable"] = out["reach_warning"] is None
+        if not out["direction_reliable"]:      # the reach's edge would decide the direction
+            keys = [k for k in out if k.startswith("back_azimuth_")]
+            out["back_azimuth_within_reach"] = {k: out[k] for k in keys}
+            for level in LEVELS:
+                tag = int(round(level * 100))
+                out[f"back_azimuth_ci{tag}_deg"] = [0.0, 360.0]
+                out[f"back_azimuth_ci{tag}_width_deg"] = 360.0
+                out[f"back_azimuth_hpd{tag}_arcs_deg"] = [[0.0, 360.0]]
+            out["back_azimuth_map_deg"] = None
         out["log_evidence"] = self.log_evidence
         out["candidates"] = int(self.probability.size)
         return out
 
     def reach_summary(self):
         """The inversion's reach (km from a site where the candidates end, and what ends
-        them), the posterior's and the prior's mass in the outermost cells, and a warning
-        line (None) when the posterior holds more than EDGE_WARNING_FRACTION there."""
+        them), the posterior's and the prior's mass in the outermost cells, their Bayes
+        factor and a warning line (None) when it passes EDGE_BAYES_FACTOR."""
         reach = self.info.get("reach_km")
         if self.edge is None or reach is None:
             return {"reach_km": reach, "reach_limit": None, "reach_edge_fraction": None,
-                    "reach_edge_prior_fraction": None, "reach_warning": None}
+                    "reach_edge_prior_fraction": None, "reach_edge_bayes_factor": None,
+                    "reach_warning": None}
         prior = np.exp(self.log_prior - logsumexp(self.log_prior)).sum(axis=(0, 1))
         fraction = float(self.epicentre[self.edge].sum())
         prior_fraction = float(prior[self.edge].sum())
+        factor = edge_bayes_factor(fraction, prior_fraction)
         warning = None
-        if fraction > EDGE_WARNING_FRACTION:
-            warning = (f"{fraction:.0%} of the posterior (of the prior: {prior_fraction:.0%}) "
-                       f"lies in the outermost candidate cells, {reach:g} km from a site "
-                       f"({self.info.get('reach_limit')}): the source may lie farther than "
-                       "this inversion can tell")
+        if factor > EDGE_BAYES_FACTOR:
+            warning = (f"{fraction:.0%} of the posterior lies in the outermost candidate "
+                       f"cells, {reach:g} km from a site ({self.info.get('reach_limit')}), "
+                       f"against {prior_fraction:.0%} of the prior (odds {factor:.3g} times "
+                       "the prior's): the source may lie farther than this inversion can "
+                       "tell, and its direction from the first site is not known either")
         return {"reach_km": float(reach), "reach_limit": self.info.get("reach_limit"),
                 "reach_edge_fraction": fraction,
-                "reach_edge_prior_fraction": prior_fraction, "reach_warning": warning}
+                "reach_edge_prior_fraction": prior_fraction,
+                "reach_edge_bayes_factor": factor, "reach_warning": warning}
 
     def frame(self):
         """One row per candidate: posterior.csv."""
@@ -324,6 +348,35 @@ class Posterior:
             np.broadcast_to(self.log_prior, self.probability.shape).ravel(),
             "log_likelihood": self.log_likelihood.ravel(),
             "posterior": self.probability.ravel()})
+
+
+def edge_bayes_factor(fraction, prior_fraction):
+    """(f / (1 - f)) / (p / (1 - p)): how much more the posterior than the prior favours
+    the outermost cells (inf when f is 1, 0 when f is 0)."""
+    f = min(max(float(fraction), 0.0), 1.0)
+    p = min(max(float(prior_fraction), 1e-300), 1.0 - 1e-16)
+    if f >= 1.0:
+        return math.inf
+    return float((f / (1.0 - f)) / (p / (1.0 - p)))
+
+
+def magnitude_interval(posterior, level=0.95):
+    """[lo, hi] Mw: the fewest consecutive candidate magnitudes holding ``level`` of
+    ``posterior`` ({mw: p}), each standing for the span halfway to its neighbours (at the
+    table's first and last magnitude, the span ends there)."""
+    mws = np.array(sorted(posterior), float)
+    mass = np.array([posterior[m] for m in sorted(posterior)], float)
+    mass = mass / mass.sum()
+    best = (0, len(mws) - 1)
+    for length in range(1, len(mws) + 1):
+        window = np.convolve(mass, np.ones(length), mode="valid")
+        if window.max() >= level - 1e-12:
+            start = int(np.argmax(window))
+            best = (start, start + length - 1)
+            break
+    lo = mws[best[0]] if best[0] == 0 else (mws[best[0]] + mws[best[0] - 1]) / 2
+    hi = mws[best[1]] if best[1] == len(mws) - 1 else (mws[best[1]] + mws[best[1] + 1]) / 2
+    return [round(float(lo), 4), round(float(hi), 4)]
 
 
 def magnitude_set(posterior, level=0.95):
@@ -402,7 +455,7 @@ def invert(model, observations, grid):
     keep = grid.slice_mask(model.table)
     if not keep.all():
         model = ForwardModel(model.table.select_slices(keep), model.kernel_deg, model.floor,
-                             model.likelihood)
+                             model.likelihood, model.mw_step)
     for column in observations.column_types():
         model.column_index(column)
     last_ring = float(model.table.distances_km[-1])
@@ -410,7 +463,7 @@ def invert(model, observations, grid):
     east, north = reached_lattice(observations, last_ring, grid)
     strikes = grid.strikes_deg
     loglike = model.log_likelihood(observations, east, north, strikes)
-    log_prior_slice = grid.log_prior_slices(model.table.slices)
+    log_prior_slice = grid.log_prior_slices(model.sources)
     log_prior = (log_prior_slice[:, None, None] - math.log(len(strikes)) - math.log(east.size)
                  + np.zeros(loglike.shape))
     farthest = max(np.hypot(s.east_km - east, s.north_km - north).max()
@@ -425,8 +478,9 @@ def invert(model, observations, grid):
             # table's last ring from some site: left out, the table cannot speak for them
             "beyond_table_fraction": 1.0 - east.size / requested.size,
             "farthest_candidate_km": float(farthest),
-            "sites_km": [[s.east_km, s.north_km] for s in observations.sites]}
-    return Posterior(model.table.slices, strikes, east, north, grid.step_km, log_prior,
+            "sites_km": [[s.east_km, s.north_km] for s in observations.sites],
+            "table_slices": model.table.slices}
+    return Posterior(model.sources, strikes, east, north, grid.step_km, log_prior,
                      loglike, info=info, edge=grid.edge_cells(east, north))
 
 

@@ -336,12 +336,16 @@ def invert_file(observations_file, options, grid, candidates, site_fragility=Non
     mech = max(summary["mechanism_posterior"], key=summary["mechanism_posterior"].get)
     log.info(f"{observations.n_fallen} fallen of {observations.n_columns} columns at "
              f"{len(observations.sites)} site(s); {summary['candidates']} candidates")
-    log.info(f"back azimuth from {summary['first_site']}: MAP {summary['back_azimuth_map_deg']:.0f}"
-             f" deg, 95 % arc [{lo:.0f}, {hi:.0f}] ({summary['back_azimuth_ci95_width_deg']:.0f} "
-             f"deg); distance 95 % {summary['distance_ci95_km'][0]:.1f}-"
-             f"{summary['distance_ci95_km'][1]:.1f} km; 95 % area "
-             f"{summary['credible_area_95_km2']:.0f} km^2; most probable mechanism {mech} "
-             f"({summary['mechanism_posterior'][mech]:.2f})")
+    direction = ("not known (the source may lie beyond the reach)"
+                 if summary["back_azimuth_map_deg"] is None else
+                 f"MAP {summary['back_azimuth_map_deg']:.0f} deg, 95 % arc [{lo:.0f}, {hi:.0f}] "
+                 f"({summary['back_azimuth_ci95_width_deg']:.0f} deg)")
+    log.info(f"back azimuth from {summary['first_site']}: {direction}; distance 95 % "
+             f"{summary['distance_ci95_km'][0]:.1f}-{summary['distance_ci95_km'][1]:.1f} km; "
+             f"95 % area {summary['credible_area_95_km2']:.0f} km^2; Mw 95 % "
+             f"{summary['magnitude_ci95'][0]:g}-{summary['magnitude_ci95'][1]:g} (the table's "
+             f"{summary['magnitude_range'][0]:g}-{summary['magnitude_range'][1]:g}); most "
+             f"probable mechanism {mech} ({summary['mechanism_posterior'][mech]:.2f})")
     _say_reach(summary)
     for site in (motions or {}).get("sites", []):
         lo_g, hi_g = site["pga_interval95_g"]

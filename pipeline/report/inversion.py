@@ -197,8 +197,10 @@ def _example_lines(demo):
     example = demo.get("example")
     if example:
         lo, hi = example["back_azimuth_ci95_deg"]
-        lines.append(f"Example file `{example['file']}`: back azimuth from site A "
-                     f"{example['back_azimuth_map_deg']:.0f} deg, 95 % arc [{lo:.0f}, {hi:.0f}]"
+        direction = ("not known (the source may lie beyond the reach)"
+                     if example["back_azimuth_map_deg"] is None else
+                     f"{example['back_azimuth_map_deg']:.0f} deg, 95 % arc [{lo:.0f}, {hi:.0f}]")
+        lines.append(f"Example file `{example['file']}`: back azimuth from site A {direction}"
                      f", 95 % area {example['credible_area_95_km2']:.0f} km^2"
                      + _reach_sentence(example) + ".\n")
     return lines

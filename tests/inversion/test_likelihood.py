@@ -92,16 +92,26 @@ def test_between_rings_log_linear(tiny):
     assert ll[0, 0, 0] == pytest.approx(math.log(fallen) + math.log(standing), rel=1e-9)
 
 
-def test_between_node_azimuths_in_the_site_frame(tiny):
+def test_between_node_azimuths_spread_between_the_two_frames(tiny):
     """Strike 45, site due north of the epicentre: node azimuth 315, half way between the
-    nodes 270 and 0.  Node 270's one fall (285) lies 15 deg clockwise of its site direction,
-    the observation too: both nodes are read at 15 deg in the site frame."""
+    nodes 270 and 0 (45 deg from each).  Each node's fall density is read over the
+    rotations between its site-frame reading and its strike-frame reading: the mean of
+    d(psi + t delta), t in [0, 1], with delta = +45 deg for node 270 (its one fall, 285,
+    lies 15 deg clockwise of its site direction) and -45 deg for node 0; P halfway."""
+    from scipy import integrate
     model = ForwardModel(tiny, KERNEL, FLOOR)
     ll = model.site_log_likelihood(site(DRUMS_15), [0.0], [-5.0], [45.0])
     kappa = kappa_by_hand(math.hypot(KERNEL, SIGMA))
-    d270 = (1 - FLOOR) * vm(0.0, kappa) + FLOOR / (2 * math.pi)
-    value = 0.5 * 0.5 * density_node0(15.0) + 0.5 * (1.5 / 5) * d270
-    assert ll[0, 0, 0] == pytest.approx(math.log(value), rel=1e-9)
+
+    def d270(psi):
+        return (1 - FLOOR) * vm(psi - 15.0, kappa) + FLOOR / (2 * math.pi)
+
+    spread0 = integrate.quad(lambda t: density_node0(15.0 - 45.0 * t), 0, 1)[0]
+    spread270 = integrate.quad(lambda t: d270(15.0 + 45.0 * t), 0, 1)[0]
+    value = 0.5 * 0.5 * spread0 + 0.5 * (1.5 / 5) * spread270
+    assert ll[0, 0, 0] == pytest.approx(math.log(value), rel=1e-4)
+    # at the node itself nothing is spread (test_at_a_node); the spread widens the reading
+    assert spread270 < d270(15.0)
 
 
 def test_floor_keeps_an_odd_fall_finite(tiny):

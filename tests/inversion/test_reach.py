@@ -16,7 +16,7 @@ from pipeline.files import InputError
 from pipeline.inversion import truth_check
 from pipeline.inversion.likelihood import ForwardModel
 from pipeline.inversion.observations import parse_observations
-from pipeline.inversion.posterior import EDGE_WARNING_FRACTION, CandidateGrid, invert
+from pipeline.inversion.posterior import EDGE_BAYES_FACTOR, CandidateGrid, invert
 
 RINGS = (2.5, 5.0, 10.0)
 MEMBERS = 8
@@ -91,9 +91,13 @@ def test_a_source_beyond_the_last_ring_is_said_to_lie_beyond(table):
     sites = {"A": (0.0, 14.0), "B": (8.0, 15.0)}
     post, summary, found = check(table, truth, sites)
     assert not found["within_reach"]
-    assert summary["reach_edge_fraction"] > EDGE_WARNING_FRACTION
+    assert summary["reach_edge_bayes_factor"] > EDGE_BAYES_FACTOR
     assert summary["reach_edge_fraction"] > summary["reach_edge_prior_fraction"]
     assert "may lie farther" in summary["reach_warning"]
+    # no direction from the reach's edge: the whole circle, the edge's arc kept apart
+    assert not summary["direction_reliable"] and summary["back_azimuth_map_deg"] is None
+    assert summary["back_azimuth_ci95_deg"] == [0.0, 360.0] and found["back_azimuth_in_95"]
+    assert summary["back_azimuth_within_reach"]["back_azimuth_ci95_width_deg"] < 360.0
     assert found["distance_in_95_or_warned"] and found["epicentre_in_95_or_warned"]
     assert not (found["distance_in_95"] or found["epicentre_in_95"])   # nothing can hold it
 
@@ -128,7 +132,7 @@ def test_invert_warns_when_the_source_may_lie_beyond(table, tmp_path, capsys):
     summary = json.loads((out / "inversion_summary.json").read_text())
     assert summary["reach_km"] == 10.0 and summary["table_last_ring_km"] == 10.0
     assert summary["beyond_table_fraction"] > 0.8          # 10 of 30 km: 1 - 1/9 of the area
-    assert summary["reach_edge_fraction"] > EDGE_WARNING_FRACTION
+    assert summary["reach_edge_bayes_factor"] > EDGE_BAYES_FACTOR
     printed = capsys.readouterr().out
     assert f"warning: {summary['reach_warning']}" in printed
     assert (f"{summary['beyond_table_fraction']:.0%} of the epicentres within --radius 30 km "
