@@ -21,8 +21,8 @@ from pathlib import Path
 from typing import Callable
 
 from pipeline import RESULTS_DIR
-from pipeline.files import (DirectoryLock, InputError, ToolError, check_jobs, check_long,
-                            write_json)
+from pipeline.files import (LONG_RUN_S, DirectoryLock, InputError, ToolError, check_jobs,
+                            check_long, write_json)
 from pipeline.campaign.executor import EXECUTORS, RUN_CORE_S, execute
 
 log = logging.getLogger(__name__)
@@ -47,6 +47,9 @@ class Campaign:
     driver: Callable = None        # driver(run, records, campaign_dir, options, gate):
     #                                runs it (several times: ensembles sized by their error)
     run_core_s: float = RUN_CORE_S
+    estimate: Callable = None      # estimate(records, **options) -> (runs, core-s a run) or
+    #                                None: the gate's count from the options alone, asked
+    #                                before any spec is built (a grid of hours takes minutes)
 
 
 def register(campaign):
@@ -108,8 +111,10 @@ def run_campaign(name, jobs=None, records=None, campaign_dir=None, animations=1,
         raise InputError(f"--out {campaign_dir} is a file, not a directory")
     existed = campaign_dir.exists()
     try:
+        allowed = allow_long is not None and jobs is not None and _gate_from_options(
+            campaign, records, options, campaign_dir, jobs, allow_long)
         specs = campaign.specs(records, campaign_dir, **(options or {}))
-        if allow_long is not None and jobs is not None:
+        if allow_long is not None and jobs is not None and not allowed:
             runs_dir = campaign_dir / "runs"
             todo = [s for s in specs if not (runs_dir / s.run_id / "summary.json").exists()]
             core_s = [s.tags.get("core_s", campaign.run_core_s) for s in todo]   # a run's own
@@ -126,6 +131,22 @@ def run_campaign(name, jobs=None, records=None, campaign_dir=None, animations=1,
                 not any(campaign_dir.glob("runs/*/summary.json")):
             shutil.rmtree(campaign_dir, ignore_errors=True)   # a refusal leaves nothing
         raise
+
+
+def _gate_from_options(campaign, records, options, campaign_dir, jobs, allow_long):
+    """The long-run gate on the campaign's own count from its options (``estimate``),
+    before its specs are built: the runs less those already finished in ``campaign_dir``
+    (a resumed campaign: a lower bound, so the gate on the specs has the last word when
+    this one passes).  True when it was over the hour and allowed (warned)."""
+    estimate = None if campaign.estimate is None else \
+        campaign.estimate(records, **(options or {}))
+    if estimate is None:
+        return False
+    runs, core_s = estimate
+    runs_dir = Path(campaign_dir) / "runs"
+    done = sum(1 for _ in runs_dir.glob("*/summary.json")) if runs_dir.is_dir() else 0
+    return check_long(f"campaign {campaign.name}", max(runs - done, 0), core_s, jobs,
+                      allow_long, "fewer records, members or parameter values") > LONG_RUN_S
 
 
 def reuse_finished(specs, campaign_dir, worker):

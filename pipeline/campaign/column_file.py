@@ -61,13 +61,14 @@ def description(column_file, meshes=False):
 
 
 def check_stiffness(stiffness):
-    if stiffness not in STIFFNESS_CHOICES:
+    """``--stiffness``: matched or paper (None, not given: matched)."""
+    if stiffness is not None and stiffness not in STIFFNESS_CHOICES:
         raise InputError(f"--stiffness must be matched or paper, got {stiffness!r}")
 
 
 def column_kn(data, stiffness="matched"):
     """Contact stiffness per point (N/m) for a description: the campaign ``columns`` rule
-    (:func:`matched_kn`) or the paper's kn."""
+    (:func:`matched_kn`; also for ``stiffness`` None) or the paper's kn."""
     check_stiffness(stiffness)
     if stiffness == "paper":
         return paper.COLUMN_KN_N_M

@@ -10,7 +10,7 @@ from pipeline import paper
 from pipeline.campaign import Campaign, register
 from pipeline.campaign.options import (CAMPAIGN_NOTE, CampaignOptions, ColumnFileOptions,
                                        column_file_param, contact_file_param, contact_of,
-                                       stiffness_param)
+                                       refuse_ignored_stiffness, stiffness_param)
 from pipeline.scenario.contact_file import contact_values, refuse_set_twice, with_contact
 from pipeline.campaign.run_dirs import finished_summary
 from pipeline.campaign.column_file import (at_slenderness, check_stiffness, column_kn,
@@ -180,12 +180,11 @@ def columns_specs(records, campaign_dir, column_files=None, column="both",
     geometries = [ColumnGeometry.load(name) for name in names]
     if column not in COLUMN_KINDS:
         raise InputError(f"--column must be both, monolithic or drums, got {column!r}")
-    if stiffness not in ("matched", "paper"):
-        raise InputError(f"--stiffness must be matched or paper, got {stiffness!r}")
+    check_stiffness(stiffness)
     recs = _records_or(records, [paper.SWEEP_RECORD, pulse_record()])
     runs = []
     for g in geometries:
-        kn = matched_kn(g) if stiffness == "matched" else paper.COLUMN_KN_N_M
+        kn = paper.COLUMN_KN_N_M if stiffness == "paper" else matched_kn(g)
         runs += [(r, twin(column=column, column_file=g.to_dict(), kn=kn)) for r in recs]
     runs = with_contact(runs, _contact(contact_file))
     return column_specs(runs, campaign_dir,
@@ -268,7 +267,7 @@ class ColumnsOptions(CampaignOptions):
     contact_file: str = contact_file_param("its kn replaces --stiffness's")
 
     def check(self):
-        contact_of(self)
+        refuse_ignored_stiffness(self, contact_of(self))
 
     def kwargs(self):
         files = [f for f in (self.column_files or "").split(",") if f]

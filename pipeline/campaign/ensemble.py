@@ -49,7 +49,8 @@ from pipeline.campaign import Campaign, register
 from pipeline.campaign.column_file import (check_stiffness, column_kn, mark, perturbed,
                                            summary_entry)
 from pipeline.campaign.options import (CampaignOptions, column_file_param, contact_file_param,
-                                       contact_of, stiffness_param)
+                                       contact_of, refuse_ignored_stiffness,
+                                       stiffness_param)
 from pipeline.scenario.contact_file import contact_values, refuse_set_twice
 from pipeline.scenario.parameters import check_time_step, param
 from pipeline.campaign.column_file import description as column_file_description
@@ -351,10 +352,11 @@ class EnsembleOptions(CampaignOptions):
     members: int = param(DEFAULT_MEMBERS, "", "members of the first Latin-hypercube batch, "
                          "and of each batch added", 1, 10000, flag="--members")
     precision: float = param(DEFAULT_PRECISION, "", "members are added until P(toppled)'s "
-                             "95 % interval is within +- this", 0.0, 0.5, flag="--precision")
+                             "95 % interval is within +- this", 0.0, 0.5, flag="--precision",
+                             low_open=True)
     arc_deg: float = param(DEFAULT_ARC_DEG, "deg", "... and, where falls gather, the mean "
-                           "direction's 95 % interval narrower than this", 0.0, 360.0,
-                           flag="--arc-deg")
+                           "direction's 95 % interval narrower than this (360: P(toppled) "
+                           "alone decides)", 0.0, 360.0, flag="--arc-deg", low_open=True)
     max_members: int = param(DEFAULT_MAX_MEMBERS, "", "the most members per record (equal "
                              "to --members: a fixed ensemble)", 1, 10000, flag="--max-members")
     seed: int = param(DEFAULT_SEED, "", "seed of the Latin hypercube", flag="--seed")
@@ -372,7 +374,9 @@ class EnsembleOptions(CampaignOptions):
         "multiplies (replacing --stiffness's)")
 
     def check(self):
-        contact_ranges(ENSEMBLE_RANGES, contact_of(self), parse_vary(self.vary))
+        contact = contact_of(self)
+        contact_ranges(ENSEMBLE_RANGES, contact, parse_vary(self.vary))
+        refuse_ignored_stiffness(self, contact, self.column_file is not None)
         if not self.members <= self.max_members:
             raise InputError(f"--max-members must lie in [--members, 10000], got "
                              f"{self.max_members}")

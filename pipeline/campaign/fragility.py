@@ -51,11 +51,12 @@ from pipeline.campaign import Campaign, register
 from pipeline.campaign import ensemble   # module: imported while ensemble may still load
 from pipeline.campaign import pulse_grid
 from pipeline.campaign.column_file import check_stiffness, column_kn, mark
+from pipeline.campaign.executor import RUN_CORE_S
 from pipeline.campaign.column_file import description as column_file_description
 from pipeline.campaign.fragility_block import DEFAULT_AZIMUTHS
 from pipeline.campaign.fragility_outputs import fragility_outputs
 from pipeline.campaign.options import (CampaignOptions, column_file_param, contact_file_param,
-                                       contact_of, stiffness_param)
+                                       contact_of, refuse_ignored_stiffness, stiffness_param)
 from pipeline.scenario.contact_file import contact_values
 from pipeline.campaign.run_dirs import finished_summary
 from pipeline.campaign.runs import column_specs, motion_cache, pulse_record, run_column_spec
@@ -70,6 +71,8 @@ log = logging.getLogger(__name__)
 DEFAULT_LEVELS = tuple(round(float(v), 3) for v in np.geomspace(0.5, 8.0, 8))   # m/s^2
 DEFAULT_MEMBERS = 4
 DEFAULT_HEADINGS = 4            # pulse grid: shaking directions per parameter set
+LEVELS_WITH_PULSES = ("--levels scales records; the pulse grid has its own PGA axis (--pulses "
+                      "pga_g=LO:HI:N): give one or the other")
 
 
 def default_records():
@@ -95,7 +98,42 @@ def parse_levels(text):
     return tuple(values)
 
 
-def fragility_specs(records, campaign_dir, levels=DEFAULT_LEVELS, members=DEFAULT_MEMBERS,
+def parse_grid(text):
+    """:func:`pipeline.campaign.pulse_grid.parse_pulses`, refusing an axis whose values
+    agree to 6 significant digits (the resolution of the pulses' files: one cell would
+    be run and counted twice)."""
+    grid = pulse_grid.parse_pulses(text)
+    for name, values in grid.items():
+        distinct = {f"{v:.6g}" for v in values}
+        if len(distinct) < len(values):
+            raise InputError(f"--pulses {name}: its {len(values)} values are only "
+                             f"{len(distinct)} distinct to 6 significant digits (the pulses' "
+                             "resolution): a cell would be run twice; give fewer steps or a "
+                             "wider LO:HI")
+    return grid
+
+
+def planned_runs(records, column_file=None, pulses=None, members=DEFAULT_MEMBERS,
+                 headings=DEFAULT_HEADINGS, levels=None, only_runs=None, **_):
+    """(runs, core-s a run) of the campaign from its options alone, the long-run gate's
+    count before any spec is built: cells x members x headings on the pulse grid (its
+    runs' cost, :func:`pipeline.campaign.pulse_grid.run_core_s`), records x levels x
+    members on scaled records; None for the runs of an adaptive stage."""
+    if only_runs is not None:
+        return None
+    if pulses is None and not records and column_file is not None:
+        if "mesh" in column_file_description(column_file, meshes=True):
+            pulses = "vsr"
+    if pulses is not None:
+        grid = parse_grid(pulses)
+        core_s = [pulse_grid.run_core_s(ratio) for ratio in grid["pgv_pga_s"]]
+        return (len(grid["pga_g"]) * len(core_s) * members * headings,
+                float(np.mean(core_s)))
+    levels = parse_levels(DEFAULT_LEVELS if levels is None else levels)
+    return len(records or default_records()) * len(levels) * members, RUN_CORE_S
+
+
+def fragility_specs(records, campaign_dir, levels=None, members=DEFAULT_MEMBERS,
                     column="both", seed=None, azimuths=DEFAULT_AZIMUTHS, column_file=None,
                     stiffness="matched", pulses=None, azimuth=None,
                     headings=DEFAULT_HEADINGS, ranges=None, jobs=None, only_runs=None,
@@ -108,7 +146,8 @@ def fragility_specs(records, campaign_dir, levels=DEFAULT_LEVELS, members=DEFAUL
     instead; ``only_runs`` (run ids) keeps those of its runs, taken from ``grid_specs``
     when the adaptive driver has made the grid's specs already.  A contact file fixes what
     it sets for every member (:func:`pipeline.campaign.ensemble.contact_ranges`; on the
-    pulse grid, :func:`pipeline.campaign.pulse_grid.pulse_runs`)."""
+    pulse grid, :func:`pipeline.campaign.pulse_grid.pulse_runs`).  ``levels``: None for
+    :data:`DEFAULT_LEVELS`; given with the pulse grid, refused (it has its own PGA axis)."""
     data = column_file_description(column_file, meshes=True)
     contact = None if contact_file is None else contact_values(contact_file)
     mesh = data is not None and "mesh" in data
@@ -117,6 +156,8 @@ def fragility_specs(records, campaign_dir, levels=DEFAULT_LEVELS, members=DEFAUL
         log.info("fragility: a mesh specimen: the pulse grid vsr (PGA 0.2-1.1 g x PGV/PGA "
                  "0.1-1.0 s, 10 x 10; --pulses to change it)")
     if pulses is not None:
+        if levels is not None:
+            raise InputError(LEVELS_WITH_PULSES)
         specs = grid_specs if grid_specs is not None else _pulse_specs(
             records, campaign_dir, data, column, pulses, members, headings, azimuth, seed,
             ranges, stiffness, jobs, quiet=only_runs is not None, contact=contact)
@@ -133,7 +174,7 @@ def fragility_specs(records, campaign_dir, levels=DEFAULT_LEVELS, members=DEFAUL
         raise InputError("--azimuth and --ranges belong to the pulse grid: add --pulses")
     check_stiffness(stiffness)
     records = list(records) if records else default_records()
-    levels = parse_levels(levels)
+    levels = parse_levels(DEFAULT_LEVELS if levels is None else levels)
     if column not in COLUMN_KINDS:
         raise InputError(f"--column must be both, monolithic or drums, got {column!r}")
     if not (isinstance(azimuths, int) and 1 <= azimuths <= 360):
@@ -203,9 +244,10 @@ def _pulse_specs(records, campaign_dir, data, column, pulses, members, headings,
 
 @dataclass(frozen=True)
 class FragilityOptions(CampaignOptions):
-    levels: str = param(",".join(f"{v:g}" for v in DEFAULT_LEVELS), "m/s^2",
-                        "horizontal PGA targets of the scaled records (8 levels 0.5-8, "
-                        "geometric)", flag="--levels", metavar="A,A,...")
+    levels: str = param(None, "m/s^2", "horizontal PGA targets of the scaled records "
+                        "(default 8 levels 0.5-8, geometric: "
+                        + ",".join(f"{v:g}" for v in DEFAULT_LEVELS) + ")", flag="--levels",
+                        metavar="A,A,...")
     members: int = param(DEFAULT_MEMBERS, "", "ensemble members per record and level "
                          "(sampled like campaign ensemble, the same at every level)", 1, 10000,
                          flag="--members")
@@ -226,8 +268,9 @@ class FragilityOptions(CampaignOptions):
     azimuth: float = param(None, "deg", "pulse grid: shake along this fixed azimuth (a "
                            "table); default: sampled per member over 360 deg (a field rock)",
                            flag="--azimuth", metavar="DEG")
-    headings: int = param(DEFAULT_HEADINGS, "", "pulse grid: sampled shaking directions per "
-                          "parameter set (1 with --azimuth)", 1, 360, flag="--headings")
+    headings: int = param(None, "", "pulse grid: sampled shaking directions per parameter "
+                          f"set (default {DEFAULT_HEADINGS}; 1 with --azimuth, which fixes "
+                          "the direction)", 1, 360, flag="--headings")
     ranges: str = param(None, "", "pulse grid: ranges the members' unknowns are drawn from "
                         f"(default {pulse_grid.DEFAULT_RANGES}; LO = HI fixes one)",
                         flag="--ranges", metavar="NAME=LO:HI;...")
@@ -243,11 +286,14 @@ class FragilityOptions(CampaignOptions):
     TAKES_JOBS = True
 
     def check(self):
-        contact_of(self)
-        parse_levels(self.levels)
+        refuse_ignored_stiffness(self, contact_of(self), self.column_file is not None)
+        if self.levels is not None:
+            parse_levels(self.levels)
         ensemble.check_seed(self.seed)
         if self.pulses is not None:
-            pulse_grid.parse_pulses(self.pulses)
+            parse_grid(self.pulses)
+            if self.levels is not None:
+                raise InputError(LEVELS_WITH_PULSES)
         if self.ranges is not None:
             pulse_grid.parse_ranges(self.ranges)
         if self.adaptive and self.pulses is None and self.column_file is None:
@@ -255,12 +301,16 @@ class FragilityOptions(CampaignOptions):
         if self.azimuth is not None and not (math.isfinite(self.azimuth)
                                              and 0 <= self.azimuth < 360):
             raise InputError(f"--azimuth must be in [0, 360) deg, got {self.azimuth:g}")
+        if self.azimuth is not None and self.headings not in (None, 1):
+            raise InputError(f"--azimuth fixes the direction: --headings {self.headings} "
+                             "would repeat it (leave --headings out, or drop --azimuth to "
+                             "sample directions)")
 
     def kwargs(self):
-        kwargs = {**super().kwargs(), "levels": parse_levels(self.levels)}
-        if self.azimuth is not None and self.headings == DEFAULT_HEADINGS:
-            kwargs["headings"] = 1          # a fixed direction: one heading
-        return kwargs
+        headings = self.headings if self.headings is not None else \
+            1 if self.azimuth is not None else DEFAULT_HEADINGS    # a fixed direction: one
+        return {**super().kwargs(), "headings": headings,
+                "levels": None if self.levels is None else parse_levels(self.levels)}
 
 
 def drive(run, records, campaign_dir, options, gate=None):
@@ -274,10 +324,11 @@ def drive(run, records, campaign_dir, options, gate=None):
     stages). A cell's runs are taken in :func:`pulse_grid.run_order`."""
     if not options.get("adaptive"):
         return run(options)
+    if gate is not None:          # before the specs: a grid of hours takes minutes to build
+        runs, core_s = planned_runs(records, **options)
+        gate("campaign fragility (adaptive; at most the full grid)", runs, core_s,
+             "a smaller --pulses grid")
     full = fragility_specs(records, campaign_dir, **options)
-    if gate is not None:
-        gate("campaign fragility (adaptive; at most the full grid)", len(full),
-             sum(s.tags["core_s"] for s in full) / len(full), "a smaller --pulses grid")
     guide = pulse_grid.block_outcomes(full)
     by_cell, guide_by_cell = {}, {}
     for spec, fell in zip(full, guide):
@@ -315,4 +366,4 @@ register(Campaign("fragility", "P(toppled | PGA, PGV, PGV/PGA) by incremental dy
                   "records scaled to a PGA ladder, a small ensemble per level, lognormal and "
                   "logistic fits, the 2D rigid block side by side (default records GM20, NF04)",
                   fragility_specs, run_column_spec, fragility_outputs, label="runs",
-                  options=FragilityOptions, driver=drive))
+                  options=FragilityOptions, driver=drive, estimate=planned_runs))

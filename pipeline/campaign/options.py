@@ -6,6 +6,8 @@ from dataclasses import dataclass, fields
 
 from pipeline import paper
 from pipeline.campaign.column_file import STIFFNESS_CHOICES, column_file_help, paper_rocking_hz
+from pipeline.files import InputError
+from pipeline.scenario.contact_file import refuse_set_twice
 from pipeline.scenario.parameters import check_fields, param
 
 CAMPAIGN_NOTE = ("the described column stands in the drums' place and a monolith of its "
@@ -22,8 +24,11 @@ def column_file_param(note="", many=False):
 
 
 def stiffness_param(note="with --column-file"):
-    return param("matched", "", (f"{note}: " if note else "") + STIFFNESS_HELP,
-                 flag="--stiffness", choices=STIFFNESS_CHOICES)
+    """The ``--stiffness`` field: None when not given (matched, where a description is
+    run), so that a combination that would ignore it is refused
+    (:func:`refuse_ignored_stiffness`)."""
+    return param(None, "", (f"{note}: " if note else "") + STIFFNESS_HELP
+                 + "; default matched", flag="--stiffness", choices=STIFFNESS_CHOICES)
 
 
 def contact_file_param(note=""):
@@ -41,6 +46,18 @@ def contact_of(options):
         return None
     from pipeline.scenario.contact_file import contact_values
     return contact_values(options.contact_file)
+
+
+def refuse_ignored_stiffness(options, contact, described=True):
+    """InputError when ``--stiffness`` is given where nothing reads it: without a
+    described column (``described`` False: the paper's column has the paper's kn) or
+    beside a contact file that sets kn (the file's kn goes over it)."""
+    if options.stiffness is None:
+        return
+    if not described:
+        raise InputError("--stiffness sets a described column's kn: add --column-file (the "
+                         "paper's column has the paper's kn)")
+    refuse_set_twice(contact, ["kn"], "--stiffness")
 
 
 @dataclass(frozen=True)
@@ -69,4 +86,4 @@ class ColumnFileOptions(CampaignOptions):
         "with --column-file its kn replaces --stiffness's")
 
     def check(self):
-        contact_of(self)
+        refuse_ignored_stiffness(self, contact_of(self), self.column_file is not None)

@@ -364,6 +364,9 @@ class ShakeTableOptions(CampaignOptions):
         parse_grid(self.grid)
         frame = load_experiments(self.experiments, self.outcome)
         tests = self.test_names()
+        if self.tests is not None and not tests:
+            raise InputError(f"--tests {self.tests!r} names no test: give TEST,TEST, or leave "
+                             "it out for all tests")
         repeated = sorted({t for t in tests if tests.count(t) > 1})
         if repeated:
             raise InputError(f"--tests names {repeated[0]} twice: a test is run and counted "

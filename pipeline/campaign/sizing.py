@@ -6,6 +6,7 @@ import logging
 import math
 from pathlib import Path
 
+from pipeline.campaign.executor import RUN_CORE_S
 from pipeline.files import write_json
 from pipeline.stats.ensemble import wilson_interval
 
@@ -92,16 +93,29 @@ def written_summaries(campaign_dir, n_records):
     return data if n_records > 1 else [data]
 
 
+def reachable_runs(records, max_members, campaign_dir):
+    """The most runs an ensemble sized by its error may make: the nominal run and
+    ``max_members`` members on each record, less the runs already finished in
+    ``campaign_dir`` (a resumed campaign)."""
+    runs_dir = Path(campaign_dir) / "runs"
+    done = sum(1 for _ in runs_dir.glob("*/summary.json")) if runs_dir.is_dir() else 0
+    return max(len(records) * (max_members + 1) - done, 0)
+
+
 def run_sized(run, records, campaign_dir, options, gate=None):
     """Add members in Latin-hypercube batches of ``options["members"]`` to the records not
     yet converged (:func:`converged`) until all are or ``max_members`` is reached; each
     record's ensemble_summary.json gets ``sizing`` (target, members, why it stopped).
     ``run(options)`` runs the campaign once (its outputs write the summaries, read back
-    here with :func:`written_summaries`) and returns its outputs dict; it asks the
-    long-run gate before each batch (``gate``, for an estimate of the driver's own: not
-    used)."""
+    here with :func:`written_summaries`) and returns its outputs dict.  Before the first
+    batch it asks the long-run gate (``gate``) for the runs it may reach: ``max_members``
+    and the nominal run on every record (:func:`reachable_runs`)."""
     batch, cap = options["members"], options["max_members"]
     precision, arc = options["precision"], options["arc_deg"]
+    if gate is not None:
+        runs = reachable_runs(records, cap, campaign_dir)
+        gate(f"campaign ensemble (up to {cap} members on each of {len(records)} "
+             "record(s))", runs, RUN_CORE_S, "a smaller --max-members or a larger --precision")
     counts = {rec: min(batch, cap) for rec in records}
     while True:
         result = run({**options, "batch": batch, "record_members": dict(counts)})

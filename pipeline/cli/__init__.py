@@ -82,8 +82,8 @@ def main(argv=None):
     parser = build_parser()
     empty = empty_path_option(argv)
     if empty:
-        print(f"error: {empty} is empty (give a path; '.' for the current directory)",
-              file=sys.stderr)
+        print(f"error: {empty} is empty (give a value; for a path, '.' is the current "
+              "directory)", file=sys.stderr)
         return 2
     args = parser.parse_args(argv)
     try:

@@ -53,7 +53,7 @@ def check_fields(obj):
         value, meta = getattr(obj, f.name), f.metadata
         name = meta.get("flag") or f.name
         if meta.get("choices"):
-            if value not in meta["choices"]:
+            if value not in meta["choices"] and not (value is None and f.default is None):
                 raise InputError(f"{name} must be one of {', '.join(meta['choices'])}, "
                                  f"got {value!r}")
             continue

@@ -15,6 +15,7 @@ QUICK_OUT_DIR = RESULTS_DIR / "synthetics-quick"
 QUICK_FMAX_HZ = 2.5
 QUICK_DURATION_S = 20.0
 RINGS_KM = (5.0, 10.0, 20.0)     # default site rings around the epicentre
+RING_RANGE_KM = (0.05, 100.0)   # epicentral distances the generator takes (as a hidden truth)
 AZIMUTH_STEP_DEG = 30.0          # default step between the sites of a ring
 MIN_AZIMUTH_STEP_DEG = 0.01      # the finest: 36,000 sites a ring (the long-run gate
 #                                  weighs what that costs before any computation)
@@ -25,8 +26,13 @@ def settings(rings_km, azimuth_step_deg, duration_s, sampling_hz, fmax_hz, out_d
         fmax_hz = min(fmax_hz, QUICK_FMAX_HZ)
         duration_s = min(duration_s, QUICK_DURATION_S)
     rings = tuple(float(r) for r in rings_km)
-    if not rings or not all(math.isfinite(r) and r > 0 for r in rings):
-        raise InputError(f"impossible site rings {rings_km} km: give distances > 0")
+    low, high = RING_RANGE_KM
+    if not rings or not all(math.isfinite(r) and low <= r <= high for r in rings):
+        raise InputError(f"site rings {', '.join(f'{r:g}' for r in rings) or 'none'} km: the "
+                         f"generator takes rings of {low:g}-{high:g} km")
+    if len(set(rings)) < len(rings):
+        raise InputError(f"site rings {', '.join(f'{r:g}' for r in rings)} km: a ring given "
+                         "twice (its sites would be computed and counted twice)")
     if not MIN_AZIMUTH_STEP_DEG <= azimuth_step_deg <= 360:
         raise InputError(f"azimuth step {azimuth_step_deg:g} deg outside "
                          f"[{MIN_AZIMUTH_STEP_DEG:g}, 360]")
