@@ -107,7 +107,7 @@ def constrain_tree(tree, specimens, ratio_model, ages_ka, age_sds_ka, rule="baye
               "prior_weights": tree.weights, "posterior_weights": posterior[rule],
               "prior": prior_stats, "posterior": post_stats, "rule": rule,
               "ages_ka": list(ages_ka), "age_sds_ka": list(age_sds_ka),
-              "target_rates": TARGET_RATES}
+              "target_rates": TARGET_RATES, "branch_ids": tree.branch_ids}
     return summary, summary["branches"], figure
 
 
