@@ -2,32 +2,46 @@
 bounds checked before and right after parsing, and short one-line renderings of
 whatever a file holds, for the one-line errors."""
 import math
+import os
 import reprlib
+import stat
 
 from pipeline.files import InputError
 
 MAX_FILE_BYTES = 1_000_000   # a column description or an observations file is a few kB
+DATA_FILE_BYTES = 64_000_000  # a hazard curve, a campaign's fragility.json or runs table
 MAX_NESTING = 16             # they nest 4-5 deep
 MAX_INT_DIGITS = 100         # longer integers are refused while parsing
 
 
 class Unreadable(ValueError):
     """A file that cannot be parsed; the message says where and why (one line).
-    ``kind``: "size" (over MAX_FILE_BYTES), "utf8" (``offset``, ``byte``: the first
-    bad byte, 0-based) or None."""
+    ``kind``: "size" (over the size limit), "type" (not a regular file), "utf8"
+    (``offset``, ``byte``: the first bad byte, 0-based) or None."""
 
     def __init__(self, message, kind=None, offset=None, byte=None):
         super().__init__(message)
         self.kind, self.offset, self.byte = kind, offset, byte
 
 
-def read_text(path):
-    """The text of a user's file: at most MAX_FILE_BYTES read, strict UTF-8 (a BOM
-    allowed).  Unreadable ("size" or "utf8"); OSError as open raises it."""
-    with open(path, "rb") as f:
-        content = f.read(MAX_FILE_BYTES + 1)
-    if len(content) > MAX_FILE_BYTES:
-        raise Unreadable(f"larger than {MAX_FILE_BYTES // 1_000_000} MB", "size")
+def read_text(path, limit=MAX_FILE_BYTES):
+    """The text of a user's file: a regular file (a named pipe, device or socket refused
+    before reading), at most ``limit`` bytes read, strict UTF-8 (a BOM allowed).
+    Unreadable ("size", "type" or "utf8"); OSError as open raises it (IsADirectoryError
+    for a directory)."""
+    _regular(os.stat(path).st_mode, path)               # nothing opened that is not a file
+    fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK)     # and what replaced it since, too
+    try:
+        _regular(os.fstat(fd).st_mode, path)
+        os.set_blocking(fd, True)
+        with os.fdopen(fd, "rb") as f:
+            fd = None
+            content = f.read(limit + 1)
+    finally:
+        if fd is not None:
+            os.close(fd)
+    if len(content) > limit:
+        raise Unreadable(f"larger than {_size_text(limit)}", "size")
     bom = 3 if content.startswith(b"\xef\xbb\xbf") else 0     # a UTF-8 BOM is allowed
     try:
         return content[bom:].decode("utf-8")
@@ -37,17 +51,34 @@ def read_text(path):
                          content[at]) from None
 
 
-def read_json(path, what):
-    """The parsed JSON of a user's file (read by :func:`read_text`); InputError (one line)
-    "``what`` not found: path" or "name: not readable JSON (why)"."""
+def _regular(mode, path):
+    if stat.S_ISDIR(mode):
+        raise IsADirectoryError(21, "Is a directory", str(path))
+    if not stat.S_ISREG(mode):
+        raise Unreadable("not a regular file (a named pipe, device or socket)", "type")
+
+
+def _size_text(limit):
+    return f"{limit / 1_000_000:g} MB"
+
+
+def read_json(path, what, limit=MAX_FILE_BYTES):
+    """The parsed JSON of a user's file (read by :func:`read_text`, at most ``limit``
+    bytes); InputError (one line) "``what`` not found: path", "``what`` path is a
+    directory" or "name: not readable JSON (why)", a nesting too deep for the parser
+    included."""
     import json
     from pathlib import Path
     path = Path(path)
-    if not path.is_file():
+    if not path.exists():
         raise InputError(f"{what} not found: {path}")
+    if path.is_dir():
+        raise InputError(f"{what} {path} is a directory")
     try:
-        return json.loads(read_text(path))
-    except (OSError, ValueError, RecursionError) as exc:      # Unreadable is a ValueError
+        return json.loads(read_text(path, limit))
+    except RecursionError:
+        raise InputError(f"{path.name}: not readable JSON (nested too deep)") from None
+    except (OSError, ValueError) as exc:      # Unreadable is a ValueError
         raise InputError(f"{path.name}: not readable JSON ({exc})") from None
 
 

@@ -6,12 +6,15 @@ from pipeline.constants import STANDARD_GRAVITY
 from pipeline.hazard.fragility import overturn_probability
 from pipeline.hazard.survival import (contribution_by_intensity, intensity_scale_bound,
                                       overturning_rate, rate_density, rate_outside,
-                                      rate_scale_bound, survival_probability)
+                                      rate_exceeding, rate_scale_bound,
+                                      survival_probability)
 from pipeline.provenance import software_versions
 
 FLOOR = 0.05                  # survival probability the bounds keep (5 %)
 INTERVAL = (2.5, 97.5)        # percentiles of the survival interval
 END_SHARE_WARNING = 0.1       # warn when a curve's end holds more of the rate than this
+REACH_WARNING = 2.0           # and beyond this x a grid's top PGA, when P above the grid
+REACH_SHARE = 0.01            # could add more than this share of the rate
 
 ASSUMPTIONS = [
     "Overturnings are a Poisson process in time: survival of age t is exp(-rate t).",
@@ -77,6 +80,8 @@ def assess(curve, specimens, ratio_model, age_ka, age_sd_ka=0.0, draws=400, seed
                 if draws else "--draws 0"
         entries.append(entry)
         outside = entry.get("outside_grid") or {}
+        entry["warnings"] += _above_grid_warning(outside, entry["fragility"],
+                                                 entry["annual_overturning_rate_per_yr"])
         for side in ("below", "above"):
             share = outside.get(f"share_{side}_grid")
             if share is not None and share > END_SHARE_WARNING:
@@ -138,7 +143,10 @@ def assess(curve, specimens, ratio_model, age_ka, age_sd_ka=0.0, draws=400, seed
             "outside_grid": "a pulse grid: the rate of overturning from PGA below the "
             "grid's first PGA and above its last (on the hazard's PGA), their shares, and "
             "the rate with P = 0 below the grid (lower bound) and with the edge's P held "
-            "down to the uplift acceleration (upper bound)",
+            "down to the uplift acceleration (upper bound); above the grid: the hazard "
+            "curve's last level and its ratio to the grid's top PGA, the rate of PGA above "
+            "the grid's top on the curve, the rate of overturning with P = 1 above the grid "
+            "(an upper bound) and how P is extended there (p_above_grid)",
             "hazard_curves": "the headline under each hazard curve given (--hazard "
             "repeated), the first being the headline's; survival_range_over_curves: min "
             "and max of their survival probabilities",
@@ -265,13 +273,41 @@ def _outside_grid(curve, fragility, ratio_model, probability, rate):
         curve.levels_m_s2, curve.rates_per_yr,
         lambda x, f=variant: overturn_probability([f], ratio_model, x)[0], zero)["rate_per_yr"]
         for name, variant in fragility.variants().items()}
+    last = float(curve.levels_m_s2[-1])
+    beyond = rate_exceeding(curve.levels_m_s2, curve.rates_per_yr, hi)
     return {"outside_grid": {
         "pga_range_m_s2": [lo, hi], "pga_range_g": [lo / STANDARD_GRAVITY, hi / STANDARD_GRAVITY],
         "rate_below_grid_per_yr": below, "rate_above_grid_per_yr": above,
         "share_below_grid": below / rate if rate > 0 else None,
         "share_above_grid": above / rate if rate > 0 else None,
         "rate_per_yr_zero_below_grid": bounds["zero"],
-        "rate_per_yr_edge_held_below_grid": bounds["edge"]}}
+        "rate_per_yr_edge_held_below_grid": bounds["edge"],
+        "hazard_last_level_g": last / STANDARD_GRAVITY,
+        "hazard_reach_over_grid_top": last / hi,
+        "hazard_rate_above_grid_per_yr": beyond,
+        "rate_per_yr_one_above_grid": rate - above + max(beyond, above),
+        "p_above_grid": fragility.describe().get("above_grid")}}
+
+
+def _above_grid_warning(outside, described, rate):
+    """A warning (list of one line, or empty) when the survival rests on P above a pulse
+    grid: P = 1 above it would add more than END_SHARE_WARNING of the rate, or more than
+    REACH_SHARE with the hazard curve reaching beyond REACH_WARNING x the grid's top PGA
+    (P held at 1 above the grid adds nothing: no warning)."""
+    if not outside:
+        return []
+    could_add = outside["rate_per_yr_one_above_grid"] - rate
+    reach = outside["hazard_reach_over_grid_top"]
+    if not (could_add > END_SHARE_WARNING * rate
+            or (reach > REACH_WARNING and could_add > REACH_SHARE * rate)):
+        return []
+    top = outside["pga_range_g"][1]
+    how = (described.get("above_grid") or {}).get("summary", "P extended above it")
+    return [f"the hazard curve reaches {outside['hazard_last_level_g']:.3g} g, {reach:.3g} x "
+            f"the grid's top PGA {top:.3g} g; above it {how}; PGA above {top:.3g} g has the "
+            f"rate {outside['hazard_rate_above_grid_per_yr']:.3g} /yr against the overturning "
+            f"rate {rate:.3g} /yr (P = 1 above the grid: "
+            f"{outside['rate_per_yr_one_above_grid']:.3g} /yr)"]
 
 
 def _site_set(curve, specimens, ratio_model, entries, age, age_sd):

@@ -18,14 +18,14 @@ mode of the hazard's disaggregation; ln PGV given ln PGA by their correlation).
 import importlib.metadata
 import math
 from dataclasses import dataclass, field, replace
-from pathlib import Path
 
 import numpy as np
 from scipy import stats
 
 from pipeline.constants import STANDARD_GRAVITY
 from pipeline.files import InputError
-from pipeline.userfiles import Unreadable, number, read_json, read_text, show
+from pipeline.hazard.fragility_file import MAX_MEMBERS, read_fragility_file
+from pipeline.userfiles import DATA_FILE_BYTES, Unreadable, number, read_text, show
 
 Z95 = stats.norm.ppf(0.975)
 RATIO_NODES = 24                  # Gauss-Hermite nodes over ln(PGV/PGA)
@@ -141,16 +141,11 @@ def load_campaign_fragility(path, column=None, form=None, below="ramp", componen
 
 def _load_campaign_fragility(path, column, form, below):
     """(fragility, "line" | "records", record ids) of :func:`load_campaign_fragility`."""
-    path = Path(path)
-    if path.is_dir():
-        path = path / "fragility.json"
-    data = read_json(path, "fragility file")
-    if isinstance(data, dict) and "pulse_grid" in data:
+    path, data = read_fragility_file(path)          # every value below checked
+    if "pulse_grid" in data:
         return load_pulse_grid(path, data, column, form or "grid", below), "line", ()
     form = form or "pga-pgv"
-    columns = data.get("columns") if isinstance(data, dict) else None
-    if not isinstance(columns, dict) or not columns:
-        raise InputError(f"{path}: not a fragility.json of campaign fragility (no 'columns')")
+    columns = data["columns"]
     if column is None:
         column = next((c for c in ("monolithic", "drums") if c in columns), next(iter(columns)))
     if column not in columns:
@@ -194,12 +189,14 @@ def member_fits(runs_path, column, form, data):
     if not runs_path.is_file():
         return None, f"no {runs_path.name} beside the file: the members' spread not available"
     try:
-        table = pd.read_csv(io.StringIO(read_text(runs_path)))
+        table = pd.read_csv(io.StringIO(read_text(runs_path, DATA_FILE_BYTES)))
         sub = table[table["column"] == column]
         groups = sorted(sub.groupby("member"), key=lambda item: item[0])
     except (OSError, Unreadable, ValueError, KeyError, pd.errors.ParserError) as exc:
         raise InputError(f"{runs_path}: not a fragility_runs.csv of campaign fragility "
                          f"({exc})") from None
+    if len(groups) > MAX_MEMBERS:
+        raise InputError(f"{runs_path}: {len(groups)} members (at most {MAX_MEMBERS})")
     block = data.get("block2d") or {}
     fits, skipped = [], []
     for member, rows in groups:
@@ -207,14 +204,18 @@ def member_fits(runs_path, column, form, data):
             y = rows["toppled"].astype(str).str.lower().isin(("true", "1")).to_numpy()
             pga = rows["pga_m_s2"].astype(float).to_numpy()
             ratio = rows["pgv_pga_s"].astype(float).to_numpy()
-        except (KeyError, ValueError):
-            raise InputError(f"{runs_path}: member {member}: no readable toppled, pga_m_s2 "
-                             "and pgv_pga_s") from None
-        label = f"member {member}"
+        except (KeyError, ValueError, TypeError):
+            raise InputError(f"{runs_path}: member {show(member)}: no readable toppled, "
+                             "pga_m_s2 and pgv_pga_s") from None
+        if not (np.isfinite(pga).all() and np.isfinite(ratio).all() and (pga > 0).all()
+                and (ratio > 0).all()):
+            raise InputError(f"{runs_path}: member {show(member)}: pga_m_s2 and pgv_pga_s "
+                             "must be positive finite numbers")
+        label = f"member {show(member)}"
         if form == "pga":
             fit = fragility_fit(pga, y)
             if fit["median"] is None:
-                skipped.append(f"{member} ({fit['note']})")
+                skipped.append(f"{show(member)} ({fit['note']})")
                 continue
             fits.append(Lognormal(float(fit["median"]), float(fit["beta"]), label=label))
         else:
@@ -222,7 +223,7 @@ def member_fits(runs_path, column, form, data):
                                    p=block.get("p_per_s"))
             b = fit["coefficients"]
             if b is None or not b["b1"] > 0:
-                skipped.append(f"{member} ({fit.get('note') or 'does not grow with PGA'})")
+                skipped.append(f"{show(member)} ({fit.get('note') or 'does not grow with PGA'})")
                 continue
             fits.append(Logistic((b["b0"], b["b1"], b["b2"]), label=label))
     note = None if not skipped else (f"{len(skipped)} of {len(groups)} member(s) not fitted "
@@ -443,12 +444,9 @@ class PulseGrid:
         nearest edge cell (its log-odds shifted to meet that cell's P, so P is continuous
         at the edge and a cell of P 0 or 1 stays so; the raw surface, with its steps, for
         ``below`` "logistic"), or without a surface the edge cell's P."""
-        from scipy.interpolate import RegularGridInterpolator  # noqa: PLC0415
         points = np.stack([np.log(pga), np.log(ratio)], axis=-1)
-        inside = RegularGridInterpolator((np.log(self.pga_m_s2), np.log(self.pgv_pga_s)),
-                                         _fill_empty(cells), bounds_error=False,
-                                         fill_value=None)
         ln_a, ln_r = np.log(self.pga_m_s2), np.log(self.pgv_pga_s)
+        inside = _interpolator(ln_a, ln_r, _fill_empty(cells))
         within = ((points[..., 0] >= ln_a[0]) & (points[..., 0] <= ln_a[-1])
                   & (points[..., 1] >= ln_r[0]) & (points[..., 1] <= ln_r[-1]))
         edge = _clip_points(points, ln_a, ln_r)
@@ -484,6 +482,7 @@ class PulseGrid:
                 "outside": "the logistic surface fitted to the same runs"
                 if self.outside is not None else "the nearest edge cell's P",
                 "below_grid": self.describe_below(),
+                "above_grid": self.describe_above(),
                 "pga_range_g": [self.pga_m_s2[0] / STANDARD_GRAVITY,
                                 self.pga_m_s2[-1] / STANDARD_GRAVITY],
                 "pgv_pga_range_s": [self.pgv_pga_s[0], self.pgv_pga_s[-1]],
@@ -492,6 +491,37 @@ class PulseGrid:
                 "outside_surface": None if self.outside is None else self.outside.describe(),
                 "note": self.note}
 
+
+    def describe_above(self):
+        """What P is above the grid's last PGA: how it is extended, the top row's P per
+        PGV/PGA and (``summary``) one line of it for the warnings."""
+        top = _fill_empty(self.p)[-1]
+        a_n = self.pga_m_s2[-1] / STANDARD_GRAVITY
+        span = f"{top.min():.3g}" if top.min() == top.max() else \
+            f"{top.min():.3g}-{top.max():.3g} over its PGV/PGA"
+        if self.outside is None:
+            definition = "P = the top edge cell's P (at the nearest PGV/PGA), held at every PGA"
+            summary = f"P held at the top cells' P ({span}) at every PGA above"
+        elif self.below == "logistic":
+            definition = ("P = the logistic surface fitted to the same runs (not continuous "
+                          "at the grid's last PGA)")
+            summary = "P from the logistic surface fitted to the runs"
+        else:
+            definition = ("logit P(a, r) = logit P(a_N, r) + logit S(a, r) - logit S(a_N, r): "
+                          "the logistic surface S fitted to the same runs carries the top "
+                          "edge cell's P upwards (a top cell of P 0 or 1 keeps it at every "
+                          "PGA above)")
+            summary = f"P carried up from the top cells' P ({span}) by the logistic surface"
+        stuck = [r for r, p in zip(self.pgv_pga_s, top) if p == 0]
+        note = None
+        if stuck and self.below != "logistic":
+            note = (f"no run overturned at the grid's last PGA ({a_n:.3g} g) for PGV/PGA "
+                    f"{', '.join(f'{r:g}' for r in stuck)} s: P stays 0 at every PGA above it")
+            summary += f"; P = 0 at every PGA above for PGV/PGA {', '.join(f'{r:g}' for r in stuck)} s"
+        return {"definition": definition, "last_pga_g": a_n,
+                "p_at_last_pga": {"pgv_pga_s": list(self.pgv_pga_s),
+                                  "P": [float(v) for v in top]},
+                "summary": summary, "note": note}
 
     def describe_below(self):
         """What P is below the grid's first PGA: the choice and its definition."""
@@ -525,6 +555,20 @@ class PulseGrid:
                 "note": note}
 
 
+def _interpolator(ln_a, ln_r, cells):
+    """Bilinear in (ln PGA, ln PGV/PGA) over the cells, asked only inside the grid's box.
+    An axis of one value (a grid of one row or column) is doubled a unit apart with its
+    cells: the points asked lie on the value, so P is interpolated along the other axis
+    only."""
+    from scipy.interpolate import RegularGridInterpolator  # noqa: PLC0415
+    axes = [np.asarray(ln_a, float), np.asarray(ln_r, float)]
+    for k in (0, 1):
+        if len(axes[k]) == 1:
+            axes[k] = np.array([axes[k][0], axes[k][0] + 1.0])
+            cells = np.concatenate([cells, cells], axis=k)
+    return RegularGridInterpolator(tuple(axes), cells, bounds_error=False, fill_value=None)
+
+
 def _carried(p_edge, surface, surface_at_edge):
     """P outside a grid: logit P = logit p_edge + logit surface - logit surface_at_edge."""
     from scipy.special import expit, logit  # noqa: PLC0415
@@ -556,22 +600,21 @@ def _fill_empty(cells):
 
 
 def load_pulse_grid(path, data, model=None, form="grid", below="ramp"):
-    """One model of a pulse-grid ``fragility.json`` (``models``: monolithic, block2d):
-    ``form`` "grid" (:class:`PulseGrid`, ``below`` what P is below it) or "pga-pgv" (its
-    logistic surface)."""
+    """One model of a pulse-grid ``fragility.json`` (``models``: monolithic, block2d), its
+    ``data`` checked by :func:`pipeline.hazard.fragility_file.check_fragility`: ``form``
+    "grid" (:class:`PulseGrid`, ``below`` what P is below it; a grid of one row or column
+    interpolated along the other axis) or "pga-pgv" (its logistic surface)."""
     if below not in BELOW_GRID:
         raise InputError(f"--below-grid must be one of {', '.join(BELOW_GRID)}, got {below!r}")
     section = data["pulse_grid"]
-    models = section.get("models") if isinstance(section, dict) else None
-    if not isinstance(models, dict) or not models:
-        raise InputError(f"{path}: pulse_grid has no 'models'")
+    models = section["models"]
     if model is None:
         model = "monolithic" if "monolithic" in models else next(iter(models))
     if model not in models:
         raise InputError(f"{path}: pulse_grid has no model {model!r} (has {', '.join(models)})")
     entry = models[model]
     where = f"{path}: pulse_grid model {model}"
-    label = f"{data.get('specimen', 'specimen')} {model} pulse grid from {path.name}"
+    label = f"{data.get('specimen') or 'specimen'} {model} pulse grid from {path.name}"
     logistic = None
     surface = entry.get("logistic") or {}
     if surface.get("coefficients") is not None:
@@ -584,35 +627,23 @@ def load_pulse_grid(path, data, model=None, form="grid", below="ramp"):
     if form != "grid":
         raise InputError(f"--fragility-form for a pulse grid must be grid or pga-pgv, got "
                          f"{form!r}")
-    try:
-        pga_g = [number(v, f"{where}: pga_g", 0, None, "g", True) for v in section["pga_g"]]
-        ratios = [number(v, f"{where}: pgv_pga_s", 0, None, "s", True)
-                  for v in section["pgv_pga_s"]]
-        cells = entry["cells"]
-    except (KeyError, TypeError):
-        raise InputError(f"{where}: no pga_g / pgv_pga_s axes or cells") from None
-    if len(pga_g) < 2 or len(ratios) < 2 or np.any(np.diff(pga_g) <= 0) \
-            or np.any(np.diff(ratios) <= 0):
-        raise InputError(f"{where}: the grid's axes must hold 2 or more increasing values")
-    n_sets = int(number(section.get("members"), f"{where}: members", 1, None))
+    pga_g = [float(v) for v in section["pga_g"]]        # checked: increasing, positive
+    ratios = [float(v) for v in section["pgv_pga_s"]]
+    n_sets = section["members"]
     n = np.zeros((len(pga_g), len(ratios)), int)
     overturned = np.zeros_like(n)
     per_set = np.full((n_sets, len(pga_g), len(ratios)), np.nan)
     index_a = {round(v, 9): i for i, v in enumerate(pga_g)}
     index_r = {round(v, 9): j for j, v in enumerate(ratios)}
-    for cell in cells:
-        try:
-            i, j = index_a[round(cell["pga_g"], 9)], index_r[round(cell["pgv_pga_s"], 9)]
-            n[i, j], overturned[i, j] = int(cell["n"]), int(cell["overturned"])
-            for s, p in zip(cell.get("sets") or [], cell.get("P_per_set") or []):
-                if p is not None:
-                    per_set[int(s), i, j] = float(p)
-        except (KeyError, TypeError, ValueError, IndexError):
-            raise InputError(f"{where}: a cell off the grid or without n/overturned: "
-                             f"{show(cell)}") from None
-    if not (0 <= overturned).all() or not (overturned <= n).all():
-        raise InputError(f"{where}: a cell with overturned outside 0..n")
+    for cell in entry["cells"]:                        # checked: on the grid, once each
+        i, j = index_a[round(cell["pga_g"], 9)], index_r[round(cell["pgv_pga_s"], 9)]
+        n[i, j], overturned[i, j] = cell["n"], cell["overturned"]
+        for s, p in zip(cell.get("sets") or [], cell.get("P_per_set") or []):
+            if p is not None:
+                per_set[s, i, j] = float(p)
     empty = int((n == 0).sum())
+    if empty == n.size:
+        raise InputError(f"{where}: no cell with runs (every n is 0)")
     note = None if not empty else (f"{empty} of {n.size} cells without runs: filled from the "
                                    "nearest cell along PGA")
     uplift = _uplift(section, where)

@@ -157,3 +157,17 @@ def rate_outside(levels_m_s2, rates_per_yr, probability, lo_m_s2, hi_m_s2,
     top = float(probability(levels[-1:])[0]) * rates[-1]
     above = float(part[x_mid > hi_m_s2].sum()) + (top if levels[-1] > hi_m_s2 else 0.0)
     return float(part[x_mid < lo_m_s2].sum()), above
+
+
+def rate_exceeding(levels_m_s2, rates_per_yr, x_m_s2):
+    """The annual rate (1/yr) of PGA above ``x_m_s2`` as the rate of overturning counts
+    the curve: lambda(x) interpolated in (ln x, ln lambda) inside it, lambda(x_1) below
+    its first level (nothing below x_1 is counted) and 0 from its last level up (the
+    exceedances of x_N are counted at x_N)."""
+    levels = np.asarray(levels_m_s2, float)
+    rates = np.asarray(rates_per_yr, float)
+    if x_m_s2 >= levels[-1]:
+        return 0.0
+    if x_m_s2 <= levels[0]:
+        return float(rates[0])
+    return float(np.exp(np.interp(math.log(x_m_s2), np.log(levels), np.log(rates))))
