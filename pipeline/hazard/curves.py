@@ -19,10 +19,13 @@ web service's, anything else a plain table.
   ``pga_<unit>,annual_rate_per_yr`` with unit ``g``, ``m_s2`` or ``cm_s2``, then one row
   per level: PGA and the annual rate of exceeding it (1/yr).
 
-Checks (a one-line InputError each): an empty file, a missing IMT or investigation time,
-an IMT other than PGA, an unknown unit, unreadable numbers, negative levels, rates or
-probabilities, levels not increasing, rates rising with the level (non-monotonic), fewer
-than two levels with a positive rate.  Said in ``notes``, never silent: levels dropped
+Checks (a one-line InputError each): a file that is not a regular file (a named pipe is
+refused before it is read) or is larger than 64 MB, an empty file, a missing IMT or
+investigation time, an IMT other than PGA, an unknown unit, unreadable numbers, a value of
+another type in the USGS JSON (metadata, imt, edition, vs30, coordinates), JSON nested too
+deep, levels not in (0, 20 g] or more than 1000 of them, negative rates or probabilities,
+an infinite or NaN rate (OpenQuake's poe of 1 aside, below), levels not increasing, rates
+rising with the level (non-monotonic), fewer than two levels with a positive rate.  Said in ``notes``, never silent: levels dropped
 because their poe is 1 (an unbounded rate) and the rates of 0 at the top (the curve ends
 at the last positive rate; the first level of rate 0 is kept as ``zero_rate_from_m_s2``).
 """
@@ -36,13 +39,16 @@ import numpy as np
 
 from pipeline.constants import STANDARD_GRAVITY
 from pipeline.files import InputError
-from pipeline.userfiles import Unreadable, json_int, read_text, show
+from pipeline.userfiles import DATA_FILE_BYTES, Unreadable, json_int, read_text, show
 
 PLAIN_UNITS = {"g": STANDARD_GRAVITY, "m_s2": 1.0, "cm_s2": 0.01}    # factor to m/s^2
 PLAIN_RATE_COLUMN = "annual_rate_per_yr"
 OPENQUAKE_PGA_UNIT = "g"               # the engine's unit of PGA (and SA)
 _IMT = r"[A-Za-z]+(?:\([0-9.]+\))?"    # PGA, PGV, SA(0.1), ...
 _OQ_LEVEL = re.compile(rf"^(poe|{_IMT})-([^:]+)(?::\w+)?$")
+MAX_PGA_M_S2 = 20.0 * STANDARD_GRAVITY   # the highest level a curve may state (20 g)
+MAX_LEVELS = 1_000                       # levels of one curve (engines give 20-50)
+MAX_INVESTIGATION_YR = 1e7
 
 
 @dataclass(frozen=True)
@@ -64,7 +70,7 @@ def load_hazard(path, site=None):
     ``site``: the row (0-based) of an OpenQuake file with several sites."""
     path = Path(path)
     try:
-        text = read_text(path)
+        text = read_text(path, DATA_FILE_BYTES)
     except FileNotFoundError:
         raise InputError(f"hazard file not found: {path}") from None
     except IsADirectoryError:
@@ -95,9 +101,9 @@ def _openquake(path, lines, site):
     if not found:
         raise InputError(f"{path}: no investigation_time in the first line")
     time_yr = _float(found.group(1), f"{path}: investigation_time")
-    if not (math.isfinite(time_yr) and time_yr > 0):
-        raise InputError(f"{path}: investigation_time must be a positive number of years, "
-                         f"got {found.group(1)}")
+    if not (math.isfinite(time_yr) and 0 < time_yr <= MAX_INVESTIGATION_YR):
+        raise InputError(f"{path}: investigation_time must be a positive number of years "
+                         f"(at most {MAX_INVESTIGATION_YR:g}), got {show(found.group(1))}")
     found = re.search(rf"\bimt\s*=\s*['\"]?({_IMT})", header)
     imt = found.group(1) if found else None
     first = 3 if len(columns) > 2 and columns[2].lower() == "depth" else 2
@@ -118,6 +124,8 @@ def _openquake(path, lines, site):
     _check_imt(imt, path)
     if not levels:
         raise InputError(f"{path}: no poe-<level> columns")
+    if len(levels) > MAX_LEVELS:
+        raise InputError(f"{path}: {len(levels)} levels (at most {MAX_LEVELS})")
     rows = [line for line in lines[2:] if line]
     if not rows:
         raise InputError(f"{path}: no site rows below the header")
@@ -135,6 +143,10 @@ def _openquake(path, lines, site):
               for k, c in enumerate(cells)]
     poe = np.array(values[first:])
     where = f"{path} (site {site})"
+    for name, value, bound in (("lon", values[0], 360.0), ("lat", values[1], 90.0)):
+        if not (math.isfinite(value) and abs(value) <= bound):
+            raise InputError(f"{where}: {name} {value:g} is not a coordinate (at most "
+                             f"{bound:g} deg in size)")
     for level, p in zip(levels, poe):
         if not math.isfinite(p):
             raise InputError(f"{where}: poe at {level:g} g is {p}")
@@ -153,7 +165,8 @@ def _openquake(path, lines, site):
               "site_index": site, "sites_in_file": len(rows),
               "lon": values[0], "lat": values[1],
               "rate_from_poe": "annual rate = -ln(1 - poe) / investigation_time (Poisson)"}
-    return _curve(np.array(levels), rates, STANDARD_GRAVITY, OPENQUAKE_PGA_UNIT, where, source)
+    return _curve(np.array(levels), rates, STANDARD_GRAVITY, OPENQUAKE_PGA_UNIT, where, source,
+                  from_poe=True)
 
 
 def _plain(path, lines):
@@ -174,6 +187,8 @@ def _plain(path, lines):
     if len(names) != 2 or names[1].lower() != PLAIN_RATE_COLUMN:
         raise InputError(f"{path}: expected the two columns pga_{unit},{PLAIN_RATE_COLUMN}, "
                          f"got {show(body[0][1])}")
+    if len(body) - 1 > MAX_LEVELS:
+        raise InputError(f"{path}: {len(body) - 1} levels (at most {MAX_LEVELS})")
     levels, rates = [], []
     for number, line in body[1:]:
         cells = line.split(",")
@@ -189,28 +204,38 @@ def _plain(path, lines):
 def _usgs(path, text):
     """The PGA curve of a USGS hazard web-service response (static curves: ``response``
     a list of {metadata: {imt: {value}, xlabel "Ground Motion (g)", xvals, latitude,
-    longitude, edition, vs30}, data: [{yvals}]}, yvals annual frequencies of exceedance)."""
+    longitude, edition {display}, vs30 {display}}, data: [{yvals}]}, yvals annual
+    frequencies of exceedance); every value read checked for its type."""
     try:
         data = json.loads(text, parse_int=json_int)
+    except RecursionError:
+        raise InputError(f"{path}: not JSON (nested too deep)") from None
     except (ValueError, Unreadable) as exc:
         raise InputError(f"{path}: not JSON ({exc})") from None
     curves = data.get("response") if isinstance(data, dict) else None
     if not isinstance(curves, list) or not all(isinstance(c, dict) for c in curves):
         raise InputError(f"{path}: not a USGS hazard-curve response (no 'response' list)")
-    imts = [((c.get("metadata") or {}).get("imt") or {}).get("value") for c in curves]
+    metas = [_usgs_object(c, "metadata", f"{path}: response[{k}]", True)
+             for k, c in enumerate(curves)]
+    imts = [_usgs_object(m, "imt", f"{path}: response[{k}].metadata", True).get("value")
+            for k, m in enumerate(metas)]
     if None in imts:
         raise InputError(f"{path}: missing IMT (a curve without metadata.imt.value)")
+    if not all(isinstance(v, str) for v in imts):
+        raise InputError(f"{path}: metadata.imt.value must be a text (e.g. PGA), got "
+                         f"{show(next(v for v in imts if not isinstance(v, str)))}")
     if "PGA" not in imts:
-        raise InputError(f"{path}: no PGA curve (IMTs: {', '.join(map(str, imts))}); survival "
+        raise InputError(f"{path}: no PGA curve (IMTs: {show(', '.join(imts))}); survival "
                          "uses PGA hazard curves")
-    curve = curves[imts.index("PGA")]
-    meta, rows = curve["metadata"], curve.get("data")
-    unit = re.search(r"\(([^)]*)\)\s*$", str(meta.get("xlabel", "")))
+    k = imts.index("PGA")
+    meta, rows, where = metas[k], curves[k].get("data"), f"{path}: response[{k}].metadata"
+    xlabel, ylabel = (_usgs_text(meta, key, where) for key in ("xlabel", "ylabel"))
+    unit = re.search(r"\(([^)]*)\)\s*$", xlabel or "")
     if not unit or unit.group(1) != "g":
-        raise InputError(f"{path}: unknown unit of PGA: xlabel {show(meta.get('xlabel'))} "
+        raise InputError(f"{path}: unknown unit of PGA: xlabel {show(xlabel)} "
                          "(expected 'Ground Motion (g)')")
-    if "annual" not in str(meta.get("ylabel", "")).lower():
-        raise InputError(f"{path}: ylabel {show(meta.get('ylabel'))} is not an annual "
+    if "annual" not in (ylabel or "").lower():
+        raise InputError(f"{path}: ylabel {show(ylabel)} is not an annual "
                          "frequency of exceedance")
     if not isinstance(rows, list) or len(rows) != 1 or not isinstance(rows[0], dict):
         raise InputError(f"{path}: expected one PGA data entry, got "
@@ -218,16 +243,54 @@ def _usgs(path, text):
     x, y = meta.get("xvals"), rows[0].get("yvals")
     if not (isinstance(x, list) and isinstance(y, list)) or len(x) != len(y):
         raise InputError(f"{path}: xvals and yvals must be lists of one length")
+    if len(x) > MAX_LEVELS:
+        raise InputError(f"{path}: {len(x)} levels (at most {MAX_LEVELS})")
     for v in x + y:
         if isinstance(v, bool) or not isinstance(v, (int, float)):
             raise InputError(f"{path}: not a number: {show(v)}")
     source = {"format": "USGS hazard web service (static curve)", "file": str(path),
-              "imt": "PGA", "unit_in_file": "g", "lat": meta.get("latitude"),
-              "lon": meta.get("longitude"),
-              "edition": (meta.get("edition") or {}).get("display"),
-              "vs30": (meta.get("vs30") or {}).get("display")}
-    return _curve(np.array(x, float), np.array(y, float), STANDARD_GRAVITY, "g", str(path),
-                  source)
+              "imt": "PGA", "unit_in_file": "g",
+              "lat": _usgs_coordinate(meta, "latitude", 90.0, where),
+              "lon": _usgs_coordinate(meta, "longitude", 360.0, where),
+              "edition": _usgs_text(_usgs_object(meta, "edition", where, True), "display",
+                                    f"{where}.edition"),
+              "vs30": _usgs_text(_usgs_object(meta, "vs30", where, True), "display",
+                                 f"{where}.vs30")}
+    try:
+        levels, rates = np.array(x, float), np.array(y, float)
+    except OverflowError:
+        raise InputError(f"{path}: a number beyond a float's range in xvals or yvals") from None
+    return _curve(levels, rates, STANDARD_GRAVITY, "g", str(path), source)
+
+
+def _usgs_object(parent, key, where, optional=False):
+    """``parent[key]``, an object ({} when ``optional`` and absent or null)."""
+    value = parent.get(key)
+    if value is None and optional:
+        return {}
+    if not isinstance(value, dict):
+        raise InputError(f"{where}.{key} must be an object, got {show(value)}")
+    return value
+
+
+def _usgs_text(parent, key, where):
+    """``parent[key]``: a text, or None when absent or null."""
+    value = parent.get(key)
+    if value is not None and not isinstance(value, str):
+        raise InputError(f"{where}.{key} must be a text, got {show(value)}")
+    return value
+
+
+def _usgs_coordinate(meta, key, bound, where):
+    """A latitude or longitude (deg, at most ``bound`` in size), or None when absent."""
+    value = meta.get(key)
+    if value is None:
+        return None
+    if isinstance(value, bool) or not isinstance(value, (int, float)) \
+            or not (math.isfinite(value) and abs(value) <= bound):
+        raise InputError(f"{where}.{key} must be a number of at most {bound:g} deg in size, "
+                         f"got {show(value)}")
+    return float(value)
 
 
 def _check_imt(imt, path):
@@ -243,14 +306,20 @@ def _float(text, what):
         raise InputError(f"{what}: not a number: {show(text.strip())}") from None
 
 
-def _curve(levels, rates, to_m_s2, unit, where, source):
+def _curve(levels, rates, to_m_s2, unit, where, source, from_poe=False):
     """HazardCurve from levels (file unit; ``to_m_s2`` converts) and annual rates: the
-    checks and repairs of the module docstring."""
+    checks and repairs of the module docstring; an infinite rate only ``from_poe`` (a
+    probability of exceedance of 1, dropped with a note), else refused."""
     if levels.size < 2:
         raise InputError(f"{where}: {levels.size} level(s); a hazard curve needs at least 2")
+    top = MAX_PGA_M_S2 / to_m_s2
     for x in levels:
-        if not (math.isfinite(x) and x > 0):
-            raise InputError(f"{where}: level {x:g} {unit}: levels must be positive")
+        if not (math.isfinite(x) and 0 < x <= top):
+            raise InputError(f"{where}: level {x:g} {unit}: levels must be positive and at "
+                             f"most {top:g} {unit} (20 g)")
+    for x, r in zip(levels, rates):
+        if math.isinf(r) and not from_poe:
+            raise InputError(f"{where}: rate at {x:g} {unit} is infinite")
     rising = np.flatnonzero(np.diff(levels) <= 0)
     if rising.size:
         k = rising[0]
