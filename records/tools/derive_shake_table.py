@@ -15,10 +15,13 @@ deterministically (reruns give the same bytes):
 * ``final_sp2_1.obj`` byte copy of models/SP2_PBRmodel/final_sp2_1.obj (SP2's mesh only:
                       a file-format test; its outcomes stay held out)
 * ``sp1.json``        specimen description (mesh, mass, rest pose, table axis)
+* ``sp1_numerical.csv`` the providers' own numerical models of SP1 (their 0/1
+                      predictions per test, columns "Specimen 1-Numerical ...")
 * ``LICENSE``         the repository's GPL-3.0 text
 
-Only the SP1 outcome column of Results_Granite.xlsx is read; the SP2 column is
-held-out validation data and is deliberately never read or written.
+Only the SP1 columns of Results_Granite.xlsx are read (the outcome and the providers'
+numerical models of SP1); the SP2 columns are held-out validation data and are
+deliberately never read or written.
 
 ``--check`` additionally prints the PGA / onset / offset / length statistics
 quoted in the README (nothing extra is written).
@@ -57,6 +60,7 @@ FS_RAW = 800.0
 DECIM = 4
 FS_OUT = FS_RAW / DECIM
 SP1_COLUMN_HEADER = "Experimental Results for response-Specimen 1"
+SP1_NUMERICAL_PREFIX = "Specimen 1-Numerical "
 HERE = Path(__file__).resolve().parent
 DEFAULT_OUT = HERE.parent / "shake_table"
 
@@ -232,6 +236,28 @@ def sha256(b: bytes) -> str:
     return hashlib.sha256(b).hexdigest()
 
 
+def sp1_numerical(mirror: str) -> tuple[list[str], list[list]]:
+    """The providers' numerical models of SP1: (column names, rows of test and 0/1 per
+    model). Only the header row and the columns named "Specimen 1-Numerical ..." are
+    read (no SP2 column)."""
+    res = read_xlsx(git_show(mirror, SRC["results"]))
+    rh = [str(c).strip() if c is not None else "" for c in res[0]]
+    cols = [k for k, h in enumerate(rh) if h.startswith(SP1_NUMERICAL_PREFIX)]
+    names = []
+    for k in cols:      # "Specimen 1-Numerical KN=10 KS=1" -> "kn10_ks1"
+        words = rh[k][len(SP1_NUMERICAL_PREFIX):].replace("=", "").lower().split()
+        names.append("_".join(words))
+    rows = []
+    for r in res[1:]:
+        if r[0] is None:
+            continue
+        values = [r[k] for k in cols]
+        if any(v not in (0, 1) for v in values):
+            raise ValueError(f"unexpected SP1 numerical prediction {values} for test {r[0]}")
+        rows.append([f"Test{int(r[0]):03d}", *(int(v) for v in values)])
+    return names, rows
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("mirror", nargs="?", default=DEFAULT_MIRROR)
@@ -273,6 +299,12 @@ def main(argv=None) -> int:
             nominal = int(180 <= t["num"] <= 247 and t["pga_g"] in (0.7, 1.1, 1.5))
             w.writerow([t["test"], t["date"], repr(t["pga_g"]), repr(t["pgv_pga_s"]),
                         t["sp1_overturned"], t["motion_file"], nominal])
+
+    names, rows = sp1_numerical(mirror)
+    with open(out / "sp1_numerical.csv", "w", newline="") as f:
+        w = csv.writer(f, lineterminator="\n")
+        w.writerow(["test", *names])
+        w.writerows(rows)
 
     mesh = git_show(mirror, SRC["mesh"])
     (out / "SP1.obj").write_bytes(mesh)
