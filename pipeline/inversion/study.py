@@ -13,13 +13,19 @@ S, K) is inverted ``trials`` times with the same draws (seeded by S, K and the t
 by L), so that a change with L is the likelihood's alone.
 
 The observed columns are runs, so they stand where the table has nodes; sources as they
-come lie off them.  A trial therefore also draws where its sites lie for the likelihood
+come lie off them.  A trial therefore also draws where its source lies for the likelihood
 (``PLACEMENTS``, equally often): ``node`` (the likelihood's table holds the sites' nodes),
 ``between`` (the likelihood's table leaves out the inner rings (or, with two rings, every
-other node azimuth) and the sites lie on those: between the rings it keeps) and
-``beyond`` (the likelihood's table leaves out the last ring and the first site lies on it:
-the source lies beyond the inversion's reach, and the right answer is a warning that it
-may lie farther).
+other node azimuth) and the sites lie on those: between the rings it keeps),
+``between_spokes`` (the likelihood's table leaves out every other node azimuth and the
+sites lie on those: halfway between spokes twice as far apart as the table's),
+``between_magnitudes`` (the source's magnitude lies between two slices of one mechanism
+and depth, at a weight w drawn uniformly: each observed column is one of the upper
+slice's with probability w, else the lower's, the mixture the likelihood assumes between
+slices, so this tests the inversion's reading of it, not whether the physics is such a
+mixture) and ``beyond`` (the likelihood's table leaves out the last ring and the first
+site lies on it: the source lies beyond the inversion's reach, and the right answer is a
+warning that it may lie farther, with no direction).
 
 Per configuration: coverage of the 95 % back-azimuth arc (with its Wilson interval: a
 coverage is calibrated when the interval holds 0.95), its median width, the share of arcs
@@ -27,7 +33,10 @@ within the paper's bound (:data:`pipeline.paper.BACK_AZIMUTH_BOUND_DEG`), the co
 credible area (and its median size), each also counting a warning that the source may lie
 beyond the reach as an answer (``*_or_warned``), per placement too, and the magnitude's:
 whether the true Mw lies in the smallest set of table magnitudes holding 95 % of the
-posterior, and the posterior probability of the true Mw.
+posterior, and the posterior probability of the true Mw.  Per placement
+(:func:`placement_summary`): the coverages of back azimuth, distance, epicentre and
+magnitude and how often the reach warning is given; over the trials within the reach its
+false alarms, beyond the reach its hits.
 """
 
 import os
@@ -39,10 +48,11 @@ import pandas as pd
 
 from pipeline.inversion import truth_check
 from pipeline.inversion.demo import BOUND_DEG, BOUND_TEXT, BOUNDED_FRACTION_KEY, FALLEN_PER_SITE, \
-    REACH_KEYS, SITE_COUNTS, _frame, _site_position, draw_site_columns, out_of_reach_row
+    OBS_UNCERTAINTY_DEG, REACH_KEYS, SITE_COUNTS, _frame, _site_position, out_of_reach_row
 from pipeline.inversion.likelihood import DEFAULT_FLOOR, DEFAULT_KERNEL_DEG, LIKELIHOODS, \
     ForwardModel
-from pipeline.inversion.posterior import OutOfReach, invert, magnitude_set
+from pipeline.inversion.observations import ColumnObservation
+from pipeline.inversion.posterior import OutOfReach, invert
 from pipeline.stats.circular import azimuth_deg
 from pipeline.stats.ensemble import wilson_interval
 from pipeline.files import InputError, die_with_parent
@@ -51,7 +61,7 @@ LIKELIHOOD_MEMBERS = (3, 6, 12, 24, 48)
 OBSERVATION_MEMBERS = 16
 STUDY_TRIALS = 200         # per configuration: Wilson intervals of about +-0.03 at 0.95
 STUDY_SEED = 2027
-PLACEMENTS = ("node", "between", "beyond")
+PLACEMENTS = ("node", "between", "between_spokes", "between_magnitudes", "beyond")
 
 
 def split_for_study(table, observation_members=OBSERVATION_MEMBERS):
@@ -74,22 +84,86 @@ def held_out_nodes(table):
         out["between"] = (np.isin(np.arange(nr), [0, nr - 1]), 1)
     elif na >= 4 and na % 2 == 0:
         out["between"] = (np.ones(nr, bool), 2)
+    if na >= 4 and na % 2 == 0:
+        out["between_spokes"] = (np.ones(nr, bool), 2)
+    if magnitude_pairs(table):
+        out["between_magnitudes"] = (np.ones(nr, bool), 1)
     if nr >= 2:
         out["beyond"] = (np.arange(nr) < nr - 1, 1)
     return out
 
 
-def _site_nodes(pool, s, placement, rings, stride):
+def magnitude_pairs(table):
+    """[(lower slice, upper slice)]: neighbouring magnitudes of one mechanism and depth."""
+    groups = {}
+    for k, sl in enumerate(table.slices):
+        groups.setdefault((sl["mechanism"], sl["depth_km"]), []).append(k)
+    pairs = []
+    for members in groups.values():
+        members = sorted(members, key=lambda k: table.slices[k]["mw"])
+        pairs += list(zip(members[:-1], members[1:]))
+    return pairs
+
+
+def _site_nodes(pool, slices, placement, rings, stride):
     """(nodes where the first site may lie, nodes for the others): (ring, azimuth) indices
-    where an observation member of slice ``s`` falls, for ``placement``."""
+    where an observation member of one of ``slices`` falls, for ``placement``."""
     nr, na = pool.toppled.shape[1:3]
-    falls = [(i, j) for i in range(nr) for j in range(na) if pool.toppled[s, i, j].any()]
-    if placement == "between":
+    falls = [(i, j) for i in range(nr) for j in range(na)
+             if any(pool.toppled[s, i, j].any() for s in slices)]
+    if placement in ("between", "between_spokes"):
         falls = [(i, j) for i, j in falls if not rings[i] or j % stride]
         return falls, falls
     if placement == "beyond":
         return [(i, j) for i, j in falls if i == nr - 1], falls
     return falls, falls
+
+
+def draw_columns(pool, slices, upper_weight, i, j, strike_deg, fallen, rng,
+                 sigma_deg=OBS_UNCERTAINTY_DEG):
+    """Columns at node (ring i, azimuth j) drawn until ``fallen`` have fallen: each from
+    the upper of ``slices`` (lower, upper) with probability ``upper_weight``, else from the
+    lower; a column type and a member at random; falls turned by the strike, with a
+    normal measurement error of ``sigma_deg``.  None when neither slice falls there."""
+    if not any(pool.toppled[s, i, j].any() for s in slices):
+        return None
+    cols, count = [], 0
+    for _ in range(50 * fallen + 50):
+        s = slices[1] if rng.uniform() < upper_weight else slices[0]
+        choices = np.argwhere(pool.valid[s, i, j])
+        c, m = choices[rng.integers(len(choices))]
+        if pool.toppled[s, i, j, c, m]:
+            az = (pool.azimuth_deg[s, i, j, c, m] + strike_deg
+                  + rng.normal(0.0, sigma_deg)) % 360.0
+            cols.append(ColumnObservation(pool.columns[c], "fallen", float(az), sigma_deg))
+            count += 1
+            if count == fallen:
+                break
+        else:
+            cols.append(ColumnObservation(pool.columns[c], "standing"))
+    return tuple(cols)
+
+
+def _draw_source(models, pool, rng):
+    """(placement, (lower, upper) slices, upper weight, true Mw) of one trial; None when
+    no observation member of the table ever falls."""
+    table = models["node"].table
+    falling = np.flatnonzero(pool.toppled.reshape(len(table.slices), -1).any(axis=1))
+    if not falling.size:
+        return None
+    s = int(rng.choice(falling))
+    placement = str(rng.choice(PLACEMENTS))
+    if placement not in models:
+        placement = "node"
+    if placement == "between_magnitudes":
+        pairs = [pq for pq in magnitude_pairs(table) if set(pq) & set(falling.tolist())]
+        if pairs:
+            lower, upper = pairs[int(rng.integers(len(pairs)))]
+            w = float(rng.uniform(0.0, 1.0))
+            mw = (1 - w) * table.slices[lower]["mw"] + w * table.slices[upper]["mw"]
+            return placement, (lower, upper), w, float(mw)
+        placement = "node"
+    return placement, (s, s), 0.0, float(table.slices[s]["mw"])
 
 
 def study_trial(models, pool, n_sites, fallen, candidates, rng):
@@ -99,19 +173,15 @@ def study_trial(models, pool, n_sites, fallen, candidates, rng):
     {placement: ForwardModel} (:func:`held_out_nodes`); a placement whose nodes see no
     fall is tried as ``node``."""
     table = models["node"].table
-    falling = np.flatnonzero(pool.toppled.reshape(len(table.slices), -1).any(axis=1))
-    if not falling.size:
+    drawn = _draw_source(models, pool, rng)
+    if drawn is None:
         return None
-    s = int(rng.choice(falling))
+    placement, pair, weight, true_mw = drawn
     strike = float(rng.uniform(0.0, 360.0))
-    placement = str(rng.choice(PLACEMENTS))
-    if placement not in models:
-        placement = "node"
-    spec = held_out_nodes(table)[placement]
-    first, others = _site_nodes(pool, s, placement, *spec)
+    first, others = _site_nodes(pool, pair, placement, *held_out_nodes(table)[placement])
     if not first:
         placement = "node"
-        first, others = _site_nodes(pool, s, "node", *held_out_nodes(table)["node"])
+        first, others = _site_nodes(pool, pair, "node", *held_out_nodes(table)["node"])
     if not first:
         return None
     model = models[placement]
@@ -121,17 +191,21 @@ def study_trial(models, pool, n_sites, fallen, candidates, rng):
     sites = []
     for k, (i, j) in enumerate([start] + [rest[p] for p in picks]):
         e, n = _site_position(pool.distances_km[i], (pool.azimuths_deg[j] + strike) % 360.0)
-        sites.append((f"S{k + 1}", e, n, draw_site_columns(pool, s, i, j, strike, fallen, rng)))
+        sites.append((f"S{k + 1}", e, n, draw_columns(pool, pair, weight, i, j, strike,
+                                                      fallen, rng)))
     observations, truth = _frame(sites)
     true_baz = azimuth_deg(truth[0], truth[1])
-    true_mw = f"{table.slices[s]['mw']:g}"
-    row = {"slice": s, "mechanism": table.slices[s]["mechanism"], "true_mw": float(true_mw),
+    row = {"slice": pair[0] if weight < 0.5 else pair[1],
+           "mechanism": table.slices[pair[0]]["mechanism"], "true_mw": true_mw,
            "sites": len(sites), "fallen_per_site": fallen, "strike_deg": strike,
            "placement": placement, "true_back_azimuth_deg": true_baz,
            "true_distance_km": float(np.hypot(*truth)),
            "site_distances_km": " ".join(f"{np.hypot(e, n):g}" for _, e, n, _ in sites),
            "standing_observed": sum(not c.fallen for *_, cols in sites for c in cols),
-           "no_candidate": False}
+           "no_candidate": False,
+           # a site as far as the likelihood's last ring: the source at the reach's edge
+           "at_reach_edge": bool(max(np.hypot(e, n) for _, e, n, _ in sites)
+                                 >= model.table.distances_km[-1] - candidates.step_km)}
     try:
         post = invert(model, observations, candidates)
     except OutOfReach:
@@ -140,11 +214,14 @@ def study_trial(models, pool, n_sites, fallen, candidates, rng):
                                                "epicentre_in_95", "distance_in_95",
                                                "credible_area_95_km2", "no_candidate")},
                 **{k: lost[k] for k in REACH_KEYS}, "mw_in_95": False, "p_true_mw": np.nan,
+                "mw_ci95_width": np.nan, "reach_edge_bayes_factor": np.nan,
                 "p_true_mechanism": np.nan}
     summary = post.summary()
     check = truth_check(post, {"epicentre_km": truth, "back_azimuth_deg": true_baz,
                                "distance_km": row["true_distance_km"],
-                               "mechanism": row["mechanism"], "mw": float(true_mw)}, summary)
+                               "mechanism": row["mechanism"], "mw": true_mw}, summary)
+    lo, hi = summary["magnitude_ci95"]
+    nearest = min(summary["magnitude_posterior"], key=lambda m: abs(float(m) - true_mw))
     return {**row,
             "back_azimuth_in_95": check["back_azimuth_in_95"],
             "width95_deg": summary["back_azimuth_ci95_width_deg"],
@@ -152,8 +229,9 @@ def study_trial(models, pool, n_sites, fallen, candidates, rng):
             "distance_in_95": check["distance_in_95"],
             "credible_area_95_km2": summary["credible_area_95_km2"],
             **{k: check[k] for k in REACH_KEYS},
-            "mw_in_95": true_mw in magnitude_set(summary["magnitude_posterior"]),
-            "p_true_mw": summary["magnitude_posterior"].get(true_mw, 0.0),
+            "reach_edge_bayes_factor": summary["reach_edge_bayes_factor"],
+            "mw_in_95": check["mw_in_95"], "mw_ci95_width": hi - lo,
+            "p_true_mw": summary["magnitude_posterior"][nearest],
             "p_true_mechanism": summary["mechanism_posterior"].get(row["mechanism"], 0.0)}
 
 
@@ -229,10 +307,15 @@ def study_summary(trials):
             part = g[g["placement"] == placement]
             per_placement[f"trials_{placement}"] = len(part)
             for column in ("back_azimuth_in_95", "epicentre_in_95_or_warned",
-                           "distance_in_95_or_warned"):
+                           "distance_in_95_or_warned", "mw_in_95"):
                 name = "coverage_" + column.replace("_in_", "_")
                 per_placement[f"{name}_{placement}"] = \
                     float(part[column].mean()) if len(part) else np.nan
+            per_placement[f"warned_{placement}"] = \
+                float(part["reach_warning"].mean()) if len(part) else np.nan
+        for column in ("back_azimuth_in_95", "epicentre_in_95", "distance_in_95", "mw_in_95"):
+            name = "coverage_" + column.replace("_in_", "_") + "_within_reach"
+            per_placement[name] = float(g[inside][column].mean()) if inside.any() else np.nan
         rows.append({**dict(zip(keys, key)), "fallen_total": key[2] * key[3], "trials": n,
                      "coverage_back_azimuth_95": hit / n, "coverage_ci95": ci,
                      "calibrated": bool(ci[0] <= 0.95 <= ci[1]),
@@ -261,6 +344,62 @@ def study_summary(trials):
                      "p_true_mechanism_median": float(g["p_true_mechanism"].median()),
                      **per_placement})
     return pd.DataFrame(rows)
+
+
+PLACEMENT_COLUMNS = ("back_azimuth_in_95", "distance_in_95", "epicentre_in_95", "mw_in_95",
+                     "reach_warning")
+
+
+def placement_summary(trials):
+    """Per likelihood, likelihood members and placement, pooled over S and K: trials,
+    how many lie within the reach, the coverages of back azimuth, distance, epicentre and
+    magnitude (Wilson intervals), the reach warning's rate and the share refused for want
+    of a candidate within reach of every site (``no_candidate``, counted as warned); and
+    the same for the sources ``well within the reach`` (every site nearer than the
+    likelihood's last ring less a cell: the warning's false alarms), ``at the reach's
+    edge`` and ``beyond the reach`` (its hits)."""
+    rows = []
+    keys = ["likelihood", "likelihood_members"]
+    for key, g in trials.groupby(keys):
+        inside = g["within_reach"].astype(bool)
+        edge = g["at_reach_edge"].astype(bool)
+        parts = [(placement, g[g["placement"] == placement]) for placement in PLACEMENTS]
+        parts += [("well within the reach", g[inside & ~edge]),
+                  ("at the reach's edge", g[inside & edge]), ("beyond the reach", g[~inside])]
+        for placement, part in parts:
+            if part.empty:
+                continue
+            row = {**dict(zip(keys, key)), "placement": placement, "trials": len(part),
+                   "within_reach": int(part["within_reach"].astype(bool).sum())}
+            for column in PLACEMENT_COLUMNS:
+                hits = int(part[column].astype(bool).sum())
+                name = column if column == "reach_warning" else \
+                    "coverage_" + column.replace("_in_", "_")
+                row[name] = hits / len(part)
+                row[f"{name}_ci95"] = wilson_interval(hits, len(part))
+            row["width_median_deg"] = float(part["width95_deg"].median())
+            row["no_candidate"] = float(part["no_candidate"].astype(bool).mean())
+            rows.append(row)
+    return pd.DataFrame(rows)
+
+
+def warning_rates(placements):
+    """{likelihood: {members, false_alarm_rate, edge_rate, hit_rate, with Wilson intervals,
+    trials and the share refused for want of a candidate}} at each likelihood's largest
+    member count: the reach warning well within the reach, at its edge and beyond it."""
+    out = {}
+    for kind, g in placements.groupby("likelihood"):
+        g = g[g["likelihood_members"] == g["likelihood_members"].max()].set_index("placement")
+        entry = {"likelihood_members": int(g["likelihood_members"].iloc[0])}
+        for label, name in (("well within the reach", "false_alarm"),
+                            ("at the reach's edge", "edge"), ("beyond the reach", "hit")):
+            if label in g.index:
+                entry[f"{name}_rate"] = float(g.loc[label, "reach_warning"])
+                entry[f"{name}_rate_ci95"] = list(g.loc[label, "reach_warning_ci95"])
+                entry[f"{name}_trials"] = int(g.loc[label, "trials"])
+                entry[f"{name}_no_candidate"] = float(g.loc[label, "no_candidate"])
+        out[kind] = entry
+    return out
 
 
 def study_answer(summary):

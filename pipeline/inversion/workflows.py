@@ -197,14 +197,14 @@ def demo(options, preset, grid, candidates):
 def member_study(options, grid, candidates):
     """invert --member-study: the forward table (run, reused or --table), then the study's
     truth tests; writes member_study.csv (one row per trial), member_study_summary.csv,
-    member_study.json (the answer per likelihood), member_study.png (the back azimuth) and
+    member_study_placements.csv (per placement of the source), member_study.json (the answer per likelihood), member_study.png (the back azimuth) and
     member_study_source.png (the epicentre and the magnitude)."""
     from pipeline.files import write_csv, write_json
     from pipeline.figures.inversion import plot_member_study, plot_member_study_source
     from pipeline.inversion.demo import BOUND_DEG
     from pipeline.inversion.study import (LIKELIHOOD_MEMBERS, OBSERVATION_MEMBERS,
-                                          STUDY_TRIALS, member_study, study_answer,
-                                          study_summary)
+                                          STUDY_TRIALS, member_study, placement_summary,
+                                          study_answer, study_summary, warning_rates)
     out = options.out or RESULTS_DIR / "inversion" / "member-study"
     if out.exists() and not out.is_dir():
         raise InputError(f"--out {out} is a file, not a directory")
@@ -226,8 +226,10 @@ def member_study(options, grid, candidates):
                          "(a grid with stronger shaking: closer rings, higher Mw)")
     summary = study_summary(rows)
     answer = study_answer(summary)
+    placements = placement_summary(rows)
     write_csv(out / "member_study.csv", rows)
     write_csv(out / "member_study_summary.csv", summary)
+    write_csv(out / "member_study_placements.csv", placements)
     figure = plot_member_study(summary, out / "member_study.png", BOUND_DEG)
     source_figure = plot_member_study_source(summary, out / "member_study_source.png")
     write_json(out / "member_study.json", {
@@ -237,6 +239,7 @@ def member_study(options, grid, candidates):
         "observation_members": OBSERVATION_MEMBERS, "trials": trials,
         "forward_table": info, "figure": figure.name, "source_figure": source_figure.name,
         "toppled_fraction_by_slice": table.toppled_fraction_by_slice(),
+        "reach_warning": warning_rates(placements),
         "elapsed_s": round(time.monotonic() - started, 1)})
     for text in answer.values():
         log.info(text)
