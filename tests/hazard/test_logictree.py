@@ -297,7 +297,20 @@ def test_command_writes_its_files(tmp_path):
     p = np.array([b["survival_probability"] for b in summary["branches"]])
     post = np.array([b["posterior_bayes"] for b in summary["branches"]])
     np.testing.assert_allclose(post, w * p / (w @ p), rtol=1e-9)
-    assert summary["monte_carlo"]["draws"] == 0 or summary["monte_carlo"] is None
+    assert summary["monte_carlo"] is None            # a stated fragility: no draws
+    assert summary["members"] is None
+
+
+def test_monte_carlo_interval_holds_the_headline():
+    """Draws of a fragility with stated 95 % intervals: each branch's survival interval
+    holds the survival of the estimate itself."""
+    tree = load_logic_tree(CASE_11)
+    fragility = Lognormal(3.0, 0.4, median_ci95=(2.5, 3.6), beta_ci95=(0.3, 0.5))
+    summary, rows, _ = constrain_tree(tree, [fragility], None, [2.0], [0.0], draws=200)
+    for row in rows:
+        lo, hi = row["survival_interval"]
+        assert lo < row["survival_probability"] < hi
+    assert summary["monte_carlo"]["draws"] == 200
 
 
 @pytest.mark.parametrize("extra, words", [
