@@ -15,6 +15,10 @@ F1, confusion) are reported per split beside the trivial baselines ("never overt
 "overturns when PGA >= g tan(critical angle)").  Outputs in the campaign directory:
 ``experiments.csv`` (per test and parameter set), ``shake_table.json`` (scores), the
 figure ``shake_table_rates.png`` (observed and predicted rate per PGA x PGV/PGA bin).
+
+With ``--members N`` the campaign runs in its members mode instead
+(:mod:`pipeline.campaign.shake_table_members`, which enters itself in :data:`MODES`):
+every test with the fragility's members, scored as probabilities.
 """
 import dataclasses
 from dataclasses import dataclass
@@ -62,6 +66,10 @@ DEFAULT_GRID = ("footprint_tolerance_m=0.001,0.003;damping=0.05,0.1;mu_s=0.3,0.7
 DEFAULT_CONTACT = dataclasses.asdict(Contact())      # the paper's contact
 PGA_EDGES_G = np.array([0.0, 0.1, 0.2, 0.3, 0.4, 0.5, 0.7, 1.0, 2.0])
 PGV_PGA_EDGES_S = np.array([0.0, 0.05, 0.1, 0.2, 0.3, 0.5, 1.0])
+# other modes of the campaign, by name: a module with check(options), specs, outputs and
+# drive (the members mode enters itself: it draws its members with the pulse grid's
+# sampler, which imports this module)
+MODES = {}
 
 def load_experiments(path=EXPERIMENTS, outcome=OUTCOME):
     """The experiment table (pandas DataFrame; ``observed`` bool, ``motion_path`` Path or
@@ -171,10 +179,13 @@ def _run_params(specimen, point, base=None):
 
 def specs(records, campaign_dir, experiments=EXPERIMENTS, specimen=SPECIMEN, outcome=OUTCOME,
           validate_from=VALIDATE_FROM, grid=DEFAULT_GRID, stage="calibration", chosen=None,
-          tests=None, axis_deg=AXIS_DEG, contact_file=None):
+          tests=None, axis_deg=AXIS_DEG, contact_file=None, **mode):
     """Run specs of one stage: every grid point on the calibration tests, or the chosen
     point on the validation tests; a contact file's values are the base the points
-    override."""
+    override.  Stage "members": the members mode's (``mode``: its options)."""
+    if stage == "members":
+        return MODES["members"].specs(records, campaign_dir, experiments, specimen, outcome,
+                                      validate_from, grid, tests, contact_file, **mode)
     if records:
         raise InputError("the shake-table campaign takes its motions from --experiments, "
                          "not --records")
@@ -198,6 +209,8 @@ def specs(records, campaign_dir, experiments=EXPERIMENTS, specimen=SPECIMEN, out
 
 def outputs(specs_, campaign_dir, failures, animations, figures=True):
     """Per-run table of this stage and its scores per grid point."""
+    if specs_ and specs_[0].tags["stage"] == "members":
+        return MODES["members"].outputs(specs_, campaign_dir, failures, animations, figures)
     campaign_dir = Path(campaign_dir)
     rows = []
     for spec in specs_:
@@ -232,7 +245,10 @@ def drive(run, records, campaign_dir, options, gate=None):
     """Calibrate on the tests before ``validate_from``, validate the chosen parameters on
     the others (none: the calibration's scores alone), write experiments.csv,
     shake_table.json and the rates figure.  ``gate(what, runs, run_core_s, advice)``: the
-    long-run gate (:func:`pipeline.files.check_long`), asked before any run."""
+    long-run gate (:func:`pipeline.files.check_long`), asked before any run.  With
+    ``members``: the members mode's driver instead."""
+    if options.get("members") is not None:
+        return MODES["members"].drive(run, records, campaign_dir, options, gate)
     campaign_dir = Path(campaign_dir)
     frame = load_experiments(options["experiments"], options["outcome"])
     if options.get("tests"):
@@ -351,9 +367,32 @@ class ShakeTableOptions(CampaignOptions):
     contact_file: str = contact_file_param(
         "its values are the base every --grid point starts from: a point's own values "
         "override them")
+    members: int = param(None, "", "members mode: run every test with this many members "
+                         "drawn as campaign fragility --column-file draws them (--ranges, "
+                         "--seed), each test's P with its Monte Carlo error, scored as "
+                         "probabilities; a test's members stop early once its first ones "
+                         "agree", 1, 1000, flag="--members")
+    seed: int = param(None, "", "members mode: Latin-hypercube seed of the members "
+                      "(default the fragility's)", flag="--seed")
+    ranges: str = param(None, "", "members mode: ranges the members are drawn from (default "
+                        "the fragility's; LO = HI fixes one)", flag="--ranges",
+                        metavar="NAME=LO:HI;...")
+    providers: Path = param(None, "", "members mode: other models' 0/1 predictions scored "
+                            "beside the members (CSV: test and one column per model; "
+                            "default for the shipped tests: the providers' models of SP1, "
+                            "records/shake_table/sp1_numerical.csv)", flag="--providers",
+                            metavar="CSV")
+    TAKES_JOBS = True
 
     def check(self):
         contact_of(self)
+        if self.members is None:
+            given = [f for f, v in (("--seed", self.seed), ("--ranges", self.ranges),
+                                    ("--providers", self.providers)) if v is not None]
+            if given:
+                raise InputError(f"{given[0]} belongs to the members mode: add --members N")
+        else:
+            MODES["members"].check(self)
         try:
             date.fromisoformat(self.validate_from)
         except (TypeError, ValueError):
@@ -385,7 +424,8 @@ class ShakeTableOptions(CampaignOptions):
                 "specimen": self.column_file or SPECIMEN,
                 "validate_from": self.validate_from, "grid": self.grid,
                 "tests": self.test_names() or None, "axis_deg": self.axis_deg,
-                "contact_file": self.contact_file}
+                "contact_file": self.contact_file, "members": self.members,
+                "seed": self.seed, "ranges": self.ranges, "providers": self.providers}
 
 
 def _worker(spec, run_dir):

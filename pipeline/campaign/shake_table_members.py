@@ -1,0 +1,237 @@
+"""The members mode of ``campaign shake-table`` (``--members N``): every test run with the
+fragility's members, each test's P with its Monte Carlo error, scored as probabilities.
+
+The members are those of ``campaign fragility --column-file``: the same Latin hypercube
+(:func:`pipeline.campaign.pulse_grid.sample_sets`) over the same ranges
+(:func:`pipeline.campaign.pulse_grid.parse_ranges`: its defaults for a mesh specimen,
+``--ranges`` over them; kn log-uniform; mu_k in the fragility's ratio to mu_s) and seed
+(the fragility's default); a contact file fixes what it sets, as there.  The table's
+motion is the test's own, along its axis as shipped (``rotate_deg`` 0).
+
+Each test's members stop early by the pulse grid's adaptive rule
+(:func:`pipeline.campaign.pulse_grid.adaptive_sampling`, every test a row of one cell
+with no guide): first :data:`~pipeline.campaign.pulse_grid.ADAPTIVE_FIRST_RUNS`
+members; a test whose Wilson 95 % interval then excludes 0.5 is decided and stops (the
+first members all agree), one whose interval holds 0.5 doubles its members, up to N.
+
+Beside the members, each test is run once with one parameter set (``--grid`` of one
+point; by default the calibration's choice, :data:`SINGLE_SET`) and scored the same way,
+with the baselines "never overturns", "PGA >= g tan(critical angle)" and other models'
+0/1 predictions (``--providers``; for the shipped tests the providers' own numerical
+models of SP1, fitted on these tests: in-sample).  Outputs (the campaign directory):
+``members.csv`` (per test: runs, overturned, P, its Wilson interval, the single set's
+prediction), ``shake_table_members.json`` (scores per split,
+:func:`pipeline.stats.forecast.forecast_scores`) and ``shake_table_reliability.png``.
+"""
+import logging
+import sys
+from datetime import date
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from pipeline.campaign import ensemble, pulse_grid, shake_table
+from pipeline.campaign.column_file import column_kn
+from pipeline.campaign.run_dirs import finished_summary
+from pipeline.campaign.runs import column_specs
+from pipeline.campaign.shake_table_scores import load_providers, write_scores
+from pipeline.files import InputError, duration_text, write_csv
+from pipeline.scenario.contact_file import contact_values, refuse_set_twice
+from pipeline.scenario.geometry import ColumnGeometry
+from pipeline.stats.ensemble import wilson_interval
+
+log = logging.getLogger(__name__)
+
+# the single parameter set scored beside the members: the calibration's choice on the
+# June-July tests (make shake-table; the parameters make contact-convergence varies kn at)
+SINGLE_SET = "footprint_tolerance_m=0.001;damping=0.1;mu_s=0.7;rotate_deg=0"
+# a run at a stiffer contact takes longer: the time step goes as sqrt(m / kn)
+KN_OF_RUN_CPU_S = 1.2e8
+
+
+def check(options):
+    """One-line refusals of the members mode's options, before any work."""
+    ensemble.check_seed(options.seed)
+    specimen = ColumnGeometry.load(options.column_file or shake_table.SPECIMEN).to_dict()
+    contact = None if options.contact_file is None else contact_values(options.contact_file)
+    member_sets(specimen, options.members, options.seed, options.ranges, contact)
+    single_set(options.grid)
+    if options.providers is not None:
+        load_providers(options.providers)
+
+
+def single_set(grid):
+    """The one parameter set run beside the members: ``grid``'s one point
+    (:data:`SINGLE_SET` for the campaign's default grid)."""
+    text = SINGLE_SET if grid == shake_table.DEFAULT_GRID else grid
+    points = shake_table.parse_grid(text)
+    if len(points) != 1:
+        raise InputError(f"--members: --grid names {len(points)} parameter sets; give one "
+                         "(the single set scored beside the members) or leave it out")
+    return points[0]
+
+
+def member_sets(specimen, members, seed, ranges, contact=None):
+    """(parameter sets, ranges drawn): the fragility's draws for this specimen."""
+    mesh = "mesh" in specimen
+    if contact:
+        given = pulse_grid.parse_ranges(ranges, mesh=False)
+        refuse_set_twice(contact, [f for name in given
+                                   for f in ((name, "mu_k") if name == "mu_s" else (name,))],
+                         "--ranges")
+    drawn = {k: v for k, v in pulse_grid.parse_ranges(ranges, mesh).items()
+             if not (contact and (k in contact or (k == "mu_s" and "mu_k" in contact)))}
+    if members > 1 and all(lo == hi for lo, hi in drawn.values()):
+        raise InputError(f"--members {members} with nothing drawn (give --ranges: a column "
+                         "description draws nothing by default) would repeat one run")
+    seed = ensemble.DEFAULT_SEED if seed is None else seed
+    return pulse_grid.sample_sets(members, seed, drawn), drawn
+
+
+def run_params(specimen, point, base):
+    """Run parameters of one member (or the single set) on the table."""
+    params = shake_table._run_params(specimen, point, base)
+    if "kn" not in point and "kn" not in (base or {}) and "mesh" not in specimen:
+        params["kn"] = column_kn(specimen)          # a description's matched kn, as there
+    return params
+
+
+def core_s(params):
+    """Core seconds of one run: the campaign's, longer at a stiffer contact."""
+    return shake_table.RUN_CPU_S * max(1.0, (params["kn"] / KN_OF_RUN_CPU_S) ** 0.5)
+
+
+def tests_of(experiments, outcome, tests, validate_from):
+    """The tests with a motion (of ``tests``), with their split."""
+    frame = shake_table.load_experiments(experiments, outcome)
+    frame = frame[[p is not None for p in frame["motion_path"]]]
+    if tests:
+        frame = frame[frame["test"].isin(tests)]
+    if frame.empty:
+        raise InputError("--members: no test with a motion to run")
+    frame = frame.copy()
+    frame["split"] = np.where(frame["day"] < date.fromisoformat(validate_from),
+                              "calibration", "validation")
+    return frame
+
+
+def specs(records, campaign_dir, experiments, specimen, outcome, validate_from, grid, tests,
+          contact_file, members=None, seed=None, ranges=None, only_runs=None, full=None,
+          **_):
+    """Every test x (N members and the single set); ``only_runs`` keeps those run ids (of
+    ``full``, the specs made already)."""
+    if full is None:
+        if records:
+            raise InputError("the shake-table campaign takes its motions from --experiments, "
+                             "not --records")
+        frame = tests_of(experiments, outcome, tests, validate_from)
+        description = ColumnGeometry.load(specimen).to_dict()
+        base = None if contact_file is None else contact_values(contact_file)
+        sets, _ = member_sets(description, members, seed, ranges, base)
+        points = [(m, p) for m, p in enumerate(sets)] + [(-1, single_set(grid))]
+        runs, tags = [], []
+        for m, point in points:
+            params = run_params(description, point, base)
+            for row in frame.itertuples():
+                runs.append((str(row.motion_path), params))
+                tags.append({"test": row.test, "observed": bool(row.observed),
+                             "stage": "members", "member": m, "point": point,
+                             "core_s": round(core_s(params), 3)})
+        full = column_specs(runs, campaign_dir, tags)
+    if only_runs is None:
+        return full
+    keep = set(only_runs)
+    return [s for s in full if s.run_id in keep]
+
+
+def outputs(specs_, campaign_dir, failures, animations, figures=True):
+    """The finished runs of this stage (``members_runs.csv``); the scores are written by
+    :func:`drive` once every stage has run."""
+    rows = []
+    for spec in specs_:
+        summary = finished_summary(Path(campaign_dir), spec.run_id)
+        if summary is not None:
+            rows.append({"test": spec.tags["test"], "member": spec.tags["member"],
+                         "observed": spec.tags["observed"],
+                         "predicted": summary.columns[0].toppled,
+                         "max_tilt_deg": summary.columns[0].max_tilt_deg,
+                         "run_id": spec.run_id})
+    if rows:
+        write_csv(Path(campaign_dir) / "members_runs.csv", pd.DataFrame(rows))
+    return {"runs_done": len(rows)}
+
+
+def drive(run, records, campaign_dir, options, gate=None):
+    """Say the cost and ask the gate, run the members test by test in the pulse grid's
+    adaptive stages, then write members.csv, the scores and the reliability diagram."""
+    frame = tests_of(options["experiments"], options["outcome"], options.get("tests"),
+                     options["validate_from"])
+    n = options["members"]
+    full = run_specs(records, campaign_dir, options)
+    most = len(full)
+    core = sum(s.tags["core_s"] for s in full)
+    jobs = max(options.get("jobs") or 1, 1)
+    log.info(f"shake-table (members): {len(frame)} tests x ({n} members + the single set): "
+             f"at most {most} YADE runs, about {duration_text(core / jobs)} on {jobs} core(s) "
+             f"(a test's members stop once its first {min(n, pulse_grid.ADAPTIVE_FIRST_RUNS)} "
+             "agree; finished runs are kept and not run again)")
+    if gate is not None:
+        gate("campaign shake-table --members", most, core / most, "fewer --tests or --members")
+    by_test = {}
+    for spec in full:
+        by_test.setdefault(spec.tags["test"], []).append(spec)
+    order = {t: sorted([s for s in rows if s.tags["member"] >= 0],
+                       key=lambda s: s.tags["member"]) for t, rows in by_test.items()}
+    single = [s.run_id for rows in by_test.values() for s in rows if s.tags["member"] < 0]
+    cells = {t: (i, 0) for i, t in enumerate(order)}
+    guide = {cell: pulse_grid.ADAPTIVE_LEVEL for cell in cells.values()}    # no guide
+
+    def run_stage(stage, targets):
+        chosen = [s.run_id for t, rows in order.items() for s in rows[:targets[cells[t]]]]
+        log.info(f"shake-table (members), stage {stage}: {len(chosen)} of "
+                 f"{most - len(single)} member runs")
+        run({**options, "stage": "members", "only_runs": chosen + single, "full": full})
+        return {cells[t]: [summary.columns[0].toppled for s in rows[:targets[cells[t]]]
+                           if (summary := finished_summary(Path(campaign_dir), s.run_id))
+                           is not None] for t, rows in order.items()}
+
+    targets, settled = pulse_grid.adaptive_sampling(guide, n, run_stage)
+    if not settled:
+        log.warning(f"shake-table (members): stopped after {pulse_grid.MAX_STAGES} stages "
+                    "with tests still undecided (their Wilson intervals say so)")
+    per_test = _per_test(frame, order, by_test, campaign_dir, targets, cells)
+    return write_scores(per_test, campaign_dir, options, full, settled)
+
+
+def run_specs(records, campaign_dir, options):
+    """The full specs of the members mode (every member of every test, and the single
+    set)."""
+    keys = ("experiments", "specimen", "outcome", "validate_from", "grid", "tests",
+            "contact_file")
+    return specs(records, campaign_dir, *(options.get(k) for k in keys),
+                 members=options["members"], seed=options.get("seed"),
+                 ranges=options.get("ranges"))
+
+
+def _per_test(frame, order, by_test, campaign_dir, targets, cells):
+    """Per test: its member runs (those of its last stage), overturned, P and Wilson 95 %
+    interval, and the single set's prediction."""
+    rows = []
+    for row in frame.itertuples():
+        done = [summary.columns[0].toppled for s in order[row.test][:targets[cells[row.test]]]
+                if (summary := finished_summary(Path(campaign_dir), s.run_id)) is not None]
+        single = [finished_summary(Path(campaign_dir), s.run_id)
+                  for s in by_test[row.test] if s.tags["member"] < 0][0]
+        k, m = int(sum(done)), len(done)
+        lo, hi = wilson_interval(k, m)
+        rows.append({"test": row.test, "date": row.date, "split": row.split,
+                     "pga_g": row.pga_g, "pgv_pga_s": row.pgv_pga_s,
+                     "observed": bool(row.observed), "runs": m, "overturned": k,
+                     "P": k / m if m else None, "ci95_low": lo, "ci95_high": hi,
+                     "single_set_predicted": None if single is None
+                     else bool(single.columns[0].toppled)})
+    return pd.DataFrame(rows)
+
+
+shake_table.MODES["members"] = sys.modules[__name__]
