@@ -131,11 +131,14 @@ def reliability_table(observed, p, edges=BIN_EDGES, confidence=0.95):
 def forecast_scores(observed, p, runs=None, edges=BIN_EDGES):
     """Every score of one set of forecasts: n, log-likelihood per test, the Brier
     decomposition, accuracy and balanced accuracy of P > 0.5, the reliability table, and
-    the clip used (``clip``: the margin, or its range over the tests)."""
+    the clip used (``clip``: the margin, or [smallest, largest] when the tests' runs
+    differ)."""
     y, q = _arrays(observed, p)
     margin = clip_margin(None if runs is None else np.asarray(runs, float).ravel())
     clip = (float(margin) if np.ndim(margin) == 0 or not np.size(margin)
             else [float(np.min(margin)), float(np.max(margin))])
+    if isinstance(clip, list) and clip[0] == clip[1]:
+        clip = clip[0]
     return {"n": int(y.size), "overturned": int(y.sum()),
             "log_likelihood_per_test": log_likelihood(y, q, runs),
             **brier_decomposition(y, q, edges), **classification(y, q),

@@ -1,0 +1,102 @@
+"""The members mode of campaign shake-table without YADE: bad options refused in one line
+before anything is written, the members drawn as the fragility draws them, and the scores
+file of a synthetic threshold model (baselines against their closed forms)."""
+import json
+import math
+from types import SimpleNamespace
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from pipeline import cli
+from pipeline.campaign import ensemble, pulse_grid
+from pipeline.campaign.shake_table import EXPERIMENTS, OUTCOME, SPECIMEN
+from pipeline.campaign.shake_table_members import member_sets
+from pipeline.campaign.shake_table_scores import write_scores
+from pipeline.scenario.geometry import ColumnGeometry
+
+
+@pytest.mark.parametrize("args, said", [
+    (["--members", "0"], "--members"),
+    (["--seed", "5"], "--seed belongs to the members mode"),
+    (["--ranges", "kn=4e7:1e8"], "--ranges belongs to the members mode"),
+    (["--members", "4", "--ranges", "kn=4e7:1e8;kn=5e7:1e8"], "names kn twice"),
+    (["--members", "4", "--ranges", "friction=0.1:0.2"], "unknown parameter 'friction'"),
+    (["--members", "4", "--ranges", "damping=0.2:0.1"], "LO <= HI"),
+    (["--members", "4", "--grid", "damping=0.05,0.1"], "names 2 parameter sets"),
+    (["--members", "4", "--seed", "-1"], "seed"),
+    (["--members", "4", "--ranges", "kn=1e8:1e8;damping=0.1:0.1;mu_s=0.7:0.7;"
+      "footprint_tolerance_m=0.001:0.001"], "nothing drawn"),
+    (["--members", "4", "--tests", "Test011,Test011"], "names Test011 twice"),
+])
+def test_bad_options_are_refused_in_one_line(tmp_path, capsys, args, said):
+    out = tmp_path / "out"
+    code = cli.main(["campaign", "shake-table", *args, "--out", str(out), "--jobs", "1"])
+    lines = [x for x in capsys.readouterr().err.splitlines() if not x.startswith("note:")]
+    assert code == 2
+    assert len(lines) == 1 and lines[0].startswith("error:") and said in lines[0], lines
+    assert not out.exists()
+
+
+def test_bad_providers_table_is_refused(tmp_path, capsys):
+    bad = tmp_path / "p.csv"
+    bad.write_text("test,model_a\nTest011,2\n")
+    code = cli.main(["campaign", "shake-table", "--members", "4", "--providers", str(bad),
+                     "--out", str(tmp_path / "out")])
+    lines = [x for x in capsys.readouterr().err.splitlines() if not x.startswith("note:")]
+    assert code == 2 and len(lines) == 1 and "column model_a must be 0 or 1" in lines[0]
+
+
+def test_members_are_the_fragilitys_draws():
+    """The members of SP1 are the parameter sets campaign fragility --column-file draws
+    for it (same seed), within its documented ranges, mu_k at 0.6/0.7 of mu_s."""
+    rock = ColumnGeometry.load(SPECIMEN).to_dict()
+    sets, drawn = member_sets(rock, 8, None, None)
+    _, fragility_sets, _, _ = pulse_grid.pulse_runs(
+        rock, "monolithic", "pga_g=0.5:0.5:1;pgv_pga_s=0.1:0.1:1", 8, 1, 90.0,
+        ensemble.DEFAULT_SEED, None)
+    assert sets == fragility_sets
+    assert drawn == {"kn": (4e7, 1.2e8), "damping": (0.05, 0.1), "mu_s": (0.6, 0.8),
+                     "footprint_tolerance_m": (0.001, 0.003)}
+    for point in sets:
+        assert 4e7 <= point["kn"] <= 1.2e8 and 0.001 <= point["footprint_tolerance_m"] <= 0.003
+        assert point["mu_k"] == pytest.approx(point["mu_s"] * 0.6 / 0.7, abs=1e-4)
+    # kn is log-uniform: as many members below the geometric mean as above it
+    assert sum(p["kn"] < math.sqrt(4e7 * 1.2e8) for p in sets) == 4
+
+
+def test_scores_of_a_synthetic_threshold_model(tmp_path):
+    """Shipped tests with P of a known threshold model as if from 8 members: the file has
+    every split, the never-overturns baseline's Brier score is the observed rate (closed
+    form: (0 - o)^2 averaged), the providers' models are scored on the same tests and the
+    reliability diagram is drawn."""
+    frame = pd.read_csv(EXPERIMENTS, keep_default_na=False)
+    frame = frame[frame["motion_file"] != ""].iloc[::5]
+    rng = np.random.default_rng(1)
+    p_true = 1 / (1 + np.exp(-(np.log(frame["pga_g"].to_numpy() / 0.2) / 0.3)))
+    k = rng.binomial(8, p_true)
+    per_test = pd.DataFrame({
+        "test": frame["test"].to_numpy(), "date": frame["date"].to_numpy(),
+        "split": np.where(frame["date"] < "2021-08-01", "calibration", "validation"),
+        "pga_g": frame["pga_g"].to_numpy(), "pgv_pga_s": frame["pgv_pga_s"].to_numpy(),
+        "observed": frame[OUTCOME].to_numpy().astype(bool), "runs": 8, "overturned": k,
+        "P": k / 8, "ci95_low": 0.0, "ci95_high": 1.0,
+        "single_set_predicted": k >= 4})
+    full = [SimpleNamespace(tags={"member": m, "point": {"m": m}}) for m in (-1, 0, 1)]
+    options = {"specimen": SPECIMEN, "experiments": EXPERIMENTS, "outcome": OUTCOME,
+               "validate_from": "2021-08-01", "members": 8, "axis_deg": 90.0}
+    write_scores(per_test, tmp_path, options, full, True)
+    result = json.loads((tmp_path / "shake_table_members.json").read_text())
+    for split in ("calibration", "validation", "all"):
+        rows = per_test if split == "all" else per_test[per_test["split"] == split]
+        s = result["splits"][split]
+        assert s["tests"] == len(rows)
+        assert s["never_overturns"]["brier"] == pytest.approx(rows["observed"].mean())
+        assert s["members"]["n"] == len(rows)
+        assert set(s["providers"]) == {"kn1_ks1", "kn3_ks1", "kn5_ks1", "kn10_ks1",
+                                       "kn15_ks1"}
+        assert s["providers"]["kn10_ks1"]["n"] == len(rows)
+    assert result["splits"]["all"]["members"]["clip"] == pytest.approx(1 / 18)
+    assert (tmp_path / "shake_table_reliability.png").stat().st_size > 10_000
+    assert len(pd.read_csv(tmp_path / "members.csv")) == len(per_test)
