@@ -301,13 +301,18 @@ def member_study_section(results):
     lines.append(_table_provenance(study.get("forward_table") or {}))
     lines.append(_toppled_by_slice(study.get("toppled_fraction_by_slice") or []))
     if "trials_beyond" in summary.columns:
+        spokes = "trials_between_spokes" in summary.columns
         lines.append("The trials' sources lie as sources come, off the table's nodes: the "
-                     "strike anywhere between the candidates' steps; the sites, in a third "
-                     "of the trials each, on the nodes of the likelihood's table, between "
-                     "the rings it keeps (its inner rings left out), or the first of them "
-                     "beyond its last ring (left out: the source lies beyond the "
-                     "inversion's reach, and the answer wanted is a warning that it may lie "
-                     "farther).\n")
+                     "strike anywhere between the candidates' steps; the sites, in equal "
+                     "shares of the trials, on the nodes of the likelihood's table, between "
+                     "the rings it keeps (its inner rings left out), "
+                     + ("halfway between its spokes (every other node azimuth left out), "
+                        "the magnitude between two slices (each observed column one of the "
+                        "upper slice's with the source's weight between them, the mixture "
+                        "the likelihood assumes between slices), " if spokes else "")
+                     + "or the first of them beyond its last ring (left out: the source "
+                     "lies beyond the inversion's reach, and the answer wanted is a warning "
+                     "that it may lie farther).\n")
     lines += [f"- {text}." for text in study["answer"].values()]
     largest = summary[summary["likelihood_members"] == summary["likelihood_members"].max()]
     names = {"fallen_per_site": "fallen per site",
@@ -324,10 +329,48 @@ def member_study_section(results):
     table = largest[["likelihood", "sites", "fallen_per_site", "trials"]
                     + [c for c in list(names)[1:] if c in largest.columns]].rename(columns=names)
     lines += ["", f"At {int(summary['likelihood_members'].max())} likelihood members per node:",
-              "", _table(table.round(2)) + "\n",
-              _figure(results, base / "member_study.png", "member study"),
+              "", _table(table.round(2)) + "\n"]
+    lines += _placement_lines(base, study)
+    lines += [_figure(results, base / "member_study.png", "member study"),
               "\nThe same truth tests for the epicentre, the distance and the magnitude (the "
               "standing columns take part in the likelihood as much as the fallen ones):\n",
               _figure(results, base / "member_study_source.png",
                       "member study: epicentre and magnitude")]
     return "\n".join(lines)
+
+
+def _placement_lines(base, study):
+    """Per placement of the source (member_study_placements.csv, at the largest likelihood
+    size, pooled over sites and columns): the coverages and the reach warning's rates
+    (member_study.json ``reach_warning``); nothing for older studies."""
+    path = base / "member_study_placements.csv"
+    if not path.exists():
+        return []
+    placements = pd.read_csv(path)
+    largest = placements[placements["likelihood_members"]
+                         == placements["likelihood_members"].max()]
+    names = {"placement": "source", "coverage_back_azimuth_95": "back azimuth",
+             "coverage_distance_95": "distance", "coverage_epicentre_95": "epicentre",
+             "coverage_mw_95": "Mw", "reach_warning": "warned",
+             "no_candidate": "no candidate", "width_median_deg": "median arc (deg)"}
+    words = {"node": "on the nodes", "between": "between the rings",
+             "between_spokes": "between the spokes", "between_magnitudes":
+             "between the magnitudes", "beyond": "beyond the last ring"}
+    table = largest[["likelihood", "trials"] + list(names)].rename(columns=names)
+    table["source"] = table["source"].map(lambda v: words.get(v, v))
+    lines = ["By where the source lies (all sites and columns together; a warning gives "
+             "the whole circle for the back azimuth, and \"no candidate\": sites too far "
+             "apart for the reach, refused and counted as warned):", "",
+             _table(table.round(2)) + "\n"]
+    for kind, rates in (study.get("reach_warning") or {}).items():
+        if "false_alarm_rate" not in rates or "hit_rate" not in rates:
+            continue
+        fa, hit = rates["false_alarm_rate_ci95"], rates["hit_rate_ci95"]
+        lines.append(
+            f"The reach warning, {kind} likelihood: given for {rates['false_alarm_rate']:.2f} "
+            f"[{fa[0]:.2f}, {fa[1]:.2f}] of {rates['false_alarm_trials']} sources well "
+            f"within the reach, {rates.get('edge_rate', float('nan')):.2f} of those at its "
+            f"edge, and {rates['hit_rate']:.2f} [{hit[0]:.2f}, {hit[1]:.2f}] of "
+            f"{rates['hit_trials']} beyond it ({rates['hit_no_candidate']:.2f} of those had "
+            "no candidate within reach of every site and were refused).\n")
+    return lines

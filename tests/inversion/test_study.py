@@ -107,6 +107,8 @@ def test_member_study_command_on_a_table_file(make_away_table, tmp_path, capsys)
     assert result["answer"]["predictive"] in section and "member_study.png" in section
     assert "member_study_source.png" in section
     assert "distance covered or warned" in section and "between the rings" in section
+    assert "By where the source lies" in section and (out / "member_study_placements.csv"
+                                                      ).stat().st_size > 0
     fractions = [s["fraction"] for s in result["toppled_fraction_by_slice"]]
     assert len(fractions) == len(table.slices) and all(0 < f < 1 for f in fractions)
     assert f"Mw {table.slices[0]['mw']:g}" in section and "Columns toppled in the table" in section
