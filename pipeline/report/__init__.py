@@ -18,6 +18,7 @@ from pipeline.report.campaigns import (columns_section, contact_stiffness_sectio
                                        rock_fragility_section, shake_table_section,
                                        speed_section, sweep_section,
                                        verification_section)
+from pipeline.report.field_rock import FIELD_ROCK_QUICK, field_rock_section
 from pipeline.report.hazard import survival_section
 from pipeline.report.inversion import inversion_section, member_study_section
 from pipeline.report.records import (back_azimuth_table, correlation_table, per_record_table,
@@ -27,7 +28,7 @@ from pipeline.report.records import (back_azimuth_table, correlation_table, per_
 from pipeline.stats.ensemble import wilson_interval
 
 __all__ = ["build_report", "back_azimuth_table", "columns_section",
-           "contact_stiffness_section", "convergence_section",
+           "contact_stiffness_section", "convergence_section", "field_rock_section",
            "correlation_table", "paper_question_section",
            "ensemble_section", "fragility_section", "inversion_section",
            "member_study_section", "per_record_table",
@@ -65,6 +66,7 @@ def build_report(results=RESULTS_DIR):
         shake_table_section(results), contact_stiffness_section(results),
         rock_fragility_section(results),
         rock_fragility_section(results, "rock-fragility-table"), survival_section(results),
+        field_rock_section(results), field_rock_section(results, FIELD_ROCK_QUICK),
         paper_question_section(results), ensemble_section(results),
         convergence_section(results), fragility_section(results), columns_section(results),
         inversion_section(results), member_study_section(results),
