@@ -47,13 +47,24 @@ def cell_matrix(levels_m_s2, rates_per_yr, cells=CELLS_PER_INTERVAL):
 
 
 def branch_rates(cells, levels_m_s2, rates_per_yr, probability):
-    """Annual rate (1/yr, B) of the events in which ``probability`` (a function of PGA,
-    m/s^2) happens, under each branch: sum over cells of P(x_mid) d_rate plus P(x_N) at the
-    last level x_N times its rate (:func:`pipeline.hazard.survival.overturning_rate`)."""
+    """Annual rate (1/yr) of the events in which ``probability`` (a function of PGA, m/s^2)
+    happens, under each branch: sum over cells of P(x_mid) d_rate plus P(x_N) at the last
+    level x_N times its rate (:func:`pipeline.hazard.survival.overturning_rate`).
+    ``probability`` gives one value per PGA (result B) or a row per fragility draw (D x
+    len(x): result D x B, one matrix product for all draws)."""
     x_mid, d_rate, _ = cells
     rates = np.atleast_2d(np.asarray(rates_per_yr, float))
-    top = float(probability(np.asarray(levels_m_s2, float)[-1:])[0])
-    return d_rate @ probability(x_mid) + top * rates[:, -1]
+    p_mid = np.asarray(probability(x_mid), float)
+    top = np.asarray(probability(np.asarray(levels_m_s2, float)[-1:]), float)[..., 0]
+    if p_mid.ndim == 1:
+        return d_rate @ p_mid + top * rates[:, -1]
+    return p_mid @ d_rate.T + top[:, None] * rates[None, :, -1]
+
+
+def draw_chunk(cells):
+    """How many fragility draws :func:`branch_rates` takes at once: their D x C cell
+    probabilities held within MAX_CELL_VALUES (at least 1)."""
+    return max(1, MAX_CELL_VALUES // cells[0].size)
 
 
 def age_chain(ages_yr):
@@ -71,7 +82,7 @@ def age_chain(ages_yr):
 
 def log_survival_fixed(set_rates, ages_yr):
     """ln P_s per branch for known ages: -sum_k dt_k lambda(S_k); ``set_rates(indices)``
-    gives lambda (1/yr, B) of a set."""
+    gives lambda (1/yr, B, or D x B for D fragility draws) of a set."""
     return -sum(dt * set_rates(members) for members, dt in age_chain(ages_yr))
 
 

@@ -5,7 +5,7 @@ import numpy as np
 
 from pipeline.constants import STANDARD_GRAVITY
 from pipeline.hazard.constrain import (FLOOR, FRACTILES, TARGET_RATES, bayes, branch_rates,
-                                       cell_matrix, change_percent, eliminate,
+                                       cell_matrix, change_percent, draw_chunk, eliminate,
                                        log_survival_fixed, log_survival_sampled,
                                        motion_at_rate, truncated_ages, weighted_mean,
                                        weighted_quantile)
@@ -64,11 +64,11 @@ def constrain_tree(tree, specimens, ratio_model, ages_ka, age_sds_ka, rule="baye
     mode, samples = _age_mode(ages, sds, rng)
     warnings = list(tree.notes)
 
-    def survival_of(fragilities, sampled=True):
-        return _log_survival(tree, cells, fragilities, ratio_model, ages, sds, mode,
+    def survival_of(batch, sampled=True):
+        return _log_survival(tree, cells, batch, ratio_model, ages, sds, mode,
                              samples if sampled else None)
 
-    log_p, age_se = survival_of(specimens)
+    log_p, age_se = (None if v is None else v[0] for v in survival_of([specimens]))
     p = np.exp(log_p)
     posterior = {"bayes": bayes(tree.weights, log_p), "eliminate": eliminate(tree.weights, p,
                                                                            floor)}
@@ -76,7 +76,7 @@ def constrain_tree(tree, specimens, ratio_model, ages_ka, age_sds_ka, rule="baye
         if w is None:
             warnings.append(_none_left(name, floor))
     members = _members(tree, specimens, survival_of, floor, warnings)
-    carlo = _draws(tree, specimens, survival_of, draws, rng, floor)
+    carlo = _draws(tree, cells, specimens, survival_of, draws, rng, floor)
     warnings += _end_warnings(tree, cells, specimens, ratio_model, posterior[rule])
     prior_stats = _statistics(tree, tree.weights)
     post_stats = None if posterior[rule] is None else _statistics(tree, posterior[rule])
@@ -121,15 +121,17 @@ def _age_mode(ages, sds, rng):
             truncated_ages(ages, sds, AGE_SAMPLES, rng))
 
 
-def _log_survival(tree, cells, fragilities, ratio_model, ages, sds, mode, samples):
-    """(ln P_s per branch, its relative standard error per branch or None)."""
+def _log_survival(tree, cells, batch, ratio_model, ages, sds, mode, samples):
+    """(ln P_s, D x B, of each of the D fragility sets in ``batch`` (lists, one fragility
+    per specimen), all integrated by one matrix product; its relative standard error
+    (D x B) or None)."""
     def set_rates(members):
-        chosen = [fragilities[j] for j in members]
-        return branch_rates(cells, tree.levels_m_s2, tree.rates_per_yr,
-                            lambda x: overturn_probability(chosen, ratio_model, x,
-                                                           "any_common"))
+        def probability(x):
+            return np.array([overturn_probability([chosen[j] for j in members], ratio_model,
+                                                  x, "any_common") for chosen in batch])
+        return branch_rates(cells, tree.levels_m_s2, tree.rates_per_yr, probability)
     if mode.startswith("one uncertain age"):
-        rate = set_rates(tuple(range(len(fragilities))))
+        rate = set_rates(tuple(range(len(batch[0]))))
         with np.errstate(divide="ignore"):
             return np.log(survival_probability(rate, ages[0], sds[0])), None
     if samples is None:
@@ -198,7 +200,7 @@ def _members(tree, specimens, survival_of, floor, warnings):
                         f"({sorted(counts)}): the members' spread not reported")
         return None
     count = counts.pop()
-    log_ps = np.array([survival_of([m[k] if m else f for m, f in zip(lists, specimens)])[0]
+    log_ps = np.array([survival_of([[m[k] if m else f for m, f in zip(lists, specimens)]])[0][0]
                        for k in range(count)])
     ps = np.exp(log_ps)
     mixture = ps.mean(axis=0)
@@ -226,15 +228,19 @@ def _members(tree, specimens, survival_of, floor, warnings):
             "mean_ground_motion_at_rates": at}
 
 
-def _draws(tree, specimens, survival_of, draws, rng, floor):
+def _draws(tree, cells, specimens, survival_of, draws, rng, floor):
     """The Monte Carlo error of the fragility: P_s, posterior weights and the posterior
-    mean's PGA at TARGET_RATES over fragility draws (intervals), or None."""
+    mean's PGA at TARGET_RATES over fragility draws (intervals), or None.  The draws are
+    integrated in chunks of :func:`~pipeline.hazard.constrain.draw_chunk`, each chunk one
+    matrix product (draws x cells times cells x branches)."""
     drawn = [f.draws(draws, rng) if draws else None for f in specimens]
     if all(d is None for d in drawn):
         return None
-    log_ps = np.array([survival_of([d[k] if d is not None else f
-                                    for d, f in zip(drawn, specimens)], sampled=False)[0]
-                       for k in range(draws)])
+    sets = [[d[k] if d is not None else f for d, f in zip(drawn, specimens)]
+            for k in range(draws)]
+    chunk = draw_chunk(cells)
+    log_ps = np.concatenate([survival_of(sets[i:i + chunk], sampled=False)[0]
+                             for i in range(0, draws, chunk)])
     ps = np.exp(log_ps)
     posteriors = [bayes(tree.weights, lp) for lp in log_ps]
     usable = np.array([w for w in posteriors if w is not None])
