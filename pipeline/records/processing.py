@@ -29,6 +29,8 @@ No step's extent scales with the file's length: the same strong motion gives
 the same processed motion however much quiet time surrounds it in the file
 (tests/records/test_processing_invariance.py).
 """
+import math
+
 import numpy as np
 from obspy import Stream, Trace
 from scipy.integrate import cumulative_trapezoid
@@ -266,15 +268,40 @@ def baseline_acceleration(disp, vel, dt, max_power=6):
     return result
 
 
+MAX_PROCESSED_SAMPLES = 4_000_000   # samples per component processing may hold (about
+#                                     0.1 GB an array; a 10-min lab table at 3.3 kHz and
+#                                     its margins: 2.8 million)
+
+
+def held_samples(n, dt, steps):
+    """The most samples per component ``steps`` may hold at once for a record of ``n``
+    samples every ``dt`` s: the record, the signal window's margin and the band-pass's
+    zero pad on each side (both a fixed time, so a fine time step makes them long)."""
+    params = dict(steps)
+    margin_s = params.get("trim_to_signal", {}).get("margin_s", 0.0)
+    band = params.get("bandpass", {})
+    pad_s = filter_transient_s(band.get("freqmin_hz", BAND["freqmin_hz"]),
+                               band.get("corners", BAND["corners"])) if band.get("pad") else 0.0
+    return n + 2 * math.ceil((margin_s + pad_s) / dt), margin_s + pad_s
+
+
 def process(enz, dt, band=(None, None), steps=DEFAULT_STEPS, name="record"):
     """Run ``steps`` on an (n, 3) acceleration (m/s^2); return (acc, vel, disp, provenance).
 
     provenance: list of {"step": name, **what it did}.  The last step must integrate.
-    A ``trim_to_signal`` step shortens the record: provenance gives its window.
+    A ``trim_to_signal`` step shortens the record: provenance gives its window.  A record
+    whose processing would hold more than MAX_PROCESSED_SAMPLES per component is refused
+    before any array is made.
     """
     unknown = [s for s, _ in steps if s not in STEPS]
     if unknown:
         raise InputError(f"unknown processing step(s): {', '.join(unknown)}")
+    held, margins_s = held_samples(len(enz), dt, steps)
+    if held > MAX_PROCESSED_SAMPLES:
+        raise InputError(f"{name}: {len(enz)} samples every {dt:.3g} s and {margins_s:g} s of "
+                         f"filter margins on each side make {held:,} samples, more than the "
+                         f"{MAX_PROCESSED_SAMPLES:,} processing holds: is the time step in "
+                         "seconds?")
     work = Work(enz, dt, band, name)
     provenance = []
     for name_, params in steps:
