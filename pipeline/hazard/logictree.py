@@ -14,7 +14,8 @@ Two formats (:func:`load_logic_tree`):
 - A plain table: comment lines starting with ``#`` anywhere, the header
   ``branch,weight,pga_<g|m_s2|cm_s2>,annual_rate_per_yr`` (an optional fifth column
   ``path``: the branch's path in the tree), then one row per branch and level (long
-  format); a branch's weight is repeated on each of its rows.
+  format); a branch's weight is repeated on each of its rows.  The IMT must be PGA (the
+  fragility's); another (``sa(1.0)_g``) only when the caller asks for it by name.
 
 Every branch's curve is on the same levels.  Levels where a curve has no finite positive
 rate (OpenQuake's probability of exceedance 1 at the lowest levels, an unbounded rate;
@@ -54,7 +55,8 @@ class LogicTree:
     """Branches of a hazard model: ``branch_ids`` and ``branch_paths`` (str, one per
     branch), ``weights`` (B, sum 1), ``levels_m_s2`` (L, PGA, increasing), ``rates_per_yr``
     (B x L, annual rate of exceeding each level, positive, not increasing along a row),
-    ``imt`` ("PGA"), ``source`` (dict: format, file, site, ...), ``notes`` (what the loader
+    ``imt`` ("PGA"; a plain table read with another ``imt`` keeps its levels in the same
+    units, g converted to m/s^2), ``source`` (dict: format, file, site, ...), ``notes`` (what the loader
     dropped or repaired, and why)."""
     branch_ids: tuple
     branch_paths: tuple
@@ -70,11 +72,15 @@ class LogicTree:
         return len(self.branch_ids)
 
 
-def load_logic_tree(path, site=None):
+def load_logic_tree(path, site=None, imt="PGA"):
     """The :class:`LogicTree` in ``path``: an OpenQuake export (its directory or its
     realizations file) or a plain table (see the module); ``site``: the row (0-based) of
-    OpenQuake curves with several sites."""
+    OpenQuake curves with several sites; ``imt``: the intensity measure the curves must be
+    of (PGA, as the fragility; a plain table may hold another, e.g. "SA(1.0)", for the
+    statistics over branches alone)."""
     path = Path(path)
+    if imt.upper() != "PGA" and (path.is_dir() or _is_openquake(path)):
+        raise InputError(f"{path}: OpenQuake exports are read for PGA only, not {imt}")
     if path.is_dir():
         found = sorted(path.glob("realizations*.csv"))
         if len(found) != 1:
@@ -82,13 +88,22 @@ def load_logic_tree(path, site=None):
                              f"(OpenQuake's export), found {len(found)}")
         return _openquake(found[0], site)
     lines = _lines(path, "logic tree file")
-    header = next((line for line in lines if line.strip() and not line.startswith("#")), "")
-    if header.replace(" ", "").lower().startswith("rlz_id,"):
+    if _header(lines).replace(" ", "").lower().startswith("rlz_id,"):
         return _openquake(path, site)
     if site is not None:
         raise InputError(f"--site applies to OpenQuake curves with several sites; {path} is "
                          "a plain table")
-    return _plain(path, lines)
+    return _plain(path, lines, imt)
+
+
+def _header(lines):
+    return next((line for line in lines if line.strip() and not line.startswith("#")), "")
+
+
+def _is_openquake(path):
+    """True when ``path`` is a realizations file (its first row rlz_id,...)."""
+    return path.is_file() and _header(_lines(path, "logic tree file")).replace(
+        " ", "").lower().startswith("rlz_id,")
 
 
 def _lines(path, what):
@@ -205,10 +220,10 @@ def _curve_files(directory):
 
 
 # ---------------------------------------------------------------- plain table
-def _plain(path, lines):
+def _plain(path, lines, imt="PGA"):
     body = [(k + 1, line) for k, line in enumerate(lines) if line and not line.startswith("#")]
     names = [n.strip().lower() for n in body[0][1].split(",")]
-    unit = _plain_header(path, names)
+    unit = _plain_header(path, names, imt)
     with_path = len(names) == 5
     branches = {}
     for number, line in body[1:]:
@@ -249,13 +264,13 @@ def _plain(path, lines):
                                           ids)
     weights, more = _weights([_number(branches[n]["weight"], f"{path}: branch {show(n)} weight")
                               for n in ids], path)
-    source = {"format": "plain logic-tree table", "file": str(path), "imt": "PGA",
+    source = {"format": "plain logic-tree table", "file": str(path), "imt": imt.upper(),
               "unit_in_file": unit}
     return LogicTree(tuple(ids), tuple(branches[n]["path"] for n in ids), weights, levels,
-                     rates, "PGA", source, tuple(notes + more))
+                     rates, imt.upper(), source, tuple(notes + more))
 
 
-def _plain_header(path, names):
+def _plain_header(path, names, imt="PGA"):
     """The unit of a plain table's level column, the header checked."""
     if len(names) not in (4, 5) or names[:2] != ["branch", "weight"] \
             or names[3] != PLAIN_RATE_COLUMN or (len(names) == 5 and names[4] != "path"):
@@ -265,7 +280,9 @@ def _plain_header(path, names):
     if not match:
         raise InputError(f"{path}: missing IMT: the third column must be pga_<unit>, got "
                          f"{show(names[2])}")
-    if match.group(1) != "pga":
+    if match.group(1) != imt.lower():
+        if imt.upper() != "PGA":
+            raise InputError(f"{path}: IMT {match.group(1).upper()}, expected {imt.upper()}")
         raise InputError(f"{path}: IMT {match.group(1).upper()}: the fragility is over PGA "
                          "(give PGA hazard curves)")
     if match.group(2) not in PLAIN_UNITS:
