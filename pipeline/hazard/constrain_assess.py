@@ -127,8 +127,11 @@ def _log_survival(tree, cells, batch, ratio_model, ages, sds, mode, samples):
     (D x B) or None)."""
     def set_rates(members):
         def probability(x):
-            return np.array([overturn_probability([chosen[j] for j in members], ratio_model,
-                                                  x, "any_common") for chosen in batch])
+            out = np.empty((len(batch), np.size(x)))     # filled in place: one copy held
+            for k, chosen in enumerate(batch):
+                out[k] = overturn_probability([chosen[j] for j in members], ratio_model, x,
+                                              "any_common")
+            return out
         return branch_rates(cells, tree.levels_m_s2, tree.rates_per_yr, probability)
     if mode.startswith("one uncertain age"):
         rate = set_rates(tuple(range(len(batch[0]))))
