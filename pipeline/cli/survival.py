@@ -85,6 +85,7 @@ def check(args):
         number(args.age_ka, "--age-ka", 0, 10000, "ka", low_open=True)
     number(args.age_sd_ka, "--age-sd-ka", 0, 10000, "ka")
     check_fragility_options(args)
+    _distinct_fragilities(args.fragility)
     if args.observations is not None and args.column is not None:
         raise InputError("--column does not apply with --observations (each column's own "
                          "type is read from the file)")
@@ -94,6 +95,23 @@ def check(args):
         raise InputError(f"--site must be 0 or more, got {args.site}")
     if args.out.exists() and not args.out.is_dir():
         raise InputError(f"--out {args.out} exists and is not a directory")
+
+
+def _distinct_fragilities(paths):
+    """Refuse the same fragility file named twice (as a file or its directory, by another
+    path or link): one specimen is not a set."""
+    seen = {}
+    for path in paths:
+        file = path / "fragility.json" if path.is_dir() else path
+        try:
+            stat = file.stat()
+            key = (stat.st_dev, stat.st_ino)
+        except OSError:
+            key = file.resolve()
+        if key in seen:
+            raise InputError(f"--fragility {path} and {seen[key]} are one file: the same "
+                             "specimen twice (a set needs distinct specimens)")
+        seen[key] = path
 
 
 def run(args):
