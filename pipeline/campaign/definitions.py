@@ -296,8 +296,8 @@ def verification_outputs(specs, campaign_dir, failures, animations, figures=True
     results = [(check, verification.CheckResult.load(runs / check.run_id))
                for check in specs if (runs / check.run_id / "summary.json").exists()]
     summary = verification.summarise_campaign(results)
-    summary["figures"] = ([p.name for p in plot_verification(results, campaign_dir)]
-                          if figures else [])
+    summary["figures"] = ([p.name for p in plot_verification(
+        results, campaign_dir, summary.get("one_cosine"))] if figures else [])
     summary["failed_runs"] = [s.run_id for s, _ in failures]
     write_json(Path(campaign_dir) / "verification.json", summary)
     for line in summary["lines"]:
@@ -305,6 +305,7 @@ def verification_outputs(specs, campaign_dir, failures, animations, figures=True
     return {"figures": summary["figures"]}
 
 
-register(Campaign("verification", "Housner, one-sine pulse and sliding checks over ranges",
+register(Campaign("verification", "Housner, one-sine pulse, sliding and one-cosine checks "
+                  "over ranges",
                   verification_specs, verification.run_check, verification_outputs,
                   label="verification runs"))

@@ -3,13 +3,16 @@
     python -m pipeline verify housner --height 0.4 --width 0.08 --theta0-ratio 0.5
     python -m pipeline verify sine-pulse --height 3.113 --width 0.795 --amplitude-ratio 6.5
     python -m pipeline verify sliding
+    python -m pipeline verify one-cosine --period 1.0 --runs 10
 """
 from pathlib import Path
 
 from pipeline import RESULTS_DIR, paper
+from pipeline.files import InputError
 from pipeline.verification import (MARBLE_BLOCK, PULSE_BLOCK, SLIDING_BELOW, SLIDING_MU,
                                    CheckResult, check_sliding_mus, verify_housner,
-                                   verify_sine_pulse, verify_sliding)
+                                   verify_one_cosine, verify_sine_pulse, verify_sliding)
+from pipeline.verification.one_cosine import MR_BLOCK, YADE_RUNS, check_period, check_runs
 
 NAME = "verify"
 ORDER = 30
@@ -40,7 +43,14 @@ def setup(p):
                     help=f"switch: mu_s sticking, mu_k = {paper.MU_K_OVER_MU_S:g} mu_s sliding "
                     "(default); "
                     "static: mu_s only, to see the effect of the kinetic coefficient")
-    for q in (h, s, sl):
+    c = sub.add_parser("one-cosine", help="smallest overturning amplitude under a one-cosine "
+                       "pulse, 2D block and YADE (Makris & Roussos 2000)")
+    c.add_argument("--height", type=float, default=MR_BLOCK["height"], help="m (3.0)")
+    c.add_argument("--width", type=float, default=MR_BLOCK["width"], help="m (1.0)")
+    c.add_argument("--depth", type=float, default=MR_BLOCK["depth"], help="m (1.0)")
+    c.add_argument("--period", type=float, default=1.0, help="pulse period T_p, s (1.0)")
+    c.add_argument("--runs", type=int, default=YADE_RUNS, help=f"YADE runs ({YADE_RUNS})")
+    for q in (h, s, sl, c):
         q.add_argument("--kn", type=float, default=None, help="face contact stiffness N/m")
         q.add_argument("--damping", type=float, default=None,
                        help="contact damping ratio (housner: 1.0, critical; others: 0.36)")
@@ -64,6 +74,8 @@ def run(args):
         print(f"YADE: {result['yade']['mode']} (direction {result['yade']['direction']:+d}, "
               f"{result['yade']['impacts_before_overturning']} impacts); integration: "
               f"{result['integration']['mode']} (direction {result['integration']['direction']:+d})")
+    elif args.test == "one-cosine":
+        result = _one_cosine(args, contact)
     else:
         kwargs = {"mu_values": tuple(args.mu_s)} if args.mu_s else {}
         if args.mu_s:
@@ -78,3 +90,17 @@ def run(args):
     CheckResult(result).save(out)
     print(f"{'PASSED' if result['passed'] else 'FAILED'}; wrote {out}")
     return 0 if result["passed"] else 1
+
+
+def _one_cosine(args, contact):
+    check_period(args.period)
+    check_runs(args.runs)
+    if not (args.height > 0 and args.width > 0 and args.depth > 0):
+        raise InputError("--height, --width and --depth must be positive")
+    result = verify_one_cosine(args.period, args.height, args.width, args.depth, args.runs,
+                               **contact)
+    y = result["yade"]
+    print(f"2D block overturns from {result['integration']['threshold_g']:.4f} g; YADE stands "
+          f"at {y['stands_g']:.4f} g, overturns at {y['overturns_g']:.4f} g ({len(y['runs'])} "
+          f"runs); eq. 43: {result['eq43_g']:.4f} g")
+    return result

@@ -1,4 +1,5 @@
-"""Figures of the verification campaign like the paper's Figs 4, 5 and 6."""
+"""Figures of the verification campaign like the paper's Figs 4, 5 and 6, and the
+one-cosine pulse's smallest overturning amplitude against Makris & Roussos (2000)."""
 from pathlib import Path
 
 import numpy as np
@@ -11,8 +12,9 @@ from pipeline.verification import (CAMPAIGN_DAMPING, CAMPAIGN_THETA0, MARBLE_BLO
                                    PULSE_BLOCK)
 
 
-def plot_verification(results, out_dir):
-    """Figures like the paper's Figs 4 (Housner decay), 5 (one-sine pulse) and 6 (sliding)."""
+def plot_verification(results, out_dir, summary=None):
+    """Figures like the paper's Figs 4 (Housner decay), 5 (one-sine pulse) and 6 (sliding);
+    with ``summary`` (the summary's ``one_cosine``) the one-cosine figure too."""
     written = []
     # Fig. 4: amplitude decay, closed form (lines) and YADE (markers)
     fig, ax = new_figure(figsize=(7, 5), constrained_layout=True)
@@ -72,4 +74,40 @@ def plot_verification(results, out_dir):
     path = Path(out_dir) / "fig6_sliding.png"
     save_figure(fig, path, dpi=120)
     written.append(path)
-    return written
+    return written + ([plot_one_cosine(summary, out_dir)] if summary else [])
+
+
+def plot_one_cosine(summary, out_dir):
+    """The smallest overturning amplitude under a one-cosine pulse over omega_p / p: the
+    2D block (line), the YADE block (markers, its bracket as an error bar) and Makris &
+    Roussos eq. 43 with its +-16 % (the verification summary's ``one_cosine``)."""
+    fig, ax = new_figure(figsize=(7.5, 5), constrained_layout=True)
+    w = np.linspace(0.5, 12.0, 100)
+    eq43 = 1 + w / 4
+    spread = summary["eq43"]["spread"]
+    ax.plot(w, eq43, "k-", lw=1, label="Makris & Roussos eq. 43: 1 + omega_p / (4 p)")
+    ax.fill_between(w, (1 - spread) * eq43, (1 + spread) * eq43, color="0.85",
+                    label=f"eq. 43 +-{100 * spread:g} %")
+    rows = [r for r in summary["curve_2d"] if r["over_alpha_g"] is not None]
+    ax.plot([r["omega_ratio"] for r in rows], [r["over_alpha_g"] for r in rows], "C0.-",
+            lw=1, ms=4, label="2D rigid block (Housner restitution)")
+    alpha = summary["alpha_rad"]
+    yade = [r for r in summary["curve_yade"] if r["threshold_g"] is not None]
+    if yade:
+        x = [r["omega_ratio"] for r in yade]
+        y = np.array([r["threshold_g"] for r in yade]) / alpha
+        err = np.array([[r["threshold_g"] - r["bracket_g"][0], r["bracket_g"][1] - r["threshold_g"]]
+                        for r in yade]).T / alpha
+        ax.errorbar(x, y, yerr=err, fmt="s", color="C3", mfc="none", ms=7,
+                    label="YADE block (bisection)")
+    f = summary["fig11"]
+    ax.plot([2 * np.pi / summary["p_per_s"]], [np.mean(f["makris_roussos_g"]) / alpha], "k*",
+            ms=11, label="Makris & Roussos Fig. 11 (T_p 1 s)")
+    ax.set(xlabel="omega_p / p", ylabel="smallest overturning amplitude a_p / (alpha g)",
+           yscale="log", xlim=(0.5, 12.0),
+           title="One-cosine pulse, block b 0.5 m, h 1.5 m (alpha 18.4 deg, p 2.16 1/s)")
+    ax.legend(fontsize=8, loc="upper left")
+    ax.grid(alpha=0.3, which="both")
+    path = Path(out_dir) / "fig_one_cosine.png"
+    save_figure(fig, path, dpi=120)
+    return path

@@ -53,7 +53,9 @@ def verification_section(results):
                  "(Augusti & Sinopoli, eq. 8) and this model put the onset near 0.15: the paper's "
                  "model dissipated more at impacts (pipeline.rocking.impact_friction_demand).\n")
     for fig, caption in (("fig4_housner.png", "Fig. 4"), ("fig5_sine_pulse.png", "Fig. 5"),
-                         ("fig6_sliding.png", "Fig. 6")):
+                         ("fig6_sliding.png", "Fig. 6"),
+                         ("fig_one_cosine.png", "One-cosine pulse against Makris & Roussos "
+                          "(2000)")):
         lines.append(_figure(results, results / "verification" / fig, caption))
     return "\n".join(lines)
 

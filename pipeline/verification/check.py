@@ -13,17 +13,21 @@ from pipeline.scenario import Contact
 from pipeline.userfiles import number
 from pipeline.verification.checks import (check_pulse_ratios, check_theta0_ratio,
                                           verify_housner, verify_sine_pulse, verify_sliding)
+from pipeline.verification.one_cosine import check_period, verify_one_cosine
 
 # kind: its setting's names (theta0/alpha and the contact damping ratio; the pulse's
-# A / (alpha g) and omega / p; the static friction coefficient)
+# A / (alpha g) and omega / p; the static friction coefficient; the one-cosine pulse's
+# period, s)
 KINDS = {"housner": ("theta0_ratio", "damping"),
          "sine-pulse": ("amplitude_ratio", "omega_ratio"),
-         "sliding": ("mu_s",)}
+         "sliding": ("mu_s",),
+         "one-cosine": ("period_s",)}
 # kind: the keys of its result that the campaign's summary and figures read
 RESULT_KEYS = {"housner": ("max_rel_error_impact_times", "max_rel_error_peaks",
                            "effective_restitution", "housner_restitution", "yade"),
                "sine-pulse": ("yade",),
-               "sliding": ("runs", "augusti_sinopoli_mu_min")}
+               "sliding": ("runs", "augusti_sinopoli_mu_min"),
+               "one-cosine": ("yade", "integration", "eq43_g", "omega_ratio", "alpha_rad")}
 SLIDING_ROW_KEYS = ("mu_s", "pure_rocking", "t", "base_x_m")
 
 
@@ -53,6 +57,8 @@ class Check(Mapping):
             Contact(damping=values["damping"])
         elif self.kind == "sine-pulse":
             check_pulse_ratios(values["amplitude_ratio"], values["omega_ratio"])
+        elif self.kind == "one-cosine":
+            check_period(values["period_s"])
         else:
             Contact(mu_s=values["mu_s"], mu_k=paper.MU_K_OVER_MU_S * values["mu_s"])
 
@@ -98,6 +104,8 @@ class Check(Mapping):
         elif self.kind == "sine-pulse":
             values = verify_sine_pulse(amplitude_ratio=s["amplitude_ratio"],
                                        omega_ratio=s["omega_ratio"], run_dir=run_dir / "yade")
+        elif self.kind == "one-cosine":
+            values = verify_one_cosine(period_s=s["period_s"], run_dir=run_dir / "yade")
         else:
             values = verify_sliding(mu_values=(s["mu_s"],), run_dir=run_dir)
         return CheckResult(values)

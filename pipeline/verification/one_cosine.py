@@ -59,6 +59,12 @@ def check_period(period_s):
         raise InputError(f"--period must be in [{lo:g}, {hi:g}] s, got {period_s!r}")
 
 
+def check_runs(runs):
+    """InputError unless the YADE runs of a bisection are a whole number in [3, MAX_RUNS]."""
+    if isinstance(runs, bool) or not isinstance(runs, int) or not 3 <= runs <= MAX_RUNS:
+        raise InputError(f"--runs must be an integer in [3, {MAX_RUNS}], got {runs!r}")
+
+
 def omega_ratio(period_s, height, width):
     """omega_p / p of a pulse of ``period_s`` on the block (h, b full sizes, m)."""
     return 2 * math.pi / period_s / rocking.block_constants(height, width)["p"]
@@ -107,36 +113,46 @@ def _scan(period_s, height, width, amplitudes_g):
 def overturning_intervals(period_s, height, width, a_max_g, step=SCAN_STEP, first_only=False):
     """The amplitude intervals (g) in which the 2D block overturns, from its uplift
     amplitude (tan alpha) up to ``a_max_g``: a scan every ``step`` (relative) with the
-    batch integrator, each edge bisected with the exact one to 1e-5.  A list of
-    [lo, hi] (hi None: still overturning at a_max_g); ``first_only``: the first."""
+    batch integrator, each edge found again with the exact one near where the scan saw
+    it and bisected to 1e-5.  A list of [lo, hi] (hi None: still overturning at
+    a_max_g); ``first_only``: the first."""
     a0 = math.tan(rocking.block_constants(height, width)["alpha"])
     grid = a0 * (1 + step) ** np.arange(1, int(math.log(a_max_g / a0) / math.log1p(step)) + 1)
-    edges = []
+    over = np.zeros(0, bool)
     for chunk in np.array_split(grid, max(1, len(grid) // 100)):
-        over = _scan(period_s, height, width, chunk)
-        edges += list(zip(chunk, over))
+        over = np.concatenate([over, _scan(period_s, height, width, chunk)])
         if first_only and over.any():
-            break
-    return _refined(edges, period_s, height, width, first_only)
+            found = _refined(grid[:len(over)], over, period_s, height, width, True)
+            if found:
+                return found
+    return _refined(grid, over, period_s, height, width, first_only)
 
 
-def _refined(edges, period_s, height, width, first_only):
-    """Intervals from the scan's (amplitude, overturned) pairs, each change of outcome
-    bisected with the exact integrator (a change it does not confirm is dropped)."""
-    def over(a):
-        return overturns_2d(a, period_s, height, width)
+def _refined(grid, scanned, period_s, height, width, first_only):
+    """Intervals from the scan's outcomes on ``grid`` (g): the exact integrator's outcome
+    on the grid points within 2 of each change the scan saw, each exact change bisected."""
+    exact = {}
+
+    def over(i):
+        if i not in exact:
+            exact[i] = overturns_2d(float(grid[i]), period_s, height, width)
+        return exact[i]
+    near = sorted({j for i in np.flatnonzero(scanned[1:] != scanned[:-1])
+                   for j in range(max(0, i - 2), min(len(grid), i + 4))})
     intervals, start = [], None
-    for (a, o), (b, p) in zip(edges[:-1], edges[1:]):
-        if o == p or over(a) == over(b):
+    for i, j in zip(near[:-1], near[1:]):
+        if j != i + 1 or over(i) == over(j):
             continue
-        lo, hi = _bisect(lambda x: over(x) != o, a, b, _RTOL)
+        o = over(i)
+        lo, hi = _bisect(lambda x: overturns_2d(x, period_s, height, width) != o,
+                         float(grid[i]), float(grid[j]), _RTOL)
         if not o:
-            start = float(hi)
+            start = hi
         elif start is not None:
-            intervals.append([start, float(lo)])
+            intervals.append([start, lo])
             start = None
         if first_only and intervals:
-            break
+            return intervals
     if start is not None:
         intervals.append([start, None])
     return intervals
@@ -194,8 +210,7 @@ def yade_threshold(period_s, guess_g, run_dir, runs=YADE_RUNS, **block):
     """The YADE block's smallest overturning amplitude (g) by bisection from a bracket
     of +-2 tolerances around ``guess_g``, ``runs`` YADE runs in all.  Returns
     {stands_g, overturns_g, threshold_g, runs: [[a_p_g, mode], ...]}."""
-    if isinstance(runs, bool) or not isinstance(runs, int) or not 3 <= runs <= MAX_RUNS:
-        raise InputError(f"--runs must be an integer in [3, {MAX_RUNS}], got {runs!r}")
+    check_runs(runs)
     done = []
 
     def over(a):
@@ -224,6 +239,7 @@ def verify_one_cosine(period_s=MR_PERIOD_S, height=MR_BLOCK["height"], width=MR_
     YADE is within TOLERANCE_YADE of the 2D block and, for Fig. 11's block and pulse,
     the 2D block within TOLERANCE_2D of Makris & Roussos."""
     check_period(period_s)
+    check_runs(runs)
     run_dir = Path(run_dir or RESULTS_DIR / "verification" / "runs" / f"one_cosine_{period_s:g}")
     a2d = min_overturning_g(period_s, height, width)
     if a2d is None:
@@ -253,3 +269,57 @@ def verify_one_cosine(period_s=MR_PERIOD_S, height=MR_BLOCK["height"], width=MR_
 def fig11_error(a_g):
     """Relative distance (>= 0) of an amplitude (g) from Fig. 11's [stands, overturns]."""
     return max(0.0, MR_STANDS_G - a_g, a_g - MR_OVERTURNS_G) / MR_OVERTURNS_G
+
+
+def summarise_one_cosine(results):
+    """The one-cosine section of the verification's summary from its YADE checks'
+    results (a list of CheckResult dicts): Fig. 11 (2D, YADE), the curve of the smallest
+    overturning amplitude (2D over CURVE_OMEGA_RATIOS, YADE at its checks' periods) beside
+    eq. 43, the safe bands; and its lines for the REPORT."""
+    c = rocking.block_constants(MR_BLOCK["height"], MR_BLOCK["width"])
+    yade = sorted(({"period_s": r["period_s"], "omega_ratio": r["omega_ratio"],
+                    "threshold_g": r["yade"]["threshold_g"],
+                    "bracket_g": [r["yade"]["stands_g"], r["yade"]["overturns_g"]],
+                    "runs": len(r["yade"]["runs"]), "integration_g": r["integration"]["threshold_g"],
+                    "rel_error": r["yade_rel_error"], "passed": r["passed"]} for r in results),
+                  key=lambda row: row["omega_ratio"])
+    a2d = min_overturning_g(MR_PERIOD_S, MR_BLOCK["height"], MR_BLOCK["width"])
+    curve = curve_2d()
+    inside = [row for row in curve if EQ43_OMEGA_RATIOS[0] <= row["omega_ratio"]
+              <= EQ43_OMEGA_RATIOS[1]]
+    eq43_error = max(abs(row["over_alpha_g"] / row["eq43_over_alpha_g"] - 1) for row in inside)
+    fig11 = {"makris_roussos_g": [MR_STANDS_G, MR_OVERTURNS_G], "integration_g": a2d,
+             "integration_rel_error": fig11_error(a2d), "tolerance_2d": TOLERANCE_2D,
+             "yade": next((row for row in yade if row["period_s"] == MR_PERIOD_S), None),
+             "tolerance_yade": TOLERANCE_YADE, "restitution": c["restitution"]}
+    out = {"fig11": fig11, "curve_2d": curve, "curve_yade": yade,
+           "eq43": {"omega_ratio_range": list(EQ43_OMEGA_RATIOS), "spread": EQ43_SPREAD,
+                    "max_rel_error_2d": eq43_error},
+           "safe_bands": safe_bands(), "alpha_rad": c["alpha"], "p_per_s": c["p"]}
+    out["lines"] = _lines(out)
+    return out
+
+
+def _lines(out):
+    """The REPORT's lines of the one-cosine check."""
+    f, y = out["fig11"], out["fig11"]["yade"]
+    lines = [f"One-cosine pulse (Makris & Roussos 2000, Fig. 11: b 0.5 m, h 1.5 m, T_p 1 s, "
+             f"stands at {MR_STANDS_G} g, overturns at {MR_OVERTURNS_G} g): the 2D block "
+             f"overturns from {f['integration_g']:.4f} g ({100 * f['integration_rel_error']:.2f} % "
+             f"outside their interval, tolerance {100 * TOLERANCE_2D:g} %, restitution "
+             f"{f['restitution']:.2f})" + (
+                 f"; the YADE block from {y['threshold_g']:.4f} g ({y['runs']} runs, "
+                 f"{100 * y['rel_error']:+.2f} % from the 2D block, tolerance "
+                 f"{100 * TOLERANCE_YADE:g} %)" if y and y["threshold_g"] else "")]
+    lo, hi = out["eq43"]["omega_ratio_range"]
+    lines.append(f"Eq. 43, a_po / (alpha g) = 1 + omega_p / (4 p): within "
+                 f"{100 * out['eq43']['max_rel_error_2d']:.1f} % of the 2D block for omega_p / p "
+                 f"{lo:g}-{hi:g} (stated +-{100 * EQ43_SPREAD:g} %); beyond ~3.7 the block "
+                 "overturns only without an impact, at amplitudes growing as omega_p^2")
+    for row in out["safe_bands"]:
+        spans = ", ".join(f"{a:.3f}-{'' if b is None else f'{b:.3f}'} g"
+                          for a, b in row["overturning_g"])
+        lines.append(f"Overturning intervals, {row['block']} block, PGV/PGA "
+                     f"{row['pgv_pga_s']:.3f} s (T_p {row['period_s']:.3f} s), up to "
+                     f"{SCAN_MAX_G[row['block']]:g} g: {spans or 'none'}")
+    return lines
