@@ -292,8 +292,10 @@ class FragilityOptions(CampaignOptions):
         ensemble.check_seed(self.seed)
         if self.pulses is not None:
             parse_grid(self.pulses)
-            if self.levels is not None:
-                raise InputError(LEVELS_WITH_PULSES)
+        if self.levels is not None and (self.pulses is not None or (
+                self.column_file is not None and "mesh" in column_file_description(
+                    self.column_file, meshes=True))):       # a mesh: the pulse grid
+            raise InputError(LEVELS_WITH_PULSES)
         if self.ranges is not None:
             pulse_grid.parse_ranges(self.ranges)
         if self.adaptive and self.pulses is None and self.column_file is None:

@@ -282,7 +282,7 @@ def held_samples(n, dt, steps):
     band = params.get("bandpass", {})
     pad_s = filter_transient_s(band.get("freqmin_hz", BAND["freqmin_hz"]),
                                band.get("corners", BAND["corners"])) if band.get("pad") else 0.0
-    return n + 2 * math.ceil((margin_s + pad_s) / dt), margin_s + pad_s
+    return n + 2 * math.ceil(round((margin_s + pad_s) / dt, 6)), margin_s + pad_s
 
 
 def process(enz, dt, band=(None, None), steps=DEFAULT_STEPS, name="record"):
