@@ -43,6 +43,7 @@ from pipeline.userfiles import Unreadable, read_text, show
 
 MAX_BRANCHES = 10_000
 MAX_LEVELS = 1_000
+ROUNDING = 1e-15                 # per weight: a sum this close to 1 is 1 written in decimals
 WEIGHT_TOLERANCE = 1e-6          # |sum of weights - 1| allowed (the sum is 1: absolute = relative)
 MAX_CURVE_FILES = 4 * MAX_BRANCHES   # hazard_curve*.csv files looked at in one directory
 REALIZATIONS_COLUMNS = ("rlz_id", "branch_path", "weight")
@@ -341,7 +342,8 @@ def _weights(values, path):
     if not abs(total - 1.0) <= WEIGHT_TOLERANCE:
         raise InputError(f"{path}: the weights sum to {total:.9g}, not 1 (within "
                          f"{WEIGHT_TOLERANCE:g})")
-    notes = [] if total == 1.0 else [f"weights summed to {total:.12g}: divided by their sum"]
+    rounding = abs(total - 1.0) <= ROUNDING * len(w)   # 1/3 + 1/3 + 1/3 written out: no note
+    notes = [] if rounding else [f"weights summed to {total:.15g}: divided by their sum"]
     zero = int((w == 0).sum())
     if zero:
         notes.append(f"{zero} branch(es) of weight 0")

@@ -245,6 +245,17 @@ def test_plain_table_reads_and_refuses_another_imt(tmp_path):
         load_logic_tree(path)
 
 
+def test_weights_that_sum_to_one_in_decimals_are_not_noted(tmp_path):
+    """Weights written to the last digit (1/3 three times, 1/500 five hundred times) sum to
+    1 within the rounding of their sum: no note; 0.3333333 three times is noted."""
+    for n, text, noted in [(3, repr(1 / 3), False), (500, repr(1 / 500), False),
+                           (3, "0.3333333", True)]:
+        rows = [f"b{i},{text},{x},{r}" for i in range(n) for x, r in ((0.1, 1e-2), (0.5, 1e-3))]
+        tree = load_logic_tree(_plain(tmp_path, "\n".join(rows) + "\n", f"w{n}{noted}.csv"))
+        assert any("summed to" in note for note in tree.notes) == noted
+        assert tree.weights.sum() == pytest.approx(1.0, abs=1e-15)
+
+
 def _copy_case(tmp_path, realizations=None, drop=None):
     for f in CASE_11.glob("*.csv"):
         if f.name != drop:
