@@ -11,7 +11,9 @@ the shaking they share, :func:`pipeline.hazard.fragility.overturn_probability` "
 Exact for earthquakes as a Poisson process: the intervals do not overlap, so their
 survivals multiply.  lambda_i is the cell integration of :mod:`pipeline.hazard.survival`
 (the same cells, the exceedances of the last level counted at it), done for all branches
-at once: the cells' PGA does not depend on the branch, their rates do (:func:`cell_matrix`).
+at once: the cells' PGA does not depend on the branch, their rates do (:func:`cell_matrix`);
+a fragility's draws too, their probabilities at the cells times the cells' rates being one
+matrix product (:func:`branch_rates`).
 
 Rules: Bayes (w_i' proportional to w_i P_s,i: the survival is the likelihood of each
 branch; every branch keeps a weight in proportion to how well it explains the standing
