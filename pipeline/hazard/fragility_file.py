@@ -25,7 +25,8 @@ from pipeline.files import InputError
 from pipeline.userfiles import DATA_FILE_BYTES, nesting, number, read_json, show
 
 MAX_MEMBERS = 10_000           # parameter sets of a campaign
-MAX_RUNS = 10_000_000          # runs of one cell, column or fit
+MAX_RUNS = 10_000_000          # runs of one cell
+MAX_TOTAL = 10 ** 15           # runs of a column, model or fit (counts only, no allocation)
 MAX_AXIS = 1_000               # values on one axis of a pulse grid
 MAX_SET_VALUES = 10_000_000    # members x cells: the per-set array a grid allocates
 MAX_ENTRIES = 64               # column types or models in one file
@@ -149,9 +150,7 @@ def _check_columns(c, data):
         where = f"columns.{_key(column)}"
         c.obj(entry, where)
         c.text(entry.get("description"), f"{where}.description")
-        runs = c.integer(entry.get("runs"), f"{where}.runs", 0, MAX_RUNS, optional=True)
-        c.integer(entry.get("toppled"), f"{where}.toppled", 0,
-                  MAX_RUNS if runs is None else runs, optional=True)
+        _counts(c, entry, where, "runs", "toppled")
         if entry.get("PGA") is not None:
             _check_lognormal(c, entry["PGA"], f"{where}.PGA")
         if entry.get("logistic") is not None:
@@ -181,10 +180,10 @@ def _check_lognormal(c, fit, where):
 
 
 def _counts(c, entry, where, total, part):
-    n = c.integer(entry.get(total), f"{where}.{total}", 0, MAX_RUNS, optional=True)
-    c.integer(entry.get(part), f"{where}.{part}", 0, MAX_RUNS if n is None else n,
+    """Two counts of runs (integers, or absent), ``part`` of ``total``."""
+    n = c.integer(entry.get(total), f"{where}.{total}", 0, MAX_TOTAL, optional=True)
+    c.integer(entry.get(part), f"{where}.{part}", 0, MAX_TOTAL if n is None else n,
               optional=True)
-    return n
 
 
 def _check_logistic(c, surface, where):
