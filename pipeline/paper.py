@@ -17,7 +17,6 @@ COLUMN_KN_N_M = 1.2e8          # kn of the column model; here per rim contact po
 DAMPING_RATIO = 0.36           # contact damping ratio
 MU_STATIC = 0.7                # static friction coefficient
 MU_KINETIC = 0.6               # kinetic friction coefficient
-MU_K_OVER_MU_S = 0.84          # friction sweep: mu_k = 0.84 mu_s (0.6 / 0.7 rounded)
 
 # Pedestal: 5 x 5 x 1 m, 74 t, moved with the ground
 PEDESTAL_SIZE_M = 5.0

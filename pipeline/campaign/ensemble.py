@@ -11,8 +11,8 @@ Ranges (``ENSEMBLE_RANGES``, all around the paper's values; override with
 ``--vary NAME=LO,HI``):
 
 - ``mu_s`` 0.55-0.85: marble on marble; Hinzen (2009) used 0.7, DEM studies of
-  classical marble columns use values in this band; mu_k = 0.84 mu_s (the
-  paper's ratio) unless given;
+  classical marble columns use values in this band; mu_k = 0.6 / 0.7 mu_s (the
+  paper's ratio, :func:`pipeline.scenario.parameters.kinetic_friction`) unless given;
 - ``damping`` 0.2-0.5 around the paper's 0.36;
 - ``kn_factor`` 0.5-2 (log-uniform) on the paper's 1.2e8 N/m per point: the
   rocking response changes < 0.5 % for kn 1.2e7-1.2e9 (measured on the block);
@@ -52,7 +52,7 @@ from pipeline.campaign.options import (CampaignOptions, column_file_param, conta
                                        contact_of, refuse_ignored_stiffness,
                                        stiffness_param)
 from pipeline.scenario.contact_file import contact_values, refuse_set_twice
-from pipeline.scenario.parameters import check_time_step, param
+from pipeline.scenario.parameters import check_time_step, kinetic_friction, param
 from pipeline.campaign.column_file import description as column_file_description
 from pipeline.campaign.runs import column_specs, run_column_spec
 from pipeline.campaign.run_dirs import finished_summary
@@ -134,8 +134,7 @@ def sample_batches(members, batch, seed, ranges=None, column="both", description
     return rows[:members]
 
 
-def sample_members(members, seed, ranges=None, column="both", mu_k_ratio=paper.MU_K_OVER_MU_S,
-                   description=None, kn=paper.COLUMN_KN_N_M, first_index=0):
+def sample_members(members, seed, ranges=None, column="both", description=None, kn=paper.COLUMN_KN_N_M, first_index=0):
     """Parameters of ``members`` runs (list of dicts for run_column_spec), Latin hypercube
     (``seed``: an integer, or a list for a batch; members numbered from ``first_index``).
 
@@ -160,7 +159,7 @@ def sample_members(members, seed, ranges=None, column="both", mu_k_ratio=paper.M
         diameter = paper.COLUMN_HEIGHT_M / paper.COLUMN_HD * (1 + v.get("diameter_tolerance", 0.0))
         mu_s = round(v.get("mu_s", paper.MU_STATIC), 6)
         params = {"column": column, "hd": round(height / diameter, 6), "height": round(height, 6),
-                  "mu_s": mu_s, "mu_k": round(mu_k_ratio * mu_s, 6),
+                  "mu_s": mu_s, "mu_k": kinetic_friction(mu_s),
                   "damping": round(v.get("damping", paper.DAMPING_RATIO), 6),
                   "kn": round(kn * v.get("kn_factor", 1.0), 1),
                   "rim_phase_deg": round(v.get("rim_phase_deg", 0.0), 6)}

@@ -26,12 +26,13 @@ import numpy as np
 from scipy.stats import qmc
 
 from pipeline.campaign.column_file import column_kn
-from pipeline.campaign.shake_table import DEFAULT_CONTACT, GRID_CONTACT, GRID_SPECIMEN
+from pipeline.campaign.shake_table import GRID_CONTACT, GRID_SPECIMEN
 from pipeline.constants import STANDARD_GRAVITY
 from pipeline.files import InputError
 from pipeline.motion.pulses import one_cosine_pulse
 from pipeline.rocking import block_constants, rocking_response_sampled
 from pipeline.scenario.geometry import ColumnGeometry
+from pipeline.scenario.parameters import kinetic_friction
 from pipeline.stats.ensemble import logistic_surface, wilson_interval
 
 G = STANDARD_GRAVITY               # m/s^2 per g (the grid's PGA is in g)
@@ -46,7 +47,6 @@ PULSE_TAIL_S = 4.0                # at rest after the pulse: the body settles or
 RANGE_BOUNDS = {"kn": GRID_CONTACT["kn"], "damping": GRID_CONTACT["damping"],
                 "mu_s": GRID_CONTACT["mu_s"], **GRID_SPECIMEN}
 DEFAULT_RANGES = "kn=4e7:1.2e8;damping=0.05:0.1;mu_s=0.6:0.8;footprint_tolerance_m=0.001:0.003"
-MU_K_OVER_MU_S = DEFAULT_CONTACT["mu_k"] / DEFAULT_CONTACT["mu_s"]
 LOG_UNIFORM = ("kn",)
 CONTOUR_LEVELS = (0.16, 0.5, 0.84)
 # the long-run gate's cost of a run, at most (it stops early once the specimen has fallen
@@ -131,7 +131,7 @@ def parse_ranges(text, mesh=True):
 
 def sample_sets(members, seed, ranges):
     """``members`` parameter sets: one Latin hypercube over ``ranges`` (kn log-uniform);
-    mu_k = MU_K_OVER_MU_S mu_s."""
+    mu_k from mu_s by the contact's one rule (:func:`~pipeline.scenario.parameters.kinetic_friction`)."""
     names = sorted(ranges)
     if not names:
         return [{} for _ in range(members)]
@@ -147,7 +147,7 @@ def sample_sets(members, seed, ranges):
                 point[name] = float(lo + q * (hi - lo))
             point[name] = float(f"{point[name]:.6g}")
         if "mu_s" in point:
-            point["mu_k"] = round(MU_K_OVER_MU_S * point["mu_s"], 4)
+            point["mu_k"] = kinetic_friction(point["mu_s"])
         sets.append(point)
     return sets
 

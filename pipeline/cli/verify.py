@@ -7,8 +7,9 @@
 """
 from pathlib import Path
 
-from pipeline import RESULTS_DIR, paper
+from pipeline import RESULTS_DIR
 from pipeline.files import InputError
+from pipeline.scenario.parameters import MU_K_OVER_MU_S
 from pipeline.verification import (MARBLE_BLOCK, PULSE_BLOCK, SLIDING_BELOW, SLIDING_MU,
                                    CheckResult, check_sliding_mus, verify_housner,
                                    verify_one_cosine, verify_sine_pulse, verify_sliding)
@@ -40,7 +41,7 @@ def setup(p):
                     f"{min(SLIDING_MU):g})")
     sl.add_argument("--theta0-deg", type=float, default=10.0, help="initial tilt (10 deg)")
     sl.add_argument("--friction", choices=["switch", "static"], default="switch",
-                    help=f"switch: mu_s sticking, mu_k = {paper.MU_K_OVER_MU_S:g} mu_s sliding "
+                    help=f"switch: mu_s sticking, mu_k = {MU_K_OVER_MU_S:.3g} mu_s sliding "
                     "(default); "
                     "static: mu_s only, to see the effect of the kinetic coefficient")
     c = sub.add_parser("one-cosine", help="smallest overturning amplitude under a one-cosine "

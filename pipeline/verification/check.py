@@ -7,7 +7,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
-from pipeline import paper, rocking
+from pipeline import rocking
 from pipeline.files import InputError, content_hash, read_run_json, write_json
 from pipeline.scenario import Contact
 from pipeline.userfiles import number
@@ -60,7 +60,7 @@ class Check(Mapping):
         elif self.kind == "one-cosine":
             check_period(values["period_s"])
         else:
-            Contact(mu_s=values["mu_s"], mu_k=paper.MU_K_OVER_MU_S * values["mu_s"])
+            Contact(mu_s=values["mu_s"])
 
     @property
     def record(self):

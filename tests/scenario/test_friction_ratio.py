@@ -1,0 +1,30 @@
+"""The rule mu_k = ratio x mu_s has one home (the contact type) and every place that
+applies it gives the same kinetic friction: the paper's pair 0.6 / 0.7."""
+import re
+from pathlib import Path
+
+import pytest
+
+import pipeline
+from pipeline.campaign import ensemble, pulse_grid
+from pipeline.campaign.shake_table import grid_contact
+from pipeline.scenario import Contact
+
+PAPER_RATIO = 0.6 / 0.7          # the paper's mu_k / mu_s, the calibration's choice for SP1
+
+
+def test_the_ratio_is_defined_once_in_the_contact_type():
+    homes = [p.relative_to(Path(pipeline.__file__).parent).as_posix()
+             for p in Path(pipeline.__file__).parent.rglob("*.py")
+             if re.search(r"^\s*MU_K_OVER_MU_S\s*=", p.read_text(), re.M)]
+    assert homes == ["scenario/parameters.py"]
+
+
+@pytest.mark.parametrize("mu_s", [0.3, 0.5, 0.75])
+def test_every_place_gives_a_static_friction_the_same_kinetic_one(mu_s):
+    expected = pytest.approx(PAPER_RATIO * mu_s, abs=5e-5)
+    assert Contact(mu_s=mu_s).mu_k == expected
+    assert grid_contact({"mu_s": mu_s})["mu_k"] == expected
+    member = ensemble.sample_members(1, 3, {"mu_s": (mu_s, mu_s, "lin")})[0]
+    assert member["mu_k"] == expected
+    assert pulse_grid.sample_sets(1, 3, {"mu_s": (mu_s, mu_s)})[0]["mu_k"] == expected
