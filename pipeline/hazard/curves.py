@@ -23,7 +23,7 @@ Checks (a one-line InputError each): a file that is not a regular file (a named 
 refused before it is read) or is larger than 64 MB, an empty file, a missing IMT or
 investigation time, an IMT other than PGA, an unknown unit, unreadable numbers, a value of
 another type in the USGS JSON (metadata, imt, edition, vs30, coordinates), JSON nested too
-deep, levels not in (0, 20 g] or more than 1000 of them, negative rates or probabilities,
+deep, levels not in (0, 100 g] or more than 1000 of them, negative rates or probabilities,
 an infinite or NaN rate (OpenQuake's poe of 1 aside, below), levels not increasing, rates
 rising with the level (non-monotonic), fewer than two levels with a positive rate.  Said in ``notes``, never silent: levels dropped
 because their poe is 1 (an unbounded rate) and the rates of 0 at the top (the curve ends
@@ -46,7 +46,7 @@ PLAIN_RATE_COLUMN = "annual_rate_per_yr"
 OPENQUAKE_PGA_UNIT = "g"               # the engine's unit of PGA (and SA)
 _IMT = r"[A-Za-z]+(?:\([0-9.]+\))?"    # PGA, PGV, SA(0.1), ...
 _OQ_LEVEL = re.compile(rf"^(poe|{_IMT})-([^:]+)(?::\w+)?$")
-MAX_PGA_M_S2 = 20.0 * STANDARD_GRAVITY   # the highest level a curve may state (20 g)
+MAX_PGA_M_S2 = 100.0 * STANDARD_GRAVITY  # the highest level a curve may state (100 g)
 MAX_LEVELS = 1_000                       # levels of one curve (engines give 20-50)
 MAX_INVESTIGATION_YR = 1e7
 
@@ -316,7 +316,7 @@ def _curve(levels, rates, to_m_s2, unit, where, source, from_poe=False):
     for x in levels:
         if not (math.isfinite(x) and 0 < x <= top):
             raise InputError(f"{where}: level {x:g} {unit}: levels must be positive and at "
-                             f"most {top:g} {unit} (20 g)")
+                             f"most {top:g} {unit} (100 g)")
     for x, r in zip(levels, rates):
         if math.isinf(r) and not from_poe:
             raise InputError(f"{where}: rate at {x:g} {unit} is infinite")
