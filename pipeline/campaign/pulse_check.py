@@ -14,11 +14,11 @@ everywhere)."""
 import math
 
 import numpy as np
-from scipy.interpolate import RegularGridInterpolator
 
 from pipeline.campaign.shake_table import (EXPERIMENTS, OUTCOME, PGA_EDGES_G, PGV_PGA_EDGES_S,
                                            load_experiments)
 from pipeline.constants import STANDARD_GRAVITY as G
+from pipeline.hazard.pulse_cells import cell_table, interpolate
 from pipeline.stats.ensemble import logistic_probability, logistic_surface, wilson_interval
 
 SPECIMENS_WITH_TESTS = {"SP1": OUTCOME}
@@ -35,22 +35,14 @@ def scores(observed, probability):
 
 
 def grid_probability(cells, pga_g, ratio):
-    """P of the cells (a full PGV/PGA x PGA grid) at the tests, bilinear, clamped to it."""
-    pgas = sorted({c["pga_g"] for c in cells})
-    ratios = sorted({c["pgv_pga_s"] for c in cells})
-    values = np.full((len(ratios), len(pgas)), np.nan)
-    for c in cells:
-        values[ratios.index(c["pgv_pga_s"]), pgas.index(c["pga_g"])] = c["P"]
+    """P of the cells (a full PGV/PGA x PGA grid) at the tests by the pulse grid's one
+    interpolation (:func:`pipeline.hazard.pulse_cells.interpolate`: bilinear in ln PGA,
+    ln PGV/PGA, as survival reads it), the nearest edge cell's P outside the grid;
+    (P, outside), or (None, None) when the grid lacks a cell."""
+    pgas, ratios, values = cell_table(cells)
     if np.isnan(values).any():
         return None, None
-    x = np.clip(pga_g, pgas[0], pgas[-1])
-    r = np.clip(ratio, ratios[0], ratios[-1])
-    outside = (x != pga_g) | (r != ratio)
-    if len(pgas) == 1 or len(ratios) == 1:
-        axis = pgas if len(ratios) == 1 else ratios
-        return np.interp(x if len(ratios) == 1 else r, axis, values.ravel()), outside
-    interp = RegularGridInterpolator((ratios, pgas), values)
-    return interp(np.column_stack([r, x])), outside
+    return interpolate(pgas, ratios, values, pga_g, ratio)
 
 
 def experiments_check(section, specimen, experiments=EXPERIMENTS):

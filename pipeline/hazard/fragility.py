@@ -25,6 +25,7 @@ from scipy import stats
 from pipeline.constants import STANDARD_GRAVITY
 from pipeline.files import InputError
 from pipeline.hazard.fragility_file import MAX_MEMBERS, read_fragility_file
+from pipeline.hazard.pulse_cells import interpolate
 from pipeline.userfiles import DATA_FILE_BYTES, Unreadable, number, read_text, show
 
 Z95 = stats.norm.ppf(0.975)
@@ -365,7 +366,8 @@ class PulseGrid:
     no run) and ``outside``: the fitted logistic surface (or None).
 
     Inside the grid P is interpolated bilinearly in (ln PGA, ln PGV/PGA) between the
-    cells' fractions: no functional form is imposed, and the cells are where the runs are.
+    cells' fractions (:mod:`pipeline.hazard.pulse_cells`, the one interpolation of a
+    pulse grid): no functional form is imposed, and the cells are where the runs are.
     Above the grid's PGA and beside its PGV/PGA P follows the logistic surface fitted to
     the same runs from the nearest edge cell: its log-odds shifted to meet that cell's P
     (continuous at the edge; the surface's trend carries it outwards); without a surface,
@@ -440,25 +442,23 @@ class PulseGrid:
         return self.pga_m_s2[0], self.pga_m_s2[-1]
 
     def _surface(self, cells, pga, ratio):
-        """Bilinear inside the grid; outside, the logistic surface's trend carried from the
-        nearest edge cell (its log-odds shifted to meet that cell's P, so P is continuous
-        at the edge and a cell of P 0 or 1 stays so; the raw surface, with its steps, for
-        ``below`` "logistic"), or without a surface the edge cell's P."""
-        points = np.stack([np.log(pga), np.log(ratio)], axis=-1)
-        ln_a, ln_r = np.log(self.pga_m_s2), np.log(self.pgv_pga_s)
-        inside = _interpolator(ln_a, ln_r, _fill_empty(cells))
-        within = ((points[..., 0] >= ln_a[0]) & (points[..., 0] <= ln_a[-1])
-                  & (points[..., 1] >= ln_r[0]) & (points[..., 1] <= ln_r[-1]))
-        edge = _clip_points(points, ln_a, ln_r)
-        held = inside(edge)                                   # the edge cell's P outside
+        """Inside the grid the cells' one interpolation (:mod:`pipeline.hazard.pulse_cells`:
+        bilinear in ln PGA, ln PGV/PGA); outside, the logistic surface's trend carried from
+        the nearest edge cell (its log-odds shifted to meet that cell's P, so P is
+        continuous at the edge and a cell of P 0 or 1 stays so; the raw surface, with its
+        steps, for ``below`` "logistic"), or without a surface the edge cell's P."""
+        held, beyond = interpolate(self.pga_m_s2, self.pgv_pga_s, _fill_empty(cells),
+                                   pga, ratio)               # the edge cell's P outside
         if self.outside is None:
             out = held
         elif self.below == "logistic":
             out = self.outside.probability(pga, ratio)
         else:
+            edge_a = np.clip(pga, self.pga_m_s2[0], self.pga_m_s2[-1])
+            edge_r = np.clip(ratio, self.pgv_pga_s[0], self.pgv_pga_s[-1])
             out = _carried(held, self.outside.probability(pga, ratio),
-                           self.outside.probability(np.exp(edge[..., 0]), np.exp(edge[..., 1])))
-        return np.clip(np.where(within, held, out), 0.0, 1.0)
+                           self.outside.probability(edge_a, edge_r))
+        return np.clip(np.where(beyond, out, held), 0.0, 1.0)
 
     def draws(self, n, rng):
         """``n`` grids with every cell's count redrawn Binomial(n_cell, P_cell): the Monte
@@ -555,20 +555,6 @@ class PulseGrid:
                 "note": note}
 
 
-def _interpolator(ln_a, ln_r, cells):
-    """Bilinear in (ln PGA, ln PGV/PGA) over the cells, asked only inside the grid's box.
-    An axis of one value (a grid of one row or column) is doubled a unit apart with its
-    cells: the points asked lie on the value, so P is interpolated along the other axis
-    only."""
-    from scipy.interpolate import RegularGridInterpolator  # noqa: PLC0415
-    axes = [np.asarray(ln_a, float), np.asarray(ln_r, float)]
-    for k in (0, 1):
-        if len(axes[k]) == 1:
-            axes[k] = np.array([axes[k][0], axes[k][0] + 1.0])
-            cells = np.concatenate([cells, cells], axis=k)
-    return RegularGridInterpolator(tuple(axes), cells, bounds_error=False, fill_value=None)
-
-
 def _carried(p_edge, surface, surface_at_edge):
     """P outside a grid: logit P = logit p_edge + logit surface - logit surface_at_edge."""
     from scipy.special import expit, logit  # noqa: PLC0415
@@ -577,12 +563,6 @@ def _carried(p_edge, surface, surface_at_edge):
              - logit(np.clip(surface_at_edge, tiny, 1 - tiny)))
     with np.errstate(divide="ignore"):
         return expit(logit(np.clip(p_edge, 0.0, 1.0)) + shift)
-
-
-def _clip_points(points, ln_a, ln_r):
-    """Points held inside the grid's box (the interpolator is only asked inside)."""
-    return np.stack([np.clip(points[..., 0], ln_a[0], ln_a[-1]),
-                     np.clip(points[..., 1], ln_r[0], ln_r[-1])], axis=-1)
 
 
 def _fill_empty(cells):

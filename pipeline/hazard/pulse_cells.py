@@ -1,0 +1,56 @@
+"""The one interpolation of a pulse grid's cells: P(overturn) at any (PGA, PGV/PGA) from
+the fractions of runs that overturned in the cells of ``campaign fragility --pulses``.
+Survival (:class:`pipeline.hazard.fragility.PulseGrid`) and the shake-table check of a
+fragility (:mod:`pipeline.campaign.pulse_check`) read P from cells through it, so the
+same cells give the same P to both.
+
+Space: bilinear in (ln PGA, ln PGV/PGA).  The fragility's smooth form, Purvance et
+al.'s logistic surface, is linear in ln PGA and ln PGV/PGA (log-odds), and a rocking
+body's threshold scales with ratios of these quantities (the overturning amplitude of a
+block grows with omega_p / p, a ratio): equal steps in log are equal steps in what
+decides overturning.  The Virtual Shake Robot's grid is linear (PGA 0.2-1.1 g, PGV/PGA
+0.1-1.0 s in steps of 0.1), so its first PGV/PGA cells span a factor of 2 while its last
+span 1.1: linear interpolation there would put the midpoint of a factor-2 cell at its
+arithmetic mean, log at its geometric one.  Log space is also free of units (g or
+m/s^2 give the same P).
+
+Outside the grid's box: the nearest edge cell's P (the point held on the box, each
+axis clipped on its own), with a mask of the points outside, so that a caller says
+what it does there: the shake-table check keeps the edge P and counts the tests
+outside; survival carries the logistic surface's trend from that edge P, or ramps P
+below the first PGA (docs/survival.md).
+"""
+import numpy as np
+from scipy.interpolate import RegularGridInterpolator
+
+
+def cell_table(cells, pga_key="pga_g", ratio_key="pgv_pga_s", p_key="P"):
+    """The axes and P of a list of cells (dicts): (pga, ratio, values n_pga x n_ratio);
+    values NaN where the list has no cell."""
+    pgas = sorted({c[pga_key] for c in cells})
+    ratios = sorted({c[ratio_key] for c in cells})
+    values = np.full((len(pgas), len(ratios)), np.nan)
+    for c in cells:
+        values[pgas.index(c[pga_key]), ratios.index(c[ratio_key])] = c[p_key]
+    return np.array(pgas, float), np.array(ratios, float), values
+
+
+def interpolate(pga_axis, ratio_axis, values, pga, ratio):
+    """P at (pga, ratio) from the cells ``values`` (n_pga x n_ratio, no NaN) on the
+    increasing axes (PGA and PGV/PGA, any one unit each, the points in the same):
+    bilinear in (ln PGA, ln PGV/PGA), the nearest edge cell's P outside the grid's box
+    (an axis of one value: along the other axis only).  Returns (P, outside) as arrays
+    of the points' broadcast shape; outside True where a point lies beyond the box."""
+    pga, ratio = np.broadcast_arrays(np.asarray(pga, float), np.asarray(ratio, float))
+    ln_a, ln_r = np.log(np.asarray(pga_axis, float)), np.log(np.asarray(ratio_axis, float))
+    with np.errstate(divide="ignore", invalid="ignore"):     # a zero is below any grid
+        ln_pga, ln_ratio = np.log(pga), np.log(ratio)
+    x, y = np.clip(ln_pga, ln_a[0], ln_a[-1]), np.clip(ln_ratio, ln_r[0], ln_r[-1])
+    outside = (x != ln_pga) | (y != ln_ratio)
+    axes, cells = [ln_a, ln_r], np.asarray(values, float)
+    for k in (0, 1):           # one value: doubled a unit apart, the points lie on it
+        if len(axes[k]) == 1:
+            axes[k] = np.array([axes[k][0], axes[k][0] + 1.0])
+            cells = np.concatenate([cells, cells], axis=k)
+    p = RegularGridInterpolator(tuple(axes), cells)(np.stack([x, y], axis=-1))
+    return np.clip(p, 0.0, 1.0), outside
