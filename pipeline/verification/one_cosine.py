@@ -27,7 +27,7 @@ MR_PERIOD_S = 1.0
 MR_STANDS_G, MR_OVERTURNS_G = 0.6245, 0.6255             # their Fig. 11
 TOLERANCE_2D = 0.005          # relative, the 2D block's threshold against Fig. 11
 # YADE against the 2D block (relative): rounded rims (pivot moved ~0.3 % of R), the
-# restitution of a critically damped contact (~0.5 % above Housner's), the finite
+# restitution of a critically damped contact (within 0.2 % of Housner's), the finite
 # stiffness (the pivot sinks and slides a little: no rigid corner) and the bisection
 TOLERANCE_YADE = 0.02
 EQ43_SPREAD = 0.16            # the stated accuracy of eq. 43
