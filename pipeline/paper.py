@@ -17,6 +17,9 @@ COLUMN_KN_N_M = 1.2e8          # kn of the column model; here per rim contact po
 DAMPING_RATIO = 0.36           # contact damping ratio
 MU_STATIC = 0.7                # static friction coefficient
 MU_KINETIC = 0.6               # kinetic friction coefficient
+# The friction sweep (Fig. 10): "mu_k was always set to 84% of mu_s" (the paper's own
+# rule for that sweep, not the model's contact rule)
+FRICTION_SWEEP_MU_K_OVER_MU_S = 0.84
 
 # Pedestal: 5 x 5 x 1 m, 74 t, moved with the ground
 PEDESTAL_SIZE_M = 5.0

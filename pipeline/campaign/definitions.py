@@ -23,7 +23,7 @@ from pipeline.files import (InputError, code_hash, content_hash, write_csv,
 from pipeline.motion import Motion, synthetics
 from pipeline.records import resolve, sets
 from pipeline.records.processing import signal_end_s
-from pipeline.scenario.parameters import MU_K_OVER_MU_S, kinetic_friction, param
+from pipeline.scenario.parameters import param
 from pipeline.simulate import run_code_version
 from pipeline.stats.circular import direction_table
 from pipeline.motion.synthetics import rupture_centre
@@ -77,7 +77,7 @@ def friction_specs(records, campaign_dir, column_file=None, stiffness="matched",
     check_stiffness(stiffness)
     contact = _contact(contact_file)
     refuse_set_twice(contact, ("mu_s", "mu_k"), "the friction campaign's sweep")
-    runs = [(r, twin(mu_s=mu, mu_k=kinetic_friction(mu)))
+    runs = [(r, twin(mu_s=mu, mu_k=round(paper.FRICTION_SWEEP_MU_K_OVER_MU_S * mu, 4)))
             for r in _records_or(records, [paper.SWEEP_RECORD, pulse_record()])
             for mu in paper.FRICTION_MU_S]
     return mark(column_specs(with_contact(described_twins(runs, data, stiffness), contact),
@@ -92,7 +92,7 @@ register(Campaign(
 
 register(Campaign(
     "friction", f"mu_s {paper.FRICTION_MU_S[0]:g}-{paper.FRICTION_MU_S[-1]:g} "
-    f"(mu_k = {MU_K_OVER_MU_S:.3g} mu_s)",
+    f"(mu_k = {paper.FRICTION_SWEEP_MU_K_OVER_MU_S:g} mu_s, the paper's rule)",
     friction_specs, run_column_spec, column_outputs("friction", "mu_s"),
     options=ColumnFileOptions))
 

@@ -28,3 +28,15 @@ def test_every_place_gives_a_static_friction_the_same_kinetic_one(mu_s):
     member = ensemble.sample_members(1, 3, {"mu_s": (mu_s, mu_s, "lin")})[0]
     assert member["mu_k"] == expected
     assert pulse_grid.sample_sets(1, 3, {"mu_s": (mu_s, mu_s)})[0]["mu_k"] == expected
+
+
+def test_the_papers_friction_sweep_keeps_its_own_rule(monkeypatch, tmp_path):
+    """Fig. 10's sweep: "the coefficient of kinematic friction mu_k was always set to 84%
+    of mu_s" (Hinzen 2009): a fact of the paper's experiment, not the contact rule."""
+    from pipeline.campaign import definitions
+    monkeypatch.setattr(definitions, "column_specs", lambda runs, campaign_dir: runs)
+    runs = definitions.friction_specs(["a record"], tmp_path)
+    pairs = {(p["mu_s"], p["mu_k"]) for _, p in runs}
+    assert len(pairs) == 9
+    for mu_s, mu_k in pairs:
+        assert mu_k == pytest.approx(0.84 * mu_s, abs=5e-5)
