@@ -1,6 +1,7 @@
 """Fragility figures: lognormal curves with binned observations (Wilson intervals) per
 intensity measure, the 3D columns against the 2D rigid block per record and level,
 and the logistic (PGA, PGV/PGA) surface."""
+import textwrap
 from pathlib import Path
 
 import numpy as np
@@ -229,21 +230,26 @@ def plot_pulse_grid(summary, path):
 
 
 def _mark_outside(ax, section, name, ratios, pgas):
-    """Where the specimen's P = 0.5 contour leaves the grid: a red arrow at the edge it
-    leaves by, per PGV/PGA, and the warnings of fragility.json written on the axes."""
+    """Where the specimen's contours leave the grid (``outside_grid`` of fragility.json):
+    a red arrow per PGV/PGA at the edge the P = 0.5 contour leaves by, and one red line per
+    level and side under the axes."""
     edges = _edges(pgas)
-    for side, y, marker in (("below", edges[0], "v"), ("above", edges[-1], "^")):
-        rows = [r["pgv_pga_s"] for r in section["models"][name]["contours"].get("0.5", [])
-                if r.get("outside_grid") == side]
-        if rows:
-            ax.plot(rows, [y] * len(rows), ls="none", marker=marker, color="C3", ms=7,
-                    clip_on=False, zorder=6, label=f"P = 0.5 {side} the grid")
-    said = [w.split(": ", 1)[1].split(": the grid")[0]
-            for w in section.get("warnings", []) if w.startswith(f"{name}: ")]
+    said = []
+    for level, rows in section["models"][name]["contours"].items():
+        for side, y, marker, edge in (("below", edges[0], "v", min(pgas)),
+                                      ("above", edges[-1], "^", max(pgas))):
+            out = [r["pgv_pga_s"] for r in rows if r.get("outside_grid") == side]
+            if not out:
+                continue
+            said.append(f"P = {level} {side} the grid ({edge:g} g) at PGV/PGA "
+                        f"{', '.join(f'{v:g}' for v in out)} s")
+            if level == "0.5":
+                ax.plot(out, [y] * len(out), ls="none", marker=marker, color="C3", ms=7,
+                        clip_on=False, zorder=6, label=f"P = 0.5 {side} the grid")
     if said:
-        ax.text(0.02, 0.02, "warning: contour outside the grid\n" + "\n".join(said),
-                transform=ax.transAxes, fontsize=5, color="C3", va="bottom", wrap=True,
-                bbox={"facecolor": "white", "alpha": 0.8, "lw": 0})
+        text = "\n".join(textwrap.fill(line, 70) for line in said)
+        ax.text(0.5, -0.16, "warning: contours leave the grid\n" + text,
+                transform=ax.transAxes, ha="center", va="top", fontsize=6, color="C3")
 
 
 def _edges(centres):

@@ -32,9 +32,9 @@ def field_rock_section(results, prefix=FIELD_ROCK):
     if prefix == FIELD_ROCK:
         size, command = f"Full size: {full} (docs/field-rock.md).", full
     else:
-        size = ("Reduced size, as `make run-all` runs it (2 parameter sets x 2 directions "
-                "over a coarser pulse grid: wider Monte Carlo intervals, coarser contours); "
-                f"the full size is {full}.")
+        size = ("Reduced size, as `make run-all` runs it (the same 4 parameter sets x 4 "
+                "directions over a coarser pulse grid, 6 x 4 cells: coarser contours); the "
+                f"full size is {full}.")
         command = "`make run-all`"
     lines = [f"## {heading}\n",
              "Double Rock, a precariously balanced granite rock of the Granite Dells, "
