@@ -320,6 +320,7 @@ def study_summary(trials):
                      "coverage_back_azimuth_95": hit / n, "coverage_ci95": ci,
                      "calibrated": bool(ci[0] <= 0.95 <= ci[1]),
                      "width_median_deg": float(g["width95_deg"].median()),
+                     **_directed(g["width95_deg"]),
                      BOUNDED_FRACTION_KEY: float((g["width95_deg"] <= BOUND_DEG).mean()),
                      "coverage_epicentre_95": float(g["epicentre_in_95"].mean()),
                      "coverage_epicentre_ci95": wilson_interval(int(g["epicentre_in_95"].sum()),
@@ -440,6 +441,9 @@ def study_answer(summary):
                  f"{int(big['fallen_per_site'])} fallen) the median arc is "
                  f"{big['width_median_deg']:.0f} deg, coverage "
                  f"{big['coverage_back_azimuth_95']:.2f}")
+        if big.get("directed_fraction", 1.0) < 1.0 and big["directed_fraction"] > 0:
+            text += (f" ({100 * big['directed_fraction']:.0f} % of the trials give a direction, "
+                     f"their median arc {big['width_median_directed_deg']:.0f} deg)")
         if not trend.empty and int(trend.iloc[0]["likelihood_members"]) != size:
             text += (f" ({trend.iloc[0]['width_median_deg']:.0f} deg, coverage "
                      f"{trend.iloc[0]['coverage_back_azimuth_95']:.2f} with "
@@ -455,3 +459,13 @@ def study_answer(summary):
                  f"{big['coverage_mw_95']:.2f} of the trials")
         out[kind] = text
     return out
+
+
+def _directed(widths_deg):
+    """The share of trials that give a direction (a 95 % arc under 360 deg: a warned
+    trial gives the whole circle) and their median arc (deg; NaN when none does)."""
+    directed = widths_deg[widths_deg < 360.0]
+    return {"directed_fraction": float(len(directed) / len(widths_deg)) if len(widths_deg)
+            else float("nan"),
+            "width_median_directed_deg": float(directed.median()) if len(directed)
+            else float("nan")}
