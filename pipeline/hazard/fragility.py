@@ -447,18 +447,20 @@ class PulseGrid:
         the nearest edge cell (its log-odds shifted to meet that cell's P, so P is
         continuous at the edge and a cell of P 0 or 1 stays so; the raw surface, with its
         steps, for ``below`` "logistic"), or without a surface the edge cell's P."""
+        pga, ratio = np.broadcast_arrays(np.asarray(pga, float), np.asarray(ratio, float))
         held, beyond = interpolate(self.pga_m_s2, self.pgv_pga_s, _fill_empty(cells),
                                    pga, ratio)               # the edge cell's P outside
-        if self.outside is None:
-            out = held
-        elif self.below == "logistic":
-            out = self.outside.probability(pga, ratio)
-        else:
-            edge_a = np.clip(pga, self.pga_m_s2[0], self.pga_m_s2[-1])
-            edge_r = np.clip(ratio, self.pgv_pga_s[0], self.pgv_pga_s[-1])
-            out = _carried(held, self.outside.probability(pga, ratio),
-                           self.outside.probability(edge_a, edge_r))
-        return np.clip(np.where(beyond, out, held), 0.0, 1.0)
+        p = np.array(held, float)
+        if self.outside is not None and beyond.any():      # the surface only where needed
+            a, r = pga[beyond], ratio[beyond]
+            if self.below == "logistic":
+                p[beyond] = self.outside.probability(a, r)
+            else:
+                edge_a = np.clip(a, self.pga_m_s2[0], self.pga_m_s2[-1])
+                edge_r = np.clip(r, self.pgv_pga_s[0], self.pgv_pga_s[-1])
+                p[beyond] = _carried(held[beyond], self.outside.probability(a, r),
+                                     self.outside.probability(edge_a, edge_r))
+        return np.clip(p, 0.0, 1.0)
 
     def draws(self, n, rng):
         """``n`` grids with every cell's count redrawn Binomial(n_cell, P_cell): the Monte
