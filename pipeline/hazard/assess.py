@@ -304,7 +304,8 @@ def _above_grid_warning(outside, described, rate):
     top = outside["pga_range_g"][1]
     how = (described.get("above_grid") or {}).get("summary", "P extended above it")
     return [f"the hazard curve reaches {outside['hazard_last_level_g']:.3g} g, {reach:.3g} x "
-            f"the grid's top PGA {top:.3g} g; above it {how}; PGA above {top:.3g} g has the "
+            f"the grid's top PGA {top:.3g} g (on the hazard's PGA); above it {how}; PGA above "
+            f"{top:.3g} g has the "
             f"rate {outside['hazard_rate_above_grid_per_yr']:.3g} /yr against the overturning "
             f"rate {rate:.3g} /yr (P = 1 above the grid: "
             f"{outside['rate_per_yr_one_above_grid']:.3g} /yr)"]
