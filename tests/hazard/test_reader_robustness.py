@@ -382,3 +382,14 @@ def test_every_cell_is_read_back_at_its_place(tmp_path):
         for r in (0.1, 0.2):
             assert grid.probability(np.array([a * G]), np.array([r]))[0] == pytest.approx(
                 round(100 * p_of(a, r)) / 100)
+
+
+@pytest.mark.parametrize("depth, message", [(100_000, "nested too deep"),
+                                            (40, "nested deeper than 32 levels")])
+def test_a_fragility_file_nested_deep_is_refused_in_one_line(tmp_path, capsys, depth, message):
+    text = '{"columns": {"monolithic": {"note": ' + "[" * depth + "]" * depth + "}}}"
+    path = write(tmp_path / "fragility.json", text)
+    with pytest.raises(InputError, match=message) as caught:
+        load_campaign_fragility(path)
+    assert "\n" not in str(caught.value)
+    _survival_refuses(tmp_path, capsys, ["--fragility", str(path)], message)
