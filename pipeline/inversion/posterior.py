@@ -352,11 +352,13 @@ class Posterior:
 
 def edge_bayes_factor(fraction, prior_fraction):
     """(f / (1 - f)) / (p / (1 - p)): how much more the posterior than the prior favours
-    the outermost cells (inf when f is 1, 0 when f is 0)."""
-    f = min(max(float(fraction), 0.0), 1.0)
-    p = min(max(float(prior_fraction), 1e-300), 1.0 - 1e-16)
-    if f >= 1.0:
-        return math.inf
+    the outermost cells; finite (f and p held within 1e-12 of 0 and 1, a JSON number), and
+    1 when every candidate cell is an outermost one (the data cannot favour them)."""
+    tiny = 1e-12
+    p = min(max(float(prior_fraction), tiny), 1.0 - tiny)
+    if float(prior_fraction) >= 1.0 - tiny:
+        return 1.0
+    f = min(max(float(fraction), 0.0), 1.0 - tiny)
     return float((f / (1.0 - f)) / (p / (1.0 - p)))
 
 

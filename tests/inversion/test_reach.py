@@ -169,3 +169,16 @@ def test_a_hidden_truth_out_of_reach_is_refused_before_any_run(table, tmp_path, 
     err = capsys.readouterr().err
     assert "sites A and B lie 26.0 km apart" in err and len(err.strip().splitlines()) == 1
     assert not out.exists()
+
+
+def test_edge_bayes_factor_is_a_finite_number_at_the_ends():
+    """All the posterior in the outermost cells: a large finite factor (JSON holds it);
+    every candidate an outermost cell: the data cannot favour them, factor 1."""
+    import math
+
+    from pipeline.inversion.posterior import edge_bayes_factor
+    assert math.isfinite(edge_bayes_factor(1.0, 0.3))
+    assert edge_bayes_factor(1.0, 0.3) > EDGE_BAYES_FACTOR
+    assert edge_bayes_factor(1.0, 1.0) == 1.0
+    assert edge_bayes_factor(0.5, 0.5) == 1.0
+    assert edge_bayes_factor(0.0, 0.3) == 0.0
