@@ -21,6 +21,8 @@ from pipeline.report.campaigns import (columns_section, contact_stiffness_sectio
 from pipeline.report.field_rock import FIELD_ROCK_QUICK, field_rock_section
 from pipeline.report.hazard import survival_section
 from pipeline.report.inversion import inversion_section, member_study_section
+from pipeline.report.shake_table_scores import QUICK as SCORES_QUICK
+from pipeline.report.shake_table_scores import shake_table_scores_section
 from pipeline.report.records import (back_azimuth_table, correlation_table, per_record_table,
                                      processing_section, record_orientation, records_section,
                                      records_statements, synthetic_section, toppled_fractions,
@@ -34,7 +36,7 @@ __all__ = ["build_report", "back_azimuth_table", "columns_section",
            "member_study_section", "per_record_table",
            "processing_section", "record_orientation", "records_section", "records_statements",
            "rock_fragility_section", "run_all_section",
-           "shake_table_section", "speed_section", "survival_section", "sweep_section",
+           "shake_table_scores_section", "shake_table_section", "speed_section", "survival_section", "sweep_section",
            "synthetic_section",
            "toppled_fractions", "verification_section", "wilson_interval", "with_back_azimuth"]
 
@@ -63,7 +65,8 @@ def build_report(results=RESULTS_DIR):
         sweep_section(results, "friction", "mu_s",
                       "friction had a minor influence on downfall directions; with mu_s = 0.1 "
                       "neither column toppled (they slid instead)."),
-        shake_table_section(results), contact_stiffness_section(results),
+        shake_table_section(results), shake_table_scores_section(results),
+        shake_table_scores_section(results, SCORES_QUICK), contact_stiffness_section(results),
         rock_fragility_section(results),
         rock_fragility_section(results, "rock-fragility-table"), survival_section(results),
         field_rock_section(results), field_rock_section(results, FIELD_ROCK_QUICK),

@@ -1,0 +1,108 @@
+"""REPORT section of the members mode of ``campaign shake-table``: each laboratory test
+as a probability, scored as a forecast (``shake_table_members.json`` of ``make
+shake-table-scores``, or of ``make shake-table-scores-quick`` / ``make run-all`` at a
+reduced size)."""
+import json
+
+import pandas as pd
+
+from pipeline.report.common import _figure, _table
+
+FULL = "shake-table-scores"
+QUICK = "shake-table-scores-quick"
+SPLITS = (("validation", "held out"), ("calibration", "calibration"), ("all", "all"))
+BASELINES = (("members", "members (P with its Monte Carlo error)"),
+             ("single_set", "one parameter set (the calibration's choice)"),
+             ("never_overturns", "never overturns"),
+             ("pga_threshold", "overturns when PGA >= g tan(critical angle)"))
+HELD_OUT_ACCURACY_GOAL = 0.90   # accuracy of P > 0.5 on the held-out tests the model aims at
+
+
+def shake_table_scores_section(results, name=FULL):
+    """The scores per split of the members, the single set, the baselines and the
+    providers' best in-sample model, and the reliability diagram; says when not run."""
+    path = results / name / "shake_table_members.json"
+    quick = name == QUICK
+    heading = "Shake-table tests as probabilities" + (" (reduced)" if quick else
+                                                         " (full scoring)")
+    command = "`make shake-table-scores-quick` (run by `make run-all`)" if quick \
+        else "`make shake-table-scores`"
+    lines = [f"## {heading}\n"]
+    if not path.is_file():
+        return "\n".join(lines + [f"Not run yet ({command}).\n"])
+    summary = json.loads(path.read_text())
+    lines.append(_intro(summary, quick))
+    for split, label in SPLITS:
+        part = summary.get("splits", {}).get(split)
+        if part:
+            lines.append(f"**{label.capitalize()}** ({part.get('tests', '?')} tests, "
+                         f"{part.get('member_runs', '?')} member runs):\n")
+            lines.append(_table(_score_rows(part)) + "\n")
+    held_out = summary.get("splits", {}).get("validation")
+    if held_out:
+        lines.append(_verdict(held_out))
+    lines.append(_figure(results, results / name / "shake_table_reliability.png",
+                         "Reliability diagram: observed overturning rate against the "
+                         "predicted P, per bin, with Wilson 95 % intervals"))
+    return "\n".join(lines)
+
+
+def _intro(summary, quick):
+    size = (f"A reduced run ({summary.get('runs', '?')} runs); the full scoring is `make "
+            "shake-table-scores`: its numbers are the model's, these the method's. "
+            if quick else f"{summary.get('runs', '?')} runs. ")
+    return (f"The specimen {summary.get('specimen', '?')} on every named test with the "
+            f"fragility's members (at most {summary.get('members', '?')} a test, stopped early "
+            "when they agree), each test's P scored as a forecast against what the laboratory "
+            f"saw; tests from {summary.get('validate_from', '?')} on are held out from the "
+            f"calibration. {size}Log-likelihood per test (higher is better; {_rule(summary)}), "
+            "Brier score (lower is better) = reliability - resolution + uncertainty, and the "
+            "accuracy of P > 0.5. The providers' models are their own in-sample 0/1 "
+            "predictions, the best of them by log-likelihood shown.\n")
+
+
+def _rule(summary):
+    rule = summary.get("rules", "")
+    return rule.split(";")[0] if rule else "P held away from 0 and 1"
+
+
+def _score_rows(part):
+    rows = []
+    for key, label in BASELINES:
+        if key in part:
+            rows.append(_row(label, part[key]))
+    providers = part.get("providers") or {}
+    if providers:
+        best = max(providers, key=lambda k: providers[k]["log_likelihood_per_test"])
+        rows.append(_row(f"providers' best in-sample model ({best})", providers[best]))
+    return pd.DataFrame(rows)
+
+
+def _row(label, scores):
+    return {"forecast": label,
+            "log-likelihood / test": f"{scores['log_likelihood_per_test']:.3f}",
+            "Brier": f"{scores['brier']:.3f}",
+            "reliability": f"{scores['reliability']:.3f}",
+            "resolution": f"{scores['resolution']:.3f}",
+            "accuracy": f"{scores['accuracy']:.3f}",
+            "balanced accuracy": f"{scores['balanced_accuracy']:.3f}"}
+
+
+def _verdict(part):
+    """Whether the members beat the single set and the providers' models on the held-out
+    tests (log-likelihood and Brier) and reach the accuracy goal."""
+    members = part["members"]
+    others = {"the single set": part.get("single_set")}
+    others.update({f"the providers' {k}": v for k, v in (part.get("providers") or {}).items()})
+    beaten = [n for n, s in others.items() if s is not None
+              and members["log_likelihood_per_test"] > s["log_likelihood_per_test"]
+              and members["brier"] < s["brier"]]
+    compared = [n for n, s in others.items() if s is not None]
+    reached = members["accuracy"] >= HELD_OUT_ACCURACY_GOAL
+    return (f"On the held-out tests the members' log-likelihood and Brier score are both "
+            f"better than those of {len(beaten)} of the {len(compared)} other forecasts"
+            + (f" (not: {', '.join(n for n in compared if n not in beaten)})"
+               if len(beaten) < len(compared) else "")
+            + f"; the accuracy of P > 0.5 is {members['accuracy']:.3f}, "
+            + ("at or above" if reached else "below")
+            + f" the {HELD_OUT_ACCURACY_GOAL:.2f} the model aims at.\n")

@@ -1,0 +1,45 @@
+"""The REPORT section of the members mode: the scores it quotes are the file's, and its
+verdict on the held-out tests follows from them (a file written here, not by a run)."""
+import json
+
+from pipeline.report.shake_table_scores import (FULL, QUICK, HELD_OUT_ACCURACY_GOAL,
+                                                shake_table_scores_section)
+
+
+def _scores(ll, brier, accuracy):
+    return {"log_likelihood_per_test": ll, "brier": brier, "reliability": 0.01,
+            "resolution": 0.05, "uncertainty": 0.2, "accuracy": accuracy,
+            "balanced_accuracy": accuracy}
+
+
+def _write(results, name, members_accuracy, provider_ll, provider_brier):
+    validation = {"tests": 10, "member_runs": 40,
+                  "members": _scores(-0.312, 0.0734, members_accuracy),
+                  "single_set": _scores(-0.40, 0.08, 0.9),
+                  "providers": {"kn1": _scores(provider_ll, provider_brier, 0.9)}}
+    (results / name).mkdir(parents=True)
+    (results / name / "shake_table_members.json").write_text(json.dumps(
+        {"specimen": "SP1", "members": 8, "runs": 50, "validate_from": "2021-08-01",
+         "splits": {"validation": validation}}))
+
+
+def test_not_run_yet_names_the_command(tmp_path):
+    text = shake_table_scores_section(tmp_path, FULL)
+    assert "Not run yet" in text and "make shake-table-scores" in text
+    assert "make run-all" in shake_table_scores_section(tmp_path, QUICK)
+
+
+def test_quotes_the_files_scores_and_judges_the_held_out_tests(tmp_path):
+    _write(tmp_path, FULL, members_accuracy=0.95, provider_ll=-0.2, provider_brier=0.06)
+    text = shake_table_scores_section(tmp_path, FULL)
+    assert "-0.312" in text and "0.073" in text
+    # the provider has the better log-likelihood: not beaten, and named
+    assert "better than those of 1 of the 2 other forecasts (not: the providers' kn1)" in text
+    assert f"0.950, at or above the {HELD_OUT_ACCURACY_GOAL:.2f}" in text
+
+
+def test_an_accuracy_under_the_goal_is_said(tmp_path):
+    _write(tmp_path, QUICK, members_accuracy=0.8, provider_ll=-0.9, provider_brier=0.09)
+    text = shake_table_scores_section(tmp_path, QUICK)
+    assert "(reduced)" in text and "2 of the 2 other forecasts" in text
+    assert "0.800, below the" in text
