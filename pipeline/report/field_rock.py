@@ -18,10 +18,13 @@ NO_PUBLISHED = ("No published fragility exists for this rock to compare with: it
                 "(Chen et al. 2024, Seismica 3(1)) use the mesh to demonstrate their simulator "
                 "and report no overturning surface for it.")
 HAZARD_NOTE = ("The hazard is illustrative, not Arizona's: the OpenQuake engine's logic-tree "
-               "quality-assurance case 11 (`records/hazard/openquake_logictree_case_11/`: one "
-               "point source under a fictional site at 0 N, 0 E, its maximum magnitude 7.0 "
-               "+0.5, 0, -0.5 on branches of weight 0.2, 0.6, 0.2). The numbers below show what "
-               "the toolkit does with a rock's survival, not the hazard at Granite Dells.")
+               "quality-assurance case 19 (`records/hazard/openquake_logictree_case_19/`: "
+               "\"SHARE OpenQuake Computational Settings\", four sources of the SHARE model of "
+               "the Ionian region around a site in Calabria, southern Italy; 16 branches, 4 "
+               "in-slab x 4 interface ground-motion models; the engine's curves from its "
+               "unchanged test input), a test of the engine, not the hazard at that site. The "
+               "numbers below show what the toolkit does with a rock's survival, not the "
+               "hazard at Granite Dells.")
 
 
 def field_rock_section(results, prefix=FIELD_ROCK):
