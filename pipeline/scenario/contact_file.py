@@ -2,6 +2,7 @@
 contact parameters a free-rocking test gave (``kn`` N/m per point, ``damping``; also
 ``mu_s``, ``mu_k`` when stated) beside what they came from (``restitution`` and its
 uncertainty, the block, the source: informational keys, not read)."""
+import re
 from pathlib import Path
 
 from pipeline.files import InputError
@@ -39,7 +40,12 @@ def contact_values(path):
     mu_s without mu_k gets the kinetic friction a run gives that mu_s."""
     from pipeline.scenario.parameters import Contact
     values = load_contact_file(path)
-    contact = Contact(**values)
+    try:
+        contact = Contact(**values)
+    except InputError as exc:        # the range check names the option: name the file's key
+        message = re.sub(r"^--([a-z][a-z0-9-]*)",
+                         lambda m: repr(m[1].replace("-", "_")), str(exc))
+        raise InputError(f"--contact-file {Path(path).name}: {message}") from None
     if "mu_s" in values and "mu_k" not in values:
         values["mu_k"] = contact.mu_k
     return values

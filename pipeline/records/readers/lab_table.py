@@ -39,6 +39,7 @@ SAMPLING_TOLERANCE = 1e-3     # relative spread of the time steps allowed
 HEADER = re.compile(r"#\s*([A-Za-z_-]+)\s*:\s*(.*?)\s*$")
 KEYS = ("lab-table", "units", "axes", "station", "event")   # the header lines read
 MAX_SAMPLES = 2_000_000       # rows of a table (10 min at 3.3 kHz; the SP1 tests: 800 Hz)
+MIN_SAMPLES = 100             # rows a table needs at the least
 MAX_DURATION_S = 3600.0       # seconds a table may span (a shake-table test lasts minutes)
 
 
@@ -86,6 +87,8 @@ def read(path, key=None):
         raise InputError(f"{name}: units {units!r}: expected one of {', '.join(UNITS)}")
     axes = [a for a in re.split(r"[,\s]+", header["axes"]) if a]
     orientations = [_orientation(a, name) for a in axes]
+    if rows < MIN_SAMPLES:
+        raise InputError(f"{name}: {rows} samples, at least {MIN_SAMPLES} needed")
     try:
         data = np.loadtxt(io.StringIO(text.replace(",", " ")), comments="#", ndmin=2)
     except ValueError as exc:
@@ -94,8 +97,8 @@ def read(path, key=None):
     if data.shape[1] != 1 + len(axes):
         raise InputError(f"{name}: {data.shape[1]} columns, expected time and "
                          f"{len(axes)} acceleration column(s) for axes {header['axes']}")
-    if len(data) < 100:
-        raise InputError(f"{name}: {len(data)} samples, at least 100 needed")
+    if len(data) < MIN_SAMPLES:
+        raise InputError(f"{name}: {len(data)} samples, at least {MIN_SAMPLES} needed")
     if not np.all(np.isfinite(data)):
         raise InputError(f"{name}: NaN or infinite values in the table")
     steps = np.diff(data[:, 0])
