@@ -72,15 +72,7 @@ def check_run_options(args):
 def run(args):
     check_run_options(args)
     column = from_args(Column, args, centred=True if args.centred else None)
-    contact, numerics = from_args(Contact, args), from_args(Numerics, args)
-    if args.contact_file is not None:
-        from pipeline.scenario.contact_file import load_contact_file
-        from_file = load_contact_file(args.contact_file)
-        both = [f"--{k.replace('_', '-')}" for k in from_file if getattr(args, k) is not None]
-        if both:
-            raise InputError(f"--contact-file sets {', '.join(both)}: give it there or on the "
-                             "command line, not both")
-        contact = from_args(Contact, args, **from_file)
+    contact, numerics = _contact(args), from_args(Numerics, args)
     check_time_step(contact, numerics)
     out = args.out
     if out is None:
@@ -89,22 +81,7 @@ def run(args):
         raise InputError(f"--out {out} exists and is not a directory")
     motion, _ = processed_motion(args.record, back_azimuth=args.back_azimuth, cache_dir=None,
                                  mode=args.processing)
-    if args.window:
-        first, last = motion.start_in_file_s, motion.start_in_file_s + motion.duration
-        if not first - 1e-9 <= args.window[0] < last:
-            where = "before the motion starts" if args.window[0] < first else \
-                "after the motion ends"
-            raise InputError(f"--window starts at {args.window[0]:g} s, {where} (it spans "
-                             f"{first:.2f} to {last:.2f} s after the record's first sample)")
-        length = min(args.window[1], last) - args.window[0]
-        if length > MAX_DURATION_S:
-            raise InputError(f"--window spans {length:.0f} s: at most {MAX_DURATION_S:g} s "
-                             "are simulated")
-    else:
-        length = motion.duration
-        if length > MAX_DURATION_S:
-            raise InputError(f"the record lasts {motion.duration:.0f} s: give --window START "
-                             f"END (at most {MAX_DURATION_S:g} s simulated)")
+    length = _simulated_length(motion, args.window)
     check_cost(scene_params(columns=column.specs(), contact=contact, numerics=numerics,
                             motion_duration=length), wall_limit_s(length + numerics.tail_s))
     with DirectoryLock(out, wait=False):
@@ -115,6 +92,55 @@ def run(args):
         print(f"note: {summary.note}")
     elif not any(c.max_tilt_deg > 0.1 for c in summary.columns):
         print("note: the motion did not make any column rock (max tilt below 0.1 deg)")
+    _print_column(column, contact, numerics)
+    if summary.start_in_file_s != 0.0:
+        print(f"times in {RECORD_CLOCK} (the simulated motion, and trajectory.npz's clock, "
+              f"start at {summary.start_in_file_s:.2f} s)")
+    for col in summary.columns:
+        print(_outcome_line(col, column.geometry is not None))
+    print(f"wrote {out / 'summary.json'} ({summary.simulated_s:.1f} s simulated in "
+          f"{summary.wall_s:.1f} s)")
+    return 0
+
+
+def _contact(args):
+    """The run's Contact: the flags, or a contact file's values beside them (a value
+    given in both refused)."""
+    if args.contact_file is None:
+        return from_args(Contact, args)
+    from pipeline.scenario.contact_file import load_contact_file
+    from_file = load_contact_file(args.contact_file)
+    both = [f"--{k.replace('_', '-')}" for k in from_file if getattr(args, k) is not None]
+    if both:
+        raise InputError(f"--contact-file sets {', '.join(both)}: give it there or on the "
+                         "command line, not both")
+    return from_args(Contact, args, **from_file)
+
+
+def _simulated_length(motion, window):
+    """Seconds of ``motion`` simulated (``window``: START END in the record's clock, or
+    None); InputError when the window misses the motion or it is too long."""
+    if window:
+        first, last = motion.start_in_file_s, motion.start_in_file_s + motion.duration
+        if not first - 1e-9 <= window[0] < last:
+            where = "before the motion starts" if window[0] < first else \
+                "after the motion ends"
+            raise InputError(f"--window starts at {window[0]:g} s, {where} (it spans "
+                             f"{first:.2f} to {last:.2f} s after the record's first sample)")
+        length = min(window[1], last) - window[0]
+        if length > MAX_DURATION_S:
+            raise InputError(f"--window spans {length:.0f} s: at most {MAX_DURATION_S:g} s "
+                             "are simulated")
+        return length
+    if motion.duration > MAX_DURATION_S:
+        raise InputError(f"the record lasts {motion.duration:.0f} s: give --window START "
+                         f"END (at most {MAX_DURATION_S:g} s simulated)")
+    return motion.duration
+
+
+def _print_column(column, contact, numerics):
+    """What was shaken: a mesh specimen's mass properties or a described column's types,
+    and a note when it rocks on soft contact springs."""
     if getattr(column.geometry, "mesh_path", None):
         rock = column.geometry
         print(f"specimen {rock.name!r} from {Path(rock.mesh_path).name}: {rock.mass:.1f} kg, "
@@ -133,25 +159,21 @@ def run(args):
             print(f"note: with --kn {contact.kn:g} this column rocks on its contact springs "
                   f"at {hz:.1f} Hz (the paper's column at {paper_rocking_hz():.1f} Hz): raise --kn (campaign "
                   "columns does) for rigid-block behaviour")
-    if summary.start_in_file_s != 0.0:
-        print(f"times in {RECORD_CLOCK} (the simulated motion, and trajectory.npz's clock, "
-              f"start at {summary.start_in_file_s:.2f} s)")
-    for col in summary.columns:
-        if not col.toppled:
-            print(f"{col.column:>10}: standing (max tilt {col.max_tilt_deg:.1f} deg)")
-            continue
-        if col.toppled_by == "rests past its critical angle":
-            print(f"{col.column:>10}: overturned toward {col.downfall_azimuth_deg:.0f} deg "
-                  f"(past its critical angle from {col.impact_time_s:.2f} s on)")
-            continue
-        first = min((b for b in col.bodies if b["struck"]), default=None,
-                    key=lambda b: b["impact_time_s"])
-        more = ""
-        if column.geometry is not None and first is not None:
-            more = f" (first to strike: {first.get('name') or 'body %d' % first['index']})"
-        how = "" if col.toppled_by in (None, "impact") else f" ({col.toppled_by})"
-        print(f"{col.column:>10}: toppled toward {col.downfall_azimuth_deg:.0f} deg "
-              f"at {col.impact_time_s:.2f} s{more}{how}")
-    print(f"wrote {out / 'summary.json'} ({summary.simulated_s:.1f} s simulated in "
-          f"{summary.wall_s:.1f} s)")
-    return 0
+
+
+def _outcome_line(col, described):
+    """One column's outcome in one line (``described``: a column file's, whose bodies
+    have names)."""
+    if not col.toppled:
+        return f"{col.column:>10}: standing (max tilt {col.max_tilt_deg:.1f} deg)"
+    if col.toppled_by == "rests past its critical angle":
+        return (f"{col.column:>10}: overturned toward {col.downfall_azimuth_deg:.0f} deg "
+                f"(past its critical angle from {col.impact_time_s:.2f} s on)")
+    first = min((b for b in col.bodies if b["struck"]), default=None,
+                key=lambda b: b["impact_time_s"])
+    more = ""
+    if described and first is not None:
+        more = f" (first to strike: {first.get('name') or 'body %d' % first['index']})"
+    how = "" if col.toppled_by in (None, "impact") else f" ({col.toppled_by})"
+    return (f"{col.column:>10}: toppled toward {col.downfall_azimuth_deg:.0f} deg "
+            f"at {col.impact_time_s:.2f} s{more}{how}")

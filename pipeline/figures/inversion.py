@@ -50,6 +50,34 @@ def plot_posterior_map(post, observations, path, truth_km=None, title=None, arro
     span = max(east_edges[-1] - east_edges[0], north_edges[-1] - north_edges[0])
     arrow_km = arrow_km or 0.06 * span
     types = sorted({c.column for s in observations.sites for c in s.columns})
+    _draw_sites(ax, observations, arrow_km, types)
+    for k, column in enumerate(types):
+        handles.append(Line2D([], [], color=colour(column, k), lw=2,
+                              label=f"{column}: observed downfall (circle: standing)"))
+    best = post.summary()["map_epicentre_km"]
+    ax.plot(*best, "*", color="orange", mec="k", ms=16, zorder=7)
+    handles.append(Line2D([], [], marker="*", color="orange", mec="k", ls="none", ms=12,
+                          label="most probable epicentre"))
+    if truth_km is not None:
+        ax.plot(*truth_km, "X", color="red", mec="w", ms=12, zorder=7)
+        handles.append(Line2D([], [], marker="X", color="red", ls="none", ms=10,
+                              label="true epicentre"))
+    handles.append(Line2D([], [], marker="^", color="w", mec="k", ls="none", ms=9,
+                          label="site"))
+    ax.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, -0.09), ncol=2,
+              fontsize=8, frameon=False)
+    _set_view(ax, post, observations, truth_km, arrow_km, east_edges, north_edges)
+    ax.set_aspect("equal")
+    ax.set_xlabel(f"East of site {observations.sites[0].name} (km)")
+    ax.set_ylabel(f"North of site {observations.sites[0].name} (km)")
+    ax.set_title(_map_title(post, title))
+    save_figure(fig, path, dpi=130, bbox_inches="tight")
+    return path
+
+
+def _draw_sites(ax, observations, arrow_km, types):
+    """The sites (triangles, named when few), their standing columns (open circles) and
+    their observed falls (arrows ``arrow_km`` long, one colour per column type)."""
     for site in observations.sites:
         ax.plot(site.east_km, site.north_km, "^", color="w", mec="k", ms=10, zorder=5)
         if len(observations.sites) <= 8:
@@ -69,22 +97,10 @@ def plot_posterior_map(post, observations, path, truth_km=None, title=None, arro
                             xytext=(site.east_km, site.north_km), zorder=6,
                             arrowprops={"arrowstyle": "-|>", "lw": 1.6,
                                         "color": colour(c.column, types.index(c.column))})
-    for k, column in enumerate(types):
-        handles.append(Line2D([], [], color=colour(column, k), lw=2,
-                              label=f"{column}: observed downfall (circle: standing)"))
-    best = post.summary()["map_epicentre_km"]
-    ax.plot(*best, "*", color="orange", mec="k", ms=16, zorder=7)
-    handles.append(Line2D([], [], marker="*", color="orange", mec="k", ls="none", ms=12,
-                          label="most probable epicentre"))
-    if truth_km is not None:
-        ax.plot(*truth_km, "X", color="red", mec="w", ms=12, zorder=7)
-        handles.append(Line2D([], [], marker="X", color="red", ls="none", ms=10,
-                              label="true epicentre"))
-    handles.append(Line2D([], [], marker="^", color="w", mec="k", ls="none", ms=9,
-                          label="site"))
-    ax.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, -0.09), ncol=2,
-              fontsize=8, frameon=False)
-    # the view: the sites and the 99 % region, with a margin, inside the lattice
+
+
+def _set_view(ax, post, observations, truth_km, arrow_km, east_edges, north_edges):
+    """The view: the sites and the 99 % region, with a margin, inside the lattice."""
     region, _ = post.epicentre_region(0.99)
     xs = np.r_[[s.east_km for s in observations.sites], post.east_km[region]]
     ys = np.r_[[s.north_km for s in observations.sites], post.north_km[region]]
@@ -96,18 +112,17 @@ def plot_posterior_map(post, observations, path, truth_km=None, title=None, arro
                 min(xs.max() + pad, max(east_edges[-1], xs.max() + step)))
     ax.set_ylim(max(ys.min() - pad, min(north_edges[0], ys.min() - step)),
                 min(ys.max() + pad, max(north_edges[-1], ys.max() + step)))
-    ax.set_aspect("equal")
-    ax.set_xlabel(f"East of site {observations.sites[0].name} (km)")
-    ax.set_ylabel(f"North of site {observations.sites[0].name} (km)")
+
+
+def _map_title(post, title):
+    """The title, with where the candidates end when they end short of the sites' reach."""
     reach = post.reach_summary()
     if reach["reach_km"] is not None:      # the coloured cells are the candidates
         title = (title or "Posterior of the epicentre") + (
             f"\ncandidates end {reach['reach_km']:g} km from the sites ({reach['reach_limit']});"
             f"\n{reach['reach_edge_fraction']:.0%} of the posterior in their outermost cells"
             + (": the source may lie farther" if reach["reach_warning"] else ""))
-    ax.set_title(title or "Posterior of the epicentre")
-    save_figure(fig, path, dpi=130, bbox_inches="tight")
-    return path
+    return title or "Posterior of the epicentre"
 
 
 def plot_marginals(post, path, truth=None):

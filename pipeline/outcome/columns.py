@@ -100,7 +100,6 @@ def column_outcomes(trajectory, start_in_file_s=0.0):
     """List of per-column result dicts (see module docstring), times (s) on the record's
     clock: the trajectory's (the motion's) clock + ``start_in_file_s``."""
     t = trajectory.t + start_in_file_s
-    pos = trajectory.pos
     axes = body_axes(trajectory.quat)
     columns = {}
     for j, body in enumerate(trajectory.bodies):
@@ -109,73 +108,84 @@ def column_outcomes(trajectory, start_in_file_s=0.0):
     for name, members in columns.items():
         first = trajectory.bodies[members[0]]
         origin = np.array(first.get("column_position", first["initial_pos"][:2]), float)
-        bodies = []
-        for j in members:
-            b = trajectory.bodies[j]
-            rims = [r for r in body_rims(b) if b["index"] > 0 or r["role"] != "base"]
-            critical = b.get("overturn_tilt_deg")      # a mesh specimen (see module doc)
-            if not rims and critical is None:
-                continue
-            tilt = tilt_deg(axes[:, j])
-            if critical is None:
-                struck = np.min([rim_lowest(pos[:, j], trajectory.quat[:, j], r, axes[:, j])
-                                 for r in rims], axis=0)
-                hits = np.flatnonzero(struck <= CONTACT_TOLERANCE_M)
-            else:
-                hits = stays_past(tilt, critical)
-            over = np.flatnonzero(tilt > 90.0)
-            lying = not over.size and tilt[-1] > LIES_TILT_DEG    # the scene stopped it lying
-            if lying:
-                over = stays_past(tilt, LIES_TILT_DEG)
-            entry = {"index": b["index"], **({"name": b["block_name"]} if b.get("block_name")
-                                             else {}),
-                     "mass_kg": b["mass"], "struck": bool(hits.size),
-                     "impact_time_s": None, "impact_point_m": None, "azimuth_deg": None,
-                     "max_tilt_deg": float(tilt.max()),
-                     "final_position_m": (pos[-1, j, :2] - origin).round(4).tolist(),
-                     "past_90_s": float(t[over[0]]) if over.size else None,
-                     "lying_at_end": bool(lying),
-                     "past_90_azimuth_deg": azimuth_deg(*axes[over[0], j, :2])
-                     if over.size else None}
-            if hits.size:
-                k = hits[0]
-                point = pos[k, j, :2] - origin
-                if critical is not None:              # where its centre of mass went
-                    point = pos[-1, j, :2] - np.asarray(b["initial_pos"][:2], float)
-                entry.update(impact_time_s=float(t[k]), impact_point_m=point.tolist(),
-                             azimuth_deg=azimuth_deg(*point))
-            bodies.append(entry)
-        if not bodies:
-            continue
-        struck = [b for b in bodies if b["struck"]]
-        upset = [b for b in bodies if b["past_90_s"] is not None]
-        result = {"column": name, "toppled": bool(struck or upset),
-                  "toppled_by": ("rests past its critical angle" if struck and
-                                 first.get("overturn_tilt_deg") is not None else
-                                 "impact" if struck else None),
-                  "downfall_azimuth_deg": None,
-                  "impact_time_s": None, "impact_point_m": None,
-                  "max_tilt_deg": max(b["max_tilt_deg"] for b in bodies),
-                  "base_slip_m": float(np.hypot(*(pos[:, members[0], :2]
-                                                   - first["initial_pos"][:2]).T).max()),
-                  "position_m": origin.tolist(), "bodies": bodies}
-        if upset and not struck:
-            result["toppled_by"] = ("tilt past 90 deg" if any(not b["lying_at_end"]
-                                                             for b in upset)
-                                    else "lying past 60 deg when the run stopped")
-        if struck:
-            weights = np.array([b["mass_kg"] for b in struck])
-            points = np.array([b["impact_point_m"] for b in struck])
-            centre = weights @ points / weights.sum()
-            result.update(downfall_azimuth_deg=azimuth_deg(*centre),
-                          impact_time_s=min(b["impact_time_s"] for b in struck),
-                          impact_point_m=centre.tolist())
-        elif upset:          # thrown over without striking the pedestal: never "standing"
-            first_over = min(upset, key=lambda b: b["past_90_s"])
-            result.update(downfall_azimuth_deg=first_over["past_90_azimuth_deg"],
-                          impact_time_s=first_over["past_90_s"])
-        results.append(result)
+        bodies = [entry for j in members
+                  if (entry := _body_outcome(trajectory, j, t, axes, origin)) is not None]
+        if bodies:
+            results.append(_column_outcome(name, bodies, trajectory.pos[:, members[0], :2],
+                                           first, origin))
     return results
+
+
+def _body_outcome(trajectory, j, t, axes, origin):
+    """Body ``j``'s result dict (see module docstring), or None for a body with nothing
+    to strike with (the base block's base rim does not count)."""
+    pos = trajectory.pos
+    b = trajectory.bodies[j]
+    rims = [r for r in body_rims(b) if b["index"] > 0 or r["role"] != "base"]
+    critical = b.get("overturn_tilt_deg")      # a mesh specimen (see module doc)
+    if not rims and critical is None:
+        return None
+    tilt = tilt_deg(axes[:, j])
+    if critical is None:
+        struck = np.min([rim_lowest(pos[:, j], trajectory.quat[:, j], r, axes[:, j])
+                         for r in rims], axis=0)
+        hits = np.flatnonzero(struck <= CONTACT_TOLERANCE_M)
+    else:
+        hits = stays_past(tilt, critical)
+    over = np.flatnonzero(tilt > 90.0)
+    lying = not over.size and tilt[-1] > LIES_TILT_DEG    # the scene stopped it lying
+    if lying:
+        over = stays_past(tilt, LIES_TILT_DEG)
+    entry = {"index": b["index"], **({"name": b["block_name"]} if b.get("block_name")
+                                     else {}),
+             "mass_kg": b["mass"], "struck": bool(hits.size),
+             "impact_time_s": None, "impact_point_m": None, "azimuth_deg": None,
+             "max_tilt_deg": float(tilt.max()),
+             "final_position_m": (pos[-1, j, :2] - origin).round(4).tolist(),
+             "past_90_s": float(t[over[0]]) if over.size else None,
+             "lying_at_end": bool(lying),
+             "past_90_azimuth_deg": azimuth_deg(*axes[over[0], j, :2])
+             if over.size else None}
+    if hits.size:
+        k = hits[0]
+        point = pos[k, j, :2] - origin
+        if critical is not None:              # where its centre of mass went
+            point = pos[-1, j, :2] - np.asarray(b["initial_pos"][:2], float)
+        entry.update(impact_time_s=float(t[k]), impact_point_m=point.tolist(),
+                     azimuth_deg=azimuth_deg(*point))
+    return entry
+
+
+def _column_outcome(name, bodies, base_xy, first, origin):
+    """A column's result dict from its bodies' (``base_xy``: its first body's horizontal
+    path, (n, 2) m; ``first``: that body's trajectory entry)."""
+    struck = [b for b in bodies if b["struck"]]
+    upset = [b for b in bodies if b["past_90_s"] is not None]
+    result = {"column": name, "toppled": bool(struck or upset),
+              "toppled_by": ("rests past its critical angle" if struck and
+                             first.get("overturn_tilt_deg") is not None else
+                             "impact" if struck else None),
+              "downfall_azimuth_deg": None,
+              "impact_time_s": None, "impact_point_m": None,
+              "max_tilt_deg": max(b["max_tilt_deg"] for b in bodies),
+              "base_slip_m": float(np.hypot(*(base_xy - first["initial_pos"][:2]).T).max()),
+              "position_m": origin.tolist(), "bodies": bodies}
+    if upset and not struck:
+        result["toppled_by"] = ("tilt past 90 deg" if any(not b["lying_at_end"]
+                                                         for b in upset)
+                                else "lying past 60 deg when the run stopped")
+    if struck:
+        weights = np.array([b["mass_kg"] for b in struck])
+        points = np.array([b["impact_point_m"] for b in struck])
+        centre = weights @ points / weights.sum()
+        result.update(downfall_azimuth_deg=azimuth_deg(*centre),
+                      impact_time_s=min(b["impact_time_s"] for b in struck),
+                      impact_point_m=centre.tolist())
+    elif upset:          # thrown over without striking the pedestal: never "standing"
+        first_over = min(upset, key=lambda b: b["past_90_s"])
+        result.update(downfall_azimuth_deg=first_over["past_90_azimuth_deg"],
+                      impact_time_s=first_over["past_90_s"])
+    return result
 
 
 def total_energy(trajectory, g=MODEL_GRAVITY):

@@ -184,12 +184,10 @@ def specimen_rocking(geometry, damping, kn, azimuth_deg=None, release_ratio=RELE
     import dataclasses
 
     import numpy as np
-    from scipy.spatial.transform import Rotation
 
-    from pipeline.outcome.columns import rotations
     from pipeline.scenario import Contact, Numerics, run_yade
     from pipeline.scenario.parameters import split_options
-    from pipeline.scenario.scene_file import base_points, released, support_line
+    from pipeline.scenario.scene_file import released
     from pipeline.scenario.writer import write_scenario
 
     contact, numerics = split_options(options)
@@ -197,50 +195,25 @@ def specimen_rocking(geometry, damping, kn, azimuth_deg=None, release_ratio=RELE
                            Numerics(**{"record_hz": 1000.0, "rest_duration_s": 0.3,
                                        **numerics}))
     azimuth = weakest_azimuth(column) if azimuth_deg is None else float(azimuth_deg)
-    line = support_line(column, azimuth)
+    line, radius, (h, b) = equivalent_block(column, azimuth, geometry.name)
     alpha = line["critical_angle_rad"]
-    if not alpha > 0:
-        raise InputError(f"{geometry.name}: its centre of mass is not above its footprint "
-                         f"toward {azimuth:g} deg")
     tilt = release_ratio * alpha
     body = column["bodies"][0]
-    # duration: Housner's block of the same lever and height, its swings scaled by the
-    # specimen's own rocking frequency about the line (p^2 = m g R / I_pivot)
-    lever_height = line["pivot"] - line["com"]
-    radius = float(np.linalg.norm(lever_height - (lever_height @ line["axis"]) * line["axis"]))
-    rotation = np.asarray(body["rotation"], float)
-    inertia = line["axis"] @ rotation @ np.asarray(body["inertia"], float) @ rotation.T @ \
-        line["axis"] + body["mass"] * radius ** 2
-    p_specimen = math.sqrt(body["mass"] * scene.gravity * radius / inertia)
-    p_block = math.sqrt(0.75 * scene.gravity / radius)
-    h, b = 2 * radius * math.cos(alpha), 2 * radius * math.sin(alpha)
     counted = impacts + SETTLING_IMPACTS
-    reference = rocking.housner_free_rocking(h, b, tilt, n_impacts=counted)
-    duration = 1.5 * float(reference["peak_times"][counted]) * p_block / p_specimen + 0.1
+    duration = _free_rocking_s(body, line, radius, scene.gravity, h, b, tilt, counted)
     scene = dataclasses.replace(scene, columns=[released(column, azimuth, tilt)],
                                 t_max=duration)
     with contextlib.nullcontext(run_dir) if run_dir is not None else \
             tempfile.TemporaryDirectory(prefix="toppling-contact-") as where:
         write_scenario(where, scene)
         trajectory = run_yade(where)
-    turns = rotations(trajectory.quat[:, 0])
-    start = Rotation.from_matrix(rotation)
-    theta = (turns * start.inv()).as_rotvec() @ line["axis"]
-    points = base_points(body)
-    lowest = lambda r: (r.as_matrix()[..., 2, :] @ points.T).min(axis=-1)   # noqa: E731
-    rise = float(lowest(start)) - lowest(turns)
+    turns, theta, rise = _turn_and_rise(trajectory, body, line)
     found = rocking.free_rocking_peaks(trajectory.t, theta, rise=rise)
     z = found["rise_peaks"][SETTLING_IMPACTS:counted + 1]
     if z.size < 2 or not np.all(z > 0):
         raise InputError(f"{geometry.name}: no impact with swings before and after it in "
                          f"{duration:.2f} s of free rocking")
-    # its whole energy above rest (J): translation, rotation, rise
-    inertia_world = turns.as_matrix() @ np.asarray(body["inertia"], float) @ \
-        turns.as_matrix().transpose(0, 2, 1)
-    w = trajectory.angvel[:, 0]
-    energy = body["mass"] * (0.5 * (trajectory.vel[:, 0] ** 2).sum(axis=1) +
-                             scene.gravity * rise) + \
-        0.5 * np.einsum("ti,tij,tj->t", w, inertia_world, w)
+    energy = _energy_above_rest(trajectory, body, turns, rise, scene.gravity)
     times = np.concatenate([[trajectory.t[0]], found["impact_times"]])
     swings = [np.median(energy[(trajectory.t > a + 0.25 * (b - a)) &
                                (trajectory.t < b - 0.25 * (b - a))])
@@ -253,6 +226,67 @@ def specimen_rocking(geometry, damping, kn, azimuth_deg=None, release_ratio=RELE
             "restitution_per_impact_from_rises": [float(e) for e in eta_rise],
             "azimuth_deg": azimuth, "critical_angle_deg": math.degrees(alpha),
             "release_deg": math.degrees(tilt), "t": trajectory.t, "tilt": theta, "rise": rise}
+
+
+def equivalent_block(column, azimuth_deg, name):
+    """(support line dict, R m, (height m, width m)) of a scene column toward
+    ``azimuth_deg``: R the distance from the support line to the centre of mass, and the
+    block of the same critical angle and R; InputError when the centre of mass is not
+    above the footprint that way (``name``: the specimen's)."""
+    import numpy as np
+
+    from pipeline.scenario.scene_file import support_line
+    line = support_line(column, azimuth_deg)
+    alpha = line["critical_angle_rad"]
+    if not alpha > 0:
+        raise InputError(f"{name}: its centre of mass is not above its footprint "
+                         f"toward {azimuth_deg:g} deg")
+    arm = line["pivot"] - line["com"]
+    radius = float(np.linalg.norm(arm - (arm @ line["axis"]) * line["axis"]))
+    return line, radius, (2 * radius * math.cos(alpha), 2 * radius * math.sin(alpha))
+
+
+def _free_rocking_s(body, line, radius, gravity, h, b, tilt, counted):
+    """Duration (s) of a free-rocking run that holds ``counted`` impacts: Housner's block
+    (h x b, released at ``tilt`` rad), its swings scaled by the specimen's own rocking
+    frequency about the support line (p^2 = m g R / I_pivot)."""
+    import numpy as np
+    rotation = np.asarray(body["rotation"], float)
+    inertia = line["axis"] @ rotation @ np.asarray(body["inertia"], float) @ rotation.T @ \
+        line["axis"] + body["mass"] * radius ** 2
+    p_specimen = math.sqrt(body["mass"] * gravity * radius / inertia)
+    p_block = math.sqrt(0.75 * gravity / radius)
+    reference = rocking.housner_free_rocking(h, b, tilt, n_impacts=counted)
+    return 1.5 * float(reference["peak_times"][counted]) * p_block / p_specimen + 0.1
+
+
+def _turn_and_rise(trajectory, body, line):
+    """(rotations from the start (scipy), tilt rad about the support line, rise m of the
+    centre of mass above its rest height: the rigid body's, above the lowest point of its
+    base outline) of the trajectory's first body."""
+    import numpy as np
+    from scipy.spatial.transform import Rotation
+
+    from pipeline.outcome.columns import rotations
+    from pipeline.scenario.scene_file import base_points
+    turns = rotations(trajectory.quat[:, 0])
+    start = Rotation.from_matrix(np.asarray(body["rotation"], float))
+    theta = (turns * start.inv()).as_rotvec() @ line["axis"]
+    points = base_points(body)
+    lowest = lambda r: (r.as_matrix()[..., 2, :] @ points.T).min(axis=-1)   # noqa: E731
+    return turns, theta, float(lowest(start)) - lowest(turns)
+
+
+def _energy_above_rest(trajectory, body, turns, rise, gravity):
+    """The first body's whole energy above rest (J) at each sample: translation, rotation,
+    rise."""
+    import numpy as np
+    inertia_world = turns.as_matrix() @ np.asarray(body["inertia"], float) @ \
+        turns.as_matrix().transpose(0, 2, 1)
+    w = trajectory.angvel[:, 0]
+    return body["mass"] * (0.5 * (trajectory.vel[:, 0] ** 2).sum(axis=1) +
+                           gravity * rise) + \
+        0.5 * np.einsum("ti,tij,tj->t", w, inertia_world, w)
 
 
 def specimen_measure(geometry, kn, azimuth_deg, cache=CACHE, **options):

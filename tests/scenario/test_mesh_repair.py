@@ -13,6 +13,7 @@ from pipeline import RECORDS_DIR
 from pipeline.files import InputError
 from pipeline.scenario import ColumnSpec
 from pipeline.scenario import mesh as mesh_module
+from pipeline.scenario import mesh_pose
 from pipeline.scenario.mesh import MeshSpecimen
 
 SP1 = RECORDS_DIR / "shake_table" / "SP1.obj"
@@ -234,7 +235,7 @@ def test_a_huge_hull_rolls_onto_its_rest_pose(tmp_path, monkeypatch):
     ellipsoid = trimesh.creation.icosphere(subdivisions=4)          # 5120 faces
     ellipsoid.apply_scale([0.2, 0.3, 0.4])
     ellipsoid.apply_transform(trimesh.transformations.rotation_matrix(0.3, [1, 1, 0]))
-    monkeypatch.setattr(mesh_module, "MAX_POSE_HULL_FACES", 600)
+    monkeypatch.setattr(mesh_pose, "MAX_POSE_HULL_FACES", 600)
     path = export(ellipsoid, tmp_path / "ellipsoid.obj")
     volume = trimesh.load(path, process=False).volume            # of the file's vertices
     with within(120):
@@ -371,7 +372,7 @@ def test_rolling_sets_a_tilted_box_down_as_statics_says(tmp_path, monkeypatch, t
     """The rolling rest pose (used past MAX_POSE_HULL_FACES) on a box tilted about East:
     within its critical angle atan(D / H) = 18.4 deg it rolls back onto its base, past it
     onto its long side (height D)."""
-    monkeypatch.setattr(mesh_module, "MAX_POSE_HULL_FACES", 0)
+    monkeypatch.setattr(mesh_pose, "MAX_POSE_HULL_FACES", 0)
     tilt = trimesh.transformations.rotation_matrix(np.radians(tilt_deg), [1, 0, 0])
     rock = MeshSpecimen.load(export(box().apply_transform(tilt), tmp_path / "tilted.obj"))
     assert rock.repairs[0].startswith("rest pose found by rolling")
