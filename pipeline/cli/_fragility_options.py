@@ -122,8 +122,7 @@ def load_specimens(args):
                                          args.below_grid, args.hazard_component,
                                          args.magnitude, args.distance_km, rotd50_fraction)
                  for path in args.fragility]
-    if args.below_grid != "ramp" and not any(getattr(f, "grid_range", lambda: None)()
-                                             for f in specimens):
+    if args.below_grid != "ramp" and all(f.grid_range() is None for f in specimens):
         raise InputError("--below-grid applies to a pulse-grid fragility (--fragility of "
                          "campaign fragility --pulses, --fragility-form grid)")
     specimens += [Lognormal(m * STANDARD_GRAVITY, b, label=f"stated lognormal: median "

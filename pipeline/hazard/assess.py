@@ -55,8 +55,8 @@ ASSUMPTIONS = [
 
 def assess(curve, specimens, ratio_model, age_ka, age_sd_ka=0.0, draws=400, seed=0,
            more_curves=()):
-    """(summary dict for survival.json, figure data dict) for ``specimens`` (fragility
-    objects of :mod:`pipeline.hazard.fragility`) at the site of ``curve``
+    """(summary dict for survival.json, figure data dict) for ``specimens``
+    (:class:`~pipeline.hazard.fragility_kinds.Fragility` objects) at the site of ``curve``
     (:class:`~pipeline.hazard.curves.HazardCurve`); ``ratio_model``: the PGV/PGA model or
     None; ages in ka (thousand years).  ``more_curves``: further hazard curves of the
     site (e.g. quantiles): the headline again under each (``hazard_curves``)."""
@@ -66,108 +66,19 @@ def assess(curve, specimens, ratio_model, age_ka, age_sd_ka=0.0, draws=400, seed
     warnings = list(curve.notes)
     entries = []
     for k, fragility in enumerate(specimens):
-        def probability(x, f=fragility):
-            return overturn_probability([f], ratio_model, x)[0]
-        members = None if drawn[k] is None else [
-            (lambda x, f=d: overturn_probability([f], ratio_model, x)[0]) for d in drawn[k]]
-        entry = _result(curve, probability, members, age, age_sd)
-        entry = {"fragility": fragility.describe(), **entry,
-                 **_per_parameter_set(curve, fragility, ratio_model, age, age_sd),
-                 **_outside_grid(curve, fragility, ratio_model, probability,
-                                 entry["annual_overturning_rate_per_yr"])}
-        if drawn[k] is None:
-            entry["survival_interval_note"] = "no uncertainty stated for this fragility" \
-                if draws else "--draws 0"
+        entry = _specimen_entry(curve, fragility, drawn[k], ratio_model, age, age_sd, draws)
         entries.append(entry)
-        outside = entry.get("outside_grid") or {}
-        entry["warnings"] += _above_grid_warning(outside, entry["fragility"],
-                                                 entry["annual_overturning_rate_per_yr"])
-        for side in ("below", "above"):
-            share = outside.get(f"share_{side}_grid")
-            if share is not None and share > END_SHARE_WARNING:
-                entry["warnings"].append(
-                    f"{100 * share:.0f} % of the overturning rate comes from PGA {side} the "
-                    "fragility's grid" + (f" (rate {outside['rate_per_yr_zero_below_grid']:.3g}"
-                                          f" to {outside['rate_per_yr_edge_held_below_grid']:.3g}"
-                                          " /yr with P = 0 or the edge's P below it)"
-                                          if side == "below" else ""))
         warnings += [f"specimen {k}: {w}" for w in entry.pop("warnings")]
-    if len(specimens) == 1:
-        headline, probability = entries[0], _combined(specimens, ratio_model, "each")
-        members = None if drawn[0] is None else [_combined([d], ratio_model, "each")
-                                                 for d in drawn[0]]
-    else:
-        probability = _combined(specimens, ratio_model, "any_common")
-        members = None
-        if all(d is not None for d in drawn):
-            members = [_combined(list(group), ratio_model, "any_common")
-                       for group in zip(*drawn)]
-        headline = _result(curve, probability, members, age, age_sd)
-        warnings += [f"set: {w}" for w in headline.pop("warnings")]
+    headline, probability, members = _headline(curve, specimens, drawn, entries, ratio_model,
+                                               age, age_sd, warnings)
     curves = [_curve_row(curve, headline, specimens, ratio_model, age, age_sd)] \
         if more_curves else []
     for k, other in enumerate(more_curves, start=1):
         result = _result(other, probability, members, age, age_sd)
         warnings += [f"hazard curve {k}: {w}" for w in list(other.notes) + result["warnings"]]
         curves.append(_curve_row(other, result, specimens, ratio_model, age, age_sd))
-    summary = {
-        "annual_overturning_rate_per_yr": headline["annual_overturning_rate_per_yr"],
-        "survival_probability": headline["survival_probability"],
-        "survival_interval": headline["survival_interval"],
-        **({} if headline["survival_interval"] is not None else {
-            "survival_interval_note": "no uncertainty stated for the fragility" if draws
-            else "--draws 0"}),
-        **({k: entries[0][k] for k in ("survival_per_parameter_set",
-                                       "survival_parameter_set_range", "outside_grid")
-            if k in entries[0]} if len(specimens) == 1 else {}),
-        "rate_scale_bound_5pct": headline["rate_scale_bound_5pct"],
-        "intensity_scale_bound_5pct": headline["intensity_scale_bound_5pct"],
-        "contribution_by_intensity": headline["contribution_by_intensity"],
-        "curve_ends": headline["curve_ends"],
-        "headline": "the specimen" if len(specimens) == 1 else
-                    "the set under common shaking (all survive)",
-        "age_ka": age_ka, "age_sd_ka": age_sd_ka,
-        "age_distribution": "fixed" if age_sd_ka == 0 else "normal truncated at 0",
-        "definitions": {
-            "annual_overturning_rate_per_yr": "integral of P(overturn | PGA) |d lambda(PGA)| "
-            "over the hazard curve, 1/yr",
-            "survival_probability": "mean over the age of exp(-rate t)",
-            "survival_interval": f"{INTERVAL[0]:g}-{INTERVAL[1]:g} percentiles over "
-            f"{draws} draws of the fragility's estimate (parametric bootstrap: of its "
-            "fitted parameters, or for a pulse grid of every cell's count, Binomial(n, P): "
-            "the Monte Carlo error), or null",
-            "survival_per_parameter_set": "the survival probability with each parameter "
-            "set's own fragility: a pulse grid's P per set in every cell, or a column "
-            "campaign member's own fit (the specimen has one set of the unknown contact "
-            "parameters in every earthquake)",
-            "outside_grid": "a pulse grid: the rate of overturning from PGA below the "
-            "grid's first PGA and above its last (on the hazard's PGA), their shares, and "
-            "the rate with P = 0 below the grid (lower bound) and with the edge's P held "
-            "down to the uplift acceleration (upper bound); above the grid: the hazard "
-            "curve's last level and its ratio to the grid's top PGA, the rate of PGA above "
-            "the grid's top on the curve, the rate of overturning with P = 1 above the grid "
-            "(an upper bound) and how P is extended there (p_above_grid)",
-            "hazard_curves": "the headline under each hazard curve given (--hazard "
-            "repeated), the first being the headline's; survival_range_over_curves: min "
-            "and max of their survival probabilities",
-            "survival_parameter_set_range": "min and max of survival_per_parameter_set: "
-            "the members' spread, reported apart from the Monte Carlo error",
-            "rate_scale_bound_5pct": "largest factor F on every rate of the hazard curve "
-            "with survival >= 0.05 (-ln 0.05 / (rate t) for a fixed age)",
-            "intensity_scale_bound_5pct": "largest factor c on the curve's PGA levels "
-            "(lambda_c(x) = lambda(x / c)) with survival >= 0.05; null with a note when "
-            "outside 0.001-1000",
-            "contribution_by_intensity": "the rate of overturning by PGA interval of the "
-            "curve (m/s^2; the last row: exceedances of the last level) and its share"},
-        "specimens": entries,
-        "hazard": {**curve.source, "levels_m_s2": curve.levels_m_s2.tolist(),
-                   "levels_g": (curve.levels_m_s2 / STANDARD_GRAVITY).tolist(),
-                   "rates_per_yr": curve.rates_per_yr.tolist(), "notes": list(curve.notes),
-                   "interpolation": "linear in (ln PGA, ln rate)"},
-        "pgv_pga": None if ratio_model is None else ratio_model.describe(),
-        "pgv_pga_used": any(f.uses_ratio for f in specimens),
-        "assumptions": ASSUMPTIONS, "warnings": warnings,
-        "draws": draws, "seed": seed, "software": software_versions()}
+    summary = _summary(curve, specimens, entries, headline, ratio_model, warnings,
+                       (age_ka, age_sd_ka, draws, seed))
     if more_curves:
         survivals = [row["survival_probability"] for row in curves]
         summary["hazard_curves"] = curves
@@ -177,6 +88,121 @@ def assess(curve, specimens, ratio_model, age_ka, age_sd_ka=0.0, draws=400, seed
     figure = _figure_data(curve, probability, headline, drawn, age, age_sd, specimens,
                           ratio_model)
     return summary, figure
+
+
+def _specimen_entry(curve, fragility, drawn, ratio_model, age, age_sd, draws):
+    """One specimen's entry of ``specimens``: its result, parameter sets and what comes
+    from outside its grid, with its ``warnings`` (a list the caller takes out)."""
+    def probability(x):
+        return overturn_probability([fragility], ratio_model, x)[0]
+    members = None if drawn is None else [
+        (lambda x, f=d: overturn_probability([f], ratio_model, x)[0]) for d in drawn]
+    entry = _result(curve, probability, members, age, age_sd)
+    entry = {"fragility": fragility.describe(), **entry,
+             **_per_parameter_set(curve, fragility, ratio_model, age, age_sd),
+             **_outside_grid(curve, fragility, ratio_model, probability,
+                             entry["annual_overturning_rate_per_yr"])}
+    if drawn is None:
+        entry["survival_interval_note"] = "no uncertainty stated for this fragility" \
+            if draws else "--draws 0"
+    outside = entry.get("outside_grid") or {}
+    entry["warnings"] += _above_grid_warning(outside, entry["fragility"],
+                                             entry["annual_overturning_rate_per_yr"])
+    for side in ("below", "above"):
+        share = outside.get(f"share_{side}_grid")
+        if share is not None and share > END_SHARE_WARNING:
+            entry["warnings"].append(
+                f"{100 * share:.0f} % of the overturning rate comes from PGA {side} the "
+                "fragility's grid" + (f" (rate {outside['rate_per_yr_zero_below_grid']:.3g}"
+                                      f" to {outside['rate_per_yr_edge_held_below_grid']:.3g}"
+                                      " /yr with P = 0 or the edge's P below it)"
+                                      if side == "below" else ""))
+    return entry
+
+
+def _headline(curve, specimens, drawn, entries, ratio_model, age, age_sd, warnings):
+    """(headline result, its probability function, its draws' functions or None): the
+    specimen's entry, or the set's under common shaking (its warnings added)."""
+    if len(specimens) == 1:
+        members = None if drawn[0] is None else [_combined([d], ratio_model, "each")
+                                                 for d in drawn[0]]
+        return entries[0], _combined(specimens, ratio_model, "each"), members
+    probability = _combined(specimens, ratio_model, "any_common")
+    members = None
+    if all(d is not None for d in drawn):
+        members = [_combined(list(group), ratio_model, "any_common") for group in zip(*drawn)]
+    headline = _result(curve, probability, members, age, age_sd)
+    warnings += [f"set: {w}" for w in headline.pop("warnings")]
+    return headline, probability, members
+
+
+def _summary(curve, specimens, entries, headline, ratio_model, warnings, run):
+    """survival.json's content but for hazard_curves and site_set; ``run``: (age_ka,
+    age_sd_ka, draws, seed)."""
+    age_ka, age_sd_ka, draws, seed = run
+    one = len(specimens) == 1
+    return {
+        "annual_overturning_rate_per_yr": headline["annual_overturning_rate_per_yr"],
+        "survival_probability": headline["survival_probability"],
+        "survival_interval": headline["survival_interval"],
+        **({} if headline["survival_interval"] is not None else {
+            "survival_interval_note": "no uncertainty stated for the fragility" if draws
+            else "--draws 0"}),
+        **({k: entries[0][k] for k in ("survival_per_parameter_set",
+                                       "survival_parameter_set_range", "outside_grid")
+            if k in entries[0]} if one else {}),
+        "rate_scale_bound_5pct": headline["rate_scale_bound_5pct"],
+        "intensity_scale_bound_5pct": headline["intensity_scale_bound_5pct"],
+        "contribution_by_intensity": headline["contribution_by_intensity"],
+        "curve_ends": headline["curve_ends"],
+        "headline": "the specimen" if one else "the set under common shaking (all survive)",
+        "age_ka": age_ka, "age_sd_ka": age_sd_ka,
+        "age_distribution": "fixed" if age_sd_ka == 0 else "normal truncated at 0",
+        "definitions": _definitions(draws),
+        "specimens": entries,
+        "hazard": {**curve.source, "levels_m_s2": curve.levels_m_s2.tolist(),
+                   "levels_g": (curve.levels_m_s2 / STANDARD_GRAVITY).tolist(),
+                   "rates_per_yr": curve.rates_per_yr.tolist(), "notes": list(curve.notes),
+                   "interpolation": "linear in (ln PGA, ln rate)"},
+        "pgv_pga": None if ratio_model is None else ratio_model.describe(),
+        "pgv_pga_used": any(f.uses_ratio for f in specimens),
+        "assumptions": ASSUMPTIONS, "warnings": warnings,
+        "draws": draws, "seed": seed, "software": software_versions()}
+
+
+def _definitions(draws):
+    """survival.json's ``definitions``."""
+    return {
+        "annual_overturning_rate_per_yr": "integral of P(overturn | PGA) |d lambda(PGA)| "
+        "over the hazard curve, 1/yr",
+        "survival_probability": "mean over the age of exp(-rate t)",
+        "survival_interval": f"{INTERVAL[0]:g}-{INTERVAL[1]:g} percentiles over "
+        f"{draws} draws of the fragility's estimate (parametric bootstrap: of its "
+        "fitted parameters, or for a pulse grid of every cell's count, Binomial(n, P): "
+        "the Monte Carlo error), or null",
+        "survival_per_parameter_set": "the survival probability with each parameter "
+        "set's own fragility: a pulse grid's P per set in every cell, or a column "
+        "campaign member's own fit (the specimen has one set of the unknown contact "
+        "parameters in every earthquake)",
+        "outside_grid": "a pulse grid: the rate of overturning from PGA below the "
+        "grid's first PGA and above its last (on the hazard's PGA), their shares, and "
+        "the rate with P = 0 below the grid (lower bound) and with the edge's P held "
+        "down to the uplift acceleration (upper bound); above the grid: the hazard "
+        "curve's last level and its ratio to the grid's top PGA, the rate of PGA above "
+        "the grid's top on the curve, the rate of overturning with P = 1 above the grid "
+        "(an upper bound) and how P is extended there (p_above_grid)",
+        "hazard_curves": "the headline under each hazard curve given (--hazard "
+        "repeated), the first being the headline's; survival_range_over_curves: min "
+        "and max of their survival probabilities",
+        "survival_parameter_set_range": "min and max of survival_per_parameter_set: "
+        "the members' spread, reported apart from the Monte Carlo error",
+        "rate_scale_bound_5pct": "largest factor F on every rate of the hazard curve "
+        "with survival >= 0.05 (-ln 0.05 / (rate t) for a fixed age)",
+        "intensity_scale_bound_5pct": "largest factor c on the curve's PGA levels "
+        "(lambda_c(x) = lambda(x / c)) with survival >= 0.05; null with a note when "
+        "outside 0.001-1000",
+        "contribution_by_intensity": "the rate of overturning by PGA interval of the "
+        "curve (m/s^2; the last row: exceedances of the last level) and its share"}
 
 
 def _combined(specimens, ratio_model, combine):
@@ -239,16 +265,10 @@ def _curve_row(curve, result, specimens, ratio_model, age, age_sd):
     return row
 
 
-def _members(fragility):
-    """The fragility's per-parameter-set fragilities, or None."""
-    members = getattr(fragility, "members", None)
-    return None if members is None else members()
-
-
 def _per_parameter_set(curve, fragility, ratio_model, age, age_sd):
     """Survival with each parameter set's own fragility (a pulse grid's sets, a column
     campaign's members), else nothing."""
-    members = _members(fragility)
+    members = fragility.members()
     if not members:
         return {}
     zero = curve.zero_rate_from_m_s2
@@ -263,10 +283,10 @@ def _per_parameter_set(curve, fragility, ratio_model, age, age_sd):
 def _outside_grid(curve, fragility, ratio_model, probability, rate):
     """How much of the rate comes from outside a pulse grid's PGA range, and the rate
     with P = 0 below it and with the edge's P held below it; nothing for other forms."""
-    grid = getattr(fragility, "grid_range", None)
-    if grid is None or grid() is None:
+    grid = fragility.grid_range()
+    if grid is None:
         return {}
-    lo, hi = grid()
+    lo, hi = grid
     below, above = rate_outside(curve.levels_m_s2, curve.rates_per_yr, probability, lo, hi)
     zero = curve.zero_rate_from_m_s2
     bounds = {name: overturning_rate(

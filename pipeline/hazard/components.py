@@ -30,6 +30,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from pipeline.files import InputError
+from pipeline.hazard.fragility_kinds import Fragility
 
 COMPONENTS = ("rotd50", "rotd100")          # the hazard curve's PGA: RotD50 or vector peak
 LINE_ROTD50_FRACTION = math.cos(math.pi / 4)
@@ -82,11 +83,12 @@ def records_fraction(records, fraction_of=None, magnitude=None, distance_km=None
 
 
 @dataclass(frozen=True)
-class OnHazardMeasure:
-    """A fragility (``inner``, over its own PGA) read on the hazard curve's PGA:
+class OnHazardMeasure(Fragility):
+    """A fragility (``inner``, a :class:`~pipeline.hazard.fragility_kinds.Fragility` over its
+    own PGA) read on the hazard curve's PGA:
     P(x) = inner P(x / ``fraction``); ``measure``: what each PGA is and where the fraction
     comes from (said in the output)."""
-    inner: object
+    inner: Fragility
     fraction: float
     measure: dict
 
@@ -113,12 +115,12 @@ class OnHazardMeasure:
         return None if inner is None else [replace(self, inner=m) for m in inner]
 
     def variants(self):
-        inner = getattr(self.inner, "variants", None)
-        return None if inner is None else {k: replace(self, inner=v) for k, v in inner().items()}
+        inner = self.inner.variants()
+        return None if inner is None else {k: replace(self, inner=v) for k, v in inner.items()}
 
     def grid_range(self):
-        inner = getattr(self.inner, "grid_range", None)
-        return None if inner is None else tuple(v * self.fraction for v in inner())
+        inner = self.inner.grid_range()
+        return None if inner is None else tuple(v * self.fraction for v in inner)
 
     def describe(self):
         return {**self.inner.describe(), "pga_measure": self.measure}

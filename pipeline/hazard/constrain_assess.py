@@ -194,7 +194,7 @@ def _g(value):
 
 def _members(tree, specimens, survival_of, floor, warnings):
     """The weights under each member of the fragility and under their mixture, or None."""
-    lists = [None if getattr(f, "members", None) is None else f.members() for f in specimens]
+    lists = [f.members() for f in specimens]
     counts = {len(m) for m in lists if m}
     if not counts:
         return None

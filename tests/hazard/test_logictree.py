@@ -22,7 +22,7 @@ from pipeline.hazard.constrain import (bayes, branch_rates, cell_matrix, elimina
                                        motion_at_rate, truncated_ages, weighted_mean,
                                        weighted_quantile)
 from pipeline.hazard.constrain_assess import constrain_tree
-from pipeline.hazard.fragility import Lognormal, overturn_probability
+from pipeline.hazard.fragility import Fragility, Lognormal, overturn_probability
 from pipeline.hazard.logictree import LogicTree, load_logic_tree
 from pipeline.hazard.survival import overturning_rate
 
@@ -31,10 +31,11 @@ CASE_19 = RECORDS_DIR / "hazard" / "openquake_logictree_case_19"
 
 
 @dataclass(frozen=True)
-class Step:
+class Step(Fragility):
     """P(overturn | PGA) = 1 at and above ``at_m_s2``, else 0."""
     at_m_s2: float
     uses_ratio = False
+    label = "step"
 
     def probability(self, pga_m_s2, pgv_pga_s=None):
         return (np.asarray(pga_m_s2, float) >= self.at_m_s2).astype(float)

@@ -1,0 +1,232 @@
+"""Loading a campaign's fragility (``campaign fragility``'s ``fragility.json``) as a
+:class:`~pipeline.hazard.fragility_kinds.Fragility`: a column campaign's lognormal PGA
+fit or logistic surface with its members' own fits (:func:`load_campaign_fragility`,
+:func:`member_fits`), or a pulse grid (:func:`load_pulse_grid`)."""
+import io
+import math
+from dataclasses import replace
+
+import numpy as np
+import pandas as pd
+
+from pipeline.constants import STANDARD_GRAVITY
+from pipeline.files import InputError
+from pipeline.hazard.components import on_hazard_measure
+from pipeline.hazard.fragility_file import MAX_MEMBERS, read_fragility_file
+from pipeline.hazard.fragility_grid import BELOW_GRID, PulseGrid
+from pipeline.hazard.fragility_kinds import Logistic, Lognormal
+from pipeline.stats.ensemble import fragility_fit, logistic_surface
+from pipeline.userfiles import DATA_FILE_BYTES, Unreadable, number, read_text, show
+
+
+def load_campaign_fragility(path, column=None, form=None, below="ramp", component=None,
+                            magnitude=None, distance_km=None, record_fraction=None):
+    """The fragility of one column entry of ``campaign fragility``'s ``fragility.json``:
+    ``form`` "pga" (its lognormal PGA fit) or "pga-pgv" (its logistic surface; default);
+    ``column``: monolithic, drums, block2d or block2d_worst (default: the first 3D one).
+    A pulse-grid file (``--pulses``): :func:`load_pulse_grid` (``form`` default "grid";
+    ``below``: P below the grid, :class:`PulseGrid`).  Each member's own fit of the same
+    form (from ``fragility_runs.csv`` beside the file, when there) in ``member_fits``.
+    ``component`` (rotd50 or rotd100, the hazard curve's PGA): the fragility put on it
+    (:func:`pipeline.hazard.components.on_hazard_measure`, ``record_fraction(record)``
+    the RotD50 / vector peak of a record's motion); None: as in the file."""
+    fragility, kind, records = _load_campaign_fragility(path, column, form, below)
+    if component is None:
+        return fragility
+    return on_hazard_measure(fragility, kind, component, records, record_fraction,
+                             magnitude, distance_km)
+
+
+def _load_campaign_fragility(path, column, form, below):
+    """(fragility, "line" | "records", record ids) of :func:`load_campaign_fragility`."""
+    path, data = read_fragility_file(path)          # every value below checked
+    if "pulse_grid" in data:
+        return load_pulse_grid(path, data, column, form or "grid", below), "line", ()
+    form = form or "pga-pgv"
+    columns = data["columns"]
+    if column is None:
+        column = next((c for c in ("monolithic", "drums") if c in columns), next(iter(columns)))
+    if column not in columns:
+        raise InputError(f"{path}: no column {column!r} (has {', '.join(columns)})")
+    entry = columns[column]
+    label = f"{column} ({entry.get('description', '')}) from {path.name}"
+    if form == "pga":
+        fit = entry.get("PGA") or {}
+        if fit.get("unit") != "m/s^2":
+            raise InputError(f"{path}: column {column}: PGA fit in unknown unit "
+                             f"{fit.get('unit')!r} (expected m/s^2)")
+        if fit.get("median") is None:
+            raise InputError(f"{path}: column {column}: PGA fragility not fitted "
+                             f"({fit.get('note') or 'no median'})")
+        where = f"{path}: column {column}: PGA"
+        pooled = Lognormal(number(fit["median"], f"{where} median", 0, None, "m/s^2", True),
+                           number(fit.get("beta"), f"{where} beta", 0, None, "", True),
+                           _pair(fit.get("median_ci95"), f"{where} median_ci95"),
+                           _pair(fit.get("beta_ci95"), f"{where} beta_ci95"),
+                           label=label, note=fit.get("note"))
+    elif form == "pga-pgv":
+        pooled = _logistic(entry.get("logistic") or {}, f"{path}: column {column}", label)
+    else:
+        raise InputError(f"--fragility-form must be pga or pga-pgv, got {form!r}")
+    fits, note = member_fits(path.parent / "fragility_runs.csv", column, form, data)
+    pooled = replace(pooled, member_fits=fits,
+                     note="; ".join(filter(None, [pooled.note, note])) or None)
+    return pooled, "records", tuple(data.get("records") or ())
+
+
+def member_fits(runs_path, column, form, data):
+    """(one fragility per member of a column campaign fitted to its own runs, note): the
+    lognormal PGA fit (form "pga") or the logistic surface ("pga-pgv") of
+    :mod:`pipeline.stats.ensemble`, as the campaign fits the pooled runs; (None, note)
+    when the runs table is absent or no member's fit is determined."""
+    if not runs_path.is_file():
+        return None, f"no {runs_path.name} beside the file: the members' spread not available"
+    try:
+        table = pd.read_csv(io.StringIO(read_text(runs_path, DATA_FILE_BYTES)))
+        sub = table[table["column"] == column]
+        groups = sorted(sub.groupby("member"), key=lambda item: item[0])
+    except (OSError, Unreadable, ValueError, KeyError, pd.errors.ParserError) as exc:
+        raise InputError(f"{runs_path}: not a fragility_runs.csv of campaign fragility "
+                         f"({exc})") from None
+    if len(groups) > MAX_MEMBERS:
+        raise InputError(f"{runs_path}: {len(groups)} members (at most {MAX_MEMBERS})")
+    block = data.get("block2d") or {}
+    fits, skipped = [], []
+    for member, rows in groups:
+        try:
+            y = rows["toppled"].astype(str).str.lower().isin(("true", "1")).to_numpy()
+            pga = rows["pga_m_s2"].astype(float).to_numpy()
+            ratio = rows["pgv_pga_s"].astype(float).to_numpy()
+        except (KeyError, ValueError, TypeError):
+            raise InputError(f"{runs_path}: member {show(member)}: no readable toppled, "
+                             "pga_m_s2 and pgv_pga_s") from None
+        if not (np.isfinite(pga).all() and np.isfinite(ratio).all() and (pga > 0).all()
+                and (ratio > 0).all()):
+            raise InputError(f"{runs_path}: member {show(member)}: pga_m_s2 and pgv_pga_s "
+                             "must be positive finite numbers")
+        label = f"member {show(member)}"
+        if form == "pga":
+            fit = fragility_fit(pga, y)
+            if fit["median"] is None:
+                skipped.append(f"{show(member)} ({fit['note']})")
+                continue
+            fits.append(Lognormal(float(fit["median"]), float(fit["beta"]), label=label))
+        else:
+            fit = logistic_surface(pga, ratio, y, alpha=block.get("alpha_rad"),
+                                   p=block.get("p_per_s"))
+            b = fit["coefficients"]
+            if b is None or not b["b1"] > 0:
+                skipped.append(f"{show(member)} ({fit.get('note') or 'does not grow with PGA'})")
+                continue
+            fits.append(Logistic((b["b0"], b["b1"], b["b2"]), label=label))
+    note = None if not skipped else (f"{len(skipped)} of {len(groups)} member(s) not fitted "
+                                     f"alone, left out of the members' spread: "
+                                     f"{'; '.join(skipped)}")
+    return (tuple(fits) or None), note
+
+
+def _logistic(surface, where, label):
+    """The :class:`Logistic` of a fragility.json's ``logistic`` entry."""
+    coefficients = surface.get("coefficients")
+    if coefficients is None:
+        raise InputError(f"{where}: logistic surface not fitted "
+                         f"({surface.get('note') or 'no coefficients'})")
+    b = tuple(number(coefficients.get(k), f"{where}: logistic {k}") for k in ("b0", "b1", "b2"))
+    if not b[1] > 0:
+        raise InputError(f"{where}: the logistic surface does not grow with PGA "
+                         f"(b1 = {b[1]:g})")
+    cov = surface.get("cov")
+    if cov is not None and not all(isinstance(v, (int, float)) for row in cov for v in row):
+        cov = None                       # a singular information matrix: written as nulls
+    se = surface.get("se") or {}
+    note = surface.get("note")
+    if cov is None:
+        note = "; ".join(filter(None, [note, "no covariance in the file: coefficients drawn "
+                                       "independently (their correlation ignored)"]))
+    return Logistic(b, tuple(map(tuple, cov)) if cov is not None else None,
+                    tuple(se.get(k) for k in ("b0", "b1", "b2")) if se else None,
+                    label=label, note=note)
+
+
+def _pair(value, what):
+    """A 95 % interval (lo, hi) from a file: positive numbers, lo <= hi; None stays None."""
+    if value is None:
+        return None
+    if not (isinstance(value, list) and len(value) == 2):
+        raise InputError(f"{what} must be a pair [lo, hi], got {show(value)}")
+    lo, hi = (number(v, what, 0, None, "", True) for v in value)
+    if lo > hi:
+        raise InputError(f"{what}: {lo:g} above {hi:g}")
+    return lo, hi
+
+
+
+def load_pulse_grid(path, data, model=None, form="grid", below="ramp"):
+    """One model of a pulse-grid ``fragility.json`` (``models``: monolithic, block2d), its
+    ``data`` checked by :func:`pipeline.hazard.fragility_file.check_fragility`: ``form``
+    "grid" (:class:`PulseGrid`, ``below`` what P is below it; a grid of one row or column
+    interpolated along the other axis) or "pga-pgv" (its logistic surface)."""
+    if below not in BELOW_GRID:
+        raise InputError(f"--below-grid must be one of {', '.join(BELOW_GRID)}, got {below!r}")
+    section = data["pulse_grid"]
+    models = section["models"]
+    if model is None:
+        model = "monolithic" if "monolithic" in models else next(iter(models))
+    if model not in models:
+        raise InputError(f"{path}: pulse_grid has no model {model!r} (has {', '.join(models)})")
+    entry = models[model]
+    where = f"{path}: pulse_grid model {model}"
+    label = f"{data.get('specimen') or 'specimen'} {model} pulse grid from {path.name}"
+    logistic = None
+    surface = entry.get("logistic") or {}
+    if surface.get("coefficients") is not None:
+        logistic = _logistic(surface, where, label)
+    if form == "pga-pgv":
+        if logistic is None:
+            raise InputError(f"{where}: logistic surface not fitted "
+                             f"({surface.get('note') or 'no coefficients'})")
+        return logistic
+    if form != "grid":
+        raise InputError(f"--fragility-form for a pulse grid must be grid or pga-pgv, got "
+                         f"{form!r}")
+    pga_g = [float(v) for v in section["pga_g"]]        # checked: increasing, positive
+    ratios = [float(v) for v in section["pgv_pga_s"]]
+    n_sets = section["members"]
+    n = np.zeros((len(pga_g), len(ratios)), int)
+    overturned = np.zeros_like(n)
+    per_set = np.full((n_sets, len(pga_g), len(ratios)), np.nan)
+    index_a = {round(v, 9): i for i, v in enumerate(pga_g)}
+    index_r = {round(v, 9): j for j, v in enumerate(ratios)}
+    for cell in entry["cells"]:                        # checked: on the grid, once each
+        i, j = index_a[round(cell["pga_g"], 9)], index_r[round(cell["pgv_pga_s"], 9)]
+        n[i, j], overturned[i, j] = cell["n"], cell["overturned"]
+        for s, p in zip(cell.get("sets") or [], cell.get("P_per_set") or []):
+            if p is not None:
+                per_set[s, i, j] = float(p)
+    empty = int((n == 0).sum())
+    if empty == n.size:
+        raise InputError(f"{where}: no cell with runs (every n is 0)")
+    note = None if not empty else (f"{empty} of {n.size} cells without runs: filled from the "
+                                   "nearest cell along PGA")
+    uplift = _uplift(section, where)
+    return PulseGrid(tuple(v * STANDARD_GRAVITY for v in pga_g), tuple(ratios), n,
+                     overturned, per_set, logistic, label, note, uplift, below)
+
+
+def _uplift(section, where):
+    """g tan(alpha) (m/s^2) of a pulse grid's 2D block (``block2d``: the smallest over its
+    runs, uplift_g_smallest, where written; else uplift_g or alpha_rad, the runs' median),
+    or None when the file has none."""
+    block = section.get("block2d") or {}
+    if block.get("uplift_g_smallest") is not None:
+        return number(block["uplift_g_smallest"], f"{where}: block2d uplift_g_smallest", 0,
+                      None, "g", True) * STANDARD_GRAVITY
+    if block.get("uplift_g") is not None:
+        return number(block["uplift_g"], f"{where}: block2d uplift_g", 0, None, "g",
+                      True) * STANDARD_GRAVITY
+    if block.get("alpha_rad") is not None:
+        alpha = number(block["alpha_rad"], f"{where}: block2d alpha_rad", 0, math.pi / 2,
+                       "rad", True)
+        return STANDARD_GRAVITY * math.tan(alpha)
+    return None
+

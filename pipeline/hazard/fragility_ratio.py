@@ -1,0 +1,110 @@
+"""PGV/PGA (s) at a PGA level, and P(overturn) averaged over it.
+
+PGV/PGA at a PGA level is lognormal: :class:`RatioLognormal` (a median and sigma the user
+states, the same at every level) or :class:`RatioFromGmm` (the median and sigma of PGV and
+PGA from Boore et al. 2014 (pygmm) at a magnitude and distance, for example the mode of
+the hazard's disaggregation; ln PGV given ln PGA by their correlation).
+:func:`overturn_probability` averages fragilities
+(:class:`~pipeline.hazard.fragility_kinds.Fragility`) over it.
+"""
+import importlib.metadata
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from pipeline.constants import STANDARD_GRAVITY
+from pipeline.files import InputError
+
+RATIO_NODES = 24                  # Gauss-Hermite nodes over ln(PGV/PGA)
+PGA_PGV_CORRELATION = 0.733       # ln PGA, ln PGV residuals: Bradley (2012), Earthq. Spectra 28(1)
+GMM_MECHANISMS = ("SS", "NS", "RS")
+
+
+@dataclass(frozen=True)
+class RatioLognormal:
+    """PGV/PGA lognormal with ``median_s`` (s) and ``sigma_ln``, the same at every PGA."""
+    median_s: float
+    sigma_ln: float
+
+    def ln_mean_sd(self, pga_m_s2):
+        pga = np.asarray(pga_m_s2, float)
+        return np.full(pga.shape, math.log(self.median_s)), np.full(pga.shape, self.sigma_ln)
+
+    def describe(self):
+        return {"source": "user", "distribution": "lognormal, the same at every PGA",
+                "median_s": self.median_s, "sigma_ln": self.sigma_ln}
+
+
+@dataclass(frozen=True)
+class RatioFromGmm:
+    """PGV/PGA at a PGA level from a ground-motion model at a magnitude and distance:
+    ln PGV given ln PGA = a is normal with mean mu_v + rho (s_v / s_a)(a - mu_a) and
+    sd s_v sqrt(1 - rho^2); PGV/PGA = PGV / a."""
+    magnitude: float
+    distance_km: float
+    vs30_m_s: float = 760.0
+    mechanism: str = "SS"
+    correlation: float = PGA_PGV_CORRELATION
+    medians: dict = field(default=None, compare=False)
+
+    def __post_init__(self):
+        import pygmm  # noqa: PLC0415  (slow import, only needed here)
+        scenario = pygmm.Scenario(mag=self.magnitude, dist_jb=self.distance_km,
+                                  v_s30=self.vs30_m_s, mechanism=self.mechanism)
+        model = pygmm.BooreStewartSeyhanAtkinson2014(scenario)
+        object.__setattr__(self, "medians", {
+            "pga_m_s2": float(model.pga) * STANDARD_GRAVITY, "ln_std_pga": float(model.ln_std_pga),
+            "pgv_m_s": float(model.pgv) / 100.0, "ln_std_pgv": float(model.ln_std_pgv)})
+
+    def ln_mean_sd(self, pga_m_s2):
+        m, rho = self.medians, self.correlation
+        ln_a = np.log(np.asarray(pga_m_s2, float))
+        eps_a = (ln_a - math.log(m["pga_m_s2"])) / m["ln_std_pga"]
+        mean_v = math.log(m["pgv_m_s"]) + rho * m["ln_std_pgv"] * eps_a
+        sd = m["ln_std_pgv"] * math.sqrt(1.0 - rho ** 2)
+        return mean_v - ln_a, np.full(ln_a.shape, sd)
+
+    def describe(self):
+        return {"source": "ground-motion model",
+                "model": "Boore, Stewart, Seyhan & Atkinson (2014), pygmm "
+                         "BooreStewartSeyhanAtkinson2014 (RotD50)",
+                "magnitude": self.magnitude, "distance_jb_km": self.distance_km,
+                "vs30_m_s": self.vs30_m_s, "mechanism": self.mechanism,
+                "pga_pgv_correlation": self.correlation,
+                "median_pga_m_s2": self.medians["pga_m_s2"],
+                "median_pgv_m_s": self.medians["pgv_m_s"],
+                "ln_std_pga": self.medians["ln_std_pga"], "ln_std_pgv": self.medians["ln_std_pgv"],
+                "pygmm": importlib.metadata.version("pygmm"),
+                "distribution": "lognormal given PGA: ln PGV | ln PGA by their correlation"}
+
+
+def overturn_probability(fragilities, ratio_model, pga_m_s2, combine="each"):
+    """P(overturn) at PGA levels (m/s^2) averaged over PGV/PGA (Gauss-Hermite in ln PGV/PGA).
+
+    ``combine``: "each" (array n_specimens x n_levels), "any_common" (P that any overturns
+    in one event, the specimens independent given the motion they share: 1 - E[prod(1 -
+    P_i)]) or "any_correlated" (the specimens' capacities fully correlated: E[max P_i]).
+    """
+    pga = np.asarray(pga_m_s2, float)
+    if any(f.uses_ratio for f in fragilities):
+        if ratio_model is None:
+            raise InputError("the fragility depends on PGV/PGA: give its distribution "
+                             "(--pgv-pga-median and --pgv-pga-sigma, or --magnitude and "
+                             "--distance-km)")
+        nodes, weights = np.polynomial.hermite_e.hermegauss(RATIO_NODES)
+        weights = weights / weights.sum()
+        mean, sd = ratio_model.ln_mean_sd(pga)
+        ratio = np.exp(mean[:, None] + sd[:, None] * nodes[None, :])
+        each = np.array([f.probability(pga[:, None], ratio) for f in fragilities])
+    else:
+        weights = np.ones(1)
+        each = np.array([f.probability(pga)[:, None] for f in fragilities])
+    if combine == "each":
+        return each @ weights
+    if combine == "any_common":
+        return 1.0 - np.prod(1.0 - each, axis=0) @ weights
+    if combine == "any_correlated":
+        return each.max(axis=0) @ weights
+    raise ValueError(f"unknown combine {combine!r}")
+
