@@ -5,17 +5,19 @@
     python -m pipeline survival --hazard curve.csv --fragility results/campaigns/fragility \\
         --column monolithic --pgv-pga-median 0.1 --pgv-pga-sigma 0.4 --age-ka 2.5
 
-Writes ``survival.json`` and ``survival.png`` to ``--out``.
+Writes ``survival.json`` and ``survival.png`` to ``--out`` (the workflow:
+:mod:`pipeline.report.survival`).
 """
 import math
 from pathlib import Path
 
 from pipeline import RESULTS_DIR
 from pipeline.constants import STANDARD_GRAVITY
-from pipeline.files import InputError, display_path, write_json
+from pipeline.files import InputError, display_path
 from pipeline.cli._fragility_options import (add_draw_options, add_fragility_options,
                                              add_ratio_options, check_fragility_options,
                                              load_specimens, parse_logistic, ratio_model)
+from pipeline.report.survival import site_motion_result, survival_files, write_site_motion
 from pipeline.userfiles import number
 
 NAME = "survival"
@@ -120,24 +122,16 @@ def run(args):
     if args.observations is not None:
         site_motion = _site_motion(args)
     if not args.hazard:
-        write_json(args.out / "site_motion.json", site_motion)
+        write_site_motion(args.out, site_motion)
         _print_site_motion(site_motion)
         print(f"wrote {display_path(args.out / 'site_motion.json')}")
         return 0
     from pipeline.hazard import load_hazard
-    from pipeline.hazard.assess import assess
     curves = [load_hazard(path, args.site) for path in args.hazard]
     specimens = load_specimens(args)
     ratio = ratio_model(args, specimens)
-    summary, data = assess(curves[0], specimens, ratio, args.age_ka, args.age_sd_ka,
-                           args.draws, args.seed, curves[1:])
-    summary["hazard_component"] = args.hazard_component
-    summary["figure"] = "survival.png"
-    if site_motion is not None:
-        summary["site_motion"] = site_motion
-    from pipeline.figures.survival import plot_survival
-    plot_survival(data, args.out / "survival.png")
-    write_json(args.out / "survival.json", summary)
+    summary = survival_files(args.out, curves, specimens, ratio, args.age_ka, args.age_sd_ka,
+                             args.draws, args.seed, args.hazard_component, site_motion)
     for line in summary["warnings"]:
         print(f"warning: {line}")
     interval = summary["survival_interval"]
@@ -151,25 +145,16 @@ def run(args):
         print(f"under {row['kind'] or row['file']}: rate {row['annual_overturning_rate_per_yr']:.3g}"
               f" /yr, survival P = {row['survival_probability']:.3g}")
     if site_motion is not None:
-        write_json(args.out / "site_motion.json", site_motion)
         _print_site_motion(site_motion)
     print(f"wrote {display_path(args.out / 'survival.json')} and survival.png")
     return 0
 
 
 def _site_motion(args):
-    """site_motion.json's content: the PGA range consistent with one site's columns."""
+    """site_motion.json's content: the PGA range consistent with one site's columns, each
+    column type's fragility from the options."""
     from pipeline.hazard.fragility import Logistic, Lognormal, load_campaign_fragility
-    from pipeline.hazard.site_motion import site_motion
-    from pipeline.inversion.observations import load_observations
     from pipeline.records import rotd50_fraction
-    observations = load_observations(args.observations)
-    name = args.observation_site
-    if name is None:
-        if len(observations.sites) != 1:
-            raise InputError(f"{args.observations.name}: {len(observations.sites)} sites: "
-                             "name one with --observation-site")
-        name = observations.sites[0].name
     if args.fragility:
         def fragility_for(column):
             return load_campaign_fragility(args.fragility[0], column, args.fragility_form,
@@ -186,11 +171,11 @@ def _site_motion(args):
                           label=f"stated logistic surface {args.logistic[0]} (every column)")
         def fragility_for(column):
             return stated
-    result = site_motion(observations, name, fragility_for, args.at_pgv_pga)
-    result["pga_measure"] = (f"{args.hazard_component}: a campaign's fragility put on it "
-                             "(fragilities.*.pga_measure)" if args.fragility else
-                             "the stated fragility's own PGA")
-    return result
+    return site_motion_result(
+        args.observations, args.observation_site, fragility_for, args.at_pgv_pga,
+        f"{args.hazard_component}: a campaign's fragility put on it "
+        "(fragilities.*.pga_measure)" if args.fragility else
+        "the stated fragility's own PGA")
 
 
 def _print_site_motion(result):

@@ -1,0 +1,48 @@
+"""The ``survival`` command's workflow: a standing specimen's survival under a site's
+hazard curves written as ``survival.json`` and ``survival.png``, and the PGA range a
+site's standing and fallen columns allow as ``site_motion.json`` (docs/survival.md).
+The command reads and checks its options and the input files; this writes the results."""
+from pipeline.files import InputError, write_json
+
+
+def site_motion_result(observations_path, site_name, fragility_for, at_pgv_pga, pga_measure):
+    """site_motion.json's content: the PGA range consistent with one site's columns
+    (``site_name`` None: the file's only site; ``fragility_for(column type)`` its
+    fragility; ``pga_measure``: what the PGA is, in words)."""
+    from pipeline.hazard.site_motion import site_motion
+    from pipeline.inversion.observations import load_observations
+    observations = load_observations(observations_path)
+    name = site_name
+    if name is None:
+        if len(observations.sites) != 1:
+            raise InputError(f"{observations_path.name}: {len(observations.sites)} sites: "
+                             "name one with --observation-site")
+        name = observations.sites[0].name
+    result = site_motion(observations, name, fragility_for, at_pgv_pga)
+    result["pga_measure"] = pga_measure
+    return result
+
+
+def write_site_motion(out, result):
+    """Write ``result`` as ``out``/site_motion.json (atomically)."""
+    write_json(out / "site_motion.json", result)
+
+
+def survival_files(out, curves, specimens, ratio, age_ka, age_sd_ka, draws, seed,
+                   hazard_component, site_motion=None):
+    """survival.json's content (:func:`pipeline.hazard.assess.assess` under ``curves``,
+    the first the headline), written with survival.png to ``out`` (and site_motion.json
+    after them when ``site_motion`` is given)."""
+    from pipeline.figures.survival import plot_survival
+    from pipeline.hazard.assess import assess
+    summary, data = assess(curves[0], specimens, ratio, age_ka, age_sd_ka, draws, seed,
+                           curves[1:])
+    summary["hazard_component"] = hazard_component
+    summary["figure"] = "survival.png"
+    if site_motion is not None:
+        summary["site_motion"] = site_motion
+    plot_survival(data, out / "survival.png")
+    write_json(out / "survival.json", summary)
+    if site_motion is not None:
+        write_site_motion(out, site_motion)
+    return summary
