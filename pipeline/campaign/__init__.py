@@ -24,6 +24,7 @@ from pipeline import RESULTS_DIR
 from pipeline.files import (LONG_RUN_S, DirectoryLock, InputError, ToolError, check_jobs,
                             check_long, write_json)
 from pipeline.campaign.executor import EXECUTORS, RUN_CORE_S, execute
+from pipeline.campaign.run_dirs import count_finished
 
 log = logging.getLogger(__name__)
 
@@ -143,8 +144,7 @@ def _gate_from_options(campaign, records, options, campaign_dir, jobs, allow_lon
     if estimate is None:
         return False
     runs, core_s = estimate
-    runs_dir = Path(campaign_dir) / "runs"
-    done = sum(1 for _ in runs_dir.glob("*/summary.json")) if runs_dir.is_dir() else 0
+    done = count_finished(campaign_dir)
     return check_long(f"campaign {campaign.name}", max(runs - done, 0), core_s, jobs,
                       allow_long, "fewer records, members or parameter values") > LONG_RUN_S
 

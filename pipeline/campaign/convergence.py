@@ -32,7 +32,7 @@ import numpy as np
 from pipeline.campaign import Campaign, register
 from pipeline.campaign.options import CampaignOptions
 from pipeline.scenario.parameters import param
-from pipeline.campaign.run_dirs import finished_summary
+from pipeline.campaign.run_dirs import finished_runs
 from pipeline.campaign.runs import column_specs, run_column_spec
 from pipeline.simulate import run_code_version
 from pipeline.campaign.ensemble import (DEFAULT_SEED, ENSEMBLE_RANGES, check_seed,
@@ -101,10 +101,8 @@ def convergence_outputs(specs, campaign_dir, failures, animations, figures=True)
 def wall_per_member(specs, campaign_dir):
     """{variant: mean wall time (s) of its finished YADE runs} from their summary.json."""
     times = {}
-    for spec in specs:
-        summary = finished_summary(campaign_dir, spec.run_id)
-        if summary is not None:
-            times.setdefault(spec.tags["variant"], []).append(summary.wall_s)
+    for spec, summary in finished_runs(campaign_dir, specs):
+        times.setdefault(spec.tags["variant"], []).append(summary.wall_s)
     return {name: float(np.mean(times[name])) for name in VARIANTS if name in times}
 
 

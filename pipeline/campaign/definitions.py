@@ -12,7 +12,7 @@ from pipeline.campaign.options import (CAMPAIGN_NOTE, CampaignOptions, ColumnFil
                                        column_file_param, contact_file_param, contact_of,
                                        refuse_ignored_stiffness, stiffness_param)
 from pipeline.scenario.contact_file import contact_values, refuse_set_twice, with_contact
-from pipeline.campaign.run_dirs import finished_summary
+from pipeline.campaign.run_dirs import finished_runs
 from pipeline.campaign.column_file import (at_slenderness, check_stiffness, column_kn,
                                            description, mark, matched_kn)
 from pipeline.campaign.runs import (column_outputs, column_specs, described_twins,
@@ -204,10 +204,7 @@ def columns_table(specs, campaign_dir):
     import pandas as pd
 
     rows = []
-    for spec in specs:
-        summary = finished_summary(campaign_dir, spec.run_id)
-        if summary is None:
-            continue
+    for spec, summary in finished_runs(campaign_dir, specs):
         geometry = ColumnGeometry.from_dict(spec.params.column.column_file)
         shapes = {"drums": geometry, "monolithic": geometry.monolithic()}
         for col in summary.columns:

@@ -32,6 +32,21 @@ def finished_summary(campaign_dir, run_id):
     return RunSummary.load(path) if path.exists() else None
 
 
+def finished_runs(campaign_dir, specs):
+    """(spec, :class:`~pipeline.outcome.summary.RunSummary`) of each of ``specs`` whose
+    run has finished in the campaign in ``campaign_dir``, in their order."""
+    for spec in specs:
+        summary = finished_summary(campaign_dir, spec.run_id)
+        if summary is not None:
+            yield spec, summary
+
+
+def count_finished(campaign_dir):
+    """How many runs the campaign in ``campaign_dir`` holds finished (0 when none)."""
+    runs_dir = Path(campaign_dir) / "runs"
+    return sum(1 for _ in runs_dir.glob("*/summary.json")) if runs_dir.is_dir() else 0
+
+
 def keep_only_summary(run_dir):
     """Delete everything in ``run_dir`` but summary.json (and the lock)."""
     for path in Path(run_dir).iterdir():

@@ -32,7 +32,7 @@ import numpy as np
 import pandas as pd
 
 from pipeline.campaign import Campaign, register
-from pipeline.campaign.run_dirs import finished_summary
+from pipeline.campaign.run_dirs import finished_runs
 from pipeline.campaign.options import (CampaignOptions, column_file_param, contact_file_param,
                                        contact_of)
 from pipeline.scenario.contact_file import contact_values
@@ -213,10 +213,7 @@ def outputs(specs_, campaign_dir, failures, animations, figures=True):
         return MODES["members"].outputs(specs_, campaign_dir, failures, animations, figures)
     campaign_dir = Path(campaign_dir)
     rows = []
-    for spec in specs_:
-        summary = finished_summary(campaign_dir, spec.run_id)
-        if summary is None:
-            continue
+    for spec, summary in finished_runs(campaign_dir, specs_):
         column = summary.columns[0]
         rows.append({"test": spec.tags["test"], "stage": spec.tags["stage"],
                      "grid_point": spec.tags["grid_point"], "observed": spec.tags["observed"],

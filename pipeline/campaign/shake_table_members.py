@@ -33,7 +33,7 @@ import pandas as pd
 
 from pipeline.campaign import ensemble, pulse_grid, shake_table
 from pipeline.campaign.column_file import column_kn
-from pipeline.campaign.run_dirs import finished_summary
+from pipeline.campaign.run_dirs import finished_runs, finished_summary
 from pipeline.campaign.runs import column_specs
 from pipeline.campaign.shake_table_scores import load_providers, write_scores
 from pipeline.files import InputError, duration_text, write_csv
@@ -149,14 +149,12 @@ def outputs(specs_, campaign_dir, failures, animations, figures=True):
     """The finished runs of this stage (``members_runs.csv``); the scores are written by
     :func:`drive` once every stage has run."""
     rows = []
-    for spec in specs_:
-        summary = finished_summary(Path(campaign_dir), spec.run_id)
-        if summary is not None:
-            rows.append({"test": spec.tags["test"], "member": spec.tags["member"],
-                         "observed": spec.tags["observed"],
-                         "predicted": summary.columns[0].toppled,
-                         "max_tilt_deg": summary.columns[0].max_tilt_deg,
-                         "run_id": spec.run_id})
+    for spec, summary in finished_runs(Path(campaign_dir), specs_):
+        rows.append({"test": spec.tags["test"], "member": spec.tags["member"],
+                     "observed": spec.tags["observed"],
+                     "predicted": summary.columns[0].toppled,
+                     "max_tilt_deg": summary.columns[0].max_tilt_deg,
+                     "run_id": spec.run_id})
     if rows:
         write_csv(Path(campaign_dir) / "members_runs.csv", pd.DataFrame(rows))
     return {"runs_done": len(rows)}
@@ -192,9 +190,9 @@ def drive(run, records, campaign_dir, options, gate=None):
         log.info(f"shake-table (members), stage {stage}: {len(chosen)} of "
                  f"{most - len(single)} member runs")
         run({**options, "stage": "members", "only_runs": chosen + single, "full": full})
-        return {cells[t]: [summary.columns[0].toppled for s in rows[:targets[cells[t]]]
-                           if (summary := finished_summary(Path(campaign_dir), s.run_id))
-                           is not None] for t, rows in order.items()}
+        return {cells[t]: [summary.columns[0].toppled for _, summary in
+                           finished_runs(Path(campaign_dir), rows[:targets[cells[t]]])]
+                for t, rows in order.items()}
 
     targets, settled = pulse_grid.adaptive_sampling(guide, n, run_stage)
     if not settled:
@@ -219,8 +217,8 @@ def _per_test(frame, order, by_test, campaign_dir, targets, cells):
     interval, and the single set's prediction."""
     rows = []
     for row in frame.itertuples():
-        done = [summary.columns[0].toppled for s in order[row.test][:targets[cells[row.test]]]
-                if (summary := finished_summary(Path(campaign_dir), s.run_id)) is not None]
+        done = [summary.columns[0].toppled for _, summary in
+                finished_runs(Path(campaign_dir), order[row.test][:targets[cells[row.test]]])]
         single = [finished_summary(Path(campaign_dir), s.run_id)
                   for s in by_test[row.test] if s.tags["member"] < 0][0]
         k, m = int(sum(done)), len(done)

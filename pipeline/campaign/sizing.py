@@ -7,6 +7,7 @@ import math
 from pathlib import Path
 
 from pipeline.campaign.executor import RUN_CORE_S
+from pipeline.campaign.run_dirs import count_finished
 from pipeline.files import write_json
 from pipeline.stats.ensemble import wilson_interval
 
@@ -97,8 +98,7 @@ def reachable_runs(records, max_members, campaign_dir):
     """The most runs an ensemble sized by its error may make: the nominal run and
     ``max_members`` members on each record, less the runs already finished in
     ``campaign_dir`` (a resumed campaign)."""
-    runs_dir = Path(campaign_dir) / "runs"
-    done = sum(1 for _ in runs_dir.glob("*/summary.json")) if runs_dir.is_dir() else 0
+    done = count_finished(campaign_dir)
     return max(len(records) * (max_members + 1) - done, 0)
 
 

@@ -10,7 +10,7 @@ import pyarrow as pa
 import pyarrow.parquet  # noqa: F401  (pandas' to_parquet engine, loaded before any run)
 
 from pipeline.files import atomic_path, write_csv
-from pipeline.campaign.run_dirs import finished_summary
+from pipeline.campaign.run_dirs import finished_runs
 from pipeline.motion import Motion
 from pipeline.motion.measures import record_parameters
 
@@ -54,10 +54,7 @@ def _tables(specs, campaign, campaign_dir):
     runs_dir = Path(campaign_dir) / "runs"
     record_params = {}
     run_rows, impact_rows = [], []
-    for spec in specs:
-        summary = finished_summary(campaign_dir, spec.run_id)
-        if summary is None:
-            continue
+    for spec, summary in finished_runs(campaign_dir, specs):
         if spec.motion_file not in record_params:
             motion = Motion.load(spec.motion_file)
             site = {k: motion.meta[k] for k in SYNTHETIC_SITE_KEYS if k in motion.meta}

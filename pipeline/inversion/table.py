@@ -11,7 +11,7 @@ import pandas as pd
 
 from pipeline import files
 from pipeline.simulate import run_code_version
-from pipeline.campaign.run_dirs import finished_summary
+from pipeline.campaign.run_dirs import finished_runs
 from pipeline.constants import COLUMN_TYPES as COLUMNS
 from pipeline.files import InputError
 from pipeline.stats.circular import circular_summary
@@ -75,10 +75,7 @@ class ForwardTable:
         ntop, naz, nval = np.zeros(shape, bool), np.full(shape, np.nan), np.zeros(shape, bool)
         wall, simulated = 0.0, 0
         na = len(grid.azimuths_deg)
-        for spec in specs:
-            summary = finished_summary(campaign_dir, spec.run_id)
-            if summary is None:
-                continue
+        for spec, summary in finished_runs(campaign_dir, specs):
             wall += summary.wall_s
             simulated += summary.simulated
             i, j = divmod(spec.tags["node"], na)

@@ -9,6 +9,7 @@ from pathlib import Path
 
 from pipeline import RESULTS_DIR
 from pipeline.campaign.executor import RUN_CORE_S as FORWARD_RUN_CORE_S
+from pipeline.campaign.run_dirs import count_finished
 from pipeline.constants import COLUMN_TYPES
 from pipeline.files import InputError, check_jobs, check_long
 
@@ -63,12 +64,6 @@ def described_columns(observations, base_dir="."):
     return out
 
 
-def finished_runs(campaign_dir):
-    """How many runs a campaign directory holds finished (0 when there is none)."""
-    runs_dir = Path(campaign_dir) / "runs"
-    return sum(1 for _ in runs_dir.glob("*/summary.json")) if runs_dir.is_dir() else 0
-
-
 def preflight(grid, forward_dir, jobs, allow_long, more_runs=0):
     """Say how many runs the forward table needs, how many may be cached and roughly how
     long the rest (and ``more_runs`` twin runs of the same cost) take on ``jobs`` cores;
@@ -76,7 +71,7 @@ def preflight(grid, forward_dir, jobs, allow_long, more_runs=0):
     without ``allow_long``).  Returns the estimate (s)."""
     from pipeline.inversion.forward import DEFAULT_FORWARD_DIR
     forward_dir = Path(forward_dir or DEFAULT_FORWARD_DIR)
-    done = finished_runs(forward_dir)
+    done = count_finished(forward_dir)
     needed = grid.n_runs()
     rest = max(0, needed - done)
     log.info(f"forward table: {needed} YADE runs, up to {min(done, needed)} of them cached in "
@@ -262,7 +257,7 @@ def hidden_truth(truth_file, options, grid, candidates):
     if out.exists() and not out.is_dir():
         raise InputError(f"--out {out} is a file, not a directory")
     started = time.monotonic()
-    truth_runs = max(0, sum(s[3] for s in truth.sites) - finished_runs(out / "truth-runs"))
+    truth_runs = max(0, sum(s[3] for s in truth.sites) - count_finished(out / "truth-runs"))
     if options.table is not None and not options.scheduler:
         check_long("the hidden truth's runs", truth_runs, FORWARD_RUN_CORE_S,
                    check_jobs(options.jobs), options.allow_long, "fewer sites or twins")
