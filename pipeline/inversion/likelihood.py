@@ -47,16 +47,22 @@ Densities are per radian.
 product above ignores: columns at one site share one ground motion, and the node's fall
 distribution is known only through its n members.  The columns of one type at one site
 are then exchangeable draws from an unknown distribution centred on the ensemble's, with
-the weight of n + 1 columns (a Polya urn / Dirichlet-process predictive): the j-th column,
+the weight of A columns (a Polya urn / Dirichlet-process predictive): the j-th column,
 after f earlier falls and s earlier standing columns of its type at the site, contributes
 
     fallen:   (A f(psi) + sum_i K(psi - psi_i)) / (A + j),   standing: (A q + s) / (A + j)
 
-with A = n + 1, f(psi) = P d(psi) and q = 1 - P as above, psi_i the earlier falls and K a
-von Mises kernel of width sqrt(kernel^2 + sigma^2 + sigma_i^2), floored like d.  The first
+with 1 / A = 1 / (n + 1) + 1 / m, f(psi) = P d(psi) and q = 1 - P as above, psi_i the
+earlier falls and K a von Mises kernel of width sqrt(kernel^2 + sigma^2 + sigma_i^2),
+floored like d.  The first
 column of a type contributes exactly what the independent product gives; later ones
-weigh less the more the site's own columns already say.  With many members (A >> j) the
-two agree.
+weigh less the more the site's own columns already say.  A sums two uncertainties of the
+site's fall distribution about the table's: the table's n members (1 / (n + 1)) and the
+site's own departure from its node (1 / m, ``site_columns``: the site's motion is not the
+node's, the candidate's strike and cell are not the source's, the site's columns are a
+few draws, not the population).  m was chosen on the member study's calibration draws
+(:data:`SITE_COLUMNS`); m -> infinity is the urn of the table's sampling alone, m -> 0
+counts a site's columns as one.  With A >> j the urn and the product agree.
 """
 import math
 
@@ -72,6 +78,8 @@ PSI_STEP_DEG = 0.5
 OBS_CHUNK = 8                  # observations per vectorised block (memory)
 VIRTUAL_STEP_DEG = 7.5         # the largest spacing of the virtual azimuths between spokes
 MW_STEP = 0.1                  # the candidates' magnitude step between the table's slices
+SITE_COLUMNS = 3.0             # m: a site's columns as m draws' worth of the node's (predictive;
+#                                chosen on the member study's calibration draws, docs/inversion.md)
 
 
 def mean_resultant_length(kappa):
@@ -120,8 +128,11 @@ class ForwardModel:
     """Per-node toppling probabilities and direction densities of a forward table."""
 
     def __init__(self, table, kernel_deg=DEFAULT_KERNEL_DEG, floor=DEFAULT_FLOOR,
-                 likelihood="independent", mw_step=MW_STEP):
+                 likelihood="independent", mw_step=MW_STEP, site_columns=SITE_COLUMNS):
         check_model_options(kernel_deg, floor, likelihood)
+        if not site_columns > 0:
+            raise InputError(f"site columns must be positive, got {site_columns:g}")
+        self.site_columns = float(site_columns)
         if not (math.isfinite(mw_step) and 0 < mw_step <= 1):
             raise InputError(f"magnitude step must lie in (0, 1], got {mw_step:g}")
         self.likelihood, self.mw_step = likelihood, float(mw_step)
@@ -250,7 +261,7 @@ class ForwardModel:
                         out += np.log(self._mixed(value))
                 continue
             # predictive: a Polya urn per site and column type, in the file's order
-            weight = float(np.mean(self.n[..., c])) + 1.0
+            weight = self.urn_weight(c)
             values = {}
             for start in range(0, len(fallen), OBS_CHUNK):
                 ks = fallen[start:start + OBS_CHUNK]
@@ -266,6 +277,11 @@ class ForwardModel:
                 out += np.log((weight * values[j] + pair) / (weight + j))
                 earlier.append(obs)
         return out
+
+    def urn_weight(self, c):
+        """A of the predictive likelihood for column type c: 1 / A = 1 / (n + 1) + 1 / m,
+        the table's sampling (n members) and the site's own draw (``site_columns``)."""
+        return 1.0 / (1.0 / (float(np.mean(self.n[..., c])) + 1.0) + 1.0 / self.site_columns)
 
     def _standing(self, c, rings, ai0, ai1, aw):
         """Interpolated 1 - P of column type c: (ns, nphi, ne)."""

@@ -457,7 +457,7 @@ def invert(model, observations, grid):
     keep = grid.slice_mask(model.table)
     if not keep.all():
         model = ForwardModel(model.table.select_slices(keep), model.kernel_deg, model.floor,
-                             model.likelihood, model.mw_step)
+                             model.likelihood, model.mw_step, model.site_columns)
     for column in observations.column_types():
         model.column_index(column)
     last_ring = float(model.table.distances_km[-1])

@@ -143,13 +143,14 @@ def test_unmodelled_column_is_one_line(tiny):
 
 def test_predictive_polya_urn_by_hand(tiny):
     """Two drums fell (15, then 25 deg) and one stands, at node (5 km, 0): n = 4 members,
-    A = 5.  First fall: as the independent product; second: the ensemble's weight A plus a
-    kernel about the first fall, over A + 1; the standing one: A (1 - P) over A + 2."""
-    model = ForwardModel(tiny, KERNEL, FLOOR, likelihood="predictive")
+    and 3 site columns: 1 / A = 1 / 5 + 1 / 3, A = 15 / 8.  First fall: as the independent
+    product; second: the weight A plus a kernel about the first fall, over A + 1; the
+    standing one: A (1 - P) over A + 2."""
+    model = ForwardModel(tiny, KERNEL, FLOOR, likelihood="predictive", site_columns=3.0)
     second = ColumnObservation("drums", "fallen", 25.0, SIGMA)
     stands = ColumnObservation("drums", "standing")
     ll = model.site_log_likelihood(site(DRUMS_15, second, stands), [0.0], [-5.0], [0.0])
-    a, p = 5.0, 0.5
+    a, p = 15.0 / 8.0, 0.5
     pair = (1 - FLOOR) * vm(10.0, kappa_by_hand(math.sqrt(KERNEL ** 2 + 2 * SIGMA ** 2))) \
         + FLOOR / (2 * math.pi)
     terms = [p * density_node0(15.0),
