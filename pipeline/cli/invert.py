@@ -8,7 +8,9 @@
 import math
 from pathlib import Path
 
-from pipeline.files import LONG_RUN_S, InputError, check_jobs
+from pipeline.cli._fields import add_arguments, from_args
+from pipeline.files import InputError
+from pipeline.inversion.workflows import InversionOptions
 from pipeline.userfiles import number
 
 NAME = "invert"
@@ -54,12 +56,10 @@ def _weights(text):
 
 def setup(p):
     from pipeline.inversion.grid import GRIDS, MECHANISMS
-    from pipeline.inversion.likelihood import DEFAULT_FLOOR, DEFAULT_KERNEL_DEG
     _what_to_run(p, GRIDS)
     _forward_grid(p.add_argument_group("forward grid (the table: one ensemble per node)"),
                   GRIDS["full"], MECHANISMS)
-    _candidates(p.add_argument_group("candidates and prior"), DEFAULT_KERNEL_DEG,
-                DEFAULT_FLOOR)
+    _candidates(p.add_argument_group("candidates and prior"))
     _site_motion(p.add_argument_group("the motion at each site from its standing and fallen "
                                       "columns (with an OBSERVATIONS.json)"))
 
@@ -84,9 +84,7 @@ def _what_to_run(p, grids):
     quick = grids["quick"]
     p.add_argument("observations", nargs="?", type=Path, metavar="OBSERVATIONS.json",
                    help="sites with their fallen and standing columns (schema: docs/inversion.md)")
-    p.add_argument("--out", type=Path, default=None, metavar="DIR",
-                   help="output directory (default results/inversion/<file stem>; "
-                   "--demo: results/inversion)")
+    add_arguments(p, InversionOptions, names=("out",))
     p.add_argument("--quick", action="store_true",
                    help=f"coarse smoke run (a few minutes): {len(quick.slices())} slices, "
                    f"rings {','.join(f'{v:g}' for v in quick.distances_km)} km every "
@@ -108,20 +106,8 @@ def _what_to_run(p, grids):
                    "(observed columns from 16 members no likelihood uses): how many fallen "
                    "columns bound the back azimuth, the epicentre and the magnitude (default "
                    "--grid study: 2,304 runs; make invert-study)")
-    p.add_argument("--scheduler", default=None, metavar="ADDRESS",
-                   help="run the forward campaign on an existing Dask cluster")
-    p.add_argument("--jobs", type=int, default=None,
-                   help="parallel YADE runs / pyprop8 processes (default: all cores)")
-    p.add_argument("--allow-long", action="store_true",
-                   help=f"start a forward table estimated to take over "
-                   f"{LONG_RUN_S / 3600:g} h on this machine (refused otherwise; the "
-                   "estimate is printed before any run)")
-    p.add_argument("--table", type=Path, default=None, metavar="FILE",
-                   help="use this forward table file (tables/forward_table_<key>.npz) as it "
-                   "is: no pyprop8, no YADE (its code version is reported, not checked)")
-    p.add_argument("--forward-dir", type=Path, default=None, metavar="DIR",
-                   help="campaign directory of the forward runs (default "
-                   "results/inversion-forward)")
+    add_arguments(p, InversionOptions,
+                  names=("scheduler", "jobs", "allow_long", "table", "forward_dir"))
 
 
 def _forward_grid(g, full, mechanisms):
@@ -153,7 +139,7 @@ def _forward_grid(g, full, mechanisms):
                    help=f"motion duration (default {full.duration_s:g} s)")
 
 
-def _candidates(c, kernel_deg, floor):
+def _candidates(c):
     """The candidate sources, the prior and the likelihood's options."""
     c.add_argument("--radius", type=float, default=None, metavar="KM",
                    help="epicentres within this distance of a site (default 30; quick 12; "
@@ -166,21 +152,7 @@ def _candidates(c, kernel_deg, floor):
                    help="prior weights of the mechanisms (default: equal)")
     c.add_argument("--gr-b", type=float, default=None, metavar="B",
                    help="Gutenberg-Richter prior on magnitude, 10^(-B M) (default uniform)")
-    c.add_argument("--kernel-deg", type=float, default=kernel_deg,
-                   help=f"width of the von Mises kernel on ensemble falls (default "
-                   f"{kernel_deg:g})")
-    c.add_argument("--floor", type=float, default=floor,
-                   help=f"fraction of uniform density mixed into every direction density "
-                   f"(default {floor:g})")
-    c.add_argument("--likelihood", choices=("independent", "predictive"),
-                   default="independent",
-                   help="independent (default): product over columns; predictive: columns "
-                   "of one site share its motion and the ensemble is finite (Polya urn: a "
-                   "site's own falls inform its next column; calibrated when there are many "
-                   "more columns per site than members per node)")
-    c.add_argument("--trials", type=int, default=None,
-                   help="trials per configuration (--demo: default 20; --member-study: "
-                   "default 200)")
+    add_arguments(c, InversionOptions, names=("kernel_deg", "floor", "likelihood", "trials"))
 
 
 def build_grids(args):
@@ -223,20 +195,16 @@ def run(args):
     if args.trials is not None and not ((args.demo or args.member_study)
                                         and 1 <= args.trials <= 1000):
         raise InputError("--trials (1-1000) goes with --demo or --member-study")
-    from pipeline.inversion.likelihood import check_model_options
-    check_model_options(args.kernel_deg, args.floor, getattr(args, "likelihood", "independent"))
-    check_jobs(args.jobs)
+    options = from_args(InversionOptions, args)
     site_fragility = _check_site_motion(args)
     preset, grid, candidates = build_grids(args)
     if args.demo:
-        return workflows.demo(inversion_options(args), preset, grid, candidates)
+        return workflows.demo(options, preset, grid, candidates)
     if args.member_study:
-        return workflows.member_study(inversion_options(args), grid, candidates)
+        return workflows.member_study(options, grid, candidates)
     if args.hidden_truth is not None:
-        return workflows.hidden_truth(args.hidden_truth, inversion_options(args), grid,
-                                      candidates)
-    return workflows.invert_file(args.observations, inversion_options(args), grid,
-                                 candidates, site_fragility)
+        return workflows.hidden_truth(args.hidden_truth, options, grid, candidates)
+    return workflows.invert_file(args.observations, options, grid, candidates, site_fragility)
 
 
 def _check_site_motion(args):
@@ -271,13 +239,3 @@ def _check_site_motion(args):
     for column in load_observations(args.observations).column_types():
         fragility_for(column)                  # a missing column type refused before work
     return fragility_for, args.at_pgv_pga
-
-
-def inversion_options(args):
-    """The workflows' options from the parsed command line."""
-    from pipeline.inversion.workflows import InversionOptions
-    return InversionOptions(out=args.out, table=args.table, forward_dir=args.forward_dir,
-                            jobs=args.jobs, scheduler=args.scheduler,
-                            allow_long=args.allow_long, trials=args.trials,
-                            kernel_deg=args.kernel_deg, floor=args.floor,
-                            likelihood=getattr(args, "likelihood", "independent"))
