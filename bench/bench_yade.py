@@ -53,6 +53,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))       # bench/mujoco_tw
 sys.path.insert(1, str(Path(__file__).resolve().parent.parent))  # this checkout's pipeline
 from pipeline import PROJECT_ROOT as PROJECT, RESULTS_DIR  # noqa: E402
 from pipeline.campaign.pulse_grid import contour_difference  # noqa: E402
+from pipeline.hazard.fragility_file import read_fragility_file  # noqa: E402
 from pipeline.files import save_figure, write_json  # noqa: E402
 from pipeline.motion import Motion  # noqa: E402
 from pipeline.motion.pulses import one_sine_pulse  # noqa: E402
@@ -767,11 +768,11 @@ def rock_fragility_adaptive(work, jobs=2):
         subprocess.run(command + (["--adaptive"] if mode == "adaptive" else []), cwd=PROJECT,
                        check=True, capture_output=True, text=True)
         wall = time.perf_counter() - started
-        summaries[mode] = json.loads((out / "fragility.json").read_text())
-        grid = summaries[mode]["pulse_grid"]
-        runs_per_cell = [c["n"] for c in grid["models"]["block2d"]["cells"]]
-        result[mode] = {"runs": grid["runs_finished"], "full_grid_runs": grid["full_grid_runs"],
-                        "yade_wall_s": grid["yade_wall_s_total"], "campaign_wall_s": wall,
+        summaries[mode] = read_fragility_file(out)
+        grid = summaries[mode].pulse_grid
+        runs_per_cell = [c["n"] for c in grid.models["block2d"].cells]
+        result[mode] = {"runs": grid.runs_finished, "full_grid_runs": grid.full_grid_runs,
+                        "yade_wall_s": grid.yade_wall_s_total, "campaign_wall_s": wall,
                         "cells_by_runs": {str(n): runs_per_cell.count(n)
                                           for n in sorted(set(runs_per_cell))}}
     result["runs_ratio"] = result["full"]["runs"] / max(result["adaptive"]["runs"], 1)

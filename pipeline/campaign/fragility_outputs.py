@@ -12,7 +12,8 @@ from pipeline.campaign.fragility_block import block_runs
 from pipeline.campaign.fragility_tables import level_table, scaled_runs, summarise
 from pipeline.campaign.pulse_outputs import pulse_outputs
 from pipeline.campaign.run_dirs import finished_summary
-from pipeline.files import write_csv, write_json
+from pipeline.files import write_csv
+from pipeline.hazard.fragility_file import FragilityFile, write_fragility_file
 from pipeline.simulate import run_code_version
 
 log = logging.getLogger(__name__)
@@ -41,16 +42,16 @@ def fragility_outputs(specs, campaign_dir, failures, animations, figures=True):
     table = table.sort_values(["record_id", "level_index", "member", "model", "column"],
                               kind="stable")
     write_csv(campaign_dir / "fragility_runs.csv", table)
-    summary = summarise(table, specs, cost)
-    write_json(campaign_dir / "fragility.json", summary)
+    summary = FragilityFile.of(summarise(table, specs, cost))
+    write_fragility_file(campaign_dir, summary)
     write_csv(campaign_dir / "fragility_levels.csv", level_table(table))
     written = []
     if figures:
         from pipeline.figures.fragility import plot_fragility
         written = plot_fragility(table, summary, campaign_dir)
-    for name, entry in summary["columns"].items():
-        fit = entry["PGA"]
-        log.info(f"{name:>14}: {entry['toppled']}/{entry['runs']} toppled; PGA median "
+    for name, entry in summary.columns.items():
+        fit = entry.fits["PGA"]
+        log.info(f"{name:>14}: {entry.toppled}/{entry.runs} toppled; PGA median "
                  + ("-" if fit["median"] is None else
                     f"{fit['median']:.2f} m/s^2 [{fit['median_ci95'][0]:.2f}, "
                     f"{fit['median_ci95'][1]:.2f}], beta {fit['beta']:.2f}"))

@@ -46,8 +46,9 @@ def grid_probability(cells, pga_g, ratio):
 
 
 def experiments_check(section, specimen, experiments=EXPERIMENTS):
-    """The ``experiments`` entry of ``pulse_grid`` for a specimen with shipped tests
-    (None for others)."""
+    """The ``experiments`` entry of ``pulse_grid`` (``section``, a
+    :class:`~pipeline.hazard.fragility_file.PulseGridSection`) for a specimen with shipped
+    tests (None for others)."""
     outcome = SPECIMENS_WITH_TESTS.get(specimen)
     if outcome is None:
         return None
@@ -55,9 +56,9 @@ def experiments_check(section, specimen, experiments=EXPERIMENTS):
     pga = frame["pga_g"].to_numpy(float)
     ratio = frame["pgv_pga_s"].to_numpy(float)
     y = frame["observed"].to_numpy(bool)
-    uplift = section["block2d"]["uplift_g"]
+    uplift = section.block2d.uplift_g
     out = {"tests": int(len(frame)), "overturned": int(y.sum()), "outcome": outcome,
-           "direction": section["direction"],
+           "direction": section.direction,
            "note": "table records, not pulses: how far the pulse fragility carries over",
            "baselines": {f"PGA >= g tan alpha ({uplift:.3f} g)": scores(y, pga >= uplift)}}
     keep = (pga > 0) & (ratio > 0)
@@ -67,12 +68,12 @@ def experiments_check(section, specimen, experiments=EXPERIMENTS):
             y[keep], logistic_probability(ceiling["coefficients"], pga[keep] * G,
                                           ratio[keep]))
     models = {}
-    for model, entry in section["models"].items():
-        p, outside = grid_probability(entry["cells"], pga, ratio)
+    for model, entry in section.models.items():
+        p, outside = grid_probability(entry.cells, pga, ratio)
         if p is None:
             continue
         result = {"grid": {**scores(y, p), "outside_grid": int(outside.sum())}}
-        coef = entry["logistic"].get("coefficients")
+        coef = (entry.logistic or {}).get("coefficients")
         if coef is not None:
             result["logistic"] = scores(y[keep], logistic_probability(
                 coef, pga[keep] * G, ratio[keep]))

@@ -554,18 +554,19 @@ def adaptive_sampling(guide_p, per_cell, run_stage, max_stages=MAX_STAGES):
 
 def contour_difference(reference, other, level="0.5"):
     """How far the P = ``level`` contour of ``other`` lies from that of ``reference`` (two
-    fragility.json dicts of the same pulse grid, e.g. the adaptive surface and the full
+    :class:`~pipeline.hazard.fragility_file.FragilityFile` of the same pulse grid, e.g.
+    the adaptive surface and the full
     grid): per PGV/PGA of the specimen model (not the 2D block) both PGAs (g), their
     difference and the reference's Monte Carlo band (the PGAs where its Wilson bounds
     cross the level); ``max_abs_diff_g`` over the rows where both cross (None if none),
     ``one_sided`` the rows where only one does, ``within_band`` whether every crossing of
     ``other`` lies inside the reference's band (an open side counts as open)."""
     def rows(summary):
-        models = summary["pulse_grid"]["models"]
+        models = summary.pulse_grid.models
         specimen = [m for m in models if m != "block2d"]
         if len(specimen) != 1:
             raise ValueError(f"expected one specimen model beside block2d, got {specimen}")
-        return {r["pgv_pga_s"]: r for r in models[specimen[0]]["contours"][level]}
+        return {r["pgv_pga_s"]: r for r in models[specimen[0]].contours[level]}
     ref, oth = rows(reference), rows(other)
     if set(ref) != set(oth):
         raise ValueError("the two fragility.json files are not of the same pulse grid")

@@ -3,6 +3,7 @@
 ``fragility.json`` (``pulse_grid``: cells, contours, logistic surface, the 2D block, the
 check against experiments where they exist) and ``fragility_pulse_grid.png``."""
 import logging
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -11,7 +12,9 @@ import pandas as pd
 from pipeline.campaign import pulse_grid
 from pipeline.campaign.column_file import summary_entry
 from pipeline.campaign.run_dirs import finished_summary
-from pipeline.files import json_safe, write_csv, write_json
+from pipeline.campaign.pulse_check import experiments_check
+from pipeline.files import json_safe, write_csv
+from pipeline.hazard.fragility_file import FragilityFile, write_fragility_file
 from pipeline.simulate import run_code_version
 
 log = logging.getLogger(__name__)
@@ -82,25 +85,25 @@ def pulse_outputs(specs, campaign_dir, figures=True):
                            "a cell's n is the runs it had"
                            if first.get("sampling") == "adaptive"
                            else "full grid: every cell x member x direction")
-    observed = None
-    from pipeline.campaign.pulse_check import experiments_check
-    observed = experiments_check(section, name)
+    summary = FragilityFile.of(json_safe({"mode": "pulses", "specimen": name,
+                                          "seed": first["seed"], "pulse_grid": section}))
+    observed = experiments_check(summary.pulse_grid, name)
     if observed is not None:
-        section["experiments"] = observed
-    summary = json_safe({"mode": "pulses", "specimen": name, "seed": first["seed"],
-                                 "pulse_grid": section})
-    write_json(campaign_dir / "fragility.json", summary)
+        summary = replace(summary, pulse_grid=replace(summary.pulse_grid,
+                                                      experiments=json_safe(observed)))
+    write_fragility_file(campaign_dir, summary)
     written = []
     if figures:
         from pipeline.figures.fragility import plot_pulse_grid
         written = plot_pulse_grid(summary, campaign_dir / "fragility_pulse_grid.png")
-    for model, entry in section["models"].items():
-        half = [c["pga_g"] for c in entry["contours"]["0.5"]]
+    grid = summary.pulse_grid
+    for model, entry in grid.models.items():
+        half = [c["pga_g"] for c in entry.contours["0.5"]]
         shown = ", ".join("-" if v is None else f"{v:.2f}" for v in half)
-        log.info(f"{model:>14}: {entry['overturned']}/{entry['runs']} overturned; P = 0.5 at "
+        log.info(f"{model:>14}: {entry.overturned}/{entry.runs} overturned; P = 0.5 at "
                  f"PGA (g) {shown} for PGV/PGA "
-                 f"{', '.join(f'{r:g}' for r in section['pgv_pga_s'])} s")
-    for warning in section["warnings"]:
+                 f"{', '.join(f'{r:g}' for r in grid.pgv_pga_s)} s")
+    for warning in grid.warnings:
         log.warning(f"warning: {warning}")
     return {"code_version": run_code_version(), **described,
             "figures": [str(Path(p).relative_to(campaign_dir)) for p in written]}

@@ -35,7 +35,9 @@ def _plain_log_ticks(axis):
 
 
 def plot_fragility(table, summary, out_dir):
-    """``fragility_curves.png``, ``fragility_2d_vs_3d.png``, ``fragility_surface.png``."""
+    """``fragility_curves.png``, ``fragility_2d_vs_3d.png``, ``fragility_surface.png`` of
+    a column campaign's runs ``table`` and its
+    :class:`~pipeline.hazard.fragility_file.FragilityFile` ``summary``."""
     out_dir = Path(out_dir)
     return [plot_curves(table, summary, out_dir / "fragility_curves.png"),
             plot_levels(table, out_dir / "fragility_2d_vs_3d.png"),
@@ -45,8 +47,8 @@ def plot_fragility(table, summary, out_dir):
 def plot_curves(table, summary, path):
     """One row per IM, one panel per 3D column: its observations and lognormal fit beside
     those of the 2D block."""
-    columns3d = [c for c, e in summary["columns"].items() if e["model"] == "3D"]
-    blocks = [c for c, e in summary["columns"].items() if e["model"] == "2D"]
+    columns3d = [c for c, e in summary.columns.items() if e.model == "3D"]
+    blocks = [c for c, e in summary.columns.items() if e.model == "2D"]
     ncol = max(len(columns3d), 1)
     fig = figure(figsize=(5.5 * ncol, 3.6 * len(IMS)))
     axes = fig.subplots(len(IMS), ncol, squeeze=False)
@@ -60,7 +62,7 @@ def plot_curves(table, summary, path):
         for c, column in enumerate(columns3d or [None]):
             ax = axes[r, c]
             for k, name in enumerate(([column] if column else []) + blocks):
-                entry = summary["columns"][name][im]
+                entry = summary.columns[name].fits[im]
                 st = _style(name)
                 bins = entry["bins"]
                 if bins:
@@ -88,8 +90,8 @@ def plot_curves(table, summary, path):
             ax.legend(fontsize=7, loc="upper left")
             if r == 0 and column:
                 ax.set_title(f"{COLUMN_LABELS.get(column, column)} vs the 2D block")
-    fig.suptitle(f"Fragility (incremental dynamic analysis): {', '.join(summary['records'])}\n"
-                 f"{summary['members']} members per level; bars: Wilson 95 %", fontsize=10)
+    fig.suptitle(f"Fragility (incremental dynamic analysis): {', '.join(summary.records)}\n"
+                 f"{summary.members} members per level; bars: Wilson 95 %", fontsize=10)
     fig.tight_layout()
     save_figure(fig, path, dpi=120)
     return path
@@ -131,7 +133,7 @@ def plot_levels(table, path):
 def plot_surface(table, summary, path):
     """Runs in the (PGA, PGV/PGA) plane (filled: toppled) with the P = 0.16, 0.5, 0.84
     contours of each model's logistic surface."""
-    names = list(summary["columns"])
+    names = list(summary.columns)
     fig = figure(figsize=(4.5 * len(names), 4))
     axes = fig.subplots(1, len(names), squeeze=False)
     pga = table["pga_m_s2"].astype(float)
@@ -148,7 +150,7 @@ def plot_surface(table, summary, path):
                    facecolors="none", edgecolors=st["color"], s=18, label="stood")
         ax.scatter(sub.loc[fell, "pga_m_s2"] * jitter[fell], sub.loc[fell, "pgv_pga_s"],
                    color=st["color"], s=18, label="toppled")
-        surface = summary["columns"][name]["logistic"]
+        surface = summary.columns[name].logistic
         if surface["coefficients"] is not None:
             P = logistic_probability(surface["coefficients"], X, Y)
             cs = ax.contour(X, Y, P, levels=[0.16, 0.5, 0.84], colors=[st["color"]],
@@ -175,25 +177,26 @@ def plot_surface(table, summary, path):
 
 
 def plot_pulse_grid(summary, path):
-    """The pulse-grid fragility of each 3D specimen model: P per cell (colour), its
+    """The pulse-grid fragility (a :class:`~pipeline.hazard.fragility_file.FragilityFile`)
+    of each 3D specimen model: P per cell (colour), its
     P = 0.16 / 0.5 / 0.84 contours (lines; the Monte Carlo band of the 0.5 contour
     shaded), the 2D rigid block's (same critical angle and pivot distance; the toolkit's
     Housner integrator) and, where experiments exist, the observed rate per bin."""
-    section = summary["pulse_grid"]
-    block = section["block2d"]["model"]
-    names = [m for m in section["models"] if m != block] or [block]
+    section = summary.pulse_grid
+    block = section.block2d.model
+    names = [m for m in section.models if m != block] or [block]
     fig = figure(figsize=(5.2 * len(names), 4.4))
     axes = fig.subplots(1, len(names), squeeze=False)[0]
-    ratios, pgas = np.array(section["pgv_pga_s"]), np.array(section["pga_g"])
+    ratios, pgas = np.array(section.pgv_pga_s), np.array(section.pga_g)
     for ax, name in zip(axes, names):
-        cells = section["models"][name]["cells"]
+        cells = section.models[name].cells
         P = np.full((len(ratios), len(pgas)), np.nan)
         for c in cells:
             P[np.argmin(abs(ratios - c["pgv_pga_s"])), np.argmin(abs(pgas - c["pga_g"]))] = c["P"]
         image = ax.pcolormesh(_edges(ratios), _edges(pgas), P.T, cmap="Greys", vmin=0, vmax=1,
                               shading="flat")
         for model, colour in ((name, "C3"), (block, "C0")):
-            contours = section["models"].get(model, {}).get("contours", {})
+            contours = section.models[model].contours if model in section.models else {}
             for level, ls in zip(("0.16", "0.5", "0.84"), (":", "-", "--")):
                 rows = [r for r in contours.get(level, []) if r["pga_g"] is not None]
                 if rows:
@@ -208,7 +211,7 @@ def plot_pulse_grid(summary, path):
                                 [r["pga_g_band"][1] for r in band], color=colour, alpha=0.2,
                                 lw=0, label="P = 0.5, Monte Carlo 95 %")
         _mark_outside(ax, section, name, ratios, pgas)
-        observed = section.get("experiments", {}).get("models", {}).get(name, {}).get("bins")
+        observed = (section.experiments or {}).get("models", {}).get(name, {}).get("bins")
         if observed:
             x = [np.mean(b["pgv_pga_s"]) for b in observed]
             y = [np.mean(b["pga_g"]) for b in observed]
@@ -220,8 +223,8 @@ def plot_pulse_grid(summary, path):
         ax.set_ylim(0.0, max(_edges(pgas)[-1], 1.2 if observed else 0.0))
         ax.set_xlabel("PGV/PGA (s)")
         ax.set_ylabel("PGA (g)")
-        ax.set_title(f"{summary['specimen']} ({name}): P(overturn), one-cosine pulses\n"
-                     f"direction: {section['direction'].split(' (')[0]}", fontsize=8)
+        ax.set_title(f"{summary.specimen} ({name}): P(overturn), one-cosine pulses\n"
+                     f"direction: {section.direction.split(' (')[0]}", fontsize=8)
         ax.legend(fontsize=6, loc="upper right")
         fig.colorbar(image, ax=ax, label="P(overturn)")
     fig.tight_layout()
@@ -235,7 +238,7 @@ def _mark_outside(ax, section, name, ratios, pgas):
     level and side under the axes."""
     edges = _edges(pgas)
     said = []
-    for level, rows in section["models"][name]["contours"].items():
+    for level, rows in section.models[name].contours.items():
         for side, y, marker, edge in (("below", edges[0], "v", min(pgas)),
                                       ("above", edges[-1], "^", max(pgas))):
             out = [r["pgv_pga_s"] for r in rows if r.get("outside_grid") == side]

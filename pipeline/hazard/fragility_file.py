@@ -1,316 +1,222 @@
-"""The typed reader of ``campaign fragility``'s ``fragility.json`` as a user passes it
-around: :func:`read_fragility_file` reads it (bounded, strict UTF-8, JSON) and
-:func:`check_fragility` checks every value a reader of it uses before any of them
-allocates or computes: types (object, list, number, string), finite numbers within their
-ranges, sizes (a 3 x 3 covariance; axes, cells, members and runs within bounds, counts
-as integers) and what would contradict itself (a duplicated cell, overturned outside
-0..n, a P outside 0-1, an interval that does not hold its estimate, a covariance that is
-not symmetric positive semi-definite).  Each refusal is one InputError naming the file
-and the key path, e.g. ``fragility.json: columns.monolithic.logistic.cov must be a 3x3
-list of numbers``.
+"""``fragility.json``, the file of ``campaign fragility``, as one type
+(:class:`FragilityFile`) with one writer (:func:`write_fragility_file`, atomic) and one
+reader (:func:`read_fragility_file`: bounded, strict UTF-8, JSON, every value its readers
+use checked by :func:`pipeline.hazard.fragility_check.check_fragility`).  The campaigns
+that write it, survival, the shake-table check, the figures and the report share it.
 
-Two layouts, as the campaign writes them: a column campaign (``columns``: per column type
-its lognormal PGA fit and logistic surface; ``records``, ``members``, ``block2d``) and a
-pulse grid (``pulse_grid``: axes ``pga_g`` x ``pgv_pga_s``, ``members``, ``models`` with
-their ``cells`` and logistic surface, ``block2d``).  Older files load: a covariance
-absent or written as nulls (a singular information matrix), cells without ``sets``, a
-2D block without ``uplift_g_smallest``.  Keys that no reader uses are not checked.
+Two layouts: a column campaign (``columns``: per column type its lognormal fits per
+intensity measure and logistic surface, :class:`ColumnFits`; ``records``, ``members``,
+``block2d``) and a pulse grid (``pulse_grid``, :class:`PulseGridSection`: axes
+``pga_g`` (g) x ``pgv_pga_s`` (s), ``members``, ``models`` (:class:`GridModel`) with
+their cells, contours and logistic surface, the 2D block :class:`Block2d`).  Keys a
+section does not name are kept as written in its ``extra`` (and written back in their
+place).  Older files load: a pulse grid's 2D block without ``uplift_g_smallest`` takes
+it from ``uplift_g`` (the runs' median critical angle) or, without that, from
+``alpha_rad`` (g tan alpha), in that order, here and nowhere else.
 """
 import math
+from dataclasses import dataclass, field, fields, replace
 from pathlib import Path
 
-import numpy as np
+from pipeline.files import write_json
+from pipeline.hazard.fragility_check import MAX_MEMBERS, check_fragility
+from pipeline.userfiles import DATA_FILE_BYTES, read_json
 
-from pipeline.files import InputError
-from pipeline.userfiles import DATA_FILE_BYTES, nesting, number, read_json, show
+__all__ = ["MAX_MEMBERS", "Block2d", "ColumnFits", "FragilityFile", "GridModel",
+           "PulseGridSection", "check_fragility", "read_fragility_file",
+           "write_fragility_file"]
+_KEPT = ("extra", "order", "path")     # fields that are not keys of the file
 
-MAX_MEMBERS = 10_000           # parameter sets of a campaign
-MAX_RUNS = 10_000_000          # runs of one cell
-MAX_TOTAL = 10 ** 15           # runs of a column, model or fit (counts only, no allocation)
-MAX_AXIS = 1_000               # values on one axis of a pulse grid
-MAX_SET_VALUES = 10_000_000    # members x cells: the per-set array a grid allocates
-MAX_ENTRIES = 64               # column types or models in one file
-MAX_RECORDS = 10_000
-MAX_TEXT = 10_000              # characters of a note, description or record id
-MAX_DEPTH = 32                 # the campaign's files nest about 8 deep
-MAX_PGA_G = 20.0               # as the hazard curves' levels
-MAX_RATIO_S = 10.0             # PGV/PGA (s)
-TOLERANCE = 1e-9               # an estimate "inside" its interval, P = overturned / n
+
+@dataclass(frozen=True)
+class Block2d:
+    """The 2D rigid block beside the specimen: ``alpha_rad`` (critical angle, rad),
+    ``p_per_s`` (frequency parameter, 1/s), ``R_m`` (pivot distance, m), ``uplift_g``
+    (g tan alpha of the runs' median alpha, g), ``uplift_g_smallest`` (of the smallest
+    alpha of any run, g), ``model`` (its model name in a pulse grid's ``models``)."""
+    alpha_rad: float | None = None
+    p_per_s: float | None = None
+    R_m: float | None = None
+    uplift_g: float | None = None
+    uplift_g_smallest: float | None = None
+    model: str | None = None
+    extra: dict = field(default_factory=dict)
+    order: tuple = field(default=(), compare=False)
+
+
+@dataclass(frozen=True)
+class GridModel:
+    """One model of a pulse grid: ``cells`` (dicts: pga_g, pgv_pga_s, n, overturned, P,
+    ci95, sets, P_per_set, set_sd), ``contours`` (level -> rows per PGV/PGA: pga_g,
+    pga_g_band, outside_grid, pga_g_per_set), ``logistic`` (the surface as
+    :func:`pipeline.stats.ensemble.logistic_surface` writes it), ``runs`` and
+    ``overturned`` (counts)."""
+    cells: tuple = ()
+    contours: dict = field(default_factory=dict)
+    logistic: dict | None = None
+    runs: int | None = None
+    overturned: int | None = None
+    extra: dict = field(default_factory=dict)
+    order: tuple = field(default=(), compare=False)
+
+
+@dataclass(frozen=True)
+class PulseGridSection:
+    """``pulse_grid``: the axes ``pga_g`` (g) and ``pgv_pga_s`` (s), ``members``
+    (parameter sets), ``headings`` (directions per set), ``models`` (name ->
+    :class:`GridModel`), ``block2d``, ``direction`` and ``ranges`` (text), the runs
+    (``runs``, ``runs_finished``, ``full_grid_runs``, ``sampling``, ``yade_wall_s_total``
+    in s), ``warnings`` and ``experiments`` (the shake-table check, or None)."""
+    pga_g: tuple = ()
+    pgv_pga_s: tuple = ()
+    members: int | None = None
+    headings: int | None = None
+    models: dict = field(default_factory=dict)
+    block2d: Block2d | None = None
+    direction: str | None = None
+    ranges: str | None = None
+    runs: int | None = None
+    runs_finished: int | None = None
+    full_grid_runs: int | None = None
+    sampling: str | None = None
+    yade_wall_s_total: float | None = None
+    warnings: tuple = ()
+    experiments: dict | None = None
+    extra: dict = field(default_factory=dict)
+    order: tuple = field(default=(), compare=False)
+
+
+@dataclass(frozen=True)
+class ColumnFits:
+    """One column type of a column campaign: ``description``, ``model`` ("3D" or "2D"),
+    ``runs`` and ``toppled`` (counts), ``fits`` (intensity measure, e.g. "PGA", -> its
+    lognormal fit: median, beta, median_ci95, beta_ci95, unit, note, bins) and
+    ``logistic`` (the surface in PGA and PGV/PGA)."""
+    description: str | None = None
+    model: str | None = None
+    runs: int | None = None
+    toppled: int | None = None
+    fits: dict = field(default_factory=dict)
+    logistic: dict | None = None
+    extra: dict = field(default_factory=dict)
+    order: tuple = field(default=(), compare=False)
+
+
+@dataclass(frozen=True)
+class FragilityFile:
+    """``fragility.json``: ``specimen`` (its name), ``mode`` ("pulses" for a pulse grid),
+    a column campaign's ``columns`` (name -> :class:`ColumnFits`), ``records`` (ids),
+    ``members`` and ``block2d``, or a pulse grid's ``pulse_grid``; ``path`` where it was
+    read from (None when built in memory)."""
+    specimen: str | None = None
+    mode: str | None = None
+    columns: dict | None = None
+    records: tuple = ()
+    members: int | None = None
+    block2d: Block2d | None = None
+    pulse_grid: PulseGridSection | None = None
+    extra: dict = field(default_factory=dict)
+    order: tuple = field(default=(), compare=False)
+    path: Path | None = field(default=None, compare=False)
+
+    @classmethod
+    def of(cls, data, path=None):
+        """The file of ``data``, a dict as the campaign writes it (not checked: the
+        reader checks)."""
+        return _build(cls, data, {
+            "columns": lambda v: None if v is None else {
+                k: _column(e) for k, e in v.items()},
+            "records": lambda v: tuple(v or ()),
+            "block2d": lambda v: None if v is None else _build(Block2d, v),
+            "pulse_grid": lambda v: None if v is None else _section(v)}, path=path)
+
+    def to_json(self):
+        """The dict written to ``fragility.json``."""
+        return _join(self, {
+            "columns": lambda v: None if v is None else {
+                k: _column_json(e) for k, e in v.items()},
+            "records": list,
+            "block2d": lambda v: None if v is None else _join(v),
+            "pulse_grid": lambda v: None if v is None else _section_json(v)})
 
 
 def read_fragility_file(path):
-    """(path of the file, its checked content): ``path`` a fragility.json or the directory
-    that holds one."""
+    """The :class:`FragilityFile` at ``path`` (a fragility.json or the directory that
+    holds one), every value its readers use checked (InputError, one line, naming the
+    file and the key path); an older file's 2D block brought to today's keys."""
     path = Path(path)
     if path.is_dir():
         path = path / "fragility.json"
-    data = read_json(path, "fragility file", DATA_FILE_BYTES)
-    return path, check_fragility(data, path)
+    data = check_fragility(read_json(path, "fragility file", DATA_FILE_BYTES), path)
+    file = FragilityFile.of(data, path)
+    grid = file.pulse_grid
+    if grid is not None and grid.block2d is not None and grid.block2d.uplift_g_smallest is None:
+        block = grid.block2d
+        least = block.uplift_g if block.uplift_g is not None else \
+            None if block.alpha_rad is None else math.tan(block.alpha_rad)
+        file = replace(file, pulse_grid=replace(grid, block2d=replace(
+            block, uplift_g_smallest=least)))
+    return file
 
 
-def check_fragility(data, name="fragility.json"):
-    """``data`` (a parsed fragility.json) when every value its readers use is of the
-    right type, size and range (see the module); else InputError naming ``name`` and the
-    key path."""
-    c = _Checker(name)
-    if not isinstance(data, dict):
-        c.fail("the file", f"must hold a JSON object (campaign fragility's fragility.json), "
-                           f"got {_kind(data)}")
-    if nesting(data, MAX_DEPTH) > MAX_DEPTH:
-        c.fail("the file", f"is nested deeper than {MAX_DEPTH} levels")
-    c.text(data.get("specimen"), "specimen")
-    if "pulse_grid" in data:
-        _check_pulse_grid(c, data["pulse_grid"])
-    elif "columns" in data:
-        _check_columns(c, data)
-    else:
-        raise InputError(f"{name}: not a fragility.json of campaign fragility (no 'columns')")
-    return data
+def write_fragility_file(directory, file):
+    """``file`` written atomically to ``directory``/fragility.json; returns its path."""
+    path = Path(directory) / "fragility.json"
+    write_json(path, file.to_json())
+    return path
 
 
-class _Checker:
-    """Typed reads of one file's values; each failure one line naming the key path."""
-
-    def __init__(self, name):
-        self.name = name
-
-    def fail(self, where, what):
-        raise InputError(f"{self.name}: {where} {what}")
-
-    def obj(self, value, where, most=None):
-        if not isinstance(value, dict):
-            self.fail(where, f"must be an object, got {_kind(value)}")
-        if most is not None and len(value) > most:
-            self.fail(where, f"holds {len(value)} entries (at most {most})")
-        return value
-
-    def lst(self, value, where, most):
-        if not isinstance(value, list):
-            self.fail(where, f"must be a list, got {_kind(value)}")
-        if len(value) > most:
-            self.fail(where, f"holds {len(value)} values (at most {most})")
-        return value
-
-    def num(self, value, where, low=None, high=None, low_open=False, optional=False):
-        if value is None and optional:
-            return None
-        return number(value, f"{self.name}: {where}", low, high, "", low_open)
-
-    def integer(self, value, where, low, high, optional=False):
-        if value is None and optional:
-            return None
-        if isinstance(value, bool) or not isinstance(value, int):
-            self.fail(where, f"must be an integer, got {show(value)}")
-        if not low <= value <= high:
-            self.fail(where, f"must be {low} to {high}, got {show(value)}")
-        return value
-
-    def text(self, value, where):
-        if value is not None and not (isinstance(value, str) and len(value) <= MAX_TEXT):
-            self.fail(where, f"must be a text of at most {MAX_TEXT} characters, got "
-                             f"{_kind(value)}")
-        return value
-
-    def pair(self, value, where, low=None, high=None, holds=None, low_open=False):
-        """A 95 % interval [lo, hi] (or None) within [low, high] that holds ``holds``."""
-        if value is None:
-            return None
-        if not (isinstance(value, list) and len(value) == 2):
-            self.fail(where, f"must be a pair [lo, hi], got {show(value)}")
-        lo, hi = (self.num(v, where, low, high, low_open) for v in value)
-        if lo > hi:
-            self.fail(where, f"is [{lo:g}, {hi:g}]: lo above hi")
-        if holds is not None and not lo - _slack(lo, holds) <= holds <= hi + _slack(hi, holds):
-            self.fail(where, f"[{lo:g}, {hi:g}] does not hold its estimate {holds:g}")
-        return lo, hi
+# ---------------------------------------------------------------- dict <-> type
+def _build(cls, data, convert=None, **more):
+    """``cls`` of a dict: its named keys (through ``convert``), the rest in ``extra``,
+    the keys' order kept."""
+    convert = convert or {}
+    names = {f.name for f in fields(cls)} - set(_KEPT)
+    known = {k: convert.get(k, _same)(v) for k, v in data.items() if k in names}
+    extra = {k: v for k, v in data.items() if k not in names}
+    return cls(**known, extra=extra, order=tuple(data), **more)
 
 
-def _slack(a, b):
-    return TOLERANCE * max(1.0, abs(a), abs(b))
+def _join(obj, convert=None):
+    """The dict of a :func:`_build` object: the keys as read, in their order, then keys
+    set since (not None)."""
+    convert = convert or {}
+    values = {f.name: getattr(obj, f.name) for f in fields(obj) if f.name not in _KEPT}
+    values.update(obj.extra)
+    keys = [k for k in obj.order if k in values]
+    keys += [k for k, v in values.items() if k not in obj.order and v is not None
+             and v != () and v != {}]
+    return {k: convert.get(k, _same)(values[k]) for k in keys}
 
 
-def _kind(value):
-    """What a JSON value is, for messages."""
-    names = {dict: "an object", list: "a list", str: "a text", bool: "true/false",
-             type(None): "null", int: "a number", float: "a number"}
-    return f"{names.get(type(value), type(value).__name__)} {show(value, 40)}"
+def _same(value):
+    return value
 
 
-def _key(name):
-    """A key of the file as it appears in a key path."""
-    return name if name.isidentifier() and len(name) <= 40 else show(name, 40)
+def _is_fit(value):
+    """A lognormal fit of an intensity measure in a column's entry."""
+    return isinstance(value, dict) and "median" in value
 
 
-# ---------------------------------------------------------------- the parts
-def _check_columns(c, data):
-    columns = c.obj(data["columns"], "columns", MAX_ENTRIES)
-    if not columns:
-        c.fail("columns", "is empty: not a fragility.json of campaign fragility (no 'columns')")
-    for column, entry in columns.items():
-        where = f"columns.{_key(column)}"
-        c.obj(entry, where)
-        c.text(entry.get("description"), f"{where}.description")
-        _counts(c, entry, where, "runs", "toppled")
-        if entry.get("PGA") is not None:
-            _check_lognormal(c, entry["PGA"], f"{where}.PGA")
-        if entry.get("logistic") is not None:
-            _check_logistic(c, entry["logistic"], f"{where}.logistic")
-    if data.get("records") is not None:
-        for k, record in enumerate(c.lst(data["records"], "records", MAX_RECORDS)):
-            if not isinstance(record, str) or not record or len(record) > MAX_TEXT:
-                c.fail(f"records[{k}]", f"must be a record id (a text), got {_kind(record)}")
-    c.integer(data.get("members"), "members", 1, MAX_MEMBERS, optional=True)
-    if data.get("block2d") is not None:
-        block = c.obj(data["block2d"], "block2d")
-        c.num(block.get("alpha_rad"), "block2d.alpha_rad", 0, math.pi / 2, True, True)
-        c.num(block.get("p_per_s"), "block2d.p_per_s", 0, 1e4, True, True)
+def _column(entry):
+    fits = {k: v for k, v in entry.items() if _is_fit(v)}
+    column = _build(ColumnFits, {k: v for k, v in entry.items() if k not in fits})
+    return replace(column, fits=fits, order=tuple(entry))
 
 
-def _check_lognormal(c, fit, where):
-    """A lognormal fit of the PGA: {unit, median, beta, median_ci95, beta_ci95, n, toppled,
-    note}, its intervals holding their estimates."""
-    c.obj(fit, where)
-    c.text(fit.get("unit"), f"{where}.unit")
-    c.text(fit.get("note"), f"{where}.note")
-    median = c.num(fit.get("median"), f"{where}.median", 0, None, True, True)
-    beta = c.num(fit.get("beta"), f"{where}.beta", 0, 100, True, True)
-    c.pair(fit.get("median_ci95"), f"{where}.median_ci95", 0, None, median, True)
-    c.pair(fit.get("beta_ci95"), f"{where}.beta_ci95", 0, None, beta, True)
-    _counts(c, fit, where, "n", "toppled")
+def _column_json(column):
+    return _join(replace(column, extra={**column.extra, **column.fits}, fits={}))
 
 
-def _counts(c, entry, where, total, part):
-    """Two counts of runs (integers, or absent), ``part`` of ``total``."""
-    n = c.integer(entry.get(total), f"{where}.{total}", 0, MAX_TOTAL, optional=True)
-    c.integer(entry.get(part), f"{where}.{part}", 0, MAX_TOTAL if n is None else n,
-              optional=True)
+def _section(section):
+    return _build(PulseGridSection, section, {
+        "pga_g": tuple, "pgv_pga_s": tuple, "warnings": tuple,
+        "block2d": lambda v: None if v is None else _build(Block2d, v),
+        "models": lambda v: {k: _build(GridModel, m, {"cells": tuple}) for k, m in v.items()}})
 
 
-def _check_logistic(c, surface, where):
-    """A logistic surface: coefficients {b0, b1, b2}, se and ci95 per coefficient (a number
-    or null, an interval holding its coefficient), cov 3 x 3 (null, or nulls where the
-    information matrix was singular), n, toppled, note."""
-    c.obj(surface, where)
-    c.text(surface.get("note"), f"{where}.note")
-    _counts(c, surface, where, "n", "toppled")
-    names = ("b0", "b1", "b2")
-    b = dict.fromkeys(names)
-    if surface.get("coefficients") is not None:
-        coefficients = c.obj(surface["coefficients"], f"{where}.coefficients")
-        b = {k: c.num(coefficients.get(k), f"{where}.coefficients.{k}") for k in names}
-    if surface.get("se") is not None:
-        se = c.obj(surface["se"], f"{where}.se")
-        for k in names:
-            c.num(se.get(k), f"{where}.se.{k}", 0, None, optional=True)
-    if surface.get("ci95") is not None:
-        ci = c.obj(surface["ci95"], f"{where}.ci95")
-        for k in names:
-            c.pair(ci.get(k), f"{where}.ci95.{k}", holds=b[k])
-    _check_cov(c, surface.get("cov"), f"{where}.cov")
-
-
-def _check_cov(c, cov, where):
-    """A 3 x 3 covariance: null, a matrix holding nulls (not used), or numbers: finite,
-    symmetric and positive semi-definite."""
-    if cov is None:
-        return
-    if not (isinstance(cov, list) and len(cov) == 3
-            and all(isinstance(row, list) and len(row) == 3 for row in cov)
-            and all(v is None or (isinstance(v, (int, float)) and not isinstance(v, bool))
-                    for row in cov for v in row)):
-        c.fail(where, f"must be a 3x3 list of numbers, got {show(cov)}")
-    if any(v is None for row in cov for v in row):
-        return
-    try:
-        matrix = np.array(cov, float)
-    except OverflowError:
-        c.fail(where, "holds a number beyond a float's range")
-    if not np.isfinite(matrix).all():
-        c.fail(where, "must hold finite numbers")
-    scale = max(float(np.abs(matrix).max()), 1e-300)
-    if not np.allclose(matrix, matrix.T, rtol=0.0, atol=TOLERANCE * scale):
-        c.fail(where, "is not symmetric")
-    if np.linalg.eigvalsh(matrix).min() < -TOLERANCE * scale:
-        c.fail(where, "is not positive semi-definite (a variance cannot be negative)")
-
-
-def _check_pulse_grid(c, section):
-    c.obj(section, "pulse_grid")
-    pga = _axis(c, section.get("pga_g"), "pulse_grid.pga_g", MAX_PGA_G)
-    ratio = _axis(c, section.get("pgv_pga_s"), "pulse_grid.pgv_pga_s", MAX_RATIO_S)
-    members = c.integer(section.get("members"), "pulse_grid.members", 1, MAX_MEMBERS)
-    if members * len(pga) * len(ratio) > MAX_SET_VALUES:
-        c.fail("pulse_grid", f"of {members} members x {len(pga)} x {len(ratio)} cells is "
-                             f"beyond {MAX_SET_VALUES:.0e} values per set and cell")
-    models = section.get("models")
-    if models is None or models == {}:
-        c.fail("pulse_grid", "has no 'models'")
-    c.obj(models, "pulse_grid.models", MAX_ENTRIES)
-    for model, entry in models.items():
-        where = f"pulse_grid.models.{_key(model)}"
-        c.obj(entry, where)
-        _counts(c, entry, where, "runs", "overturned")
-        if entry.get("logistic") is not None:
-            _check_logistic(c, entry["logistic"], f"{where}.logistic")
-        _check_cells(c, entry.get("cells"), f"{where}.cells", pga, ratio, members)
-    if section.get("block2d") is not None:
-        block = c.obj(section["block2d"], "pulse_grid.block2d")
-        for key in ("uplift_g_smallest", "uplift_g"):
-            c.num(block.get(key), f"pulse_grid.block2d.{key}", 0, MAX_PGA_G, True, True)
-        c.num(block.get("alpha_rad"), "pulse_grid.block2d.alpha_rad", 0, math.atan(MAX_PGA_G),
-              True, True)
-
-
-def _axis(c, values, where, high):
-    """An axis of the grid: 1 to MAX_AXIS increasing positive numbers, distinct to 9
-    digits (the cells are found by them)."""
-    if values is None:
-        c.fail(where, "is missing: the grid's axes are pga_g and pgv_pga_s")
-    values = [c.num(v, where, 0, high, True) for v in c.lst(values, where, MAX_AXIS)]
-    if not values:
-        c.fail(where, "is empty")
-    for a, b in zip(values, values[1:]):
-        if round(a, 9) >= round(b, 9):
-            c.fail(where, f"must increase (distinct to 9 digits): {a!r} then {b!r}")
-    return {round(v, 9): k for k, v in enumerate(values)}
-
-
-def _check_cells(c, cells, where, pga, ratio, members):
-    """The cells of one model: each on the grid once, overturned of n, P and its interval,
-    P per parameter set (``sets`` indices below ``members``)."""
-    if cells is None:
-        c.fail(where, "is missing: a model holds its cells")
-    seen = set()
-    for k, cell in enumerate(c.lst(cells, where, len(pga) * len(ratio))):
-        at = f"{where}[{k}]"
-        c.obj(cell, at)
-        a = c.num(cell.get("pga_g"), f"{at}.pga_g", 0, None, True)
-        r = c.num(cell.get("pgv_pga_s"), f"{at}.pgv_pga_s", 0, None, True)
-        key = (pga.get(round(a, 9)), ratio.get(round(r, 9)))
-        if None in key:
-            c.fail(at, f"is a cell off the grid: pga_g {a:g}, pgv_pga_s {r:g}")
-        if key in seen:
-            c.fail(at, f"duplicates the cell at pga_g {a:g}, pgv_pga_s {r:g}")
-        seen.add(key)
-        n = c.integer(cell.get("n"), f"{at}.n", 0, MAX_RUNS)
-        k_over = c.integer(cell.get("overturned"), f"{at}.overturned", 0, n)
-        p = c.num(cell.get("P"), f"{at}.P", 0, 1, optional=True)
-        if p is not None and n > 0 and abs(p - k_over / n) > TOLERANCE:
-            c.fail(f"{at}.P", f"{p:g} is not overturned / n = {k_over}/{n}")
-        c.pair(cell.get("ci95"), f"{at}.ci95", 0, 1, k_over / n if n > 0 else None)
-        _check_sets(c, cell, at, members)
-
-
-def _check_sets(c, cell, at, members):
-    sets, p_sets = cell.get("sets"), cell.get("P_per_set")
-    if p_sets is not None:
-        for s, p in enumerate(c.lst(p_sets, f"{at}.P_per_set", members)):
-            c.num(p, f"{at}.P_per_set[{s}]", 0, 1, optional=True)
-    if sets is None:
-        return
-    indices = [c.integer(s, f"{at}.sets", 0, members - 1)
-               for s in c.lst(sets, f"{at}.sets", members)]
-    if len(set(indices)) != len(indices):
-        c.fail(f"{at}.sets", "names a parameter set twice")
-    if p_sets is not None and len(p_sets) != len(indices):
-        c.fail(f"{at}.P_per_set", f"holds {len(p_sets)} values for {len(indices)} sets")
+def _section_json(section):
+    return _join(section, {
+        "pga_g": list, "pgv_pga_s": list, "warnings": list,
+        "block2d": lambda v: None if v is None else _join(v),
+        "models": lambda v: {k: _join(m, {"cells": list}) for k, m in v.items()}})

@@ -3,7 +3,6 @@
 fit or logistic surface with its members' own fits (:func:`load_campaign_fragility`,
 :func:`member_fits`), or a pulse grid (:func:`load_pulse_grid`)."""
 import io
-import math
 from dataclasses import replace
 
 import numpy as np
@@ -39,19 +38,20 @@ def load_campaign_fragility(path, column=None, form=None, below="ramp", componen
 
 def _load_campaign_fragility(path, column, form, below):
     """(fragility, "line" | "records", record ids) of :func:`load_campaign_fragility`."""
-    path, data = read_fragility_file(path)          # every value below checked
-    if "pulse_grid" in data:
-        return load_pulse_grid(path, data, column, form or "grid", below), "line", ()
+    file = read_fragility_file(path)          # every value below checked
+    path = file.path
+    if file.pulse_grid is not None:
+        return load_pulse_grid(file, column, form or "grid", below), "line", ()
     form = form or "pga-pgv"
-    columns = data["columns"]
+    columns = file.columns
     if column is None:
         column = next((c for c in ("monolithic", "drums") if c in columns), next(iter(columns)))
     if column not in columns:
         raise InputError(f"{path}: no column {column!r} (has {', '.join(columns)})")
     entry = columns[column]
-    label = f"{column} ({entry.get('description', '')}) from {path.name}"
+    label = f"{column} ({entry.description or ''}) from {path.name}"
     if form == "pga":
-        fit = entry.get("PGA") or {}
+        fit = entry.fits.get("PGA") or {}
         if fit.get("unit") != "m/s^2":
             raise InputError(f"{path}: column {column}: PGA fit in unknown unit "
                              f"{fit.get('unit')!r} (expected m/s^2)")
@@ -65,20 +65,22 @@ def _load_campaign_fragility(path, column, form, below):
                            _pair(fit.get("beta_ci95"), f"{where} beta_ci95"),
                            label=label, note=fit.get("note"))
     elif form == "pga-pgv":
-        pooled = _logistic(entry.get("logistic") or {}, f"{path}: column {column}", label)
+        pooled = _logistic(entry.logistic or {}, f"{path}: column {column}", label)
     else:
         raise InputError(f"--fragility-form must be pga or pga-pgv, got {form!r}")
-    fits, note = member_fits(path.parent / "fragility_runs.csv", column, form, data)
+    fits, note = member_fits(path.parent / "fragility_runs.csv", column, form, file.block2d)
     pooled = replace(pooled, member_fits=fits,
                      note="; ".join(filter(None, [pooled.note, note])) or None)
-    return pooled, "records", tuple(data.get("records") or ())
+    return pooled, "records", file.records
 
 
-def member_fits(runs_path, column, form, data):
+def member_fits(runs_path, column, form, block=None):
     """(one fragility per member of a column campaign fitted to its own runs, note): the
     lognormal PGA fit (form "pga") or the logistic surface ("pga-pgv") of
     :mod:`pipeline.stats.ensemble`, as the campaign fits the pooled runs; (None, note)
-    when the runs table is absent or no member's fit is determined."""
+    when the runs table is absent or no member's fit is determined.  ``block``: the
+    file's :class:`~pipeline.hazard.fragility_file.Block2d` (the surface's alpha and p)
+    or None."""
     if not runs_path.is_file():
         return None, f"no {runs_path.name} beside the file: the members' spread not available"
     try:
@@ -90,7 +92,6 @@ def member_fits(runs_path, column, form, data):
                          f"({exc})") from None
     if len(groups) > MAX_MEMBERS:
         raise InputError(f"{runs_path}: {len(groups)} members (at most {MAX_MEMBERS})")
-    block = data.get("block2d") or {}
     fits, skipped = [], []
     for member, rows in groups:
         try:
@@ -112,8 +113,8 @@ def member_fits(runs_path, column, form, data):
                 continue
             fits.append(Lognormal(float(fit["median"]), float(fit["beta"]), label=label))
         else:
-            fit = logistic_surface(pga, ratio, y, alpha=block.get("alpha_rad"),
-                                   p=block.get("p_per_s"))
+            fit = logistic_surface(pga, ratio, y, alpha=None if block is None else block.alpha_rad,
+                                   p=None if block is None else block.p_per_s)
             b = fit["coefficients"]
             if b is None or not b["b1"] > 0:
                 skipped.append(f"{show(member)} ({fit.get('note') or 'does not grow with PGA'})")
@@ -161,24 +162,24 @@ def _pair(value, what):
 
 
 
-def load_pulse_grid(path, data, model=None, form="grid", below="ramp"):
-    """One model of a pulse-grid ``fragility.json`` (``models``: monolithic, block2d), its
-    ``data`` checked by :func:`pipeline.hazard.fragility_file.check_fragility`: ``form``
-    "grid" (:class:`PulseGrid`, ``below`` what P is below it; a grid of one row or column
+def load_pulse_grid(file, model=None, form="grid", below="ramp"):
+    """One model of a pulse-grid :class:`~pipeline.hazard.fragility_file.FragilityFile`
+    (``models``: monolithic, block2d; read and checked by its reader): ``form`` "grid"
+    (:class:`PulseGrid`, ``below`` what P is below it; a grid of one row or column
     interpolated along the other axis) or "pga-pgv" (its logistic surface)."""
     if below not in BELOW_GRID:
         raise InputError(f"--below-grid must be one of {', '.join(BELOW_GRID)}, got {below!r}")
-    section = data["pulse_grid"]
-    models = section["models"]
+    path, section = file.path, file.pulse_grid
+    models = section.models
     if model is None:
         model = "monolithic" if "monolithic" in models else next(iter(models))
     if model not in models:
         raise InputError(f"{path}: pulse_grid has no model {model!r} (has {', '.join(models)})")
     entry = models[model]
     where = f"{path}: pulse_grid model {model}"
-    label = f"{data.get('specimen') or 'specimen'} {model} pulse grid from {path.name}"
+    label = f"{file.specimen or 'specimen'} {model} pulse grid from {path.name}"
     logistic = None
-    surface = entry.get("logistic") or {}
+    surface = entry.logistic or {}
     if surface.get("coefficients") is not None:
         logistic = _logistic(surface, where, label)
     if form == "pga-pgv":
@@ -189,44 +190,34 @@ def load_pulse_grid(path, data, model=None, form="grid", below="ramp"):
     if form != "grid":
         raise InputError(f"--fragility-form for a pulse grid must be grid or pga-pgv, got "
                          f"{form!r}")
-    pga_g = [float(v) for v in section["pga_g"]]        # checked: increasing, positive
-    ratios = [float(v) for v in section["pgv_pga_s"]]
-    n_sets = section["members"]
-    n = np.zeros((len(pga_g), len(ratios)), int)
-    overturned = np.zeros_like(n)
-    per_set = np.full((n_sets, len(pga_g), len(ratios)), np.nan)
-    index_a = {round(v, 9): i for i, v in enumerate(pga_g)}
-    index_r = {round(v, 9): j for j, v in enumerate(ratios)}
-    for cell in entry["cells"]:                        # checked: on the grid, once each
-        i, j = index_a[round(cell["pga_g"], 9)], index_r[round(cell["pgv_pga_s"], 9)]
-        n[i, j], overturned[i, j] = cell["n"], cell["overturned"]
-        for s, p in zip(cell.get("sets") or [], cell.get("P_per_set") or []):
-            if p is not None:
-                per_set[s, i, j] = float(p)
+    n, overturned, per_set = _cells(section, entry)
     empty = int((n == 0).sum())
     if empty == n.size:
         raise InputError(f"{where}: no cell with runs (every n is 0)")
     note = None if not empty else (f"{empty} of {n.size} cells without runs: filled from the "
                                    "nearest cell along PGA")
-    uplift = _uplift(section, where)
-    return PulseGrid(tuple(v * STANDARD_GRAVITY for v in pga_g), tuple(ratios), n,
-                     overturned, per_set, logistic, label, note, uplift, below)
+    block = section.block2d
+    uplift = None if block is None or block.uplift_g_smallest is None else \
+        block.uplift_g_smallest * STANDARD_GRAVITY
+    return PulseGrid(tuple(float(v) * STANDARD_GRAVITY for v in section.pga_g),
+                     tuple(float(v) for v in section.pgv_pga_s), n, overturned, per_set,
+                     logistic, label, note, uplift, below)
 
 
-def _uplift(section, where):
-    """g tan(alpha) (m/s^2) of a pulse grid's 2D block (``block2d``: the smallest over its
-    runs, uplift_g_smallest, where written; else uplift_g or alpha_rad, the runs' median),
-    or None when the file has none."""
-    block = section.get("block2d") or {}
-    if block.get("uplift_g_smallest") is not None:
-        return number(block["uplift_g_smallest"], f"{where}: block2d uplift_g_smallest", 0,
-                      None, "g", True) * STANDARD_GRAVITY
-    if block.get("uplift_g") is not None:
-        return number(block["uplift_g"], f"{where}: block2d uplift_g", 0, None, "g",
-                      True) * STANDARD_GRAVITY
-    if block.get("alpha_rad") is not None:
-        alpha = number(block["alpha_rad"], f"{where}: block2d alpha_rad", 0, math.pi / 2,
-                       "rad", True)
-        return STANDARD_GRAVITY * math.tan(alpha)
-    return None
-
+def _cells(section, entry):
+    """(n, overturned, P per set) arrays (n_pga x n_ratio; sets x n_pga x n_ratio, NaN
+    where a set has no run) of one model's cells, checked on the grid once each."""
+    pga_g = [float(v) for v in section.pga_g]        # checked: increasing, positive
+    ratios = [float(v) for v in section.pgv_pga_s]
+    n = np.zeros((len(pga_g), len(ratios)), int)
+    overturned = np.zeros_like(n)
+    per_set = np.full((section.members, len(pga_g), len(ratios)), np.nan)
+    index_a = {round(v, 9): i for i, v in enumerate(pga_g)}
+    index_r = {round(v, 9): j for j, v in enumerate(ratios)}
+    for cell in entry.cells:
+        i, j = index_a[round(cell["pga_g"], 9)], index_r[round(cell["pgv_pga_s"], 9)]
+        n[i, j], overturned[i, j] = cell["n"], cell["overturned"]
+        for s, p in zip(cell.get("sets") or [], cell.get("P_per_set") or []):
+            if p is not None:
+                per_set[s, i, j] = float(p)
+    return n, overturned, per_set

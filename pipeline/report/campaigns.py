@@ -7,6 +7,7 @@ from pathlib import Path
 
 import pandas as pd
 
+from pipeline.hazard.fragility_file import read_fragility_file
 from pipeline.motion import RECORD_CLOCK
 from pipeline.report.common import _figure, _fmt, _p, _read_csv, _spread, _table
 
@@ -237,16 +238,14 @@ def fragility_section(results):
         return ("## Fragility\n\nNot run yet (`python -m pipeline campaign fragility`: "
                 "P(toppled) against PGA, PGV and PGV/PGA from scaled records, beside a 2D "
                 "rigid block).\n")
-    summary = json.loads(path.read_text())
-    if summary.get("mode") == "pulses":
+    summary = read_fragility_file(path)
+    if summary.pulse_grid is not None:
         return rock_fragility_section(results, "fragility")
     rows = []
-    for name, entry in summary.get("columns", {}).items():
-        row = {"model": entry.get("description", name),
-               "runs (toppled)": f"{entry.get('runs')} ({entry.get('toppled')})"}
-        for im, fit in entry.items():
-            if not isinstance(fit, dict) or "median" not in fit:
-                continue
+    for name, entry in summary.columns.items():
+        row = {"model": name if entry.description is None else entry.description,
+               "runs (toppled)": f"{entry.runs} ({entry.toppled})"}
+        for im, fit in entry.fits.items():
             lo_hi = fit.get("median_ci95") or [None, None]
             row[f"{im} median [95 %] {fit.get('unit', '')}".strip()] = (
                 "-" if fit["median"] is None else
@@ -254,8 +253,8 @@ def fragility_section(results):
                 f"beta {_fmt(fit.get('beta'), 2)}")
         rows.append(row)
     lines = ["## Fragility (campaign fragility)\n",
-             f"Records {', '.join(map(str, summary.get('records', [])))}; "
-             f"{summary.get('members')} members per record and level; lognormal "
+             f"Records {', '.join(map(str, summary.records))}; "
+             f"{summary.members} members per record and level; lognormal "
              "maximum-likelihood fits P(toppled | IM) = Phi(ln(IM / median) / beta).\n",
              _table(pd.DataFrame(rows)) + "\n"]
     for fig in ("fragility_curves.png", "fragility_2d_vs_3d.png", "fragility_surface.png"):
@@ -483,28 +482,28 @@ def rock_fragility_section(results, name="rock-fragility"):
     has run."""
     heading, what = ROCK_FRAGILITY.get(name, (f"Fragility over a pulse grid ({name})", ""))
     path = results / name / "fragility.json"
-    summary = json.loads(path.read_text()) if path.exists() else {}
-    section = summary.get("pulse_grid")
+    summary = read_fragility_file(path) if path.exists() else None
+    section = None if summary is None else summary.pulse_grid
     if section is None:
         return f"## {heading}\n\nNot run yet (`make rock-fragility`: {what}).\n"
-    block = section["block2d"]
+    block = section.block2d
     lines = [f"## {heading}\n",
-             f"{summary['specimen']}: one-cosine displacement pulses over PGA "
-             f"{min(section['pga_g']):g}-{max(section['pga_g']):g} g x PGV/PGA "
-             f"{min(section['pgv_pga_s']):g}-{max(section['pgv_pga_s']):g} s "
-             f"({len(section['pga_g'])} x {len(section['pgv_pga_s'])} cells); "
-             f"{section['members']} parameter sets drawn from `{section['ranges']}` x "
-             f"{section['headings']} direction(s); direction: {section['direction']}. "
-             f"{section['runs_finished']} of {section['runs']} runs finished. The 2D rigid "
+             f"{summary.specimen}: one-cosine displacement pulses over PGA "
+             f"{min(section.pga_g):g}-{max(section.pga_g):g} g x PGV/PGA "
+             f"{min(section.pgv_pga_s):g}-{max(section.pgv_pga_s):g} s "
+             f"({len(section.pga_g)} x {len(section.pgv_pga_s)} cells); "
+             f"{section.members} parameter sets drawn from `{section.ranges}` x "
+             f"{section.headings} direction(s); direction: {section.direction}. "
+             f"{section.runs_finished} of {section.runs} runs finished. The 2D rigid "
              f"block (the toolkit's Housner integrator) has the specimen's critical angle "
-             f"({math.degrees(block['alpha_rad']):.1f} deg, median over the runs) and pivot "
-             f"distance ({block['R_m']:.3f} m).\n",
+             f"({math.degrees(block.alpha_rad):.1f} deg, median over the runs) and pivot "
+             f"distance ({block.R_m:.3f} m).\n",
              "PGA (g) where P(overturn) crosses each level, per PGV/PGA (linear between "
              "cells; in brackets where the Wilson 95 % bounds cross it, the Monte Carlo "
              "band; - beyond the grid):\n"]
     rows = []
-    for model, entry in section["models"].items():
-        for level, contour in entry["contours"].items():
+    for model, entry in section.models.items():
+        for level, contour in entry.contours.items():
             row = {"model": model, "P": level}
             for r in contour:
                 lo, hi = r["pga_g_band"]
@@ -512,28 +511,28 @@ def rock_fragility_section(results, name="rock-fragility"):
                     f"{_fmt(r['pga_g'], 2)} [{_fmt(lo, 2)}, {_fmt(hi, 2)}]")
             rows.append(row)
     lines.append(_table(pd.DataFrame(rows)) + "\n")
-    lines += [f"Warning: {w}.\n" for w in section.get("warnings", [])]
-    for model, entry in section["models"].items():
-        per_set = [r for r in entry["contours"].get("0.5", []) if r.get("pga_g_per_set")]
+    lines += [f"Warning: {w}.\n" for w in section.warnings]
+    for model, entry in section.models.items():
+        per_set = [r for r in entry.contours.get("0.5", []) if r.get("pga_g_per_set")]
         shown = [f"{r['pgv_pga_s']:g} s: " + ", ".join(_fmt(v, 2) for v in
                                                       r["pga_g_per_set"].values())
                  for r in per_set]
         if shown:
             lines.append(f"P = 0.5 of each parameter set ({model}; the members' spread): "
                          + "; ".join(shown) + ".\n")
-    spread = [c["set_sd"] for e in section["models"].values() for c in e["cells"]
+    spread = [c["set_sd"] for e in section.models.values() for c in e.cells
               if c["set_sd"] is not None]
     if spread:
         lines.append(f"Spread of P across the parameter sets (sd per cell): up to "
                      f"{max(spread):.2f}, mean {sum(spread) / len(spread):.2f}.\n")
-    for model, entry in section["models"].items():
-        d = (entry.get("logistic") or {}).get("dimensionless")
+    for model, entry in section.models.items():
+        d = (entry.logistic or {}).get("dimensionless")
         if d:
             lines.append(f"Logistic surface ({model}): logit P = {d['c0']:.2f} + "
                          f"{d['b1']:.2f} ln(PGA / (g tan alpha)) + {d['b2']:.2f} ln(p PGV/PGA)"
                          + (" (Firth-penalised: separable outcomes)"
-                            if entry["logistic"].get("separated") else "") + ".\n")
-    check = section.get("experiments")
+                            if entry.logistic.get("separated") else "") + ".\n")
+    check = section.experiments
     if check:
         def score_row(label, score):
             return {"prediction": label,

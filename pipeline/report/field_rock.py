@@ -5,6 +5,7 @@ import json
 
 import pandas as pd
 
+from pipeline.hazard.fragility_file import read_fragility_file
 from pipeline.report.campaigns import rock_fragility_section
 from pipeline.report.common import _figure, _fmt, _table
 from pipeline.report.hazard import survival_section
@@ -47,7 +48,7 @@ def field_rock_section(results, prefix=FIELD_ROCK):
     fragility = results / f"{prefix}-fragility" / "fragility.json"
     if fragility.is_file():
         lines.append("### Fragility\n")
-        lines.append(_cost(json.loads(fragility.read_text())))
+        lines.append(_cost(read_fragility_file(fragility)))
         lines.append(_demote(rock_fragility_section(results, f"{prefix}-fragility")))
     else:
         lines.append(f"Fragility: not run yet ({command}).\n")
@@ -62,13 +63,13 @@ def field_rock_section(results, prefix=FIELD_ROCK):
 
 def _cost(summary):
     """What the adaptive design ran against the full grid, and its YADE time."""
-    grid = summary["pulse_grid"]
-    runs, full = grid.get("runs"), grid.get("full_grid_runs")
+    grid = summary.pulse_grid
+    runs, full = grid.runs, grid.full_grid_runs
     if not runs or not full:
         return ""
     return (f"Cost: {runs} runs of the full grid's {full} ({full / runs:.1f} times fewer; "
-            f"{grid.get('sampling', '').split(':')[0]}), "
-            f"{grid.get('yade_wall_s_total', 0) / 60:.1f} min of YADE wall time summed over "
+            f"{(grid.sampling or '').split(':')[0]}), "
+            f"{(grid.yade_wall_s_total or 0) / 60:.1f} min of YADE wall time summed over "
             "the runs.\n")
 
 

@@ -13,6 +13,7 @@ import pytest
 
 from pipeline.campaign import CAMPAIGNS, get, pulse_grid, run_campaign
 from pipeline.campaign.fragility import FragilityOptions, drive
+from pipeline.hazard.fragility_file import FragilityFile, read_fragility_file
 from pipeline.motion.pulses import one_cosine_pulse
 from pipeline.outcome.summary import ColumnOutcome, RunSummary
 from pipeline.rocking import rocking_response_sampled
@@ -49,30 +50,30 @@ def test_the_adaptive_surface_matches_the_full_grid_with_fewer_runs(tmp_path, mo
         options = FragilityOptions(**given, adaptive=mode == "adaptive").kwargs()
         drive(lambda opts, out=out: run_campaign("fragility", jobs=1, campaign_dir=out,
                                                  options=opts), [], out, options)
-        summaries[mode] = json.loads((out / "fragility.json").read_text())
-    full, adaptive = (summaries[m]["pulse_grid"] for m in ("full", "adaptive"))
-    assert full["runs_finished"] == full["full_grid_runs"] == 10 * 2 * 2 * 2
-    assert adaptive["runs_finished"] < full["runs_finished"]
+        summaries[mode] = read_fragility_file(out)
+    full, adaptive = (summaries[m].pulse_grid for m in ("full", "adaptive"))
+    assert full.runs_finished == full.full_grid_runs == 10 * 2 * 2 * 2
+    assert adaptive.runs_finished < full.runs_finished
     # the model is stabler than the guide: somewhere a probe disagreed and a cell the guide
     # called certain was run in full (the driver's widening, not only its first stage)
-    guide = {(c["pgv_pga_s"], c["pga_g"]): c["P"] for c in full["models"]["block2d"]["cells"]}
-    rock = {(c["pgv_pga_s"], c["pga_g"]): c for c in adaptive["models"]["box"]["cells"]}
+    guide = {(c["pgv_pga_s"], c["pga_g"]): c["P"] for c in full.models["block2d"].cells}
+    rock = {(c["pgv_pga_s"], c["pga_g"]): c for c in adaptive.models["box"].cells}
     assert any(guide[k] in (0.0, 1.0) and c["n"] > 1 and c["P"] != guide[k]
                for k, c in rock.items())
     difference = pulse_grid.contour_difference(summaries["full"], summaries["adaptive"])
     crossing = [r for r in difference["rows"] if r["pga_g_reference"] is not None]
     assert len(crossing) == 2                      # the threshold lies inside the grid
-    print(difference, adaptive["runs_finished"])
+    print(difference, adaptive.runs_finished)
     assert difference["within_band"]
     assert difference["max_abs_diff_g"] == pytest.approx(0.0, abs=1e-9)
 
 
 def fragility(rows):
-    """A fragility.json dict of one specimen model with the given P = 0.5 contour rows
+    """A fragility file of one specimen model with the given P = 0.5 contour rows
     (pgv_pga_s, pga_g, band lo, band hi)."""
     contour = [{"pgv_pga_s": r, "pga_g": a, "pga_g_band": [lo, hi]} for r, a, lo, hi in rows]
-    return {"pulse_grid": {"models": {"block2d": {"contours": {"0.5": []}},
-                                      "rock": {"contours": {"0.5": contour}}}}}
+    return FragilityFile.of({"pulse_grid": {"models": {"block2d": {"contours": {"0.5": []}},
+                                                       "rock": {"contours": {"0.5": contour}}}}})
 
 
 def test_contour_difference_on_constructed_contours():
@@ -122,13 +123,13 @@ def threshold_model(pga_g, ratios, members, headings, seed, bias=1.0):
 
 
 def model_summary(outcomes, order, runs, pga_g, ratios):
-    """A fragility.json dict of the model's first ``runs[cell]`` runs per cell."""
+    """A fragility file of the model's first ``runs[cell]`` runs per cell."""
     rows = [{"model": "rock", "pga_g": pga_g[j], "pgv_pga_s": ratios[i], "member": m,
              "toppled": fell[r]}
             for (i, j), fell in outcomes.items() for r, (m, _) in enumerate(order[:runs[(i, j)]])]
     cells = pulse_grid.cell_table(pd.DataFrame(rows), "rock")
-    return {"pulse_grid": {"models": {"rock": {"cells": cells,
-                                               "contours": pulse_grid.contours(cells)}}}}
+    return FragilityFile.of({"pulse_grid": {"models": {"rock": {
+        "cells": cells, "contours": pulse_grid.contours(cells)}}}})
 
 
 def test_the_adaptive_stages_save_five_times_the_runs_on_a_fine_grid_of_a_cheap_model():
@@ -162,9 +163,9 @@ def test_the_adaptive_stages_save_five_times_the_runs_on_a_fine_grid_of_a_cheap_
           f"{difference['max_abs_diff_g']} g")
     # the statistics say what was run: a cell's n is its runs, its interval Wilson's of them
     full_cells = {(list(ratios).index(c["pgv_pga_s"]), list(pga_g).index(c["pga_g"])): c
-                  for c in full["pulse_grid"]["models"]["rock"]["cells"]}
+                  for c in full.pulse_grid.models["rock"].cells}
     top = pulse_grid.first_crossings({cell: c["P"] for cell, c in full_cells.items()})
-    for cell in adaptive["pulse_grid"]["models"]["rock"]["cells"]:
+    for cell in adaptive.pulse_grid.models["rock"].cells:
         i, j = list(ratios).index(cell["pgv_pga_s"]), list(pga_g).index(cell["pga_g"])
         assert cell["n"] == targets[(i, j)]
         assert cell["ci95"] == pytest.approx(wilson_interval(cell["overturned"], cell["n"]))

@@ -1,0 +1,76 @@
+"""fragility.json as one type: what the one writer writes the one reader gives back, the
+older spellings of a pulse grid's 2D block load, and the same file read by survival and
+by the shake-table check gives both one P."""
+import copy
+import json
+import math
+
+import numpy as np
+import pytest
+
+from pipeline.campaign.pulse_check import grid_probability
+from pipeline.constants import STANDARD_GRAVITY as G
+from pipeline.files import InputError
+from pipeline.hazard.fragility import load_campaign_fragility
+from pipeline.hazard.fragility_file import (FragilityFile, read_fragility_file,
+                                            write_fragility_file)
+from tests.hazard.test_reader_robustness import COLUMN, grid_document
+
+
+@pytest.mark.parametrize("document", [COLUMN, grid_document()], ids=["columns", "grid"])
+def test_written_then_read_is_the_same_file_and_the_same_json(tmp_path, document):
+    file = FragilityFile.of(copy.deepcopy(document))
+    path = write_fragility_file(tmp_path, file)
+    assert json.loads(path.read_text()) == document          # nothing added, nothing lost
+    read = read_fragility_file(tmp_path)
+    assert read == file and read.path == path
+
+
+def test_sections_are_typed():
+    columns = FragilityFile.of(copy.deepcopy(COLUMN))
+    entry = columns.columns["monolithic"]
+    assert entry.fits["PGA"]["median"] == 3.0 and entry.logistic["coefficients"]["b1"] == 3.0
+    assert columns.records == ("R1", "R2") and columns.block2d.alpha_rad == 0.2
+    grid = FragilityFile.of(grid_document()).pulse_grid
+    assert grid.pga_g == (0.1, 0.2, 0.4) and grid.members == 2
+    assert len(grid.models["monolithic"].cells) == 6 and grid.block2d.uplift_g == 0.05
+
+
+@pytest.mark.parametrize("drop, expected_g", [
+    (("uplift_g_smallest",), 0.05),                       # the runs' median: uplift_g
+    (("uplift_g_smallest", "uplift_g"), math.tan(0.3)),   # g tan(alpha)
+])
+def test_older_spellings_of_the_uplift_load(tmp_path, drop, expected_g):
+    document = grid_document(uplift_g=0.05)
+    block = document["pulse_grid"]["block2d"]
+    block["alpha_rad"] = 0.3
+    for key in drop:
+        del block[key]
+    (tmp_path / "fragility.json").write_text(json.dumps(document))
+    assert read_fragility_file(tmp_path).pulse_grid.block2d.uplift_g_smallest == \
+        pytest.approx(expected_g)
+    assert load_campaign_fragility(tmp_path).uplift_m_s2 == pytest.approx(expected_g * G)
+
+
+def test_the_reader_refuses_in_one_line(tmp_path):
+    document = grid_document()
+    document["pulse_grid"]["members"] = 0
+    (tmp_path / "fragility.json").write_text(json.dumps(document))
+    with pytest.raises(InputError, match="pulse_grid.members") as caught:
+        read_fragility_file(tmp_path)
+    assert "\n" not in str(caught.value)
+
+
+def test_survival_and_the_shake_table_check_read_one_p_from_the_cells(tmp_path):
+    """P = a / (a + r) in the cells (not bilinear in either space): at points inside
+    the grid the pulse grid of survival and the check's interpolation agree."""
+    document = grid_document(pga_g=(0.1, 0.2, 0.4, 0.8), ratios=(0.1, 0.3, 0.9),
+                             p_of=lambda a, r: a / (a + r), n=400)
+    (tmp_path / "fragility.json").write_text(json.dumps(document))
+    file = read_fragility_file(tmp_path)
+    grid = load_campaign_fragility(tmp_path)
+    pga_g, ratio = np.array([0.15, 0.33, 0.7]), np.array([0.2, 0.5, 0.12])
+    checked, outside = grid_probability(file.pulse_grid.models["monolithic"].cells, pga_g,
+                                        ratio)
+    assert not outside.any()
+    np.testing.assert_allclose(grid.probability(pga_g * G, ratio), checked, atol=1e-12)
