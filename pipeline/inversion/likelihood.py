@@ -70,6 +70,7 @@ import numpy as np
 from scipy import optimize, special
 
 from pipeline.files import InputError
+from pipeline.inversion.observations import ColumnObservation
 
 LIKELIHOODS = ("independent", "predictive")
 DEFAULT_KERNEL_DEG = 20.0
@@ -236,14 +237,8 @@ class ForwardModel:
 
     def site_log_likelihood(self, site, east_km, north_km, strikes_deg):
         """Log-likelihood of one site's columns: (n_sources, n_strikes, n_epicentres)."""
-        east, north = np.asarray(east_km, float), np.asarray(north_km, float)
-        strikes = np.asarray(strikes_deg, float)
-        dx, dy = site.east_km - east, site.north_km - north
-        r = np.hypot(dx, dy)
-        alpha = np.mod(np.degrees(np.arctan2(dx, dy)), 360.0)     # epicentre -> site
-        rings = self.distance_weights(r)
-        ai0, ai1, aw = self.azimuth_weights(alpha[None, :] - strikes[:, None])   # (nphi, ne)
-        ns, ne, nphi = len(self.sources), east.size, strikes.size
+        alpha, rings, ai0, ai1, aw = self._geometry(site, east_km, north_km, strikes_deg)
+        ns, nphi, ne = len(self.sources), ai0.shape[0], alpha.size
         out = np.zeros((ns, nphi, ne))
         by_type = {}
         for obs in site.columns:
@@ -277,6 +272,32 @@ class ForwardModel:
                 out += np.log((weight * values[j] + pair) / (weight + j))
                 earlier.append(obs)
         return out
+
+    def _geometry(self, site, east_km, north_km, strikes_deg):
+        """(azimuth epicentre -> site deg (ne,), ring weights, virtual azimuth weights
+        (nphi, ne)) of ``site`` from each candidate epicentre and strike."""
+        east, north = np.asarray(east_km, float), np.asarray(north_km, float)
+        dx, dy = site.east_km - east, site.north_km - north
+        alpha = np.mod(np.degrees(np.arctan2(dx, dy)), 360.0)
+        theta = alpha[None, :] - np.asarray(strikes_deg, float)[:, None]
+        return (alpha, self.distance_weights(np.hypot(dx, dy)))\
+            + tuple(self.azimuth_weights(theta))
+
+    def column_distribution(self, site, column, east_km, north_km, strikes_deg, psi_deg,
+                            sigma_deg):
+        """What the model expects of one column of type ``column`` at ``site``: (1 - P:
+        (ns, nphi, ne), P d at the geographic downfall azimuths ``psi_deg`` (per radian,
+        observed with ``sigma_deg``): (npsi, ns, nphi, ne)), per candidate source."""
+        c = self.column_index(column)
+        alpha, rings, ai0, ai1, aw = self._geometry(site, east_km, north_km, strikes_deg)
+        q = self._mixed(self._standing(c, rings, ai0, ai1, aw))
+        pseudo = [ColumnObservation(column, "fallen", float(p), float(sigma_deg))
+                  for p in psi_deg]
+        fallen = []
+        for start in range(0, len(pseudo), 4 * OBS_CHUNK):
+            fallen += [self._mixed(v) for v in self._fallen(
+                c, pseudo[start:start + 4 * OBS_CHUNK], alpha, rings, ai0, ai1, aw)]
+        return q, np.stack(fallen)
 
     def urn_weight(self, c):
         """A of the predictive likelihood for column type c: 1 / A = 1 / (n + 1) + 1 / m,

@@ -36,6 +36,7 @@ from scipy.special import logsumexp
 
 from pipeline.files import InputError
 from pipeline.stats.circular import azimuth_deg
+from pipeline.inversion.fit import fit_check
 from pipeline.inversion.likelihood import ForwardModel
 from pipeline.inversion.observations import Observations, Site
 
@@ -305,27 +306,35 @@ class Posterior:
     def reach_summary(self):
         """The inversion's reach (km from a site where the candidates end, and what ends
         them), the posterior's and the prior's mass in the outermost cells, their Bayes
-        factor and a warning line (None) when it passes EDGE_BAYES_FACTOR."""
+        factor, the fit check's p-value (:mod:`pipeline.inversion.fit`) and a warning line
+        (None) when the factor passes EDGE_BAYES_FACTOR or the fit check warns."""
         reach = self.info.get("reach_km")
         if self.edge is None or reach is None:
             return {"reach_km": reach, "reach_limit": None, "reach_edge_fraction": None,
                     "reach_edge_prior_fraction": None, "reach_edge_bayes_factor": None,
+                    "reach_edge_warning": False, "fit_p_value": None, "fit_warning": None,
                     "reach_warning": None}
         prior = np.exp(self.log_prior - logsumexp(self.log_prior)).sum(axis=(0, 1))
         fraction = float(self.epicentre[self.edge].sum())
         prior_fraction = float(prior[self.edge].sum())
         factor = edge_bayes_factor(fraction, prior_fraction)
-        warning = None
+        warning, fit = None, self.info.get("fit") or {}
         if factor > EDGE_BAYES_FACTOR:
             warning = (f"{fraction:.0%} of the posterior lies in the outermost candidate "
                        f"cells, {reach:g} km from a site ({self.info.get('reach_limit')}), "
                        f"against {prior_fraction:.0%} of the prior (odds {factor:.3g} times "
                        "the prior's): the source may lie farther than this inversion can "
                        "tell, and its direction from the first site is not known either")
+        if fit.get("fit_warning"):
+            warning = fit["fit_warning"] if warning is None else \
+                f"{warning}; and {fit['fit_warning']}"
         return {"reach_km": float(reach), "reach_limit": self.info.get("reach_limit"),
                 "reach_edge_fraction": fraction,
                 "reach_edge_prior_fraction": prior_fraction,
-                "reach_edge_bayes_factor": factor, "reach_warning": warning}
+                "reach_edge_bayes_factor": factor,
+                "reach_edge_warning": bool(factor > EDGE_BAYES_FACTOR),
+                "fit_p_value": fit.get("fit_p_value"),
+                "fit_warning": fit.get("fit_warning"), "reach_warning": warning}
 
     def frame(self):
         """One row per candidate: posterior.csv."""
@@ -482,8 +491,10 @@ def invert(model, observations, grid):
             "farthest_candidate_km": float(farthest),
             "sites_km": [[s.east_km, s.north_km] for s in observations.sites],
             "table_slices": model.table.slices}
-    return Posterior(model.sources, strikes, east, north, grid.step_km, log_prior,
+    post = Posterior(model.sources, strikes, east, north, grid.step_km, log_prior,
                      loglike, info=info, edge=grid.edge_cells(east, north))
+    post.info["fit"] = fit_check(model, observations, post)
+    return post
 
 
 def reached_lattice(observations, last_ring_km, grid):

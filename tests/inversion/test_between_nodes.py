@@ -1,6 +1,7 @@
 """The inversion between its table's nodes, on small tables whose truths are known by
 construction: a magnitude halfway between two slices, a source between spokes, a source
 well inside the reach (no warning) and one beyond it (the warning, and no direction)."""
+import dataclasses
 import math
 
 import numpy as np
@@ -144,8 +145,10 @@ def test_a_source_well_inside_the_reach_gives_no_warning():
         obs = []
         for name, (e, n) in sites.items():
             share = 2.5 / math.hypot(e, n)
-            obs.append(observed({name: (e, n)}, truth, share, columns=12, spread_deg=5.0,
-                                seed=seed).sites[0])
+            site = observed({name: (e, n)}, truth, share, columns=12, spread_deg=5.0,
+                            seed=seed).sites[0]         # alone in its file: at (0, 0)
+            obs.append(dataclasses.replace(site, east_km=e - sites["A"][0],
+                                           north_km=n - sites["A"][1]))
         from pipeline.inversion.observations import Observations
         summary, found = checked(table, Observations(tuple(obs)), truth,
                                  CandidateGrid(radius_km=15, step_km=1.0), sites["A"])
