@@ -352,24 +352,29 @@ def study_summary(trials):
 
 
 PLACEMENT_COLUMNS = ("back_azimuth_in_95", "distance_in_95", "epicentre_in_95", "mw_in_95",
-                     "reach_warning")
+                     "reach_warning", "fit_warning")
+WELL_WITHIN = "well within the reach"
 
 
 def placement_summary(trials):
     """Per likelihood, likelihood members and placement, pooled over S and K: trials,
     how many lie within the reach, the coverages of back azimuth, distance, epicentre and
     magnitude (Wilson intervals), the reach warning's rate and the share refused for want
-    of a candidate within reach of every site (``no_candidate``, counted as warned); and
-    the same for the sources ``well within the reach`` (every site nearer than the
-    likelihood's last ring less a cell: the warning's false alarms), ``at the reach's
-    edge`` and ``beyond the reach`` (its hits)."""
+    of a candidate within reach of every site (``no_candidate``, counted as warned), the
+    fit check's share of it (``fit_warning``); the same for each placement's sources well
+    within the reach, and for all sources ``well within the reach`` (every site nearer
+    than the likelihood's last ring less a cell: the warning's false alarms), ``at the
+    reach's edge`` and ``beyond the reach`` (its hits)."""
     rows = []
     keys = ["likelihood", "likelihood_members"]
     for key, g in trials.groupby(keys):
         inside = g["within_reach"].astype(bool)
         edge = g["at_reach_edge"].astype(bool)
         parts = [(placement, g[g["placement"] == placement]) for placement in PLACEMENTS]
-        parts += [("well within the reach", g[inside & ~edge]),
+        parts += [(f"{placement}, {WELL_WITHIN}", g[(g["placement"] == placement) & inside
+                                                    & ~edge])
+                  for placement in PLACEMENTS if placement != "beyond"]
+        parts += [(WELL_WITHIN, g[inside & ~edge]),
                   ("at the reach's edge", g[inside & edge]), ("beyond the reach", g[~inside])]
         for placement, part in parts:
             if part.empty:
@@ -377,8 +382,10 @@ def placement_summary(trials):
             row = {**dict(zip(keys, key)), "placement": placement, "trials": len(part),
                    "within_reach": int(part["within_reach"].astype(bool).sum())}
             for column in PLACEMENT_COLUMNS:
+                if column not in part:
+                    continue
                 hits = int(part[column].astype(bool).sum())
-                name = column if column == "reach_warning" else \
+                name = column if column.endswith("_warning") else \
                     "coverage_" + column.replace("_in_", "_")
                 row[name] = hits / len(part)
                 row[f"{name}_ci95"] = wilson_interval(hits, len(part))
@@ -396,13 +403,15 @@ def warning_rates(placements):
     for kind, g in placements.groupby("likelihood"):
         g = g[g["likelihood_members"] == g["likelihood_members"].max()].set_index("placement")
         entry = {"likelihood_members": int(g["likelihood_members"].iloc[0])}
-        for label, name in (("well within the reach", "false_alarm"),
+        for label, name in ((WELL_WITHIN, "false_alarm"),
                             ("at the reach's edge", "edge"), ("beyond the reach", "hit")):
             if label in g.index:
                 entry[f"{name}_rate"] = float(g.loc[label, "reach_warning"])
                 entry[f"{name}_rate_ci95"] = list(g.loc[label, "reach_warning_ci95"])
                 entry[f"{name}_trials"] = int(g.loc[label, "trials"])
                 entry[f"{name}_no_candidate"] = float(g.loc[label, "no_candidate"])
+                if "fit_warning" in g.columns:
+                    entry[f"{name}_fit_rate"] = float(g.loc[label, "fit_warning"])
         out[kind] = entry
     return out
 

@@ -352,12 +352,15 @@ def _placement_lines(base, study):
     names = {"placement": "source", "coverage_back_azimuth_95": "back azimuth",
              "coverage_distance_95": "distance", "coverage_epicentre_95": "epicentre",
              "coverage_mw_95": "Mw", "reach_warning": "warned",
+             "fit_warning": "of which by the fit check",
              "no_candidate": "no candidate", "width_median_deg": "median arc (deg)"}
     words = {"node": "on the nodes", "between": "between the rings",
              "between_spokes": "between the spokes", "between_magnitudes":
              "between the magnitudes", "beyond": "beyond the last ring"}
-    table = largest[["likelihood", "trials"] + list(names)].rename(columns=names)
-    table["source"] = table["source"].map(lambda v: words.get(v, v))
+    table = largest[["likelihood", "trials"] + [c for c in names if c in largest.columns]]
+    table = table.rename(columns=names)
+    table["source"] = table["source"].map(
+        lambda v: ", ".join(words.get(part, part) for part in v.split(", ")))
     lines = ["By where the source lies (all sites and columns together; a warning gives "
              "the whole circle for the back azimuth, and \"no candidate\": sites too far "
              "apart for the reach, refused and counted as warned):", "",
@@ -372,5 +375,9 @@ def _placement_lines(base, study):
             f"within the reach, {rates.get('edge_rate', float('nan')):.2f} of those at its "
             f"edge, and {rates['hit_rate']:.2f} [{hit[0]:.2f}, {hit[1]:.2f}] of "
             f"{rates['hit_trials']} beyond it ({rates['hit_no_candidate']:.2f} of those had "
-            "no candidate within reach of every site and were refused).\n")
+            "no candidate within reach of every site and were refused"
+            + (f"; the fit check gave it for {rates['false_alarm_fit_rate']:.2f} of the "
+               f"sources well within and {rates['hit_fit_rate']:.2f} of those beyond"
+               if {"hit_fit_rate", "false_alarm_fit_rate"} <= set(rates) else "")
+            + ").\n")
     return lines

@@ -152,7 +152,16 @@ def test_truths_lie_off_the_likelihoods_nodes_too(make_away_table):
     assert placements.loc["beyond the reach", "trials"] == beyond.sum()
     assert placements.loc["beyond the reach", "reach_warning"] == \
         rows.loc[beyond, "reach_warning"].mean()
+    well = rows["within_reach"].astype(bool) & ~rows["at_reach_edge"].astype(bool)
+    for placement in ("node", "between", "between_spokes"):
+        part = (rows["placement"] == placement) & well
+        if part.any():
+            assert placements.loc[f"{placement}, well within the reach", "trials"] == \
+                part.sum()
+    # the fit check's warnings are among the warnings given
+    assert (rows["fit_warning"].astype(bool) <= rows["reach_warning"].astype(bool)).all()
     rates = warning_rates(placement_summary(rows))["independent"]
+    assert {"hit_fit_rate", "false_alarm_fit_rate"} <= set(rates)
     assert rates["hit_rate"] == placements.loc["beyond the reach", "reach_warning"]
     assert set(rates) >= {"false_alarm_rate", "hit_rate", "false_alarm_rate_ci95"}
     assert (summary["trials_node"] + summary["trials_between"] + summary["trials_beyond"]
