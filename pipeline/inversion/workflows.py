@@ -226,8 +226,10 @@ def member_study(options, grid, candidates):
     from pipeline.files import write_csv, write_json
     from pipeline.figures.inversion import plot_member_study, plot_member_study_source
     from pipeline.inversion.demo import BOUND_DEG
+    from pipeline.inversion.likelihood import SITE_COLUMNS
     from pipeline.inversion.study import (LIKELIHOOD_MEMBERS, OBSERVATION_MEMBERS,
-                                          STUDY_TRIALS, member_study, placement_summary,
+                                          STUDY_SEED, STUDY_TRIALS, member_study,
+                                          placement_summary,
                                           study_answer, study_summary, warning_rates)
     out = options.out or RESULTS_DIR / "inversion" / "member-study"
     if out.exists() and not out.is_dir():
@@ -261,6 +263,7 @@ def member_study(options, grid, candidates):
                                                        .tolist()),
         "requested_likelihood_members": list(LIKELIHOOD_MEMBERS),
         "observation_members": OBSERVATION_MEMBERS, "trials": trials,
+        "site_columns": SITE_COLUMNS, "seed": STUDY_SEED,
         "forward_table": info, "figure": figure.name, "source_figure": source_figure.name,
         "toppled_fraction_by_slice": table.toppled_fraction_by_slice(),
         "reach_warning": warning_rates(placements),

@@ -297,7 +297,11 @@ def member_study_section(results):
              f"{_fmt(grid.get('azimuth_step_deg'))} deg): the observed columns come from the "
              f"last {study['observation_members']} members, which no likelihood uses; the "
              f"likelihood from the first {', '.join(map(str, study['likelihood_members']))}; "
-             f"{study['trials']} trials per configuration, the same draws for every size.\n"]
+             f"{study['trials']} trials per configuration, the same draws for every size"
+             + (f"; the predictive likelihood counts a site's columns as m = "
+                f"{study['site_columns']:g} site columns' worth of its node's (chosen on "
+                f"draws of another seed than these trials' {study['seed']})" if "site_columns" in study
+                else "") + ".\n"]
     lines.append(_table_provenance(study.get("forward_table") or {}))
     lines.append(_toppled_by_slice(study.get("toppled_fraction_by_slice") or []))
     if "trials_beyond" in summary.columns:
