@@ -10,9 +10,10 @@ intensity measure and logistic surface, :class:`ColumnFits`; ``records``, ``memb
 ``pga_g`` (g) x ``pgv_pga_s`` (s), ``members``, ``models`` (:class:`GridModel`) with
 their cells, contours and logistic surface, the 2D block :class:`Block2d`).  Keys a
 section does not name are kept as written in its ``extra`` (and written back in their
-place).  Older files load: a pulse grid's 2D block without ``uplift_g_smallest`` takes
-it from ``uplift_g`` (the runs' median critical angle) or, without that, from
-``alpha_rad`` (g tan alpha), in that order, here and nowhere else.
+place).  Older files load, brought to today's spelling here and nowhere else: a
+covariance written as nulls (a singular information matrix) is none, and a pulse grid's
+2D block without ``uplift_g_smallest`` takes it from ``uplift_g`` (the runs' median
+critical angle) or, without that, from ``alpha_rad`` (g tan alpha), in that order.
 """
 import math
 from dataclasses import dataclass, field, fields, replace
@@ -143,20 +144,40 @@ class FragilityFile:
 def read_fragility_file(path):
     """The :class:`FragilityFile` at ``path`` (a fragility.json or the directory that
     holds one), every value its readers use checked (InputError, one line, naming the
-    file and the key path); an older file's 2D block brought to today's keys."""
+    file and the key path); an older file brought to today's spelling (:func:`_current`)."""
     path = Path(path)
     if path.is_dir():
         path = path / "fragility.json"
     data = check_fragility(read_json(path, "fragility file", DATA_FILE_BYTES), path)
-    file = FragilityFile.of(data, path)
+    return _current(FragilityFile.of(data, path))
+
+
+def _current(file):
+    """``file`` in today's spelling: a logistic surface's covariance written as nulls (a
+    singular information matrix) made None; a pulse grid's 2D block without
+    ``uplift_g_smallest`` given it from ``uplift_g``, else from g tan(``alpha_rad``)."""
+    if file.columns is not None:
+        file = replace(file, columns={k: replace(e, logistic=_surface(e.logistic))
+                                      for k, e in file.columns.items()})
     grid = file.pulse_grid
-    if grid is not None and grid.block2d is not None and grid.block2d.uplift_g_smallest is None:
-        block = grid.block2d
+    if grid is None:
+        return file
+    grid = replace(grid, models={k: replace(m, logistic=_surface(m.logistic))
+                                 for k, m in grid.models.items()})
+    block = grid.block2d
+    if block is not None and block.uplift_g_smallest is None:
         least = block.uplift_g if block.uplift_g is not None else \
             None if block.alpha_rad is None else math.tan(block.alpha_rad)
-        file = replace(file, pulse_grid=replace(grid, block2d=replace(
-            block, uplift_g_smallest=least)))
-    return file
+        grid = replace(grid, block2d=replace(block, uplift_g_smallest=least))
+    return replace(file, pulse_grid=grid)
+
+
+def _surface(surface):
+    """A logistic surface with a covariance of nulls made None (checked: 3 x 3)."""
+    cov = None if surface is None else surface.get("cov")
+    if cov is None or not any(v is None for row in cov for v in row):
+        return surface
+    return {**surface, "cov": None}
 
 
 def write_fragility_file(directory, file):

@@ -136,9 +136,7 @@ def _logistic(surface, where, label):
     if not b[1] > 0:
         raise InputError(f"{where}: the logistic surface does not grow with PGA "
                          f"(b1 = {b[1]:g})")
-    cov = surface.get("cov")
-    if cov is not None and not all(isinstance(v, (int, float)) for row in cov for v in row):
-        cov = None                       # a singular information matrix: written as nulls
+    cov = surface.get("cov")             # None too where the file wrote nulls (singular)
     se = surface.get("se") or {}
     note = surface.get("note")
     if cov is None:
