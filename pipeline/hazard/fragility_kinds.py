@@ -121,7 +121,10 @@ class Logistic(Fragility):
     def draws(self, n, rng):
         b = np.array(self.coefficients, float)
         if self.cov is not None:
-            sample = rng.multivariate_normal(b, np.array(self.cov, float), n)
+            # the reader checked cov positive semi-definite (within rounding): no warning
+            # for an eigenvalue that rounding puts just below zero
+            sample = rng.multivariate_normal(b, np.array(self.cov, float), n,
+                                             check_valid="ignore")
         elif self.se is not None:
             se = np.array([0.0 if s is None else s for s in self.se], float)
             sample = b + rng.standard_normal((n, 3)) * se

@@ -65,7 +65,7 @@ def _cost(summary):
     """What the adaptive design ran against the full grid, and its YADE time."""
     grid = summary.pulse_grid
     runs, full = grid.runs, grid.full_grid_runs
-    if not runs or not full:
+    if runs is None or full is None or runs == 0:       # 0 runs: nothing to compare
         return ""
     return (f"Cost: {runs} runs of the full grid's {full} ({full / runs:.1f} times fewer; "
             f"{(grid.sampling or '').split(':')[0]}), "
