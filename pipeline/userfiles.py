@@ -62,6 +62,20 @@ def _size_text(limit):
     return f"{limit / 1_000_000:g} MB"
 
 
+def read_user_text(path, what, limit=MAX_FILE_BYTES):
+    """The text of a user's file (:func:`read_text`, at most ``limit`` bytes); InputError
+    (one line) "``what`` not found: path", "``what`` path is a directory" or "``what``
+    path: why"."""
+    try:
+        return read_text(path, limit)
+    except FileNotFoundError:
+        raise InputError(f"{what} not found: {path}") from None
+    except IsADirectoryError:
+        raise InputError(f"{what} {path} is a directory") from None
+    except (OSError, Unreadable) as exc:
+        raise InputError(f"{what} {path}: {exc}") from None
+
+
 def read_json(path, what, limit=MAX_FILE_BYTES):
     """The parsed JSON of a user's file (read by :func:`read_text`, at most ``limit``
     bytes); InputError (one line) "``what`` not found: path", "``what`` path is a

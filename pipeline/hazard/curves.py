@@ -39,7 +39,7 @@ import numpy as np
 
 from pipeline.constants import STANDARD_GRAVITY
 from pipeline.files import InputError
-from pipeline.userfiles import DATA_FILE_BYTES, Unreadable, json_int, read_text, show
+from pipeline.userfiles import DATA_FILE_BYTES, Unreadable, json_int, read_user_text, show
 
 PLAIN_UNITS = {"g": STANDARD_GRAVITY, "m_s2": 1.0, "cm_s2": 0.01}    # factor to m/s^2
 PLAIN_RATE_COLUMN = "annual_rate_per_yr"
@@ -69,14 +69,7 @@ def load_hazard(path, site=None):
     """The hazard curve in ``path`` (OpenQuake CSV, USGS JSON or plain table: see the module);
     ``site``: the row (0-based) of an OpenQuake file with several sites."""
     path = Path(path)
-    try:
-        text = read_text(path, DATA_FILE_BYTES)
-    except FileNotFoundError:
-        raise InputError(f"hazard file not found: {path}") from None
-    except IsADirectoryError:
-        raise InputError(f"hazard file {path} is a directory") from None
-    except (OSError, Unreadable) as exc:
-        raise InputError(f"hazard file {path}: {exc}") from None
+    text = read_user_text(path, "hazard file", DATA_FILE_BYTES)
     lines = [line.strip() for line in text.splitlines()]
     while lines and not lines[-1]:
         lines.pop()

@@ -39,7 +39,7 @@ import numpy as np
 
 from pipeline.hazard.curves import PLAIN_RATE_COLUMN, PLAIN_UNITS, load_hazard
 from pipeline.files import InputError
-from pipeline.userfiles import Unreadable, read_text, show
+from pipeline.userfiles import DATA_FILE_BYTES, read_user_text, show
 
 MAX_BRANCHES = 10_000
 MAX_LEVELS = 1_000
@@ -108,14 +108,7 @@ def _is_openquake(path):
 
 
 def _lines(path, what):
-    try:
-        text = read_text(path)
-    except FileNotFoundError:
-        raise InputError(f"{what} not found: {path}") from None
-    except IsADirectoryError:
-        raise InputError(f"{what} {path} is a directory") from None
-    except (OSError, Unreadable) as exc:
-        raise InputError(f"{what} {path}: {exc}") from None
+    text = read_user_text(path, what, DATA_FILE_BYTES)
     lines = [line.strip() for line in text.splitlines()]
     if not any(line and not line.startswith("#") for line in lines):
         raise InputError(f"{what} {path} is empty")
