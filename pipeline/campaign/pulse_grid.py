@@ -14,7 +14,7 @@ from is unknown), stratified so that each member's directions cover the circle.
 Per grid cell and specimen model: n runs, overturned, P with its Wilson 95 % interval
 (Monte Carlo error of the pooled estimate), P per parameter set and their spread (the
 part of the uncertainty the unknown parameters carry, after the binomial noise of each
-set's own estimate is removed).  Contours at P = 0.16, 0.5, 0.84 in PGA per PGV/PGA
+set's own estimate is removed).  Contours at the P of ``CONTOUR_LEVELS``, in PGA per PGV/PGA
 (linear between cells), with the contours of the Wilson bounds as their Monte Carlo
 band; the logistic surface of Purvance et al. (2008) in dimensionless groups; the 2D
 rigid block of the same critical angle and pivot distance (the toolkit's Housner
@@ -26,9 +26,10 @@ import numpy as np
 from scipy.stats import qmc
 
 from pipeline.campaign.column_file import column_kn
-from pipeline.campaign.shake_table import GRID_CONTACT, GRID_SPECIMEN
+from pipeline.campaign.shake_table import GRID_CONTACT, GRID_SPECIMEN, neighbourhood_ranges
 from pipeline.constants import STANDARD_GRAVITY
 from pipeline.files import InputError
+from pipeline.hazard.pulse_cells import CONTOUR_LEVELS
 from pipeline.motion.pulses import one_cosine_pulse
 from pipeline.rocking import block_constants, rocking_response_sampled
 from pipeline.scenario.geometry import ColumnGeometry
@@ -42,13 +43,12 @@ PULSE_AXES = {"pga_g": (0.01, 5.0), "pgv_pga_s": (0.01, 3.0)}
 MAX_AXIS_SIZE = 50
 PULSE_DT_S = 0.005                # sample interval of the pulses, at most
 PULSE_TAIL_S = 4.0                # at rest after the pulse: the body settles or falls
-# member ranges: defaults span the shake-table calibration's grid around its choice
-# (docs/rock-fragility.md says why); bounds as the calibration's --grid
+# member ranges: defaults from the shake-table calibration's neighbourhood
+# (shake_table.CALIBRATION_NEIGHBOURHOOD); bounds as the calibration's --grid
 RANGE_BOUNDS = {"kn": GRID_CONTACT["kn"], "damping": GRID_CONTACT["damping"],
                 "mu_s": GRID_CONTACT["mu_s"], **GRID_SPECIMEN}
-DEFAULT_RANGES = "kn=4e7:1.2e8;damping=0.05:0.1;mu_s=0.6:0.8;footprint_tolerance_m=0.001:0.003"
+DEFAULT_RANGES = neighbourhood_ranges()
 LOG_UNIFORM = ("kn",)
-CONTOUR_LEVELS = (0.16, 0.5, 0.84)
 # the long-run gate's cost of a run, at most (it stops early once the specimen has fallen
 # or settled): SP1 over the vsr grid took 1,600 runs in 166 s on 2 cores (2026-11-27),
 # 0.09 s of YADE per simulated second (runs stop early: the bound takes twice that) and

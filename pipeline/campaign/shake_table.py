@@ -61,8 +61,41 @@ GRID_SPECIMEN = {"footprint_tolerance_m": (0.0, 0.05)}
 # and the motion: rotate_deg turns the table motion clockwise (180: the other sign of an
 # axis whose sign the laboratory does not state)
 GRID_MOTION = {"rotate_deg": (0.0, 360.0)}
-DEFAULT_GRID = ("footprint_tolerance_m=0.001,0.003;damping=0.05,0.1;mu_s=0.3,0.7;"
-                "rotate_deg=0,180")
+# The shake-table calibration's neighbourhood of a rock's seating and contact, one home
+# for the values the calibration grid tries and the ranges a fragility's members draw
+# from (campaign fragility --ranges; docs/rock-fragility.md says why): per parameter,
+# (grid values, member range).  The footprint and damping ranges span the grid's two
+# values; mu_s: the grid tries 0.3 (the providers' PyBullet value) and 0.7, the members
+# draw about the calibration's choice of 0.7; kn: the grid keeps the contact's own (the
+# paper's or a contact file's), the members draw the stiffnesses that scored alike;
+# rotate_deg: the grid tries both signs of the table's axis, the members draw directions.
+CALIBRATION_NEIGHBOURHOOD = {
+    "footprint_tolerance_m": ((0.001, 0.003), (0.001, 0.003)),
+    "damping": ((0.05, 0.1), (0.05, 0.1)),
+    "mu_s": ((0.3, 0.7), (0.6, 0.8)),
+    "rotate_deg": ((0, 180), None),
+    "kn": ((), (4e7, 1.2e8)),
+}
+
+
+def _number(value):
+    """A value as the grid's and the ranges' text spell it: 0.001, 4e7, 1.2e8."""
+    return f"{value:g}".replace("e+0", "e").replace("e+", "e")
+
+
+def neighbourhood_grid():
+    """The calibration grid's text (``name=V,V;...``) of the neighbourhood."""
+    return ";".join(f"{name}={','.join(_number(v) for v in grid)}"
+                    for name, (grid, _) in CALIBRATION_NEIGHBOURHOOD.items() if grid)
+
+
+def neighbourhood_ranges(order=("kn", "damping", "mu_s", "footprint_tolerance_m")):
+    """The members' ranges' text (``name=LO:HI;...``) of the neighbourhood."""
+    return ";".join(f"{name}={_number(CALIBRATION_NEIGHBOURHOOD[name][1][0])}:"
+                    f"{_number(CALIBRATION_NEIGHBOURHOOD[name][1][1])}" for name in order)
+
+
+DEFAULT_GRID = neighbourhood_grid()
 DEFAULT_CONTACT = dataclasses.asdict(Contact())      # the paper's contact
 PGA_EDGES_G = np.array([0.0, 0.1, 0.2, 0.3, 0.4, 0.5, 0.7, 1.0, 2.0])
 PGV_PGA_EDGES_S = np.array([0.0, 0.05, 0.1, 0.2, 0.3, 0.5, 1.0])

@@ -9,6 +9,7 @@ from scipy import stats
 
 from pipeline.figures.style import COLUMN_COLOURS, COLUMN_LABELS, COLUMN_MARKERS, figure
 from pipeline.files import save_figure
+from pipeline.hazard.pulse_cells import CONTOUR_LEVELS
 from pipeline.stats.ensemble import logistic_probability, wilson_interval
 
 BLOCK_STYLE = {"block2d": {"color": "0.35", "ls": "--", "marker": "D",
@@ -131,8 +132,8 @@ def plot_levels(table, path):
 
 
 def plot_surface(table, summary, path):
-    """Runs in the (PGA, PGV/PGA) plane (filled: toppled) with the P = 0.16, 0.5, 0.84
-    contours of each model's logistic surface."""
+    """Runs in the (PGA, PGV/PGA) plane (filled: toppled) with the contours of each
+    model's logistic surface at the P of :data:`~pipeline.hazard.pulse_cells.CONTOUR_LEVELS`."""
     names = list(summary.columns)
     fig = figure(figsize=(4.5 * len(names), 4))
     axes = fig.subplots(1, len(names), squeeze=False)
@@ -153,7 +154,7 @@ def plot_surface(table, summary, path):
         surface = summary.columns[name].logistic
         if surface["coefficients"] is not None:
             P = logistic_probability(surface["coefficients"], X, Y)
-            cs = ax.contour(X, Y, P, levels=[0.16, 0.5, 0.84], colors=[st["color"]],
+            cs = ax.contour(X, Y, P, levels=list(CONTOUR_LEVELS), colors=[st["color"]],
                             linestyles=[":", "-", "--"], linewidths=1.2)
             ax.clabel(cs, fmt="%.2f", fontsize=7)
         ax.set_xscale("log")
@@ -178,9 +179,9 @@ def plot_surface(table, summary, path):
 
 def plot_pulse_grid(summary, path):
     """The pulse-grid fragility (a :class:`~pipeline.hazard.fragility_file.FragilityFile`)
-    of each 3D specimen model: P per cell (colour), its
-    P = 0.16 / 0.5 / 0.84 contours (lines; the Monte Carlo band of the 0.5 contour
-    shaded), the 2D rigid block's (same critical angle and pivot distance; the toolkit's
+    of each 3D specimen model: P per cell (colour), its contours at the P of
+    :data:`~pipeline.hazard.pulse_cells.CONTOUR_LEVELS` (lines; the Monte Carlo band of
+    the 0.5 contour shaded), the 2D rigid block's (same critical angle and pivot distance; the toolkit's
     Housner integrator) and, where experiments exist, the observed rate per bin."""
     section = summary.pulse_grid
     block = section.block2d.model
@@ -197,7 +198,7 @@ def plot_pulse_grid(summary, path):
                               shading="flat")
         for model, colour in ((name, "C3"), (block, "C0")):
             contours = section.models[model].contours if model in section.models else {}
-            for level, ls in zip(("0.16", "0.5", "0.84"), (":", "-", "--")):
+            for level, ls in zip((f"{p:g}" for p in CONTOUR_LEVELS), (":", "-", "--")):
                 rows = [r for r in contours.get(level, []) if r["pga_g"] is not None]
                 if rows:
                     who = "2D rigid block (Housner integrator)" if model == block else name

@@ -18,6 +18,7 @@ from pipeline.files import InputError
 
 RATIO_NODES = 24                  # Gauss-Hermite nodes over ln(PGV/PGA)
 PGA_PGV_CORRELATION = 0.733       # ln PGA, ln PGV residuals: Bradley (2012), Earthq. Spectra 28(1)
+DEFAULT_VS30_M_S = 760.0          # the model's site: rock (B/C), the USGS hazard curves' Vs30
 GMM_MECHANISMS = ("SS", "NS", "RS")
 
 
@@ -43,7 +44,7 @@ class RatioFromGmm:
     sd s_v sqrt(1 - rho^2); PGV/PGA = PGV / a."""
     magnitude: float
     distance_km: float
-    vs30_m_s: float = 760.0
+    vs30_m_s: float = DEFAULT_VS30_M_S
     mechanism: str = "SS"
     correlation: float = PGA_PGV_CORRELATION
     medians: dict = field(default=None, compare=False)

@@ -23,6 +23,8 @@ below the first PGA (docs/survival.md).
 import numpy as np
 from scipy.interpolate import RegularGridInterpolator
 
+CONTOUR_LEVELS = (0.16, 0.5, 0.84)   # P of a pulse grid's contours: median and +-1 sigma
+
 
 def cell_table(cells, pga_key="pga_g", ratio_key="pgv_pga_s", p_key="P"):
     """The axes and P of a list of cells (dicts): (pga, ratio, values n_pga x n_ratio);

@@ -341,3 +341,20 @@ def test_a_contour_that_leaves_the_grid_is_said_on_its_side_with_its_rows():
     (one,) = pulse_grid.contours([c for c in cells if c["pgv_pga_s"] == 0.5
                                   and c["pga_g"] == 0.2], levels=(0.5,))["0.5"]
     assert one["outside_grid"] is None        # a single PGA has no contour to leave
+
+
+def test_members_span_the_calibration_grid():
+    """The fragility's default member ranges and the shake-table calibration's default grid
+    read one neighbourhood: footprint and damping span the grid's two values, mu_s lies
+    about the calibration's choice of 0.7, and every grid value lies in its bounds."""
+    from pipeline.campaign import shake_table
+    points = shake_table.parse_grid(shake_table.DEFAULT_GRID)
+    ranges = pulse_grid.parse_ranges("")
+    assert len(points) == 2 ** 4
+    for name in ("footprint_tolerance_m", "damping"):
+        tried = sorted({p[name] for p in points})
+        assert (tried[0], tried[-1]) == ranges[name]
+    assert sorted({p["mu_s"] for p in points}) == [0.3, 0.7]
+    assert ranges["mu_s"][0] < 0.7 < ranges["mu_s"][1]
+    assert sorted({p["rotate_deg"] for p in points}) == [0.0, 180.0]
+    assert ranges["kn"] == (4e7, 1.2e8)
