@@ -3,6 +3,7 @@
 default, unit, bounds and help; parsed values go back through the dataclass, which
 checks them."""
 import dataclasses
+import typing
 from pathlib import Path
 
 
@@ -22,7 +23,8 @@ def _help(f):
 def add_arguments(parser, cls, names=None):
     """Add the flagged fields of parameter dataclass ``cls`` to an argparse parser (their
     defaults None: the dataclass decides).  Field types: int, float, str, Path; bool is a
-    switch, tuple a flag that may be given several times."""
+    switch, tuple a flag that may be given several times (``tuple[float, ...]``: each
+    value of that type)."""
     for f in dataclasses.fields(cls):
         meta = f.metadata
         if not meta.get("flag") or (names is not None and f.name not in names):
@@ -37,8 +39,10 @@ def add_arguments(parser, cls, names=None):
         elif kind is bool:
             kwargs["action"] = "store_const"
             kwargs["const"] = True
-        elif kind is tuple:
+        elif kind is tuple or typing.get_origin(kind) is tuple:
             kwargs["action"] = "append"
+            if typing.get_args(kind):
+                kwargs["type"] = typing.get_args(kind)[0]
         else:
             kwargs["type"] = kind
         parser.add_argument(meta["flag"], **kwargs)

@@ -11,13 +11,10 @@ import io
 import math
 from pathlib import Path
 
-from pipeline import RESULTS_DIR
-from pipeline.cli._fragility_options import (add_draw_options, add_fragility_options,
-                                             add_ratio_options, check_fragility_options,
-                                             load_specimens, ratio_model)
+from pipeline.cli._fields import add_arguments, from_args
 from pipeline.constants import STANDARD_GRAVITY
-from pipeline.files import InputError, display_path, write_json, write_text
-from pipeline.userfiles import number
+from pipeline.files import display_path, write_json, write_text
+from pipeline.report.survival_options import ConstrainOptions
 
 NAME = "constrain"
 ORDER = 46
@@ -30,93 +27,43 @@ DESCRIPTION = (
     "with P_s below --floor dropped).  Writes the prior and the constrained mean and "
     "fractile curves, the ground motion at 1e-3, 4e-4 and 1e-4 per year before and after, "
     "the weights per branch and a figure.  See docs/constrained-hazard.md.")
-DEFAULT_OUT = RESULTS_DIR / "constrain"
-MAX_SPECIMENS = 20
 
 
 def setup(p):
-    p.add_argument("--logic-tree", type=Path, required=True, metavar="PATH",
-                   help="OpenQuake's export (the directory, or its realizations.csv, with "
-                   "one hazard_curve CSV per realisation) or a plain table branch,weight,"
-                   "pga_<g|m_s2|cm_s2>,annual_rate_per_yr (one row per branch and level)")
-    p.add_argument("--site", type=int, default=None, metavar="N",
-                   help="row (0-based) of OpenQuake curves with several sites")
-    add_fragility_options(p)
-    p.add_argument("--age-ka", type=float, action="append", default=[], metavar="KA",
-                   help="a specimen's age in thousand years (above 0, at most 10000): one "
-                   "per specimen, in the order of the fragilities, or one for all")
-    p.add_argument("--age-sd-ka", type=float, action="append", default=[], metavar="KA",
-                   help="its standard deviation (ka, 0-10000; normal truncated at 0): one "
-                   "per specimen or one for all; default 0")
-    p.add_argument("--rule", choices=("bayes", "eliminate"), default="bayes",
-                   help="the headline's rule: bayes (weights x survival probability; "
-                   "default) or eliminate (branches of survival below --floor dropped); "
-                   "both are written")
-    p.add_argument("--floor", type=float, default=0.05, metavar="P",
-                   help="survival probability below which elimination drops a branch "
-                   "(0-1, above 0 and below 1); default 0.05")
-    add_ratio_options(p)
-    add_draw_options(p)
-    p.add_argument("--out", type=Path, default=DEFAULT_OUT, metavar="DIR",
-                   help=f"output directory (default {display_path(DEFAULT_OUT)})")
-
-
-def check(args):
-    """Every option range-checked before any work (InputError, one line); returns the
-    ages and their sds (ka), one per specimen."""
-    check_fragility_options(args)
-    n = len(args.fragility) + len(args.median_g) + len(args.logistic)
-    if n > MAX_SPECIMENS:
-        raise InputError(f"{n} specimens (at most {MAX_SPECIMENS})")
-    if args.column is not None and not args.fragility:
-        raise InputError("--column applies to --fragility files")
-    if args.site is not None and args.site < 0:
-        raise InputError(f"--site must be 0 or more, got {args.site}")
-    if not args.age_ka:
-        raise InputError("give --age-ka (one per specimen, or one for all)")
-    ages = _per_specimen(args.age_ka, n, "--age-ka")
-    sds = _per_specimen(args.age_sd_ka or [0.0], n, "--age-sd-ka")
-    for a in ages:
-        number(a, "--age-ka", 0, 10000, "ka", low_open=True)
-    for s in sds:
-        number(s, "--age-sd-ka", 0, 10000, "ka")
-    number(args.floor, "--floor", 0, 1, low_open=True)
-    if args.floor >= 1:
-        raise InputError(f"--floor must be below 1, got {args.floor:g}")
-    if args.out.exists() and not args.out.is_dir():
-        raise InputError(f"--out {args.out} exists and is not a directory")
-    return ages, sds
-
-
-def _per_specimen(values, n, flag):
-    if len(values) == 1:
-        return list(values) * n
-    if len(values) != n:
-        raise InputError(f"give one {flag} per specimen ({n}) or one for all, got "
-                         f"{len(values)}")
-    return list(values)
+    """The flags of :class:`~pipeline.report.survival_options.ConstrainOptions`, in the
+    order of the help; ``--logic-tree`` by hand (a required flag)."""
+    o = ConstrainOptions
+    field = o.__dataclass_fields__["logic_tree"]
+    p.add_argument("--logic-tree", dest="logic_tree", type=Path, required=True,
+                   metavar=field.metadata["metavar"], help=field.metadata["help"])
+    add_arguments(p, o, ("site",))
+    add_arguments(p, o, o.FRAGILITY_FLAGS)
+    add_arguments(p, o, ("age_ka", "age_sd_ka", "rule", "floor"))
+    add_arguments(p.add_argument_group(o.RATIO_GROUP), o, o.RATIO_FLAGS)
+    add_arguments(p, o, (*o.DRAW_FLAGS, "out"))
 
 
 def run(args):
-    ages, sds = check(args)
+    o = from_args(ConstrainOptions, args)
+    ages, sds = o.ages()
     from pipeline.hazard.constrain_assess import constrain_tree
     from pipeline.hazard.logictree import load_logic_tree
-    tree = load_logic_tree(args.logic_tree, args.site)
-    specimens = load_specimens(args)
-    ratio = ratio_model(args, specimens)
-    summary, rows, figure = constrain_tree(tree, specimens, ratio, ages, sds, args.rule,
-                                           args.floor, args.draws, args.seed)
-    summary["hazard_component"] = args.hazard_component
+    tree = load_logic_tree(o.logic_tree, o.site)
+    specimens = o.specimens()
+    ratio = o.ratio_model(specimens)
+    summary, rows, figure = constrain_tree(tree, specimens, ratio, ages, sds, o.rule,
+                                           o.floor, o.draws, o.seed)
+    summary["hazard_component"] = o.hazard_component
     summary["files"] = ["branch_weights.csv", "prior_curves.csv", "constrained_curves.csv",
                         "constrain.json", "constrain.png"]
     from pipeline.figures.constrain import plot_constrain
-    out = args.out
+    out = o.out
     plot_constrain(figure, out / "constrain.png")
     write_text(out / "branch_weights.csv", _branch_table(rows))
     write_text(out / "prior_curves.csv", _curve_table(summary, summary["prior"], "prior"))
     if summary["posterior"] is not None:
         write_text(out / "constrained_curves.csv",
-                   _curve_table(summary, summary["posterior"], f"constrained ({args.rule})"))
+                   _curve_table(summary, summary["posterior"], f"constrained ({o.rule})"))
     else:
         summary["files"].remove("constrained_curves.csv")
     write_json(out / "constrain.json", summary)
