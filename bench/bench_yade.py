@@ -59,7 +59,7 @@ from pipeline.motion import Motion  # noqa: E402
 from pipeline.motion.pulses import one_sine_pulse  # noqa: E402
 from pipeline.outcome.columns import (column_outcomes, rotation_from_start_deg,  # noqa: E402
                                       total_energy)
-from pipeline.scenario import (Column, Contact, Numerics, run_yade, scene_params,  # noqa: E402
+from pipeline.scenario import (Column, Contact, Numerics, RunParams, run_yade, scene_params,  # noqa: E402
                                write_scenario)
 from pipeline.scenario.runner import reuse_processes  # noqa: E402
 from pipeline.scenario.scene_file import Measurement, SceneFile  # noqa: E402
@@ -395,7 +395,7 @@ def quiet_motion(work, records=QUIET_RECORDS):
         record, mode = task
         motion, _ = processed_motion(record)
         return simulate(motion, work / "quiet" / f"{record}_{mode}",
-                        numerics=Numerics(quiet_motion=mode), record=record)
+                        RunParams(numerics=Numerics(quiet_motion=mode)), record=record)
 
     tasks = [(r, m) for r in records for m in ("skip", "simulate")]
     with reuse_processes(), ThreadPoolExecutor(2) as pool:

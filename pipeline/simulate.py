@@ -15,8 +15,7 @@ from pipeline.files import InputError, code_hash
 from pipeline.provenance import software_versions
 from pipeline.outcome.columns import summarise
 from pipeline.outcome.summary import RunSummary
-from pipeline.scenario import (Column, Contact, Drive, Numerics, RunParams, run_yade,
-                               scene_params, write_scenario)
+from pipeline.scenario import RunParams, run_yade, scene_params, write_scenario
 from pipeline.scenario.parameters import MAX_SCALE
 
 
@@ -109,25 +108,24 @@ def geometry_parameters(column):
     g = column.geometry
     if g is None:
         return {}
-    drums, _ = column.geometries()
-    return {"hd": round(g.height / g.base_width, 6), "height": g.height,
-            "n_drums": len(drums.bodies()), "density": g.density,
+    return {**column.sizes(),
             "column_file": (column.column_file if isinstance(column.column_file, str)
                             else g.name), "geometry": g.to_dict()}
 
 
-def simulate(motion, out_dir, column=None, contact=None, numerics=None, window=None,
-             rotate_deg=0.0, scale=1.0, back_azimuth=None, record=None, motion_file=None,
+def simulate(motion, out_dir, run=None, back_azimuth=None, record=None, motion_file=None,
              timeout_s=None):
     """Run one scenario of ``motion`` (a processed :class:`~pipeline.motion.Motion`) and
     write ``out_dir/summary.json`` last (atomically); return its
-    :class:`~pipeline.outcome.summary.RunSummary`.  ``window`` (s) and the summary's
-    times are on the record's clock; the scene and its trajectory on the motion's.
-
-    column, contact, numerics: parameter dataclasses (defaults: the paper's).
+    :class:`~pipeline.outcome.summary.RunSummary`.  ``run``: the run's parameters, whole
+    (:class:`~pipeline.scenario.parameters.RunParams`: column, contact, numerics and
+    drive; default the paper's, the whole motion).  The drive's ``window`` (s) and the
+    summary's times are on the record's clock; the scene and its trajectory on the
+    motion's.
     """
-    column, contact, numerics = column or Column(), contact or Contact(), numerics or Numerics()
-    run = RunParams(column, contact, numerics, Drive(window, rotate_deg, scale))
+    run = RunParams() if run is None else run
+    column, contact, numerics = run.column, run.contact, run.numerics
+    window, rotate_deg, scale = run.drive.window, run.drive.rotate_deg, run.drive.scale
     if back_azimuth is not None:
         motion = dataclasses.replace(motion, meta=dict(motion.meta,
                                                        back_azimuth_deg=back_azimuth_of(

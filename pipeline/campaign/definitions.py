@@ -224,7 +224,7 @@ def columns_table(specs, campaign_dir):
                 "max_tilt_deg": col.max_tilt_deg, "base_slip_m": col.base_slip_m,
                 "uplift_ratio": round(g.uplift_ratio(), 4), "height_m": g.height,
                 "mass_kg": round(sum(b.mass for b in g.bodies())),
-                "kn": summary.parameters["kn"],
+                "kn": spec.params.contact.kn,
                 "back_azimuth_deg": summary.back_azimuth_deg, "run_id": spec.run_id})
     return pd.DataFrame(rows, columns=COLUMNS_TABLE)
 

@@ -60,10 +60,8 @@ def run_column_spec(spec, run_dir):
     """Worker: one twin-model (or single column) run of a spec; ``column_file`` in its
     parameters is a column description (dict, so that the run id covers its content) or
     a shipped example's name."""
-    p = spec.params
-    simulate(Motion.load(spec.motion_file), run_dir, column=p.column, contact=p.contact,
-             numerics=p.numerics, window=p.drive.window, rotate_deg=p.drive.rotate_deg,
-             scale=p.drive.scale, record=spec.record_id, motion_file=spec.motion_file)
+    simulate(Motion.load(spec.motion_file), run_dir, spec.params, record=spec.record_id,
+             motion_file=spec.motion_file)
 
 
 def twin(**params):

@@ -62,10 +62,11 @@ def _tables(specs, campaign, campaign_dir):
                 site["site_id"] = site.pop("station")
             record_params[spec.motion_file] = {**record_parameters(motion), **site}
         rp = record_params[spec.motion_file]
-        p = summary.parameters
+        sizes, contact = spec.params.column.sizes(), spec.params.contact
         base = {"campaign": campaign, "run_id": spec.run_id, "record_id": spec.record_id,
-                "hd": p["hd"], "height_m": p["height"], "n_drums": p["n_drums"],
-                "mu_s": p["mu_s"], "mu_k": p["mu_k"], "kn": p["kn"], "damping": p["damping"]}
+                "hd": sizes["hd"], "height_m": sizes["height"], "n_drums": sizes["n_drums"],
+                "mu_s": contact.mu_s, "mu_k": contact.mu_k, "kn": contact.kn,
+                "damping": contact.damping}
         for col in summary.columns:
             point = col.impact_point_m or [math.nan, math.nan]
             run_rows.append({
@@ -87,7 +88,8 @@ def _tables(specs, campaign, campaign_dir):
                         "run_id": spec.run_id, "column": col.column,
                         "body_index": body["index"], "impact_time_s": body["impact_time_s"],
                         "x_m": body["impact_point_m"][0], "y_m": body["impact_point_m"][1],
-                        "hd": p["hd"], "mu_s": p["mu_s"], "record_id": spec.record_id})
+                        "hd": sizes["hd"], "mu_s": contact.mu_s,
+                        "record_id": spec.record_id})
     return pd.DataFrame(run_rows), pd.DataFrame(impact_rows, columns=IMPACT_COLUMNS)
 
 

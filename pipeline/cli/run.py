@@ -10,7 +10,7 @@ from pipeline.constants import COLUMN_TYPES
 from pipeline.files import DirectoryLock, InputError
 from pipeline.motion import RECORD_CLOCK
 from pipeline.records import processed_motion, resolve
-from pipeline.scenario import Column, Contact, Drive, Numerics
+from pipeline.scenario import Column, Contact, Drive, Numerics, RunParams
 from pipeline.cli._fields import add_arguments, add_column_file_argument, from_args
 from pipeline.scenario.parameters import check_cost, check_time_step, scene_params
 from pipeline.scenario.runner import wall_limit_s
@@ -85,9 +85,8 @@ def run(args):
     check_cost(scene_params(columns=column.specs(), contact=contact, numerics=numerics,
                             motion_duration=length), wall_limit_s(length + numerics.tail_s))
     with DirectoryLock(out, wait=False):
-        summary = simulate(motion, out, column=column, contact=contact, numerics=numerics,
-                           window=args.window, rotate_deg=args.rotate, scale=args.scale,
-                           back_azimuth=args.back_azimuth)
+        summary = simulate(motion, out, RunParams(column, contact, numerics, Drive(
+            args.window, args.rotate, args.scale)), back_azimuth=args.back_azimuth)
     if not summary.simulated:
         print(f"note: {summary.note}")
     elif not any(c.max_tilt_deg > 0.1 for c in summary.columns):

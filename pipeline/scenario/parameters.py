@@ -190,6 +190,16 @@ class Column:
         """Column diameter (m)."""
         return self.height / self.hd
 
+    def sizes(self):
+        """{hd, height (m), n_drums, density (kg/m^3)} of the column built: a described
+        column's own (hd h/d of its base, to 6 places), else the fields'."""
+        if self.geometry is None:
+            return {"hd": self.hd, "height": self.height, "n_drums": self.n_drums,
+                    "density": self.density}
+        g = self.geometry
+        return {"hd": round(g.height / g.base_width, 6), "height": g.height,
+                "n_drums": len(g.bodies()), "density": g.density}
+
     def geometries(self):
         """(drums, monolith) geometries: the paper's equal drums and cylinder, or the
         described column and a monolith of its outline."""

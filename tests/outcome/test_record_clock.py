@@ -17,7 +17,7 @@ from pipeline.motion.pulses import raw_pulse
 from pipeline.outcome.columns import summarise
 from pipeline.outcome.summary import RunSummary
 from pipeline.report.campaigns import sweep_section
-from pipeline.scenario import RunParams
+from pipeline.scenario import Drive, RunParams
 from pipeline.simulate import drive_motion, simulate
 
 MOTION_START_S = -30.0     # record time of the motion's first sample: 30 s of margin
@@ -83,7 +83,7 @@ def test_a_run_on_a_padded_motion_reports_record_times_up_to_the_report(
     scene = dataclasses.replace(make_lying_trajectory(70.0), motion_end=15.0)  # its clock
     monkeypatch.setattr(simulate_module, "run_yade", lambda run_dir, timeout_s=None: scene)
     motion_file = motion.save(tmp_path / "clock.npz")
-    summary = simulate(motion, tmp_path / "runs" / "r1", window=(5.0, 20.0))
+    summary = simulate(motion, tmp_path / "runs" / "r1", RunParams(drive=Drive((5.0, 20.0))))
     (col,) = summary.columns
     assert col.toppled and col.impact_time_s == pytest.approx(6.0, abs=1e-9)
     assert summary.start_in_file_s == pytest.approx(5.0, abs=1e-9)

@@ -82,14 +82,14 @@ def test_provenance_records_the_taper_length_in_seconds(tmp_path):
 
 @pytest.mark.yade
 def test_same_column_outcome_with_ten_minutes_of_noise_appended(tmp_path):
-    from pipeline.scenario import Column
+    from pipeline.scenario import Column, RunParams
     from pipeline.simulate import simulate
     enz, dt = raw_record("NF04")
     outcomes = []
     for name, data in (("base", enz), ("noise", variants(enz, dt)["10 min of low-level noise appended"])):
         acc, vel, disp, _ = processing.process(data, dt)
         summary = simulate(Motion(dt, acc, vel, disp, meta={"record_id": name}), tmp_path / name,
-                           column=Column("monolithic"))
+                           RunParams(column=Column("monolithic")))
         outcomes.append(summary.columns[0])
     base, noisy = outcomes
     assert base.toppled == noisy.toppled

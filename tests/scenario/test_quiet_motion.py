@@ -13,7 +13,7 @@ from scipy.integrate import cumulative_trapezoid
 from pipeline.constants import MODEL_GRAVITY as G
 from pipeline.motion import Motion
 from pipeline.outcome import Trajectory
-from pipeline.scenario import Column, Contact, Numerics
+from pipeline.scenario import Column, Contact, Numerics, RunParams
 from pipeline.simulate import PRECHECK_MARGIN, quiet_window, simulate
 
 DT = 0.005                      # s
@@ -80,8 +80,8 @@ def test_turning_the_motion_keeps_the_window():
 
 # ---------------------------------------------------------------- YADE
 def run(tmp_path, name, motion, quiet, **numerics):
-    return simulate(motion, tmp_path / name, column=MONOLITH,
-                    numerics=Numerics(quiet_motion=quiet, **numerics))
+    return simulate(motion, tmp_path / name, RunParams(
+        column=MONOLITH, numerics=Numerics(quiet_motion=quiet, **numerics)))
 
 
 @pytest.mark.yade
