@@ -204,14 +204,19 @@ class Posterior:
         return edges[:-1] + bin_km / 2, hist / hist.sum()
 
     def distance_interval(self, level=0.95):
+        """[lo, hi] km from the first site: the shortest interval of distances holding
+        ``level`` of the posterior (on the sub-grid; it reaches the candidates' last
+        distance when the posterior piles there, where equal tails would stop short)."""
         e, n, mass = self._subsamples()
         d = np.hypot(e, n)
-        order = np.argsort(d)
-        cdf = np.cumsum(mass[order]) / mass.sum()
-        tail = (1 - level) / 2
-        lo = d[order][np.searchsorted(cdf, tail)]
-        hi = d[order][min(np.searchsorted(cdf, 1 - tail), len(d) - 1)]
-        return [float(lo), float(hi)]
+        order = np.argsort(d, kind="stable")
+        d = d[order]
+        before = np.concatenate([[0.0], np.cumsum(mass[order]) / mass.sum()])
+        ends = np.searchsorted(before, before[:-1] + level - 1e-12)   # one past the last
+        starts = np.flatnonzero(ends < len(before))
+        widths = d[ends[starts] - 1] - d[starts]
+        k = starts[int(np.argmin(widths))]
+        return [float(d[k]), float(d[ends[k] - 1])]
 
     def marginal(self, key):
         """{value: probability} over slices' ``key`` (mechanism, depth_km, mw)."""
