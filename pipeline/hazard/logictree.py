@@ -37,7 +37,7 @@ from pathlib import Path
 
 import numpy as np
 
-from pipeline.hazard.curves import PLAIN_RATE_COLUMN, PLAIN_UNITS, load_hazard
+from pipeline.hazard.curves import MAX_PGA_M_S2, PLAIN_RATE_COLUMN, PLAIN_UNITS, load_hazard
 from pipeline.files import InputError
 from pipeline.userfiles import DATA_FILE_BYTES, read_user_text, show
 
@@ -293,8 +293,9 @@ def _plain_curve(path, name, rows, to_m_s2, unit):
     if levels.size < 2:
         raise InputError(f"{where}: {levels.size} level(s); a hazard curve needs at least 2")
     for x, r in zip(levels, rates):
-        if not (math.isfinite(x) and x > 0):
-            raise InputError(f"{where}: level {x:g} {unit}: levels must be positive")
+        if not (math.isfinite(x) and 0 < x * to_m_s2 <= MAX_PGA_M_S2):
+            raise InputError(f"{where}: level {x:g} {unit}: levels must lie in (0, "
+                             f"{MAX_PGA_M_S2 / to_m_s2:g}] {unit} (100 g)")
         if not math.isfinite(r) or r < 0:
             raise InputError(f"{where}: rate {r:g} at {x:g} {unit} must be finite and 0 or "
                              "more")

@@ -395,3 +395,41 @@ def test_command_refusals_write_nothing(tmp_path, capsys, extra, words):
     assert status == 2 and not out.exists()
     err = capsys.readouterr().err.strip()
     assert words in err and "\n" not in err
+
+
+def test_a_standing_column_reweights_power_law_branches_in_closed_form(tmp_path):
+    """The archaeoseismologists' version: a column campaign's fragility.json (its
+    lognormal PGA fit, median 3 m/s^2, beta 0.4, on the campaign's own PGA) and an age of
+    2.5 ka under three power-law branches lambda_i(x) = k_i x^-K written as a plain table:
+    lambda_ov,i = k_i m^-K exp(K^2 beta^2 / 2), w_i' = w_i exp(-lambda_ov,i t) / sum
+    (the curves span 1e-3 to 900 m/s^2, so their ends hold a negligible rate)."""
+    from tests.hazard.test_reader_robustness import COLUMN
+    fragility = tmp_path / "fragility.json"
+    fragility.write_text(json.dumps(COLUMN))
+    ks, exponent, weights = (2e-3, 5e-4, 1e-4), 2.0, (0.2, 0.5, 0.3)
+    levels = np.geomspace(1e-3, 900.0, 121)
+    rows = ["branch,weight,pga_m_s2,annual_rate_per_yr"]
+    rows += [f"b{i},{w},{float(x)!r},{float(k * x ** -exponent)!r}"
+             for i, (k, w) in enumerate(zip(ks, weights)) for x in levels]
+    tree = tmp_path / "tree.csv"
+    tree.write_text("\n".join(rows) + "\n")
+    out = tmp_path / "out"
+    status = main(["constrain", "--logic-tree", str(tree), "--fragility", str(fragility),
+                   "--fragility-form", "pga", "--hazard-component", "rotd100",
+                   "--age-ka", "2.5", "--draws", "0", "--out", str(out)])
+    assert status == 0
+    summary = json.loads((out / "constrain.json").read_text())
+    lam = np.array(ks) * 3.0 ** -exponent * math.exp(exponent ** 2 * 0.4 ** 2 / 2)
+    p = np.exp(-lam * 2500.0)
+    got = np.array([b["survival_probability"] for b in summary["branches"]])
+    np.testing.assert_allclose(got, p, rtol=1e-3)
+    post = np.array([b["posterior_bayes"] for b in summary["branches"]])
+    w = np.array(weights)
+    np.testing.assert_allclose(post, w * p / (w @ p), rtol=1e-3)
+
+
+def test_a_plain_tree_above_100_g_is_refused(tmp_path):
+    tree = tmp_path / "tree.csv"
+    tree.write_text("branch,weight,pga_g,annual_rate_per_yr\na,1,0.1,0.01\na,1,150,1e-9\n")
+    with pytest.raises(InputError, match=r"level 150 g: levels must lie in \(0, 100\] g"):
+        load_logic_tree(tree)
