@@ -369,7 +369,9 @@ def run_demo(table, out_dir, candidates, paper_tables=None, trials=DEFAULT_TRIAL
         "candidate_grid": candidates.as_dict(), "prior": candidates.prior_statement(),
         "observation_uncertainty_deg": OBS_UNCERTAINTY_DEG,
         "trials_per_configuration": trials, "coverage": coverage,
-        "narrowing": narrow.to_dict(orient="records"),
+        # a configuration whose trials all gave no direction has no MAP error: null
+        "narrowing": narrow.astype(object).where(narrow.notna(), None).to_dict(
+            orient="records"),
         BOUND_ANSWER_KEY: bound_answer(narrow),
         "paper_scenario": {"joint": paper_joint,
                            "per_source": _paper_per_source(paper_sites)},
