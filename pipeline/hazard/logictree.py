@@ -137,7 +137,8 @@ def _openquake(path, site):
     levels, rates, notes = _common_levels(
         [(c.levels_m_s2, c.rates_per_yr, c.zero_rate_from_m_s2) for c in loaded],
         [f"rlz-{r[0]:03d}" for r in rows])
-    notes = [f"rlz-{r[0]:03d}: {n}" for r, c in zip(rows, loaded) for n in c.notes] + notes
+    notes = _grouped([(f"rlz-{r[0]:03d}", n) for r, c in zip(rows, loaded)
+                      for n in c.notes]) + notes
     first = loaded[0].source
     source = {"format": "OpenQuake realizations and hazard curves", "file": str(path),
               "directory": str(path.parent), "imt": "PGA",
@@ -322,6 +323,14 @@ def _number(text, what):
 
 def _levels_text(levels):
     return f"{levels[0]:.6g}-{levels[-1]:.6g}" if levels.size else "none"
+
+
+def _grouped(labelled):
+    """One note per text, naming every branch it holds for ("rlz-000, rlz-001: ...")."""
+    branches = {}
+    for label, note in labelled:
+        branches.setdefault(note, []).append(label)
+    return [f"{', '.join(labels)}: {note}" for note, labels in branches.items()]
 
 
 def _weights(values, path):

@@ -433,3 +433,13 @@ def test_a_plain_tree_above_100_g_is_refused(tmp_path):
     tree.write_text("branch,weight,pga_g,annual_rate_per_yr\na,1,0.1,0.01\na,1,150,1e-9\n")
     with pytest.raises(InputError, match=r"level 150 g: levels must lie in \(0, 100\] g"):
         load_logic_tree(tree)
+
+
+def test_a_note_shared_by_branches_is_said_once_naming_them():
+    """OpenQuake's case 19: four branches (one in-slab model) end at the same level; the
+    loader says it once for the four, never twice for one text."""
+    notes = load_logic_tree(CASE_19).notes
+    texts = [n.split(": ", 1)[1] for n in notes if n.startswith("rlz-")]
+    assert len(texts) == len(set(texts))
+    named = [n.split(": ", 1)[0].split(", ") for n in notes if n.startswith("rlz-")]
+    assert all(len(group) == 4 for group in named)
