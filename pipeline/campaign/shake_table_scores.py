@@ -59,7 +59,10 @@ def providers_of(options):
 
 
 def split_scores(rows, threshold_g, providers):
-    """Scores of one split's tests (``rows``: members.csv rows with a P)."""
+    """Scores of one split's tests (``rows``: members.csv rows with a P); None for a split
+    without tests (e.g. only held-out tests named with --tests)."""
+    if rows.empty:
+        return None
     y = rows["observed"].to_numpy(bool)
     out = {"tests": int(len(rows)), "member_runs": int(rows["runs"].sum()),
            "members": forecast_scores(y, rows["P"].to_numpy(float), rows["runs"].to_numpy())}
@@ -92,6 +95,7 @@ def write_scores(per_test, campaign_dir, options, full, settled):
     splits = {split: split_scores(scored if split == "all" else
                                   scored[scored["split"] == split], threshold_g, providers)
               for split in SPLITS}
+    splits = {split: scores for split, scores in splits.items() if scores is not None}
     member_specs = [s for s in full if s.tags["member"] >= 0]
     sets = sorted({s.tags["member"]: s.tags["point"] for s in member_specs}.items())
     result = {

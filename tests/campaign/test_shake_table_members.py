@@ -100,3 +100,13 @@ def test_scores_of_a_synthetic_threshold_model(tmp_path):
     assert result["splits"]["all"]["members"]["clip"] == pytest.approx(1 / 18)
     assert (tmp_path / "shake_table_reliability.png").stat().st_size > 10_000
     assert len(pd.read_csv(tmp_path / "members.csv")) == len(per_test)
+
+
+def test_a_split_without_tests_has_no_scores():
+    """Only held-out tests named: the calibration split is left out, not scored empty."""
+    import pandas as pd
+
+    from pipeline.campaign.shake_table_scores import split_scores
+    empty = pd.DataFrame({"observed": [], "P": [], "runs": [], "single_set_predicted": [],
+                          "pga_g": [], "test": []})
+    assert split_scores(empty, 0.26, {}) is None
