@@ -48,10 +48,10 @@ import pandas as pd
 
 from pipeline.inversion import truth_check
 from pipeline.inversion.demo import BOUND_DEG, BOUND_TEXT, BOUNDED_FRACTION_KEY, FALLEN_PER_SITE, \
-    OBS_UNCERTAINTY_DEG, REACH_KEYS, SITE_COUNTS, _frame, _site_position, out_of_reach_row
+    OBS_UNCERTAINTY_DEG, REACH_KEYS, SITE_COUNTS, _frame, _site_position, draw_site_columns, \
+    out_of_reach_row
 from pipeline.inversion.likelihood import DEFAULT_FLOOR, DEFAULT_KERNEL_DEG, LIKELIHOODS, \
     ForwardModel
-from pipeline.inversion.observations import ColumnObservation
 from pipeline.inversion.posterior import OutOfReach, invert
 from pipeline.stats.circular import azimuth_deg
 from pipeline.stats.ensemble import wilson_interval
@@ -127,21 +127,11 @@ def draw_columns(pool, slices, upper_weight, i, j, strike_deg, fallen, rng,
     normal measurement error of ``sigma_deg``.  None when neither slice falls there."""
     if not any(pool.toppled[s, i, j].any() for s in slices):
         return None
-    cols, count = [], 0
-    for _ in range(50 * fallen + 50):
-        s = slices[1] if rng.uniform() < upper_weight else slices[0]
-        choices = np.argwhere(pool.valid[s, i, j])
-        c, m = choices[rng.integers(len(choices))]
-        if pool.toppled[s, i, j, c, m]:
-            az = (pool.azimuth_deg[s, i, j, c, m] + strike_deg
-                  + rng.normal(0.0, sigma_deg)) % 360.0
-            cols.append(ColumnObservation(pool.columns[c], "fallen", float(az), sigma_deg))
-            count += 1
-            if count == fallen:
-                break
-        else:
-            cols.append(ColumnObservation(pool.columns[c], "standing"))
-    return tuple(cols)
+
+    def pick_slice():
+        return slices[1] if rng.uniform() < upper_weight else slices[0]
+    return draw_site_columns(pool, slices[0], i, j, strike_deg, fallen, rng, sigma_deg,
+                             pick_slice)
 
 
 def _draw_source(models, pool, rng):
