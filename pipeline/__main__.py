@@ -1,13 +1,14 @@
 """``python -m pipeline`` and the ``toppling`` console script.
 
-Ctrl-C at any moment, during the imports of start-up too, ends with one line and exit
-status 130 (after finished results are written); SIGTERM (a plain ``kill``) the same way
-with exit status 143."""
+Ctrl-C at any moment from the command's first line on, during the imports of start-up
+too, ends with one line and exit status 130 (after finished results are written); SIGTERM
+(a plain ``kill``) the same way with exit status 143.  (Before that line, in the first
+tens of milliseconds, Python starts itself and a Ctrl-C is its own.)"""
 import os
 import signal
 import sys
 
-from pipeline import INTERRUPTED, interrupted_status, stop_on_sigterm, stopped_by
+from pipeline import INTERRUPTED, interrupted_status, stop_asked, stop_on_signals, stopped_by
 
 
 def console():
@@ -17,13 +18,14 @@ def console():
     for signum in (signal.SIGINT, signal.SIGTERM):
         signal.signal(signum, lambda signum, frame: pending.append(signum))
     from pipeline.cli import main
-    signal.signal(signal.SIGINT, signal.default_int_handler)
-    stop_on_sigterm()
+    stop_on_signals()
     try:
         if pending:
             stopped_by(pending[0])
             raise KeyboardInterrupt
         code = main()
+        if stop_asked() and code != interrupted_status():
+            raise KeyboardInterrupt            # a stop a library swallowed, unseen by main()
     except KeyboardInterrupt:                  # during start-up, before main() handles it
         print(INTERRUPTED, file=sys.stderr)
         code = interrupted_status()

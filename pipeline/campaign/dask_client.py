@@ -10,6 +10,7 @@ import threading
 import uuid
 from pathlib import Path
 
+from pipeline import raise_if_stop_asked
 from pipeline.campaign.dask_worker import TASK_PREFIX, WORKER_CODE, kill_task_processes, run_task
 from pipeline.campaign.run_dirs import RunError, book_finished, write_error
 from pipeline.files import DirectoryLock, ToolError, atomic_path, code_hash
@@ -61,6 +62,7 @@ def execute_dask(todo, runs_dir, jobs, worker, bar, scheduler):
 
         limit = jobs if (scheduler and jobs) else len(queue)
         while queue or running:
+            raise_if_stop_asked()                     # a Ctrl-C a library swallowed
             while queue and len(running) < limit:
                 submit(queue.pop())
             if not running:

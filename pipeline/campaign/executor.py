@@ -36,6 +36,7 @@ from pathlib import Path
 
 from tqdm import tqdm
 
+from pipeline import raise_if_stop_asked
 from pipeline.campaign.dask_client import execute_dask
 from pipeline.campaign.run_dirs import book_finished, keep_only_summary
 from pipeline.files import DirectoryLock, InputError, duration_text
@@ -184,6 +185,7 @@ def _execute_threads(todo, runs_dir, jobs, worker, bar):
     pending = set(futures)
     try:
         while pending:
+            raise_if_stop_asked()                  # a Ctrl-C a library swallowed
             finished, pending = wait(pending, timeout=0.5, return_when=FIRST_COMPLETED)
             for future in finished:
                 book_finished(futures[future], future.exception(), runs_dir, failures, bar)

@@ -4,6 +4,7 @@ import contextlib
 import io
 import math
 import re
+import signal
 import time
 from pathlib import Path
 
@@ -140,3 +141,25 @@ def test_the_revision_paces_per_second_of_motion(monkeypatch):
     forecast_lines([20.0] * 20, weights=[4, 4] + [1] * 18)
     # said: the first forecast, then the revision's "not the ... said before", then its rest
     assert said[:3] == [pytest.approx(90.0), pytest.approx(30.0), pytest.approx(15 * 100 / 11)]
+
+
+@pytest.fixture
+def swallowed_ctrl_c():
+    """A Ctrl-C whose KeyboardInterrupt a library lost: raised in a ``__del__`` (as in the
+    import machinery's weakref callbacks), where Python only prints it."""
+    import pipeline
+
+    class Swallower:
+        def __del__(self):
+            pipeline.stop(signal.SIGINT)
+
+    Swallower()                                # collected at once: the exception is lost
+    yield
+    pipeline._STOP_ASKED.clear()
+
+
+@pytest.mark.filterwarnings("ignore::pytest.PytestUnraisableExceptionWarning")
+def test_a_ctrl_c_a_library_swallowed_still_stops_the_campaign(tmp_path, swallowed_ctrl_c):
+    failures, interrupted = execute(specs(6), tmp_path, 1, sleeper(0.3))
+    assert interrupted and failures == []
+    assert len(list(tmp_path.glob("runs/*/summary.json"))) < 6
