@@ -73,7 +73,8 @@ campaigns: setup
 	  --logic-tree $(FIELD_ROCK_TREE) --fragility results/field-rock-quick-fragility/fragility.json \
 	  $(FIELD_ROCK_SITE) --out results/field-rock-quick-constrain)
 	$(call timed,shake-table scores (reduced),$(PY) -m pipeline campaign shake-table --members 4 \
-	  --tests $(SCORES_QUICK_TESTS) --out results/shake-table-scores-quick --animations 0 \
+	  --tests $(SCORES_QUICK_TESTS) --candidates "$(SCORES_QUICK_CANDIDATES)" \
+	  --out results/shake-table-scores-quick --animations 0 \
 	  --jobs $(JOBS))
 
 run-all: campaigns
@@ -91,23 +92,30 @@ shake-table: setup
 	  --allow-long
 	$(PY) -m pipeline report
 
-# each shake-table test of SP1 predicted by the fragility's members (its draws, ranges and
-# seed; SCORES_RANGES to change them, e.g. "kn=4e7:1.2e9"), scored as probabilities per
-# split beside the calibration's single set, the baselines and the providers' models of
-# SP1: at most 8 members a test (a test stops once its first 4 agree), at most 4,410 runs
-# of the 490 tests, about 1 h on 2 cores; the quick one 24 tests (12 June-July, 12 August,
-# spread over PGA) with 4 members, a few minutes
+# each shake-table test of SP1 predicted by the fragility's members (its draws and seed),
+# scored as probabilities per split beside the calibration's single set, the baselines and
+# the providers' models of SP1.  The members' ranges are chosen first on the June-July
+# tests alone: each of SCORES_CANDIDATES (the fragility's defaults, kn ten times wider, the
+# footprint near the calibration's choice, both) is run there and the best log-likelihood
+# wins; frozen, it is then run on the August tests.  At most 8 members a test (a test stops
+# once its first 4 agree); about 45 min on 2 cores.  The quick one: 24 tests (12 June-July,
+# 12 August, spread over PGA), 4 members, the first two candidates, a few minutes.
+# SCORES_RANGES="..." scores one set of ranges instead of choosing.
 SCORES_MEMBERS ?= 8
 SCORES_RANGES ?=
+SCORES_CANDIDATES ?= default|kn=4e7:1.2e9|footprint_tolerance_m=0.001:0.0015|footprint_tolerance_m=0.001:0.0015;kn=4e7:1.2e9
+SCORES_QUICK_CANDIDATES := default|kn=4e7:1.2e9
 SCORES_QUICK_TESTS := Test323,Test382,Test379,Test044,Test372,Test273,Test283,Test075,Test091,Test316,Test131,Test178,Test693,Test702,Test473,Test442,Test445,Test594,Test609,Test626,Test540,Test548,Test646,Test566
 shake-table-scores: setup
 	$(PY) -m pipeline campaign shake-table --members $(SCORES_MEMBERS) \
-	  $(if $(SCORES_RANGES),--ranges "$(SCORES_RANGES)") --out results/shake-table-scores \
+	  $(if $(SCORES_RANGES),--ranges "$(SCORES_RANGES)",--candidates "$(SCORES_CANDIDATES)") \
+	  --out results/shake-table-scores \
 	  --animations 0 --jobs $(JOBS) --allow-long
 
 shake-table-scores-quick: setup
 	$(PY) -m pipeline campaign shake-table --members 4 --tests $(SCORES_QUICK_TESTS) \
-	  $(if $(SCORES_RANGES),--ranges "$(SCORES_RANGES)") --out results/shake-table-scores-quick \
+	  $(if $(SCORES_RANGES),--ranges "$(SCORES_RANGES)",--candidates "$(SCORES_QUICK_CANDIDATES)") \
+	  --out results/shake-table-scores-quick \
 	  --animations 0 --jobs $(JOBS)
 
 # the contact stiffness alone, kn x1, x3, x10, side by side in

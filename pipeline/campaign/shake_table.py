@@ -407,6 +407,11 @@ class ShakeTableOptions(CampaignOptions):
     ranges: str = param(None, "", "members mode: ranges the members are drawn from (default "
                         "the fragility's; LO = HI fixes one)", flag="--ranges",
                         metavar="NAME=LO:HI;...")
+    candidates: str = param(None, "", "members mode: candidate ranges separated by '|' "
+                            "('default': the fragility's), each run on the calibration tests "
+                            "and scored by log-likelihood; the best is frozen, then run and "
+                            "scored on every test", flag="--candidates",
+                            metavar="RANGES|RANGES")
     providers: Path = param(None, "", "members mode: other models' 0/1 predictions scored "
                             "beside the members (CSV: test and one column per model; "
                             "default for the shipped tests: the providers' models of SP1, "
@@ -418,6 +423,7 @@ class ShakeTableOptions(CampaignOptions):
         contact_of(self)
         if self.members is None:
             given = [f for f, v in (("--seed", self.seed), ("--ranges", self.ranges),
+                                    ("--candidates", self.candidates),
                                     ("--providers", self.providers)) if v is not None]
             if given:
                 raise InputError(f"{given[0]} belongs to the members mode: add --members N")
@@ -444,6 +450,12 @@ class ShakeTableOptions(CampaignOptions):
         if unknown:
             raise InputError(f"--tests: unknown test(s) {', '.join(unknown)} (not in "
                              f"{Path(self.experiments).name})")
+        if self.members is not None and self.candidates is not None:
+            run = MODES["members"].tests_of(self.experiments, self.outcome, tests or None,
+                                            self.validate_from)
+            if not (run["split"] == "calibration").any():
+                raise InputError(f"--candidates: no test before --validate-from "
+                                 f"{self.validate_from} to choose the ranges on")
 
     def test_names(self):
         """The tests of ``--tests`` (an empty list: all)."""
@@ -455,7 +467,8 @@ class ShakeTableOptions(CampaignOptions):
                 "validate_from": self.validate_from, "grid": self.grid,
                 "tests": self.test_names() or None, "axis_deg": self.axis_deg,
                 "contact_file": self.contact_file, "members": self.members,
-                "seed": self.seed, "ranges": self.ranges, "providers": self.providers}
+                "seed": self.seed, "ranges": self.ranges, "candidates": self.candidates,
+                "providers": self.providers}
 
 
 def _worker(spec, run_dir):

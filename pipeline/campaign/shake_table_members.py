@@ -40,12 +40,17 @@ from pipeline.files import InputError, duration_text, write_csv
 from pipeline.scenario.contact_file import contact_values, refuse_set_twice
 from pipeline.scenario.geometry import ColumnGeometry
 from pipeline.stats.ensemble import wilson_interval
+from pipeline.stats.forecast import forecast_scores
 
 log = logging.getLogger(__name__)
 
 # the single parameter set scored beside the members: the calibration's choice on the
 # June-July tests (make shake-table; the parameters make contact-convergence varies kn at)
 SINGLE_SET = "footprint_tolerance_m=0.001;damping=0.1;mu_s=0.7;rotate_deg=0"
+MAX_CANDIDATES = 8
+CHOICE_RULE = ("each candidate's members on the calibration tests only; chosen: the highest "
+               "log-likelihood per test (ties: the lower Brier score, then the first given); "
+               "frozen, then run and scored on every test")
 # a run at a stiffer contact takes longer: the time step goes as sqrt(m / kn)
 KN_OF_RUN_CPU_S = 1.2e8
 
@@ -56,6 +61,17 @@ def check(options):
     specimen = ColumnGeometry.load(options.column_file or shake_table.SPECIMEN).to_dict()
     contact = None if options.contact_file is None else contact_values(options.contact_file)
     member_sets(specimen, options.members, options.seed, options.ranges, contact)
+    if options.candidates is not None:
+        if options.ranges is not None:
+            raise InputError("--candidates and --ranges: give one (--candidates chooses the "
+                             "ranges on the calibration tests)")
+        for text in options.candidates.split("|"):
+            text = "" if text.strip() == "default" else text
+            try:
+                member_sets(specimen, options.members, options.seed, text, contact)
+            except InputError as exc:
+                raise InputError(str(exc).replace("--ranges", "--candidates")) from None
+        candidate_ranges(options.candidates, "mesh" in specimen)
     single_set(options.grid)
     if options.providers is not None:
         load_providers(options.providers)
@@ -162,20 +178,50 @@ def outputs(specs_, campaign_dir, failures, animations, figures=True):
 
 def drive(run, records, campaign_dir, options, gate=None):
     """Say the cost and ask the gate, run the members test by test in the pulse grid's
-    adaptive stages, then write members.csv, the scores and the reliability diagram."""
+    adaptive stages, then write members.csv, the scores and the reliability diagram.
+    With ``candidates``: each candidate's members on the calibration tests first, the
+    best by log-likelihood chosen (:func:`choose_ranges`), then the chosen on every test."""
+    mesh = "mesh" in ColumnGeometry.load(options["specimen"]).to_dict()
+    candidates = candidate_ranges(options.get("candidates"), mesh)
     frame = tests_of(options["experiments"], options["outcome"], options.get("tests"),
                      options["validate_from"])
-    n = options["members"]
-    full = run_specs(records, campaign_dir, options)
-    most = len(full)
-    core = sum(s.tags["core_s"] for s in full)
-    jobs = max(options.get("jobs") or 1, 1)
-    log.info(f"shake-table (members): {len(frame)} tests x ({n} members + the single set): "
-             f"at most {most} YADE runs, about {duration_text(core / jobs)} on {jobs} core(s) "
-             f"(a test's members stop once its first {min(n, pulse_grid.ADAPTIVE_FIRST_RUNS)} "
+    calibration = list(frame.loc[frame["split"] == "calibration", "test"])
+    passes = ([{**options, "ranges": c, "tests": calibration} for c in candidates]
+              + [options] if candidates else [options])
+    fulls = [run_specs(records, campaign_dir, o) for o in passes]
+    n, jobs = options["members"], max(options.get("jobs") or 1, 1)
+    most = len({s.run_id for full in fulls for s in full})
+    core = sum({s.run_id: s.tags["core_s"] for full in fulls for s in full}.values())
+    what = (f"{len(candidates)} candidate ranges on {len(calibration)} calibration tests, "
+            f"then the chosen on {len(frame)} tests" if candidates else f"{len(frame)} tests")
+    log.info(f"shake-table (members): {what} x ({n} members + the single set): at most "
+             f"{most} YADE runs, about {duration_text(core / jobs)} on {jobs} core(s) (a "
+             f"test's members stop once its first {min(n, pulse_grid.ADAPTIVE_FIRST_RUNS)} "
              "agree; finished runs are kept and not run again)")
     if gate is not None:
         gate("campaign shake-table --members", most, core / most, "fewer --tests or --members")
+    choice = None
+    if candidates:
+        tried = []
+        for text, opts, full in zip(candidates, passes, fulls):
+            log.info(f"shake-table (members): candidate ranges {text or 'default'} on the "
+                     f"{len(calibration)} calibration tests")
+            per_test, _ = _members(run, campaign_dir, opts, full,
+                                   frame[frame["test"].isin(calibration)])
+            tried.append((text, per_test))
+        choice = choose_ranges(tried)
+        log.info(f"shake-table (members): chosen on the calibration tests: ranges "
+                 f"{choice['chosen'] or 'default'}")
+        options = {**options, "ranges": choice["chosen"]}
+        fulls[-1] = run_specs(records, campaign_dir, options)
+    per_test, settled = _members(run, campaign_dir, options, fulls[-1], frame)
+    return write_scores(per_test, campaign_dir, options, fulls[-1], settled, choice)
+
+
+def _members(run, campaign_dir, options, full, frame):
+    """Run ``full``'s members test by test in adaptive stages; (members.csv rows of
+    ``frame``'s tests, whether every test settled)."""
+    n = options["members"]
     by_test = {}
     for spec in full:
         by_test.setdefault(spec.tags["test"], []).append(spec)
@@ -188,7 +234,7 @@ def drive(run, records, campaign_dir, options, gate=None):
     def run_stage(stage, targets):
         chosen = [s.run_id for t, rows in order.items() for s in rows[:targets[cells[t]]]]
         log.info(f"shake-table (members), stage {stage}: {len(chosen)} of "
-                 f"{most - len(single)} member runs")
+                 f"{len(full) - len(single)} member runs")
         run({**options, "stage": "members", "only_runs": chosen + single, "full": full})
         return {cells[t]: [summary.columns[0].toppled for _, summary in
                            finished_runs(Path(campaign_dir), rows[:targets[cells[t]]])]
@@ -198,8 +244,42 @@ def drive(run, records, campaign_dir, options, gate=None):
     if not settled:
         log.warning(f"shake-table (members): stopped after {pulse_grid.MAX_STAGES} stages "
                     "with tests still undecided (their Wilson intervals say so)")
-    per_test = _per_test(frame, order, by_test, campaign_dir, targets, cells)
-    return write_scores(per_test, campaign_dir, options, full, settled)
+    return _per_test(frame, order, by_test, campaign_dir, targets, cells), settled
+
+
+def candidate_ranges(text, mesh=True):
+    """``--candidates``: the candidate ranges' texts ('' for the defaults), or [] for
+    none; one-line InputError for fewer than two, more than MAX_CANDIDATES or a repeat."""
+    if text is None:
+        return []
+    out = ["" if c.strip() in ("", "default") else c.strip() for c in text.split("|")]
+    if not 2 <= len(out) <= MAX_CANDIDATES:
+        raise InputError(f"--candidates: give 2 to {MAX_CANDIDATES} ranges separated by '|' "
+                         f"('default' for the fragility's), got {len(out)}")
+    drawn = [tuple(sorted(pulse_grid.parse_ranges(c, mesh).items())) for c in out]
+    repeated = [c or "default" for k, c in enumerate(out) if drawn[k] in drawn[:k]]
+    if repeated:
+        raise InputError(f"--candidates: {repeated[0]!r} draws the same ranges as an earlier "
+                         "candidate")
+    return out
+
+
+def choose_ranges(tried):
+    """The candidate with the highest log-likelihood per test on the calibration tests
+    (a proper score; ties: the lower Brier score, then the first): {"rule", "chosen",
+    "candidates": [{"ranges", scores}]}.  ``tried``: (ranges text, members.csv rows)."""
+    scored = []
+    for text, rows in tried:
+        rows = rows[rows["P"].notna()]
+        s = forecast_scores(rows["observed"].to_numpy(bool), rows["P"].to_numpy(float),
+                            rows["runs"].to_numpy())
+        scored.append({"ranges": text or None, "tests": s["n"],
+                       "member_runs": int(rows["runs"].sum()),
+                       **{k: s[k] for k in ("log_likelihood_per_test", "brier", "accuracy",
+                                            "balanced_accuracy")}})
+    best = max(range(len(scored)), key=lambda k: (scored[k]["log_likelihood_per_test"],
+                                                  -scored[k]["brier"], -k))
+    return {"rule": CHOICE_RULE, "chosen": tried[best][0], "candidates": scored}
 
 
 def run_specs(records, campaign_dir, options):

@@ -81,9 +81,10 @@ def split_scores(rows, threshold_g, providers):
     return out
 
 
-def write_scores(per_test, campaign_dir, options, full, settled):
+def write_scores(per_test, campaign_dir, options, full, settled, choice=None):
     """Write members.csv, shake_table_members.json and the reliability diagram; return
-    the JSON's dict."""
+    the JSON's dict.  ``choice``: how the ranges were chosen on the calibration tests
+    (:func:`pipeline.campaign.shake_table_members.choose_ranges`), if they were."""
     campaign_dir = Path(campaign_dir)
     specimen = ColumnGeometry.load(options["specimen"])
     axis = options.get("axis_deg", shake_table.AXIS_DEG)
@@ -110,7 +111,7 @@ def write_scores(per_test, campaign_dir, options, full, settled):
                                                    .sum()),
         "runs_at_most": len(full), "adaptive_settled": settled,
         "rules": CLIP_RULE, "bin_edges": [float(e) for e in BIN_EDGES],
-        "splits": splits, "lines": lines_of(splits)}
+        "ranges_choice": choice, "splits": splits, "lines": choice_lines(choice) + lines_of(splits)}
     write_json(campaign_dir / "shake_table_members.json", result)
     from pipeline.figures.reliability import plot_reliability
     plot_reliability({s: v["members"]["reliability_diagram"] for s, v in splits.items()},
@@ -129,6 +130,20 @@ def _line(name, s):
             f"{s['brier']:.3f} (REL {s['reliability']:.3f}, RES {s['resolution']:.3f}, UNC "
             f"{s['uncertainty']:.3f}), accuracy {s['accuracy']:.3f}, balanced "
             f"{'n/a' if acc is None else f'{acc:.3f}'}")
+
+
+def choice_lines(choice):
+    """What the log says of the candidate ranges on the calibration tests."""
+    if not choice:
+        return []
+    out = ["candidate ranges on the calibration tests (chosen by log-likelihood):"]
+    for c in choice["candidates"]:
+        mark = "*" if c["ranges"] == (choice["chosen"] or None) else " "
+        out.append(f" {mark}{c['ranges'] or 'default'}: log-likelihood "
+                   f"{c['log_likelihood_per_test']:.3f}/test, Brier {c['brier']:.3f}, "
+                   f"accuracy {c['accuracy']:.3f} ({c['tests']} tests, "
+                   f"{c['member_runs']} member runs)")
+    return out
 
 
 def lines_of(splits):
