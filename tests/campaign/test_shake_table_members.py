@@ -12,7 +12,7 @@ import pytest
 from pipeline import cli
 from pipeline.campaign import ensemble, pulse_grid
 from pipeline.campaign.shake_table import EXPERIMENTS, OUTCOME, SPECIMEN
-from pipeline.campaign.shake_table_members import member_sets
+from pipeline.campaign.shake_table_members import choose_ranges, member_sets
 from pipeline.campaign.shake_table_scores import write_scores
 from pipeline.scenario.geometry import ColumnGeometry
 
@@ -29,6 +29,18 @@ from pipeline.scenario.geometry import ColumnGeometry
     (["--members", "4", "--ranges", "kn=1e8:1e8;damping=0.1:0.1;mu_s=0.7:0.7;"
       "footprint_tolerance_m=0.001:0.001"], "nothing drawn"),
     (["--members", "4", "--tests", "Test011,Test011"], "names Test011 twice"),
+    (["--candidates", "default|kn=4e7:1e9"], "--candidates belongs to the members mode"),
+    (["--members", "4", "--candidates", "kn=4e7:1e9"], "give 2 to 8 ranges"),
+    (["--members", "4", "--candidates", "|".join(["default"] + [f"kn=4e7:{k}e8" for k in
+                                                               range(2, 10)])],
+     "give 2 to 8 ranges"),
+    (["--members", "4", "--candidates", "default|"], "same ranges as an earlier"),
+    (["--members", "4", "--candidates", "default|kn=4e7:1.2e8"], "same ranges as an earlier"),
+    (["--members", "4", "--candidates", "default|kn=4e7"], "--candidates kn='4e7': expected"),
+    (["--members", "4", "--candidates", "default|kn=4e7:1e9", "--ranges", "kn=4e7:1e8"],
+     "give one"),
+    (["--members", "4", "--candidates", "default|kn=4e7:1e9", "--tests", "Test693"],
+     "no test before --validate-from"),
 ])
 def test_bad_options_are_refused_in_one_line(tmp_path, capsys, args, said):
     out = tmp_path / "out"
@@ -110,3 +122,26 @@ def test_a_split_without_tests_has_no_scores():
     empty = pd.DataFrame({"observed": [], "P": [], "runs": [], "single_set_predicted": [],
                           "pga_g": [], "test": []})
     assert split_scores(empty, 0.26, {}) is None
+
+
+def _rows(observed, p, runs=8):
+    return pd.DataFrame({"observed": observed, "P": p, "runs": [runs] * len(p)})
+
+
+def test_the_candidate_with_the_best_log_likelihood_is_chosen_not_the_best_accuracy():
+    """Two candidates with the same accuracy of P > 0.5: the one whose probabilities are
+    nearer the outcomes wins by log-likelihood; on a tie, the lower Brier score."""
+    observed = [True, True, False, False]
+    sure = _rows(observed, [1.0, 1.0, 0.0, 0.0])        # right and sure
+    hedged = _rows(observed, [0.625, 0.75, 0.375, 0.25])  # right, less sure
+    wrong = _rows(observed, [0.0, 0.0, 1.0, 1.0])
+    choice = choose_ranges([("kn=4e7:1e9", hedged), ("", sure), ("damping=0.05:0.06", wrong)])
+    assert choice["chosen"] == ""
+    scores = {c["ranges"]: c for c in choice["candidates"]}
+    assert scores[None]["accuracy"] == scores["kn=4e7:1e9"]["accuracy"] == 1.0
+    clip = 1 / (2 * (8 + 1))                            # the Jeffreys clip of 8 agreeing runs
+    assert scores[None]["log_likelihood_per_test"] == pytest.approx(math.log(1 - clip))
+    assert scores["kn=4e7:1e9"]["log_likelihood_per_test"] == pytest.approx(
+        np.mean(np.log([0.625, 0.75, 0.625, 0.75])))
+    tie = choose_ranges([("a=1:2", hedged), ("b=1:2", hedged.assign(P=[0.625, 0.75, 0.375, 0.25]))])
+    assert tie["chosen"] == "a=1:2"                     # equal scores: the first given
