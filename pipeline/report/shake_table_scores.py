@@ -32,6 +32,8 @@ def shake_table_scores_section(results, name=FULL):
         return "\n".join(lines + [f"Not run yet ({command}).\n"])
     summary = json.loads(path.read_text())
     lines.append(_intro(summary, quick))
+    if summary.get("ranges_choice"):
+        lines.append(_choice(summary["ranges_choice"]))
     for split, label in SPLITS:
         part = summary.get("splits", {}).get(split)
         if part:
@@ -59,6 +61,21 @@ def _intro(summary, quick):
             "Brier score (lower is better) = reliability - resolution + uncertainty, and the "
             "accuracy of P > 0.5. The providers' models are their own in-sample 0/1 "
             "predictions, the best of them by log-likelihood shown.\n")
+
+
+def _choice(choice):
+    """The candidate ranges as scored on the calibration tests, the chosen one marked."""
+    chosen = choice.get("chosen") or None
+    rows = [{"members' ranges (over the defaults)": c.get("ranges") or "default",
+             "chosen": "yes" if c.get("ranges") == chosen else "",
+             "log-likelihood / test": f"{c['log_likelihood_per_test']:.3f}",
+             "Brier": f"{c['brier']:.3f}", "accuracy": f"{c['accuracy']:.3f}",
+             "tests": c.get("tests", "?"), "member runs": c.get("member_runs", "?")}
+            for c in choice.get("candidates", [])]
+    return ("The members' ranges were chosen before any held-out test was run: each "
+            "candidate's members on the calibration tests alone, the highest log-likelihood "
+            "per test chosen and frozen, then run on the held-out tests:\n\n"
+            + _table(pd.DataFrame(rows)) + "\n")
 
 
 def _rule(summary):

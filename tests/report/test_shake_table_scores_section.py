@@ -43,3 +43,20 @@ def test_an_accuracy_under_the_goal_is_said(tmp_path):
     text = shake_table_scores_section(tmp_path, QUICK)
     assert "(reduced)" in text and "2 of the 2 other forecasts" in text
     assert "0.800, below the" in text
+
+
+def test_the_candidate_ranges_are_quoted_with_the_chosen_marked(tmp_path):
+    _write(tmp_path, FULL, members_accuracy=0.95, provider_ll=-0.2, provider_brier=0.06)
+    path = tmp_path / FULL / "shake_table_members.json"
+    summary = json.loads(path.read_text())
+    summary["ranges_choice"] = {"chosen": "kn=4e7:1.2e9", "candidates": [
+        {"ranges": None, "tests": 259, "member_runs": 1268, "log_likelihood_per_test": -0.5641,
+         "brier": 0.2043, "accuracy": 0.7992},
+        {"ranges": "kn=4e7:1.2e9", "tests": 259, "member_runs": 1300,
+         "log_likelihood_per_test": -0.4987, "brier": 0.1811, "accuracy": 0.8301}]}
+    path.write_text(json.dumps(summary))
+    text = shake_table_scores_section(tmp_path, FULL)
+    rows = [line for line in text.splitlines() if "-0.564" in line or "-0.499" in line]
+    assert len(rows) == 2
+    assert "default" in rows[0] and "yes" not in rows[0]
+    assert "kn=4e7:1.2e9" in rows[1] and "yes" in rows[1] and "0.830" in rows[1]
