@@ -59,4 +59,4 @@ def test_the_candidate_ranges_are_quoted_with_the_chosen_marked(tmp_path):
     rows = [line for line in text.splitlines() if "-0.564" in line or "-0.499" in line]
     assert len(rows) == 2
     assert "default" in rows[0] and "yes" not in rows[0]
-    assert "kn=4e7:1.2e9" in rows[1] and "yes" in rows[1] and "0.830" in rows[1]
+    assert "kn=4e7:1.2e9" in rows[1] and "yes" in rows[1] and "0.83 " in rows[1]
