@@ -159,7 +159,7 @@ def build_grids(args):
     """(preset name, TableGrid, CandidateGrid) from the options; InputError if impossible."""
     from pipeline.inversion.grid import GRIDS, parse_mechanisms
     from pipeline.campaign.ensemble import check_seed
-    from pipeline.inversion.posterior import CandidateGrid
+    from pipeline.inversion.candidates import CandidateGrid
     from pipeline.inversion.workflows import CANDIDATE_PRESETS
     if args.quick and args.grid not in (None, "quick"):
         raise InputError("--quick is --grid quick: give one of them")

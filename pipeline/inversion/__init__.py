@@ -9,9 +9,10 @@ Modules: :mod:`~pipeline.inversion.observations` (the file's schema and checks),
 :mod:`~pipeline.inversion.grid` (the grid and its pyprop8 motions),
 :mod:`~pipeline.inversion.forward` (the symmetries, the campaign),
 :mod:`~pipeline.inversion.table` (the forward table),
-:mod:`~pipeline.inversion.likelihood`, :mod:`~pipeline.inversion.posterior` (candidates,
-prior, credible regions), :mod:`~pipeline.inversion.demo` (synthetic truth tests and the
-paper's scenario).  docs/inversion.md.
+:mod:`~pipeline.inversion.likelihood`, :mod:`~pipeline.inversion.candidates` (candidates,
+prior, reach), :mod:`~pipeline.inversion.posterior` (the posterior and its summary),
+:mod:`~pipeline.inversion.credible` (credible regions), :mod:`~pipeline.inversion.demo`
+(synthetic truth tests and the paper's scenario).  docs/inversion.md.
 """
 import math
 import time
@@ -19,7 +20,8 @@ from pathlib import Path
 
 from pipeline.files import DirectoryLock, write_csv, write_json
 from pipeline.inversion.likelihood import DEFAULT_FLOOR, DEFAULT_KERNEL_DEG, ForwardModel
-from pipeline.inversion.posterior import in_arc, invert
+from pipeline.inversion.credible import in_arc
+from pipeline.inversion.posterior import invert
 
 EXAMPLES_DIR = Path(__file__).resolve().parent / "examples"
 

@@ -32,7 +32,9 @@ from pipeline.inversion.likelihood import (DEFAULT_FLOOR, DEFAULT_KERNEL_DEG, LI
                                            ForwardModel)
 from pipeline.inversion.observations import ColumnObservation, Observations, Site
 from pipeline.inversion import truth_check
-from pipeline.inversion.posterior import OutOfReach, in_arc, invert, within_reach
+from pipeline.inversion.candidates import OutOfReach, within_reach
+from pipeline.inversion.credible import in_arc
+from pipeline.inversion.posterior import invert
 from pipeline.stats.circular import angle_difference_deg, azimuth_deg
 from pipeline.motion.synthetics import SOURCES
 

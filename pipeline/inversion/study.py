@@ -52,7 +52,8 @@ from pipeline.inversion.demo import BOUND_DEG, BOUND_TEXT, BOUNDED_FRACTION_KEY,
     out_of_reach_row
 from pipeline.inversion.likelihood import DEFAULT_FLOOR, DEFAULT_KERNEL_DEG, LIKELIHOODS, \
     ForwardModel
-from pipeline.inversion.posterior import OutOfReach, invert
+from pipeline.inversion.candidates import OutOfReach
+from pipeline.inversion.posterior import invert
 from pipeline.stats.circular import azimuth_deg
 from pipeline.stats.ensemble import wilson_interval
 from pipeline.files import InputError, die_with_parent

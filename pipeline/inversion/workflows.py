@@ -296,7 +296,7 @@ def hidden_truth(truth_file, options, grid, candidates):
     table, info = forward_table(options, grid, more_runs=truth_runs)
     table_grid = TableGrid(**table.info["grid"]) if table.info.get("grid") else grid
     check_hidden(truth, table_grid)
-    from pipeline.inversion.posterior import check_reach
+    from pipeline.inversion.candidates import check_reach
     check_reach(truth.sites, table.distances_km[-1], candidates)     # before any run
     log.info(f"hidden truth: {sum(s[3] for s in truth.sites)} twin runs at "
              f"{len(truth.sites)} site(s)")

@@ -11,7 +11,9 @@ from pipeline.files import InputError
 from pipeline.inversion import truth_check
 from pipeline.inversion.likelihood import ForwardModel, magnitude_sources
 from pipeline.inversion.observations import parse_observations
-from pipeline.inversion.posterior import CandidateGrid, invert, magnitude_interval
+from pipeline.inversion.candidates import CandidateGrid
+from pipeline.inversion.credible import magnitude_interval
+from pipeline.inversion.posterior import invert
 from pipeline.inversion.table import ForwardTable
 
 AZIMUTHS = (0.0, 90.0, 180.0, 270.0)

@@ -11,7 +11,7 @@ from pipeline import cli
 from pipeline.inversion import EXAMPLES_DIR
 from pipeline.inversion.demo import bound_answer, narrowing, split_members, truth_tests
 from pipeline.inversion.likelihood import ForwardModel
-from pipeline.inversion.posterior import CandidateGrid
+from pipeline.inversion.candidates import CandidateGrid
 
 SUMMARY_KEYS = {"map_epicentre_km", "back_azimuth_map_deg", "back_azimuth_ci68_deg",
                 "back_azimuth_ci95_deg", "distance_ci95_km", "mechanism_posterior",

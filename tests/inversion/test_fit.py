@@ -5,7 +5,8 @@ import numpy as np
 from pipeline.inversion.fit import FIT_P_VALUE
 from pipeline.inversion.likelihood import ForwardModel
 from pipeline.inversion.observations import ColumnObservation, Observations, Site
-from pipeline.inversion.posterior import CandidateGrid, invert
+from pipeline.inversion.candidates import CandidateGrid
+from pipeline.inversion.posterior import invert
 
 GRID = CandidateGrid(radius_km=10.0, step_km=1.0, strike_step_deg=90.0)
 

@@ -6,8 +6,9 @@ import pytest
 
 from pipeline.inversion.likelihood import ForwardModel
 from pipeline.inversion.observations import parse_observations
-from pipeline.inversion.posterior import (CandidateGrid, arc_width, circular_credible, in_arc,
-                                          invert)
+from pipeline.inversion.candidates import CandidateGrid
+from pipeline.inversion.credible import arc_width, circular_credible, in_arc
+from pipeline.inversion.posterior import invert
 
 
 def observations_away_from(truth, sites, per_site=3, spread=0.0):

@@ -16,7 +16,8 @@ from pipeline.files import InputError
 from pipeline.inversion import truth_check
 from pipeline.inversion.likelihood import ForwardModel
 from pipeline.inversion.observations import parse_observations
-from pipeline.inversion.posterior import EDGE_BAYES_FACTOR, CandidateGrid, invert
+from pipeline.inversion.candidates import CandidateGrid
+from pipeline.inversion.posterior import EDGE_BAYES_FACTOR, invert
 
 RINGS = (2.5, 5.0, 10.0)
 MEMBERS = 8

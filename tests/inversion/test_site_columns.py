@@ -9,7 +9,8 @@ import pytest
 from pipeline.files import InputError
 from pipeline.inversion.likelihood import ForwardModel
 from pipeline.inversion.observations import ColumnObservation, Observations, Site
-from pipeline.inversion.posterior import CandidateGrid, invert
+from pipeline.inversion.candidates import CandidateGrid
+from pipeline.inversion.posterior import invert
 from pipeline.inversion.table import ForwardTable
 
 RINGS = (2.5, 5.0, 10.0)

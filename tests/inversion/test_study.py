@@ -4,7 +4,8 @@ import dataclasses
 
 import numpy as np
 
-from pipeline.inversion.posterior import CandidateGrid, magnitude_set
+from pipeline.inversion.candidates import CandidateGrid
+from pipeline.inversion.credible import magnitude_set
 from pipeline.inversion.study import member_study, split_for_study, study_answer, study_summary
 
 
