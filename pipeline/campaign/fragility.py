@@ -32,13 +32,15 @@ logit P = b0 + b1 ln PGA + b2 ln(PGV/PGA) after Purvance et al. (2008)
 With ``--column-file`` the members are the described column with the sampled height and
 diameter tolerances (its tilt and offsets as described, none sampled), and the 2D block
 has each member's overall height and base width
-(:func:`pipeline.campaign.pulse_grid.block_size`).
+(:func:`pipeline.campaign.pulse_block.block_size`).
 
 This module is the campaign (specs, options, the adaptive driver); the 2D block batch is
 :mod:`pipeline.campaign.fragility_block`, the tables and fits
 :mod:`pipeline.campaign.fragility_tables`, the files
 :mod:`pipeline.campaign.fragility_outputs`, the pulse grid
-:mod:`pipeline.campaign.pulse_grid` (its files :mod:`pipeline.campaign.pulse_outputs`).
+:mod:`pipeline.campaign.pulse_grid` (its 2D block :mod:`pipeline.campaign.pulse_block`,
+summary :mod:`pipeline.campaign.pulse_summary`, adaptive sampling
+:mod:`pipeline.campaign.pulse_adaptive`, files :mod:`pipeline.campaign.pulse_outputs`).
 """
 import logging
 import math
@@ -49,7 +51,7 @@ import numpy as np
 from pipeline import paper
 from pipeline.campaign import Campaign, register
 from pipeline.campaign import ensemble   # module: imported while ensemble may still load
-from pipeline.campaign import pulse_grid
+from pipeline.campaign import pulse_adaptive, pulse_block, pulse_grid
 from pipeline.campaign.column_file import check_stiffness, column_kn, mark
 from pipeline.campaign.executor import RUN_CORE_S
 from pipeline.campaign.column_file import description as column_file_description
@@ -317,13 +319,13 @@ class FragilityOptions(CampaignOptions):
 
 def drive(run, records, campaign_dir, options, gate=None):
     """Run the campaign; with ``adaptive`` (pulse grid) in stages that decide, cell by
-    cell, on which side of P = 0.5 it lies (:func:`pulse_grid.next_targets`): first
-    :data:`pulse_grid.ADAPTIVE_FIRST_RUNS` runs where the 2D block of the same members and
-    directions is uncertain or steps (and one cell either side in PGA), one probe run
+    cell, on which side of P = 0.5 it lies (:func:`pulse_adaptive.next_targets`): first
+    :data:`pulse_adaptive.ADAPTIVE_FIRST_RUNS` runs where the 2D block of the same members
+    and directions is uncertain or steps (and one cell either side in PGA), one probe run
     elsewhere; then a cell whose Wilson interval still holds 0.5 doubles its runs (up to
     the full grid's), and a probe goes to the first count where it disagrees with the
-    block or a neighbour; until nothing changes (at most :data:`pulse_grid.MAX_STAGES`
-    stages). A cell's runs are taken in :func:`pulse_grid.run_order`."""
+    block or a neighbour; until nothing changes (at most :data:`pulse_adaptive.MAX_STAGES`
+    stages). A cell's runs are taken in :func:`pulse_adaptive.run_order`."""
     if not options.get("adaptive"):
         return run(options)
     if gate is not None:          # before the specs: a grid of hours takes minutes to build
@@ -331,15 +333,15 @@ def drive(run, records, campaign_dir, options, gate=None):
         gate("campaign fragility (adaptive; at most the full grid)", runs, core_s,
              "a smaller --pulses grid")
     full = fragility_specs(records, campaign_dir, **options)
-    guide = pulse_grid.block_outcomes(full)
+    guide = pulse_block.block_outcomes(full)
     by_cell, guide_by_cell = {}, {}
     for spec, fell in zip(full, guide):
-        by_cell.setdefault(pulse_grid.cell_key(spec), []).append(spec)
-        guide_by_cell.setdefault(pulse_grid.cell_key(spec), []).append(fell)
+        by_cell.setdefault(pulse_adaptive.cell_key(spec), []).append(spec)
+        guide_by_cell.setdefault(pulse_adaptive.cell_key(spec), []).append(fell)
     headings = full[0].tags["headings"]
     for rows in by_cell.values():
-        rows.sort(key=lambda s: pulse_grid.run_order(s.tags["member"], s.tags["heading"],
-                                                     headings))
+        rows.sort(key=lambda s: pulse_adaptive.run_order(s.tags["member"], s.tags["heading"],
+                                                         headings))
     guide_p = {cell: float(np.mean(fell)) for cell, fell in guide_by_cell.items()}
     per_cell = len(full) // len(by_cell)
     result = None
@@ -357,10 +359,10 @@ def drive(run, records, campaign_dir, options, gate=None):
                        if (summary := finished_summary(campaign_dir, spec.run_id)) is not None]
                 for cell, rows in by_cell.items()}
 
-    _, settled = pulse_grid.adaptive_sampling(guide_p, per_cell, run_stage)
+    _, settled = pulse_adaptive.adaptive_sampling(guide_p, per_cell, run_stage)
     if not settled:
-        log.warning(f"fragility (adaptive): stopped after {pulse_grid.MAX_STAGES} stages with "
-                    "cells still undecided (their Wilson intervals say so)")
+        log.warning(f"fragility (adaptive): stopped after {pulse_adaptive.MAX_STAGES} stages "
+                    "with cells still undecided (their Wilson intervals say so)")
     return result
 
 

@@ -1,6 +1,6 @@
 """The 2D rigid block of the ``fragility`` campaign: the project's Housner block
 (:func:`pipeline.rocking.rocking_response_sampled`, Housner's equation and restitution)
-of each member's size and slenderness (:func:`pipeline.campaign.pulse_grid.block_size`),
+of each member's size and slenderness (:func:`pipeline.campaign.pulse_block.block_size`),
 without friction limit, sliding or vertical motion, shaken by the same scaled records as
 the 3D runs: once along the record's strongest azimuth (``az_max_acc_deg``, the direction
 of the horizontal PGA: ``block2d``) and at ``azimuths`` directions over 180 deg
@@ -11,7 +11,7 @@ import time
 import numpy as np
 import pandas as pd
 
-from pipeline.campaign.pulse_grid import BLOCK_MAX_STEP_S, BLOCK_T_AFTER_S, block_size
+from pipeline.campaign.pulse_block import BLOCK_MAX_STEP_S, BLOCK_T_AFTER_S, block_size
 from pipeline.motion import Motion
 from pipeline.motion.measures import record_parameters
 from pipeline.rocking import rocking_response_sampled

@@ -9,7 +9,7 @@ import numpy as np
 import pandas as pd
 
 from pipeline.campaign.column_file import summary_entry
-from pipeline.campaign.pulse_grid import block_size
+from pipeline.campaign.pulse_block import block_size
 from pipeline.campaign.tables import collect
 from pipeline.constants import MODEL_GRAVITY
 from pipeline.files import json_safe

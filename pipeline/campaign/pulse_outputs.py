@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from pipeline.campaign import pulse_grid
+from pipeline.campaign import pulse_block, pulse_grid, pulse_summary
 from pipeline.campaign.column_file import summary_entry
 from pipeline.campaign.run_dirs import finished_summary
 from pipeline.campaign.pulse_check import experiments_check
@@ -42,7 +42,7 @@ def pulse_table(specs, campaign_dir):
                          "mu_k": contact.mu_k,
                          "footprint_tolerance_m": described.get("footprint_tolerance_m")})
     if done:
-        fell = pulse_grid.block_outcomes(done)
+        fell = pulse_block.block_outcomes(done)
         for spec, toppled in zip(done, fell):
             rows.append({"run_id": spec.run_id, "model": BLOCK_MODEL,
                          "pga_g": spec.tags["pga_g"], "pgv_pga_s": spec.tags["pgv_pga_s"],
@@ -66,7 +66,7 @@ def pulse_outputs(specs, campaign_dir, figures=True):
         azimuths[(spec.tags["member"], spec.tags["heading"])] = spec.tags["azimuth_deg"]
     azimuth_array = np.array([[azimuths.get((m, h), np.nan) for h in range(first["headings"])]
                               for m in range(first["members"])])
-    section = pulse_grid.summarise_grid(table, done, grid, sets, azimuth_array,
+    section = pulse_summary.summarise_grid(table, done, grid, sets, azimuth_array,
                                         first["azimuth"], first["ranges"]
                                         or pulse_grid.DEFAULT_RANGES)
     described = summary_entry(specs)

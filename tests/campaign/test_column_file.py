@@ -12,7 +12,7 @@ import pytest
 
 from pipeline.cli._fields import from_args
 from pipeline import campaign, cli, paper
-from pipeline.campaign import pulse_grid
+from pipeline.campaign import pulse_block
 from pipeline.campaign.fragility_block import block_runs
 from pipeline.campaign.column_file import at_slenderness, column_file_help, perturbed
 from pipeline.campaign.column_file import matched_kn
@@ -224,14 +224,14 @@ def test_fragility_block_takes_the_described_height_and_base_width(record, tmp_p
     for spec in specs:
         data = spec.params.column.column_file
         g = ColumnGeometry.from_dict(data)
-        height, width = pulse_grid.block_size(spec.params)
+        height, width = pulse_block.block_size(spec.params)
         assert height == pytest.approx(g.height) and width == pytest.approx(g.base_width)
         assert abs(height / 10.43 - 1) <= 0.01 + 1e-9 and abs(width / 1.905 - 1) <= 0.01 + 1e-9
         assert not any("offset_m" in b for b in data["blocks"])       # as described
     table, _ = block_runs(specs)
     for spec in specs:
         rows = table[table["run_id"] == spec.run_id]
-        height, width = pulse_grid.block_size(spec.params)
+        height, width = pulse_block.block_size(spec.params)
         assert rows["height_m"].tolist() == pytest.approx([height] * 2)
         assert rows["alpha_rad"].tolist() == pytest.approx([math.atan(width / height)] * 2)
 

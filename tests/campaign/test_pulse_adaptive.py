@@ -11,7 +11,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from pipeline.campaign import CAMPAIGNS, get, pulse_grid, run_campaign
+from pipeline.campaign import (CAMPAIGNS, get, pulse_adaptive, pulse_block, pulse_grid,
+                               pulse_summary, run_campaign)
 from pipeline.campaign.fragility import FragilityOptions, drive
 from pipeline.hazard.fragility_file import FragilityFile, read_fragility_file
 from pipeline.motion.pulses import one_cosine_pulse
@@ -26,7 +27,7 @@ WIDER = 2.0         # the model's base is this much wider than the guide's: a st
 def stabler_block_worker(spec, run_dir):
     """Worker: the 2D block of the run's height and WIDER x its width under the run's
     pulse, written as the run's summary (the specimen's one column)."""
-    height, width = pulse_grid.block_of(spec.params, spec.tags["azimuth_deg"])
+    height, width = pulse_block.block_of(spec.params, spec.tags["azimuth_deg"])
     pulse = one_cosine_pulse(spec.tags["pga_g"] * pulse_grid.G, spec.tags["pgv_pga_s"], 0.0,
                              pulse_grid.PULSE_DT_S, 0.0)
     fell = bool(rocking_response_sampled(height, WIDER * width, pulse.acc[:, 1], pulse.dt,
@@ -60,7 +61,7 @@ def test_the_adaptive_surface_matches_the_full_grid_with_fewer_runs(tmp_path, mo
     rock = {(c["pgv_pga_s"], c["pga_g"]): c for c in adaptive.models["box"].cells}
     assert any(guide[k] in (0.0, 1.0) and c["n"] > 1 and c["P"] != guide[k]
                for k, c in rock.items())
-    difference = pulse_grid.contour_difference(summaries["full"], summaries["adaptive"])
+    difference = pulse_summary.contour_difference(summaries["full"], summaries["adaptive"])
     crossing = [r for r in difference["rows"] if r["pga_g_reference"] is not None]
     assert len(crossing) == 2                      # the threshold lies inside the grid
     print(difference, adaptive.runs_finished)
@@ -78,21 +79,21 @@ def fragility(rows):
 
 def test_contour_difference_on_constructed_contours():
     full = fragility([(0.1, 0.40, 0.35, 0.45), (0.3, 0.25, 0.20, None), (0.5, None, 0.5, None)])
-    same = pulse_grid.contour_difference(full, full)
+    same = pulse_summary.contour_difference(full, full)
     assert same["max_abs_diff_g"] == 0.0 and same["within_band"] and same["one_sided"] == 0
     other = fragility([(0.1, 0.43, 0, 1), (0.3, 0.19, 0, 1), (0.5, None, 0, 1)])
-    d = pulse_grid.contour_difference(full, other)
+    d = pulse_summary.contour_difference(full, other)
     assert [r["diff_g"] for r in d["rows"][:2]] == [pytest.approx(0.03), pytest.approx(-0.06)]
     assert d["rows"][2]["diff_g"] is None
     assert d["max_abs_diff_g"] == pytest.approx(0.06)
     assert not d["within_band"]                    # 0.19 g lies below the band 0.20 g - open
     inside = fragility([(0.1, 0.43, 0, 1), (0.3, 0.9, 0, 1), (0.5, None, 0, 1)])
-    assert pulse_grid.contour_difference(full, inside)["within_band"]   # an open upper side
+    assert pulse_summary.contour_difference(full, inside)["within_band"]   # an open upper side
     one_sided = fragility([(0.1, 0.43, 0, 1), (0.3, 0.25, 0, 1), (0.5, 0.7, 0, 1)])
-    d = pulse_grid.contour_difference(full, one_sided)
+    d = pulse_summary.contour_difference(full, one_sided)
     assert d["one_sided"] == 1 and not d["within_band"]
     with pytest.raises(ValueError, match="same pulse grid"):
-        pulse_grid.contour_difference(full, fragility([(0.1, 0.4, 0, 1)]))
+        pulse_summary.contour_difference(full, fragility([(0.1, 0.4, 0, 1)]))
 
 
 def threshold_model(pga_g, ratios, members, headings, seed, bias=1.0):
@@ -101,13 +102,13 @@ def threshold_model(pga_g, ratios, members, headings, seed, bias=1.0):
     wider one way than the other: +-20 %), with the member (lognormal, 15 %) and run to
     run (5 %); ``bias`` scales the direction-only threshold instead (the guide: a body
     less stable than the rock, as the 2D block may be). Returns cell -> outcomes in
-    :func:`pulse_grid.run_order`."""
+    :func:`pulse_adaptive.run_order`."""
     rng = np.random.default_rng(seed)
     azimuths = pulse_grid.member_azimuths(members, headings, seed)
     member_z, run_z = rng.standard_normal(members), rng.standard_normal(
         (len(ratios), len(pga_g), members, headings))
     order = sorted(((m, h) for m in range(members) for h in range(headings)),
-                   key=lambda mh: pulse_grid.run_order(*mh, headings))
+                   key=lambda mh: pulse_adaptive.run_order(*mh, headings))
     outcomes = {}
     for i, ratio in enumerate(ratios):
         base = 0.25 + 0.5 * np.exp(-ratio / 0.15)
@@ -127,9 +128,9 @@ def model_summary(outcomes, order, runs, pga_g, ratios):
     rows = [{"model": "rock", "pga_g": pga_g[j], "pgv_pga_s": ratios[i], "member": m,
              "toppled": fell[r]}
             for (i, j), fell in outcomes.items() for r, (m, _) in enumerate(order[:runs[(i, j)]])]
-    cells = pulse_grid.cell_table(pd.DataFrame(rows), "rock")
+    cells = pulse_summary.cell_table(pd.DataFrame(rows), "rock")
     return FragilityFile.of({"pulse_grid": {"models": {"rock": {
-        "cells": cells, "contours": pulse_grid.contours(cells)}}}})
+        "cells": cells, "contours": pulse_summary.contours(cells)}}}})
 
 
 def test_the_adaptive_stages_save_five_times_the_runs_on_a_fine_grid_of_a_cheap_model():
@@ -150,13 +151,13 @@ def test_the_adaptive_stages_save_five_times_the_runs_on_a_fine_grid_of_a_cheap_
         stages.append(stage)
         return {cell: fell[:targets[cell]] for cell, fell in outcomes.items()}
 
-    targets, settled = pulse_grid.adaptive_sampling(guide_p, per_cell, run_stage)
+    targets, settled = pulse_adaptive.adaptive_sampling(guide_p, per_cell, run_stage)
     assert settled and len(stages) >= 3
     full_runs = len(outcomes) * per_cell
     assert full_runs / sum(targets.values()) >= 5.0
     full = model_summary(outcomes, order, {c: per_cell for c in outcomes}, pga_g, ratios)
     adaptive = model_summary(outcomes, order, targets, pga_g, ratios)
-    difference = pulse_grid.contour_difference(full, adaptive)
+    difference = pulse_summary.contour_difference(full, adaptive)
     assert all(r["pga_g_reference"] is not None for r in difference["rows"])  # inside the grid
     assert difference["within_band"]
     print(f"{full_runs} / {sum(targets.values())} runs, largest 0.5 contour difference "
@@ -164,7 +165,7 @@ def test_the_adaptive_stages_save_five_times_the_runs_on_a_fine_grid_of_a_cheap_
     # the statistics say what was run: a cell's n is its runs, its interval Wilson's of them
     full_cells = {(list(ratios).index(c["pgv_pga_s"]), list(pga_g).index(c["pga_g"])): c
                   for c in full.pulse_grid.models["rock"].cells}
-    top = pulse_grid.first_crossings({cell: c["P"] for cell, c in full_cells.items()})
+    top = pulse_adaptive.first_crossings({cell: c["P"] for cell, c in full_cells.items()})
     for cell in adaptive.pulse_grid.models["rock"].cells:
         i, j = list(ratios).index(cell["pgv_pga_s"]), list(pga_g).index(cell["pga_g"])
         assert cell["n"] == targets[(i, j)]

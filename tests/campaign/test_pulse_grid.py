@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 import trimesh
 
-from pipeline.campaign import pulse_grid
+from pipeline.campaign import pulse_adaptive, pulse_grid, pulse_summary
 from pipeline.campaign.pulse_check import scores
 from pipeline.files import InputError
 from pipeline.motion.measures import horizontal_peak
@@ -225,7 +225,7 @@ def test_report_section_says_not_run_yet_then_quotes_the_file(tmp_path):
     cells = [{"pga_g": a, "pgv_pga_s": 0.5, "n": 4, "overturned": k, "P": k / 4,
               "ci95": [0.0, 1.0], "P_per_set": [k / 4], "set_sd": 0.0, "set_spread_sd": None}
              for a, k in ((0.2, 0), (0.4, 2), (0.6, 4))]
-    model = {"cells": cells, "contours": pulse_grid.contours(cells),
+    model = {"cells": cells, "contours": pulse_summary.contours(cells),
              "logistic": {"coefficients": None}, "runs": 12, "overturned": 6}
     section = {"pga_g": [0.2, 0.4, 0.6], "pgv_pga_s": [0.5], "members": 1, "headings": 4,
                "ranges": "kn=1e8:1e8", "direction": "sampled", "runs_finished": 12, "runs": 12,
@@ -241,11 +241,11 @@ def test_report_section_says_not_run_yet_then_quotes_the_file(tmp_path):
 def test_contours_interpolate_between_cells_and_say_none_beyond_the_grid():
     cells = [{"pga_g": a, "pgv_pga_s": 0.3, "P": p, "ci95": [max(p - 0.2, 0), min(p + 0.2, 1)]}
              for a, p in ((0.2, 0.0), (0.4, 0.25), (0.6, 0.75), (0.8, 1.0))]
-    (row,) = pulse_grid.contours(cells, levels=(0.5,))["0.5"]
+    (row,) = pulse_summary.contours(cells, levels=(0.5,))["0.5"]
     assert row["pga_g"] == pytest.approx(0.5)
     lo, hi = row["pga_g_band"]
     assert lo < 0.5 < hi
-    (row,) = pulse_grid.contours([dict(c, P=0.0, ci95=[0, 0.1]) for c in cells], (0.5,))["0.5"]
+    (row,) = pulse_summary.contours([dict(c, P=0.0, ci95=[0, 0.1]) for c in cells], (0.5,))["0.5"]
     assert row["pga_g"] is None
 
 
@@ -264,39 +264,39 @@ def test_adaptive_stages_run_cells_until_their_side_of_one_half_is_decided():
     # one PGV/PGA row of 8 PGA cells: the guide certain below cell 3 and above cell 4
     guide = {(0, j): p for j, p in enumerate((0.0, 0.0, 0.0, 0.3, 0.8, 1.0, 1.0, 1.0))}
     # uncertain cells, the certain ones next to them (a step) and one beyond
-    assert pulse_grid.guide_cells(guide) == {(0, j) for j in range(1, 7)}
+    assert pulse_adaptive.guide_cells(guide) == {(0, j) for j in range(1, 7)}
     # the first counts near it, up to one cell above where the guide reaches 0.5
-    first = pulse_grid.first_targets(guide, per_cell=16)
+    first = pulse_adaptive.first_targets(guide, per_cell=16)
     assert [first[(0, j)] for j in range(8)] == [1, 4, 4, 4, 4, 4, 1, 1]
     F, T = False, True
     seen = {(0, 0): [F], (0, 1): [F] * 4, (0, 2): [F] * 4, (0, 3): [F, T, F, F],
             (0, 4): [T, T, T, F], (0, 5): [T] * 4, (0, 6): [T], (0, 7): [T]}
-    after = pulse_grid.next_targets(guide, seen, first, per_cell=16)
+    after = pulse_adaptive.next_targets(guide, seen, first, per_cell=16)
     # the contour lies between cells 3 (1 of 4) and 4 (3 of 4): both run in full; 0 of 4
     # or 4 of 4 elsewhere: the Wilson interval excludes 0.5 (upper 0.49): decided; probes
     # that agree with the guide and their neighbours stay probes
     assert [after[(0, j)] for j in range(8)] == [1, 4, 4, 16, 16, 4, 1, 1]
     # a probe that overturns where the guide is certain it stands: the first count
-    assert pulse_grid.next_targets(guide, {**seen, (0, 0): [T]}, first, 16)[(0, 0)] == 4
+    assert pulse_adaptive.next_targets(guide, {**seen, (0, 0): [T]}, first, 16)[(0, 0)] == 4
     # below the contour a mixed cell doubles until its interval excludes 0.5; above it a
     # cell does not move the contour and stops; no cell passes the full grid's count
     seen = {**seen, (0, 2): [F, T, F, F], (0, 3): [F] * 4, (0, 4): [F, T, T, F]}
-    after = pulse_grid.next_targets(guide, seen, first, per_cell=10)
+    after = pulse_adaptive.next_targets(guide, seen, first, per_cell=10)
     assert [after[(0, j)] for j in range(2, 6)] == [8, 10, 10, 4]
     seen = {**seen, (0, 2): [F, T] + [F] * 6}         # 1 of 8: [0.02, 0.47], decided
-    assert pulse_grid.next_targets(guide, seen, after, per_cell=10)[(0, 2)] == 8
+    assert pulse_adaptive.next_targets(guide, seen, after, per_cell=10)[(0, 2)] == 8
     # a probe that agrees with the guide but not with its neighbour: both to the first
     # count (the specimen's threshold beyond the guide's)
     guide = {(0, j): p for j, p in enumerate((0.0, 0.0, 0.0, 0.0, 1.0, 1.0))}
-    assert pulse_grid.guide_cells(guide) == {(0, 2), (0, 3), (0, 4), (0, 5)}
-    first = pulse_grid.first_targets(guide, per_cell=16)
+    assert pulse_adaptive.guide_cells(guide) == {(0, 2), (0, 3), (0, 4), (0, 5)}
+    first = pulse_adaptive.first_targets(guide, per_cell=16)
     seen = {(0, 0): [F], (0, 1): [T], (0, 2): [T] * 4, (0, 3): [T] * 4, (0, 4): [T] * 4,
             (0, 5): [T] * 4}
-    after = pulse_grid.next_targets(guide, seen, first, per_cell=16)
+    after = pulse_adaptive.next_targets(guide, seen, first, per_cell=16)
     assert [after[(0, j)] for j in range(6)] == [4, 4, 4, 4, 4, 4]
     # the first runs of a cell are distinct members from distinct direction sectors
     order = sorted(((m, h) for m in range(4) for h in range(4)),
-                   key=lambda mh: pulse_grid.run_order(*mh, headings=4))
+                   key=lambda mh: pulse_adaptive.run_order(*mh, headings=4))
     assert order[:4] == [(0, 0), (1, 1), (2, 2), (3, 3)]
 
 
@@ -311,7 +311,7 @@ def test_contours_per_parameter_set_show_the_members_spread():
     cells = [{"pga_g": a, "pgv_pga_s": 0.3, "P": (p0 + p1) / 2, "ci95": [0, 1],
               "P_per_set": [p0, p1], "sets": [0, 1]}
              for a, p0, p1 in ((0.2, 0.0, 0.0), (0.4, 1.0, 0.0), (0.6, 1.0, 1.0))]
-    (row,) = pulse_grid.contours(cells, levels=(0.5,))["0.5"]
+    (row,) = pulse_summary.contours(cells, levels=(0.5,))["0.5"]
     assert row["pga_g_per_set"] == {"0": pytest.approx(0.3), "1": pytest.approx(0.5)}
     assert row["pga_g"] == pytest.approx(0.4)
 
@@ -324,10 +324,10 @@ def test_a_contour_that_leaves_the_grid_is_said_on_its_side_with_its_rows():
             0.5: (0.75, 1.0, 1.0, 1.0), 0.7: (0.75, 0.75, 1.0, 1.0)}
     cells = [{"pga_g": a, "pgv_pga_s": ratio, "P": p, "ci95": [max(p - 0.3, 0), min(p + 0.3, 1)]}
              for ratio, ps in rows.items() for a, p in zip((0.2, 0.4, 0.6, 0.8), ps)]
-    contour = pulse_grid.contours(cells, levels=(0.5,))["0.5"]
+    contour = pulse_summary.contours(cells, levels=(0.5,))["0.5"]
     assert [r["outside_grid"] for r in contour] == ["above", None, "below", "below"]
     assert [r["pga_g"] for r in contour] == [None, pytest.approx(0.5), None, None]
-    warnings = pulse_grid.contour_warnings({"monolithic": {"contours": {"0.5": contour}}},
+    warnings = pulse_summary.contour_warnings({"monolithic": {"contours": {"0.5": contour}}},
                                            [0.2, 0.4, 0.6, 0.8])
     assert len(warnings) == 2
     below, above = warnings
@@ -336,9 +336,9 @@ def test_a_contour_that_leaves_the_grid_is_said_on_its_side_with_its_rows():
     assert above.startswith("monolithic: the P = 0.5 contour lies above the grid's highest "
                             "PGA (0.8 g) for PGV/PGA 0.1 s")
     inside = [dict(c, P=min(1.0, (c["pga_g"] - 0.2) / 0.6)) for c in cells]
-    held = pulse_grid.contours(inside, levels=(0.16, 0.5, 0.84))
-    assert pulse_grid.contour_warnings({"m": {"contours": held}}, [0.2, 0.4, 0.6, 0.8]) == []
-    (one,) = pulse_grid.contours([c for c in cells if c["pgv_pga_s"] == 0.5
+    held = pulse_summary.contours(inside, levels=(0.16, 0.5, 0.84))
+    assert pulse_summary.contour_warnings({"m": {"contours": held}}, [0.2, 0.4, 0.6, 0.8]) == []
+    (one,) = pulse_summary.contours([c for c in cells if c["pgv_pga_s"] == 0.5
                                   and c["pga_g"] == 0.2], levels=(0.5,))["0.5"]
     assert one["outside_grid"] is None        # a single PGA has no contour to leave
 
