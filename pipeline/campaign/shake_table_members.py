@@ -9,8 +9,8 @@ The members are those of ``campaign fragility --column-file``: the same Latin hy
 motion is the test's own, along its axis as shipped (``rotate_deg`` 0).
 
 Each test's members stop early by the pulse grid's adaptive rule
-(:func:`pipeline.campaign.pulse_grid.adaptive_sampling`, every test a row of one cell
-with no guide): first :data:`~pipeline.campaign.pulse_grid.ADAPTIVE_FIRST_RUNS`
+(:func:`pipeline.campaign.pulse_adaptive.adaptive_sampling`, every test a row of one cell
+with no guide): first :data:`~pipeline.campaign.pulse_adaptive.ADAPTIVE_FIRST_RUNS`
 members; a test whose Wilson 95 % interval then excludes 0.5 is decided and stops (the
 first members all agree), one whose interval holds 0.5 doubles its members, up to N.
 
@@ -31,7 +31,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from pipeline.campaign import ensemble, pulse_grid, shake_table
+from pipeline.campaign import ensemble, pulse_adaptive, pulse_grid, shake_table
 from pipeline.campaign.column_file import column_kn
 from pipeline.campaign.run_dirs import finished_runs, finished_summary
 from pipeline.campaign.runs import column_specs
@@ -196,7 +196,7 @@ def drive(run, records, campaign_dir, options, gate=None):
             f"then the chosen on {len(frame)} tests" if candidates else f"{len(frame)} tests")
     log.info(f"shake-table (members): {what} x ({n} members + the single set): at most "
              f"{most} YADE runs, about {duration_text(core / jobs)} on {jobs} core(s) (a "
-             f"test's members stop once its first {min(n, pulse_grid.ADAPTIVE_FIRST_RUNS)} "
+             f"test's members stop once its first {min(n, pulse_adaptive.ADAPTIVE_FIRST_RUNS)} "
              "agree; finished runs are kept and not run again)")
     if gate is not None:
         gate("campaign shake-table --members", most, core / most, "fewer --tests or --members")
@@ -229,7 +229,7 @@ def _members(run, campaign_dir, options, full, frame):
                        key=lambda s: s.tags["member"]) for t, rows in by_test.items()}
     single = [s.run_id for rows in by_test.values() for s in rows if s.tags["member"] < 0]
     cells = {t: (i, 0) for i, t in enumerate(order)}
-    guide = {cell: pulse_grid.ADAPTIVE_LEVEL for cell in cells.values()}    # no guide
+    guide = {cell: pulse_adaptive.ADAPTIVE_LEVEL for cell in cells.values()}    # no guide
 
     def run_stage(stage, targets):
         chosen = [s.run_id for t, rows in order.items() for s in rows[:targets[cells[t]]]]
@@ -240,9 +240,9 @@ def _members(run, campaign_dir, options, full, frame):
                            finished_runs(Path(campaign_dir), rows[:targets[cells[t]]])]
                 for t, rows in order.items()}
 
-    targets, settled = pulse_grid.adaptive_sampling(guide, n, run_stage)
+    targets, settled = pulse_adaptive.adaptive_sampling(guide, n, run_stage)
     if not settled:
-        log.warning(f"shake-table (members): stopped after {pulse_grid.MAX_STAGES} stages "
+        log.warning(f"shake-table (members): stopped after {pulse_adaptive.MAX_STAGES} stages "
                     "with tests still undecided (their Wilson intervals say so)")
     return _per_test(frame, order, by_test, campaign_dir, targets, cells), settled
 
