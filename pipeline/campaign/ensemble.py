@@ -65,7 +65,8 @@ from pipeline.constants import RIM_POINTS
 from pipeline.scenario.geometry import ColumnGeometry
 from pipeline.campaign.sizing import (DEFAULT_ARC_DEG, DEFAULT_MAX_MEMBERS, DEFAULT_PRECISION,
                                       run_sized, write_summaries)
-from pipeline.stats.ensemble import pooled_summary, record_summary
+from pipeline.stats.ensemble import record_summary
+from pipeline.stats.pooled import pooled_summary
 
 log = logging.getLogger(__name__)
 

@@ -19,10 +19,10 @@ horizontal PGA: ``block2d``) and at ``--azimuths`` directions over 180 deg
 For IM = PGA, PGV (horizontal vector peaks of the scaled motion) and PGV/PGA
 (unchanged by scaling: identified only across records) the outputs give the
 lognormal fragility (median and dispersion beta with 95 % intervals,
-:func:`pipeline.stats.ensemble.fragility_fit`) per column type, the binned
+:func:`pipeline.stats.fragility.fragility_fit`) per column type, the binned
 fractions with Wilson intervals, and the two-parameter logistic surface
 logit P = b0 + b1 ln PGA + b2 ln(PGV/PGA) after Purvance et al. (2008)
-(:func:`pipeline.stats.ensemble.logistic_surface`).  Files (see ``fragility.json`` keys in
+(:func:`pipeline.stats.fragility.logistic_surface`).  Files (see ``fragility.json`` keys in
 :func:`pipeline.campaign.fragility_tables.summarise`): ``fragility.json``,
 ``fragility_runs.csv`` (one row per run and column, 3D and 2D), ``fragility_levels.csv``
 (fraction toppled per record and level, 3D columns beside the 2D block), figures

@@ -14,8 +14,8 @@ from pipeline.campaign.tables import collect
 from pipeline.constants import MODEL_GRAVITY
 from pipeline.files import json_safe
 from pipeline.rocking import block_constants
-from pipeline.stats.ensemble import (binned_fractions, fragility_fit, logistic_surface,
-                                     wilson_interval)
+from pipeline.stats.ensemble import wilson_interval
+from pipeline.stats.fragility import binned_fractions, fragility_fit, logistic_surface
 
 # intensity measures: name -> (runs-table column, unit, label)
 INTENSITY_MEASURES = {"PGA": ("pga_m_s2", "m/s^2", "PGA (m/s$^2$)"),

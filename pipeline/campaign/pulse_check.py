@@ -19,7 +19,8 @@ from pipeline.campaign.shake_table import (EXPERIMENTS, OUTCOME, PGA_EDGES_G, PG
                                            load_experiments)
 from pipeline.constants import STANDARD_GRAVITY as G
 from pipeline.hazard.pulse_cells import cell_table, interpolate
-from pipeline.stats.ensemble import logistic_probability, logistic_surface, wilson_interval
+from pipeline.stats.ensemble import wilson_interval
+from pipeline.stats.fragility import logistic_probability, logistic_surface
 
 SPECIMENS_WITH_TESTS = {"SP1": OUTCOME}
 CLIP = 0.01

@@ -15,7 +15,8 @@ import numpy as np
 from pipeline.campaign.pulse_block import block_reference
 from pipeline.campaign.pulse_grid import G, PULSE_TAIL_S
 from pipeline.hazard.pulse_cells import CONTOUR_LEVELS
-from pipeline.stats.ensemble import logistic_surface, wilson_interval
+from pipeline.stats.ensemble import wilson_interval
+from pipeline.stats.fragility import logistic_surface
 
 
 def cell_table(table, model):

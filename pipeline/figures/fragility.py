@@ -10,7 +10,8 @@ from scipy import stats
 from pipeline.figures.style import COLUMN_COLOURS, COLUMN_LABELS, COLUMN_MARKERS, figure
 from pipeline.files import save_figure
 from pipeline.hazard.pulse_cells import CONTOUR_LEVELS
-from pipeline.stats.ensemble import logistic_probability, wilson_interval
+from pipeline.stats.ensemble import wilson_interval
+from pipeline.stats.fragility import logistic_probability
 
 BLOCK_STYLE = {"block2d": {"color": "0.35", "ls": "--", "marker": "D",
                            "label": "2D block, strongest azimuth"},

@@ -50,7 +50,7 @@ class GridModel:
     """One model of a pulse grid: ``cells`` (dicts: pga_g, pgv_pga_s, n, overturned, P,
     ci95, sets, P_per_set, set_sd), ``contours`` (level -> rows per PGV/PGA: pga_g,
     pga_g_band, outside_grid, pga_g_per_set), ``logistic`` (the surface as
-    :func:`pipeline.stats.ensemble.logistic_surface` writes it), ``runs`` and
+    :func:`pipeline.stats.fragility.logistic_surface` writes it), ``runs`` and
     ``overturned`` (counts)."""
     cells: tuple = ()
     contours: dict = field(default_factory=dict)

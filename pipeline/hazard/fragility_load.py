@@ -14,7 +14,7 @@ from pipeline.hazard.components import on_hazard_measure
 from pipeline.hazard.fragility_file import MAX_MEMBERS, read_fragility_file
 from pipeline.hazard.fragility_grid import BELOW_GRID, PulseGrid
 from pipeline.hazard.fragility_kinds import Logistic, Lognormal
-from pipeline.stats.ensemble import fragility_fit, logistic_surface
+from pipeline.stats.fragility import fragility_fit, logistic_surface
 from pipeline.userfiles import DATA_FILE_BYTES, Unreadable, number, read_text, show
 
 
@@ -77,7 +77,7 @@ def _load_campaign_fragility(path, column, form, below):
 def member_fits(runs_path, column, form, block=None):
     """(one fragility per member of a column campaign fitted to its own runs, note): the
     lognormal PGA fit (form "pga") or the logistic surface ("pga-pgv") of
-    :mod:`pipeline.stats.ensemble`, as the campaign fits the pooled runs; (None, note)
+    :mod:`pipeline.stats.fragility`, as the campaign fits the pooled runs; (None, note)
     when the runs table is absent or no member's fit is determined.  ``block``: the
     file's :class:`~pipeline.hazard.fragility_file.Block2d` (the surface's alpha and p)
     or None."""

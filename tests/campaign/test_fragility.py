@@ -16,8 +16,9 @@ from pipeline.files import InputError
 from pipeline.motion import Motion
 from pipeline.motion.measures import horizontal_peak
 from pipeline.motion.pulses import one_sine_pulse
-from pipeline.stats.ensemble import (binned_fractions, fragility_fit, logistic_probability,
-                                     logistic_surface, separated)
+from pipeline.stats.fragility import (binned_fractions, fragility_fit, logistic_probability,
+                                      logistic_surface)
+from pipeline.stats.regression import separated
 
 G = 9.81
 TRUE = {"b0": 1.0, "b1": 3.0, "b2": 2.0}

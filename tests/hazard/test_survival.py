@@ -19,7 +19,7 @@ from pipeline.hazard.fragility import (Logistic, Lognormal, RatioFromGmm, RatioL
                                        load_campaign_fragility, overturn_probability)
 from pipeline.hazard.survival import (contribution_by_intensity, intensity_scale_bound,
                                       overturning_rate, rate_scale_bound, survival_probability)
-from pipeline.stats.ensemble import logistic_surface
+from pipeline.stats.fragility import logistic_surface
 
 CASE_14 = RECORDS_DIR / "hazard" / "oq_classical_case_14_hazard_curve-rlz-000_PGA.csv"
 

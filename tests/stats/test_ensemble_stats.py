@@ -6,7 +6,8 @@ import pytest
 from scipy import stats
 
 from pipeline.stats.ensemble import (bootstrap_mean_azimuth_ci, circular_density,
-                                     direction_fractions, lognormal_fragility, wilson_interval)
+                                     direction_fractions, wilson_interval)
+from pipeline.stats.fragility import lognormal_fragility
 
 
 def test_wilson_interval_by_hand():

@@ -3,7 +3,8 @@ distributions, Holm's procedure by hand and the symmetry of turning every direct
 import numpy as np
 import pandas as pd
 
-from pipeline.stats.ensemble import compare_ensembles, holm_reject, pooled_answer, pooled_summary
+from pipeline.stats.ensemble import compare_ensembles, holm_reject
+from pipeline.stats.pooled import pooled_answer, pooled_summary
 
 
 def _records(rng, n_records, members, p, spread_deg=None, centre_deg=0.0):
