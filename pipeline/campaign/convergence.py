@@ -35,8 +35,8 @@ from pipeline.scenario.parameters import param
 from pipeline.campaign.run_dirs import finished_runs
 from pipeline.campaign.runs import column_specs, run_column_spec
 from pipeline.simulate import run_code_version
-from pipeline.campaign.ensemble import (DEFAULT_SEED, ENSEMBLE_RANGES, check_seed,
-                                        sample_batches)
+from pipeline.campaign.ensemble_members import (DEFAULT_SEED, ENSEMBLE_RANGES, check_seed,
+                                                sample_batches)
 from pipeline.campaign.tables import collect
 from pipeline.constants import RIM_POINTS
 from pipeline.files import InputError, write_csv, write_json

@@ -3,7 +3,7 @@
 Each record is scaled to a ladder of horizontal PGA targets (``--levels``, m/s^2,
 the peak of the horizontal acceleration vector of the scaled motion; the
 vertical is scaled with it) and, at every level, the same small ensemble of
-column models (``pipeline.campaign.ensemble.sample_members``: friction, damping,
+column models (``pipeline.campaign.ensemble_members.sample_members``: friction, damping,
 stiffness, geometry tolerances, rim phase; one Latin hypercube for all levels,
 so each member is one column shaken ever harder) is run in YADE through the
 ``scale`` parameter of :func:`pipeline.simulate.simulate`.
@@ -50,7 +50,7 @@ import numpy as np
 
 from pipeline import paper
 from pipeline.campaign import Campaign, register
-from pipeline.campaign import ensemble   # module: imported while ensemble may still load
+from pipeline.campaign import ensemble_members
 from pipeline.campaign import pulse_adaptive, pulse_block, pulse_grid
 from pipeline.campaign.column_file import check_stiffness, column_kn, mark
 from pipeline.campaign.executor import RUN_CORE_S
@@ -147,7 +147,7 @@ def fragility_specs(records, campaign_dir, levels=None, members=DEFAULT_MEMBERS,
     a mesh specimen: the preset vsr) the pulse grid of :mod:`pipeline.campaign.pulse_grid`
     instead; ``only_runs`` (run ids) keeps those of its runs, taken from ``grid_specs``
     when the adaptive driver has made the grid's specs already.  A contact file fixes what
-    it sets for every member (:func:`pipeline.campaign.ensemble.contact_ranges`; on the
+    it sets for every member (:func:`pipeline.campaign.ensemble_members.contact_ranges`; on the
     pulse grid, :func:`pipeline.campaign.pulse_grid.pulse_runs`).  ``levels``: None for
     :data:`DEFAULT_LEVELS`; given with the pulse grid, refused (it has its own PGA axis)."""
     data = column_file_description(column_file, meshes=True)
@@ -181,19 +181,19 @@ def fragility_specs(records, campaign_dir, levels=None, members=DEFAULT_MEMBERS,
         raise InputError(f"--column must be both, monolithic or drums, got {column!r}")
     if not (isinstance(azimuths, int) and 1 <= azimuths <= 360):
         raise InputError(f"--azimuths must be an integer in [1, 360], got {azimuths!r}")
-    seed = ensemble.DEFAULT_SEED if seed is None else seed
+    seed = ensemble_members.DEFAULT_SEED if seed is None else seed
     # the 2D block needs each member's height and h/d: no tilt or offset descriptions here
-    ranges = ensemble.contact_ranges({k: v for k, v in ensemble.ENSEMBLE_RANGES.items()
-                                      if k not in ensemble.GEOMETRY_KEYS}, contact)
+    ranges = ensemble_members.contact_ranges({k: v for k, v in ensemble_members.ENSEMBLE_RANGES.items()
+                                      if k not in ensemble_members.GEOMETRY_KEYS}, contact)
     base_kn = (contact or {}).get("kn")
     if data is None:
-        member_params = ensemble.sample_members(members, seed, ranges, column=column,
+        member_params = ensemble_members.sample_members(members, seed, ranges, column=column,
                                                 kn=base_kn or paper.COLUMN_KN_N_M)
     else:
-        member_params = ensemble.sample_members(members, seed, ranges, column=column,
+        member_params = ensemble_members.sample_members(members, seed, ranges, column=column,
                                                 description=data,
                                                 kn=base_kn or column_kn(data, stiffness))
-    member_params = ensemble.with_fixed_contact(member_params, contact)
+    member_params = ensemble_members.with_fixed_contact(member_params, contact)
     cache = motion_cache(campaign_dir)
     runs, extra = [], []
     for record in records:
@@ -221,7 +221,7 @@ def _pulse_specs(records, campaign_dir, data, column, pulses, members, headings,
     if column not in COLUMN_KINDS:
         raise InputError(f"--column must be both, monolithic or drums, got {column!r}")
     check_stiffness(stiffness)
-    seed = ensemble.DEFAULT_SEED if seed is None else seed
+    seed = ensemble_members.DEFAULT_SEED if seed is None else seed
     grid, sets, azimuths, runs = pulse_grid.pulse_runs(
         data, column, pulses, members, headings, azimuth, seed, ranges, stiffness, contact)
     cache = motion_cache(campaign_dir)
@@ -255,7 +255,7 @@ class FragilityOptions(CampaignOptions):
                          flag="--members")
     column: str = param("both", "", "column model (both: the twin model)", flag="--column",
                         choices=COLUMN_KINDS)
-    seed: int = param(ensemble.DEFAULT_SEED, "", "seed of the Latin hypercube", flag="--seed")
+    seed: int = param(ensemble_members.DEFAULT_SEED, "", "seed of the Latin hypercube", flag="--seed")
     azimuths: int = param(DEFAULT_AZIMUTHS, "", "2D block: shaking directions over 180 deg for "
                           "its worst case", 1, 360, flag="--azimuths")
     column_file: str = column_file_param(
@@ -291,7 +291,7 @@ class FragilityOptions(CampaignOptions):
         refuse_ignored_stiffness(self, contact_of(self), self.column_file is not None)
         if self.levels is not None:
             parse_levels(self.levels)
-        ensemble.check_seed(self.seed)
+        ensemble_members.check_seed(self.seed)
         if self.pulses is not None:
             parse_grid(self.pulses)
         if self.levels is not None and (self.pulses is not None or (

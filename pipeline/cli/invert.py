@@ -158,7 +158,7 @@ def _candidates(c):
 def build_grids(args):
     """(preset name, TableGrid, CandidateGrid) from the options; InputError if impossible."""
     from pipeline.inversion.grid import GRIDS, parse_mechanisms
-    from pipeline.campaign.ensemble import check_seed
+    from pipeline.campaign.ensemble_members import check_seed
     from pipeline.inversion.candidates import CandidateGrid
     from pipeline.inversion.workflows import CANDIDATE_PRESETS
     if args.quick and args.grid not in (None, "quick"):

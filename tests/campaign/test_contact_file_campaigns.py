@@ -6,7 +6,7 @@ import json
 import pytest
 
 from pipeline import cli
-from pipeline.campaign import ensemble
+from pipeline.campaign import ensemble, ensemble_members
 from pipeline.campaign.definitions import records_specs
 from pipeline.campaign.shake_table import specs as shake_table_specs
 
@@ -33,7 +33,7 @@ def test_ensemble_fixes_the_files_damping_and_multiplies_its_kn(tmp_path, contac
     members = [s for s in specs if s.tags["member"] >= 0]
     assert {s.params.contact.damping for s in specs} == {FILE["damping"]}
     factors = [s.params.contact.kn / FILE["kn"] for s in members]
-    lo, hi, _ = ensemble.ENSEMBLE_RANGES["kn_factor"]
+    lo, hi, _ = ensemble_members.ENSEMBLE_RANGES["kn_factor"]
     assert all(lo - 1e-6 <= f <= hi + 1e-6 for f in factors) and len(set(factors)) == 6
     nominal = next(s for s in specs if s.tags["member"] == -1)
     assert nominal.params.contact.kn == FILE["kn"]

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from pipeline import cli
-from pipeline.campaign.ensemble import ENSEMBLE_RANGES, parse_vary, sample_members
+from pipeline.campaign.ensemble_members import ENSEMBLE_RANGES, parse_vary, sample_members
 from pipeline.files import InputError
 from pipeline.motion import Motion
 from pipeline.motion.pulses import one_sine_pulse
@@ -123,12 +123,12 @@ def test_the_member_cap_ends_the_sizing_and_says_so(tmp_path):
 
 
 def test_batches_keep_the_members_that_ran():
-    from pipeline.campaign import ensemble
-    first = ensemble.sample_members(6, ensemble.DEFAULT_SEED)
-    grown = ensemble.sample_batches(18, 6, ensemble.DEFAULT_SEED)
+    from pipeline.campaign import ensemble_members
+    first = ensemble_members.sample_members(6, ensemble_members.DEFAULT_SEED)
+    grown = ensemble_members.sample_batches(18, 6, ensemble_members.DEFAULT_SEED)
     assert grown[:6] == first                      # a fixed 6-member ensemble, unchanged
     assert grown[6:12] != first and grown[12:] != grown[6:12]
-    assert grown == ensemble.sample_batches(18, 6, ensemble.DEFAULT_SEED)   # reproducible
+    assert grown == ensemble_members.sample_batches(18, 6, ensemble_members.DEFAULT_SEED)   # reproducible
 
 
 def test_mean_direction_error_is_the_circular_standard_error():

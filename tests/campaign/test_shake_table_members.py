@@ -10,7 +10,7 @@ import pandas as pd
 import pytest
 
 from pipeline import cli
-from pipeline.campaign import ensemble, pulse_grid
+from pipeline.campaign import ensemble_members, pulse_grid
 from pipeline.campaign.shake_table import EXPERIMENTS, OUTCOME, SPECIMEN
 from pipeline.campaign.shake_table_members import choose_ranges, member_sets
 from pipeline.campaign.shake_table_scores import write_scores
@@ -67,7 +67,7 @@ def test_members_are_the_fragilitys_draws():
     sets, drawn = member_sets(rock, 8, None, None)
     _, fragility_sets, _, _ = pulse_grid.pulse_runs(
         rock, "monolithic", "pga_g=0.5:0.5:1;pgv_pga_s=0.1:0.1:1", 8, 1, 90.0,
-        ensemble.DEFAULT_SEED, None)
+        ensemble_members.DEFAULT_SEED, None)
     assert sets == fragility_sets
     assert drawn == {"kn": (4e7, 1.2e8), "damping": (0.05, 0.1), "mu_s": (0.6, 0.8),
                      "footprint_tolerance_m": (0.001, 0.003)}

@@ -6,7 +6,7 @@ from pathlib import Path
 import pytest
 
 import pipeline
-from pipeline.campaign import ensemble, pulse_grid
+from pipeline.campaign import ensemble_members, pulse_grid
 from pipeline.campaign.shake_table import grid_contact
 from pipeline.scenario import Contact
 
@@ -25,7 +25,7 @@ def test_every_place_gives_a_static_friction_the_same_kinetic_one(mu_s):
     expected = pytest.approx(PAPER_RATIO * mu_s, abs=5e-5)
     assert Contact(mu_s=mu_s).mu_k == expected
     assert grid_contact({"mu_s": mu_s})["mu_k"] == expected
-    member = ensemble.sample_members(1, 3, {"mu_s": (mu_s, mu_s, "lin")})[0]
+    member = ensemble_members.sample_members(1, 3, {"mu_s": (mu_s, mu_s, "lin")})[0]
     assert member["mu_k"] == expected
     assert pulse_grid.sample_sets(1, 3, {"mu_s": (mu_s, mu_s)})[0]["mu_k"] == expected
 
