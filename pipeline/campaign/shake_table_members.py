@@ -31,7 +31,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from pipeline.campaign import ensemble, pulse_adaptive, pulse_grid, shake_table
+from pipeline.campaign import ensemble_members, pulse_adaptive, pulse_grid, shake_table
 from pipeline.campaign.column_file import column_kn
 from pipeline.campaign.run_dirs import finished_runs, finished_summary
 from pipeline.campaign.runs import column_specs
@@ -57,7 +57,7 @@ KN_OF_RUN_CPU_S = 1.2e8
 
 def check(options):
     """One-line refusals of the members mode's options, before any work."""
-    ensemble.check_seed(options.seed)
+    ensemble_members.check_seed(options.seed)
     specimen = ColumnGeometry.load(options.column_file or shake_table.SPECIMEN).to_dict()
     contact = None if options.contact_file is None else contact_values(options.contact_file)
     member_sets(specimen, options.members, options.seed, options.ranges, contact)
@@ -101,7 +101,7 @@ def member_sets(specimen, members, seed, ranges, contact=None):
     if members > 1 and all(lo == hi for lo, hi in drawn.values()):
         raise InputError(f"--members {members} with nothing drawn (give --ranges: a column "
                          "description draws nothing by default) would repeat one run")
-    seed = ensemble.DEFAULT_SEED if seed is None else seed
+    seed = ensemble_members.DEFAULT_SEED if seed is None else seed
     return pulse_grid.sample_sets(members, seed, drawn), drawn
 
 

@@ -20,7 +20,7 @@ scenario's exactly, other magnitudes scale lengths and durations self-similarly
 (x 10^(0.5 (Mw - 6.5)), L ~ M0^(1/3)).  The epicentre is the hypocentre's surface point.
 
 Every node gets the nominal twin run (the paper's values) and ``members`` Latin-hypercube
-members (:func:`pipeline.campaign.ensemble.sample_members`, one seed: member k has the same
+members (:func:`pipeline.campaign.ensemble_members.sample_members`, one seed: member k has the same
 column parameters at every node).  The runs are the campaign ``inversion-forward`` on the
 executor, so they are cached by content (run id = hash of motion, parameters and code) and
 a second inversion reuses every finished run.
@@ -39,7 +39,7 @@ from pipeline.files import InputError, write_csv
 from pipeline.inversion.grid import GRIDS, TableGrid, node_positions, slice_motions
 from pipeline.inversion.table import ForwardTable
 from pipeline.campaign.column_file import column_kn
-from pipeline.campaign.ensemble import nominal, sample_members
+from pipeline.campaign.ensemble_members import nominal, sample_members
 from pipeline.campaign import run_campaign
 
 log = logging.getLogger(__name__)
