@@ -247,7 +247,7 @@ def convergence(work):
     """Outcome of the 5 m/s^2 pulse toward N30E against the time-step factor (the default
     at the paper's damping, its half and its quarter) and the number of rim contact
     points (default early stop)."""
-    from pipeline.scenario.parameters import dt_factor_for
+    from pipeline.scenario.time_step import dt_factor_for
     default = dt_factor_for(Contact(), Numerics())
     factors = (default / 4, default / 2, default)
     rows = []
@@ -497,7 +497,7 @@ def time_step_limit(work, seconds):
     STABILITY_DAMPINGS, at the largest allowed factor and 1.3x it, on this machine's
     libm and on the second libm path (SECOND_LIBM_TUNABLES); the largest rotation of a
     body from where it was placed (deg).  Two runs at once (no speed is measured)."""
-    from pipeline.scenario.parameters import largest_stable_dt_factor
+    from pipeline.scenario.time_step import largest_stable_dt_factor
     from pipeline.scenario.runner import SECOND_LIBM_TUNABLES
     from pipeline.verification.checks import STILL_MODELS, still_rotation_deg
     cases = [(z, r, m) for z in STABILITY_DAMPINGS for r in STABILITY_RATIOS

@@ -250,7 +250,7 @@ for c, col in enumerate(COLUMNS):
                            initial_rotation=body["rotation"]))
 
 # ---------------------------------------------------------------- time step
-# from the lightest body resting on its whole base rim (pipeline.scenario.parameters.time_step_s)
+# from the lightest body resting on its whole base rim (pipeline.scenario.time_step.time_step_s)
 O.dt = P["time_step_s"]
 
 # ---------------------------------------------------------------- motion

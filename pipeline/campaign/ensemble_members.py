@@ -44,7 +44,8 @@ from pipeline.scenario import Contact, Numerics
 from pipeline.scenario.column_format import MAX_OFFSET_M
 from pipeline.scenario.contact_file import refuse_set_twice
 from pipeline.scenario.geometry import ColumnGeometry
-from pipeline.scenario.parameters import check_time_step, kinetic_friction
+from pipeline.scenario.parameters import kinetic_friction
+from pipeline.scenario.time_step import check_time_step
 from pipeline.simulate import check_scale
 
 DEFAULT_SEED = 20091001        # BSSA 99(5), October 2009

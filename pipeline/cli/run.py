@@ -12,7 +12,8 @@ from pipeline.motion import RECORD_CLOCK
 from pipeline.records import processed_motion, resolve
 from pipeline.scenario import Column, Contact, Drive, Numerics, RunParams
 from pipeline.cli._fields import add_arguments, add_column_file_argument, from_args
-from pipeline.scenario.parameters import check_cost, check_time_step, scene_params
+from pipeline.scenario.scene_build import scene_params
+from pipeline.scenario.time_step import check_cost, check_time_step
 from pipeline.scenario.runner import wall_limit_s
 from pipeline.simulate import MAX_SCALE, back_azimuth_of, simulate
 

@@ -8,9 +8,9 @@ A scenario directory holds ``params.json`` (the scene file: every parameter,
 """
 from pipeline.scenario.bodies import ColumnSpec
 from pipeline.scenario.geometry import ColumnGeometry
-from pipeline.scenario.parameters import (PEDESTAL, Block, Column, Contact, Drive,
-                                          Numerics, RunParams, scene_params)
+from pipeline.scenario.parameters import Block, Column, Contact, Drive, Numerics, RunParams
 from pipeline.scenario.runner import YadeError, run_yade
+from pipeline.scenario.scene_build import PEDESTAL, scene_params
 from pipeline.scenario.scene_file import SceneFile
 from pipeline.scenario.specimen import Specimen
 from pipeline.scenario.writer import write_scenario

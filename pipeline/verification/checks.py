@@ -19,7 +19,8 @@ from pipeline.outcome.columns import body_axes, rotation_from_start_deg
 from pipeline.scenario import (Block, Column, ColumnGeometry, ColumnSpec, Contact, Numerics,
                                run_yade, scene_params, write_scenario)
 from pipeline.scenario.solids import ColumnBlock, Frustum
-from pipeline.scenario.parameters import kinetic_friction, split_options, time_step_s
+from pipeline.scenario.parameters import kinetic_friction, split_options
+from pipeline.scenario.time_step import time_step_s
 
 MARBLE_BLOCK = paper.MARBLE_BLOCK_M
 PULSE_BLOCK = paper.PULSE_BLOCK_M

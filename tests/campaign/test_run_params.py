@@ -15,7 +15,7 @@ from pipeline.files import InputError
 from pipeline.outcome.summary import RunSummary
 from pipeline.scenario import Column, Drive, RunParams
 from pipeline.scenario.geometry import ColumnGeometry
-from pipeline.scenario.parameters import dt_factor_for
+from pipeline.scenario.time_step import dt_factor_for
 
 ROOT = Path(__file__).resolve().parents[2]
 SCENE = ROOT / "yade_scripts" / "column_scene.py"

@@ -129,7 +129,7 @@ def test_a_run_that_cannot_finish_in_its_wall_clock_limit_is_refused_before_it_s
     assert "60 bodies" in err and "wall-clock limit" in err
     assert not (tmp_path / "out").exists()
     from pipeline.scenario import ColumnGeometry, ColumnSpec, scene_params
-    from pipeline.scenario.parameters import check_cost
+    from pipeline.scenario.time_step import check_cost
     sixty = ColumnGeometry.from_dict(column)
     params = scene_params(columns=[ColumnSpec("drums", "drums", 0.0, 0.0, sixty)],
                           motion_duration=120.0)

@@ -10,7 +10,7 @@ import pytest
 from pipeline.files import InputError
 from pipeline.motion import Motion
 from pipeline.scenario import Column, Contact, Numerics, scene_params, write_scenario
-from pipeline.scenario.parameters import largest_stable_dt_factor
+from pipeline.scenario.time_step import largest_stable_dt_factor
 from pipeline.scenario.writer import SCENE_TEMPLATE
 
 

@@ -16,7 +16,7 @@ from pipeline.motion.pulses import one_sine_pulse as pulse
 from pipeline.outcome.columns import column_outcomes, total_energy
 from pipeline.scenario import Block, Column, Contact, Numerics, run_yade, scene_params, \
     write_scenario
-from pipeline.scenario.parameters import check_time_step, largest_stable_dt_factor
+from pipeline.scenario.time_step import check_time_step, largest_stable_dt_factor
 from pipeline.scenario.scene_file import SceneFile
 from pipeline.verification.checks import still_rotation_deg
 
