@@ -30,21 +30,19 @@ from pipeline import paper
 from pipeline.files import InputError, write_csv, write_json
 from pipeline.inversion.likelihood import (DEFAULT_FLOOR, DEFAULT_KERNEL_DEG, LIKELIHOODS,
                                            ForwardModel)
-from pipeline.inversion.observations import ColumnObservation, Observations, Site
 from pipeline.inversion import truth_check
 from pipeline.inversion.candidates import OutOfReach, within_reach
 from pipeline.inversion.credible import in_arc
+from pipeline.inversion.paper_scenario import paper_outputs
 from pipeline.inversion.posterior import invert
-from pipeline.stats.circular import angle_difference_deg, azimuth_deg
-from pipeline.motion.synthetics import SOURCES
+from pipeline.inversion.sites import OBS_UNCERTAINTY_DEG, draw_site_columns, map_azimuth_error, \
+    site_frame, site_position
+from pipeline.stats.circular import azimuth_deg
 
 FALLEN_PER_SITE = (1, 3, 10, 30)
 SITE_COUNTS = (1, 3)
 DEFAULT_TRIALS = 20
-OBS_UNCERTAINTY_DEG = 10.0
 DEMO_SEED = 2009
-PAPER_RINGS_KM = (5.0, 10.0, 20.0)
-PAPER_MECHANISMS = {"strike_slip": "strike-slip", "thrust": "thrust"}
 # the paper's question: a 95 % back-azimuth arc no wider than BOUND_DEG (deg), and its
 # words and result keys
 BOUND_DEG = 2 * paper.BACK_AZIMUTH_BOUND_DEG
@@ -58,48 +56,6 @@ def split_members(table):
     """(likelihood half: even member indices, observation half: odd ones)."""
     even = table.members % 2 == 0
     return table.select_members(even), table.select_members(~even)
-
-
-def _site_position(r_km, alpha_deg):
-    a = math.radians(alpha_deg)
-    return r_km * math.sin(a), r_km * math.cos(a)
-
-
-def _frame(sites_world, truth_world=(0.0, 0.0)):
-    """Sites relative to the first one; the truth in that frame."""
-    e0, n0 = sites_world[0][1], sites_world[0][2]
-    sites = [Site(name, e - e0, n - n0, cols) for name, e, n, cols in sites_world]
-    truth = (truth_world[0] - e0, truth_world[1] - n0)
-    return Observations(tuple(sites), "synthetic"), truth
-
-
-def draw_site_columns(pool, s, i, j, strike_deg, fallen, rng, sigma_deg=OBS_UNCERTAINTY_DEG,
-                      pick_slice=None):
-    """Columns at node (slice s, ring i, azimuth j) drawn from ``pool`` until ``fallen``
-    have fallen: a column type and a member at random, falls turned by the strike with a
-    normal measurement error of ``sigma_deg``; ``pick_slice()``, when given, chooses each
-    column's slice instead of ``s``.  None when no slice that may be picked has a fall
-    there (the caller checks that for ``pick_slice``)."""
-    if pick_slice is None:
-        if not pool.toppled[s, i, j].any():
-            return None
-        def pick_slice():
-            return s
-    cols, count = [], 0
-    for _ in range(50 * fallen + 50):
-        k = pick_slice()
-        choices = np.argwhere(pool.valid[k, i, j])
-        c, m = choices[rng.integers(len(choices))]
-        if pool.toppled[k, i, j, c, m]:
-            az = (pool.azimuth_deg[k, i, j, c, m] + strike_deg
-                  + rng.normal(0.0, sigma_deg)) % 360.0
-            cols.append(ColumnObservation(pool.columns[c], "fallen", float(az), sigma_deg))
-            count += 1
-            if count == fallen:
-                break
-        else:
-            cols.append(ColumnObservation(pool.columns[c], "standing"))
-    return tuple(cols)
 
 
 def truth_trial(model, pool, mechanism, n_sites, fallen, candidates, rng):
@@ -116,10 +72,10 @@ def truth_trial(model, pool, mechanism, n_sites, fallen, candidates, rng):
     for k, pick in enumerate(picks):
         i, j = nodes[pick]
         alpha = (table.azimuths_deg[j] + strike) % 360.0
-        e, n = _site_position(table.distances_km[i], alpha)
+        e, n = site_position(table.distances_km[i], alpha)
         cols = draw_site_columns(pool, s, i, j, strike, fallen, rng)
         sites.append((f"S{k + 1}", e, n, cols))
-    observations, truth = _frame(sites)
+    observations, truth = site_frame(sites)
     true_baz = azimuth_deg(truth[0], truth[1])
     d = math.hypot(*truth)
     row = {"mechanism": mechanism, "sites": len(sites), "fallen_per_site": fallen,
@@ -154,14 +110,6 @@ def truth_trial(model, pool, mechanism, n_sites, fallen, candidates, rng):
             "credible_area_95_km2": summary["credible_area_95_km2"],
             "p_true_mechanism": summary["mechanism_posterior"].get(mechanism, 0.0)}, \
         (post, observations, truth)
-
-
-def map_azimuth_error(summary, true_baz):
-    """The MAP back azimuth's error (deg); NaN when the summary gives no direction (the
-    source may lie beyond the reach)."""
-    if summary["back_azimuth_map_deg"] is None:
-        return np.nan
-    return angle_difference_deg(summary["back_azimuth_map_deg"], true_baz)
 
 
 REACH_KEYS = ("within_reach", "reach_warning", "reach_edge_fraction",
@@ -253,100 +201,6 @@ def bound_answer(narrow):
 
 
 # ---------------------------------------------------------------- paper scenario
-def paper_grid(main_grid, source_name, quick=False):
-    """The forward grid holding the nominal twin runs at the paper's sites of one source."""
-    src = SOURCES[source_name]
-    mech = PAPER_MECHANISMS[source_name]
-    return main_grid.replace(mechanisms=((mech, src["dip_deg"], src["rake_deg"]),),
-                             depths_km=(src["depth_km"],), magnitudes=(src["mw"],),
-                             distances_km=PAPER_RINGS_KM[:2] if quick else PAPER_RINGS_KM,
-                             members=0, nominal=True)
-
-
-def paper_nodes(table, source_name):
-    """(slice, ring indices, azimuth indices) of the paper's sites in ``table`` or None."""
-    src = SOURCES[source_name]
-    try:
-        s = table.slice_index(PAPER_MECHANISMS[source_name], src["depth_km"], src["mw"])
-    except KeyError:
-        return None
-    if table.nominal_toppled is None:
-        return None
-    sl = table.slices[s]
-    if (sl["dip_deg"], sl["rake_deg"]) != (src["dip_deg"], src["rake_deg"]):
-        return None
-    rings = [i for i, r in enumerate(table.distances_km) if r in PAPER_RINGS_KM]
-    return (s, rings, list(range(len(table.azimuths_deg)))) if rings else None
-
-
-def paper_scenario(model, obs_table, source_name, candidates):
-    """Per site of the paper's rings: what its twin (nominal run) shows and what the
-    inversion of that one site gives; plus the joint inversion of the sites within half
-    the forward table's last ring of the source (then every candidate within that half of
-    the source is within the table's reach of every site; None when no ring is that near)."""
-    src = SOURCES[source_name]
-    strike = src["strike_deg"]
-    s, rings, azimuths = paper_nodes(obs_table, source_name)
-    rows, all_sites = [], []
-    for i in rings:
-        for j in azimuths:
-            theta = obs_table.azimuths_deg[j]
-            site_az = (theta + strike) % 360.0          # epicentre -> site, geographic
-            e, n = _site_position(obs_table.distances_km[i], site_az)
-            cols = []
-            for c, column in enumerate(obs_table.columns):
-                if not obs_table.nominal_valid[s, i, j, c]:
-                    continue
-                if obs_table.nominal_toppled[s, i, j, c]:
-                    az = (obs_table.nominal_azimuth_deg[s, i, j, c] + strike) % 360.0
-                    cols.append(ColumnObservation(column, "fallen", float(az),
-                                                  OBS_UNCERTAINTY_DEG))
-                else:
-                    cols.append(ColumnObservation(column, "standing"))
-            name = f"r{obs_table.distances_km[i]:g}_az{site_az:03.0f}"
-            if obs_table.distances_km[i] <= model.table.distances_km[-1] / 2 + 1e-9:
-                all_sites.append((name, e, n, tuple(cols)))
-            observations, truth = _frame([(name, e, n, tuple(cols))])
-            post = invert(model, observations, candidates)
-            summary = post.summary()
-            true_baz = (site_az + 180.0) % 360.0
-            fell = {c.column: (round(c.downfall_azimuth_deg) if c.fallen else "stands")
-                    for c in cols}
-            rows.append({"source": source_name, "site": name,
-                         "distance_km": float(obs_table.distances_km[i]),
-                         "true_back_azimuth_deg": true_baz,
-                         "drums": fell.get("drums"), "monolithic": fell.get("monolithic"),
-                         "fallen": sum(c.fallen for c in cols),
-                         "width95_deg": summary["back_azimuth_ci95_width_deg"],
-                         "back_azimuth_in_95": in_arc(true_baz, summary["back_azimuth_ci95_deg"]),
-                         "map_back_azimuth_deg": summary["back_azimuth_map_deg"],
-                         "map_error_deg": map_azimuth_error(summary, true_baz),
-                         "epicentre_in_95": post.contains(*truth, level=0.95),
-                         "credible_area_95_km2": summary["credible_area_95_km2"],
-                         "reach_warning": summary["reach_warning"] is not None,
-                         "p_true_mechanism": summary["mechanism_posterior"].get(
-                             PAPER_MECHANISMS[source_name], 0.0)})
-    if not all_sites:
-        return pd.DataFrame(rows), None, None
-    observations, truth = _frame(all_sites)
-    joint = invert(model, observations, candidates)
-    js = joint.summary()
-    true_baz = azimuth_deg(*truth)
-    joint_row = {"source": source_name, "sites": len(all_sites),
-                 "sites_within_km": max(math.hypot(e, n) for _, e, n, _ in all_sites),
-                 "fallen": observations.n_fallen, "columns": observations.n_columns,
-                 "epicentre_error_km": math.hypot(js["map_epicentre_km"][0] - truth[0],
-                                                  js["map_epicentre_km"][1] - truth[1]),
-                 "epicentre_in_95": joint.contains(*truth, level=0.95),
-                 "credible_area_95_km2": js["credible_area_95_km2"],
-                 "mechanism_posterior": js["mechanism_posterior"],
-                 "strike_map_deg": js["map_candidate"]["strike_deg"],
-                 "true_strike_deg": strike, "reach_km": js["reach_km"],
-                 "reach_edge_fraction": js["reach_edge_fraction"],
-                 "reach_warning": js["reach_warning"]}
-    return pd.DataFrame(rows), joint_row, (joint, observations, truth)
-
-
 # ---------------------------------------------------------------- the whole demo
 def run_demo(table, out_dir, candidates, paper_tables=None, trials=DEFAULT_TRIALS,
              kernel_deg=DEFAULT_KERNEL_DEG, floor=DEFAULT_FLOOR, forward_info=None,
@@ -365,7 +219,7 @@ def run_demo(table, out_dir, candidates, paper_tables=None, trials=DEFAULT_TRIAL
         forward_info)
     coverage = _coverage(trials_frame)
     # one column per type and site: both likelihoods give the same paper-scenario numbers
-    paper_sites, paper_joint, paper_figures = _paper_outputs(
+    paper_sites, paper_joint, paper_figures = paper_outputs(
         ForwardModel(table, kernel_deg, floor), paper_tables, candidates, out_dir,
         forward_info)
     figures += paper_figures
@@ -437,37 +291,6 @@ def _coverage(trials_frame):
         "within_reach": float(g["within_reach"].mean()),
         "reach_warning": float(g["reach_warning"].mean())}
         for kind, g in trials_frame.groupby("likelihood", sort=False)}
-
-
-def _paper_outputs(full_model, paper_tables, candidates, out_dir, forward_info):
-    """The paper's sources inverted site by site and all sites together:
-    paper_scenario_sites.csv and the maps; returns (per-site rows, joint rows, figures)."""
-    from pipeline.inversion import write_outputs
-    paper_rows, paper_joint, figures = [], [], []
-    for source_name, obs_table in (paper_tables or {}).items():
-        if obs_table is None or paper_nodes(obs_table, source_name) is None:
-            continue
-        sites, joint_row, detail = paper_scenario(full_model, obs_table, source_name,
-                                                  candidates)
-        paper_rows.append(sites)
-        if joint_row is None:
-            continue
-        joint, observations, truth = detail
-        paper_joint.append(joint_row)
-        sub = out_dir / f"paper_{source_name}_all_sites"
-        write_outputs(joint, observations, sub, forward_info,
-                      truth={"epicentre_km": list(truth),
-                             "mechanism": PAPER_MECHANISMS[source_name],
-                             "back_azimuth_deg": math.degrees(math.atan2(*truth)) % 360,
-                             "distance_km": math.hypot(*truth)},
-                      title=f"The paper's {source_name} source: the twins of the "
-                            f"{joint_row['sites']} sites within "
-                            f"{joint_row['sites_within_km']:g} km")
-        figures.append(sub / "posterior_map.png")
-    paper_sites = pd.concat(paper_rows, ignore_index=True) if paper_rows else pd.DataFrame()
-    if not paper_sites.empty:
-        write_csv(out_dir / "paper_scenario_sites.csv", paper_sites)
-    return paper_sites, paper_joint, figures
 
 
 def _paper_per_source(sites):

@@ -153,8 +153,8 @@ def demo(options, preset, grid, candidates):
     """invert --demo: the forward table, the paper scenario's tables, the truth tests
     (demo_summary.json) and the two-site example."""
     from pipeline.inversion import EXAMPLES_DIR, run_inversion
-    from pipeline.inversion.demo import (BOUND_ANSWER_KEY, BOUND_TEXT, DEFAULT_TRIALS, paper_grid,
-                                         paper_nodes, run_demo)
+    from pipeline.inversion.demo import BOUND_ANSWER_KEY, BOUND_TEXT, DEFAULT_TRIALS, run_demo
+    from pipeline.inversion.paper_scenario import paper_grid, paper_nodes
     from pipeline.inversion.forward import run_forward, table_path
     from pipeline.inversion.table import ForwardTable
     from pipeline.inversion.observations import load_observations
@@ -228,9 +228,9 @@ def member_study(options, grid, candidates):
     from pipeline.inversion.demo import BOUND_DEG
     from pipeline.inversion.likelihood import SITE_COLUMNS
     from pipeline.inversion.study import (LIKELIHOOD_MEMBERS, OBSERVATION_MEMBERS,
-                                          STUDY_SEED, STUDY_TRIALS, member_study,
-                                          placement_summary,
-                                          study_answer, study_summary, warning_rates)
+                                          STUDY_SEED, STUDY_TRIALS, member_study)
+    from pipeline.inversion.study_summary import (placement_summary, study_answer,
+                                                  study_summary, warning_rates)
     out = options.out or RESULTS_DIR / "inversion" / "member-study"
     if out.exists() and not out.is_dir():
         raise InputError(f"--out {out} is a file, not a directory")

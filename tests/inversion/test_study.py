@@ -6,7 +6,8 @@ import numpy as np
 
 from pipeline.inversion.candidates import CandidateGrid
 from pipeline.inversion.credible import magnitude_set
-from pipeline.inversion.study import member_study, split_for_study, study_answer, study_summary
+from pipeline.inversion.study import member_study, split_for_study
+from pipeline.inversion.study_summary import placement_summary, study_answer, study_summary, warning_rates
 
 
 def test_observations_come_from_members_no_likelihood_uses(make_away_table):
@@ -148,7 +149,6 @@ def test_truths_lie_off_the_likelihoods_nodes_too(make_away_table):
                    "warned_within_reach", "coverage_back_azimuth_95_between"):
         assert column in summary
     assert summary["beyond_reach_warned"].between(0.0, 1.0).all()
-    from pipeline.inversion.study import placement_summary, warning_rates
     placements = placement_summary(rows).set_index("placement")
     assert placements.loc["beyond the reach", "trials"] == beyond.sum()
     assert placements.loc["beyond the reach", "reach_warning"] == \
