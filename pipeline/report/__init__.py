@@ -4,7 +4,8 @@
 
 Sections for campaigns that have not run say so instead of inventing numbers.  One module
 per kind of section: ``records`` (records, processing, synthetics), ``campaigns``
-(verification, sweeps, ensembles, fragility, real columns, shake table, speed),
+(verification, sweeps, real columns, shake table, speed, run-all's cost), ``ensembles``
+(ensembles, the paper's question, convergence), ``contact_stiffness``, ``fragility``,
 ``inversion``; shared helpers in ``common``."""
 import datetime
 import json
@@ -12,12 +13,12 @@ from pathlib import Path
 
 from pipeline import RESULTS_DIR, __version__
 from pipeline.files import write_text
-from pipeline.report.campaigns import (columns_section, contact_stiffness_section,
-                                       convergence_section, ensemble_section,
-                                       fragility_section, paper_question_section, run_all_section,
-                                       rock_fragility_section, shake_table_section,
-                                       speed_section, sweep_section,
-                                       verification_section)
+from pipeline.report.campaigns import (columns_section, run_all_section, shake_table_section,
+                                       speed_section, sweep_section, verification_section)
+from pipeline.report.contact_stiffness import contact_stiffness_section
+from pipeline.report.ensembles import (convergence_section, ensemble_section,
+                                       paper_question_section)
+from pipeline.report.fragility import fragility_section, rock_fragility_section
 from pipeline.report.field_rock import FIELD_ROCK_QUICK, field_rock_section
 from pipeline.report.hazard import survival_section
 from pipeline.report.inversion import inversion_section, member_study_section

@@ -63,7 +63,7 @@ def test_specs_sample_each_setting_independently(tmp_path):
 
 def test_the_report_says_where_p_toppled_was_not_tested(tmp_path):
     import json
-    from pipeline.report.campaigns import convergence_section
+    from pipeline.report.ensembles import convergence_section
     rng = np.random.default_rng(5)
     rows = _members(rng, "default", 10, 1.0, 10.0) + _members(rng, "rim 32", 10, 1.0, 12.0)
     result = compare_variants(pd.DataFrame(rows), {"default": 10.0, "rim 32": 25.0})
