@@ -9,7 +9,9 @@ import re
 import numpy as np
 import pytest
 
-from pipeline import cli, paper, rocking
+from pipeline import cli, paper
+from pipeline.rocking.decay import fit_free_rocking
+from pipeline.rocking.response import housner_free_rocking
 from pipeline.files import InputError
 
 BLOCK = paper.MARBLE_BLOCK_M          # the paper's marble block: 0.40 x 0.08 m, h/b 5
@@ -19,7 +21,7 @@ H, B = BLOCK["height"], BLOCK["width"]
 def recorded_decay(restitution, dt=0.002, impacts=8):
     """A decay as an instrument records it: uniform samples of the rigid block's tilt,
     released from rest at half its overturning angle."""
-    out = rocking.housner_free_rocking(H, B, 0.5 * math.atan(B / H), n_impacts=impacts,
+    out = housner_free_rocking(H, B, 0.5 * math.atan(B / H), n_impacts=impacts,
                                        restitution=restitution)
     t = np.arange(0.0, out["t"][-1], dt)
     return out, t, np.interp(t, out["t"], out["theta"])
@@ -28,7 +30,7 @@ def recorded_decay(restitution, dt=0.002, impacts=8):
 @pytest.mark.parametrize("restitution", [0.75, 0.85, 0.93, None])
 def test_restitution_recovered_from_a_tilt_record(restitution):
     out, t, theta = recorded_decay(restitution)
-    fit = rocking.fit_free_rocking(H, B, t=t, theta=theta)
+    fit = fit_free_rocking(H, B, t=t, theta=theta)
     assert fit["restitution"] == pytest.approx(out["restitution"], abs=2e-3)
     assert fit["restitution_sd"] < 2e-3          # a rigid block: every impact alike
     assert fit["impacts"] >= 6
@@ -39,7 +41,7 @@ def test_restitution_recovered_from_a_tilt_record(restitution):
 def test_tilt_in_degrees_and_noise():
     out, t, theta = recorded_decay(0.85)
     noisy = theta + np.random.default_rng(1).normal(0.0, 2e-4, theta.size)
-    fit = rocking.fit_free_rocking(H, B, t=t, theta=noisy)
+    fit = fit_free_rocking(H, B, t=t, theta=noisy)
     # noise of 2e-4 rad on amplitudes of ~0.05 rad: restitution within 0.01, scatter said
     assert fit["restitution"] == pytest.approx(0.85, abs=0.01)
     assert fit["restitution_sd"] > 0 and fit["restitution_se"] < fit["restitution_sd"]
@@ -47,12 +49,12 @@ def test_tilt_in_degrees_and_noise():
 
 @pytest.mark.parametrize("restitution", [0.8, 0.9])
 def test_restitution_from_frequency_and_amplitude_ratio(restitution):
-    out = rocking.housner_free_rocking(H, B, 0.5 * math.atan(B / H), n_impacts=6,
+    out = housner_free_rocking(H, B, 0.5 * math.atan(B / H), n_impacts=6,
                                        restitution=restitution)
     impacts, peaks = out["impact_times"], np.abs(out["peak_theta"])
     # the swing between impacts 2 and 3 has the amplitude after 3 impacts: half a cycle
     frequency = 1.0 / (2.0 * (impacts[3] - impacts[2]))
-    fit = rocking.fit_free_rocking(H, B, frequency_hz=frequency,
+    fit = fit_free_rocking(H, B, frequency_hz=frequency,
                                    amplitude_ratios=[peaks[4] / peaks[3]])
     # the amplitude from the linearised period (eq 7): slender block, within 0.005
     assert fit["restitution"] == pytest.approx(restitution, abs=5e-3)
@@ -62,7 +64,7 @@ def test_restitution_from_frequency_and_amplitude_ratio(restitution):
 def test_amplitude_beyond_alpha_refused():
     out, t, theta = recorded_decay(0.85)
     with pytest.raises(InputError, match="overturning angle"):
-        rocking.fit_free_rocking(H, B, t=t, theta=theta * 57.3)
+        fit_free_rocking(H, B, t=t, theta=theta * 57.3)
 
 
 def test_command_writes_the_contact_file(tmp_path, capsys):

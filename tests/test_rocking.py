@@ -4,7 +4,13 @@ import math
 import numpy as np
 import pytest
 
-from pipeline import rocking as rk
+from pipeline.rocking.decay import restitution_from_peaks
+from pipeline.rocking.housner import (augusti_sinopoli_mu_min, block_constants, cylinder_constants,
+                                      housner_closed_form, housner_half_periods,
+                                      impact_friction_demand)
+from pipeline.rocking.pulse import (MODE_NO_OVERTURN, MODE_OVERTURN_WITHOUT_IMPACT, mode_edges,
+                                    overturning_map, sine_pulse_response)
+from pipeline.rocking.response import housner_free_rocking, rocking_response
 from pipeline.files import InputError
 
 G = 9.81
@@ -17,7 +23,7 @@ def energy_per_mass(c, theta, omega):
 
 
 def test_paper_block_constants():
-    c = rk.block_constants(PAPER_H, PAPER_B)
+    c = block_constants(PAPER_H, PAPER_B)
     assert c["alpha"] == pytest.approx(0.25, abs=1e-3)
     assert c["p"] == pytest.approx(2.14, abs=2e-3)
     assert c["uplift_acc"] == pytest.approx(G * PAPER_B / PAPER_H)
@@ -27,9 +33,9 @@ def test_paper_block_constants():
 
 
 def test_energy_conserved_between_impacts_and_reduced_by_eta_squared():
-    c = rk.block_constants(PAPER_H, PAPER_B)
+    c = block_constants(PAPER_H, PAPER_B)
     eta = 0.8
-    out = rk.housner_free_rocking(PAPER_H, PAPER_B, 0.7 * c["alpha"], n_impacts=4,
+    out = housner_free_rocking(PAPER_H, PAPER_B, 0.7 * c["alpha"], n_impacts=4,
                                   restitution=eta, dt_out=0.002)
     t, e = out["t"], energy_per_mass(c, out["theta"], out["omega"])
     bounds = np.concatenate([[0.0], out["impact_times"], [np.inf]])
@@ -48,8 +54,8 @@ def test_energy_conserved_between_impacts_and_reduced_by_eta_squared():
 
 
 def test_elastic_rocking_keeps_its_amplitude():
-    c = rk.block_constants(PAPER_H, PAPER_B)
-    out = rk.housner_free_rocking(PAPER_H, PAPER_B, -0.4 * c["alpha"], n_impacts=6,
+    c = block_constants(PAPER_H, PAPER_B)
+    out = housner_free_rocking(PAPER_H, PAPER_B, -0.4 * c["alpha"], n_impacts=6,
                                   restitution=1.0)
     np.testing.assert_allclose(np.abs(out["peak_theta"]), 0.4 * c["alpha"], rtol=1e-7)
     assert np.all(np.sign(out["peak_theta"]) == (-1) ** (np.arange(7) + 1))
@@ -58,9 +64,9 @@ def test_elastic_rocking_keeps_its_amplitude():
 
 
 def test_linearised_quarter_period_is_cosh_solution():
-    c = rk.block_constants(PAPER_H, PAPER_B)
+    c = block_constants(PAPER_H, PAPER_B)
     alpha, p, theta0 = c["alpha"], c["p"], 0.3 * c["alpha"]
-    out = rk.housner_free_rocking(PAPER_H, PAPER_B, theta0, n_impacts=1, linearised=True)
+    out = housner_free_rocking(PAPER_H, PAPER_B, theta0, n_impacts=1, linearised=True)
     t1 = math.acosh(alpha / (alpha - theta0)) / p
     assert out["impact_times"][0] == pytest.approx(t1, rel=1e-9)
     before = out["t"] < t1
@@ -73,64 +79,64 @@ def test_linearised_quarter_period_is_cosh_solution():
 
 def test_slender_block_small_tilt_follows_linearised_solution():
     height, width = 10.0, 0.5                 # alpha ~ 0.05 rad: sin(x) ~ x within 0.1 %
-    c = rk.block_constants(height, width)
+    c = block_constants(height, width)
     p, theta0 = c["p"], 0.5 * c["alpha"]
-    out = rk.housner_free_rocking(height, width, theta0, n_impacts=1)
+    out = housner_free_rocking(height, width, theta0, n_impacts=1)
     assert out["impact_times"][0] == pytest.approx(math.acosh(2.0) / p, rel=2e-3)
 
 
 def test_closed_form_eq6_eq7_match_linearised_integration():
-    c = rk.block_constants(PAPER_H, PAPER_B)
+    c = block_constants(PAPER_H, PAPER_B)
     for ratio in (0.2, 0.5, 0.9):
-        out = rk.housner_free_rocking(PAPER_H, PAPER_B, ratio * c["alpha"], n_impacts=8,
+        out = housner_free_rocking(PAPER_H, PAPER_B, ratio * c["alpha"], n_impacts=8,
                                       linearised=True)
-        amplitudes = rk.housner_closed_form(ratio, c["energy_ratio"], 8)
+        amplitudes = housner_closed_form(ratio, c["energy_ratio"], 8)
         np.testing.assert_allclose(out["peak_ratio"], amplitudes, rtol=1e-7)
-        half = rk.housner_half_periods(PAPER_H, PAPER_B, ratio, 8)
+        half = housner_half_periods(PAPER_H, PAPER_B, ratio, 8)
         expected_impacts = half[0] / 2 + np.concatenate([[0.0], np.cumsum(half[1:8])])
         np.testing.assert_allclose(out["impact_times"], expected_impacts, rtol=1e-7)
 
 
 def test_closed_form_limits():
     # no loss: amplitude kept; released at the top (theta0 = alpha): stays there
-    np.testing.assert_allclose(rk.housner_closed_form(0.4, 1.0, 5), 0.4)
-    np.testing.assert_allclose(rk.housner_closed_form(1.0, 0.8, 3), [1, 1 - math.sqrt(0.2),
+    np.testing.assert_allclose(housner_closed_form(0.4, 1.0, 5), 0.4)
+    np.testing.assert_allclose(housner_closed_form(1.0, 0.8, 3), [1, 1 - math.sqrt(0.2),
                                                                      1 - math.sqrt(0.36),
                                                                      1 - math.sqrt(1 - 0.512)])
 
 
 def test_nonlinear_paper_block_impact_times_match_shared_notes():
-    c = rk.block_constants(PAPER_H, PAPER_B)
-    out = rk.housner_free_rocking(PAPER_H, PAPER_B, 0.5 * c["alpha"], n_impacts=4)
+    c = block_constants(PAPER_H, PAPER_B)
+    out = housner_free_rocking(PAPER_H, PAPER_B, 0.5 * c["alpha"], n_impacts=4)
     np.testing.assert_allclose(out["impact_times"], [0.6165, 1.6123, 2.4528, 3.1785], atol=1e-3)
 
 
 def test_nonlinear_peaks_follow_exact_energy_recurrence_and_give_back_eta():
-    c = rk.block_constants(PAPER_H, PAPER_B)
-    out = rk.housner_free_rocking(PAPER_H, PAPER_B, 0.8 * c["alpha"], n_impacts=5)
+    c = block_constants(PAPER_H, PAPER_B)
+    out = housner_free_rocking(PAPER_H, PAPER_B, 0.8 * c["alpha"], n_impacts=5)
     peaks = np.abs(out["peak_theta"])
     # cos(alpha - theta_{k+1}) - cos(alpha) = eta^2 (cos(alpha - theta_k) - cos(alpha))
     lhs = np.cos(c["alpha"] - peaks[1:]) - math.cos(c["alpha"])
     rhs = c["energy_ratio"] * (np.cos(c["alpha"] - peaks[:-1]) - math.cos(c["alpha"]))
     np.testing.assert_allclose(lhs, rhs, rtol=1e-7)
-    est = rk.restitution_from_peaks(peaks, c["alpha"])
+    est = restitution_from_peaks(peaks, c["alpha"])
     assert est["eta"] == pytest.approx(c["restitution"], rel=1e-7)
     np.testing.assert_allclose(est["eta_per_impact"], c["restitution"], rtol=1e-7)
 
 
 def test_free_release_beyond_alpha_overturns_that_way():
-    c = rk.block_constants(PAPER_H, PAPER_B)
-    out = rk.housner_free_rocking(PAPER_H, PAPER_B, -1.01 * c["alpha"], n_impacts=3)
+    c = block_constants(PAPER_H, PAPER_B)
+    out = housner_free_rocking(PAPER_H, PAPER_B, -1.01 * c["alpha"], n_impacts=3)
     assert out["overturned"] and out["impact_times"].size == 0
 
 
 def test_no_uplift_below_g_tan_alpha_and_uplift_above():
-    c = rk.block_constants(PAPER_H, PAPER_B)
-    below = rk.rocking_response(PAPER_H, PAPER_B,
+    c = block_constants(PAPER_H, PAPER_B)
+    below = rocking_response(PAPER_H, PAPER_B,
                                 lambda t: 0.99 * c["uplift_acc"] * math.sin(7.0 * t), 3.0)
     assert below["uplift_times"].size == 0
     assert np.all(below["theta"] == 0) and below["max_abs_theta"] == 0
-    above = rk.rocking_response(PAPER_H, PAPER_B,
+    above = rocking_response(PAPER_H, PAPER_B,
                                 lambda t: 1.05 * c["uplift_acc"] * math.sin(7.0 * t), 3.0)
     # first uplift when sin(7 t) = 1 / 1.05, onto the West corner (East push)
     assert above["uplift_times"][0] == pytest.approx(math.asin(1 / 1.05) / 7.0, abs=1e-6)
@@ -138,21 +144,21 @@ def test_no_uplift_below_g_tan_alpha_and_uplift_above():
 
 
 def test_east_push_rocks_block_onto_west_corner():
-    c = rk.block_constants(PAPER_H, PAPER_B)
-    out = rk.rocking_response(PAPER_H, PAPER_B, lambda t: 2.0 * c["uplift_acc"] * (t < 0.2),
+    c = block_constants(PAPER_H, PAPER_B)
+    out = rocking_response(PAPER_H, PAPER_B, lambda t: 2.0 * c["uplift_acc"] * (t < 0.2),
                               1.0, still_after=0.2)
     first_moves = out["theta"][out["theta"] != 0][:10]
     assert np.all(first_moves < 0)
 
 
 def test_mirror_symmetry():
-    c = rk.block_constants(PAPER_H, PAPER_B)
+    c = block_constants(PAPER_H, PAPER_B)
 
     def acc(t):
         return 1.6 * c["uplift_acc"] * math.sin(2 * math.pi * 0.9 * t) * math.exp(-0.3 * t)
 
-    out = rk.rocking_response(PAPER_H, PAPER_B, acc, 6.0)
-    mirror = rk.rocking_response(PAPER_H, PAPER_B, lambda t: -acc(t), 6.0)
+    out = rocking_response(PAPER_H, PAPER_B, acc, 6.0)
+    mirror = rocking_response(PAPER_H, PAPER_B, lambda t: -acc(t), 6.0)
     assert out["uplift_times"].size and out["n_impacts"] > 0
     np.testing.assert_array_equal(out["t"], mirror["t"])
     np.testing.assert_allclose(mirror["theta"], -out["theta"], atol=1e-12)
@@ -167,7 +173,7 @@ def test_sine_pulse_three_modes_in_paper_order():
     # push), a safe band, overturning without impact (towards -x, the first push).
     modes = {}
     for ratio in (6.0, 7.0, 8.0):
-        modes[ratio] = rk.sine_pulse_response(PAPER_H, PAPER_B, ratio, 5.0, restitution=0.9)
+        modes[ratio] = sine_pulse_response(PAPER_H, PAPER_B, ratio, 5.0, restitution=0.9)
     assert modes[6.0]["mode_name"] == "overturn_after_impact"
     assert modes[6.0]["n_impacts"] == 1 and modes[6.0]["overturn_direction"] == 1
     assert modes[6.0]["relative_direction"] == -1
@@ -177,7 +183,7 @@ def test_sine_pulse_three_modes_in_paper_order():
 
 
 def test_sine_pulse_mode_edges_near_shared_notes():
-    edges = rk.mode_edges(PAPER_H, PAPER_B, 5.0, [6.0, 7.0, 8.0], restitution=0.9, tol=0.01)
+    edges = mode_edges(PAPER_H, PAPER_B, 5.0, [6.0, 7.0, 8.0], restitution=0.9, tol=0.01)
     assert [(e["mode_below"], e["mode_above"]) for e in edges] == [
         ("overturn_after_impact", "no_overturn"), ("no_overturn", "overturn_without_impact")]
     # shared notes (independent rigid integration, confirmed by YADE): ~6.76 and ~7.5
@@ -186,48 +192,48 @@ def test_sine_pulse_mode_edges_near_shared_notes():
 
 
 def test_sine_pulse_below_uplift_does_nothing():
-    c = rk.block_constants(PAPER_H, PAPER_B)
+    c = block_constants(PAPER_H, PAPER_B)
     ratio = 0.95 * math.tan(c["alpha"]) / c["alpha"]
-    out = rk.sine_pulse_response(PAPER_H, PAPER_B, ratio, 5.0)
+    out = sine_pulse_response(PAPER_H, PAPER_B, ratio, 5.0)
     assert out["mode_name"] == "no_overturn" and out["uplift_times"].size == 0
 
 
 def test_overturning_map_matches_single_runs():
     amps, omegas = [1.05, 6.0, 8.0], [3.0, 5.0]
-    grid = rk.overturning_map(PAPER_H, PAPER_B, amps, omegas, restitution=0.9)
+    grid = overturning_map(PAPER_H, PAPER_B, amps, omegas, restitution=0.9)
     assert grid["mode"].shape == (2, 3)
     for i, w in enumerate(omegas):
         for j, a in enumerate(amps):
-            single = rk.sine_pulse_response(PAPER_H, PAPER_B, a, w, restitution=0.9)
+            single = sine_pulse_response(PAPER_H, PAPER_B, a, w, restitution=0.9)
             assert grid["mode"][i, j] == single["mode"]
     # a pulse barely above uplift (tan(alpha) / alpha = 1.02) cannot topple the block
-    assert grid["mode"][0, 0] == rk.MODE_NO_OVERTURN
-    assert grid["mode"][1, 2] == rk.MODE_OVERTURN_WITHOUT_IMPACT
+    assert grid["mode"][0, 0] == MODE_NO_OVERTURN
+    assert grid["mode"][1, 2] == MODE_OVERTURN_WITHOUT_IMPACT
 
 
 def test_augusti_sinopoli_criterion_hand_value():
     # h/b = 5 (the paper's marble block): 3 * 0.2 / (4 + 0.04) = 0.148515
-    assert rk.augusti_sinopoli_mu_min(0.08, 0.40) == pytest.approx(0.6 / 4.04, rel=1e-12)
-    assert rk.augusti_sinopoli_mu_min(0.08, 0.40) == pytest.approx(0.148515, abs=1e-6)
+    assert augusti_sinopoli_mu_min(0.08, 0.40) == pytest.approx(0.6 / 4.04, rel=1e-12)
+    assert augusti_sinopoli_mu_min(0.08, 0.40) == pytest.approx(0.148515, abs=1e-6)
 
 
 def test_housner_impact_impulse_ratio_equals_eq8():
     for height, width in ((0.40, 0.08), (PAPER_H, PAPER_B), (2.0, 1.0)):
-        assert rk.impact_friction_demand(width, height) == pytest.approx(
-            rk.augusti_sinopoli_mu_min(width, height), rel=1e-12)
+        assert impact_friction_demand(width, height) == pytest.approx(
+            augusti_sinopoli_mu_min(width, height), rel=1e-12)
     # a lossier impact needs more friction
-    assert rk.impact_friction_demand(0.08, 0.40, 0.88) > 0.3
+    assert impact_friction_demand(0.08, 0.40, 0.88) > 0.3
 
 
 def test_bad_input_raises():
     with pytest.raises(InputError):
-        rk.block_constants(-1.0, 0.5)
+        block_constants(-1.0, 0.5)
     with pytest.raises(InputError):
-        rk.housner_free_rocking(PAPER_H, PAPER_B, 0.0)
+        housner_free_rocking(PAPER_H, PAPER_B, 0.0)
     with pytest.raises(InputError):
-        rk.housner_free_rocking(PAPER_H, PAPER_B, 0.1, restitution=1.5)
+        housner_free_rocking(PAPER_H, PAPER_B, 0.1, restitution=1.5)
     with pytest.raises(InputError):
-        rk.restitution_from_peaks([0.3, 0.2], alpha=0.25)
+        restitution_from_peaks([0.3, 0.2], alpha=0.25)
 
 
 def test_cylinder_constants_from_its_mass_properties_and_an_impact_balance():
@@ -235,7 +241,7 @@ def test_cylinder_constants_from_its_mass_properties_and_an_impact_balance():
     restitution from angular momentum about the new pivot written out as vectors."""
     from pipeline.scenario.solids import Frustum
     h, d = 3.5, 3.5 / 6
-    c = rk.cylinder_constants(h, d)
+    c = cylinder_constants(h, d)
     m, zc, (ixx, _, _) = Frustum(h, d, d).mass_properties(1.0)
     R = math.hypot(zc, d / 2)
     assert c["R"] == pytest.approx(R) and c["alpha"] == pytest.approx(math.atan(d / h))
@@ -250,7 +256,7 @@ def test_cylinder_constants_from_its_mass_properties_and_an_impact_balance():
     h_b = ixx * omega + m * np.cross(np.array([d / 2, 0.0, zc]), v)[1]
     assert c["restitution"] == pytest.approx(h_b / (ixx + m * R ** 2))
     # the block's constants through the same balance (its I_G = m (b^2 + h^2) / 12)
-    b = rk.block_constants(h, d)
+    b = block_constants(h, d)
     i_block = (d ** 2 + h ** 2) / 12
     h_block = i_block + np.cross([d / 2, 0.0, h / 2], np.cross([0, 1.0, 0],
                                                                 [-d / 2, 0, h / 2]))[1]
@@ -259,12 +265,12 @@ def test_cylinder_constants_from_its_mass_properties_and_an_impact_balance():
 
 def test_cylinder_free_rocking_keeps_its_energy_between_impacts():
     h, d = 3.5, 3.5 / 6
-    c = rk.cylinder_constants(h, d)
-    out = rk.housner_free_rocking(h, d, 0.5 * c["alpha"], n_impacts=3, shape="cylinder")
+    c = cylinder_constants(h, d)
+    out = housner_free_rocking(h, d, 0.5 * c["alpha"], n_impacts=3, shape="cylinder")
     before = out["t"] < out["impact_times"][0]
     energy = energy_per_mass(c, out["theta"][before], out["omega"][before])
     assert np.ptp(energy) < 1e-8 * G * c["R"]
     assert out["impact_omega_after"][0] == pytest.approx(
         c["restitution"] * out["impact_omega_before"][0])
     with pytest.raises(InputError, match="shape"):
-        rk.housner_free_rocking(h, d, 0.1, shape="sphere")
+        housner_free_rocking(h, d, 0.1, shape="sphere")

@@ -9,7 +9,7 @@ so each member is one column shaken ever harder) is run in YADE through the
 ``scale`` parameter of :func:`pipeline.simulate.simulate`.
 
 The same scaled records shake the project's 2D rigid block
-(:func:`pipeline.rocking.rocking_response_sampled`, Housner's equation and
+(:func:`pipeline.rocking.sampled.rocking_response_sampled`, Housner's equation and
 restitution) of each member's size and slenderness (width = diameter, so
 alpha = atan(d / h)), without friction limit, sliding or vertical motion: once
 along the record's strongest azimuth (``az_max_acc_deg``, the direction of the

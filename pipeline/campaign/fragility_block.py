@@ -1,5 +1,5 @@
 """The 2D rigid block of the ``fragility`` campaign: the project's Housner block
-(:func:`pipeline.rocking.rocking_response_sampled`, Housner's equation and restitution)
+(:func:`pipeline.rocking.sampled.rocking_response_sampled`, Housner's equation and restitution)
 of each member's size and slenderness (:func:`pipeline.campaign.pulse_block.block_size`),
 without friction limit, sliding or vertical motion, shaken by the same scaled records as
 the 3D runs: once along the record's strongest azimuth (``az_max_acc_deg``, the direction
@@ -14,7 +14,7 @@ import pandas as pd
 from pipeline.campaign.pulse_block import BLOCK_MAX_STEP_S, BLOCK_T_AFTER_S, block_size
 from pipeline.motion import Motion
 from pipeline.motion.measures import record_parameters
-from pipeline.rocking import rocking_response_sampled
+from pipeline.rocking.sampled import rocking_response_sampled
 
 DEFAULT_AZIMUTHS = 12
 BLOCK_CHUNK_SAMPLES = 10_000_000   # acceleration samples x cases integrated at once (memory)

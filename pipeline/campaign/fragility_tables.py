@@ -13,7 +13,7 @@ from pipeline.campaign.pulse_block import block_size
 from pipeline.campaign.tables import collect
 from pipeline.constants import MODEL_GRAVITY
 from pipeline.files import json_safe
-from pipeline.rocking import block_constants
+from pipeline.rocking.housner import block_constants
 from pipeline.stats.ensemble import wilson_interval
 from pipeline.stats.fragility import binned_fractions, fragility_fit, logistic_surface
 
@@ -119,7 +119,7 @@ def summarise(table, specs, cost):
                     "restitution": "Housner, 1 - 1.5 sin^2 alpha",
                     "excitation": "horizontal acceleration projected on an azimuth; no "
                                   "vertical motion, no sliding",
-                    "integrator": "pipeline.rocking.rocking_response_sampled"},
+                    "integrator": "pipeline.rocking.sampled.rocking_response_sampled"},
         "cost": cost})
 
 

@@ -1,7 +1,7 @@
 """The 2D rigid block of the pulse grid (:mod:`pipeline.campaign.pulse_grid`): a block
 of the same critical angle and pivot distance as the specimen along each run's azimuth
 (height, width in m), rocked by the toolkit's Housner integrator
-(:func:`pipeline.rocking.rocking_response_sampled`) under the same pulses (PGA in g).
+(:func:`pipeline.rocking.sampled.rocking_response_sampled`) under the same pulses (PGA in g).
 """
 import math
 
@@ -9,7 +9,8 @@ import numpy as np
 
 from pipeline.campaign.pulse_grid import G, PULSE_DT_S
 from pipeline.motion.pulses import one_cosine_pulse
-from pipeline.rocking import block_constants, rocking_response_sampled
+from pipeline.rocking.housner import block_constants
+from pipeline.rocking.sampled import rocking_response_sampled
 from pipeline.scenario.geometry import ColumnGeometry
 
 

@@ -158,7 +158,8 @@ def summarise_grid(table, specs, grid, sets, azimuths, azimuth, ranges_text):
                     "uplift_g_smallest": math.tan(block["alpha_smallest"]),
                     "definition": "2D rigid block of the specimen's critical angle and pivot "
                                   "distance along each run's azimuth (Housner's equation "
-                                  "and restitution, pipeline.rocking.rocking_response_sampled); "
+                                  "and restitution, "
+                                  "pipeline.rocking.sampled.rocking_response_sampled); "
                                   "its constants the runs' medians; uplift_g_smallest: g tan "
                                   "of the smallest critical angle of any run (no run's rigid "
                                   "block leaves rest below it)"},

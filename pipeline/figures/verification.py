@@ -5,7 +5,8 @@ from pathlib import Path
 import numpy as np
 from matplotlib.colors import ListedColormap
 
-from pipeline import rocking
+from pipeline.rocking.housner import block_constants, housner_closed_form
+from pipeline.rocking.pulse import MODE_NAMES, overturning_map
 from pipeline.figures.style import new_figure
 from pipeline.files import save_figure
 from pipeline.verification import (CAMPAIGN_DAMPING, CAMPAIGN_THETA0, MARBLE_BLOCK,
@@ -20,8 +21,8 @@ def plot_verification(results, out_dir, summary=None):
     fig, ax = new_figure(figsize=(7, 5), constrained_layout=True)
     for r0 in CAMPAIGN_THETA0:
         n = np.arange(0, 6)
-        const = rocking.block_constants(MARBLE_BLOCK["height"], MARBLE_BLOCK["width"])
-        ax.plot(n, rocking.housner_closed_form(r0, const["energy_ratio"], 5), "k-", lw=0.8)
+        const = block_constants(MARBLE_BLOCK["height"], MARBLE_BLOCK["width"])
+        ax.plot(n, housner_closed_form(r0, const["energy_ratio"], 5), "k-", lw=0.8)
         for z, marker in zip(CAMPAIGN_DAMPING, ("x", "o")):
             for s, r in results:
                 if s.kind == "housner" and s["theta0_ratio"] == r0 and s["damping"] == z:
@@ -40,11 +41,11 @@ def plot_verification(results, out_dir, summary=None):
     # Fig. 5: overturning map (integration) with YADE outcomes
     amps = np.linspace(1.0, 12.0, 45)
     omegas = np.linspace(2.0, 10.0, 17)
-    grid = rocking.overturning_map(PULSE_BLOCK["height"], PULSE_BLOCK["width"], amps, omegas)
+    grid = overturning_map(PULSE_BLOCK["height"], PULSE_BLOCK["width"], amps, omegas)
     fig, ax = new_figure(figsize=(8, 5.5), constrained_layout=True)
     cmap = ListedColormap(["#e8f0e8", "#f6c9a0", "#b9d3ee"])
     ax.pcolormesh(amps, omegas, grid["mode"], cmap=cmap, vmin=-0.5, vmax=2.5, shading="nearest")
-    codes = {v: k for k, v in rocking.MODE_NAMES.items()}
+    codes = {v: k for k, v in MODE_NAMES.items()}
     markers = {0: "o", 1: "^", 2: "s"}
     for name, code in codes.items():
         pts = [(s["amplitude_ratio"], s["omega_ratio"]) for s, r in results

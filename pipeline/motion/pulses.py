@@ -6,7 +6,7 @@ import numpy as np
 from scipy.integrate import cumulative_trapezoid
 
 from pipeline.motion import Motion
-from pipeline import rocking
+from pipeline.rocking.pulse import sine_pulse
 
 
 def one_sine_pulse(azimuth_deg=0.0, amplitude=5.0, period=1.0, duration=6.0, dt=0.005):
@@ -26,9 +26,9 @@ def one_sine_pulse(azimuth_deg=0.0, amplitude=5.0, period=1.0, duration=6.0, dt=
 
 def phased_sine_pulse(amplitude, omega, psi, dt=0.001, tail_s=4.0):
     """a(t) = A sin(omega t + psi) from phase psi to 2 pi along East, then zero for
-    ``tail_s`` seconds (the pulse of :func:`pipeline.rocking.sine_pulse`), integrated
+    ``tail_s`` seconds (the pulse of :func:`pipeline.rocking.pulse.sine_pulse`), integrated
     to velocity and displacement (trapezoid)."""
-    acc_func, t_pulse = rocking.sine_pulse(amplitude, omega, psi)
+    acc_func, t_pulse = sine_pulse(amplitude, omega, psi)
     t = np.arange(0.0, t_pulse + tail_s, dt)
     acc_e = np.array([acc_func(ti) for ti in t])
     vel_e = cumulative_trapezoid(acc_e, dx=dt, initial=0)

@@ -7,7 +7,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
-from pipeline import rocking
+from pipeline.rocking.pulse import MODE_NAMES
 from pipeline.files import InputError, content_hash, read_run_json, write_json
 from pipeline.scenario import Contact
 from pipeline.userfiles import number
@@ -144,7 +144,7 @@ class CheckResult(Mapping):
         if kind == "housner" and "peaks_over_alpha" not in self.values.get("yade", {}):
             missing.append("yade.peaks_over_alpha")
         if kind == "sine-pulse" and self.values.get("yade", {}).get("mode") \
-                not in rocking.MODE_NAMES.values():
+                not in MODE_NAMES.values():
             missing.append("yade.mode (a mode name)")
         if kind == "sliding" and not (self.values.get("runs") and all(
                 set(SLIDING_ROW_KEYS) <= set(row) for row in self.values["runs"])):

@@ -11,7 +11,11 @@ from pathlib import Path
 
 import numpy as np
 
-from pipeline import RESULTS_DIR, paper, rocking
+from pipeline import RESULTS_DIR, paper
+from pipeline.rocking.decay import restitution_from_peaks
+from pipeline.rocking.housner import augusti_sinopoli_mu_min, block_constants, housner_closed_form
+from pipeline.rocking.pulse import sine_pulse_response
+from pipeline.rocking.response import housner_free_rocking
 from pipeline.files import InputError
 from pipeline.motion import Motion
 from pipeline.motion.pulses import phased_sine_pulse
@@ -118,9 +122,9 @@ def verify_housner(height=MARBLE_BLOCK["height"], width=MARBLE_BLOCK["width"],
             not 1 <= n_impacts <= MAX_IMPACTS:
         raise InputError(f"--impacts must be an integer in [1, {MAX_IMPACTS}], got {n_impacts!r}")
     contact = {**MARBLE_CONTACT, "damping": HOUSNER_DAMPING, **contact}
-    const = rocking.block_constants(height, width)
+    const = block_constants(height, width)
     alpha = const["alpha"]
-    ref = rocking.housner_free_rocking(height, width, theta0_ratio * alpha, n_impacts=n_impacts)
+    ref = housner_free_rocking(height, width, theta0_ratio * alpha, n_impacts=n_impacts)
     ref_times = ref["impact_times"][:n_impacts]
     ref_peaks = ref["peak_ratio"][1:n_impacts + 1]        # after impact 1..n
     duration = float(ref["peak_times"][n_impacts]) + 0.05
@@ -129,8 +133,8 @@ def verify_housner(height=MARBLE_BLOCK["height"], width=MARBLE_BLOCK["width"],
                             duration=duration, **contact)
     times, peaks = impacts_and_peaks(t, theta)
     times, peaks = times[:n_impacts], peaks[1:n_impacts + 1] / alpha   # peaks after each impact
-    closed = rocking.housner_closed_form(theta0_ratio, const["energy_ratio"], n_impacts)[1:]
-    r_eff = rocking.restitution_from_peaks(np.concatenate([[theta0_ratio], peaks]) * alpha,
+    closed = housner_closed_form(theta0_ratio, const["energy_ratio"], n_impacts)[1:]
+    r_eff = restitution_from_peaks(np.concatenate([[theta0_ratio], peaks]) * alpha,
                                            alpha)["eta"]
     result = {
         "test": "housner", "height_m": height, "width_m": width, "depth_m": depth,
@@ -151,7 +155,7 @@ def verify_housner(height=MARBLE_BLOCK["height"], width=MARBLE_BLOCK["width"],
 
 
 def sine_pulse_motion(reference, dt=0.001, tail_s=4.0):
-    """The one-sine ground motion (East) of a rocking.sine_pulse_response result."""
+    """The one-sine ground motion (East) of a sine_pulse_response result."""
     return phased_sine_pulse(reference["amplitude"], reference["omega"], reference["psi"],
                              dt=dt, tail_s=tail_s)
 
@@ -177,8 +181,8 @@ def verify_sine_pulse(height=PULSE_BLOCK["height"], width=PULSE_BLOCK["width"],
     the integration (overturned or not, impacts before overturning, direction)."""
     check_pulse_ratios(amplitude_ratio, omega_ratio)
     contact = {**dataclasses.asdict(Contact()), **contact}
-    const = rocking.block_constants(height, width)
-    ref = rocking.sine_pulse_response(height, width, amplitude_ratio, omega_ratio)
+    const = block_constants(height, width)
+    ref = sine_pulse_response(height, width, amplitude_ratio, omega_ratio)
     motion = sine_pulse_motion(ref)
     run_dir = Path(run_dir or RESULTS_DIR / "verification" / "runs" /
                    f"pulse_{amplitude_ratio:g}_{omega_ratio:g}")
@@ -206,7 +210,7 @@ def check_sliding_mus(mu_values, height=MARBLE_BLOCK["height"], width=MARBLE_BLO
     there (the verify command asks this before any run), or a mu_s out of range."""
     for mu in mu_values:
         Contact(mu_s=mu)
-    mu_min = rocking.augusti_sinopoli_mu_min(width, height)
+    mu_min = augusti_sinopoli_mu_min(width, height)
     if not any(mu <= SLIDING_BELOW * mu_min for mu in mu_values):
         raise InputError(f"--mu-s needs a value at or below {SLIDING_BELOW * mu_min:.3f} "
                          f"({SLIDING_BELOW:g} x the Augusti & Sinopoli limit {mu_min:.3f} of "
@@ -223,10 +227,11 @@ def verify_sliding(mu_values=SLIDING_MU,
     impacts against the Augusti & Sinopoli criterion (eq 8); passed: pure rocking from 0.4
     (or 1.1 x eq 8) up, sliding at and below 0.9 x eq 8.  Rigid-block theory puts
     the onset of sliding at eq 8 (0.149 for h/b = 5); the paper's model slid from ~0.3
-    because its impacts lose more energy than Housner's (rocking.impact_friction_demand)."""
+    because its impacts lose more energy than Housner's
+    (:func:`pipeline.rocking.housner.impact_friction_demand`)."""
     contact = {**MARBLE_CONTACT, **contact}
-    const = rocking.block_constants(height, width)
-    mu_min = rocking.augusti_sinopoli_mu_min(width, height)
+    const = block_constants(height, width)
+    mu_min = augusti_sinopoli_mu_min(width, height)
     base = Path(run_dir or RESULTS_DIR / "verification" / "runs")
     rows = []
     for mu in mu_values:

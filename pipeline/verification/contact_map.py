@@ -5,7 +5,7 @@ contact point) has no restitution of rocking of its own: a block's restitution (
 velocity after / before an impact) comes out of the impacts of its corner springs.  It is
 measured here by free rocking of the block in YADE (released from rest at half its
 overturning angle, :func:`pipeline.verification.checks.run_block`; the restitution from its
-successive amplitudes, :func:`pipeline.rocking.fit_free_rocking`), and the damping found
+successive amplitudes, :func:`pipeline.rocking.decay.fit_free_rocking`), and the damping found
 by bisection: the restitution falls monotonically with the damping, from an almost
 elastic impact at 0 to Housner's perfectly inelastic value (1 - 1.5 sin^2 alpha) at 1.
 A restitution outside that range is not reachable by this law and is refused.  Each
@@ -16,7 +16,9 @@ import json
 import math
 import tempfile
 
-from pipeline import RESULTS_DIR, paper, rocking
+from pipeline import RESULTS_DIR, paper
+from pipeline.rocking.decay import fit_free_rocking, free_rocking_peaks
+from pipeline.rocking.response import housner_free_rocking
 from pipeline.files import InputError, code_hash, write_json
 from pipeline.verification.checks import MARBLE_CONTACT, run_block
 
@@ -35,14 +37,14 @@ def rocking_restitution(height, width, depth, damping, kn=paper.MARBLE_BLOCK_KN_
     at contact damping ratio ``damping`` and stiffness ``kn`` (N/m per point), released
     from rest at ``release_ratio`` of its overturning angle."""
     alpha = math.atan(width / height)
-    reference = rocking.housner_free_rocking(height, width, release_ratio * alpha,
+    reference = housner_free_rocking(height, width, release_ratio * alpha,
                                              n_impacts=IMPACTS)
     duration = float(reference["peak_times"][IMPACTS]) + 0.05
     with tempfile.TemporaryDirectory(prefix="toppling-contact-") as run_dir:
         t, theta, _ = run_block(run_dir, height, width, depth, release_ratio * alpha,
                                 duration=duration, density=density,
                                 **{**MARBLE_CONTACT, "kn": kn, "damping": damping})
-    return rocking.fit_free_rocking(height, width, t=t, theta=theta)["restitution"]
+    return fit_free_rocking(height, width, t=t, theta=theta)["restitution"]
 
 
 def cached_measure(measure, key, cache=CACHE):
@@ -208,7 +210,7 @@ def specimen_rocking(geometry, damping, kn, azimuth_deg=None, release_ratio=RELE
         write_scenario(where, scene)
         trajectory = run_yade(where)
     turns, theta, rise = _turn_and_rise(trajectory, body, line)
-    found = rocking.free_rocking_peaks(trajectory.t, theta, rise=rise)
+    found = free_rocking_peaks(trajectory.t, theta, rise=rise)
     z = found["rise_peaks"][SETTLING_IMPACTS:counted + 1]
     if z.size < 2 or not np.all(z > 0):
         raise InputError(f"{geometry.name}: no impact with swings before and after it in "
@@ -256,7 +258,7 @@ def _free_rocking_s(body, line, radius, gravity, h, b, tilt, counted):
         line["axis"] + body["mass"] * radius ** 2
     p_specimen = math.sqrt(body["mass"] * gravity * radius / inertia)
     p_block = math.sqrt(0.75 * gravity / radius)
-    reference = rocking.housner_free_rocking(h, b, tilt, n_impacts=counted)
+    reference = housner_free_rocking(h, b, tilt, n_impacts=counted)
     return 1.5 * float(reference["peak_times"][counted]) * p_block / p_specimen + 0.1
 
 

@@ -183,7 +183,7 @@ def fit_contact(options):
     ``options.out``: the restitution fitted to the decay, the block or specimen, and with
     ``damping_map`` the damping that gives it in YADE and its interval.  The bisection's
     lines are printed as it goes; what the result says is the caller's to print."""
-    from pipeline.rocking import fit_free_rocking
+    from pipeline.rocking.decay import fit_free_rocking
     if options.column_file is not None:
         geometry, azimuth, alpha, (height, width) = _specimen(options)
     else:

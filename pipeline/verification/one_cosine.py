@@ -16,7 +16,10 @@ from pathlib import Path
 
 import numpy as np
 
-from pipeline import RESULTS_DIR, rocking
+from pipeline import RESULTS_DIR
+from pipeline.rocking.housner import block_constants
+from pipeline.rocking.response import rocking_response
+from pipeline.rocking.sampled import rocking_response_sampled
 from pipeline.constants import MODEL_GRAVITY
 from pipeline.files import InputError
 from pipeline.motion.pulses import one_cosine_pulse
@@ -67,13 +70,13 @@ def check_runs(runs):
 
 def omega_ratio(period_s, height, width):
     """omega_p / p of a pulse of ``period_s`` on the block (h, b full sizes, m)."""
-    return 2 * math.pi / period_s / rocking.block_constants(height, width)["p"]
+    return 2 * math.pi / period_s / block_constants(height, width)["p"]
 
 
 def eq43_g(period_s, height, width):
     """Makris & Roussos eq. 43: the smallest overturning amplitude (g),
     alpha (1 + omega_p / (4 p))."""
-    c = rocking.block_constants(height, width)
+    c = block_constants(height, width)
     return c["alpha"] * (1 + omega_ratio(period_s, height, width) / 4)
 
 
@@ -85,7 +88,7 @@ def overturns_2d(a_p_g, period_s, height, width):
 
     def acc(t):
         return a * math.cos(w * t) if t <= period_s else 0.0
-    out = rocking.rocking_response(height, width, acc, period_s + _T_AFTER_S,
+    out = rocking_response(height, width, acc, period_s + _T_AFTER_S,
                                    still_after=period_s, dt_out=None,
                                    rest_max_step=min(1e-3, period_s / 200))
     return bool(out["overturned"])
@@ -101,12 +104,12 @@ def _bisect(overturns, lo, hi, rtol):
 
 def _scan(period_s, height, width, amplitudes_g):
     """Overturned (bool array) of the 2D block under each amplitude (g), all at once
-    (:func:`pipeline.rocking.rocking_response_sampled`)."""
+    (:func:`pipeline.rocking.sampled.rocking_response_sampled`)."""
     n = 400
     dt = period_s / n
     shape = np.cos(2 * math.pi * np.arange(n + 1) / n)
     acc = shape[:, None] * np.asarray(amplitudes_g)[None, :] * MODEL_GRAVITY
-    return rocking.rocking_response_sampled(height, width, acc, dt, t_after=_T_AFTER_S,
+    return rocking_response_sampled(height, width, acc, dt, t_after=_T_AFTER_S,
                                             max_step=min(1e-3, dt))["overturned"]
 
 
@@ -116,7 +119,7 @@ def overturning_intervals(period_s, height, width, a_max_g, step=SCAN_STEP, firs
     batch integrator, each edge found again with the exact one near where the scan saw
     it and bisected to 1e-5.  A list of [lo, hi] (hi None: still overturning at
     a_max_g); ``first_only``: the first."""
-    a0 = math.tan(rocking.block_constants(height, width)["alpha"])
+    a0 = math.tan(block_constants(height, width)["alpha"])
     grid = a0 * (1 + step) ** np.arange(1, int(math.log(a_max_g / a0) / math.log1p(step)) + 1)
     over = np.zeros(0, bool)
     for chunk in np.array_split(grid, max(1, len(grid) // 100)):
@@ -184,7 +187,7 @@ def curve_2d(height=MR_BLOCK["height"], width=MR_BLOCK["width"],
              omega_ratios=CURVE_OMEGA_RATIOS):
     """The smallest overturning amplitude of the 2D block and eq. 43 over omega_p / p:
     a list of {omega_ratio, period_s, min_overturning_g, over_alpha_g, eq43_over_alpha_g}."""
-    c = rocking.block_constants(height, width)
+    c = block_constants(height, width)
     rows = []
     for w in omega_ratios:
         period = 2 * math.pi / (w * c["p"])
@@ -202,7 +205,7 @@ def overturns_yade(a_p_g, period_s, run_dir, height=MR_BLOCK["height"],
                               dt=0.001, tail_s=4.0)
     t, theta, _ = run_block(run_dir, height, width, depth, motion=motion,
                             duration=motion.duration, **{**YADE_CONTACT, **contact})
-    mode = classify_rocking(t, theta, rocking.block_constants(height, width)["alpha"])[0]
+    mode = classify_rocking(t, theta, block_constants(height, width)["alpha"])[0]
     return mode != "no_overturn", mode
 
 
@@ -246,7 +249,7 @@ def verify_one_cosine(period_s=MR_PERIOD_S, height=MR_BLOCK["height"], width=MR_
         raise InputError(f"the 2D block does not overturn below 100 g at period {period_s:g} s")
     yade = yade_threshold(period_s, a2d, run_dir, runs, height=height, width=width,
                           depth=depth, **contact)
-    c = rocking.block_constants(height, width)
+    c = block_constants(height, width)
     result = {"test": "one-cosine", "period_s": period_s, "height_m": height, "width_m": width,
               "depth_m": depth, "alpha_rad": c["alpha"], "p_per_s": c["p"],
               "omega_ratio": omega_ratio(period_s, height, width),
@@ -276,7 +279,7 @@ def summarise_one_cosine(results):
     results (a list of CheckResult dicts): Fig. 11 (2D, YADE), the curve of the smallest
     overturning amplitude (2D over CURVE_OMEGA_RATIOS, YADE at its checks' periods) beside
     eq. 43, the safe bands; and its lines for the REPORT."""
-    c = rocking.block_constants(MR_BLOCK["height"], MR_BLOCK["width"])
+    c = block_constants(MR_BLOCK["height"], MR_BLOCK["width"])
     yade = sorted(({"period_s": r["period_s"], "omega_ratio": r["omega_ratio"],
                     "threshold_g": r["yade"]["threshold_g"],
                     "bracket_g": [r["yade"]["stands_g"], r["yade"]["overturns_g"]],

@@ -5,9 +5,9 @@ and rim spheres fixed (``make contact-convergence``).
 
 Per body and factor: the impact times and the restitution of every impact (angular
 velocity after / before it, from the successive amplitudes of the trajectory:
-:func:`pipeline.rocking.restitution_from_peaks`), against Housner's rigid body (his
-perfectly inelastic impact: :func:`pipeline.rocking.block_constants`,
-:func:`pipeline.rocking.cylinder_constants`; the impact times from his equation
+:func:`pipeline.rocking.decay.restitution_from_peaks`), against Housner's rigid body (his
+perfectly inelastic impact: :func:`pipeline.rocking.housner.block_constants`,
+:func:`pipeline.rocking.housner.cylinder_constants`; the impact times from his equation
 integrated with that restitution) and against x1; the time step (s) the scene used and the
 wall time (s) of the YADE run.  The damping ratio is ``HOUSNER_DAMPING`` (critical): the
 setting whose impact is Housner's (docs/campaigns.md, Verification).  The same runs at the
@@ -20,7 +20,10 @@ from pathlib import Path
 
 import numpy as np
 
-from pipeline import paper, rocking
+from pipeline import paper
+from pipeline.rocking.decay import free_rocking_peaks, restitution_from_peaks
+from pipeline.rocking.housner import SHAPES
+from pipeline.rocking.response import housner_free_rocking
 from pipeline.files import InputError
 from pipeline.verification.checks import (HOUSNER_DAMPING, MARBLE_BLOCK, MARBLE_CONTACT,
                                           run_block, run_cylinder)
@@ -52,8 +55,8 @@ def check_factors(factors):
 def reference(body, theta0_ratio=THETA0_RATIO, impacts=IMPACTS):
     """Housner's rigid body of ``body`` (a BODIES entry): its constants and the impact
     times (s) of its free rocking from theta0_ratio x alpha."""
-    constants = rocking.SHAPES[body["shape"]](body["height"], body["width"])
-    free = rocking.housner_free_rocking(body["height"], body["width"],
+    constants = SHAPES[body["shape"]](body["height"], body["width"])
+    free = housner_free_rocking(body["height"], body["width"],
                                         theta0_ratio * constants["alpha"], n_impacts=impacts,
                                         shape=body["shape"])
     return constants, free
@@ -62,11 +65,11 @@ def reference(body, theta0_ratio=THETA0_RATIO, impacts=IMPACTS):
 def measure(t, theta, alpha, impacts=IMPACTS):
     """Impact times (s) and restitution of each impact from a free-rocking trajectory (t s,
     theta rad): the first ``impacts`` impacts that have an amplitude after them."""
-    found = rocking.free_rocking_peaks(t, theta)
+    found = free_rocking_peaks(t, theta)
     peaks = found["peaks"][:impacts + 1]
     if peaks.size < 2:
         raise InputError("free rocking: no impact with an amplitude after it")
-    eta = rocking.restitution_from_peaks(peaks, alpha)["eta_per_impact"]
+    eta = restitution_from_peaks(peaks, alpha)["eta_per_impact"]
     return {"impact_times_s": found["impact_times"][:eta.size].tolist(),
             "restitution_per_impact": eta.tolist(), "restitution": float(np.mean(eta))}
 

@@ -8,7 +8,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from pipeline import rocking
+from pipeline.rocking.housner import SHAPES
+from pipeline.rocking.response import housner_free_rocking
 from pipeline.campaign import contact_convergence as cc
 from pipeline.files import InputError
 from pipeline.verification import stiffness
@@ -62,8 +63,8 @@ def test_nothing_to_summarise_is_one_error_and_missing_parts_are_said(tmp_path):
 
 
 def housner_run(shape, height, width, restitution=None):
-    c = rocking.SHAPES[shape](height, width)
-    free = rocking.housner_free_rocking(height, width, 0.5 * c["alpha"], n_impacts=6,
+    c = SHAPES[shape](height, width)
+    free = housner_free_rocking(height, width, 0.5 * c["alpha"], n_impacts=6,
                                         restitution=restitution, shape=shape)
     return c, free
 

@@ -8,7 +8,10 @@ import sys
 import numpy as np
 import pytest
 
-from pipeline import cli, rocking
+from pipeline import cli
+from pipeline.rocking.housner import block_constants
+from pipeline.rocking.pulse import sine_pulse, sine_pulse_response
+from pipeline.rocking.sampled import rocking_response_sampled
 from pipeline.campaign import fragility as fr
 from pipeline.campaign import fragility_block
 from pipeline.campaign.fragility_tables import MODELS_2D, level_table
@@ -106,7 +109,7 @@ def _pulse_record(path, amplitude=5.0, period=1.0, duration=4.0, azimuth=30.0):
 def test_block_never_topples_below_g_tan_alpha_and_always_under_a_huge_pulse(tmp_path,
                                                                            monkeypatch):
     # the paper's column: h = 3.5 m, h/d = 6, so g tan(alpha) = 9.81 / 6 = 1.635 m/s^2
-    assert rocking.block_constants(3.5, 3.5 / 6)["uplift_acc"] == pytest.approx(G / 6)
+    assert block_constants(3.5, 3.5 / 6)["uplift_acc"] == pytest.approx(G / 6)
     record = _pulse_record(tmp_path / "pulse.npz", period=0.5)
     specs = fr.fragility_specs([str(record)], tmp_path / "campaign", levels="1.6,60",
                                members=3, column="monolithic", azimuths=6)
@@ -137,14 +140,14 @@ def test_sampled_block_agrees_with_the_event_driven_integration():
     """One-sine pulses across the three modes of Zhang & Makris: same outcome, overturning
     times within 0.1 s."""
     height, width = 3.113, 0.795
-    c = rocking.block_constants(height, width)
+    c = block_constants(height, width)
     cases = [(3.0, 2.0), (3.0, 5.0), (5.0, 5.0), (5.0, 9.0), (8.0, 4.0), (8.0, 9.0)]
     for omega_ratio, amplitude_ratio in cases:
-        ref = rocking.sine_pulse_response(height, width, amplitude_ratio, omega_ratio,
+        ref = sine_pulse_response(height, width, amplitude_ratio, omega_ratio,
                                           dt_out=None)
-        acc_func, t_pulse = rocking.sine_pulse(ref["amplitude"], ref["omega"], ref["psi"])
+        acc_func, t_pulse = sine_pulse(ref["amplitude"], ref["omega"], ref["psi"])
         t = np.arange(0.0, t_pulse + 0.001, 0.001)
-        out = rocking.rocking_response_sampled(height, width, [acc_func(x) for x in t], 0.001)
+        out = rocking_response_sampled(height, width, [acc_func(x) for x in t], 0.001)
         assert bool(out["overturned"][0]) == ref["overturned"], (omega_ratio, amplitude_ratio)
         assert out["decided"][0]
         if ref["overturned"]:

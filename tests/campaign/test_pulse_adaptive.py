@@ -17,7 +17,7 @@ from pipeline.campaign.fragility import FragilityOptions, drive
 from pipeline.hazard.fragility_file import FragilityFile, read_fragility_file
 from pipeline.motion.pulses import one_cosine_pulse
 from pipeline.outcome.summary import ColumnOutcome, RunSummary
-from pipeline.rocking import rocking_response_sampled
+from pipeline.rocking.sampled import rocking_response_sampled
 from pipeline.stats.ensemble import wilson_interval
 from tests.campaign.test_pulse_grid import box_description
 

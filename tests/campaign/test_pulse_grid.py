@@ -16,7 +16,8 @@ from pipeline.campaign.pulse_check import scores
 from pipeline.files import InputError
 from pipeline.motion.measures import horizontal_peak
 from pipeline.motion.pulses import one_cosine_pulse
-from pipeline.rocking import block_constants, rocking_response_sampled
+from pipeline.rocking.housner import block_constants
+from pipeline.rocking.sampled import rocking_response_sampled
 
 
 @pytest.mark.parametrize("pga, ratio, azimuth", [(0.2 * 9.80665, 0.1, 0.0), (5.0, 0.37, 30.0),

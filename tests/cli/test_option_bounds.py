@@ -8,7 +8,9 @@ import math
 import numpy as np
 import pytest
 
-from pipeline import cli, paper, rocking
+from pipeline import cli, paper
+from pipeline.rocking.decay import fit_free_rocking, slowest_rocking_hz
+from pipeline.rocking.response import housner_free_rocking
 from pipeline.files import InputError
 
 SP1 = "records/shake_table/sp1.json"
@@ -211,14 +213,14 @@ def test_a_block_too_small_for_the_frequency_is_one_line(tmp_path, capsys):
     assert "no block of that size rocks at that frequency" in err
     assert f"{slowest:.3g} Hz" in err
     assert not out.exists()
-    assert rocking.slowest_rocking_hz(0.01, 0.005) == pytest.approx(slowest, rel=1e-3)
+    assert slowest_rocking_hz(0.01, 0.005) == pytest.approx(slowest, rel=1e-3)
 
 
 def decay(restitution, noise_rad, seed, tail_s=1.0, dt=0.002):
     """A rigid block's decay (Housner's equation, ``restitution``) released at half its
     overturning angle, sampled every ``dt`` s, at rest ``tail_s`` s after its last
     peak, with white noise of ``noise_rad``."""
-    out = rocking.housner_free_rocking(H, B, 0.5 * math.atan(B / H), n_impacts=8,
+    out = housner_free_rocking(H, B, 0.5 * math.atan(B / H), n_impacts=8,
                                        restitution=restitution)
     t = np.arange(0.0, out["t"][-1] + tail_s, dt)
     theta = np.interp(t, out["t"], out["theta"], right=0.0)
@@ -232,7 +234,7 @@ def test_a_noisy_decay_gives_its_restitution_within_its_error(restitution, seed)
     its zero crossings are no swings; the restitution within 4 standard errors and
     0.01 of the true one (the former mean over impacts read 2.0 here and refused it)."""
     t, theta = decay(restitution, 1e-3, seed)
-    fit = rocking.fit_free_rocking(H, B, t=t, theta=theta)
+    fit = fit_free_rocking(H, B, t=t, theta=theta)
     assert fit["restitution_se"] is not None and fit["restitution_se"] < 0.005
     assert abs(fit["restitution"] - restitution) < max(4 * fit["restitution_se"], 1e-3)
     assert abs(fit["restitution"] - restitution) < 0.01
@@ -245,7 +247,7 @@ def test_a_constant_amplitude_is_refused(tmp_path, capsys, noise_rad):
     theta = 0.05 * np.sin(2 * math.pi * 1.3 * t)
     theta += np.random.default_rng(0).normal(0.0, noise_rad, t.size)
     with pytest.raises(InputError, match="do not decay"):
-        rocking.fit_free_rocking(H, B, t=t, theta=theta)
+        fit_free_rocking(H, B, t=t, theta=theta)
     record = tmp_path / "decay.csv"
     record.write_text("time_s,tilt_rad\n" + "".join(f"{a:.4f},{b:.7f}\n"
                                                     for a, b in zip(t, theta)))

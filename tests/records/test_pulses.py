@@ -14,7 +14,8 @@ from obspy import Stream, Trace
 from scipy.integrate import cumulative_trapezoid
 from scipy.signal import butter, sosfiltfilt
 
-from pipeline import cli, records, rocking
+from pipeline import cli, records
+from pipeline.rocking.sampled import rocking_response_sampled
 from pipeline.motion import Motion
 from pipeline.motion.pulses import raw_pulse
 from pipeline.records import processing
@@ -36,7 +37,7 @@ def block_outcomes(*accelerations):
     block under each horizontal acceleration (m/s^2, samples DT apart)."""
     result = []
     for acc in accelerations:
-        r = rocking.rocking_response_sampled(MONOLITH["height"], MONOLITH["width"], acc, DT)
+        r = rocking_response_sampled(MONOLITH["height"], MONOLITH["width"], acc, DT)
         result.append((bool(r["overturned"][0]), int(r["overturn_direction"][0])))
     return result
 
