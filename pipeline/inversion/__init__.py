@@ -19,7 +19,8 @@ import time
 from pathlib import Path
 
 from pipeline.files import DirectoryLock, write_csv, write_json
-from pipeline.inversion.likelihood import DEFAULT_FLOOR, DEFAULT_KERNEL_DEG, ForwardModel
+from pipeline.inversion.likelihood import DEFAULT_FLOOR, DEFAULT_KERNEL_DEG, DEFAULT_LIKELIHOOD, \
+    ForwardModel
 from pipeline.inversion.credible import in_arc
 from pipeline.inversion.posterior import invert
 
@@ -67,7 +68,8 @@ def write_outputs(post, observations, out_dir, forward_info=None, truth=None, ti
 
 
 def run_inversion(observations, out_dir, table, candidates, kernel_deg=None, floor=None,
-                  forward_info=None, likelihood="independent", truth=None, site_motion=None):
+                  forward_info=None, likelihood=DEFAULT_LIKELIHOOD, truth=None,
+                  site_motion=None):
     """Invert ``observations`` with the forward ``table`` over ``candidates`` and write the
     outputs into ``out_dir`` (locked while writing); return the summary dict.  ``truth``
     (a hidden-truth test's source: :meth:`pipeline.inversion.truth.HiddenTruth.as_truth`)

@@ -40,7 +40,7 @@ like those of either slice in proportion).  :attr:`ForwardModel.sources` lists t
 candidates, :attr:`ForwardModel.mix` their weights over the table's slices.  Magnitudes
 beyond the table's range are not candidates: the table cannot answer for them.
 
-Log-likelihood = sum over columns (``likelihood="independent"``, the default).
+Log-likelihood = sum over columns (``likelihood="independent"``).
 Densities are per radian.
 
 ``likelihood="predictive"`` accounts for the ensemble's own sampling error, which the
@@ -62,7 +62,9 @@ site's own departure from its node (1 / m, ``site_columns``: the site's motion i
 node's, the candidate's strike and cell are not the source's, the site's columns are a
 few draws, not the population).  m was chosen on the member study's calibration draws
 (:data:`SITE_COLUMNS`); m -> infinity is the urn of the table's sampling alone, m -> 0
-counts a site's columns as one.  With A >> j the urn and the product agree.
+counts a site's columns as one.  With A >> j the urn and the product agree.  The
+predictive likelihood is the default (:data:`DEFAULT_LIKELIHOOD`): in the member study its
+95 % regions are calibrated within the reach, where the product's are too narrow.
 """
 import math
 
@@ -73,6 +75,9 @@ from pipeline.files import InputError
 from pipeline.inversion.observations import ColumnObservation
 
 LIKELIHOODS = ("independent", "predictive")
+# the default: calibrated in the member study (95 % regions hold the truth in about 0.95 of
+# the trials within the reach, where the independent product is too sure)
+DEFAULT_LIKELIHOOD = "predictive"
 DEFAULT_KERNEL_DEG = 20.0
 DEFAULT_FLOOR = 0.05
 PSI_STEP_DEG = 0.5
@@ -129,7 +134,7 @@ class ForwardModel:
     """Per-node toppling probabilities and direction densities of a forward table."""
 
     def __init__(self, table, kernel_deg=DEFAULT_KERNEL_DEG, floor=DEFAULT_FLOOR,
-                 likelihood="independent", mw_step=MW_STEP, site_columns=SITE_COLUMNS):
+                 likelihood=DEFAULT_LIKELIHOOD, mw_step=MW_STEP, site_columns=SITE_COLUMNS):
         check_model_options(kernel_deg, floor, likelihood)
         if not site_columns > 0:
             raise InputError(f"site columns must be positive, got {site_columns:g}")

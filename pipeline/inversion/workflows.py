@@ -12,7 +12,8 @@ from pipeline.campaign.executor import RUN_CORE_S as FORWARD_RUN_CORE_S
 from pipeline.campaign.run_dirs import count_finished
 from pipeline.constants import COLUMN_TYPES
 from pipeline.files import LONG_RUN_S, InputError, check_jobs, check_long
-from pipeline.inversion.likelihood import DEFAULT_FLOOR, DEFAULT_KERNEL_DEG, check_model_options
+from pipeline.inversion.likelihood import DEFAULT_FLOOR, DEFAULT_KERNEL_DEG, DEFAULT_LIKELIHOOD, \
+    check_model_options
 from pipeline.scenario.parameters import check_fields, param
 
 log = logging.getLogger(__name__)
@@ -41,11 +42,11 @@ class InversionOptions:
                               f"(default {DEFAULT_KERNEL_DEG:g})", flag="--kernel-deg")
     floor: float = param(None, "", f"fraction of uniform density mixed into every direction "
                          f"density (default {DEFAULT_FLOOR:g})", flag="--floor")
-    likelihood: str = param(None, "", "independent (default): product over columns; "
-                            "predictive: columns of one site share its motion and the ensemble "
-                            "is finite (Polya urn: a site's own falls inform its next column; "
-                            "calibrated when there are many more columns per site than "
-                            "members per node)", flag="--likelihood",
+    likelihood: str = param(None, "", "predictive (default): columns of one site share its "
+                            "motion and the ensemble is finite (Polya urn: a site's own falls "
+                            "inform its next column; calibrated in the member study); "
+                            "independent: the product over columns (too sure when a site has "
+                            "several columns)", flag="--likelihood",
                             choices=("independent", "predictive"))
     trials: int = param(None, "", "trials per configuration (--demo: default 20; "
                         "--member-study: default 200)", flag="--trials")
@@ -53,7 +54,7 @@ class InversionOptions:
     def __post_init__(self):
         check_fields(self)
         for name, default in (("kernel_deg", DEFAULT_KERNEL_DEG), ("floor", DEFAULT_FLOOR),
-                              ("likelihood", "independent")):
+                              ("likelihood", DEFAULT_LIKELIHOOD)):
             if getattr(self, name) is None:
                 object.__setattr__(self, name, default)
         check_model_options(self.kernel_deg, self.floor, self.likelihood)

@@ -50,10 +50,10 @@ def observed(sites, truth, fallen_share, columns=40, spread_deg=0.0, seed=1):
     return parse_observations({"sites": out})
 
 
-def checked(table, observations, truth, grid, first_site):
+def checked(table, observations, truth, grid, first_site, likelihood="predictive"):
     """(summary, truth check) of ``truth`` (east, north km, Mw) in the frame where the
     first site lies at ``first_site`` (the inversion's frame is the first site's)."""
-    post = invert(ForwardModel(table), observations, grid)
+    post = invert(ForwardModel(table, likelihood=likelihood), observations, grid)
     e, n = truth[0] - first_site[0], truth[1] - first_site[1]
     summary = post.summary()
     return summary, truth_check(post, {
@@ -160,12 +160,15 @@ def test_a_source_well_inside_the_reach_gives_no_warning():
 
 def test_a_source_beyond_the_reach_gives_the_warning_and_no_direction():
     """One site 16 km from the source, the table's rings end at 10 km: 2 of 12 columns
-    fall (the share at 16 km), fewer than anywhere within the reach; the warning, and
-    the whole circle for the back azimuth."""
+    fall (the share at 16 km), fewer than anywhere within the reach when the 12 are read
+    as 12 independent draws (the predictive likelihood reads a site's columns as a few:
+    2 of 12 then does not tell 16 km from 10); the warning, and the whole circle for the
+    back azimuth."""
     truth = (0.0, 0.0, 6.5)
     summary, found = checked(reach_table(), observed({"A": (0.0, 16.0)}, truth, 2.5 / 16,
                                                      columns=12), truth,
-                             CandidateGrid(radius_km=20, step_km=1.0), (0.0, 16.0))
+                             CandidateGrid(radius_km=20, step_km=1.0), (0.0, 16.0),
+                             likelihood="independent")
     assert not found["within_reach"] and found["reach_warning"]
     assert summary["back_azimuth_ci95_deg"] == [0.0, 360.0]
     assert summary["back_azimuth_map_deg"] is None and not summary["direction_reliable"]

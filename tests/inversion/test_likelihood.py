@@ -161,8 +161,8 @@ def test_predictive_polya_urn_by_hand(tiny):
     # alone says (P = 0.5 of a fall): the urn learns from the site's own columns
     falls = site(DRUMS_15, second)
     urn = model.site_log_likelihood(falls, [0.0], [-5.0], [0.0])
-    independent = ForwardModel(tiny, KERNEL, FLOOR).site_log_likelihood(falls, [0.0], [-5.0],
-                                                                         [0.0])
+    independent = ForwardModel(tiny, KERNEL, FLOOR, "independent").site_log_likelihood(
+        falls, [0.0], [-5.0], [0.0])
     assert urn[0, 0, 0] > independent[0, 0, 0]
 
 
@@ -171,5 +171,6 @@ def test_predictive_equals_independent_for_one_column_per_type(tiny):
     east, north, strikes = np.array([0.0, 3.0, -2.0]), np.array([-5.0, -1.0, 4.0]), [0, 45]
     a = ForwardModel(tiny, likelihood="predictive").site_log_likelihood(obs, east, north,
                                                                          strikes)
-    b = ForwardModel(tiny).site_log_likelihood(obs, east, north, strikes)
+    b = ForwardModel(tiny, likelihood="independent").site_log_likelihood(obs, east, north,
+                                                                          strikes)
     np.testing.assert_allclose(a, b, rtol=1e-12)

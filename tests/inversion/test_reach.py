@@ -122,14 +122,16 @@ def test_sites_too_far_apart_for_the_table_are_one_line(table):
 
 
 def test_invert_warns_when_the_source_may_lie_beyond(table, tmp_path, capsys):
-    """The command's outputs: the reach's keys in inversion_summary.json, a warning line."""
+    """The command's outputs: the reach's keys in inversion_summary.json, a warning line
+    (the independent likelihood: one site's 12 columns read as 12 draws, sharp enough to
+    put the posterior on the edge; the predictive reads them as a few)."""
     import json
     path = table.save(tmp_path / "toy.npz")
     observations = tmp_path / "far.json"
     observations.write_text(json.dumps(hidden_source((0.0, 0.0), {"A": (0.0, 16.0)}).as_dict()))
     out = tmp_path / "out"
     assert cli.main(["invert", str(observations), "--table", str(path), "--out", str(out),
-                     "--radius", "30", "--step", "1"]) == 0
+                     "--radius", "30", "--step", "1", "--likelihood", "independent"]) == 0
     summary = json.loads((out / "inversion_summary.json").read_text())
     assert summary["reach_km"] == 10.0 and summary["table_last_ring_km"] == 10.0
     assert summary["beyond_table_fraction"] > 0.8          # 10 of 30 km: 1 - 1/9 of the area

@@ -48,11 +48,11 @@ def repeated(fallen, azimuth_deg, copies):
 def test_one_column_repeated_says_what_one_column_says():
     table = flat_table()
     for fallen in (True, False):
-        single = invert(ForwardModel(table), repeated(fallen, 40.0, 1), GRID)
+        single = invert(ForwardModel(table, likelihood="independent"), repeated(fallen, 40.0, 1), GRID)
         many = invert(ForwardModel(table, likelihood="predictive", site_columns=ONE),
                       repeated(fallen, 40.0, 30), GRID)
         assert np.allclose(many.epicentre, single.epicentre, atol=1e-9)
-        sure = invert(ForwardModel(table), repeated(fallen, 40.0, 30), GRID)
+        sure = invert(ForwardModel(table, likelihood="independent"), repeated(fallen, 40.0, 30), GRID)
         assert not np.allclose(sure.epicentre, single.epicentre, atol=1e-3)
 
 
@@ -75,7 +75,7 @@ def test_correlated_columns_cover_with_site_columns_not_with_the_product():
     table = flat_table()
     calibrated = coverage(ForwardModel(table, likelihood="predictive", site_columns=ONE),
                           300, 30, 1)
-    product = coverage(ForwardModel(table), 300, 30, 1)
+    product = coverage(ForwardModel(table, likelihood="independent"), 300, 30, 1)
     assert 0.91 <= calibrated <= 0.99          # Bayes: E[mass of the 95 % region] ~ 0.95
     assert product < 0.85                      # 30 copies taken for 30 columns
 
