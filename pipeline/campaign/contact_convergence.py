@@ -37,7 +37,7 @@ import pandas as pd
 from scipy.stats import binomtest
 
 from pipeline.campaign.run_dirs import finished_summary
-from pipeline.campaign.shake_table import EXPERIMENTS, load_experiments
+from pipeline.campaign.shake_table_experiments import EXPERIMENTS, SPECIMEN, load_experiments
 from pipeline.files import InputError, ToolError, read_run_json, write_json
 from pipeline.outcome.summary import RunSummary
 from pipeline.stats.circular import circular_summary
@@ -214,7 +214,6 @@ def rock_restitution(rock, specimen=None, log=print):
     """The rock's rocking restitution in YADE at the rock part's footprint and damping
     per stiffness factor, and at its x1 kn per damping ratio (ROCK_DAMPINGS and its
     own); Housner's for a block of its critical angle beside (1 - 1.5 sin^2 alpha)."""
-    from pipeline.campaign.shake_table import SPECIMEN
     from pipeline.scenario import ColumnGeometry
     from pipeline.verification.contact_map import specimen_measure
 

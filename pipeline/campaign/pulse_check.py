@@ -15,7 +15,7 @@ import math
 
 import numpy as np
 
-from pipeline.campaign.shake_table import (EXPERIMENTS, OUTCOME, PGA_EDGES_G, PGV_PGA_EDGES_S,
+from pipeline.campaign.shake_table_experiments import (EXPERIMENTS, OUTCOME, PGA_EDGES_G, PGV_PGA_EDGES_S,
                                            load_experiments)
 from pipeline.constants import STANDARD_GRAVITY as G
 from pipeline.hazard.pulse_cells import cell_table, interpolate

@@ -21,7 +21,8 @@ import numpy as np
 from scipy.stats import qmc
 
 from pipeline.campaign.column_file import column_kn
-from pipeline.campaign.shake_table import GRID_CONTACT, GRID_SPECIMEN, neighbourhood_ranges
+from pipeline.campaign.shake_table_experiments import GRID_CONTACT, GRID_SPECIMEN, \
+    neighbourhood_ranges
 from pipeline.constants import STANDARD_GRAVITY
 from pipeline.files import InputError
 from pipeline.motion.pulses import one_cosine_pulse
@@ -35,7 +36,7 @@ MAX_AXIS_SIZE = 50
 PULSE_DT_S = 0.005                # sample interval of the pulses, at most
 PULSE_TAIL_S = 4.0                # at rest after the pulse: the body settles or falls
 # member ranges: defaults from the shake-table calibration's neighbourhood
-# (shake_table.CALIBRATION_NEIGHBOURHOOD); bounds as the calibration's --grid
+# (shake_table_experiments.CALIBRATION_NEIGHBOURHOOD); bounds as the calibration's --grid
 RANGE_BOUNDS = {"kn": GRID_CONTACT["kn"], "damping": GRID_CONTACT["damping"],
                 "mu_s": GRID_CONTACT["mu_s"], **GRID_SPECIMEN}
 DEFAULT_RANGES = neighbourhood_ranges()

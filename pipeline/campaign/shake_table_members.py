@@ -31,7 +31,8 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from pipeline.campaign import ensemble_members, pulse_adaptive, pulse_grid, shake_table
+from pipeline.campaign import ensemble_members, pulse_adaptive, pulse_grid, shake_table, \
+    shake_table_experiments
 from pipeline.campaign.column_file import column_kn
 from pipeline.campaign.run_dirs import finished_runs, finished_summary
 from pipeline.campaign.runs import column_specs
@@ -58,7 +59,7 @@ KN_OF_RUN_CPU_S = 1.2e8
 def check(options):
     """One-line refusals of the members mode's options, before any work."""
     ensemble_members.check_seed(options.seed)
-    specimen = ColumnGeometry.load(options.column_file or shake_table.SPECIMEN).to_dict()
+    specimen = ColumnGeometry.load(options.column_file or shake_table_experiments.SPECIMEN).to_dict()
     contact = None if options.contact_file is None else contact_values(options.contact_file)
     member_sets(specimen, options.members, options.seed, options.ranges, contact)
     if options.candidates is not None:
@@ -80,8 +81,8 @@ def check(options):
 def single_set(grid):
     """The one parameter set run beside the members: ``grid``'s one point
     (:data:`SINGLE_SET` for the campaign's default grid)."""
-    text = SINGLE_SET if grid == shake_table.DEFAULT_GRID else grid
-    points = shake_table.parse_grid(text)
+    text = SINGLE_SET if grid == shake_table_experiments.DEFAULT_GRID else grid
+    points = shake_table_experiments.parse_grid(text)
     if len(points) != 1:
         raise InputError(f"--members: --grid names {len(points)} parameter sets; give one "
                          "(the single set scored beside the members) or leave it out")
@@ -107,7 +108,7 @@ def member_sets(specimen, members, seed, ranges, contact=None):
 
 def run_params(specimen, point, base):
     """Run parameters of one member (or the single set) on the table."""
-    params = shake_table._run_params(specimen, point, base)
+    params = shake_table_experiments.grid_run_params(specimen, point, base)
     if "kn" not in point and "kn" not in (base or {}) and "mesh" not in specimen:
         params["kn"] = column_kn(specimen)          # a description's matched kn, as there
     return params
@@ -120,7 +121,7 @@ def core_s(params):
 
 def tests_of(experiments, outcome, tests, validate_from):
     """The tests with a motion (of ``tests``), with their split."""
-    frame = shake_table.load_experiments(experiments, outcome)
+    frame = shake_table_experiments.load_experiments(experiments, outcome)
     frame = frame[[p is not None for p in frame["motion_path"]]]
     if tests:
         frame = frame[frame["test"].isin(tests)]

@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from pipeline.campaign import shake_table
+from pipeline.campaign import shake_table_experiments
 from pipeline.files import InputError, write_csv, write_json
 from pipeline.records import RECORDS_DIR
 from pipeline.scenario.geometry import ColumnGeometry
@@ -53,7 +53,7 @@ def providers_of(options):
     the providers' models of SP1."""
     path = options.get("providers")
     if path is None and Path(options["experiments"]).resolve() == \
-            shake_table.EXPERIMENTS.resolve() and options["outcome"] == shake_table.OUTCOME:
+            shake_table_experiments.EXPERIMENTS.resolve() and options["outcome"] == shake_table_experiments.OUTCOME:
         path = PROVIDERS
     return path, ({} if path is None else load_providers(path))
 
@@ -87,7 +87,7 @@ def write_scores(per_test, campaign_dir, options, full, settled, choice=None):
     (:func:`pipeline.campaign.shake_table_members.choose_ranges`), if they were."""
     campaign_dir = Path(campaign_dir)
     specimen = ColumnGeometry.load(options["specimen"])
-    axis = options.get("axis_deg", shake_table.AXIS_DEG)
+    axis = options.get("axis_deg", shake_table_experiments.AXIS_DEG)
     critical = specimen.critical_angle_along_deg(axis)
     threshold_g = math.tan(math.radians(critical))
     path, providers = providers_of(options)

@@ -192,7 +192,7 @@ def test_rock_restitution_runs_the_rock_parts_point(monkeypatch):
     assert all(c[3] == {"mu_s": 0.3} for c in calls)
     assert out["factors"]["x3"]["restitution"] == pytest.approx(0.9 + 0.0007 + 3e-4)
     assert [r["damping"] for r in out["by_damping"]] == sorted({*cc.ROCK_DAMPINGS, 0.07})
-    from pipeline.campaign.shake_table import SPECIMEN
+    from pipeline.campaign.shake_table_experiments import SPECIMEN
     geometry = ColumnGeometry.load(SPECIMEN).to_dict()
     geometry["footprint_tolerance_m"] = 0.002
     alpha = math.radians(ColumnGeometry.from_dict(geometry).critical_angle_along_deg(90.0))

@@ -348,8 +348,8 @@ def test_members_span_the_calibration_grid():
     """The fragility's default member ranges and the shake-table calibration's default grid
     read one neighbourhood: footprint and damping span the grid's two values, mu_s lies
     about the calibration's choice of 0.7, and every grid value lies in its bounds."""
-    from pipeline.campaign import shake_table
-    points = shake_table.parse_grid(shake_table.DEFAULT_GRID)
+    from pipeline.campaign import shake_table_experiments
+    points = shake_table_experiments.parse_grid(shake_table_experiments.DEFAULT_GRID)
     ranges = pulse_grid.parse_ranges("")
     assert len(points) == 2 ** 4
     for name in ("footprint_tolerance_m", "damping"):

@@ -7,8 +7,8 @@ import math
 import numpy as np
 import pytest
 
-from pipeline.campaign.shake_table import (EXPERIMENTS, SPECIMEN, load_experiments,
-                                           grid_contact, parse_grid)
+from pipeline.campaign.shake_table_experiments import (EXPERIMENTS, SPECIMEN, load_experiments,
+                                                       grid_contact, parse_grid)
 from pipeline.files import InputError
 from pipeline.records import build_motion, resolve
 from pipeline.scenario import ColumnGeometry

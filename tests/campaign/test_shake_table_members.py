@@ -11,7 +11,7 @@ import pytest
 
 from pipeline import cli
 from pipeline.campaign import ensemble_members, pulse_grid
-from pipeline.campaign.shake_table import EXPERIMENTS, OUTCOME, SPECIMEN
+from pipeline.campaign.shake_table_experiments import EXPERIMENTS, OUTCOME, SPECIMEN
 from pipeline.campaign.shake_table_members import choose_ranges, member_sets
 from pipeline.campaign.shake_table_scores import write_scores
 from pipeline.scenario.geometry import ColumnGeometry

@@ -7,7 +7,7 @@ import pytest
 
 import pipeline
 from pipeline.campaign import ensemble_members, pulse_grid
-from pipeline.campaign.shake_table import grid_contact
+from pipeline.campaign.shake_table_experiments import grid_contact
 from pipeline.scenario import Contact
 
 PAPER_RATIO = 0.6 / 0.7          # the paper's mu_k / mu_s, the calibration's choice for SP1
