@@ -51,7 +51,12 @@ def column_specs(runs, campaign_dir, tags=None, **common):
     tags = [{}] * len(runs) if tags is None else list(tags)
     if len(tags) != len(runs):
         raise ValueError("column_specs: one tags dict per run")
-    return [RunSpec.create(record, resolved[record][0], resolved[record][1], params, version,
+    built = {}        # id of a parameters dict shared by many runs -> (it, its RunParams)
+    for _, params in runs:
+        if not isinstance(params, RunParams) and id(params) not in built:
+            built[id(params)] = (params, RunParams.from_dict(params))   # checked once
+    return [RunSpec.create(record, resolved[record][0], resolved[record][1],
+                           built[id(params)][1] if id(params) in built else params, version,
                            **common, **more)
             for (record, params), more in zip(runs, tags)]
 

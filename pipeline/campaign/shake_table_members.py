@@ -189,6 +189,8 @@ def drive(run, records, campaign_dir, options, gate=None):
     calibration = list(frame.loc[frame["split"] == "calibration", "test"])
     passes = ([{**options, "ranges": c, "tests": calibration} for c in candidates]
               + [options] if candidates else [options])
+    log.info(f"shake-table (members): preparing the runs of {len(frame)} tests "
+             f"({len(passes)} set(s) of ranges; tens of seconds each)")
     fulls = [run_specs(records, campaign_dir, o) for o in passes]
     n, jobs = options["members"], max(options.get("jobs") or 1, 1)
     most = len({s.run_id for full in fulls for s in full})
