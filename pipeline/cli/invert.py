@@ -10,7 +10,7 @@ from pathlib import Path
 
 from pipeline.cli._fields import add_arguments, from_args
 from pipeline.files import InputError
-from pipeline.inversion.workflows import InversionOptions
+from pipeline.inversion.options import CANDIDATE_PRESETS, InversionOptions
 from pipeline.userfiles import number
 
 NAME = "invert"
@@ -160,7 +160,6 @@ def build_grids(args):
     from pipeline.inversion.grid import GRIDS, parse_mechanisms
     from pipeline.campaign.ensemble_members import check_seed
     from pipeline.inversion.candidates import CandidateGrid
-    from pipeline.inversion.workflows import CANDIDATE_PRESETS
     if args.quick and args.grid not in (None, "quick"):
         raise InputError("--quick is --grid quick: give one of them")
     preset = "quick" if args.quick else (

@@ -4,75 +4,39 @@ inversion of an observations file, the demo, the member study or a hidden truth.
 writes its files under ``options.out`` and returns the command's exit status."""
 import logging
 import time
-from dataclasses import dataclass
 from pathlib import Path
 
 from pipeline import RESULTS_DIR
+from pipeline.campaign import run_campaign
+from pipeline.campaign.column_file import description
 from pipeline.campaign.executor import RUN_CORE_S as FORWARD_RUN_CORE_S
 from pipeline.campaign.run_dirs import count_finished
 from pipeline.constants import COLUMN_TYPES
-from pipeline.files import LONG_RUN_S, InputError, check_jobs, check_long
-from pipeline.inversion.likelihood import DEFAULT_FLOOR, DEFAULT_KERNEL_DEG, DEFAULT_LIKELIHOOD, \
-    check_model_options
-from pipeline.scenario.parameters import check_fields, param
+from pipeline.figures.inversion import plot_member_study, plot_member_study_source
+from pipeline.files import InputError, check_jobs, check_long, write_csv, write_json
+from pipeline.hazard.site_motion import site_motion
+from pipeline.inversion import EXAMPLES_DIR, run_inversion, study
+from pipeline.inversion.candidates import check_reach
+from pipeline.inversion.demo import BOUND_ANSWER_KEY, BOUND_DEG, BOUND_TEXT, DEFAULT_TRIALS, \
+    run_demo
+from pipeline.inversion.forward import DEFAULT_FORWARD_DIR, run_forward, table_path
+from pipeline.inversion.grid import TableGrid
+from pipeline.inversion.likelihood import SITE_COLUMNS
+from pipeline.inversion.observations import load_observations, parse_observations
+from pipeline.inversion.paper_scenario import paper_grid, paper_nodes
+from pipeline.inversion.study_summary import placement_summary, study_answer, study_summary, \
+    warning_rates
+from pipeline.inversion.table import ForwardTable
+from pipeline.inversion.truth import check_hidden, load_truth
+from pipeline.scenario.column_format import example_names
 
 log = logging.getLogger(__name__)
-
-
-@dataclass(frozen=True)
-class InversionOptions:
-    """What the workflows take from the command line (see ``toppling invert --help``),
-    declared as :func:`~pipeline.scenario.parameters.param` fields (the command builds
-    their flags); checked on creation, before any work."""
-    out: Path = param(None, "", "output directory (default results/inversion/<file stem>; "
-                      "--demo: results/inversion)", flag="--out", metavar="DIR")
-    scheduler: str = param(None, "", "run the forward campaign on an existing Dask cluster",
-                           flag="--scheduler", metavar="ADDRESS")
-    jobs: int = param(None, "", "parallel YADE runs / pyprop8 processes (default: all cores)",
-                      flag="--jobs")
-    allow_long: bool = param(False, "", f"start a forward table estimated to take over "
-                             f"{LONG_RUN_S / 3600:g} h on this machine (refused otherwise; "
-                             "the estimate is printed before any run)", flag="--allow-long")
-    table: Path = param(None, "", "use this forward table file (tables/forward_table_<key>.npz) "
-                        "as it is: no pyprop8, no YADE (its code version is reported, not "
-                        "checked)", flag="--table", metavar="FILE")
-    forward_dir: Path = param(None, "", "campaign directory of the forward runs (default "
-                              "results/inversion-forward)", flag="--forward-dir", metavar="DIR")
-    kernel_deg: float = param(None, "", f"width of the von Mises kernel on ensemble falls "
-                              f"(default {DEFAULT_KERNEL_DEG:g})", flag="--kernel-deg")
-    floor: float = param(None, "", f"fraction of uniform density mixed into every direction "
-                         f"density (default {DEFAULT_FLOOR:g})", flag="--floor")
-    likelihood: str = param(None, "", "predictive (default): columns of one site share its "
-                            "motion and the ensemble is finite (Polya urn: a site's own falls "
-                            "inform its next column; calibrated in the member study); "
-                            "independent: the product over columns (too sure when a site has "
-                            "several columns)", flag="--likelihood",
-                            choices=("independent", "predictive"))
-    trials: int = param(None, "", "trials per configuration (--demo: default 20; "
-                        "--member-study: default 200)", flag="--trials")
-
-    def __post_init__(self):
-        check_fields(self)
-        for name, default in (("kernel_deg", DEFAULT_KERNEL_DEG), ("floor", DEFAULT_FLOOR),
-                              ("likelihood", DEFAULT_LIKELIHOOD)):
-            if getattr(self, name) is None:
-                object.__setattr__(self, name, default)
-        check_model_options(self.kernel_deg, self.floor, self.likelihood)
-        check_jobs(self.jobs)
-
-
-CANDIDATE_PRESETS = {"quick": {"radius_km": 12.0, "step_km": 1.0, "strike_step_deg": 90.0},
-                     "study": {"radius_km": 15.0, "step_km": 1.0, "strike_step_deg": 30.0},
-                     "demo": {"radius_km": 25.0, "step_km": 1.0, "strike_step_deg": 30.0},
-                     "full": {"radius_km": 30.0, "step_km": 1.0, "strike_step_deg": 30.0}}
 
 
 def described_columns(observations, base_dir="."):
     """{column name in the observations: its description dict} for every column that is a
     column file (a shipped example's name, or a file, relative to ``base_dir`` (the
     observations file's folder) when it is there); one-line errors before anything runs."""
-    from pipeline.campaign.column_file import description
-    from pipeline.scenario.column_format import example_names
     out = {}
     for name in observations.column_types():
         if name in COLUMN_TYPES:
@@ -99,7 +63,6 @@ def preflight(grid, forward_dir, jobs, allow_long, more_runs=0):
     long the rest (and ``more_runs`` twin runs of the same cost) take on ``jobs`` cores;
     the long-run gate (:func:`pipeline.files.check_long`: InputError past LONG_RUN_S
     without ``allow_long``).  Returns the estimate (s)."""
-    from pipeline.inversion.forward import DEFAULT_FORWARD_DIR
     forward_dir = Path(forward_dir or DEFAULT_FORWARD_DIR)
     done = count_finished(forward_dir)
     needed = grid.n_runs()
@@ -116,8 +79,6 @@ def forward_table(options, grid, sibling_of=None, more_runs=0):
     """(ForwardTable, info dict): the --table file (``sibling_of``: the table of ``grid``
     beside that file), or the campaign's (run or reused); ``more_runs``: twin runs the
     command starts after the table, counted by the long-run gate with it."""
-    from pipeline.inversion.forward import run_forward, table_path
-    from pipeline.inversion.table import ForwardTable
     path = options.table if sibling_of is None else \
         Path(sibling_of).parent / table_path(".", grid).name
     if sibling_of is not None and not path.is_file():
@@ -153,12 +114,6 @@ def _say_reach(summary):
 def demo(options, preset, grid, candidates):
     """invert --demo: the forward table, the paper scenario's tables, the truth tests
     (demo_summary.json) and the two-site example."""
-    from pipeline.inversion import EXAMPLES_DIR, run_inversion
-    from pipeline.inversion.demo import BOUND_ANSWER_KEY, BOUND_TEXT, DEFAULT_TRIALS, run_demo
-    from pipeline.inversion.paper_scenario import paper_grid, paper_nodes
-    from pipeline.inversion.forward import run_forward, table_path
-    from pipeline.inversion.table import ForwardTable
-    from pipeline.inversion.observations import load_observations
     out = options.out or RESULTS_DIR / "inversion"
     if out.exists() and not out.is_dir():
         raise InputError(f"--out {out} is a file, not a directory")
@@ -203,7 +158,6 @@ def demo(options, preset, grid, candidates):
                                                     "reach_limit", "reach_edge_fraction",
                                                     "reach_warning")}}
     summary["elapsed_s"] = round(time.monotonic() - started, 1)
-    from pipeline.files import write_json
     write_json(out / "demo_summary.json", summary)
     for kind, cov in summary["coverage"].items():
         log.info(f"truth tests, {kind} likelihood: {cov['trials']} inversions; the 95 % "
@@ -224,20 +178,12 @@ def member_study(options, grid, candidates):
     truth tests; writes member_study.csv (one row per trial), member_study_summary.csv,
     member_study_placements.csv (per placement of the source), member_study.json (the answer per likelihood), member_study.png (the back azimuth) and
     member_study_source.png (the epicentre and the magnitude)."""
-    from pipeline.files import write_csv, write_json
-    from pipeline.figures.inversion import plot_member_study, plot_member_study_source
-    from pipeline.inversion.demo import BOUND_DEG
-    from pipeline.inversion.likelihood import SITE_COLUMNS
-    from pipeline.inversion.study import (LIKELIHOOD_MEMBERS, OBSERVATION_MEMBERS,
-                                          STUDY_SEED, STUDY_TRIALS, member_study)
-    from pipeline.inversion.study_summary import (placement_summary, study_answer,
-                                                  study_summary, warning_rates)
     out = options.out or RESULTS_DIR / "inversion" / "member-study"
     if out.exists() and not out.is_dir():
         raise InputError(f"--out {out} is a file, not a directory")
     started = time.monotonic()
     table, info = forward_table(options, grid)
-    trials = STUDY_TRIALS if options.trials is None else options.trials
+    trials = study.STUDY_TRIALS if options.trials is None else options.trials
 
     jobs = check_jobs(options.jobs)
     log.info(f"member study: {trials} trials per configuration on {jobs} process(es)")
@@ -246,7 +192,7 @@ def member_study(options, grid, candidates):
         log.info(f"  {kind} likelihood, {size} members: done "
                  f"({time.monotonic() - started:.0f} s)")
 
-    rows = member_study(table, candidates, trials=trials, kernel_deg=options.kernel_deg,
+    rows = study.member_study(table, candidates, trials=trials, kernel_deg=options.kernel_deg,
                         floor=options.floor, jobs=jobs, progress=progress)
     if rows.empty:
         raise InputError("no column of the observed members ever fell: nothing to test "
@@ -262,9 +208,9 @@ def member_study(options, grid, candidates):
     write_json(out / "member_study.json", {
         "answer": answer, "likelihood_members": sorted(summary["likelihood_members"].unique()
                                                        .tolist()),
-        "requested_likelihood_members": list(LIKELIHOOD_MEMBERS),
-        "observation_members": OBSERVATION_MEMBERS, "trials": trials,
-        "site_columns": SITE_COLUMNS, "seed": STUDY_SEED,
+        "requested_likelihood_members": list(study.LIKELIHOOD_MEMBERS),
+        "observation_members": study.OBSERVATION_MEMBERS, "trials": trials,
+        "site_columns": SITE_COLUMNS, "seed": study.STUDY_SEED,
         "forward_table": info, "figure": figure.name, "source_figure": source_figure.name,
         "toppled_fraction_by_slice": table.toppled_fraction_by_slice(),
         "reach_warning": warning_rates(placements),
@@ -279,12 +225,6 @@ def hidden_truth(truth_file, options, grid, candidates):
     """invert --hidden-truth: the forward table, the hidden members' runs at the truth's
     sites (campaign inversion-truth in OUT/truth-runs), observations.json from them, and
     the inversion with the truth marked and checked (inversion_summary.json: truth)."""
-    from pipeline.campaign import run_campaign
-    from pipeline.files import write_json
-    from pipeline.inversion import run_inversion
-    from pipeline.inversion.grid import TableGrid
-    from pipeline.inversion.observations import parse_observations
-    from pipeline.inversion.truth import check_hidden, load_truth
     truth = load_truth(truth_file)
     out = options.out or RESULTS_DIR / "inversion" / f"truth-{truth_file.stem}"
     if out.exists() and not out.is_dir():
@@ -297,7 +237,6 @@ def hidden_truth(truth_file, options, grid, candidates):
     table, info = forward_table(options, grid, more_runs=truth_runs)
     table_grid = TableGrid(**table.info["grid"]) if table.info.get("grid") else grid
     check_hidden(truth, table_grid)
-    from pipeline.inversion.candidates import check_reach
     check_reach(truth.sites, table.distances_km[-1], candidates)     # before any run
     log.info(f"hidden truth: {sum(s[3] for s in truth.sites)} twin runs at "
              f"{len(truth.sites)} site(s)")
@@ -326,7 +265,6 @@ def hidden_truth(truth_file, options, grid, candidates):
 def site_motions(observations, fragility_for, pgv_pga_s=None):
     """site_motion.json's content: the PGA range each site's standing and fallen columns
     allow (:func:`pipeline.hazard.site_motion.site_motion`), every site with columns."""
-    from pipeline.hazard.site_motion import site_motion
     sites = [site_motion(observations, site.name, fragility_for, pgv_pga_s)
              for site in observations.sites if site.columns]
     return {"sites": sites,
@@ -342,8 +280,6 @@ def invert_file(observations_file, options, grid, candidates, site_fragility=Non
     the described columns' tables, then the inversion (``options.out``, default
     results/inversion/<file stem>).  ``site_fragility`` ((fragility_for(column type),
     PGV/PGA) or None): the PGA range at each site too (site_motion.json)."""
-    from pipeline.inversion import run_inversion
-    from pipeline.inversion.observations import load_observations
     observations = load_observations(observations_file)
     motions = None if site_fragility is None else site_motions(observations, *site_fragility)
     described = described_columns(observations, observations_file.parent)
@@ -353,7 +289,6 @@ def invert_file(observations_file, options, grid, candidates, site_fragility=Non
     started = time.monotonic()
     table, info = forward_table(options, grid)
     if options.table is not None and described and table.info.get("grid"):
-        from pipeline.inversion.grid import TableGrid          # the --table file's grid
         grid = TableGrid(**table.info["grid"])
     for name, data in described.items():
         column_table, column_info = forward_table(options, grid.replace(column_file=data),

@@ -12,14 +12,25 @@ A restitution outside that range is not reachable by this law and is refused.  E
 measured restitution is kept in a cache file (JSON, ``CACHE``) by block, density, kn,
 damping and the model's code, so a block mapped once is not run again.
 """
+import contextlib
+import dataclasses
 import json
 import math
+import statistics
 import tempfile
 
+import numpy as np
+from scipy.spatial.transform import Rotation
+
 from pipeline import RESULTS_DIR, paper
+from pipeline.files import InputError, code_hash, content_hash, write_json
+from pipeline.outcome.columns import rotations
 from pipeline.rocking.decay import fit_free_rocking, free_rocking_peaks
 from pipeline.rocking.response import housner_free_rocking
-from pipeline.files import InputError, code_hash, write_json
+from pipeline.scenario import ColumnSpec, Contact, Numerics, run_yade, scene_params
+from pipeline.scenario.parameters import split_options
+from pipeline.scenario.scene_file import base_points, released, support_line
+from pipeline.scenario.writer import write_scenario
 from pipeline.verification.checks import MARBLE_CONTACT, run_block
 
 RESTITUTION_TOLERANCE = 0.0005   # |measured - stated| restitution the bisection stops at
@@ -143,7 +154,6 @@ def damping_for_restitution(restitution, height, width, depth, kn=paper.MARBLE_B
 def _scene(geometry, contact, numerics):
     """(scene file, its one column dict) of the specimen (a column description as the
     monolith of its outline) alone at the table's centre, at rest."""
-    from pipeline.scenario import ColumnSpec, scene_params
     spec = ColumnSpec("specimen", "monolithic", 0.0, 0.0, geometry.monolithic())
     scene = scene_params(columns=[spec], contact=contact, numerics=numerics, t_max=1.0)
     return scene, scene.columns[0]
@@ -152,7 +162,6 @@ def _scene(geometry, contact, numerics):
 def weakest_azimuth(column, step_deg=1.0):
     """Azimuth (deg) toward which a scene column's critical angle is smallest (the weak
     side), on a grid of ``step_deg``."""
-    from pipeline.scenario.scene_file import support_line
     azimuths = [k * step_deg for k in range(int(round(360.0 / step_deg)))]
     return min(azimuths, key=lambda a: support_line(column, a)["critical_angle_rad"])
 
@@ -182,15 +191,8 @@ def specimen_rocking(geometry, damping, kn, azimuth_deg=None, release_ratio=RELE
     restitution_per_impact, impacts, azimuth_deg,
     critical_angle_deg, release_deg, and the record (t s, tilt rad about the support
     line, rise m).  ``run_dir``: keep the run there (default: a temporary directory)."""
-    import contextlib
-    import dataclasses
 
-    import numpy as np
 
-    from pipeline.scenario import Contact, Numerics, run_yade
-    from pipeline.scenario.parameters import split_options
-    from pipeline.scenario.scene_file import released
-    from pipeline.scenario.writer import write_scenario
 
     contact, numerics = split_options(options)
     scene, column = _scene(geometry, Contact(**{**contact, "kn": kn, "damping": damping}),
@@ -235,9 +237,7 @@ def equivalent_block(column, azimuth_deg, name):
     ``azimuth_deg``: R the distance from the support line to the centre of mass, and the
     block of the same critical angle and R; InputError when the centre of mass is not
     above the footprint that way (``name``: the specimen's)."""
-    import numpy as np
 
-    from pipeline.scenario.scene_file import support_line
     line = support_line(column, azimuth_deg)
     alpha = line["critical_angle_rad"]
     if not alpha > 0:
@@ -252,7 +252,6 @@ def _free_rocking_s(body, line, radius, gravity, h, b, tilt, counted):
     """Duration (s) of a free-rocking run that holds ``counted`` impacts: Housner's block
     (h x b, released at ``tilt`` rad), its swings scaled by the specimen's own rocking
     frequency about the support line (p^2 = m g R / I_pivot)."""
-    import numpy as np
     rotation = np.asarray(body["rotation"], float)
     inertia = line["axis"] @ rotation @ np.asarray(body["inertia"], float) @ rotation.T @ \
         line["axis"] + body["mass"] * radius ** 2
@@ -266,11 +265,7 @@ def _turn_and_rise(trajectory, body, line):
     """(rotations from the start (scipy), tilt rad about the support line, rise m of the
     centre of mass above its rest height: the rigid body's, above the lowest point of its
     base outline) of the trajectory's first body."""
-    import numpy as np
-    from scipy.spatial.transform import Rotation
 
-    from pipeline.outcome.columns import rotations
-    from pipeline.scenario.scene_file import base_points
     turns = rotations(trajectory.quat[:, 0])
     start = Rotation.from_matrix(np.asarray(body["rotation"], float))
     theta = (turns * start.inv()).as_rotvec() @ line["axis"]
@@ -282,7 +277,6 @@ def _turn_and_rise(trajectory, body, line):
 def _energy_above_rest(trajectory, body, turns, rise, gravity):
     """The first body's whole energy above rest (J) at each sample: translation, rotation,
     rise."""
-    import numpy as np
     inertia_world = turns.as_matrix() @ np.asarray(body["inertia"], float) @ \
         turns.as_matrix().transpose(0, 2, 1)
     w = trajectory.angvel[:, 0]
@@ -295,9 +289,7 @@ def specimen_measure(geometry, kn, azimuth_deg, cache=CACHE, **options):
     """:func:`cached_measure` of the specimen's restitution: the median of
     :func:`specimen_rocking` over the releases SPECIMEN_RELEASES (a rock's single
     releases scatter; key: the description's content, azimuth, kn, options)."""
-    import statistics
 
-    from pipeline.files import content_hash
     key = content_hash(geometry.to_dict(), azimuth_deg, kn, SPECIMEN_RELEASES, IMPACTS,
                        options)
     return cached_measure(lambda damping: statistics.median(

@@ -1,0 +1,59 @@
+"""The ``invert`` command's options, declared as :func:`~pipeline.scenario.parameters.param`
+fields (the command builds their flags from them), and the candidate grids' presets
+(km, deg); checked on creation, before any work.  Light: the command imports it at
+start-up, the workflows (:mod:`pipeline.inversion.workflows`) only when it runs."""
+from dataclasses import dataclass
+from pathlib import Path
+
+from pipeline.files import LONG_RUN_S, check_jobs
+from pipeline.inversion.likelihood import DEFAULT_FLOOR, DEFAULT_KERNEL_DEG, DEFAULT_LIKELIHOOD, \
+    check_model_options
+from pipeline.scenario.parameters import check_fields, param
+
+
+@dataclass(frozen=True)
+class InversionOptions:
+    """What the workflows take from the command line (see ``toppling invert --help``),
+    declared as :func:`~pipeline.scenario.parameters.param` fields (the command builds
+    their flags); checked on creation, before any work."""
+    out: Path = param(None, "", "output directory (default results/inversion/<file stem>; "
+                      "--demo: results/inversion)", flag="--out", metavar="DIR")
+    scheduler: str = param(None, "", "run the forward campaign on an existing Dask cluster",
+                           flag="--scheduler", metavar="ADDRESS")
+    jobs: int = param(None, "", "parallel YADE runs / pyprop8 processes (default: all cores)",
+                      flag="--jobs")
+    allow_long: bool = param(False, "", f"start a forward table estimated to take over "
+                             f"{LONG_RUN_S / 3600:g} h on this machine (refused otherwise; "
+                             "the estimate is printed before any run)", flag="--allow-long")
+    table: Path = param(None, "", "use this forward table file (tables/forward_table_<key>.npz) "
+                        "as it is: no pyprop8, no YADE (its code version is reported, not "
+                        "checked)", flag="--table", metavar="FILE")
+    forward_dir: Path = param(None, "", "campaign directory of the forward runs (default "
+                              "results/inversion-forward)", flag="--forward-dir", metavar="DIR")
+    kernel_deg: float = param(None, "", f"width of the von Mises kernel on ensemble falls "
+                              f"(default {DEFAULT_KERNEL_DEG:g})", flag="--kernel-deg")
+    floor: float = param(None, "", f"fraction of uniform density mixed into every direction "
+                         f"density (default {DEFAULT_FLOOR:g})", flag="--floor")
+    likelihood: str = param(None, "", "predictive (default): columns of one site share its "
+                            "motion and the ensemble is finite (Polya urn: a site's own falls "
+                            "inform its next column; calibrated in the member study); "
+                            "independent: the product over columns (too sure when a site has "
+                            "several columns)", flag="--likelihood",
+                            choices=("independent", "predictive"))
+    trials: int = param(None, "", "trials per configuration (--demo: default 20; "
+                        "--member-study: default 200)", flag="--trials")
+
+    def __post_init__(self):
+        check_fields(self)
+        for name, default in (("kernel_deg", DEFAULT_KERNEL_DEG), ("floor", DEFAULT_FLOOR),
+                              ("likelihood", DEFAULT_LIKELIHOOD)):
+            if getattr(self, name) is None:
+                object.__setattr__(self, name, default)
+        check_model_options(self.kernel_deg, self.floor, self.likelihood)
+        check_jobs(self.jobs)
+
+
+CANDIDATE_PRESETS = {"quick": {"radius_km": 12.0, "step_km": 1.0, "strike_step_deg": 90.0},
+                     "study": {"radius_km": 15.0, "step_km": 1.0, "strike_step_deg": 30.0},
+                     "demo": {"radius_km": 25.0, "step_km": 1.0, "strike_step_deg": 30.0},
+                     "full": {"radius_km": 30.0, "step_km": 1.0, "strike_step_deg": 30.0}}
