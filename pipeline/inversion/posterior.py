@@ -126,11 +126,17 @@ class Posterior:
         return int(np.argmin(np.hypot(self.east_km - east_km, self.north_km - north_km)))
 
     def contains(self, east_km, north_km, level=0.95):
-        """Whether the cell holding (east, north) lies in the HPD region (False outside the
-        candidate lattice)."""
+        """Whether the cell holding (east, north) lies in the HPD region.  A point within
+        the reach whose lattice cell is not a candidate (its centre beyond the last ring
+        of a site: a sliver between the outermost centres and the reach's boundary)
+        belongs to the nearest candidate cell; a point beyond the reach or off the
+        lattice is in no cell (False)."""
         k = self.cell_of(east_km, north_km)
         if max(abs(self.east_km[k] - east_km), abs(self.north_km[k] - north_km)) > \
-                self.step_km / 2 + 1e-9:
+                self.step_km / 2 + 1e-9 and not (
+                    self.within_reach(east_km, north_km)
+                    and math.hypot(self.east_km[k] - east_km, self.north_km[k] - north_km)
+                    <= 2.0 * self.step_km + 1e-9):
             return False
         return bool(self.epicentre_region(level)[0][k])
 

@@ -185,3 +185,19 @@ def test_edge_bayes_factor_is_a_finite_number_at_the_ends():
     assert edge_bayes_factor(1.0, 1.0) == 1.0
     assert edge_bayes_factor(0.5, 0.5) == 1.0
     assert edge_bayes_factor(0.0, 0.3) == 0.0
+
+
+def test_a_point_on_the_reachs_edge_belongs_to_its_nearest_candidate_cell(table):
+    """One site, the reach 10 km, cells of 1 km centred at odd half-kilometres: the point
+    (7.05, 7.03) km lies 9.96 km from the site, inside the reach, but its cell's centre
+    (7.5, 7.5) lies 10.6 km away and is no candidate; it belongs to the nearest candidate,
+    (7.5, 6.5) (9.92 km).
+    The point (7.2, 7.2), 10.18 km away, lies beyond the reach: in no cell.  With the
+    whole posterior as the region (level 1) the first is held, the second is not."""
+    observations = hidden_source((0.0, 3.0), {"A": (0.0, 0.0)})
+    post = invert(ForwardModel(table), observations, CandidateGrid(radius_km=12, step_km=1))
+    cells = set(zip(np.round(post.east_km, 3), np.round(post.north_km, 3)))
+    assert (7.5, 7.5) not in cells and {(6.5, 7.5), (7.5, 6.5)} <= cells
+    assert post.contains(7.05, 7.03, level=1.0)
+    assert not post.contains(7.2, 7.2, level=1.0)
+    assert not post.contains(30.0, 0.0, level=1.0)              # off the lattice
