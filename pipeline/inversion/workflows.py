@@ -19,7 +19,7 @@ from pipeline.inversion import EXAMPLES_DIR, run_inversion, study
 from pipeline.inversion.candidates import check_reach
 from pipeline.inversion.demo import BOUND_ANSWER_KEY, BOUND_DEG, BOUND_TEXT, DEFAULT_TRIALS, \
     run_demo
-from pipeline.inversion.forward import DEFAULT_FORWARD_DIR, run_forward, table_path
+from pipeline.inversion import forward
 from pipeline.inversion.grid import TableGrid
 from pipeline.inversion.likelihood import SITE_COLUMNS
 from pipeline.inversion.observations import load_observations, parse_observations
@@ -63,7 +63,7 @@ def preflight(grid, forward_dir, jobs, allow_long, more_runs=0):
     long the rest (and ``more_runs`` twin runs of the same cost) take on ``jobs`` cores;
     the long-run gate (:func:`pipeline.files.check_long`: InputError past LONG_RUN_S
     without ``allow_long``).  Returns the estimate (s)."""
-    forward_dir = Path(forward_dir or DEFAULT_FORWARD_DIR)
+    forward_dir = Path(forward_dir or forward.DEFAULT_FORWARD_DIR)
     done = count_finished(forward_dir)
     needed = grid.n_runs()
     rest = max(0, needed - done)
@@ -80,7 +80,7 @@ def forward_table(options, grid, sibling_of=None, more_runs=0):
     beside that file), or the campaign's (run or reused); ``more_runs``: twin runs the
     command starts after the table, counted by the long-run gate with it."""
     path = options.table if sibling_of is None else \
-        Path(sibling_of).parent / table_path(".", grid).name
+        Path(sibling_of).parent / forward.table_path(".", grid).name
     if sibling_of is not None and not path.is_file():
         raise InputError(f"--table: no forward table of the described column "
                          f"{grid.column_file['name']!r} ({path.name}) beside {sibling_of}")
@@ -94,7 +94,8 @@ def forward_table(options, grid, sibling_of=None, more_runs=0):
         return table, info
     if not options.scheduler:
         preflight(grid, options.forward_dir, check_jobs(options.jobs), options.allow_long, more_runs)
-    table, cost = run_forward(grid, options.forward_dir, check_jobs(options.jobs), options.scheduler)
+    table, cost = forward.run_forward(grid, options.forward_dir, check_jobs(options.jobs),
+                                      options.scheduler)
     return table, {**cost, "grid": grid.as_dict(), "grid_key": grid.key(),
                    "code_version": table.info.get("code_version"), "reused_file": False}
 
@@ -127,7 +128,7 @@ def demo(options, preset, grid, candidates):
             continue
         pgrid = paper_grid(grid, source, quick=preset == "quick")
         if options.table is not None:      # a table file: its siblings, else nothing is run
-            sibling = Path(options.table).parent / table_path(".", pgrid).name
+            sibling = Path(options.table).parent / forward.table_path(".", pgrid).name
             if sibling.is_file():
                 paper_tables[source] = ForwardTable.load(sibling)
                 costs[f"paper_{source}"] = {"table": str(sibling), "reused_file": True,
@@ -137,7 +138,7 @@ def demo(options, preset, grid, candidates):
             else:
                 log.info(f"paper scenario, {source}: no {sibling.name} beside --table: skipped")
             continue
-        paper_tables[source], cost = run_forward(pgrid, options.forward_dir,
+        paper_tables[source], cost = forward.run_forward(pgrid, options.forward_dir,
                                                  check_jobs(options.jobs), options.scheduler)
         costs[f"paper_{source}"] = {**cost, "grid": pgrid.as_dict()}
     summary = run_demo(table, out, candidates, paper_tables, DEFAULT_TRIALS if options.trials is None else options.trials,
