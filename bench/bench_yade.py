@@ -28,11 +28,15 @@ One run prints, and writes to results/bench/bench.json (+ convergence.png):
    directions, each in a fresh directory: runs (and the adaptive cells by their runs),
    YADE wall time (the runs' own wall times summed), campaign wall time, and their
    P = 0.5 contours (g) side by side with the full grid's Monte Carlo band; the load
-   average at the start (wall times grow with what else the machine runs).
+   average at the start (wall times grow with what else the machine runs);
+12. run_wing: the ``run`` command of this checkout beside that of the revision before the
+   fragility wing was typed (RUN_WING_REFERENCE, from ``git archive``), alternating, on a
+   pulse record and a long record: command and YADE wall seconds, outcomes, ratios.
 
 Units: seconds (s), metres, m/s^2; azimuths in degrees clockwise from North.
 ``--quick`` shortens every run and skips the convergence table (for development);
-``--only-rock-fragility`` runs section 11 alone and adds it to an existing bench.json.
+``--only-rock-fragility`` (section 11) and ``--only-run-wing`` (section 12) run one section
+and add it to an existing bench.json.
 """
 import argparse
 import contextlib
@@ -770,7 +774,7 @@ def rock_fragility_adaptive(work, jobs=2):
         wall = time.perf_counter() - started
         summaries[mode] = read_fragility_file(out)
         grid = summaries[mode].pulse_grid
-        runs_per_cell = [c["n"] for c in grid.models["block2d"].cells]
+        runs_per_cell = [c.n for c in grid.models["block2d"].cells]
         result[mode] = {"runs": grid.runs_finished, "full_grid_runs": grid.full_grid_runs,
                         "yade_wall_s": grid.yade_wall_s_total, "campaign_wall_s": wall,
                         "cells_by_runs": {str(n): runs_per_cell.count(n)
@@ -808,6 +812,79 @@ def print_rock_fragility(r):
           "grid's band")
 
 
+# ---------------------------------------------------------------- 12. run wing against a revision
+RUN_WING_REFERENCE = "e505b77"   # the code before the fragility wing was typed (fragility file,
+                                 # one interpolation, one friction rule, RunParams passed whole)
+RUN_WING_RECORDS = ("GM20", "RC-CCC")   # a near-field pulse record and a long far record
+RUN_WING_REPEATS = 3
+
+
+def run_wing(work, reference=RUN_WING_REFERENCE, records=RUN_WING_RECORDS,
+             repeats=RUN_WING_REPEATS):
+    """The ``run`` command (record processing, scene, YADE, summary) of this checkout and of
+    the git revision ``reference`` side by side: each record's twin-model run once untimed
+    per tree (caches), then ``repeats`` times, the two trees alternating so that a change
+    in the machine's load meets both.  Per tree and record: median command wall s, median
+    YADE wall s (summary.json), outcomes; ``ratio`` = this checkout / reference."""
+    tree = work / f"reference_{reference}"
+    tree.mkdir()
+    archive = subprocess.run(["git", "-C", str(PROJECT), "archive", reference],
+                             capture_output=True)
+    if archive.returncode:
+        return {"reference": reference, "skipped": archive.stderr.decode().strip()[:200]}
+    subprocess.run(["tar", "-x", "-C", str(tree)], input=archive.stdout, check=True)
+    trees = {"this": PROJECT, "reference": tree}
+
+    def one(name, record, out):
+        started = time.perf_counter()
+        subprocess.run([sys.executable, "-m", "pipeline", "run", "--record", record,
+                        "--out", str(out)], cwd=trees[name], check=True, capture_output=True,
+                       env={**os.environ, "PYTHONPATH": str(trees[name])})
+        wall = time.perf_counter() - started
+        summary = json.loads((out / "summary.json").read_text())
+        return wall, summary
+
+    rows = []
+    for record in records:
+        row = {"record": record}
+        for name in trees:
+            one(name, record, work / f"run_wing_{name}_{record}_warm")
+        samples = {name: [] for name in trees}
+        for k in range(repeats):
+            for name in (trees if k % 2 == 0 else reversed(list(trees))):
+                samples[name].append(one(name, record, work / f"run_wing_{name}_{record}_{k}"))
+        for name, runs in samples.items():
+            summary = runs[-1][1]
+            row[name] = {"command_wall_s": float(np.median([w for w, _ in runs])),
+                         "yade_wall_s": float(np.median([s["wall_s"] for _, s in runs])),
+                         "simulated_s": summary["simulated_s"],
+                         "columns": {c["column"]: (c["toppled"], c["downfall_azimuth_deg"])
+                                     for c in summary["columns"]}}
+        row["command_ratio"] = row["this"]["command_wall_s"] / row["reference"]["command_wall_s"]
+        row["yade_ratio"] = row["this"]["yade_wall_s"] / row["reference"]["yade_wall_s"]
+        rows.append(row)
+    return {"reference": reference, "repeats": repeats, "records": rows,
+            "load_average_1min": os.getloadavg()[0]}
+
+
+def print_run_wing(r):
+    if "skipped" in r:
+        print(f"\n12. Run wing against {r['reference']}: skipped ({r['skipped']})")
+        return
+    print(f"\n12. The run command against revision {r['reference']}, twin model, median of "
+          f"{r['repeats']} alternating runs (load average {r['load_average_1min']:.1f} at the end)")
+    print(f"   {'record':<10}{'tree':<11}{'command s':>10}{'YADE s':>9}{'simulated s':>13}"
+          "   outcomes (toppled, azimuth deg)")
+    for row in r["records"]:
+        for name in ("this", "reference"):
+            m = row[name]
+            outcomes = "; ".join(f"{c} {t} {fmt(a)}" for c, (t, a) in m["columns"].items())
+            print(f"   {row['record']:<10}{name:<11}{m['command_wall_s']:10.2f}"
+                  f"{m['yade_wall_s']:9.2f}{m['simulated_s']:13.2f}   {outcomes}")
+        print(f"   {'':<10}this / reference: command {row['command_ratio']:.3f}x, "
+              f"YADE {row['yade_ratio']:.3f}x")
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true",
@@ -821,7 +898,18 @@ def main(argv=None):
     parser.add_argument("--only-rock-fragility", action="store_true",
                         help="run only section 11 (adaptive against full pulse grid) and add "
                         "it to the bench.json in --out")
+    parser.add_argument("--only-run-wing", action="store_true",
+                        help="run only section 12 (the run command against revision "
+                        f"{RUN_WING_REFERENCE}) and add it to the bench.json in --out")
     args = parser.parse_args(argv)
+    if args.only_run_wing:
+        path = args.out / "bench.json"
+        result = json.loads(path.read_text()) if path.is_file() else {}
+        with tempfile.TemporaryDirectory(prefix="bench_yade_") as tmp:
+            result["run_wing"] = run_wing(Path(tmp))
+        print_run_wing(result["run_wing"])
+        write_json(path, result)
+        return 0
     if args.only_rock_fragility:
         path = args.out / "bench.json"
         result = json.loads(path.read_text()) if path.is_file() else {}
@@ -871,6 +959,8 @@ def main(argv=None):
         print_ctrl_c(result["ctrl_c"])
         result["rock_fragility_adaptive"] = rock_fragility_adaptive(work)
         print_rock_fragility(result["rock_fragility_adaptive"])
+        result["run_wing"] = run_wing(work, repeats=1 if args.quick else RUN_WING_REPEATS)
+        print_run_wing(result["run_wing"])
     result["bench_wall_s"] = time.perf_counter() - started
     write_json(args.out / "bench.json", result)
     print(f"\nbench: {result['bench_wall_s']:.0f} s wall; wrote {args.out / 'bench.json'}")

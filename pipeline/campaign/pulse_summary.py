@@ -180,14 +180,14 @@ def contour_difference(reference, other, level="0.5"):
         specimen = [m for m in models if m != "block2d"]
         if len(specimen) != 1:
             raise ValueError(f"expected one specimen model beside block2d, got {specimen}")
-        return {r["pgv_pga_s"]: r for r in models[specimen[0]].contours[level]}
+        return {r.pgv_pga_s: r for r in models[specimen[0]].contours[level]}
     ref, oth = rows(reference), rows(other)
     if set(ref) != set(oth):
         raise ValueError("the two fragility.json files are not of the same pulse grid")
     table, diffs, one_sided, within = [], [], 0, True
     for ratio in sorted(ref):
-        a, b = ref[ratio]["pga_g"], oth[ratio]["pga_g"]
-        lo, hi = ref[ratio]["pga_g_band"]
+        a, b = ref[ratio].pga_g, oth[ratio].pga_g
+        lo, hi = ref[ratio].pga_g_band
         diff = None if a is None or b is None else b - a
         if diff is not None:
             diffs.append(abs(diff))

@@ -194,23 +194,22 @@ def plot_pulse_grid(summary, path):
         cells = section.models[name].cells
         P = np.full((len(ratios), len(pgas)), np.nan)
         for c in cells:
-            P[np.argmin(abs(ratios - c["pgv_pga_s"])), np.argmin(abs(pgas - c["pga_g"]))] = c["P"]
+            P[np.argmin(abs(ratios - c.pgv_pga_s)), np.argmin(abs(pgas - c.pga_g))] = c.P
         image = ax.pcolormesh(_edges(ratios), _edges(pgas), P.T, cmap="Greys", vmin=0, vmax=1,
                               shading="flat")
         for model, colour in ((name, "C3"), (block, "C0")):
             contours = section.models[model].contours if model in section.models else {}
             for level, ls in zip((f"{p:g}" for p in CONTOUR_LEVELS), (":", "-", "--")):
-                rows = [r for r in contours.get(level, []) if r["pga_g"] is not None]
+                rows = [r for r in contours.get(level, ()) if r.pga_g is not None]
                 if rows:
                     who = "2D rigid block (Housner integrator)" if model == block else name
-                    ax.plot([r["pgv_pga_s"] for r in rows], [r["pga_g"] for r in rows],
+                    ax.plot([r.pgv_pga_s for r in rows], [r.pga_g for r in rows],
                             color=colour, ls=ls, lw=1.6, label=f"{who} P = {level}")
-            band = [r for r in contours.get("0.5", [])
-                    if None not in r["pga_g_band"]]
+            band = [r for r in contours.get("0.5", ()) if None not in r.pga_g_band]
             if band and model == name:
-                ax.fill_between([r["pgv_pga_s"] for r in band],
-                                [r["pga_g_band"][0] for r in band],
-                                [r["pga_g_band"][1] for r in band], color=colour, alpha=0.2,
+                ax.fill_between([r.pgv_pga_s for r in band],
+                                [r.pga_g_band[0] for r in band],
+                                [r.pga_g_band[1] for r in band], color=colour, alpha=0.2,
                                 lw=0, label="P = 0.5, Monte Carlo 95 %")
         _mark_outside(ax, section, name, ratios, pgas)
         observed = (section.experiments or {}).get("models", {}).get(name, {}).get("bins")
@@ -243,7 +242,7 @@ def _mark_outside(ax, section, name, ratios, pgas):
     for level, rows in section.models[name].contours.items():
         for side, y, marker, edge in (("below", edges[0], "v", min(pgas)),
                                       ("above", edges[-1], "^", max(pgas))):
-            out = [r["pgv_pga_s"] for r in rows if r.get("outside_grid") == side]
+            out = [r.pgv_pga_s for r in rows if r.outside_grid == side]
             if not out:
                 continue
             said.append(f"P = {level} {side} the grid ({edge:g} g) at PGV/PGA "

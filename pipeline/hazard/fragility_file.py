@@ -23,7 +23,8 @@ from pipeline.files import write_json
 from pipeline.hazard.fragility_check import MAX_MEMBERS, check_fragility
 from pipeline.userfiles import DATA_FILE_BYTES, read_json
 
-__all__ = ["MAX_MEMBERS", "Block2d", "ColumnFits", "FragilityFile", "GridModel",
+__all__ = ["MAX_MEMBERS", "Block2d", "ColumnFits", "ContourRow", "FragilityFile",
+           "GridCell", "GridModel",
            "PulseGridSection", "check_fragility", "read_fragility_file",
            "write_fragility_file"]
 _KEPT = ("extra", "order", "path")     # fields that are not keys of the file
@@ -46,10 +47,47 @@ class Block2d:
 
 
 @dataclass(frozen=True)
+class GridCell:
+    """One cell of a pulse grid's model: at ``pga_g`` (g) and ``pgv_pga_s`` (s), ``n``
+    runs of which ``overturned`` overturned, ``P`` their fraction with its Wilson 95 %
+    interval ``ci95``; ``sets`` (indices of the parameter sets run there), ``P_per_set``
+    (each set's P over its headings, None where it has no run), ``set_sd`` (their
+    standard deviation) and ``set_spread_sd`` (with each set's binomial variance
+    removed)."""
+    pga_g: float
+    pgv_pga_s: float
+    n: int = 0
+    overturned: int = 0
+    P: float | None = None
+    ci95: tuple | None = None
+    sets: tuple | None = None
+    P_per_set: tuple | None = None
+    set_sd: float | None = None
+    set_spread_sd: float | None = None
+    extra: dict = field(default_factory=dict)
+    order: tuple = field(default=(), compare=False)
+
+
+@dataclass(frozen=True)
+class ContourRow:
+    """Where one PGV/PGA row (``pgv_pga_s``, s) of a model's cells crosses a contour's
+    level: ``pga_g`` (g; None where the row does not cross), ``pga_g_band`` (where the
+    cells' Wilson bounds cross it, g; an open side None), ``outside_grid`` ("below" or
+    "above" where the crossing lies beyond the grid, else None) and ``pga_g_per_set``
+    (parameter set index, as text, -> its own crossing, g)."""
+    pgv_pga_s: float
+    pga_g: float | None = None
+    pga_g_band: tuple | None = None
+    outside_grid: str | None = None
+    pga_g_per_set: dict | None = None
+    extra: dict = field(default_factory=dict)
+    order: tuple = field(default=(), compare=False)
+
+
+@dataclass(frozen=True)
 class GridModel:
-    """One model of a pulse grid: ``cells`` (dicts: pga_g, pgv_pga_s, n, overturned, P,
-    ci95, sets, P_per_set, set_sd), ``contours`` (level -> rows per PGV/PGA: pga_g,
-    pga_g_band, outside_grid, pga_g_per_set), ``logistic`` (the surface as
+    """One model of a pulse grid: ``cells`` (:class:`GridCell`), ``contours`` (level,
+    e.g. "0.5", -> :class:`ContourRow` per PGV/PGA), ``logistic`` (the surface as
     :func:`pipeline.stats.fragility.logistic_surface` writes it), ``runs`` and
     ``overturned`` (counts)."""
     cells: tuple = ()
@@ -233,11 +271,30 @@ def _section(section):
     return _build(PulseGridSection, section, {
         "pga_g": tuple, "pgv_pga_s": tuple, "warnings": tuple,
         "block2d": lambda v: None if v is None else _build(Block2d, v),
-        "models": lambda v: {k: _build(GridModel, m, {"cells": tuple}) for k, m in v.items()}})
+        "models": lambda v: {k: _model(m) for k, m in v.items()}})
 
 
 def _section_json(section):
     return _join(section, {
         "pga_g": list, "pgv_pga_s": list, "warnings": list,
         "block2d": lambda v: None if v is None else _join(v),
-        "models": lambda v: {k: _join(m, {"cells": list}) for k, m in v.items()}})
+        "models": lambda v: {k: _model_json(m) for k, m in v.items()}})
+
+
+_ROW_LISTS = ("ci95", "sets", "P_per_set", "pga_g_band")   # tuples in a row's type
+_ROW_JSON = {k: lambda v: None if v is None else list(v) for k in _ROW_LISTS}
+
+
+def _model(model):
+    tuples = {k: lambda v: None if v is None else tuple(v) for k in _ROW_LISTS}
+    return _build(GridModel, model, {
+        "cells": lambda v: tuple(_build(GridCell, c, tuples) for c in v or ()),
+        "contours": lambda v: {level: tuple(_build(ContourRow, r, tuples) for r in rows)
+                               for level, rows in (v or {}).items()}})
+
+
+def _model_json(model):
+    return _join(model, {
+        "cells": lambda v: [_join(c, _ROW_JSON) for c in v],
+        "contours": lambda v: {level: [_join(r, _ROW_JSON) for r in rows]
+                               for level, rows in v.items()}})

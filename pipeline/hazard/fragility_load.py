@@ -213,9 +213,9 @@ def _cells(section, entry):
     index_a = {round(v, 9): i for i, v in enumerate(pga_g)}
     index_r = {round(v, 9): j for j, v in enumerate(ratios)}
     for cell in entry.cells:
-        i, j = index_a[round(cell["pga_g"], 9)], index_r[round(cell["pgv_pga_s"], 9)]
-        n[i, j], overturned[i, j] = cell["n"], cell["overturned"]
-        for s, p in zip(cell.get("sets") or [], cell.get("P_per_set") or []):
+        i, j = index_a[round(cell.pga_g, 9)], index_r[round(cell.pgv_pga_s, 9)]
+        n[i, j], overturned[i, j] = cell.n, cell.overturned
+        for s, p in zip(cell.sets or (), cell.P_per_set or ()):
             if p is not None:
                 per_set[s, i, j] = float(p)
     return n, overturned, per_set

@@ -26,14 +26,15 @@ from scipy.interpolate import RegularGridInterpolator
 CONTOUR_LEVELS = (0.16, 0.5, 0.84)   # P of a pulse grid's contours: median and +-1 sigma
 
 
-def cell_table(cells, pga_key="pga_g", ratio_key="pgv_pga_s", p_key="P"):
-    """The axes and P of a list of cells (dicts): (pga, ratio, values n_pga x n_ratio);
-    values NaN where the list has no cell."""
-    pgas = sorted({c[pga_key] for c in cells})
-    ratios = sorted({c[ratio_key] for c in cells})
+def cell_table(cells):
+    """The axes and P of a pulse grid's cells
+    (:class:`~pipeline.hazard.fragility_file.GridCell`): (pga, ratio, values n_pga x
+    n_ratio) in the cells' units; values NaN where no cell is given."""
+    pgas = sorted({c.pga_g for c in cells})
+    ratios = sorted({c.pgv_pga_s for c in cells})
     values = np.full((len(pgas), len(ratios)), np.nan)
     for c in cells:
-        values[pgas.index(c[pga_key]), ratios.index(c[ratio_key])] = c[p_key]
+        values[pgas.index(c.pga_g), ratios.index(c.pgv_pga_s)] = c.P
     return np.array(pgas, float), np.array(ratios, float), values
 
 

@@ -80,22 +80,22 @@ def rock_fragility_section(results, name="rock-fragility"):
         for level, contour in entry.contours.items():
             row = {"model": model, "P": level}
             for r in contour:
-                lo, hi = r["pga_g_band"]
-                row[f"PGV/PGA {r['pgv_pga_s']:g} s"] = (
-                    f"{_fmt(r['pga_g'], 2)} [{_fmt(lo, 2)}, {_fmt(hi, 2)}]")
+                lo, hi = r.pga_g_band
+                row[f"PGV/PGA {r.pgv_pga_s:g} s"] = (
+                    f"{_fmt(r.pga_g, 2)} [{_fmt(lo, 2)}, {_fmt(hi, 2)}]")
             rows.append(row)
     lines.append(_table(pd.DataFrame(rows)) + "\n")
     lines += [f"Warning: {w}.\n" for w in section.warnings]
     for model, entry in section.models.items():
-        per_set = [r for r in entry.contours.get("0.5", []) if r.get("pga_g_per_set")]
-        shown = [f"{r['pgv_pga_s']:g} s: " + ", ".join(_fmt(v, 2) for v in
-                                                      r["pga_g_per_set"].values())
+        per_set = [r for r in entry.contours.get("0.5", ()) if r.pga_g_per_set]
+        shown = [f"{r.pgv_pga_s:g} s: " + ", ".join(_fmt(v, 2) for v in
+                                                    r.pga_g_per_set.values())
                  for r in per_set]
         if shown:
             lines.append(f"P = 0.5 of each parameter set ({model}; the members' spread): "
                          + "; ".join(shown) + ".\n")
-    spread = [c["set_sd"] for e in section.models.values() for c in e.cells
-              if c["set_sd"] is not None]
+    spread = [c.set_sd for e in section.models.values() for c in e.cells
+              if c.set_sd is not None]
     if spread:
         lines.append(f"Spread of P across the parameter sets (sd per cell): up to "
                      f"{max(spread):.2f}, mean {sum(spread) / len(spread):.2f}.\n")

@@ -57,9 +57,9 @@ def test_the_adaptive_surface_matches_the_full_grid_with_fewer_runs(tmp_path, mo
     assert adaptive.runs_finished < full.runs_finished
     # the model is stabler than the guide: somewhere a probe disagreed and a cell the guide
     # called certain was run in full (the driver's widening, not only its first stage)
-    guide = {(c["pgv_pga_s"], c["pga_g"]): c["P"] for c in full.models["block2d"].cells}
-    rock = {(c["pgv_pga_s"], c["pga_g"]): c for c in adaptive.models["box"].cells}
-    assert any(guide[k] in (0.0, 1.0) and c["n"] > 1 and c["P"] != guide[k]
+    guide = {(c.pgv_pga_s, c.pga_g): c.P for c in full.models["block2d"].cells}
+    rock = {(c.pgv_pga_s, c.pga_g): c for c in adaptive.models["box"].cells}
+    assert any(guide[k] in (0.0, 1.0) and c.n > 1 and c.P != guide[k]
                for k, c in rock.items())
     difference = pulse_summary.contour_difference(summaries["full"], summaries["adaptive"])
     crossing = [r for r in difference["rows"] if r["pga_g_reference"] is not None]
@@ -163,15 +163,15 @@ def test_the_adaptive_stages_save_five_times_the_runs_on_a_fine_grid_of_a_cheap_
     print(f"{full_runs} / {sum(targets.values())} runs, largest 0.5 contour difference "
           f"{difference['max_abs_diff_g']} g")
     # the statistics say what was run: a cell's n is its runs, its interval Wilson's of them
-    full_cells = {(list(ratios).index(c["pgv_pga_s"]), list(pga_g).index(c["pga_g"])): c
+    full_cells = {(list(ratios).index(c.pgv_pga_s), list(pga_g).index(c.pga_g)): c
                   for c in full.pulse_grid.models["rock"].cells}
-    top = pulse_adaptive.first_crossings({cell: c["P"] for cell, c in full_cells.items()})
+    top = pulse_adaptive.first_crossings({cell: c.P for cell, c in full_cells.items()})
     for cell in adaptive.pulse_grid.models["rock"].cells:
-        i, j = list(ratios).index(cell["pgv_pga_s"]), list(pga_g).index(cell["pga_g"])
-        assert cell["n"] == targets[(i, j)]
-        assert cell["ci95"] == pytest.approx(wilson_interval(cell["overturned"], cell["n"]))
+        i, j = list(ratios).index(cell.pgv_pga_s), list(pga_g).index(cell.pga_g)
+        assert cell.n == targets[(i, j)]
+        assert cell.ci95 == pytest.approx(wilson_interval(cell.overturned, cell.n))
         # up to the contour (above it cells stop: they do not move it), each cell's side
         # of 0.5 is the full grid's wherever the full grid is sure of it
         sure = full_cells[(i, j)]
-        if j <= top[i] and not sure["ci95"][0] <= 0.5 <= sure["ci95"][1]:
-            assert (cell["P"] >= 0.5) == (sure["P"] >= 0.5)
+        if j <= top[i] and not sure.ci95[0] <= 0.5 <= sure.ci95[1]:
+            assert (cell.P >= 0.5) == (sure.P >= 0.5)

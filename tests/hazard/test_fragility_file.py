@@ -12,8 +12,9 @@ from pipeline.campaign.pulse_check import grid_probability
 from pipeline.constants import STANDARD_GRAVITY as G
 from pipeline.files import InputError
 from pipeline.hazard.fragility import load_campaign_fragility
-from pipeline.hazard.fragility_file import (FragilityFile, read_fragility_file,
-                                            write_fragility_file)
+from pipeline.campaign.pulse_summary import contours
+from pipeline.hazard.fragility_file import (ContourRow, FragilityFile, GridCell,
+                                            read_fragility_file, write_fragility_file)
 from tests.hazard.test_reader_robustness import COLUMN, grid_document
 
 
@@ -34,6 +35,22 @@ def test_sections_are_typed():
     grid = FragilityFile.of(grid_document()).pulse_grid
     assert grid.pga_g == (0.1, 0.2, 0.4) and grid.members == 2
     assert len(grid.models["monolithic"].cells) == 6 and grid.block2d.uplift_g == 0.05
+
+
+def test_cells_and_contour_rows_are_typed_and_written_back_as_the_campaign_wrote_them(tmp_path):
+    document = grid_document(p_of=lambda a, r: min(1.0, a / (2 * r)))
+    model = document["pulse_grid"]["models"]["monolithic"]
+    model["contours"] = json.loads(json.dumps(contours(model["cells"])))   # the campaign's
+    path = write_fragility_file(tmp_path, FragilityFile.of(copy.deepcopy(document)))
+    assert json.loads(path.read_text()) == document
+    read = read_fragility_file(path).pulse_grid.models["monolithic"]
+    cell = read.cells[0]
+    assert isinstance(cell, GridCell) and (cell.pga_g, cell.pgv_pga_s) == (0.1, 0.1)
+    assert cell.P == cell.overturned / cell.n == 0.5 and cell.sets == (0, 1)
+    row = read.contours["0.5"][0]
+    assert isinstance(row, ContourRow) and row.pgv_pga_s == 0.1
+    assert row.pga_g == pytest.approx(0.1)   # P = a / 0.2 reaches 0.5 at the first cell
+    assert len(row.pga_g_band) == 2 and set(row.pga_g_per_set) == {"0", "1"}
 
 
 @pytest.mark.parametrize("drop, expected_g", [

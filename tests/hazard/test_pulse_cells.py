@@ -7,6 +7,7 @@ import pytest
 from pipeline.campaign.pulse_check import grid_probability
 from pipeline.constants import STANDARD_GRAVITY as G
 from pipeline.hazard.fragility import PulseGrid
+from pipeline.hazard.fragility_file import GridCell
 from pipeline.hazard.pulse_cells import cell_table, interpolate
 
 PGA_G = np.round(np.linspace(0.2, 1.1, 10), 9)           # the Virtual Shake Robot's grid
@@ -20,7 +21,7 @@ def _log_bilinear(a, r):
 
 
 def _cells(p=_log_bilinear):
-    return [{"pga_g": float(a), "pgv_pga_s": float(r), "P": float(p(a, r))}
+    return [GridCell(pga_g=float(a), pgv_pga_s=float(r), P=float(p(a, r)))
             for a in PGA_G for r in RATIO_S]
 
 
