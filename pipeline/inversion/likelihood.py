@@ -17,9 +17,12 @@ A fallen column observed at geographic azimuth psi_obs contributes
 f(psi_obs - alpha) = sum_nodes w P_n d_n(psi_obs - alpha), a standing one
 sum_nodes w (1 - P_n): the sub-density of "fell toward psi" and the probability of
 standing are interpolated as mixtures of the four surrounding nodes, bilinearly in
-log distance (clamped at the first and last ring: the inversion's candidates never lie
-beyond the last ring of a site, :func:`pipeline.inversion.posterior.invert`) and in node
-azimuth (periodic).  Interpolating in the site frame moves a fall direction that is fixed
+log distance (clamped at the first ring) and in node azimuth (periodic).  The inversion's
+candidates never lie beyond the last ring of a site
+(:func:`pipeline.inversion.posterior.invert`); only its test of the sources beyond
+(:mod:`pipeline.inversion.beyond`) reads there: the last ring's direction density, its
+P carried on by the decay of log-odds P with log distance between the last two rings
+(never rising: a node whose P rises between them keeps its last P).  Interpolating in the site frame moves a fall direction that is fixed
 relative to the source-to-site direction smoothly between nodes.
 
 Between spokes (node azimuths ``h`` deg apart) the table cannot tell whether the falls
@@ -69,10 +72,11 @@ predictive likelihood is the default (:data:`DEFAULT_LIKELIHOOD`): in the member
 import math
 
 import numpy as np
-from scipy import optimize, special
+from scipy import special
 
 from pipeline.files import InputError
 from pipeline.inversion.observations import ColumnObservation
+from pipeline.stats.circular import concentration, von_mises_pdf
 
 LIKELIHOODS = ("independent", "predictive")
 # the default: calibrated in the member study (95 % regions hold the truth in about 0.95 of
@@ -86,32 +90,6 @@ VIRTUAL_STEP_DEG = 7.5         # the largest spacing of the virtual azimuths bet
 MW_STEP = 0.1                  # the candidates' magnitude step between the table's slices
 SITE_COLUMNS = 3.0             # m: a site's columns as m draws' worth of the node's (predictive;
 #                                chosen on the member study's calibration draws, docs/inversion.md)
-
-
-def mean_resultant_length(kappa):
-    """A(kappa) = I1(kappa) / I0(kappa) of a von Mises distribution."""
-    return special.i1e(kappa) / special.i0e(kappa)
-
-
-def concentration(sigma_deg):
-    """Von Mises concentration whose mean resultant length is the wrapped normal's,
-    exp(-sigma^2 / 2) (sigma in deg); inf for sigma 0."""
-    sigma = math.radians(float(sigma_deg))
-    if sigma <= 0:
-        return math.inf
-    target = math.exp(-sigma * sigma / 2.0)
-    if target < 1e-8:
-        return 0.0
-    return float(optimize.brentq(lambda k: mean_resultant_length(k) - target, 1e-10, 1e8,
-                                 xtol=1e-12, rtol=1e-12))
-
-
-def von_mises_pdf(x_rad, kappa):
-    """Von Mises density (per radian) at angles ``x_rad`` about 0, stable for large kappa."""
-    x = np.asarray(x_rad, float)
-    if kappa == 0:
-        return np.full(x.shape, 1.0 / (2 * math.pi))
-    return np.exp(kappa * (np.cos(x) - 1.0)) / (2 * math.pi * special.i0e(kappa))
 
 
 def p_toppled(k, n):
@@ -208,16 +186,30 @@ class ForwardModel:
 
     # ------------------------------------------------------------------ weights
     def distance_weights(self, r_km):
-        """(i0, i1, w1): rings around r, weight of i1, linear in log r, clamped."""
+        """(i0, i1, w1, beyond): rings around r, weight of i1, linear in log r, clamped;
+        ``beyond`` ln(r / last ring) where r lies beyond the last ring (else 0)."""
         rings = np.log(self.table.distances_km)
         x = np.log(np.maximum(np.asarray(r_km, float), 1e-6))
+        beyond = np.maximum(x - rings[-1], 0.0)
         if len(rings) == 1:
             zero = np.zeros(x.shape, int)
-            return zero, zero, np.zeros(x.shape)
+            return zero, zero, np.zeros(x.shape), beyond
         i1 = np.clip(np.searchsorted(rings, x), 1, len(rings) - 1)
         i0 = i1 - 1
         w1 = np.clip((x - rings[i0]) / (rings[i1] - rings[i0]), 0.0, 1.0)
-        return i0, i1, w1
+        return i0, i1, w1, beyond
+
+    def decay(self, c, beyond):
+        """P beyond the last ring over the last ring's P, per slice, candidate and virtual
+        azimuth (ns, ne, n_virtual), for column type c at ``beyond`` = ln(r / last ring)
+        (ne,): log-odds P carried on along the slope between the last two rings, never
+        rising (one ring: no slope, P held)."""
+        last = special.logit(self.p[:, -1, :, c])                       # (ns, nv)
+        rings = np.log(self.table.distances_km)
+        slope = np.zeros(last.shape) if len(rings) == 1 else np.minimum(
+            (last - special.logit(self.p[:, -2, :, c])) / (rings[-1] - rings[-2]), 0.0)
+        far = special.expit(last[:, None, :] + slope[:, None, :] * beyond[None, :, None])
+        return far / self.p[:, -1, :, c][:, None, :]
 
     def azimuth_weights(self, theta_deg):
         """(i0, i1, w1): virtual azimuths around theta (periodic), weight of i1."""
@@ -311,15 +303,18 @@ class ForwardModel:
 
     def _standing(self, c, rings, ai0, ai1, aw):
         """Interpolated 1 - P of column type c: (ns, nphi, ne)."""
-        ri0, ri1, rw = rings
+        ri0, ri1, rw, beyond = rings
         q = 1.0 - self.p[..., c]                                          # (ns, nr, na)
         qe = (1 - rw)[None, :, None] * q[:, ri0, :] + rw[None, :, None] * q[:, ri1, :]
+        if beyond.any():
+            qe = 1.0 - self.decay(c, beyond) * (1.0 - qe)
         return np.stack([_pick(qe, ai0[f], ai1[f], aw[f]) for f in range(len(ai0))], axis=1)
 
     def _fallen(self, c, chunk, alpha, rings, ai0, ai1, aw):
         """Interpolated P d(psi_obs - alpha) of each fallen observation in ``chunk``: list of
         (ns, nphi, ne) arrays in the chunk's order."""
-        ri0, ri1, rw = rings
+        ri0, ri1, rw, beyond = rings
+        scale = self.decay(c, beyond)[:, None] if beyond.any() else 1.0   # (ns, 1, ne, na)
         result = [None] * len(chunk)
         for sigma in sorted({o.uncertainty_deg for o in chunk}):
             index = [k for k, o in enumerate(chunk) if o.uncertainty_deg == sigma]
@@ -332,7 +327,7 @@ class ForwardModel:
                 hi = table[:, ring[None, :], :, j1]
                 g = g + wr[None, :, None, None] * (
                     (1 - pw)[..., None, None] * lo + pw[..., None, None] * hi)
-            g = g.transpose(2, 0, 1, 3)                                   # (ns, no, ne, na)
+            g = g.transpose(2, 0, 1, 3) * scale                           # (ns, no, ne, na)
             val = np.stack([_pick(g, ai0[f], ai1[f], aw[f]) for f in range(len(ai0))],
                            axis=1)                                        # (ns, nphi, no, ne)
             for slot, k in enumerate(index):

@@ -25,6 +25,7 @@ import numpy as np
 import pandas as pd
 from scipy.special import logsumexp
 
+from pipeline.inversion.beyond import BEYOND_BAYES_FACTOR, ONE_SITE_NOTE, beyond_test
 from pipeline.inversion.candidates import reached_lattice, within_reach
 from pipeline.inversion.credible import arc_width, circular_credible, magnitude_interval
 from pipeline.inversion.fit import fit_check
@@ -203,11 +204,19 @@ class Posterior:
         factor, the fit check's p-value (:mod:`pipeline.inversion.fit`) and a warning line
         (None) when the factor passes EDGE_BAYES_FACTOR or the fit check warns."""
         reach = self.info.get("reach_km")
+        beyond = self.info.get("beyond") or {}
+        beyond_factor = beyond.get("beyond_bayes_factor")
+        beyond_warning = beyond_factor is not None and beyond_factor > BEYOND_BAYES_FACTOR
+        one_site = len(self.info.get("sites_km") or ()) == 1 and reach is not None
+        tested = {"beyond_bayes_factor": beyond_factor,
+                  "beyond_shell_km": beyond.get("beyond_shell_km"),
+                  "beyond_warning": bool(beyond_warning),
+                  "reach_note": ONE_SITE_NOTE.format(reach=reach) if one_site else None}
         if self.edge is None or reach is None:
             return {"reach_km": reach, "reach_limit": None, "reach_edge_fraction": None,
                     "reach_edge_prior_fraction": None, "reach_edge_bayes_factor": None,
                     "reach_edge_warning": False, "fit_p_value": None, "fit_warning": None,
-                    "reach_warning": None}
+                    **tested, "reach_warning": None}
         prior = np.exp(self.log_prior - logsumexp(self.log_prior)).sum(axis=(0, 1))
         fraction = float(self.epicentre[self.edge].sum())
         prior_fraction = float(prior[self.edge].sum())
@@ -219,6 +228,14 @@ class Posterior:
                        f"against {prior_fraction:.0%} of the prior (odds {factor:.3g} times "
                        "the prior's): the source may lie farther than this inversion can "
                        "tell, and its direction from the first site is not known either")
+        if beyond_warning:
+            lo, hi = beyond["beyond_shell_km"]
+            said = (f"the falls are {beyond_factor:.3g} times as likely from a source beyond "
+                    f"the reach (farthest site {lo:g}-{hi:g} km, the table's decay with "
+                    "distance carried on) as from one within it: the source may lie farther "
+                    "than this inversion can tell, and its direction from the first site is "
+                    "not known either")
+            warning = said if warning is None else f"{warning}; and {said}"
         if fit.get("fit_warning"):
             warning = fit["fit_warning"] if warning is None else \
                 f"{warning}; and {fit['fit_warning']}"
@@ -228,7 +245,7 @@ class Posterior:
                 "reach_edge_bayes_factor": factor,
                 "reach_edge_warning": bool(factor > EDGE_BAYES_FACTOR),
                 "fit_p_value": fit.get("fit_p_value"),
-                "fit_warning": fit.get("fit_warning"), "reach_warning": warning}
+                "fit_warning": fit.get("fit_warning"), **tested, "reach_warning": warning}
 
     def frame(self):
         """One row per candidate: posterior.csv."""
@@ -299,6 +316,7 @@ def invert(model, observations, grid):
     post = Posterior(model.sources, strikes, east, north, grid.step_km, log_prior,
                      loglike, info=info, edge=grid.edge_cells(east, north))
     post.info["fit"] = fit_check(model, observations, post)
+    post.info["beyond"] = beyond_test(model, observations, grid, log_prior_slice, loglike)
     return post
 
 

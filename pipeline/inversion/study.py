@@ -206,6 +206,7 @@ def study_trial(models, pool, n_sites, fallen, candidates, rng):
                 **{k: lost[k] for k in REACH_KEYS}, "mw_in_95": False, "p_true_mw": np.nan,
                 "mw_ci95_width": np.nan, "reach_edge_bayes_factor": np.nan,
                 "reach_edge_warning": False, "fit_warning": False, "fit_p_value": np.nan,
+                "beyond_bayes_factor": np.nan, "beyond_warning": False,
                 "p_true_mechanism": np.nan}
     summary = post.summary()
     check = truth_check(post, {"epicentre_km": truth, "back_azimuth_deg": true_baz,
@@ -224,6 +225,8 @@ def study_trial(models, pool, n_sites, fallen, candidates, rng):
             "reach_edge_warning": summary["reach_edge_warning"],
             "fit_warning": summary["fit_warning"] is not None,
             "fit_p_value": summary["fit_p_value"],
+            "beyond_bayes_factor": summary["beyond_bayes_factor"],
+            "beyond_warning": summary["beyond_warning"],
             "mw_in_95": check["mw_in_95"], "mw_ci95_width": hi - lo,
             "p_true_mw": summary["magnitude_posterior"][nearest],
             "p_true_mechanism": summary["mechanism_posterior"].get(row["mechanism"], 0.0)}

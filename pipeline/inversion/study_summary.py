@@ -67,8 +67,10 @@ def study_summary(trials):
 
 
 PLACEMENT_COLUMNS = ("back_azimuth_in_95", "distance_in_95", "epicentre_in_95", "mw_in_95",
-                     "reach_warning", "fit_warning")
+                     "reach_warning", "fit_warning", "beyond_warning")
 WELL_WITHIN = "well within the reach"
+REACH_PARTS = ((WELL_WITHIN, "false_alarm"), ("at the reach's edge", "edge"),
+               ("beyond the reach", "hit"))      # (placement label, warning_rates' name)
 
 
 def placement_summary(trials):
@@ -79,7 +81,8 @@ def placement_summary(trials):
     fit check's share of it (``fit_warning``); the same for each placement's sources well
     within the reach, and for all sources ``well within the reach`` (every site nearer
     than the likelihood's last ring less a cell: the warning's false alarms), ``at the
-    reach's edge`` and ``beyond the reach`` (its hits)."""
+    reach's edge`` and ``beyond the reach`` (its hits), and these three per number of
+    sites (``..., 1 site(s)``)."""
     rows = []
     keys = ["likelihood", "likelihood_members"]
     for key, g in trials.groupby(keys):
@@ -89,8 +92,11 @@ def placement_summary(trials):
         parts += [(f"{placement}, {WELL_WITHIN}", g[(g["placement"] == placement) & inside
                                                     & ~edge])
                   for placement in PLACEMENTS if placement != "beyond"]
-        parts += [(WELL_WITHIN, g[inside & ~edge]),
-                  ("at the reach's edge", g[inside & edge]), ("beyond the reach", g[~inside])]
+        reach = [(WELL_WITHIN, inside & ~edge), ("at the reach's edge", inside & edge),
+                 ("beyond the reach", ~inside)]
+        parts += [(label, g[mask]) for label, mask in reach]
+        parts += [(f"{label}, {sites} site(s)", g[mask & (g["sites"] == sites)])
+                  for sites in sorted(g["sites"].unique()) for label, mask in reach]
         for placement, part in parts:
             if part.empty:
                 continue
@@ -112,23 +118,36 @@ def placement_summary(trials):
 
 def warning_rates(placements):
     """{likelihood: {members, false_alarm_rate, edge_rate, hit_rate, with Wilson intervals,
-    trials and the share refused for want of a candidate}} at each likelihood's largest
-    member count: the reach warning well within the reach, at its edge and beyond it."""
+    trials, the share refused for want of a candidate, the fit check's and the test of
+    the sources beyond's shares, and ``by_sites``: the same per number of sites}} at each
+    likelihood's largest member count: the reach warning well within the reach, at its
+    edge and beyond it."""
     out = {}
     for kind, g in placements.groupby("likelihood"):
         g = g[g["likelihood_members"] == g["likelihood_members"].max()].set_index("placement")
-        entry = {"likelihood_members": int(g["likelihood_members"].iloc[0])}
-        for label, name in ((WELL_WITHIN, "false_alarm"),
-                            ("at the reach's edge", "edge"), ("beyond the reach", "hit")):
-            if label in g.index:
-                entry[f"{name}_rate"] = float(g.loc[label, "reach_warning"])
-                entry[f"{name}_rate_ci95"] = list(g.loc[label, "reach_warning_ci95"])
-                entry[f"{name}_trials"] = int(g.loc[label, "trials"])
-                entry[f"{name}_no_candidate"] = float(g.loc[label, "no_candidate"])
-                if "fit_warning" in g.columns:
-                    entry[f"{name}_fit_rate"] = float(g.loc[label, "fit_warning"])
+        entry = {"likelihood_members": int(g["likelihood_members"].iloc[0]),
+                 **_rates(g, "")}
+        sites = sorted({p.rsplit(", ", 1)[1].split()[0] for p in g.index
+                        if p.endswith(" site(s)")}, key=int)
+        entry["by_sites"] = {n: _rates(g, f", {n} site(s)") for n in sites}
         out[kind] = entry
     return out
+
+
+def _rates(g, suffix):
+    entry = {}
+    for label, name in REACH_PARTS:
+        label += suffix
+        if label not in g.index:
+            continue
+        entry[f"{name}_rate"] = float(g.loc[label, "reach_warning"])
+        entry[f"{name}_rate_ci95"] = list(g.loc[label, "reach_warning_ci95"])
+        entry[f"{name}_trials"] = int(g.loc[label, "trials"])
+        entry[f"{name}_no_candidate"] = float(g.loc[label, "no_candidate"])
+        for column, key in (("fit_warning", "fit"), ("beyond_warning", "beyond_test")):
+            if column in g.columns:
+                entry[f"{name}_{key}_rate"] = float(g.loc[label, column])
+    return entry
 
 
 def study_answer(summary):

@@ -110,6 +110,8 @@ def _say_reach(summary):
                  "a site lie beyond and are left out")
     if summary.get("reach_warning"):
         log.warning(f"{summary['reach_warning']}")
+    if summary.get("reach_note"):
+        log.info(f"note: {summary['reach_note']}")
 
 
 def demo(options, preset, grid, candidates):

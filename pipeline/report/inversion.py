@@ -356,7 +356,7 @@ def _placement_lines(base, study):
     names = {"placement": "source", "coverage_back_azimuth_95": "back azimuth",
              "coverage_distance_95": "distance", "coverage_epicentre_95": "epicentre",
              "coverage_mw_95": "Mw", "reach_warning": "warned",
-             "fit_warning": "of which by the fit check",
+             "fit_warning": "by the fit check", "beyond_warning": "by the test beyond",
              "no_candidate": "no candidate", "width_median_deg": "median arc (deg)"}
     words = {"node": "on the nodes", "between": "between the rings",
              "between_spokes": "between the spokes", "between_magnitudes":
@@ -383,5 +383,17 @@ def _placement_lines(base, study):
             + (f"; the fit check gave it for {rates['false_alarm_fit_rate']:.2f} of the "
                f"sources well within and {rates['hit_fit_rate']:.2f} of those beyond"
                if {"hit_fit_rate", "false_alarm_fit_rate"} <= set(rates) else "")
-            + ").\n")
+            + (f"; the test of the sources beyond gave it for "
+               f"{rates['false_alarm_beyond_test_rate']:.2f} and {rates['hit_beyond_test_rate']:.2f}"
+               if {"hit_beyond_test_rate", "false_alarm_beyond_test_rate"} <= set(rates)
+               else "")
+            + ")." + _by_sites(rates.get("by_sites") or {}) + "\n")
     return lines
+
+
+def _by_sites(by_sites):
+    """The reach warning's rates per number of sites, in words."""
+    said = [f"{n} site(s): {r['false_alarm_rate']:.2f} of {r['false_alarm_trials']} well "
+            f"within, {r['hit_rate']:.2f} of {r['hit_trials']} beyond"
+            for n, r in by_sites.items() if {"false_alarm_rate", "hit_rate"} <= set(r)]
+    return (" By the number of sites: " + "; ".join(said) + ".") if said else ""

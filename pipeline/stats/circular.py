@@ -4,12 +4,15 @@ Angles in degrees clockwise from North; astropy.stats does the work in radians.
 Differences are wrapped to (-180, 180]; axial statistics double the angles
 (a direction known up to 180 deg).  Direction classes relative to the back
 azimuth: toward (|downfall - back azimuth| <= 45 deg: falls toward the
-epicentre), away (>= 135 deg), transverse otherwise.
+epicentre), away (>= 135 deg), transverse otherwise.  Von Mises kernels (the
+inversion's direction densities): their density, and the concentration whose mean
+resultant length is a wrapped normal's of a given width.
 """
 import math
 
 import numpy as np
 import pandas as pd
+from scipy import optimize, special
 from astropy.stats import circcorrcoef, circmean, circvar, rayleightest
 
 from pipeline.constants import COLUMN_TYPES
@@ -237,3 +240,30 @@ def mean_direction_error_deg(azimuths_deg):
         return None
     r2 = float(np.cos(2 * (a - math.atan2(s, c))).mean())
     return float(math.degrees(math.sqrt(max(0.0, 1 - r2) / (2 * a.size * r * r))))
+
+
+# ---------------------------------------------------------------- von Mises kernels
+def mean_resultant_length(kappa):
+    """A(kappa) = I1(kappa) / I0(kappa) of a von Mises distribution."""
+    return special.i1e(kappa) / special.i0e(kappa)
+
+
+def concentration(sigma_deg):
+    """Von Mises concentration whose mean resultant length is the wrapped normal's,
+    exp(-sigma^2 / 2) (sigma in deg); inf for sigma 0."""
+    sigma = math.radians(float(sigma_deg))
+    if sigma <= 0:
+        return math.inf
+    target = math.exp(-sigma * sigma / 2.0)
+    if target < 1e-8:
+        return 0.0
+    return float(optimize.brentq(lambda k: mean_resultant_length(k) - target, 1e-10, 1e8,
+                                 xtol=1e-12, rtol=1e-12))
+
+
+def von_mises_pdf(x_rad, kappa):
+    """Von Mises density (per radian) at angles ``x_rad`` about 0, stable for large kappa."""
+    x = np.asarray(x_rad, float)
+    if kappa == 0:
+        return np.full(x.shape, 1.0 / (2 * math.pi))
+    return np.exp(kappa * (np.cos(x) - 1.0)) / (2 * math.pi * special.i0e(kappa))

@@ -6,7 +6,8 @@ import pytest
 from scipy import optimize, special
 
 from pipeline.inversion.table import ForwardTable
-from pipeline.inversion.likelihood import ForwardModel, concentration
+from pipeline.inversion.likelihood import ForwardModel
+from pipeline.stats.circular import concentration
 from pipeline.inversion.observations import ColumnObservation, Site
 
 KERNEL, SIGMA, FLOOR = 20.0, 10.0, 0.05

@@ -165,6 +165,15 @@ def test_truths_lie_off_the_likelihoods_nodes_too(make_away_table):
     assert {"hit_fit_rate", "false_alarm_fit_rate"} <= set(rates)
     assert rates["hit_rate"] == placements.loc["beyond the reach", "reach_warning"]
     assert set(rates) >= {"false_alarm_rate", "hit_rate", "false_alarm_rate_ci95"}
+    # the test of the sources beyond: its warnings are among the warnings given, and the
+    # rates per number of sites are those of the trials with that many sites
+    assert (rows["beyond_warning"].astype(bool) <= rows["reach_warning"].astype(bool)).all()
+    assert {"hit_beyond_test_rate", "false_alarm_beyond_test_rate"} <= set(rates)
+    for n, by in rates["by_sites"].items():
+        part = beyond & (rows["sites"] == int(n))
+        if part.any():
+            assert by["hit_trials"] == part.sum()
+            assert by["hit_rate"] == rows.loc[part, "reach_warning"].astype(bool).mean()
     assert (summary["trials_node"] + summary["trials_between"] + summary["trials_beyond"]
             + summary["trials_between_spokes"] == summary["trials"]).all()
     # between spokes: the first site from the source halfway between the kept spokes

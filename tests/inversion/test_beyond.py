@@ -1,0 +1,97 @@
+"""The test of the sources beyond the reach: the table's decay with distance carried past
+its last ring in closed form, a source beyond the reach warned about (with no direction),
+a source well within it not, and nothing of the test in the posterior.
+
+The toy physics of tests/inversion/test_reach.py: every fallen column falls away from the
+source, a share 2.5 km / r of the columns falls; the table holds it at 2.5, 5 and 10 km."""
+import math
+
+import numpy as np
+import pytest
+from scipy.special import expit, logit
+
+from pipeline.inversion.beyond import BEYOND_BAYES_FACTOR, SHELL_FACTOR, shell_lattice
+from pipeline.inversion.candidates import CandidateGrid
+from pipeline.inversion.likelihood import ForwardModel
+from pipeline.inversion.posterior import invert
+from tests.inversion.test_reach import MEMBERS, RINGS, check, hidden_source, share_toppled
+
+
+@pytest.fixture
+def table(make_away_table):
+    return make_away_table(members=MEMBERS, p_fall=[share_toppled(r) for r in RINGS],
+                           distances=RINGS)
+
+
+def test_p_beyond_the_last_ring_carries_on_the_log_odds_slope_of_the_last_two(table):
+    """At 16 and 40 km: P of the 10 km ring (k = 2 of 8: (2 + 1/2) / 9) carried on along
+    the log-odds slope from the 5 km ring (k = 4: 1/2) in ln r; at the ring itself P."""
+    model = ForwardModel(table)
+    p5, p10 = 4.5 / 9, 2.5 / 9
+    slope = (logit(p10) - logit(p5)) / math.log(2.0)
+    for r in (10.0, 16.0, 40.0):
+        factor = model.decay(0, np.array([math.log(r / 10.0)]))
+        expected = expit(logit(p10) + slope * math.log(r / 10.0))
+        assert factor * p10 == pytest.approx(np.full(factor.shape, expected), rel=1e-12)
+    # the toy's own share at 20 km is 1/8: the carried-on P comes near it
+    assert model.decay(0, np.array([math.log(2.0)]))[0, 0, 0] * p10 == pytest.approx(
+        share_toppled(20.0), abs=0.01)
+
+
+def test_p_never_rises_beyond_the_last_ring(make_away_table):
+    """A table whose P rises from the 5 to the 10 km ring keeps the 10 km ring's P beyond."""
+    rising = make_away_table(members=MEMBERS, p_fall=[1.0, 0.25, 0.5], distances=RINGS)
+    factor = ForwardModel(rising).decay(0, np.array([0.0, math.log(3.0)]))
+    assert factor == pytest.approx(np.ones(factor.shape))
+
+
+def test_a_source_beyond_the_reach_is_warned_about_by_the_shell(table):
+    """Sites 14 and 17 km from the source (beyond the 10 km ring, within the shell of 10 to
+    20 km): the falls are likelier from the shell than from the candidates, the summary
+    warns and gives no direction."""
+    _, summary, found = check(table, (0.0, 0.0), {"A": (0.0, 14.0), "B": (8.0, 15.0)})
+    assert not found["within_reach"]
+    assert summary["beyond_shell_km"] == [10.0, SHELL_FACTOR * 10.0]
+    assert summary["beyond_bayes_factor"] > BEYOND_BAYES_FACTOR and summary["beyond_warning"]
+    assert "likely from a source beyond the reach" in summary["reach_warning"]
+    assert not summary["direction_reliable"] and summary["back_azimuth_map_deg"] is None
+
+
+def test_a_source_well_within_the_reach_is_not(table):
+    """Sites 7, 3.6 and 7 km from the source: the shell explains the falls worse than the
+    candidates; no warning, and the posterior is what the candidates alone give."""
+    sites = {"A": (7.0, 0.0), "B": (-2.0, -3.0), "C": (0.0, 7.0)}
+    post, summary, found = check(table, (0.0, 0.0), sites)
+    assert found["within_reach"]
+    assert summary["beyond_bayes_factor"] < BEYOND_BAYES_FACTOR
+    assert not summary["beyond_warning"] and summary["reach_warning"] is None
+    model = ForwardModel(table)
+    alone = model.log_likelihood(hidden_source((0.0, 0.0), sites), post.east_km,
+                                 post.north_km, post.strikes_deg)
+    assert post.log_likelihood == pytest.approx(alone, abs=0)
+
+
+def test_the_shell_lies_beyond_the_last_ring_of_some_site_and_within_twice_it(table):
+    observations = hidden_source((3.0, 4.0), {"A": (0.0, 0.0), "B": (6.0, 0.0)})
+    east, north = shell_lattice(observations, CandidateGrid(radius_km=30, step_km=1), 10.0)
+    farthest = np.maximum(np.hypot(east, north), np.hypot(east - 6.0, north))
+    assert east.size and (farthest > 10.0).all() and (farthest <= 20.0 + 1e-9).all()
+
+
+def test_a_table_of_one_ring_has_no_decay_to_carry_and_no_test(make_away_table):
+    one = make_away_table(members=MEMBERS, p_fall=[0.5], distances=(10.0,))
+    observations = hidden_source((0.0, 0.0), {"A": (0.0, 14.0)})
+    summary = invert(ForwardModel(one), observations,
+                     CandidateGrid(radius_km=30, step_km=1)).summary()
+    assert summary["beyond_bayes_factor"] is None and not summary["beyond_warning"]
+
+
+def test_one_site_says_in_a_note_that_it_cannot_tell_and_keeps_its_direction(table):
+    """One site 6 km from the source: the shell about the site and the disk inside it
+    explain its falls alike; no warning, a note, and the direction (the candidates are a
+    disk about the site, they do not turn it) stays."""
+    _, summary, found = check(table, (0.0, 0.0), {"A": (6.0, 0.0)})
+    assert summary["reach_note"].startswith("one site: its falls cannot tell")
+    assert summary["direction_reliable"] and found["back_azimuth_in_95"]
+    _, two, _ = check(table, (0.0, 0.0), {"A": (6.0, 0.0), "B": (0.0, 6.0)})
+    assert two["reach_note"] is None
