@@ -885,6 +885,18 @@ def print_run_wing(r):
               f"YADE {row['yade_ratio']:.3f}x")
 
 
+def only_section(out, key, measure, show):
+    """Run one section (``measure(work)``), print it and add it under ``key`` to the
+    bench.json in ``out``; exit status 0."""
+    path = out / "bench.json"
+    result = json.loads(path.read_text()) if path.is_file() else {}
+    with tempfile.TemporaryDirectory(prefix="bench_yade_") as tmp:
+        result[key] = measure(Path(tmp))
+    show(result[key])
+    write_json(path, result)
+    return 0
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true",
@@ -903,21 +915,10 @@ def main(argv=None):
                         f"{RUN_WING_REFERENCE}) and add it to the bench.json in --out")
     args = parser.parse_args(argv)
     if args.only_run_wing:
-        path = args.out / "bench.json"
-        result = json.loads(path.read_text()) if path.is_file() else {}
-        with tempfile.TemporaryDirectory(prefix="bench_yade_") as tmp:
-            result["run_wing"] = run_wing(Path(tmp))
-        print_run_wing(result["run_wing"])
-        write_json(path, result)
-        return 0
+        return only_section(args.out, "run_wing", run_wing, print_run_wing)
     if args.only_rock_fragility:
-        path = args.out / "bench.json"
-        result = json.loads(path.read_text()) if path.is_file() else {}
-        with tempfile.TemporaryDirectory(prefix="bench_yade_") as tmp:
-            result["rock_fragility_adaptive"] = rock_fragility_adaptive(Path(tmp))
-        print_rock_fragility(result["rock_fragility_adaptive"])
-        write_json(path, result)
-        return 0
+        return only_section(args.out, "rock_fragility_adaptive", rock_fragility_adaptive,
+                            print_rock_fragility)
     shaking_s = args.duration or (3.0 if args.quick else 20.0)
     started = time.perf_counter()
     result = {"quick": args.quick}

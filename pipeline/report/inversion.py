@@ -396,4 +396,10 @@ def _by_sites(by_sites):
     said = [f"{n} site(s): {r['false_alarm_rate']:.2f} of {r['false_alarm_trials']} well "
             f"within, {r['hit_rate']:.2f} of {r['hit_trials']} beyond"
             for n, r in by_sites.items() if {"false_alarm_rate", "hit_rate"} <= set(r)]
-    return (" By the number of sites: " + "; ".join(said) + ".") if said else ""
+    if not said:
+        return ""
+    return (" By the number of sites: " + "; ".join(said) + "." + (
+        " One site cannot tell a source beyond the reach from a nearer, smaller one (the "
+        "test of the sources beyond cannot either), so every one-site inversion says so in "
+        "a note instead; its direction does not depend on it (the table above: the back "
+        "azimuth's coverage beyond the reach with one site)." if "1" in by_sites else ""))
