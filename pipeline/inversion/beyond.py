@@ -20,8 +20,9 @@ within it).  One site cannot tell: the shell about it and the disk inside explai
 falls alike (in the member study's calibration draws the test warned as often for sources
 within the reach as beyond it at every threshold), so a one-site inversion says so in a
 note (``reach_note``) instead of a warning: its direction stays, since the candidates are
-a disk about the site and do not turn it.  The shell's likelihood is an extrapolation of the table: it enters the
-test only, never the posterior, its regions or its magnitudes.
+a disk about the site and do not turn it.  The shell's likelihood is an extrapolation
+of the table: it enters the test only, never the posterior, its regions or its
+magnitudes.
 """
 import dataclasses
 import math

@@ -22,8 +22,9 @@ candidates never lie beyond the last ring of a site
 (:func:`pipeline.inversion.posterior.invert`); only its test of the sources beyond
 (:mod:`pipeline.inversion.beyond`) reads there: the last ring's direction density, its
 P carried on by the decay of log-odds P with log distance between the last two rings
-(never rising: a node whose P rises between them keeps its last P).  Interpolating in the site frame moves a fall direction that is fixed
-relative to the source-to-site direction smoothly between nodes.
+(never rising: a node whose P rises between them keeps its last P).  Interpolating in
+the site frame moves a fall direction that is fixed relative to the source-to-site
+direction smoothly between nodes.
 
 Between spokes (node azimuths ``h`` deg apart) the table cannot tell whether the falls
 keep their direction relative to the source-to-site direction (the site frame, in which

@@ -95,3 +95,19 @@ def test_one_site_says_in_a_note_that_it_cannot_tell_and_keeps_its_direction(tab
     assert summary["direction_reliable"] and found["back_azimuth_in_95"]
     _, two, _ = check(table, (0.0, 0.0), {"A": (6.0, 0.0), "B": (0.0, 6.0)})
     assert two["reach_note"] is None
+
+
+def test_invert_prints_the_one_site_note_and_writes_the_tests_keys(table, tmp_path, capsys):
+    import json
+
+    from pipeline import cli
+    path = table.save(tmp_path / "toy.npz")
+    observations = tmp_path / "one.json"
+    observations.write_text(json.dumps(hidden_source((0.0, 0.0), {"A": (6.0, 0.0)}).as_dict()))
+    out = tmp_path / "out"
+    assert cli.main(["invert", str(observations), "--table", str(path), "--out", str(out),
+                     "--radius", "30", "--step", "1"]) == 0
+    summary = json.loads((out / "inversion_summary.json").read_text())
+    assert f"note: {summary['reach_note']}" in capsys.readouterr().out
+    assert summary["beyond_shell_km"] == [10.0, 20.0] and summary["beyond_warning"] is False
+    assert 0 < summary["beyond_bayes_factor"] < BEYOND_BAYES_FACTOR
