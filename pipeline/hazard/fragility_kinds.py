@@ -18,7 +18,7 @@ from abc import ABC, abstractmethod
 from dataclasses import dataclass, field, replace
 
 import numpy as np
-from scipy import stats
+from scipy import special, stats
 
 from pipeline.constants import STANDARD_GRAVITY
 
@@ -116,7 +116,7 @@ class Logistic(Fragility):
     def probability(self, pga_m_s2, pgv_pga_s):
         b0, b1, b2 = self.coefficients
         eta = b0 + b1 * np.log(np.asarray(pga_m_s2, float)) + b2 * np.log(pgv_pga_s)
-        return 1.0 / (1.0 + np.exp(-eta))
+        return special.expit(eta)          # no overflow for any eta
 
     def draws(self, n, rng):
         b = np.array(self.coefficients, float)

@@ -4,7 +4,7 @@ Wilson intervals, and Purvance's logistic surface in ln PGA (m/s^2) and ln PGV/P
 import math
 
 import numpy as np
-from scipy import optimize, stats
+from scipy import optimize, special, stats
 
 from pipeline.constants import MODEL_GRAVITY
 from pipeline.stats.ensemble import wilson_interval
@@ -135,7 +135,7 @@ def logistic_probability(coefficients, pga, pgv_pga):
     """P(toppled) of a logistic surface (``logistic_surface(...)["coefficients"]``)."""
     eta = (coefficients["b0"] + coefficients["b1"] * np.log(pga)
            + coefficients["b2"] * np.log(pgv_pga))
-    return 1.0 / (1.0 + np.exp(-eta))
+    return special.expit(eta)              # no overflow for any eta
 
 
 def fragility_fit(im, toppled, min_distinct=3):
