@@ -282,14 +282,14 @@ def _section_json(section):
 
 
 _ROW_LISTS = ("ci95", "sets", "P_per_set", "pga_g_band")   # tuples in a row's type
-_ROW_JSON = {k: lambda v: None if v is None else list(v) for k in _ROW_LISTS}
+_ROW_TUPLES = dict.fromkeys(_ROW_LISTS, lambda v: None if v is None else tuple(v))
+_ROW_JSON = dict.fromkeys(_ROW_LISTS, lambda v: None if v is None else list(v))
 
 
 def _model(model):
-    tuples = {k: lambda v: None if v is None else tuple(v) for k in _ROW_LISTS}
     return _build(GridModel, model, {
-        "cells": lambda v: tuple(_build(GridCell, c, tuples) for c in v or ()),
-        "contours": lambda v: {level: tuple(_build(ContourRow, r, tuples) for r in rows)
+        "cells": lambda v: tuple(_build(GridCell, c, _ROW_TUPLES) for c in v or ()),
+        "contours": lambda v: {level: tuple(_build(ContourRow, r, _ROW_TUPLES) for r in rows)
                                for level, rows in (v or {}).items()}})
 
 

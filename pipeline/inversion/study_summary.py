@@ -82,25 +82,26 @@ def placement_summary(trials):
     within the reach, and for all sources ``well within the reach`` (every site nearer
     than the likelihood's last ring less a cell: the warning's false alarms), ``at the
     reach's edge`` and ``beyond the reach`` (its hits), and these three per number of
-    sites (``..., 1 site(s)``)."""
+    sites (``..., 1 site(s)``, their number in ``sites``; None for the others)."""
     rows = []
     keys = ["likelihood", "likelihood_members"]
     for key, g in trials.groupby(keys):
         inside = g["within_reach"].astype(bool)
         edge = g["at_reach_edge"].astype(bool)
-        parts = [(placement, g[g["placement"] == placement]) for placement in PLACEMENTS]
-        parts += [(f"{placement}, {WELL_WITHIN}", g[(g["placement"] == placement) & inside
-                                                    & ~edge])
+        parts = [(placement, None, g[g["placement"] == placement]) for placement in PLACEMENTS]
+        parts += [(f"{placement}, {WELL_WITHIN}", None,
+                   g[(g["placement"] == placement) & inside & ~edge])
                   for placement in PLACEMENTS if placement != "beyond"]
         reach = [(WELL_WITHIN, inside & ~edge), ("at the reach's edge", inside & edge),
                  ("beyond the reach", ~inside)]
-        parts += [(label, g[mask]) for label, mask in reach]
-        parts += [(f"{label}, {sites} site(s)", g[mask & (g["sites"] == sites)])
+        parts += [(label, None, g[mask]) for label, mask in reach]
+        parts += [(f"{label}, {sites} site(s)", int(sites), g[mask & (g["sites"] == sites)])
                   for sites in sorted(g["sites"].unique()) for label, mask in reach]
-        for placement, part in parts:
+        for placement, sites, part in parts:
             if part.empty:
                 continue
-            row = {**dict(zip(keys, key)), "placement": placement, "trials": len(part),
+            row = {**dict(zip(keys, key)), "placement": placement, "sites": sites,
+                   "trials": len(part),
                    "within_reach": int(part["within_reach"].astype(bool).sum())}
             for column in PLACEMENT_COLUMNS:
                 if column not in part:
@@ -127,9 +128,8 @@ def warning_rates(placements):
         g = g[g["likelihood_members"] == g["likelihood_members"].max()].set_index("placement")
         entry = {"likelihood_members": int(g["likelihood_members"].iloc[0]),
                  **_rates(g, "")}
-        sites = sorted({p.rsplit(", ", 1)[1].split()[0] for p in g.index
-                        if p.endswith(" site(s)")}, key=int)
-        entry["by_sites"] = {n: _rates(g, f", {n} site(s)") for n in sites}
+        sites = sorted(int(n) for n in g["sites"].dropna().unique())
+        entry["by_sites"] = {str(n): _rates(g, f", {n} site(s)") for n in sites}
         out[kind] = entry
     return out
 
