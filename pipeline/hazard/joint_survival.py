@@ -9,9 +9,13 @@ j (:class:`pipeline.hazard.joint_hazard.JointHazard`).  The rate of overturning 
 
     lambda_ov = sum_ij r_ij <P>_ij
 
-with <P>_ij the fragility averaged over the cell, the events taken as spread evenly in
-(ln PGA, ln PGV) inside it (Gauss-Legendre, ``nodes`` x ``nodes`` points).  Nothing
-outside the levels is counted; the shares of lambda_ov in the top PGA row and the top PGV
+with <P>_ij the fragility averaged over the cell (Gauss-Legendre, ``nodes`` x ``nodes``
+points), the events spread inside it with a density log-linear in ln PGA and in ln PGV,
+its slopes from the neighbouring cells' rates (an even spread would weigh a cell's upper
+part as much as its lower, where a falling hazard puts more events: 5 % too much rate on
+the shipped QA case; with the slopes the integration error falls faster than the cells'
+width squared, :mod:`tests.hazard.test_joint_survival`).  Nothing outside the levels is
+counted; the shares of lambda_ov in the top PGA row and the top PGV
 column are reported (where the grid's end may cut the rate).  Survival over an age is
 E[exp(-lambda_ov T)] over the age's distribution (:mod:`pipeline.hazard.ages`).
 
@@ -40,9 +44,29 @@ class JointRate:
     share_top_pgv: float | None
 
 
-def cell_mean_probability(pga_levels_m_s2, pgv_levels_m_s, probability, nodes=CELL_NODES):
-    """P(overturn) averaged over each cell (PGA cells x PGV cells), the events spread
-    evenly in (ln PGA, ln PGV) inside the cell (Gauss-Legendre, ``nodes`` per axis)."""
+def log_slopes(cell_rates, axis):
+    """d ln(rate density) / d(cell) along ``axis`` at each cell: the central difference of
+    ln rate over its two neighbours, one-sided at an edge or beside an empty cell, 0 where
+    neither neighbour holds a rate (or the cell holds none)."""
+    r = np.moveaxis(np.asarray(cell_rates, float), axis, 0)
+    with np.errstate(divide="ignore"):
+        ln_r = np.where(r > 0, np.log(np.where(r > 0, r, 1.0)), np.nan)
+    up = np.full(r.shape, np.nan)
+    down = np.full(r.shape, np.nan)
+    up[:-1] = ln_r[1:] - ln_r[:-1]
+    down[1:] = ln_r[1:] - ln_r[:-1]
+    both = np.isfinite(up) & np.isfinite(down)
+    slope = np.where(both, 0.5 * (np.nan_to_num(up) + np.nan_to_num(down)),
+                     np.where(np.isfinite(up), up, np.where(np.isfinite(down), down, 0.0)))
+    return np.moveaxis(slope, 0, axis)
+
+
+def cell_mean_probability(pga_levels_m_s2, pgv_levels_m_s, probability, cell_rates=None,
+                          nodes=CELL_NODES):
+    """P(overturn) averaged over each cell (PGA cells x PGV cells), the events spread in
+    (ln PGA, ln PGV) inside the cell with a density log-linear along each axis, its
+    slopes from the neighbouring cells' rates (:func:`log_slopes`; even without
+    ``cell_rates``); Gauss-Legendre, ``nodes`` per axis."""
     x, w = np.polynomial.legendre.leggauss(nodes)
     t, w = 0.5 * (x + 1.0), 0.5 * w                  # nodes and weights on [0, 1]
     ln_a, ln_v = np.log(pga_levels_m_s2), np.log(pgv_levels_m_s)
@@ -52,7 +76,12 @@ def cell_mean_probability(pga_levels_m_s2, pgv_levels_m_s, probability, nodes=CE
     ratio = v[None, :, None, :] / pga
     p = probability(pga, ratio)
     p = np.broadcast_to(p, (a.shape[0], v.shape[0], nodes, nodes))
-    return np.einsum("ijkl,k,l->ij", p, w, w)
+    shape = p.shape[:2]
+    s_a = np.zeros(shape) if cell_rates is None else log_slopes(cell_rates, 0)
+    s_v = np.zeros(shape) if cell_rates is None else log_slopes(cell_rates, 1)
+    weight = (w * np.exp(s_a[..., None] * (t - 0.5)))[..., :, None] * \
+        (w * np.exp(s_v[..., None] * (t - 0.5)))[..., None, :]
+    return np.einsum("ijkl,ijkl->ij", p, weight) / weight.sum(axis=(2, 3))
 
 
 def joint_overturning_rate(pga_levels_m_s2, pgv_levels_m_s, cell_rates_per_yr, probability,
@@ -61,7 +90,8 @@ def joint_overturning_rate(pga_levels_m_s2, pgv_levels_m_s, cell_rates_per_yr, p
     (``cell_rates_per_yr``: PGA cells x PGV cells, 1/yr) as a :class:`JointRate`."""
     rates = np.asarray(cell_rates_per_yr, float)
     part = rates * cell_mean_probability(np.asarray(pga_levels_m_s2, float),
-                                         np.asarray(pgv_levels_m_s, float), probability, nodes)
+                                         np.asarray(pgv_levels_m_s, float), probability,
+                                         rates, nodes)
     total = float(part.sum())
     return JointRate(total, float(rates.sum()),
                      float(part[-1, :].sum()) / total if total > 0 else None,
