@@ -120,11 +120,12 @@ def _regular_file(path):
 
 
 def _read(path, f):
-    if "mrd" not in f:
+    if not isinstance(f.get("mrd"), h5py.Dataset):
         raise InputError(f"{path}: no dataset 'mrd' (run the calculation with "
                          "postproc_func = compute_mrd.main)")
     params = _oqparam(path, f)
-    args = params.get("postproc_args") or {}
+    args = params.get("postproc_args")
+    args = args if isinstance(args, dict) else {}
     imts = (args.get("imt1"), args.get("imt2"))
     if sorted(map(str, imts)) != sorted(REQUIRED_IMTS):
         raise InputError(f"{path}: the mrd is of {imts[0]} and {imts[1]}; the joint hazard "
@@ -136,7 +137,10 @@ def _read(path, f):
             levels[imt] = np.asarray(imtls[imt], float)
         except (KeyError, TypeError, ValueError):
             raise InputError(f"{path}: no levels of {imt} in oqparam") from None
-    mrd = np.asarray(f["mrd"][()], float)
+    try:
+        mrd = np.asarray(f["mrd"][()], float)
+    except (TypeError, ValueError):
+        raise InputError(f"{path}: mrd does not hold numbers") from None
     if mrd.ndim != 3:
         raise InputError(f"{path}: mrd has {mrd.ndim} dimensions, not 3 (levels x levels "
                          "x sites)")
@@ -162,7 +166,7 @@ def _read(path, f):
 
 
 def _oqparam(path, f):
-    if "oqparam" not in f:
+    if not isinstance(f.get("oqparam"), h5py.Dataset):
         raise InputError(f"{path}: no 'oqparam' (the calculation's parameters)")
     raw = f["oqparam"][()]
     try:
@@ -177,8 +181,8 @@ def _oqparam(path, f):
 def _sites(path, f):
     try:
         lon, lat = (np.asarray(f[f"sitecol/{k}"][()], float) for k in ("lon", "lat"))
-    except KeyError:
-        raise InputError(f"{path}: no sitecol/lon and sitecol/lat") from None
+    except (KeyError, TypeError, ValueError):
+        raise InputError(f"{path}: no sitecol/lon and sitecol/lat (numbers)") from None
     if lon.shape != lat.shape or lon.ndim != 1:
         raise InputError(f"{path}: sitecol/lon and sitecol/lat differ in shape")
     return tuple((float(a), float(b)) for a, b in zip(lon, lat))

@@ -104,6 +104,12 @@ def test_levels_that_do_not_match_the_mrd_are_refused(tmp_path):
 
 @pytest.mark.parametrize("edit, message", [
     (lambda f: f.__delitem__("mrd"), "no dataset 'mrd'"),
+    (lambda f: (f.__delitem__("mrd"), f.create_group("mrd")), "no dataset 'mrd'"),
+    (lambda f: (f.__delitem__("oqparam"), f.create_group("oqparam")), "no 'oqparam'"),
+    (lambda f: (f.__delitem__("mrd"), f.create_dataset("mrd", data=np.zeros((39, 39)))),
+     "2 dimensions, not 3"),
+    (lambda f: _set_params(f, lambda p: p.__setitem__("postproc_args", ["PGA"])),
+     "the mrd is of None and None"),
     (lambda f: f.__delitem__("sitecol/lat"), "no sitecol/lon and sitecol/lat"),
     (lambda f: f["mrd"].__setitem__((0, 0, 0), -1.0), "a negative rate"),
     (lambda f: f["mrd"].__setitem__((0, 0, 0), np.nan), "not a finite number"),
