@@ -177,6 +177,8 @@ def _header(path, line):
         if not found:
             raise InputError(f"{path}: no {key} in the first line")
         meta[key] = _number(path, 0, key, found.group(1))
+    if not meta["investigation_time"] > 0:
+        raise InputError(f"{path}: investigation_time must be a positive number of years")
     for key in ("mag_bin_edges", "dist_bin_edges"):
         found = re.search(rf"\b{key}\s*=\s*\[([^\]]*)\]", line)
         if not found:
