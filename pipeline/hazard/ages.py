@@ -22,6 +22,7 @@ from dataclasses import dataclass
 from enum import Enum
 
 import numpy as np
+from scipy import stats
 from scipy.special import log_ndtr
 
 from pipeline.files import InputError
@@ -58,6 +59,11 @@ class AgeModel(ABC):
     def describe(self):
         """A JSON-ready dict: the kind, its values (years) and what survival means."""
 
+    @abstractmethod
+    def draw(self, n, rng):
+        """``n`` ages (years) drawn from the age's distribution (``rng`` a numpy
+        Generator), for a Monte Carlo over several specimens' ages."""
+
 
 @dataclass(frozen=True)
 class LowerBound(AgeModel):
@@ -70,6 +76,10 @@ class LowerBound(AgeModel):
 
     def survival(self, rate_per_yr):
         return np.exp(-np.asarray(rate_per_yr, float) * self.min_yr)
+
+    def draw(self, n, rng):
+        """The bound itself: survival's upper bound, as :meth:`survival` gives it."""
+        return np.full(n, float(self.min_yr))
 
     def describe(self):
         return {"kind": self.kind.value, "min_yr": self.min_yr,
@@ -97,6 +107,9 @@ class UniformInterval(AgeModel):
             mean = np.where(x > 0, -np.expm1(-x) / np.where(x > 0, x, 1.0), 1.0)
         return np.exp(-rate * self.lo_yr) * mean
 
+    def draw(self, n, rng):
+        return rng.uniform(self.lo_yr, self.hi_yr, n)
+
     def describe(self):
         return {"kind": self.kind.value, "lo_yr": self.lo_yr, "hi_yr": self.hi_yr,
                 "survival": "(exp(-rate lo) - exp(-rate hi)) / (rate (hi - lo)): the age "
@@ -121,6 +134,10 @@ class AgeSamples(AgeModel):
         rate = np.asarray(rate_per_yr, float)
         ages = np.asarray(self.ages_yr, float)
         return np.exp(-rate[..., None] * ages).mean(axis=-1)
+
+    def draw(self, n, rng):
+        """The samples drawn with replacement."""
+        return rng.choice(np.asarray(self.ages_yr, float), n, replace=True)
 
     def describe(self):
         ages = np.asarray(self.ages_yr, float)
@@ -150,6 +167,12 @@ class TruncatedNormal(AgeModel):
         mu, s = self.mean_yr, self.sd_yr
         return np.exp(-rate * mu + 0.5 * (rate * s) ** 2 + log_ndtr((mu - rate * s * s) / s)
                       - log_ndtr(mu / s))
+
+    def draw(self, n, rng):
+        if self.sd_yr == 0:
+            return np.full(n, float(self.mean_yr))
+        return stats.truncnorm.rvs(-self.mean_yr / self.sd_yr, np.inf, loc=self.mean_yr,
+                                   scale=self.sd_yr, size=n, random_state=rng)
 
     def describe(self):
         return {"kind": self.kind.value, "mean_yr": self.mean_yr, "sd_yr": self.sd_yr,

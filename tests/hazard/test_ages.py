@@ -106,3 +106,16 @@ def test_samples_from_a_file_column(tmp_path):
     path.write_text("age_ka\n")
     with pytest.raises(InputError, match="no age samples"):
         load_age_samples(path, "age_ka")
+
+
+@pytest.mark.parametrize("age", [UniformInterval(13_000.0, 22_000.0),
+                                 TruncatedNormal(10_000.0, 6_000.0),
+                                 AgeSamples((9_000.0, 12_000.0, 30_000.0)),
+                                 LowerBound(10_500.0)])
+def test_drawn_ages_average_to_the_closed_form(age):
+    """A Monte Carlo over drawn ages (as a set of several specimens needs) gives each
+    kind's closed form within its standard error."""
+    rate = 1e-4
+    survival = np.exp(-rate * age.draw(40_000, np.random.default_rng(7)))
+    error = survival.std(ddof=1) / math.sqrt(survival.size)
+    assert survival.mean() == pytest.approx(float(age.survival(rate)), abs=4 * error + 1e-15)

@@ -1,12 +1,12 @@
-"""A set of specimens of different ages at one site, shaken by the same earthquakes,
-against a Monte Carlo of Poisson event histories; the product over sites."""
+"""A set of specimens of different ages at one site, shaken by the same earthquakes: the
+age chain of ``constrain`` (:func:`pipeline.hazard.constrain.log_survival_fixed`)
+against a Monte Carlo of Poisson event histories."""
 import math
 
 import numpy as np
 import pytest
 
-from pipeline.files import InputError
-from pipeline.hazard.site_sets import site_set_survival, sites_survival
+from pipeline.hazard.constrain import log_survival_fixed
 
 EVENTS_PER_YR = 2e-4                    # every event the same motion at the site
 P_EACH = np.array([0.3, 0.5, 0.2])      # P(overturn) of each specimen in one event
@@ -15,6 +15,10 @@ AGES_YR = np.array([12_000.0, 5_000.0, 20_000.0])
 
 def _any_rate(indices):
     return EVENTS_PER_YR * (1.0 - np.prod(1.0 - P_EACH[list(indices)]))
+
+
+def site_set_survival(ages, any_rate):
+    return math.exp(log_survival_fixed(any_rate, ages))
 
 
 def test_specimens_of_different_ages_against_simulated_histories():
@@ -40,11 +44,3 @@ def test_equal_ages_are_one_rate_of_any_overturning():
         math.exp(-8_000.0 * _any_rate((0, 1, 2))), rel=1e-14)
     one = site_set_survival([8_000.0], lambda idx: EVENTS_PER_YR * P_EACH[0])
     assert one == pytest.approx(math.exp(-8_000.0 * EVENTS_PER_YR * 0.3), rel=1e-14)
-
-
-def test_sites_multiply_and_bad_values_are_refused():
-    assert sites_survival([0.5, 0.8]) == pytest.approx(0.4)
-    with pytest.raises(InputError, match="probabilities in"):
-        sites_survival([0.5, 1.2])
-    with pytest.raises(InputError, match="not negative"):
-        site_set_survival([-1.0], _any_rate)
