@@ -10,6 +10,7 @@ table motion's turn (deg); :data:`CALIBRATION_NEIGHBOURHOOD` is the one home of 
 the calibration tries and the ranges a fragility's members draw.
 """
 import dataclasses
+import io
 import itertools
 import math
 from datetime import date
@@ -22,6 +23,7 @@ from pipeline.files import InputError
 from pipeline.records import RECORDS_DIR
 from pipeline.scenario.geometry import ColumnGeometry
 from pipeline.scenario.parameters import Contact
+from pipeline.userfiles import DATA_FILE_BYTES, read_user_text
 
 EXPERIMENTS = RECORDS_DIR / "shake_table" / "tests.csv"
 SPECIMEN = RECORDS_DIR / "shake_table" / "sp1.json"
@@ -84,7 +86,9 @@ def load_experiments(path=EXPERIMENTS, outcome=OUTCOME):
     duplicated test or a motion file that is named but absent."""
     path = Path(path)
     try:
-        frame = pd.read_csv(path, dtype={"test": str, "motion_file": str},
+        frame = pd.read_csv(io.StringIO(read_user_text(path, "experiment table",
+                                                       DATA_FILE_BYTES)),
+                            dtype={"test": str, "motion_file": str},
                             keep_default_na=False)
     except (OSError, ValueError, pd.errors.ParserError) as exc:
         raise InputError(f"{path.name}: not a readable experiment table "

@@ -3,6 +3,7 @@ declared size counted in its bytes, its geometry alone (vertices merged by posit
 degenerate and duplicate faces dropped, the winding made consistent), an open base
 closed by a planar cap, and one-line errors where it is no solid.  What was repaired is
 listed as it is done (:mod:`pipeline.scenario.mesh` says it and keeps it)."""
+import io
 import re
 import struct
 from pathlib import Path
@@ -10,6 +11,7 @@ from pathlib import Path
 import numpy as np
 
 from pipeline.files import InputError
+from pipeline.userfiles import read_user_bytes
 
 MAX_FACES = 1_000_000             # triangles of a mesh (a scan decimated for simulation)
 ZERO_VOLUME = 1e-9                # volumes below this fraction of size^3 are flat surfaces
@@ -37,7 +39,9 @@ def _read(path, scale, name, where):
     """The mesh file as its geometry (:func:`_geometry`), its repairs and its size (m)."""
     import trimesh
     try:
-        loaded = trimesh.load(path, force="mesh", process=False)
+        loaded = trimesh.load(io.BytesIO(read_user_bytes(path, f"{where}: mesh")),
+                              file_type=Path(path).suffix.lower().lstrip("."), force="mesh",
+                              process=False)
     except Exception as exc:  # trimesh raises many kinds on a broken file
         raise InputError(f"{where}: mesh {name} unreadable "
                          f"({str(exc).splitlines()[0][:120] if str(exc) else type(exc).__name__})") \
