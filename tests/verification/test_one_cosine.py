@@ -130,11 +130,14 @@ def test_verify_refuses_an_out_file_it_cannot_write_before_any_work(tmp_path, mo
         assert len(err.splitlines()) == 1 and words in err, err
 
 
-def test_a_slow_pulse_overturns_a_slender_block_just_above_its_uplift():
-    # omega_p / p = 0.25: nearly quasi-static, the threshold just above tan(alpha) (the
-    # amplitude that lifts the block), which the scan's first amplitude already exceeds
-    h, b = 0.3, 0.01
-    c = block_constants(h, b)
-    period = 2 * math.pi / (0.25 * c["p"])
-    a = oc.min_overturning_g(period, h, b)
-    assert a is not None and math.tan(c["alpha"]) < a < 1.05 * math.tan(c["alpha"])
+@pytest.mark.parametrize("hb", [3.0, 30.0])
+def test_at_the_slowest_pulse_taken_the_threshold_in_g_does_not_depend_on_the_size(hb):
+    # a_po / g depends on alpha and omega_p / p alone (dimensional analysis): the same at
+    # the slowest pulse the check takes on a 0.1 m and a 3 m block, above the uplift
+    tan_alpha = 1 / hb
+    found = []
+    for h in (0.1, 3.0):
+        p = block_constants(h, h / hb)["p"]
+        found.append(oc.min_overturning_g(2 * math.pi / (oc.MIN_OMEGA_RATIO * p), h, h / hb))
+    assert found[0] == pytest.approx(found[1], rel=1e-4)
+    assert tan_alpha < found[0] < 1.1 * tan_alpha
