@@ -200,6 +200,9 @@ def fit_contact(options):
         t, theta = load_free_rocking(options.free_rocking)
         fit = fit_free_rocking(height, width, t=t, theta=theta)
         source = {"free_rocking": str(options.free_rocking)}
+        if fit["rest"] is not None:           # the noise at rest left out: said in the file
+            source["at_rest_from_s"], source["swings_at_rest"] = \
+                fit["rest"]["from_s"], fit["rest"]["swings"]
     if not 0.0 < fit["restitution"] <= 1.0:
         raise InputError(f"the decay gives a restitution of {fit['restitution']:.3f}, outside "
                          "(0, 1]: amplitudes that grow are not a free-rocking decay")
