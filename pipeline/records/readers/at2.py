@@ -80,7 +80,7 @@ def _at2_orientation(component, path):
 def read_at2(path):
     """One PEER AT2 component as an obspy Trace in m/s^2 (stats.azimuth not set)."""
     path = Path(path)
-    lines = path.read_text(encoding="latin-1").splitlines()
+    lines = read_bytes(path).decode("latin-1").splitlines()
     if len(lines) < 5 or not lines[0].upper().startswith("PEER"):
         raise InputError(f"{path.name}: not a PEER AT2 file")
     if "UNITS OF G" not in lines[2].upper():
