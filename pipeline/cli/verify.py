@@ -13,7 +13,8 @@ from pipeline.scenario.parameters import MU_K_OVER_MU_S
 from pipeline.verification import (MARBLE_BLOCK, PULSE_BLOCK, SLIDING_BELOW, SLIDING_MU,
                                    CheckResult, check_sliding_mus, verify_housner,
                                    verify_one_cosine, verify_sine_pulse, verify_sliding)
-from pipeline.verification.one_cosine import MR_BLOCK, YADE_RUNS, check_one_cosine
+from pipeline.verification.one_cosine import (MR_BLOCK, YADE_RUNS, check_block_sizes,
+                                              check_one_cosine)
 
 NAME = "verify"
 ORDER = 30
@@ -63,6 +64,8 @@ def run(args):
     contact = {k: v for k, v in (("kn", args.kn), ("damping", args.damping)) if v is not None}
     out = args.out or RESULTS_DIR / "verification" / f"{args.test}.json"
     check_out_file(out)
+    if args.test in ("housner", "sine-pulse"):
+        check_block_sizes(args.height, args.width, args.depth)
     if args.test == "housner":
         result = verify_housner(args.height, args.width, args.depth, args.theta0_ratio,
                                 args.impacts, **contact)

@@ -83,16 +83,21 @@ def check_runs(runs):
         raise InputError(f"--runs must be an integer in [3, {MAX_RUNS}], got {runs!r}")
 
 
-def check_block(height, width, depth):
+def check_block_sizes(height, width, depth):
     """InputError unless the block's sizes (m) are within the verification block's ranges
-    (:class:`~pipeline.scenario.parameters.Block`) and its slenderness h / b within
-    :data:`SLENDERNESS_RANGE`, the rocking block this check is about."""
+    (:class:`~pipeline.scenario.parameters.Block`), named as the flags of ``verify``."""
     for name, value in (("height", height), ("width", width), ("depth", depth)):
         low, high = BLOCK_SIZES_M[name]
         if isinstance(value, bool) or not isinstance(value, (int, float)) or \
                 not (math.isfinite(value) and low <= value <= high):
             raise InputError(f"--{name} must be a finite block size in [{low:g}, {high:g}] m, "
                              f"got {value!r}")
+
+
+def check_block(height, width, depth):
+    """:func:`check_block_sizes`, and the slenderness h / b within
+    :data:`SLENDERNESS_RANGE`, the rocking block this check is about."""
+    check_block_sizes(height, width, depth)
     low, high = SLENDERNESS_RANGE
     ratio = height / width
     if not low <= ratio <= high:

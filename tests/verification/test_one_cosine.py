@@ -141,3 +141,13 @@ def test_at_the_slowest_pulse_taken_the_threshold_in_g_does_not_depend_on_the_si
         found.append(oc.min_overturning_g(2 * math.pi / (oc.MIN_OMEGA_RATIO * p), h, h / hb))
     assert found[0] == pytest.approx(found[1], rel=1e-4)
     assert tan_alpha < found[0] < 1.1 * tan_alpha
+
+
+@pytest.mark.parametrize("test", [["housner"], ["sine-pulse", "--amplitude-ratio", "6.5"]])
+def test_the_other_block_checks_name_a_size_out_of_range(tmp_path, capsys, test):
+    from pipeline.cli import main
+    out = tmp_path / "o.json"
+    assert main(["verify", *test, "--height", "inf", "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err == "error: --height must be a finite block size in [0.01, 30] m, got inf"
+    assert not out.exists()
