@@ -112,3 +112,9 @@ def test_other_loaders_refuse_a_named_pipe(fifo, loader):
             "free_rocking": load_free_rocking}[loader]
     with hang_bound(), pytest.raises(InputError, match="is not a regular file"):
         load(Path(fifo))
+
+
+def test_a_named_pipe_as_the_forward_table_is_refused(fifo):
+    from pipeline.inversion.table import ForwardTable
+    with hang_bound(), pytest.raises(InputError, match="forward table .* is not a regular file"):
+        ForwardTable.load(fifo)
