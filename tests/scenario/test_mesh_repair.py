@@ -413,12 +413,12 @@ def test_a_mesh_just_outside_the_sizes_says_its_size_in_enough_digits(tmp_path, 
 
 
 def test_sp1_with_unshared_jittered_corners_is_merged_and_said(tmp_path, capsys):
-    """Every face with its own corners, each moved by up to 0.2 um (an exporter's
-    rounding): the corners within 1e-6 of the size (0.8 um) are merged, and said; the
-    specimen is SP1's to the jitter."""
+    """Every face with its own corners, each coordinate moved by up to 2 um (an
+    exporter's rounding): the corners within 1e-5 of the size (7.9 um) are merged, and
+    said; the specimen is SP1's to the jitter."""
     vertices, faces = sp1_as_written()
     corners, triangles = split(vertices, faces)
-    corners = corners + np.random.default_rng(2).uniform(-2e-7, 2e-7, corners.shape)
+    corners = corners + np.random.default_rng(2).uniform(-2e-6, 2e-6, corners.shape)
     path = tmp_path / "sp1_jittered.obj"
     path.write_text("".join(f"v {x:.17g} {y:.17g} {z:.17g}\n" for x, y, z in corners)
                     + "".join(f"f {a + 1} {b + 1} {c + 1}\n" for a, b, c in triangles))
@@ -426,8 +426,8 @@ def test_sp1_with_unshared_jittered_corners_is_merged_and_said(tmp_path, capsys)
         rock, shipped = load(path, mass_kg=SP1_MASS), load(SP1, mass_kg=SP1_MASS)
     assert rock.volume_m3 == pytest.approx(shipped.volume_m3, rel=1e-5)
     assert rock.inertia == pytest.approx(shipped.inertia, rel=1e-4)
-    near = [r for r in rock.repairs if "of another merged (1e-06 of the mesh's size)" in r]
-    assert len(near) == 1 and "within 7.9e-07 m" in near[0]
+    near = [r for r in rock.repairs if "of another merged (1e-05 of the mesh's size)" in r]
+    assert len(near) == 1 and "within 7.9e-06 m" in near[0]
     assert near[0] in capsys.readouterr().err
 
 
@@ -438,4 +438,4 @@ def test_sp1_with_corners_farther_apart_says_they_are_unshared(tmp_path):
     path = tmp_path / "sp1_apart.obj"
     path.write_text("".join(f"v {x:.17g} {y:.17g} {z:.17g}\n" for x, y, z in corners)
                     + "".join(f"f {a + 1} {b + 1} {c + 1}\n" for a, b, c in triangles))
-    refused(path, "its faces share few vertices, none closer than 7.9e-07 m")
+    refused(path, "its faces share few vertices, none closer than 7.9e-06 m")
