@@ -174,6 +174,21 @@ class DirectoryLock:
         return False
 
 
+def check_out_file(path, flag="--out"):
+    """InputError (one line) unless a file can be written at ``path``: not a directory,
+    its nearest existing folder a writable directory (checked before any work)."""
+    path = Path(path)
+    if path.is_dir():
+        raise InputError(f"{flag} {path} is a directory, not a file")
+    folder = path.parent
+    while not folder.exists() and folder != folder.parent:
+        folder = folder.parent
+    if not folder.is_dir():
+        raise InputError(f"{flag} {path}: {folder} is a file, not a folder")
+    if not os.access(folder, os.W_OK | os.X_OK):
+        raise InputError(f"{flag} {path}: {folder} is not writable")
+
+
 def display_path(path):
     """``path`` as people read it: relative to the project when inside it."""
     try:

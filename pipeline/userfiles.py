@@ -24,11 +24,11 @@ class Unreadable(ValueError):
         self.kind, self.offset, self.byte = kind, offset, byte
 
 
-def read_text(path, limit=MAX_FILE_BYTES):
-    """The text of a user's file: a regular file (a named pipe, device or socket refused
-    before reading), at most ``limit`` bytes read, strict UTF-8 (a BOM allowed).
-    Unreadable ("size", "type" or "utf8"); OSError as open raises it (IsADirectoryError
-    for a directory)."""
+def read_bytes(path, limit=None):
+    """The bytes of a user's file: a regular file (a named pipe, device or socket refused
+    before it is opened, and again on the opened descriptor), at most ``limit`` bytes
+    (None: no limit).  Unreadable ("size", "type"); OSError as open raises it
+    (IsADirectoryError for a directory).  Every loader of a file reads it here."""
     _regular(os.stat(path).st_mode, path)               # nothing opened that is not a file
     fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK)     # and what replaced it since, too
     try:
@@ -36,12 +36,20 @@ def read_text(path, limit=MAX_FILE_BYTES):
         os.set_blocking(fd, True)
         with os.fdopen(fd, "rb") as f:
             fd = None
-            content = f.read(limit + 1)
+            content = f.read() if limit is None else f.read(limit + 1)
     finally:
         if fd is not None:
             os.close(fd)
-    if len(content) > limit:
+    if limit is not None and len(content) > limit:
         raise Unreadable(f"larger than {_size_text(limit)}", "size")
+    return content
+
+
+def read_text(path, limit=MAX_FILE_BYTES):
+    """The text of a user's file (:func:`read_bytes`, at most ``limit`` bytes), strict
+    UTF-8 (a BOM allowed).  Unreadable ("size", "type" or "utf8"); OSError as open
+    raises it (IsADirectoryError for a directory)."""
+    content = read_bytes(path, limit)
     bom = 3 if content.startswith(b"\xef\xbb\xbf") else 0     # a UTF-8 BOM is allowed
     try:
         return content[bom:].decode("utf-8")
@@ -51,11 +59,24 @@ def read_text(path, limit=MAX_FILE_BYTES):
                          content[at]) from None
 
 
+def check_regular(path, what):
+    """InputError "``what`` path is not a regular file" when ``path`` exists as a named
+    pipe, device or socket (checked by its status, nothing opened)."""
+    try:
+        mode = os.stat(path).st_mode
+    except OSError:
+        return
+    if not (stat.S_ISREG(mode) or stat.S_ISDIR(mode)):
+        raise InputError(f"{what} {path} is not a regular file (a named pipe, device or "
+                         "socket)")
+
+
 def _regular(mode, path):
     if stat.S_ISDIR(mode):
         raise IsADirectoryError(21, "Is a directory", str(path))
     if not stat.S_ISREG(mode):
-        raise Unreadable("not a regular file (a named pipe, device or socket)", "type")
+        raise Unreadable(f"{path} is not a regular file (a named pipe, device or socket)",
+                         "type")
 
 
 def _size_text(limit):
@@ -64,16 +85,29 @@ def _size_text(limit):
 
 def read_user_text(path, what, limit=MAX_FILE_BYTES):
     """The text of a user's file (:func:`read_text`, at most ``limit`` bytes); InputError
-    (one line) "``what`` not found: path", "``what`` path is a directory" or "``what``
-    path: why"."""
+    (one line) "``what`` not found: path", "``what`` path is a directory", "``what``
+    path is not a regular file" or "``what`` path: why"."""
+    return _user(read_text, path, what, limit)
+
+
+def read_user_bytes(path, what, limit=None):
+    """The bytes of a user's file (:func:`read_bytes`, at most ``limit`` bytes); the
+    one-line InputErrors of :func:`read_user_text`."""
+    return _user(read_bytes, path, what, limit)
+
+
+def _user(reader, path, what, limit):
     try:
-        return read_text(path, limit)
+        return reader(path, limit)
     except FileNotFoundError:
         raise InputError(f"{what} not found: {path}") from None
     except IsADirectoryError:
         raise InputError(f"{what} {path} is a directory") from None
-    except (OSError, Unreadable) as exc:
-        raise InputError(f"{what} {path}: {exc}") from None
+    except Unreadable as exc:
+        raise InputError(f"{what} {exc}" if exc.kind == "type" else f"{what} {path}: {exc}") \
+            from None
+    except OSError as exc:
+        raise InputError(f"{what} {path}: {exc.strerror or exc}") from None
 
 
 def read_json(path, what, limit=MAX_FILE_BYTES):

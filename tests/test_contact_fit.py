@@ -171,3 +171,37 @@ def test_a_column_file_is_read_as_its_equivalent_block(tmp_path, capsys):
                      "--block", f"{H},{B}", "--out", str(by_block)]) == 0
     assert written["restitution"] == pytest.approx(
         json.loads(by_block.read_text())["restitution"], abs=1e-9)
+
+
+def test_noise_recorded_at_rest_is_cut_from_the_decay_and_said(tmp_path, capsys):
+    """A decay (restitution 0.85) that comes to rest and then records smooth noise of
+    3 mrad for 4 s: the noise's swings, each above the noise the second differences
+    measure, do not decay; read as swings they pull the restitution to ~0.99.  They are
+    left out from where the block is at rest, and the command says so."""
+    out = housner_free_rocking(H, B, 0.5 * math.atan(B / H), n_impacts=8, restitution=0.85)
+    t = np.arange(0.0, out["t"][-1] + 4.0, 0.002)
+    theta = np.interp(t, out["t"], out["theta"], right=0.0)
+    noise = np.convolve(np.random.default_rng(0).normal(0.0, 1.0, t.size), np.ones(25) / 25,
+                        mode="same")
+    at_rest = t > out["t"][-1]
+    theta[at_rest] += 3e-3 * noise[at_rest] / noise.std()
+    fit = fit_free_rocking(H, B, t=t, theta=theta)
+    assert fit["restitution"] == pytest.approx(0.85, abs=2e-3)
+    assert fit["rest"] is not None and fit["rest"]["swings"] > 10
+    assert fit["rest"]["from_s"] <= out["t"][-1]
+    decay = tmp_path / "decay.csv"
+    decay.write_text("time_s,tilt_rad\n" + "".join(f"{a:.4f},{b:.7f}\n"
+                                                  for a, b in zip(t, theta)))
+    target = tmp_path / "contact.json"
+    assert cli.main(["contact", "--free-rocking", str(decay), "--block", f"{H},{B}",
+                     "--out", str(target)]) == 0
+    said = capsys.readouterr().out
+    assert "note: the block is at rest from" in said and "left out of the fit" in said
+    written = json.loads(target.read_text())
+    assert written["restitution"] == pytest.approx(0.85, abs=3e-3)
+    assert written["source"]["swings_at_rest"] == fit["rest"]["swings"]
+
+
+def test_a_clean_decay_has_nothing_at_rest():
+    out, t, theta = recorded_decay(0.85)
+    assert fit_free_rocking(H, B, t=t, theta=theta)["rest"] is None

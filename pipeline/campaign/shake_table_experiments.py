@@ -10,6 +10,7 @@ table motion's turn (deg); :data:`CALIBRATION_NEIGHBOURHOOD` is the one home of 
 the calibration tries and the ranges a fragility's members draw.
 """
 import dataclasses
+import io
 import itertools
 import math
 from datetime import date
@@ -22,6 +23,7 @@ from pipeline.files import InputError
 from pipeline.records import RECORDS_DIR
 from pipeline.scenario.geometry import ColumnGeometry
 from pipeline.scenario.parameters import Contact
+from pipeline.userfiles import DATA_FILE_BYTES, check_regular, read_user_text, show
 
 EXPERIMENTS = RECORDS_DIR / "shake_table" / "tests.csv"
 SPECIMEN = RECORDS_DIR / "shake_table" / "sp1.json"
@@ -81,10 +83,12 @@ PGV_PGA_EDGES_S = np.array([0.0, 0.05, 0.1, 0.2, 0.3, 0.5, 1.0])
 def load_experiments(path=EXPERIMENTS, outcome=OUTCOME):
     """The experiment table (pandas DataFrame; ``observed`` bool, ``motion_path`` Path or
     None).  One-line InputError for a missing column, a bad date, an outcome not 0/1, a
-    duplicated test or a motion file that is named but absent."""
+    duplicated or blank test name or a motion file that is named but absent."""
     path = Path(path)
     try:
-        frame = pd.read_csv(path, dtype={"test": str, "motion_file": str},
+        frame = pd.read_csv(io.StringIO(read_user_text(path, "experiment table",
+                                                       DATA_FILE_BYTES)),
+                            dtype={"test": str, "motion_file": str},
                             keep_default_na=False)
     except (OSError, ValueError, pd.errors.ParserError) as exc:
         raise InputError(f"{path.name}: not a readable experiment table "
@@ -94,6 +98,10 @@ def load_experiments(path=EXPERIMENTS, outcome=OUTCOME):
         raise InputError(f"{path.name}: missing column(s) {', '.join(missing)}")
     if frame.empty:
         raise InputError(f"{path.name}: no experiments (a header and no rows)")
+    for row, name in enumerate(frame["test"], start=2):
+        if not (name.strip() and name.isprintable() and len(name) <= 200):
+            raise InputError(f"{path.name}, row {row}: test name {show(name)} must be 1-200 "
+                             "printable characters, not blank")
     if frame["test"].duplicated().any():
         raise InputError(f"{path.name}: test {frame['test'][frame['test'].duplicated()].iloc[0]}"
                          " appears twice")
@@ -113,8 +121,10 @@ def load_experiments(path=EXPERIMENTS, outcome=OUTCOME):
     paths = []
     for name in frame["motion_file"]:
         motion = path.parent / name if name else None
-        if motion is not None and not motion.is_file():
-            raise InputError(f"{path.name}: motion file {name} not found")
+        if motion is not None:
+            check_regular(motion, f"{path.name}: motion file")
+            if not motion.is_file():
+                raise InputError(f"{path.name}: motion file {name} not found")
         paths.append(motion)
     frame["motion_path"] = paths
     return frame

@@ -119,6 +119,35 @@ def core_s(params):
     return shake_table.RUN_CPU_S * max(1.0, (params["kn"] / KN_OF_RUN_CPU_S) ** 0.5)
 
 
+def _point_kn(specimen, point, base):
+    """The contact stiffness (N/m) of one member's run, as :func:`run_params` sets it,
+    without building its geometry."""
+    kn = shake_table_experiments.grid_contact(point, base)["kn"]
+    if "kn" not in point and "kn" not in (base or {}) and "mesh" not in specimen:
+        kn = column_kn(specimen)
+    return kn
+
+
+def planned_runs(specimen, options, candidates, n_calibration, n_tests):
+    """(at most how many YADE runs, their core seconds) of the members mode, counted from
+    the options alone, no run spec built: each candidate's members on the calibration
+    tests, then the chosen's on the others (the costliest candidate's), the single set on
+    every test; without candidates, the members and the single set on every test."""
+    base = None if options.get("contact_file") is None else \
+        contact_values(options["contact_file"])
+
+    def member_core_s(ranges):
+        sets, _ = member_sets(specimen, options["members"], options.get("seed"), ranges, base)
+        return [core_s({"kn": _point_kn(specimen, p, base)}) for p in sets]
+    single = core_s({"kn": _point_kn(specimen, single_set(options["grid"]), base)})
+    per = [member_core_s(c) for c in candidates] or [member_core_s(options.get("ranges"))]
+    n_first = n_calibration if candidates else n_tests
+    runs = sum(map(len, per)) * n_first + max(map(len, per)) * (n_tests - n_first) + n_tests
+    core = (sum(map(sum, per)) * n_first + max(map(sum, per)) * (n_tests - n_first)
+            + single * n_tests)
+    return runs, core
+
+
 def tests_of(experiments, outcome, tests, validate_from):
     """The tests with a motion (of ``tests``), with their split."""
     frame = shake_table_experiments.load_experiments(experiments, outcome)
@@ -182,19 +211,15 @@ def drive(run, records, campaign_dir, options, gate=None):
     adaptive stages, then write members.csv, the scores and the reliability diagram.
     With ``candidates``: each candidate's members on the calibration tests first, the
     best by log-likelihood chosen (:func:`choose_ranges`), then the chosen on every test."""
-    mesh = "mesh" in ColumnGeometry.load(options["specimen"]).to_dict()
-    candidates = candidate_ranges(options.get("candidates"), mesh)
+    specimen = ColumnGeometry.load(options["specimen"]).to_dict()
+    candidates = candidate_ranges(options.get("candidates"), "mesh" in specimen)
     frame = tests_of(options["experiments"], options["outcome"], options.get("tests"),
                      options["validate_from"])
     calibration = list(frame.loc[frame["split"] == "calibration", "test"])
     passes = ([{**options, "ranges": c, "tests": calibration} for c in candidates]
               + [options] if candidates else [options])
-    log.info(f"shake-table (members): preparing the runs of {len(frame)} tests "
-             f"({len(passes)} set(s) of ranges; tens of seconds each)")
-    fulls = [run_specs(records, campaign_dir, o) for o in passes]
     n, jobs = options["members"], max(options.get("jobs") or 1, 1)
-    most = len({s.run_id for full in fulls for s in full})
-    core = sum({s.run_id: s.tags["core_s"] for full in fulls for s in full}.values())
+    most, core = planned_runs(specimen, options, candidates, len(calibration), len(frame))
     what = (f"{len(candidates)} candidate ranges on {len(calibration)} calibration tests, "
             f"then the chosen on {len(frame)} tests" if candidates else f"{len(frame)} tests")
     log.info(f"shake-table (members): {what} x ({n} members + the single set): at most "
@@ -203,6 +228,9 @@ def drive(run, records, campaign_dir, options, gate=None):
              "agree; finished runs are kept and not run again)")
     if gate is not None:
         gate("campaign shake-table --members", most, core / most, "fewer --tests or --members")
+    log.info(f"shake-table (members): preparing the runs of {len(frame)} tests "
+             f"({len(passes)} set(s) of ranges; tens of seconds each)")
+    fulls = [run_specs(records, campaign_dir, o) for o in passes]
     choice = None
     if candidates:
         tried = []

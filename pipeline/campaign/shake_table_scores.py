@@ -4,6 +4,7 @@ validation: the held-out tests from it on; all), beside the single parameter set
 baselines, every one scored as a probability forecast the same way
 (:func:`pipeline.stats.forecast.forecast_scores`: a 0/1 forecast is P = 0 or 1).
 Files: ``members.csv``, ``shake_table_members.json``, ``shake_table_reliability.png``."""
+import io
 import logging
 import math
 from pathlib import Path
@@ -16,6 +17,7 @@ from pipeline.files import InputError, write_csv, write_json
 from pipeline.records import RECORDS_DIR
 from pipeline.scenario.geometry import ColumnGeometry
 from pipeline.stats.forecast import BIN_EDGES, forecast_scores
+from pipeline.userfiles import DATA_FILE_BYTES, read_user_text
 
 log = logging.getLogger(__name__)
 
@@ -32,7 +34,8 @@ def load_providers(path):
     table without ``test`` or a value not 0/1."""
     path = Path(path)
     try:
-        frame = pd.read_csv(path, dtype={"test": str})
+        frame = pd.read_csv(io.StringIO(read_user_text(path, "--providers", DATA_FILE_BYTES)),
+                            dtype={"test": str})
     except (OSError, ValueError, pd.errors.ParserError) as exc:
         raise InputError(f"--providers {path.name}: not a readable table "
                          f"({str(exc).splitlines()[0][:120]})") from None

@@ -27,6 +27,10 @@ def setup(p):
 def run(args):
     options = from_args(ContactOptions, args)
     result = fit_contact(options)
+    if "at_rest_from_s" in result["source"]:
+        print(f"note: the block is at rest from {result['source']['at_rest_from_s']:.3f} s: "
+              f"the {result['source']['swings_at_rest']} swings from there on (the "
+              "record's noise about zero, which does not decay) are left out of the fit")
     if options.damping_map:
         _print_damping(result)
     spread = "" if result["restitution_sd"] is None else \

@@ -8,12 +8,13 @@
 from pathlib import Path
 
 from pipeline import RESULTS_DIR
-from pipeline.files import InputError
+from pipeline.files import check_out_file
 from pipeline.scenario.parameters import MU_K_OVER_MU_S
 from pipeline.verification import (MARBLE_BLOCK, PULSE_BLOCK, SLIDING_BELOW, SLIDING_MU,
                                    CheckResult, check_sliding_mus, verify_housner,
                                    verify_one_cosine, verify_sine_pulse, verify_sliding)
-from pipeline.verification.one_cosine import MR_BLOCK, YADE_RUNS, check_period, check_runs
+from pipeline.verification.one_cosine import (MR_BLOCK, YADE_RUNS, check_block_sizes,
+                                              check_one_cosine)
 
 NAME = "verify"
 ORDER = 30
@@ -61,6 +62,10 @@ def setup(p):
 
 def run(args):
     contact = {k: v for k, v in (("kn", args.kn), ("damping", args.damping)) if v is not None}
+    out = args.out or RESULTS_DIR / "verification" / f"{args.test}.json"
+    check_out_file(out)
+    if args.test in ("housner", "sine-pulse"):
+        check_block_sizes(args.height, args.width, args.depth)
     if args.test == "housner":
         result = verify_housner(args.height, args.width, args.depth, args.theta0_ratio,
                                 args.impacts, **contact)
@@ -87,17 +92,13 @@ def run(args):
             print(f"mu_s {r['mu_s']:.3f}: {'pure rocking' if r['pure_rocking'] else 'sliding':>12}"
                   f", slip at impacts {1000 * r['slip_at_impacts_m']:.1f} mm")
         print(f"Augusti & Sinopoli: pure rocking needs mu_s > {result['augusti_sinopoli_mu_min']:.3f}")
-    out = args.out or RESULTS_DIR / "verification" / f"{args.test}.json"
     CheckResult(result).save(out)
     print(f"{'PASSED' if result['passed'] else 'FAILED'}; wrote {out}")
     return 0 if result["passed"] else 1
 
 
 def _one_cosine(args, contact):
-    check_period(args.period)
-    check_runs(args.runs)
-    if not (args.height > 0 and args.width > 0 and args.depth > 0):
-        raise InputError("--height, --width and --depth must be positive")
+    check_one_cosine(args.period, args.height, args.width, args.depth, args.runs, **contact)
     result = verify_one_cosine(args.period, args.height, args.width, args.depth, args.runs,
                                **contact)
     y = result["yade"]

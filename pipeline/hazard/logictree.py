@@ -39,7 +39,7 @@ import numpy as np
 
 from pipeline.hazard.curves import MAX_PGA_M_S2, PLAIN_RATE_COLUMN, PLAIN_UNITS, load_hazard
 from pipeline.files import InputError
-from pipeline.userfiles import DATA_FILE_BYTES, read_user_text, show
+from pipeline.userfiles import DATA_FILE_BYTES, read_user_bytes, read_user_text, show
 
 MAX_BRANCHES = 10_000
 MAX_LEVELS = 1_000
@@ -192,11 +192,8 @@ def _curve_files(directory):
                          f"{MAX_CURVE_FILES})")
     curves, other_imts = {}, set()
     for path in files:
-        try:
-            with open(path, encoding="utf-8", errors="replace") as f:
-                first = f.readline(4096)
-        except OSError as exc:
-            raise InputError(f"{path}: {exc.strerror or exc}") from None
+        head = read_user_bytes(path, "hazard curve file", DATA_FILE_BYTES)[:4096]
+        first = head.decode("utf-8", errors="replace").split("\n", 1)[0]
         kind, imt = _KIND.search(first), _IMT.search(first)
         if kind is None:
             continue                      # a statistic (mean, quantile) or not a curve

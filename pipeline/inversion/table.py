@@ -2,6 +2,7 @@
 grid (:mod:`pipeline.inversion.grid`), from the finished runs of the campaign
 ``inversion-forward`` (:mod:`pipeline.inversion.forward`), saved and loaded as one npz."""
 import dataclasses
+import io
 import json
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -15,6 +16,7 @@ from pipeline.campaign.run_dirs import finished_runs
 from pipeline.constants import COLUMN_TYPES as COLUMNS
 from pipeline.files import InputError
 from pipeline.stats.circular import circular_summary
+from pipeline.userfiles import read_user_bytes
 
 @dataclass
 class ForwardTable:
@@ -212,10 +214,11 @@ class ForwardTable:
     @classmethod
     def load(cls, path):
         path = Path(path)
-        if not path.is_file():
+        if not path.exists():
             raise InputError(f"forward table not found: {path}")
+        content = read_user_bytes(path, "forward table")
         try:
-            with np.load(path, allow_pickle=False) as archive:
+            with np.load(io.BytesIO(content), allow_pickle=False) as archive:
                 data = {k: archive[k] for k in archive.files}
             meta = json.loads(str(data.pop("meta")))
         except (ValueError, OSError, EOFError, KeyError):

@@ -15,6 +15,7 @@ record's clock of the motion's first sample (negative where the processing added
 before the record; absent: 0, a motion that is its own record), so record time = motion
 time + ``start_in_file_s``.
 """
+import io
 import json
 import math
 from dataclasses import dataclass, field, replace
@@ -23,6 +24,7 @@ from pathlib import Path
 import numpy as np
 
 from pipeline.files import InputError, write_npz
+from pipeline.userfiles import read_user_bytes
 
 NPZ_KEYS = ("dt", "acc", "vel", "disp", "meta")
 RECORD_CLOCK = "s after the record's first sample"    # the unit of every time a user reads
@@ -100,10 +102,11 @@ class Motion:
     def load(cls, path):
         """Read a processed motion ``.npz``; InputError names what is wrong."""
         path = Path(path)
-        if not path.is_file():
+        if not path.exists():
             raise InputError(f"processed motion not found: {path}")
         try:
-            with np.load(path, allow_pickle=False) as archive:
+            content = read_user_bytes(path, "processed motion")
+            with np.load(io.BytesIO(content), allow_pickle=False) as archive:
                 missing = [k for k in NPZ_KEYS if k not in archive.files]
                 if missing:
                     raise InputError(f"{path.name}: not a processed motion file "

@@ -8,6 +8,7 @@ the result by content: the input files' bytes, the catalogue row, the
 processing steps and the code of this package, never by name.
 """
 import glob
+import io
 import logging
 import re
 import sys
@@ -24,6 +25,7 @@ from pipeline.motion import NPZ_KEYS, Motion
 from pipeline.records import processing
 from pipeline.records.catalog import catalog, catalog_row
 from pipeline.records.readers import is_pattern, read_record
+from pipeline.userfiles import check_regular, read_user_bytes
 
 log = logging.getLogger(__name__)
 
@@ -72,10 +74,12 @@ def resolve(record):
     path = Path(record)
     if is_pattern(path) and glob.glob(str(path)):
         return Source(_sanitise(path.name.split("*")[0].strip("._") or "record"), path)
+    check_regular(path, "record file")
     if path.is_file():
         if path.suffix.lower() == ".npz":
             try:
-                with np.load(path, allow_pickle=False) as archive:
+                content = read_user_bytes(path, "record file")
+                with np.load(io.BytesIO(content), allow_pickle=False) as archive:
                     names = set(archive.files)
             except (ValueError, OSError, EOFError):
                 raise InputError(f"{path.name}: unreadable npz") from None

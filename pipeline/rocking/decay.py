@@ -13,6 +13,7 @@ from pipeline.rocking.housner import block_constants
 
 NOISE_SWINGS = 10.0           # a recorded swing counts above this many noise sd
 MAX_AMPLITUDE_OF_ALPHA = 0.99  # free rocking from a frequency: amplitudes below this x alpha
+REST_SWINGS = 3               # swings after the decay none of which it exceeds: at rest
 
 
 def restitution_from_peaks(peaks, alpha):
@@ -79,11 +80,18 @@ def fit_free_rocking(height, width, t=None, theta=None, frequency_hz=None,
     period, eq 7: theta / alpha = 1 - 1 / cosh(p T / 4)).  Returns dict: restitution
     (mean over impacts), restitution_sd (scatter of single impacts; None for one),
     restitution_se (standard error of the mean; None for one), restitution_per_impact,
-    impacts, housner_restitution (1 - 1.5 sin^2 alpha), alpha (rad), p (1/s)."""
+    impacts, housner_restitution (1 - 1.5 sin^2 alpha), alpha (rad), p (1/s), rest (a
+    tilt record whose swings stop decaying, the block at rest and its noise recorded:
+    {from_s, swings} of the swings left out, :func:`decaying_swings`; else None)."""
     c = block_constants(height, width, g)
     alpha = c["alpha"]
+    rest = None
     if t is not None:
-        peaks = swing_amplitudes(t, theta)
+        peaks, times = swing_amplitudes(t, theta, with_times=True)
+        kept = decaying_swings(peaks)
+        if kept < peaks.size:
+            rest = {"from_s": float(times[kept]), "swings": int(peaks.size - kept)}
+            peaks = peaks[:kept]
         if np.any(peaks >= alpha):
             raise InputError(f"free rocking: an amplitude of {np.max(peaks):.4g} rad is at or "
                              f"beyond the block's overturning angle alpha {alpha:.4g} rad "
@@ -112,7 +120,20 @@ def fit_free_rocking(height, width, t=None, theta=None, frequency_hz=None,
         se = sd / math.sqrt(n)
     return dict(restitution=restitution, restitution_sd=sd, restitution_se=se,
                 restitution_per_impact=eta, impacts=int(n),
-                housner_restitution=c["restitution"], alpha=alpha, p=c["p"])
+                housner_restitution=c["restitution"], alpha=alpha, p=c["p"], rest=rest)
+
+
+def decaying_swings(amplitudes):
+    """How many of the leading swing ``amplitudes`` are the decay: those before the first
+    swing no larger than one after it, when at least REST_SWINGS swings follow it (the
+    block at rest, its record's noise swinging about zero, does not decay); all of them
+    otherwise (the fit then judges whether they decay)."""
+    a = np.asarray(amplitudes, float)
+    later = np.maximum.accumulate(a[::-1])[::-1][1:]      # the largest after each swing
+    first = np.flatnonzero(a[:-1] <= later)
+    if first.size and first[0] >= 2 and a.size - first[0] >= REST_SWINGS:
+        return int(first[0])
+    return int(a.size)
 
 
 def slowest_rocking_hz(height, width, g=MODEL_GRAVITY):
@@ -132,20 +153,21 @@ def tilt_noise_sd(theta):
     return float(np.median(np.abs(d2 - np.median(d2))) / (0.6745 * math.sqrt(6.0)))
 
 
-def swing_amplitudes(t, theta):
+def swing_amplitudes(t, theta, with_times=False):
     """Successive swing amplitudes (rad) of a recorded free-rocking decay (``t`` s,
     ``theta`` rad; swings between changes of sign, as :func:`free_rocking_peaks`) that
     stand above its noise (sd :func:`tilt_noise_sd`): a swing under NOISE_SWINGS sd is
     noise crossing zero (about an impact, or once the block is at rest) and is left out.
     On a noisy record a swing's amplitude is the top of a parabola fitted to its samples
     within NOISE_SWINGS / 2 sd of its highest (the highest sample alone reads high by
-    about 2 sd).  InputError with fewer than two swings."""
+    about 2 sd).  InputError with fewer than two swings.  ``with_times``: also the time
+    (s) each swing starts."""
     free_rocking_peaks(t, theta)                     # the checks of a record
     t, theta = np.asarray(t, float), np.asarray(theta, float)
     sd = tilt_noise_sd(theta)
     crossing = np.flatnonzero(np.sign(theta[1:]) * np.sign(theta[:-1]) < 0)
     bounds = np.concatenate([[0], crossing + 1, [t.size]])
-    amplitudes = []
+    amplitudes, starts = [], []
     for a, b in zip(bounds[:-1], bounds[1:]):
         swing = np.abs(theta[a:b])
         top = int(np.argmax(swing))
@@ -153,10 +175,11 @@ def swing_amplitudes(t, theta):
             continue                              # noise, or still rising at the end
         near = swing >= swing[top] - 0.5 * NOISE_SWINGS * sd
         amplitudes.append(_parabola_top(t[a:b][near], swing[near], swing[top]))
+        starts.append(t[a])
     if len(amplitudes) < 2:
         raise InputError("free rocking: at least one impact with amplitudes before and after "
                          f"it is needed (above the record's noise: {NOISE_SWINGS * sd:.2g} rad)")
-    return np.array(amplitudes)
+    return (np.array(amplitudes), np.array(starts)) if with_times else np.array(amplitudes)
 
 
 def _parabola_top(t, y, highest):

@@ -6,7 +6,7 @@ import re
 from pathlib import Path
 
 from pipeline.files import InputError
-from pipeline.userfiles import keys_text, number, read_json
+from pipeline.userfiles import keys_text, number, read_json, read_user_bytes
 
 CONTACT_KEYS = ("kn", "damping", "mu_s", "mu_k")
 INFORMATION_KEYS = ("restitution", "restitution_sd", "restitution_se", "impacts",
@@ -56,7 +56,7 @@ def contact_provenance(path):
     and the contact values taken from it."""
     import hashlib
     path = Path(path)
-    return {"file": str(path), "sha256": hashlib.sha256(path.read_bytes()).hexdigest(),
+    return {"file": str(path), "sha256": hashlib.sha256(read_user_bytes(path, "--contact-file")).hexdigest(),
             "values": contact_values(path)}
 
 

@@ -51,7 +51,7 @@ from pipeline.scenario.mesh_surface import MAX_FACES, declared_counts
 from pipeline.scenario.outline import perimeter_points
 from pipeline.scenario.scene_file import SceneBody, SceneColumn
 from pipeline.scenario.specimen import Specimen
-from pipeline.userfiles import keys_text, number, show
+from pipeline.userfiles import keys_text, number, read_user_bytes, show
 
 log = logging.getLogger(__name__)
 
@@ -303,12 +303,12 @@ def _close_base_m(data, units, where):
 def _checked_file(mesh, sha256, where):
     """The SHA-256 of mesh file ``mesh``, after its size, its described digest
     (``sha256``, None: any) and its declared counts are checked, before it is read."""
-    if not mesh.is_file():
+    if not mesh.exists():
         raise InputError(f"{where}: mesh file not found: {mesh}")
     if mesh.stat().st_size > MAX_MESH_BYTES:
         raise InputError(f"{where}: mesh {mesh.name} is larger than "
                          f"{MAX_MESH_BYTES // 1_000_000} MB")
-    content = mesh.read_bytes()
+    content = read_user_bytes(mesh, f"{where}: mesh", MAX_MESH_BYTES)
     digest = hashlib.sha256(content).hexdigest()
     if sha256 not in (None, digest):
         raise InputError(f"{where}: mesh {mesh.name} is not the file described "

@@ -1,8 +1,10 @@
 """A mesh file read as a closed solid surface (metres, in the table frame's axes): its
 declared size counted in its bytes, its geometry alone (vertices merged by position,
+those of an open surface also within NEAR_VERTICES of its size,
 degenerate and duplicate faces dropped, the winding made consistent), an open base
 closed by a planar cap, and one-line errors where it is no solid.  What was repaired is
 listed as it is done (:mod:`pipeline.scenario.mesh` says it and keeps it)."""
+import io
 import re
 import struct
 from pathlib import Path
@@ -10,11 +12,17 @@ from pathlib import Path
 import numpy as np
 
 from pipeline.files import InputError
+from pipeline.userfiles import read_user_bytes, show
 
 MAX_FACES = 1_000_000             # triangles of a mesh (a scan decimated for simulation)
 ZERO_VOLUME = 1e-9                # volumes below this fraction of size^3 are flat surfaces
 CLOSE_BASE_REACH = 0.25           # the ground plane within this fraction of the size
 SIZE_RANGE_M = (0.02, 30.0)       # largest extent of a specimen
+# an open surface whose vertices lie this close (a fraction of the mesh's size) merges
+# them when that closes edges of it: copies of one corner written apart (a per-face
+# export, float rounding); 1e-5 is 7.9 um on SP1, ten times below a scan's precision
+# (~0.1 mm) and its 0.1 % shortest edges (89 um; edges shorter still collapse and go)
+NEAR_VERTICES = 1e-5
 
 
 def read_solid(path, scale, rotation, close_base, where):
@@ -36,25 +44,101 @@ def read_solid(path, scale, rotation, close_base, where):
 def _read(path, scale, name, where):
     """The mesh file as its geometry (:func:`_geometry`), its repairs and its size (m)."""
     import trimesh
+    content = read_user_bytes(path, f"{where}: mesh")
+    suffix = Path(path).suffix.lower()
+    _check_ply_lines(content, suffix, name, where)
     try:
-        loaded = trimesh.load(path, force="mesh", process=False)
+        loaded = trimesh.load(io.BytesIO(content), file_type=suffix.lstrip("."), force="mesh",
+                              process=False)
     except Exception as exc:  # trimesh raises many kinds on a broken file
         raise InputError(f"{where}: mesh {name} unreadable "
                          f"({str(exc).splitlines()[0][:120] if str(exc) else type(exc).__name__})") \
             from None
-    if not isinstance(loaded, trimesh.Trimesh) or len(loaded.faces) < 4 \
-            or not np.isfinite(loaded.vertices).all():
+    if not isinstance(loaded, trimesh.Trimesh) or len(loaded.faces) < 4:
         raise InputError(f"{where}: mesh {name} holds no closed surface")
+    _check_vertices(np.asarray(loaded.vertices), np.asarray(loaded.faces), name, where)
     if len(loaded.faces) > MAX_FACES:
         raise InputError(f"{where}: mesh {name} has {len(loaded.faces):,} faces, more than "
                          f"{MAX_FACES:,}: decimate it first")
     mesh, repairs = _geometry(loaded, scale)
     size = float(np.ptp(mesh.vertices, axis=0).max()) if len(mesh.faces) else 0.0
     if not SIZE_RANGE_M[0] <= size <= SIZE_RANGE_M[1]:
-        raise InputError(f"{where}: mesh {name} is {size:g} m across with units "
-                         f"{'m' if scale == 1 else 'cm' if scale == 0.01 else 'mm'}: expected "
-                         f"{SIZE_RANGE_M[0]:g}-{SIZE_RANGE_M[1]:g} m (check 'units')")
-    return mesh, repairs, size
+        raise InputError(f"{where}: mesh {name} is {_outside_text(size, SIZE_RANGE_M)} m across "
+                         f"with units {'m' if scale == 1 else 'cm' if scale == 0.01 else 'mm'}: "
+                         f"expected {SIZE_RANGE_M[0]:g}-{SIZE_RANGE_M[1]:g} m (check 'units')")
+    return _merged_near(mesh, size, repairs), repairs, size
+
+
+def _check_ply_lines(content, suffix, name, where):
+    """An ASCII PLY's data lines are as many as its header declares elements (vertices and
+    faces); InputError (malformed or truncated) otherwise."""
+    head, end, body = content.partition(b"end_header")
+    if suffix != ".ply" or not end or b"format ascii" not in head:
+        return
+    declared = sum(int(n) for n in re.findall(rb"(?m)^element\s+\S+\s+(\d+)", head))
+    lines = sum(1 for line in body.splitlines() if line.strip())
+    if lines != declared:
+        vertices, faces = declared_counts(content, suffix)
+        raise InputError(f"{where}: mesh {name} is malformed or truncated: its header declares "
+                         f"{vertices or 0:,} vertices and {faces or 0:,} faces ({declared:,} "
+                         f"data lines), the file holds {lines:,} data lines")
+
+
+def _check_vertices(vertices, faces, name, where):
+    """InputError for vertices with NaN or infinite coordinates, or faces that name a
+    vertex the file does not hold."""
+    bad = np.flatnonzero(~np.isfinite(vertices).all(axis=1))
+    if bad.size:
+        raise InputError(f"{where}: mesh {name} has {_count(bad.size, 'vertex', 'vertices')} "
+                         f"with NaN or infinite coordinates (the first: vertex {bad[0] + 1} of "
+                         f"{len(vertices):,}, {show(tuple(vertices[bad[0]].tolist()))})")
+    if faces.size and (faces.min() < 0 or faces.max() >= len(vertices)):
+        raise InputError(f"{where}: mesh {name} is malformed: a face names vertex "
+                         f"{int(faces.max()) + 1}, the file holds {len(vertices):,} vertices")
+
+
+def _outside_text(value, bounds):
+    """``value`` with the fewest digits (at least 4) that show it outside ``bounds``."""
+    for digits in range(4, 18):
+        text = f"{value:.{digits}g}"
+        if not bounds[0] <= float(text) <= bounds[1]:
+            return text
+    return repr(value)
+
+
+def _merged_near(mesh, size, repairs):
+    """``mesh`` with its vertices closer than NEAR_VERTICES x ``size`` (m) merged, each
+    group to its mean, when its surface is open and that closes edges of it (said in
+    ``repairs``); else ``mesh`` as it is."""
+    import trimesh
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+    from scipy.spatial import cKDTree
+    if mesh.is_watertight:
+        return mesh
+    tolerance = NEAR_VERTICES * size
+    pairs = cKDTree(mesh.vertices).query_pairs(tolerance, output_type="ndarray")
+    if not len(pairs):
+        return mesh
+    n = len(mesh.vertices)
+    k, group = connected_components(coo_matrix((np.ones(len(pairs)), pairs.T), shape=(n, n)),
+                                    directed=False)
+    vertices = np.zeros((k, 3))
+    np.add.at(vertices, group, mesh.vertices)
+    vertices /= np.bincount(group, minlength=k)[:, None]
+    merged, more = _geometry(trimesh.Trimesh(vertices, group[mesh.faces], process=False), 1.0)
+    if _open_edges(merged) >= _open_edges(mesh):
+        return mesh
+    repairs.append(f"{_count(n - k, 'vertex', 'vertices')} within {tolerance:.2g} m of "
+                   f"another merged ({NEAR_VERTICES:g} of the mesh's size)")
+    repairs.extend(more)
+    return merged
+
+
+def _open_edges(mesh):
+    """How many edges of ``mesh`` belong to one face only."""
+    import trimesh
+    return len(trimesh.grouping.group_rows(mesh.edges_sorted, require_count=1))
 
 
 def _fix_winding(mesh, repairs):
@@ -176,9 +260,14 @@ def _open_text(mesh, loops, name):
                                   axis=1).sum()) for loop in loops]
     largest = loops[int(np.argmax(sizes))]
     centre = ", ".join(f"{c:.4g}" for c in mesh.vertices[largest].mean(axis=0))
+    apart = ""
+    if len(loops) > len(mesh.faces) / 4:         # most faces alone: their corners unshared
+        tolerance = NEAR_VERTICES * float(np.ptp(mesh.vertices, axis=0).max())
+        apart = (f"; its faces share few vertices, none closer than {tolerance:.2g} m "
+                 f"({NEAR_VERTICES:g} of its size) to another")
     return (f"mesh {name} is not closed: {_count(len(loops), 'hole')}, the largest "
             f"{max(sizes):.3g} m around its edge, centred at ({centre}) m (the mesh's axes "
-            "in metres): close it, or give \"close_base\" for an open base")
+            f"in metres){apart}: close it, or give \"close_base\" for an open base")
 
 
 def _close_base(mesh, loops, close_base, name):

@@ -8,6 +8,7 @@ flags), every one checked when the options are made, before any work.
 The decay file is a CSV with a header: ``time_s`` and ``tilt_rad`` or ``tilt_deg`` (the
 block's tilt in its rocking plane, signed).
 """
+import io
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -18,6 +19,7 @@ import pandas as pd
 from pipeline import paper
 from pipeline.files import InputError, write_json
 from pipeline.scenario.parameters import check_fields, param
+from pipeline.userfiles import DATA_FILE_BYTES, read_user_text
 
 MAX_ROWS = 1_000_000
 TILT_COLUMNS = {"tilt_rad": 1.0, "tilt_deg": math.pi / 180.0}
@@ -159,10 +161,11 @@ def _numbers(text, what, count=None):
 def load_free_rocking(path):
     """(time s, tilt rad) arrays of a decay CSV; one-line InputError otherwise."""
     path = Path(path)
-    if not path.is_file():
+    if not path.exists():
         raise InputError(f"--free-rocking {path}: file not found")
     try:
-        frame = pd.read_csv(path, nrows=MAX_ROWS + 1)
+        frame = pd.read_csv(io.StringIO(read_user_text(path, "--free-rocking",
+                                                       DATA_FILE_BYTES)), nrows=MAX_ROWS + 1)
     except (OSError, ValueError, UnicodeDecodeError, pd.errors.ParserError) as exc:
         raise InputError(f"{path.name}: not a readable CSV ({str(exc).splitlines()[0][:100]})"
                          ) from None
@@ -197,6 +200,9 @@ def fit_contact(options):
         t, theta = load_free_rocking(options.free_rocking)
         fit = fit_free_rocking(height, width, t=t, theta=theta)
         source = {"free_rocking": str(options.free_rocking)}
+        if fit["rest"] is not None:           # the noise at rest left out: said in the file
+            source["at_rest_from_s"], source["swings_at_rest"] = \
+                fit["rest"]["from_s"], fit["rest"]["swings"]
     if not 0.0 < fit["restitution"] <= 1.0:
         raise InputError(f"the decay gives a restitution of {fit['restitution']:.3f}, outside "
                          "(0, 1]: amplitudes that grow are not a free-rocking decay")

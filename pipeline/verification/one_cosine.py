@@ -11,6 +11,7 @@ a_po / (alpha g) ~ 1 + omega_p / (4 p) (about +-16 %); and the fine amplitude sc
 show where a block stands again above that amplitude (overturning is not monotone in it).
 Amplitudes a_p are in g (the model's 9.81 m/s^2), periods in s.
 """
+import dataclasses
 import math
 from pathlib import Path
 
@@ -23,6 +24,7 @@ from pipeline.rocking.sampled import rocking_response_sampled
 from pipeline.constants import MODEL_GRAVITY
 from pipeline.files import InputError
 from pipeline.motion.pulses import one_cosine_pulse
+from pipeline.scenario import Block, Contact
 from pipeline.verification.checks import HOUSNER_DAMPING, classify_rocking, run_block
 
 MR_BLOCK = {"height": 3.0, "width": 1.0, "depth": 1.0}   # b 0.5, h 1.5 m: alpha 18.43 deg
@@ -43,6 +45,19 @@ YADE_CONTACT = {"damping": HOUSNER_DAMPING}  # critical: Housner's restitution (
 YADE_RUNS = 10
 MAX_RUNS = 20
 PERIOD_RANGE_S = (0.1, 10.0)
+# h / b of the block: Makris & Roussos's theory (and Housner's restitution 1 - 1.5 sin^2
+# alpha, 0.25 at h = b, negative beyond b / h = 1.41) is of a block that rocks rather than
+# slides or squats, taller than wide; the upper bound is the slenderness the column
+# campaigns reach (scenario.parameters.Column.hd), 1.9 deg: an uplift at 0.033 g
+SLENDERNESS_RANGE = (1.0, 30.0)
+# omega_p / p below this is a nearly quasi-static pulse: the block overturns just above
+# tan alpha, after more impacts than the 2D integration follows on a small slender block
+# (its threshold in g, which depends on alpha and omega_p / p alone, is then found on a
+# 3 m block and missed on a 0.3 m one at 0.3); Fig. 11's curve starts at 1, the
+# verification's longest pulse is at 0.97
+MIN_OMEGA_RATIO = 0.5
+BLOCK_SIZES_M = {f.name: (f.metadata["low"], f.metadata["high"])
+                 for f in dataclasses.fields(Block) if f.name in ("height", "width", "depth")}
 # SP1's equivalent block: its weak-side critical angle and pivot distance
 # (records/shake_table/README.md, Footprint: 14.7 deg, 0.302 m)
 SP1_ALPHA_DEG, SP1_R_M = 14.7, 0.302
@@ -66,6 +81,47 @@ def check_runs(runs):
     """InputError unless the YADE runs of a bisection are a whole number in [3, MAX_RUNS]."""
     if isinstance(runs, bool) or not isinstance(runs, int) or not 3 <= runs <= MAX_RUNS:
         raise InputError(f"--runs must be an integer in [3, {MAX_RUNS}], got {runs!r}")
+
+
+def check_block_sizes(height, width, depth):
+    """InputError unless the block's sizes (m) are within the verification block's ranges
+    (:class:`~pipeline.scenario.parameters.Block`), named as the flags of ``verify``."""
+    for name, value in (("height", height), ("width", width), ("depth", depth)):
+        low, high = BLOCK_SIZES_M[name]
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or \
+                not (math.isfinite(value) and low <= value <= high):
+            raise InputError(f"--{name} must be a finite block size in [{low:g}, {high:g}] m, "
+                             f"got {value!r}")
+
+
+def check_block(height, width, depth):
+    """:func:`check_block_sizes`, and the slenderness h / b within
+    :data:`SLENDERNESS_RANGE`, the rocking block this check is about."""
+    check_block_sizes(height, width, depth)
+    low, high = SLENDERNESS_RANGE
+    ratio = height / width
+    if not low <= ratio <= high:
+        what = "wider than tall" if ratio < low else "more slender than the check takes"
+        raise InputError(f"--height {height:g} / --width {width:g} = {ratio:.4g}: the block is "
+                         f"{what}; the one-cosine check is of a block that rocks (Housner's "
+                         f"restitution 1 - 1.5 sin^2 alpha), slenderness h/b in "
+                         f"[{low:g}, {high:g}]")
+
+
+def check_one_cosine(period_s, height, width, depth, runs, **contact):
+    """Every setting of the one-cosine check range-checked (one-line InputError), before
+    any integration or YADE run: the period, the block, the runs and the contact."""
+    check_period(period_s)
+    check_block(height, width, depth)
+    ratio = omega_ratio(period_s, height, width)
+    if ratio < MIN_OMEGA_RATIO:
+        raise InputError(f"--period {period_s:g} s on this block is omega_p / p = {ratio:.3g}, "
+                         f"a quasi-static pulse: the check needs omega_p / p of at least "
+                         f"{MIN_OMEGA_RATIO:g} (--period at most "
+                         f"{2 * math.pi / (MIN_OMEGA_RATIO * block_constants(height, width)['p']):.3g}"
+                         " s)")
+    check_runs(runs)
+    Contact(**contact)
 
 
 def omega_ratio(period_s, height, width):
@@ -241,8 +297,7 @@ def verify_one_cosine(period_s=MR_PERIOD_S, height=MR_BLOCK["height"], width=MR_
     block's (bisected to 1e-5), the YADE block's (``runs`` runs) and eq. 43; passed when
     YADE is within TOLERANCE_YADE of the 2D block and, for Fig. 11's block and pulse,
     the 2D block within TOLERANCE_2D of Makris & Roussos."""
-    check_period(period_s)
-    check_runs(runs)
+    check_one_cosine(period_s, height, width, depth, runs, **contact)
     run_dir = Path(run_dir or RESULTS_DIR / "verification" / "runs" / f"one_cosine_{period_s:g}")
     a2d = min_overturning_g(period_s, height, width)
     if a2d is None:

@@ -69,11 +69,25 @@ def test_experiment_table_errors_are_one_line(tmp_path):
                         (good.replace(",1,\n", ",2,\n"), "0 or 1"),
                         (good + "T1,2021-06-02,0.1,0.05,0,\n", "twice"),
                         (good.replace(",1,\n", ",1,nowhere.txt\n"), "not found"),
-                        (good.replace("0.1,0.05", "-1,0.05"), ">= 0")):
+                        (good.replace("0.1,0.05", "-1,0.05"), ">= 0"),
+                        (good.replace("\nT1,", "\n,"), "test name '' must be"),
+                        (good.replace("\nT1,", "\n  ,"), "not blank")):
         path.write_text(text)
         with pytest.raises(InputError, match=words) as info:
             load_experiments(path)
         assert "\n" not in str(info.value)
+
+
+def test_tables_with_a_byte_order_mark_are_read(tmp_path):
+    """A spreadsheet's UTF-8 export starts with a byte-order mark: the experiment table
+    and the providers' table are read as without it."""
+    from pipeline.campaign.shake_table_scores import load_providers
+    path = tmp_path / "e.csv"
+    path.write_bytes(b"\xef\xbb\xbftest,date,pga_g,pgv_pga_s,sp1_overturned,motion_file\n"
+                     b"T1,2021-06-01,0.1,0.05,1,\n")
+    assert load_experiments(path)["test"].tolist() == ["T1"]
+    path.write_bytes(b"\xef\xbb\xbftest,model_a\nT1,1\n")
+    assert load_providers(path) == {"model_a": {"T1": 1}}
 
 
 def test_shipped_experiments_are_sp1_only_and_complete():

@@ -145,3 +145,41 @@ def test_the_candidate_with_the_best_log_likelihood_is_chosen_not_the_best_accur
         np.mean(np.log([0.625, 0.75, 0.625, 0.75])))
     tie = choose_ranges([("a=1:2", hedged), ("b=1:2", hedged.assign(P=[0.625, 0.75, 0.375, 0.25]))])
     assert tie["chosen"] == "a=1:2"                     # equal scores: the first given
+
+
+def test_the_long_run_gate_counts_the_runs_before_any_spec_is_built(tmp_path, capsys,
+                                                                    monkeypatch):
+    from pipeline.campaign import shake_table_members
+
+    def no_specs(*args, **kwargs):
+        raise AssertionError("run specs built before the long-run gate")
+    monkeypatch.setattr(shake_table_members, "run_specs", no_specs)
+    out = tmp_path / "out"
+    code = cli.main(["campaign", "shake-table", "--members", "1000", "--candidates",
+                     "default|mu_s=0.3:0.9", "--jobs", "1", "--out", str(out)])
+    lines = [x for x in capsys.readouterr().err.splitlines() if not x.startswith("note:")]
+    assert code == 2 and len(lines) == 1 and "add --allow-long" in lines[0], lines
+    assert not out.exists()
+
+
+def test_the_planned_runs_are_those_the_specs_hold(tmp_path):
+    """The gate's count from the options alone is the number of distinct runs (and their
+    core seconds) of the specs the members mode builds: each candidate on the calibration
+    tests, then the chosen on every test (counted at the costliest candidate)."""
+    from pipeline.campaign import shake_table_members as stm
+    from pipeline.campaign.shake_table import ShakeTableOptions
+    options = {**ShakeTableOptions().kwargs(), "members": 2, "specimen": SPECIMEN,
+               "tests": ["Test011", "Test012", "Test412"]}
+    specimen = ColumnGeometry.load(SPECIMEN).to_dict()
+    candidates = ["", "kn=4e7:5e7"]
+    calibration = ["Test011", "Test012"]
+    runs, core = stm.planned_runs(specimen, options, candidates, len(calibration), 3)
+    built = []
+    for chosen in candidates:
+        specs = [s for c in candidates for s in stm.run_specs(
+            [], tmp_path, {**options, "ranges": c, "tests": calibration})]
+        specs += stm.run_specs([], tmp_path, {**options, "ranges": chosen})
+        distinct = {s.run_id: s.tags["core_s"] for s in specs}
+        built.append((len(distinct), sum(distinct.values())))
+    assert runs == max(n for n, _ in built) == 2 * 2 * 2 + 2 * 1 + 3
+    assert core == pytest.approx(max(c for _, c in built), rel=1e-3)

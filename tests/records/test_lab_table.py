@@ -80,3 +80,31 @@ def test_malformed_tables_are_one_line_errors(tmp_path, header, rows, words):
     with pytest.raises(InputError, match=words) as info:
         read_record(path)
     assert "\n" not in str(info.value)
+
+
+def test_a_byte_order_mark_before_the_header_is_passed_over(tmp_path):
+    t, (a,) = samples()
+    plain = table(tmp_path / "plain.txt", ["# lab-table: x", "# units: g", "# axes: 90"],
+                  np.column_stack([t, a]))
+    marked = tmp_path / "marked.txt"
+    marked.write_bytes(b"\xef\xbb\xbf" + plain.read_bytes())
+    stream, info = read_record(marked)
+    assert info["format"] == "lab-table"
+    assert stream[0].data == pytest.approx(read_record(plain)[0][0].data, rel=0, abs=0)
+
+
+@pytest.mark.parametrize("units, peak, refused", [("g", 19.9, False), ("g", 59_000.0, True),
+                                                  ("m/s^2", 300.0, True)])
+def test_accelerations_beyond_a_table_s_reach_are_refused(tmp_path, units, peak, refused):
+    # 20 g: beyond any shake table or recorded earthquake (~4 g); 59,000 g is a table in
+    # other units than its header says
+    t, (a,) = samples()
+    path = table(tmp_path / "lab.txt", ["# lab-table: x", f"# units: {units}", "# axes: 90"],
+                 np.column_stack([t, a / np.abs(a).max() * peak]))
+    if not refused:
+        assert np.abs(read_record(path)[0][0].data).max() == pytest.approx(
+            peak * STANDARD_GRAVITY, rel=1e-6)
+        return
+    with pytest.raises(InputError, match="beyond the 20 g a lab table may reach") as info:
+        read_record(path)
+    assert "\n" not in str(info.value)

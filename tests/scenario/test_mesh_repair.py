@@ -380,3 +380,62 @@ def test_rolling_sets_a_tilted_box_down_as_statics_says(tmp_path, monkeypatch, t
     assert rock.height == pytest.approx(height, abs=1e-7)
     assert rock.settled_by_deg == pytest.approx(tilt_deg if height == H else 90 - tilt_deg,
                                                 abs=1e-5)
+
+
+# ---------------------------------------------------------------- what is wrong, named
+@pytest.mark.parametrize("value", [np.nan, np.inf, -np.inf])
+def test_non_finite_vertices_are_named(tmp_path, value):
+    mesh = box()
+    vertices = np.array(mesh.vertices)
+    vertices[3, 1] = value
+    path = tmp_path / "bad.obj"
+    path.write_text("".join(f"v {x:.17g} {y:.17g} {z:.17g}\n" for x, y, z in vertices)
+                    + "".join(f"f {a + 1} {b + 1} {c + 1}\n" for a, b, c in mesh.faces))
+    refused(path, r"1 vertex with NaN or infinite coordinates \(the first: vertex 4 of 8")
+
+
+@pytest.mark.parametrize("element, given", [("vertex 8", "vertex 10"), ("vertex 8", "vertex 6"),
+                                            ("face 12", "face 14"), ("face 12", "face 11")])
+def test_a_ply_whose_counts_disagree_with_its_data_is_malformed(tmp_path, element, given):
+    text = trimesh.exchange.ply.export_ply(box(), encoding="ascii").decode()
+    assert f"element {element}\n" in text
+    path = tmp_path / "box.ply"
+    path.write_text(text.replace(f"element {element}\n", f"element {given}\n"))
+    refused(path, "is malformed or truncated: its header declares .* the file holds 20 data "
+                  "lines")
+
+
+@pytest.mark.parametrize("size, shown", [(30.0000001, "30.0000001"), (0.0199999, "0.0199999"),
+                                         (45.0, "45")])
+def test_a_mesh_just_outside_the_sizes_says_its_size_in_enough_digits(tmp_path, size, shown):
+    path = export(box(extents=(size, size / 2, size / 2)), tmp_path / "box.obj")
+    refused(path, f"is {shown} m across with units m: expected 0.02-30 m")
+
+
+def test_sp1_with_unshared_jittered_corners_is_merged_and_said(tmp_path, capsys):
+    """Every face with its own corners, each coordinate moved by up to 2 um (an
+    exporter's rounding): the corners within 1e-5 of the size (7.9 um) are merged, and
+    said; the specimen is SP1's to the jitter."""
+    vertices, faces = sp1_as_written()
+    corners, triangles = split(vertices, faces)
+    corners = corners + np.random.default_rng(2).uniform(-2e-6, 2e-6, corners.shape)
+    path = tmp_path / "sp1_jittered.obj"
+    path.write_text("".join(f"v {x:.17g} {y:.17g} {z:.17g}\n" for x, y, z in corners)
+                    + "".join(f"f {a + 1} {b + 1} {c + 1}\n" for a, b, c in triangles))
+    with within(120):
+        rock, shipped = load(path, mass_kg=SP1_MASS), load(SP1, mass_kg=SP1_MASS)
+    assert rock.volume_m3 == pytest.approx(shipped.volume_m3, rel=1e-5)
+    assert rock.inertia == pytest.approx(shipped.inertia, rel=1e-4)
+    near = [r for r in rock.repairs if "of another merged (1e-05 of the mesh's size)" in r]
+    assert len(near) == 1 and "within 7.9e-06 m" in near[0]
+    assert near[0] in capsys.readouterr().err
+
+
+def test_sp1_with_corners_farther_apart_says_they_are_unshared(tmp_path):
+    vertices, faces = sp1_as_written()
+    corners, triangles = split(vertices, faces)
+    corners = corners + np.random.default_rng(3).uniform(-1e-4, 1e-4, corners.shape)
+    path = tmp_path / "sp1_apart.obj"
+    path.write_text("".join(f"v {x:.17g} {y:.17g} {z:.17g}\n" for x, y, z in corners)
+                    + "".join(f"f {a + 1} {b + 1} {c + 1}\n" for a, b, c in triangles))
+    refused(path, "its faces share few vertices, none closer than 7.9e-06 m")

@@ -86,3 +86,68 @@ def test_the_yade_block_stands_below_and_overturns_above_fig_11_within_its_toler
     k = 2 * oc.TOLERANCE_YADE
     assert not oc.overturns_yade(0.6245 * (1 - k), 1.0, tmp_path / "below")[0]
     assert oc.overturns_yade(0.6255 * (1 + k), 1.0, tmp_path / "above")[0]
+
+
+@pytest.mark.parametrize("flags, words", [
+    (["--height", "inf"], "--height must be a finite block size in [0.01, 30] m"),
+    (["--height", "1e300"], "--height must be a finite block size in [0.01, 30] m"),
+    (["--width", "1e-300"], "--width must be a finite block size in [0.005, 30] m"),
+    (["--width", "inf"], "--width must be a finite block size in [0.005, 30] m"),
+    (["--depth", "nan"], "--depth must be a finite block size"),
+    (["--height", "1", "--width", "3"], "the block is wider than tall"),
+    (["--height", "30", "--width", "0.5"], "more slender than the check takes"),
+    (["--height", "0.3", "--width", "0.01", "--period", "10"], "a quasi-static pulse"),
+    (["--damping", "5"], "--damping 5 outside the allowed range [0, 1]"),
+    (["--kn", "-1"], "--kn -1 outside the allowed range"),
+])
+def test_verify_one_cosine_names_the_range_of_a_bad_option_before_any_work(
+        tmp_path, monkeypatch, capsys, flags, words):
+    from pipeline.cli import main
+
+    def no_work(*args, **kwargs):
+        raise AssertionError("worked before its options were checked")
+    monkeypatch.setattr(oc, "min_overturning_g", no_work)
+    monkeypatch.setattr(oc, "run_block", no_work)
+    out = tmp_path / "o.json"
+    assert main(["verify", "one-cosine", *flags, "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and words in err, err
+    assert not out.exists()
+
+
+def test_verify_refuses_an_out_file_it_cannot_write_before_any_work(tmp_path, monkeypatch,
+                                                                    capsys):
+    from pipeline.cli import main
+
+    def no_work(*args, **kwargs):
+        raise AssertionError("worked before --out was checked")
+    monkeypatch.setattr(oc, "min_overturning_g", no_work)
+    (tmp_path / "file").write_text("x")
+    for out, words in ((tmp_path / "file" / "sub" / "o.json", "is a file, not a folder"),
+                       (tmp_path, "is a directory, not a file")):
+        assert main(["verify", "one-cosine", "--out", str(out)]) == 2
+        err = capsys.readouterr().err.strip()
+        assert len(err.splitlines()) == 1 and words in err, err
+
+
+@pytest.mark.parametrize("hb", [3.0, 30.0])
+def test_at_the_slowest_pulse_taken_the_threshold_in_g_does_not_depend_on_the_size(hb):
+    # a_po / g depends on alpha and omega_p / p alone (dimensional analysis): the same at
+    # the slowest pulse the check takes on a 0.1 m and a 3 m block, above the uplift
+    tan_alpha = 1 / hb
+    found = []
+    for h in (0.1, 3.0):
+        p = block_constants(h, h / hb)["p"]
+        found.append(oc.min_overturning_g(2 * math.pi / (oc.MIN_OMEGA_RATIO * p), h, h / hb))
+    assert found[0] == pytest.approx(found[1], rel=1e-4)
+    assert tan_alpha < found[0] < 1.1 * tan_alpha
+
+
+@pytest.mark.parametrize("test", [["housner"], ["sine-pulse", "--amplitude-ratio", "6.5"]])
+def test_the_other_block_checks_name_a_size_out_of_range(tmp_path, capsys, test):
+    from pipeline.cli import main
+    out = tmp_path / "o.json"
+    assert main(["verify", *test, "--height", "inf", "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err == "error: --height must be a finite block size in [0.01, 30] m, got inf"
+    assert not out.exists()

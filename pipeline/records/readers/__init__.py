@@ -23,6 +23,7 @@ import pkgutil
 from pathlib import Path
 
 from pipeline.files import InputError
+from pipeline.userfiles import read_user_bytes
 
 VERTICAL_UP, VERTICAL_DOWN = -90.0, 90.0
 HEAD_BYTES = 4096
@@ -53,7 +54,7 @@ def read_record(path, key=None):
             raise InputError(f"no record files match {path}")
         head = read_bytes(matches[0])[:HEAD_BYTES]
     else:
-        if not path.is_file():
+        if not path.exists():
             raise InputError(f"record file not found: {path}")
         head = read_bytes(path)[:HEAD_BYTES]
     for module in formats():
@@ -66,10 +67,7 @@ def read_record(path, key=None):
 def read_bytes(path):
     """The file's bytes, gunzipped when it is gzip-compressed."""
     path = Path(path)
-    try:
-        raw = path.read_bytes()
-    except OSError as exc:
-        raise InputError(f"{path.name}: cannot read ({exc.strerror or exc})") from None
+    raw = read_user_bytes(path, "record file")
     if raw[:2] == b"\x1f\x8b":
         try:
             raw = gzip.decompress(raw)

@@ -12,7 +12,7 @@ from obspy import Stream, Trace
 
 from pipeline.constants import STANDARD_GRAVITY
 from pipeline.files import InputError
-from pipeline.records.readers import VERTICAL_DOWN, VERTICAL_UP
+from pipeline.records.readers import HEAD_BYTES, VERTICAL_DOWN, VERTICAL_UP, read_bytes
 
 FORMAT = "at2"
 PRIORITY = 50
@@ -55,8 +55,7 @@ def read_at2_group(path):
 
 
 def _at2_title(path):
-    with open(path, encoding="latin-1") as handle:
-        first, second = handle.readline(), handle.readline()
+    first, second = (read_bytes(path)[:HEAD_BYTES].decode("latin-1").splitlines() + ["", ""])[:2]
     if not first.upper().startswith("PEER") or "," not in second:
         raise InputError(f"{path.name}: not a PEER AT2 file (header)")
     prefix, component = second.strip().rsplit(",", 1)
@@ -81,7 +80,7 @@ def _at2_orientation(component, path):
 def read_at2(path):
     """One PEER AT2 component as an obspy Trace in m/s^2 (stats.azimuth not set)."""
     path = Path(path)
-    lines = path.read_text(encoding="latin-1").splitlines()
+    lines = read_bytes(path).decode("latin-1").splitlines()
     if len(lines) < 5 or not lines[0].upper().startswith("PEER"):
         raise InputError(f"{path.name}: not a PEER AT2 file")
     if "UNITS OF G" not in lines[2].upper():

@@ -1,4 +1,5 @@
 """The compact FEMA P695 file ``records/fema_p695.npz`` (needs a key such as NF11)."""
+import io
 import json
 from pathlib import Path
 
@@ -7,6 +8,7 @@ from obspy import Stream, Trace
 
 from pipeline.constants import STANDARD_GRAVITY
 from pipeline.files import InputError
+from pipeline.records.readers import read_bytes
 
 FORMAT = "fema-p695"
 PRIORITY = 10
@@ -29,7 +31,7 @@ def read_fema_p695(path, key):
     orientation of each component comes from the catalogue (see records/README.md),
     so ``stats.azimuth`` is None here and the caller sets it.
     """
-    with np.load(path, allow_pickle=False) as archive:
+    with np.load(io.BytesIO(read_bytes(path)), allow_pickle=False) as archive:
         meta = json.loads(str(archive["metadata"]))["records"]
         if key not in meta:
             raise InputError(f"{Path(path).name}: no record {key!r} (known: FF01-FF22, NF01-NF28)")

@@ -13,7 +13,8 @@ The file (plain or gzip-compressed) starts with ``#`` header lines; three are re
 
 Columns are separated by blanks or commas: time (s, uniformly sampled) and the
 acceleration components in the order of ``axes``; at most MAX_SAMPLES rows and
-MAX_DURATION_S seconds (checked before the table is parsed into arrays).  Units or axes
+MAX_DURATION_S seconds (checked before the table is parsed into arrays), accelerations up
+to MAX_ACCELERATION_G; a UTF-8 byte-order mark before the first line is passed over.  Units or axes
 stated twice (two ``# units:`` lines that name units, two ``# axes:`` lines of axes; a
 ``# units:`` line describing the columns in words is a comment), or a title, station or
 event given twice, are refused (which one is meant?); so is a table whose header lacks
@@ -41,12 +42,16 @@ KEYS = ("lab-table", "units", "axes", "station", "event")   # the header lines r
 MAX_SAMPLES = 2_000_000       # rows of a table (10 min at 3.3 kHz; the SP1 tests: 800 Hz)
 MIN_SAMPLES = 100             # rows a table needs at the least
 MAX_DURATION_S = 3600.0       # seconds a table may span (a shake-table test lasts minutes)
+# the largest table acceleration read (in g): no shake table nor recorded earthquake comes
+# near (the strongest records peak at about 4 g); a table in cm/s^2 declared in g is 981 x
+MAX_ACCELERATION_G = 20.0
+BOM = b"\xef\xbb\xbf"             # a UTF-8 byte-order mark (spreadsheet exports write one)
 
 
 def detect(path, head):
     """A table that starts with ``# lab-table``, or with ``#`` lines holding a lab
     table's header (``# units:``, ``# axes:``): :func:`read` then names what is missing."""
-    text = head.lstrip().lower()
+    text = head.removeprefix(BOM).lstrip().lower()
     if text.startswith(b"# lab-table"):
         return True
     lines = text.decode("utf-8", errors="replace").splitlines()
@@ -61,7 +66,7 @@ def detect(path, head):
 
 def read(path, key=None):
     name = path.name
-    text = read_bytes(path).decode("utf-8", errors="replace")
+    text = read_bytes(path).removeprefix(BOM).decode("utf-8", errors="replace")
     lines, rows = {}, 0
     for line in text.splitlines():
         if not line.startswith("#"):
@@ -101,6 +106,11 @@ def read(path, key=None):
         raise InputError(f"{name}: {len(data)} samples, at least {MIN_SAMPLES} needed")
     if not np.all(np.isfinite(data)):
         raise InputError(f"{name}: NaN or infinite values in the table")
+    peak = float(np.abs(data[:, 1:]).max()) * UNITS[units] / STANDARD_GRAVITY
+    if peak > MAX_ACCELERATION_G:
+        raise InputError(f"{name}: table acceleration up to {peak:.4g} g, beyond the "
+                         f"{MAX_ACCELERATION_G:g} g a lab table may reach (no shake table or "
+                         "recorded earthquake comes near): check '# units:'")
     steps = np.diff(data[:, 0])
     dt = float(np.median(steps))
     if dt <= 0 or np.abs(steps - dt).max() > SAMPLING_TOLERANCE * dt:

@@ -4,12 +4,13 @@ Orientation from SEED channel codes (E/N/Z) or SAC ``cmpaz``/``cmpinc``; SAC
 headers also give station and event coordinates.  A glob pattern reads the
 single-channel files of one record together.
 """
+import io
 from pathlib import Path
 
 import obspy
 
 from pipeline.files import InputError
-from pipeline.records.readers import orientation_from_code
+from pipeline.records.readers import is_pattern, orientation_from_code, read_bytes
 
 FORMAT = "obspy"
 PRIORITY = 100
@@ -27,7 +28,7 @@ def read(path, key=None):
 def read_obspy(path):
     """MiniSEED, SAC, ... via obspy; orientation from channel codes or SAC cmpaz/cmpinc."""
     try:
-        stream = obspy.read(str(path))
+        stream = obspy.read(str(path) if is_pattern(path) else io.BytesIO(read_bytes(path)))
     except Exception as exc:  # obspy raises many types for unknown formats
         raise InputError(f"{Path(path).name}: not a readable record file ({type(exc).__name__})") \
             from None
