@@ -109,6 +109,7 @@ class SpecimenOptions:
         if not self.median_g and not self.fragility and not self.logistic:
             raise InputError("no fragility: give --median-g and --beta, --logistic or "
                              "--fragility")
+        _distinct_files(self.fragility, "--fragility", "specimen", "fragility.json")
         self._check_ratio()
         number(self.vs30, "--vs30", 150, 1500, "m/s")
         if self.pga_pgv_correlation is not None:
@@ -229,7 +230,7 @@ class SurvivalOptions(SpecimenOptions):
             number(self.age_ka, "--age-ka", 0, 10000, "ka", low_open=True)
         number(self.age_sd_ka, "--age-sd-ka", 0, 10000, "ka")
         self.check_specimens()
-        _distinct_fragilities(self.fragility)
+        _distinct_files(self.hazard, "--hazard", "curve")
         if self.observations is not None and self.column is not None:
             raise InputError("--column does not apply with --observations (each column's own "
                              "type is read from the file)")
@@ -322,20 +323,20 @@ def _per_specimen(values, n, flag):
     return list(values)
 
 
-def _distinct_fragilities(paths):
-    """Refuse the same fragility file named twice (as a file or its directory, by another
-    path or link): one specimen is not a set."""
+def _distinct_files(paths, flag, what, inside=None):
+    """Refuse one file named twice by ``flag`` (as a file or, with ``inside``, its
+    directory; by another path or a link): one ``what`` is not two."""
     seen = {}
     for path in paths:
-        file = path / "fragility.json" if path.is_dir() else path
+        file = path / inside if inside is not None and path.is_dir() else path
         try:
             stat = file.stat()
             key = (stat.st_dev, stat.st_ino)
         except OSError:
             key = file.resolve()
         if key in seen:
-            raise InputError(f"--fragility {path} and {seen[key]} are one file: the same "
-                             "specimen twice (a set needs distinct specimens)")
+            raise InputError(f"{flag} {path} and {seen[key]} are one file: the same {what} "
+                             "twice (a set needs distinct ones)")
         seen[key] = path
 
 

@@ -53,3 +53,43 @@ def test_survival_leaves_no_site_motion_of_an_earlier_run(tmp_path):
     assert main(["survival", "--observations", str(observations), "--median-g", "0.3",
                  "--beta", "0.4", "--out", str(out)]) == 0
     assert _names(out) == ["site_motion.json"]
+
+
+# ---------------------------------------------------------------- one rock twice
+def _fragility(path):
+    from tests.hazard.test_reader_robustness import COLUMN
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(json.dumps(COLUMN))
+    return path
+
+
+@pytest.mark.parametrize("as_directory", [False, True])
+def test_constrain_refuses_one_fragility_given_twice(tmp_path, capsys, as_directory):
+    fragility = _fragility(tmp_path / "campaign" / "fragility.json")
+    other = fragility.parent if as_directory else fragility
+    out = tmp_path / "out"
+    assert main(["constrain", "--logic-tree", str(CASE_11), "--fragility", str(fragility),
+                 "--fragility", str(other), "--fragility-form", "pga", "--age-ka", "2",
+                 "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "the same specimen twice" in err and len(err.splitlines()) == 1
+    assert not out.exists()
+
+
+def test_survival_refuses_one_hazard_curve_given_twice(tmp_path, capsys):
+    out = tmp_path / "out"
+    assert main(["survival", "--hazard", str(CASE_14), "--hazard", str(CASE_14), "--site",
+                 "0", "--median-g", "0.3", "--beta", "0.4", "--age-ka", "2",
+                 "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "the same curve twice" in err and len(err.splitlines()) == 1
+    assert not out.exists()
+
+
+def test_campaign_columns_refuses_one_description_given_twice(tmp_path):
+    from pipeline.campaign.definitions import columns_specs
+    from pipeline.files import InputError
+    from pipeline.scenario.geometry import EXAMPLES_DIR
+    with pytest.raises(InputError, match="the same specimen twice"):
+        columns_specs([], tmp_path, column_files=["roman-granite",
+                                                  str(EXAMPLES_DIR / "roman-granite.json")])
