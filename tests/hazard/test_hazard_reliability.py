@@ -93,3 +93,44 @@ def test_campaign_columns_refuses_one_description_given_twice(tmp_path):
     with pytest.raises(InputError, match="the same specimen twice"):
         columns_specs([], tmp_path, column_files=["roman-granite",
                                                   str(EXAMPLES_DIR / "roman-granite.json")])
+
+
+# ---------------------------------------------------------------- absurd hazard values
+@pytest.mark.parametrize("table, words", [
+    ("pga_g,annual_rate_per_yr\n0.1,1e300\n0.2,1e299\n0.5,1e298\n1.0,1e297\n",
+     "annual rate 1e+300 at 0.1 g: at most 1000 per year"),
+    ("pga_g,annual_rate_per_yr\n1e-9,1e-1\n0.2,1e-3\n", "level 1e-09 g"),
+    ("pga_m_s2,annual_rate_per_yr\n1e-7,1e-1\n2,1e-3\n", "(1e-6 g to 100 g)"),
+])
+def test_survival_refuses_absurd_curve_values_and_writes_nothing(tmp_path, capsys, table,
+                                                                  words):
+    curve = tmp_path / "curve.csv"
+    curve.write_text(table)
+    out = tmp_path / "out"
+    assert main(["survival", "--hazard", str(curve), "--median-g", "0.3", "--beta", "0.4",
+                 "--age-ka", "2", "--age-sd-ka", "1", "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert words in err and len(err.splitlines()) == 1
+    assert not out.exists()
+
+
+def test_constrain_refuses_absurd_rates_of_a_branch_and_writes_nothing(tmp_path, capsys):
+    tree = tmp_path / "tree.csv"
+    tree.write_text("branch,weight,pga_g,annual_rate_per_yr\n"
+                    "a,0.5,0.1,1e-2\na,0.5,0.5,1e-3\nb,0.5,0.1,1e300\nb,0.5,0.5,1e299\n")
+    out = tmp_path / "out"
+    assert main(["constrain", "--logic-tree", str(tree), *DOC, "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "branch 'b': annual rate 1e+300" in err and len(err.splitlines()) == 1
+    assert not out.exists()
+
+
+def test_an_openquake_curve_of_a_tiny_investigation_time_is_refused(tmp_path):
+    """poe 0.5 in 1e-6 yr is a rate of 6.9e5 per year: refused as the plain table's."""
+    from pipeline.files import InputError
+    from pipeline.hazard import load_hazard
+    curve = tmp_path / "oq.csv"
+    curve.write_text("#,,,\"kind='mean', investigation_time=1e-6, imt='PGA'\"\n"
+                     "lon,lat,poe-0.1,poe-0.2\n0.0,0.0,0.5,0.1\n")
+    with pytest.raises(InputError, match="at most 1000 per year"):
+        load_hazard(curve)
