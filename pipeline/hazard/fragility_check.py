@@ -34,6 +34,7 @@ MAX_TEXT = 10_000              # characters of a note, description or record id
 MAX_DEPTH = 32                 # the campaign's files nest about 8 deep
 MAX_PGA_G = 20.0               # as the hazard curves' levels
 MAX_RATIO_S = 10.0             # PGV/PGA (s)
+MAX_HEADINGS = 360             # directions per parameter set (campaign fragility --headings)
 TOLERANCE = 1e-9               # an estimate "inside" its interval, P = overturned / n
 
 
@@ -228,6 +229,8 @@ def _check_pulse_grid(c, section):
     pga = _axis(c, section.get("pga_g"), "pulse_grid.pga_g", MAX_PGA_G)
     ratio = _axis(c, section.get("pgv_pga_s"), "pulse_grid.pgv_pga_s", MAX_RATIO_S)
     members = c.integer(section.get("members"), "pulse_grid.members", 1, MAX_MEMBERS)
+    headings = c.integer(section.get("headings"), "pulse_grid.headings", 1, MAX_HEADINGS,
+                         optional=True)
     if members * len(pga) * len(ratio) > MAX_SET_VALUES:
         c.fail("pulse_grid", f"of {members} members x {len(pga)} x {len(ratio)} cells is "
                              f"beyond {MAX_SET_VALUES:.0e} values per set and cell")
@@ -241,7 +244,7 @@ def _check_pulse_grid(c, section):
         _counts(c, entry, where, "runs", "overturned")
         if entry.get("logistic") is not None:
             _check_logistic(c, entry["logistic"], f"{where}.logistic")
-        _check_cells(c, entry.get("cells"), f"{where}.cells", pga, ratio, members)
+        _check_cells(c, entry.get("cells"), f"{where}.cells", pga, ratio, members, headings)
     if section.get("block2d") is not None:
         block = c.obj(section["block2d"], "pulse_grid.block2d")
         for key in ("uplift_g_smallest", "uplift_g"):
@@ -264,9 +267,10 @@ def _axis(c, values, where, high):
     return {round(v, 9): k for k, v in enumerate(values)}
 
 
-def _check_cells(c, cells, where, pga, ratio, members):
+def _check_cells(c, cells, where, pga, ratio, members, headings=None):
     """The cells of one model: each on the grid once, overturned of n, P and its interval,
-    P per parameter set (``sets`` indices below ``members``)."""
+    P per parameter set (``sets`` indices below ``members``; agreeing with the cell's
+    counts, :func:`_check_set_counts`)."""
     if cells is None:
         c.fail(where, "is missing: a model holds its cells")
     seen = set()
@@ -288,6 +292,7 @@ def _check_cells(c, cells, where, pga, ratio, members):
             c.fail(f"{at}.P", f"{p:g} is not overturned / n = {k_over}/{n}")
         c.pair(cell.get("ci95"), f"{at}.ci95", 0, 1, k_over / n if n > 0 else None)
         _check_sets(c, cell, at, members)
+        _check_set_counts(c, cell, at, n, k_over, headings)
 
 
 def _check_sets(c, cell, at, members):
@@ -303,3 +308,30 @@ def _check_sets(c, cell, at, members):
         c.fail(f"{at}.sets", "names a parameter set twice")
     if p_sets is not None and len(p_sets) != len(indices):
         c.fail(f"{at}.P_per_set", f"holds {len(p_sets)} values for {len(indices)} sets")
+
+
+def _check_set_counts(c, cell, at, n, overturned, headings):
+    """``P_per_set`` against the cell's counts.  Each set listed ran at least once: at
+    most n sets, and the pooled P (overturned / n, the sets' P weighted by their runs)
+    lies between the smallest and the largest set's P (within half a run).  With ``headings`` (a set's runs
+    in a cell, at most): n at most sets x headings, and a cell where every set ran
+    every heading has overturned = headings x the sum of the sets' P."""
+    given = cell.get("P_per_set") or ()
+    values = [p for p in given if p is not None]
+    if not values:
+        return
+    where = f"{at}.P_per_set"
+    if len(values) > n:
+        c.fail(where, f"holds {len(values)} sets' P for {n} runs (n)")
+    pooled, slack = overturned / n, 0.5 / n + TOLERANCE       # within half a run
+    if not min(values) - slack <= pooled <= max(values) + slack:
+        c.fail(where, f"from {min(values):g} to {max(values):g} contradicts overturned / n "
+                      f"= {overturned}/{n}")
+    if headings is None or len(values) != len(given):
+        return
+    if n > len(given) * headings:
+        c.fail(f"{at}.n", f"{n} is more than {len(given)} sets x {headings} headings")
+    counted = sum(values) * headings
+    if n == len(given) * headings and abs(counted - overturned) > TOLERANCE * max(1, n):
+        c.fail(where, f"gives {counted:g} overturned runs ({headings} headings per set), "
+                      f"the cell {overturned}")

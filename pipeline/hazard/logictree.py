@@ -25,7 +25,8 @@ interpolated in (ln PGA, ln rate), where neither has a value.
 One-line refusals (InputError): weights negative or not numbers, weights whose sum differs
 from 1 by more than :data:`WEIGHT_TOLERANCE` (then they are divided by their sum, so that
 they sum to 1 to the last bit), curves on different levels, sites or IMTs, a branch
-without a curve, a curve without a branch, a branch twice, a curve's values as
+without a curve, a curve without a branch, a branch twice, OpenQuake curves of different
+investigation times (two calculations' curves), a curve's values as
 :func:`pipeline.hazard.curves.check_curve` refuses them (levels outside 1e-6 g to 100 g,
 rates not finite, negative, above 1e3 per year or rising with the level), more than :data:`MAX_BRANCHES` branches or :data:`MAX_LEVELS`
 levels (and each file at most ``pipeline.userfiles.MAX_FILE_BYTES``).
@@ -131,6 +132,7 @@ def _openquake(path, site):
             raise InputError(f"branch {rlz} ({branch_path}) has no PGA hazard curve in "
                              f"{path.parent} (no hazard_curve*.csv of kind rlz-{rlz:03d})")
         loaded.append(load_hazard(curves[rlz], site))
+    _one_investigation_time(loaded, [curves[r[0]].name for r in rows])
     sites = {(c.source.get("lon"), c.source.get("lat")) for c in loaded}
     if len(sites) > 1:
         raise InputError(f"{path.parent}: the curves are of different sites "
@@ -151,6 +153,18 @@ def _openquake(path, site):
     weights, more = _weights([r[2] for r in rows], path)
     return LogicTree(tuple(str(r[0]) for r in rows), tuple(r[1] for r in rows), weights,
                      levels, rates, "PGA", source, tuple(notes + more))
+
+
+def _one_investigation_time(loaded, names):
+    """InputError unless every curve states one investigation time: the realisations of
+    one calculation share it, so curves of two are two calculations' (each curve's
+    rates are annual, -ln(1 - poe) / T, but their branches are not one tree's)."""
+    times = [c.source["investigation_time_yr"] for c in loaded]
+    for name, time in zip(names, times):
+        if time != times[0]:
+            raise InputError(f"{name}: investigation_time {time:g} yr, {names[0]}: "
+                             f"{times[0]:g} yr: the realisations of one calculation share "
+                             "one investigation time (curves of two calculations mixed?)")
 
 
 def _realizations(path):

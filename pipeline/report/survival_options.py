@@ -13,6 +13,7 @@ from pipeline.constants import STANDARD_GRAVITY
 from pipeline.files import InputError, display_path
 from pipeline.hazard.components import COMPONENTS
 from pipeline.hazard.fragility import BELOW_GRID, GMM_MECHANISMS
+from pipeline.hazard.fragility_kinds import BETA_RANGE, MEDIAN_G_RANGE
 from pipeline.hazard.fragility_ratio import DEFAULT_VS30_M_S, PGA_PGV_CORRELATION
 from pipeline.scenario.parameters import check_fields, param
 from pipeline.userfiles import number
@@ -48,9 +49,11 @@ class SpecimenOptions:
         "edge's P held down to the uplift acceleration) or logistic (the fitted surface)",
         flag="--below-grid", choices=BELOW_GRID)
     median_g: tuple[float, ...] = param(
-        (), "", "a stated lognormal fragility over PGA: median PGA (g), 0-10; repeat with "
+        (), "", f"a stated lognormal fragility over PGA: median PGA (g), "
+        f"{MEDIAN_G_RANGE[0]:g}-{MEDIAN_G_RANGE[1]:g} (as a file's PGA fit); repeat with "
         "--beta for a set", flag="--median-g", metavar="G")
-    beta: tuple[float, ...] = param((), "", "its dispersion (natural log), 0.01-3",
+    beta: tuple[float, ...] = param((), "", f"its dispersion (natural log), "
+                                    f"{BETA_RANGE[0]:g}-{BETA_RANGE[1]:g}",
                                     flag="--beta", metavar="B")
     logistic: tuple[str, ...] = param(
         (), "", "a stated logistic surface logit P = b0 + b1 ln(PGA / 1 m/s^2) + b2 "
@@ -98,9 +101,9 @@ class SpecimenOptions:
     def check_specimens(self):
         """The fragility, PGV/PGA and draw options range-checked (InputError, one line)."""
         for v in self.median_g:
-            number(v, "--median-g", 0, 10, "g", low_open=True)
+            number(v, "--median-g", *MEDIAN_G_RANGE, "g")
         for v in self.beta:
-            number(v, "--beta", 0.01, 3)
+            number(v, "--beta", *BETA_RANGE)
         if len(self.median_g) != len(self.beta):
             raise InputError(f"give one --beta per --median-g ({len(self.median_g)} medians, "
                              f"{len(self.beta)} betas)")

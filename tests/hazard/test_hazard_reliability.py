@@ -134,3 +134,119 @@ def test_an_openquake_curve_of_a_tiny_investigation_time_is_refused(tmp_path):
                      "lon,lat,poe-0.1,poe-0.2\n0.0,0.0,0.5,0.1\n")
     with pytest.raises(InputError, match="at most 1000 per year"):
         load_hazard(curve)
+
+
+# ---------------------------------------------------------------- values from files
+@pytest.mark.parametrize("change, words", [
+    ({"beta": 50.0, "beta_ci95": [40.0, 60.0]}, "PGA beta 50 outside the allowed range [0.01, 3]"),
+    ({"median": 1e300, "median_ci95": [1e299, 1e301]}, "PGA median 1e+300 outside"),
+    ({"median": 1e-12, "median_ci95": [1e-13, 1e-11]}, "PGA median 1e-12 outside"),
+])
+def test_a_files_pga_fit_gets_the_command_lines_ranges(tmp_path, change, words):
+    from pipeline.files import InputError
+    from pipeline.hazard.fragility import load_campaign_fragility
+    from tests.hazard.test_reader_robustness import COLUMN
+    data = json.loads(json.dumps(COLUMN))
+    data["columns"]["monolithic"]["PGA"].update(change)
+    path = tmp_path / "fragility.json"
+    path.write_text(json.dumps(data))
+    with pytest.raises(InputError, match=words.replace("[", r"\[").replace("+", r"\+")):
+        load_campaign_fragility(path, None, "pga")
+
+
+@pytest.mark.parametrize("argv, words", [
+    (["--median-g", "1e-12", "--beta", "0.4"], "--median-g 1e-12 outside"),
+    (["--median-g", "0.3", "--beta", "50"], "--beta 50 outside"),
+])
+def test_the_command_line_refuses_what_a_file_is_refused(tmp_path, capsys, argv, words):
+    out = tmp_path / "out"
+    assert main(["survival", "--hazard", str(CASE_14), "--site", "0", *argv,
+                 "--age-ka", "2", "--out", str(out)]) == 2
+    assert words in capsys.readouterr().err and not out.exists()
+
+
+def test_a_column_without_a_pga_fit_is_said_so(tmp_path):
+    from pipeline.files import InputError
+    from pipeline.hazard.fragility import load_campaign_fragility
+    from tests.hazard.test_reader_robustness import COLUMN
+    data = json.loads(json.dumps(COLUMN))
+    del data["columns"]["monolithic"]["PGA"]
+    path = tmp_path / "fragility.json"
+    path.write_text(json.dumps(data))
+    with pytest.raises(InputError, match="column monolithic: no PGA fit in the file") as err:
+        load_campaign_fragility(path, None, "pga")
+    assert "None" not in str(err.value)
+
+
+def _grid(cells_p_per_set, overturned, n=20, headings=None):
+    from tests.hazard.test_reader_robustness import grid_document
+    data = grid_document(n=n)
+    cell = data["pulse_grid"]["models"]["monolithic"]["cells"][0]
+    cell.update(overturned=overturned, P=overturned / n, ci95=[0.0, 1.0],
+                P_per_set=cells_p_per_set)
+    if headings is not None:
+        data["pulse_grid"]["headings"] = headings
+    return data
+
+
+@pytest.mark.parametrize("data, words", [
+    (_grid([1.0, 1.0], 10), "from 1 to 1 contradicts overturned / n = 10/20"),
+    (_grid([0.0, 0.1], 10), "from 0 to 0.1 contradicts"),
+    (_grid([0.3, 0.5], 10, headings=10), "gives 8 overturned runs (10 headings per set), "
+                                         "the cell 10"),
+    (_grid([0.5, 0.5], 10, headings=5), "n 20 is more than 2 sets x 5 headings"),
+])
+def test_sets_p_that_contradict_the_cells_counts_are_refused(tmp_path, data, words):
+    from pipeline.files import InputError
+    from pipeline.hazard.fragility_file import check_fragility
+    with pytest.raises(InputError, match=r"cells\[0\]") as err:
+        check_fragility(data, "fragility.json")
+    assert words in str(err.value)
+
+
+def test_what_the_pulse_campaign_writes_agrees_with_the_counts_check():
+    """Cells of a campaign's table where some sets ran only some headings (the adaptive
+    stages): the campaign's own cell table passes the check; every set all headings
+    too."""
+    import numpy as np
+    import pandas as pd
+
+    from pipeline.campaign.pulse_summary import cell_table
+    from pipeline.hazard.fragility_check import _Checker, _check_set_counts
+    rng = np.random.default_rng(3)
+    for full in (False, True):
+        rows = [{"model": "monolithic", "pgv_pga_s": 0.1, "pga_g": a, "member": m,
+                 "heading": h, "toppled": bool(rng.random() < a)}
+                for a in (0.2, 0.5, 0.8) for m in range(4) for h in range(6)
+                if full or rng.random() < 0.6]
+        for k, cell in enumerate(cell_table(pd.DataFrame(rows), "monolithic")):
+            _check_set_counts(_Checker("fragility.json"), cell, f"cells[{k}]", cell["n"],
+                              cell["overturned"], 6)
+
+
+def test_curves_of_two_investigation_times_are_not_one_tree(tmp_path):
+    import shutil
+
+    from pipeline.files import InputError
+    from pipeline.hazard.logictree import load_logic_tree
+    tree = tmp_path / "tree"
+    shutil.copytree(CASE_11, tree)
+    curve = tree / "hazard_curve-smltp_b1_b3-gsimltp_b1.csv"
+    curve.write_text(curve.read_text().replace("investigation_time=1.0",
+                                               "investigation_time=50.0"))
+    with pytest.raises(InputError, match="investigation_time 50 yr, .*: 1 yr"):
+        load_logic_tree(tree)
+
+
+def test_a_pulse_grid_of_its_2d_block_alone_is_not_taken_for_the_rock(tmp_path):
+    from pipeline.files import InputError
+    from pipeline.hazard.fragility import load_campaign_fragility
+    from tests.hazard.test_reader_robustness import grid_document
+    data = grid_document()
+    models = data["pulse_grid"]["models"]
+    models["block2d"] = models.pop("monolithic")
+    path = tmp_path / "fragility.json"
+    path.write_text(json.dumps(data))
+    with pytest.raises(InputError, match="holds only its 2D rigid block's model"):
+        load_campaign_fragility(path)
+    assert "block2d pulse grid" in load_campaign_fragility(path, "block2d").label
