@@ -12,6 +12,7 @@ from pipeline import RESULTS_DIR
 from pipeline.constants import STANDARD_GRAVITY
 from pipeline.files import InputError, display_path
 from pipeline.hazard.components import COMPONENTS
+from pipeline.hazard.constrain import FLOOR
 from pipeline.hazard.fragility import BELOW_GRID, GMM_MECHANISMS
 from pipeline.hazard.fragility_kinds import BETA_RANGE, MEDIAN_G_RANGE
 from pipeline.hazard.fragility_ratio import DEFAULT_VS30_M_S, PGA_PGV_CORRELATION
@@ -272,13 +273,13 @@ class ConstrainOptions(SpecimenOptions):
                       "default) or eliminate (branches of survival below --floor dropped); "
                       "both are written", flag="--rule", choices=("bayes", "eliminate"))
     floor: float = param(None, "", "survival probability below which elimination drops a "
-                         "branch (0-1, above 0 and below 1); default 0.05", flag="--floor",
+                         f"branch (0-1, above 0 and below 1); default {FLOOR:g}", flag="--floor",
                          metavar="P")
     out: Path = param(None, "", f"output directory (default {display_path(CONSTRAIN_OUT)})",
                       flag="--out", metavar="DIR")
 
     def __post_init__(self):
-        self._fill(rule="bayes", floor=0.05, out=CONSTRAIN_OUT)
+        self._fill(rule="bayes", floor=FLOOR, out=CONSTRAIN_OUT)
         if self.logic_tree is None:
             raise InputError("give --logic-tree")
         self.check_specimens()
@@ -293,9 +294,7 @@ class ConstrainOptions(SpecimenOptions):
             number(a, "--age-ka", 0, 10000, "ka", low_open=True)
         for s in sds:
             number(s, "--age-sd-ka", 0, 10000, "ka")
-        number(self.floor, "--floor", 0, 1, low_open=True)
-        if self.floor >= 1:
-            raise InputError(f"--floor must be below 1, got {self.floor:g}")
+        number(self.floor, "--floor", 0, 1, low_open=True, high_open=True)
         _check_out(self.out)
 
     def ages(self):
@@ -308,6 +307,12 @@ class ConstrainOptions(SpecimenOptions):
 def _check_column_site(options):
     if options.column is not None and not options.fragility:
         raise InputError("--column applies to --fragility files")
+    if options.fragility_form is not None and not options.fragility:
+        raise InputError("--fragility-form applies to --fragility files (a stated fragility "
+                         "has its own form)")
+    if options.below_grid != "ramp" and not options.fragility:
+        raise InputError("--below-grid applies to a pulse-grid fragility (--fragility of "
+                         "campaign fragility --pulses)")
     if options.site is not None and options.site < 0:
         raise InputError(f"--site must be 0 or more, got {options.site}")
 

@@ -250,3 +250,53 @@ def test_a_pulse_grid_of_its_2d_block_alone_is_not_taken_for_the_rock(tmp_path):
     with pytest.raises(InputError, match="holds only its 2D rigid block's model"):
         load_campaign_fragility(path)
     assert "block2d pulse grid" in load_campaign_fragility(path, "block2d").label
+
+
+# ---------------------------------------------------------------- messages
+@pytest.mark.parametrize("extra, words", [
+    (["--floor", "0"], "--floor 0 outside the allowed range (0, 1)"),
+    (["--floor", "1"], "--floor 1 outside the allowed range (0, 1)"),
+    (["--age-ka", "10000.001"], "--age-ka 10000.001 outside the allowed range (0, 10000] ka"),
+    (["--fragility-form", "grid"], "--fragility-form applies to --fragility files"),
+    (["--below-grid", "zero"], "--below-grid applies to a pulse-grid fragility"),
+])
+def test_constrain_says_what_it_checks(tmp_path, capsys, extra, words):
+    out = tmp_path / "out"
+    ages = [] if "--age-ka" in extra else ["--age-ka", "2"]
+    assert main(["constrain", "--logic-tree", str(CASE_11), "--median-g", "0.3", "--beta",
+                 "0.4", *ages, *extra, "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert words in err and len(err.splitlines()) == 1
+    assert not out.exists()
+
+
+def test_survival_refuses_a_fragility_form_without_a_fragility_file(tmp_path, capsys):
+    out = tmp_path / "out"
+    assert main(["survival", "--hazard", str(CASE_14), "--site", "0", "--median-g", "0.3",
+                 "--beta", "0.4", "--age-ka", "2", "--fragility-form", "grid",
+                 "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "--fragility-form applies to --fragility files" in err
+    assert len(err.splitlines()) == 1 and not out.exists()
+
+
+def test_a_weight_0_branch_that_survives_is_named_not_called_below_the_floor(tmp_path,
+                                                                              capsys):
+    """Branches a and b (weights 0.5) give the specimen a survival far below 0.05, z
+    (weight 0, rates a million times lower) far above: elimination leaves no weight, and
+    the warning says it is z's weight, not that every branch lies below the floor."""
+    tree = tmp_path / "tree.csv"
+    tree.write_text("branch,weight,pga_g,annual_rate_per_yr\n"
+                    "a,0.5,0.1,1e-1\na,0.5,1.0,1e-2\nb,0.5,0.1,2e-1\nb,0.5,1.0,2e-2\n"
+                    "z,0,0.1,1e-7\nz,0,1.0,1e-8\n")
+    out = tmp_path / "out"
+    assert main(["constrain", "--logic-tree", str(tree), "--median-g", "0.3", "--beta", "0.4",
+                 "--age-ka", "2", "--rule", "eliminate", "--draws", "0",
+                 "--out", str(out)]) == 0
+    summary = json.loads((out / "constrain.json").read_text())
+    p = {b["branch"]: b["survival_probability"] for b in summary["branches"]}
+    assert p["a"] < 0.05 and p["b"] < 0.05 < p["z"]
+    said = [w for w in summary["warnings"] if "elimination" in w]
+    assert said == ["only branches of weight 0 (z) give a survival probability of at least "
+                    "0.05: elimination leaves no weight on any branch, no constrained curve "
+                    "under that rule"]
