@@ -33,7 +33,9 @@ MAX_RECORDS = 10_000
 MAX_TEXT = 10_000              # characters of a note, description or record id
 MAX_DEPTH = 32                 # the campaign's files nest about 8 deep
 MAX_PGA_G = 20.0               # as the hazard curves' levels
+MIN_PGA_G = 1e-6               # the lowest PGA a grid may hold (g), as a hazard curve
 MAX_RATIO_S = 10.0             # PGV/PGA (s)
+MIN_RATIO_S = 0.001            # the lowest, as --pgv-pga-median
 MAX_HEADINGS = 360             # directions per parameter set (campaign fragility --headings)
 TOLERANCE = 1e-9               # an estimate "inside" its interval, P = overturned / n
 
@@ -226,8 +228,9 @@ def _check_cov(c, cov, where):
 
 def _check_pulse_grid(c, section):
     c.obj(section, "pulse_grid")
-    pga = _axis(c, section.get("pga_g"), "pulse_grid.pga_g", MAX_PGA_G)
-    ratio = _axis(c, section.get("pgv_pga_s"), "pulse_grid.pgv_pga_s", MAX_RATIO_S)
+    pga = _axis(c, section.get("pga_g"), "pulse_grid.pga_g", MIN_PGA_G, MAX_PGA_G)
+    ratio = _axis(c, section.get("pgv_pga_s"), "pulse_grid.pgv_pga_s", MIN_RATIO_S,
+                  MAX_RATIO_S)
     members = c.integer(section.get("members"), "pulse_grid.members", 1, MAX_MEMBERS)
     headings = c.integer(section.get("headings"), "pulse_grid.headings", 1, MAX_HEADINGS,
                          optional=True)
@@ -253,12 +256,12 @@ def _check_pulse_grid(c, section):
               True, True)
 
 
-def _axis(c, values, where, high):
-    """An axis of the grid: 1 to MAX_AXIS increasing positive numbers, distinct to 9
-    digits (the cells are found by them)."""
+def _axis(c, values, where, low, high):
+    """An axis of the grid: 1 to MAX_AXIS increasing numbers from ``low`` to ``high``,
+    distinct to 9 digits (the cells are found by them)."""
     if values is None:
         c.fail(where, "is missing: the grid's axes are pga_g and pgv_pga_s")
-    values = [c.num(v, where, 0, high, True) for v in c.lst(values, where, MAX_AXIS)]
+    values = [c.num(v, where, low, high) for v in c.lst(values, where, MAX_AXIS)]
     if not values:
         c.fail(where, "is empty")
     for a, b in zip(values, values[1:]):

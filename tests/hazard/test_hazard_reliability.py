@@ -300,3 +300,23 @@ def test_a_weight_0_branch_that_survives_is_named_not_called_below_the_floor(tmp
     assert said == ["only branches of weight 0 (z) give a survival probability of at least "
                     "0.05: elimination leaves no weight on any branch, no constrained curve "
                     "under that rule"]
+
+
+@pytest.mark.parametrize("axis, values, words", [
+    ("pga_g", [1e-12, 0.2, 0.4], "pulse_grid.pga_g 1e-12 outside the allowed range [1e-06, 20]"),
+    ("pgv_pga_s", [1e-9, 0.2], "pulse_grid.pgv_pga_s 1e-09 outside the allowed range "
+                               "[0.001, 10]"),
+])
+def test_a_pulse_grids_axes_take_the_hazard_inputs_lower_bounds(axis, values, words):
+    from pipeline.files import InputError
+    from pipeline.hazard.fragility_file import check_fragility
+    from tests.hazard.test_reader_robustness import grid_document
+    data = grid_document()
+    old = data["pulse_grid"][axis]
+    data["pulse_grid"][axis] = values
+    for model in data["pulse_grid"]["models"].values():
+        for cell in model["cells"]:
+            cell[axis] = values[old.index(cell[axis])]
+    with pytest.raises(InputError) as err:
+        check_fragility(data, "fragility.json")
+    assert words in str(err.value)
