@@ -70,6 +70,33 @@ def json_text(obj) -> str:
     return json.dumps(obj, indent=2, allow_nan=False, default=_json_default) + "\n"
 
 
+def result_json_text(obj, name: str) -> str:
+    """:func:`json_text` of a command's result ``name`` (e.g. constrain.json), made before
+    any file of it is written: a NaN or an infinity in it is a ToolError naming its key
+    (one line, nothing written), not a traceback after some files."""
+    try:
+        return json_text(obj)
+    except ValueError:
+        where = _non_finite(obj)
+        if where is None:
+            raise
+        raise ToolError(f"{name}: {where} is not a finite number; nothing written (please "
+                        "report this with the command that gave it)") from None
+
+
+def _non_finite(obj, path="") -> str | None:
+    """The key path of the first NaN or infinity in ``obj``, or None."""
+    if isinstance(obj, dict):
+        items = ((f"{path}.{k}" if path else str(k), v) for k, v in obj.items())
+    elif isinstance(obj, (list, tuple, np.ndarray)):
+        items = ((f"{path}[{k}]", v) for k, v in enumerate(obj))
+    else:
+        is_number = isinstance(obj, (float, np.floating))
+        return (path or "the value") if is_number and not math.isfinite(obj) else None
+    return next((found for key, value in items
+                 if (found := _non_finite(value, key)) is not None), None)
+
+
 def write_json(path, obj):
     write_text(path, json_text(obj))
 

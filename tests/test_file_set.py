@@ -66,3 +66,17 @@ def test_a_stop_during_the_swap_comes_after_the_set_is_whole(tmp_path, monkeypat
                 (stage / name).write_text("new")
     assert seen[-1] == list(NAMES) and len(seen) == len(NAMES)
     assert all((tmp_path / n).read_text() == "new" for n in NAMES)
+
+
+def test_a_result_that_json_cannot_hold_is_one_line_naming_its_key():
+    import math
+
+    import numpy as np
+
+    from pipeline.files import ToolError, result_json_text
+    assert result_json_text({"a": [1.0, 2]}, "x.json").startswith("{")
+    with pytest.raises(ToolError, match=r"^x.json: branches\[1\].p is not a finite number; "
+                                        "nothing written"):
+        result_json_text({"branches": [{"p": 0.5}, {"p": math.nan}]}, "x.json")
+    with pytest.raises(ToolError, match=r"^x.json: rates\[2\] is not"):
+        result_json_text({"rates": np.array([1.0, 2.0, np.inf])}, "x.json")

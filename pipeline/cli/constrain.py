@@ -13,7 +13,7 @@ from pathlib import Path
 
 from pipeline.cli._fields import add_arguments, from_args
 from pipeline.constants import STANDARD_GRAVITY
-from pipeline.files import display_path, file_set, json_text, write_text
+from pipeline.files import display_path, file_set, result_json_text, write_text
 from pipeline.report.survival_options import ConstrainOptions
 
 NAME = "constrain"
@@ -62,7 +62,7 @@ def run(args):
         files["constrained_curves.csv"] = _curve_table(summary, summary["posterior"],
                                                        f"constrained ({o.rule})")
     summary["files"] = [*files, "constrain.json", "constrain.png"]
-    files["constrain.json"] = json_text(summary)          # whole before any file is written
+    files["constrain.json"] = result_json_text(summary, "constrain.json")   # before any file
     from pipeline.figures.constrain import plot_constrain
     out = o.out
     with file_set(out, FILES, ("constrain.json",)) as stage:

@@ -2,7 +2,7 @@
 hazard curves written as ``survival.json`` and ``survival.png``, and the PGA range a
 site's standing and fallen columns allow as ``site_motion.json`` (docs/survival.md).
 The command reads and checks its options and the input files; this writes the results."""
-from pipeline.files import InputError, file_set, json_text, write_text
+from pipeline.files import InputError, file_set, result_json_text, write_text
 
 FILES = ("survival.json", "survival.png", "site_motion.json")   # every file survival writes
 SUMMARIES = ("survival.json", "site_motion.json")           # what says what the set holds
@@ -29,7 +29,7 @@ def site_motion_result(observations_path, site_name, fragility_for, at_pgv_pga, 
 def write_site_motion(out, result):
     """Write ``result`` as ``out``/site_motion.json (atomically; an earlier run's
     survival.json and survival.png removed: they are not of this run)."""
-    text = json_text(result)
+    text = result_json_text(result, "site_motion.json")
     with file_set(out, FILES, SUMMARIES) as stage:
         write_text(stage / "site_motion.json", text)
 
@@ -47,9 +47,9 @@ def survival_files(out, curves, specimens, ratio, age_ka, age_sd_ka, draws, seed
     summary["figure"] = "survival.png"
     if site_motion is not None:
         summary["site_motion"] = site_motion
-    texts = {"survival.json": json_text(summary)}       # whole before any file is written
+    texts = {"survival.json": result_json_text(summary, "survival.json")}   # before any file
     if site_motion is not None:
-        texts["site_motion.json"] = json_text(site_motion)
+        texts["site_motion.json"] = result_json_text(site_motion, "site_motion.json")
     with file_set(out, FILES, SUMMARIES) as stage:
         plot_survival(data, stage / "survival.png")
         for name, text in texts.items():
