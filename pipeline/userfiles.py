@@ -130,7 +130,7 @@ def number(value, what, low=None, high=None, unit="", low_open=False, high_open=
         raise InputError(f"{what} {show(value)} is beyond a float's range") from None
 
 
-def _beside(value, *bounds):
+def _beside(value: float, *bounds: float | None) -> str:
     """``value`` as :func:`number_text` gives it, or in all its digits where that reads
     as a bound it is not (10000.001 beside 10000)."""
     text = number_text(value)

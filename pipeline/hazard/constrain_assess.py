@@ -10,6 +10,7 @@ from pipeline.hazard.constrain import (FLOOR, FRACTILES, TARGET_RATES, bayes, br
                                        motion_at_rate, truncated_ages, weighted_mean,
                                        weighted_quantile)
 from pipeline.hazard.fragility import overturn_probability
+from pipeline.hazard.logictree import LogicTree
 from pipeline.hazard.survival import survival_probability
 from pipeline.provenance import software_versions
 
@@ -142,7 +143,7 @@ def _log_survival(tree, cells, batch, ratio_model, ages, sds, mode, samples):
     return log_survival_sampled(set_rates, samples)
 
 
-def _none_left(rule, floor, tree, p):
+def _none_left(rule: str, floor: float, tree: LogicTree, p: np.ndarray) -> str:
     """Why ``rule`` leaves no branch: every branch's survival probability ``p`` is 0
     (bayes) or below ``floor`` (eliminate), or only branches of weight 0 have more."""
     needed = p > 0 if rule == "bayes" else p >= floor

@@ -303,7 +303,8 @@ def _float(text, what):
         raise InputError(f"{what}: not a number: {show(text.strip())}") from None
 
 
-def check_curve(levels, rates, to_m_s2, unit, where, from_poe=False):
+def check_curve(levels: np.ndarray, rates: np.ndarray, to_m_s2: float, unit: str,
+                where: str, from_poe: bool = False) -> None:
     """The one check of a hazard curve's values, as a file gives them (``levels`` in the
     file's ``unit``, ``to_m_s2`` to m/s^2; ``rates`` 1/yr): at least 2 levels, each from
     MIN_PGA_M_S2 to MAX_PGA_M_S2 and increasing; each rate a number from 0 to

@@ -313,7 +313,8 @@ def _check_sets(c, cell, at, members):
         c.fail(f"{at}.P_per_set", f"holds {len(p_sets)} values for {len(indices)} sets")
 
 
-def _check_set_counts(c, cell, at, n, overturned, headings):
+def _check_set_counts(c: "_Checker", cell: dict, at: str, n: int, overturned: int,
+                      headings: int | None) -> None:
     """``P_per_set`` against the cell's counts.  Each set listed ran at least once: at
     most n sets, and the pooled P (overturned / n, the sets' P weighted by their runs)
     lies between the smallest and the largest set's P (within half a run).  With ``headings`` (a set's runs

@@ -11,7 +11,7 @@ import pandas as pd
 from pipeline.constants import STANDARD_GRAVITY
 from pipeline.files import InputError
 from pipeline.hazard.components import on_hazard_measure
-from pipeline.hazard.fragility_file import MAX_MEMBERS, read_fragility_file
+from pipeline.hazard.fragility_file import MAX_MEMBERS, FragilityFile, read_fragility_file
 from pipeline.hazard.fragility_grid import BELOW_GRID, PulseGrid
 from pipeline.hazard.fragility_kinds import BETA_RANGE, MEDIAN_G_RANGE, Logistic, Lognormal
 from pipeline.stats.fragility import fragility_fit, logistic_surface
@@ -136,7 +136,7 @@ def member_fits(runs_path, column, form, block=None):
     return (tuple(fits) or None), note
 
 
-def _lognormal_outside(median_m_s2, beta):
+def _lognormal_outside(median_m_s2: float, beta: float) -> str | None:
     """What of a fitted lognormal lies outside the ranges a stated one takes (text), or
     None."""
     low, high = MEDIAN_G_RANGE
@@ -224,7 +224,7 @@ def load_pulse_grid(file, model=None, form="grid", below="ramp"):
                      logistic, label, note, uplift, below)
 
 
-def _specimen_model(file):
+def _specimen_model(file: FragilityFile) -> str:
     """The name of a pulse grid's specimen model (monolithic, or the first that is not
     its 2D block); InputError when it holds only the 2D block's: the rigid block of the
     specimen's critical angle is not the rock."""

@@ -155,7 +155,7 @@ def _openquake(path, site):
                      levels, rates, "PGA", source, tuple(notes + more))
 
 
-def _one_investigation_time(loaded, names):
+def _one_investigation_time(loaded: list, names: list[str]) -> None:
     """InputError unless every curve states one investigation time: the realisations of
     one calculation share it, so curves of two are two calculations' (each curve's
     rates are annual, -ln(1 - poe) / T, but their branches are not one tree's)."""

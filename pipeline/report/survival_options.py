@@ -331,7 +331,8 @@ def _per_specimen(values, n, flag):
     return list(values)
 
 
-def _distinct_files(paths, flag, what, inside=None):
+def _distinct_files(paths: tuple[Path, ...], flag: str, what: str,
+                   inside: str | None = None) -> None:
     """Refuse one file named twice by ``flag`` (as a file or, with ``inside``, its
     directory; by another path or a link): one ``what`` is not two."""
     seen = {}

@@ -6,6 +6,7 @@ import re
 from pathlib import Path
 
 from pipeline.files import InputError
+from pipeline.scenario.parameters import Contact
 from pipeline.userfiles import keys_text, number, read_json
 
 CONTACT_KEYS = ("kn", "damping", "mu_s", "mu_k")
@@ -45,12 +46,11 @@ def contact_values(path):
     return values
 
 
-def checked_contact(values, path, **flags):
+def checked_contact(values: dict[str, float], path: Path, **flags: float) -> Contact:
     """The :class:`~pipeline.scenario.parameters.Contact` of a contact file's ``values``
     and the command line's ``flags`` (the other contact fields); a value out of range is
     one InputError naming the file and its key when the file gave it, the flag when the
     command line did."""
-    from pipeline.scenario.parameters import Contact
     try:
         return Contact(**flags, **values)
     except InputError as exc:        # the range check names the option: name the file's key
