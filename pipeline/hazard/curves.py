@@ -25,9 +25,9 @@ investigation time, an IMT other than PGA, an unknown unit, unreadable numbers, 
 another type in the USGS JSON (metadata, imt, edition, vs30, coordinates), JSON nested too
 deep, levels not in [1e-6 g, 100 g] or more than 1000 of them, negative rates or
 probabilities, an infinite or NaN rate (OpenQuake's poe of 1 aside, below), a rate above
-1e3 per year (:func:`check_curve`: the one check of a curve's values, the logic tree's
-too), levels not increasing, rates
-rising with the level (non-monotonic), fewer than two levels with a positive rate.  Said in ``notes``, never silent: levels dropped
+1e3 per year, levels not increasing, rates rising with the level (non-monotonic)
+(:func:`check_curve`: the one check of a curve's values, the logic tree's too), fewer
+than two levels with a positive rate.  Said in ``notes``, never silent: levels dropped
 because their poe is 1 (an unbounded rate) and the rates of 0 at the top (the curve ends
 at the last positive rate; the first level of rate 0 is kept as ``zero_rate_from_m_s2``).
 """

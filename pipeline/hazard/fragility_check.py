@@ -20,7 +20,9 @@ import math
 
 import numpy as np
 
+from pipeline.constants import STANDARD_GRAVITY
 from pipeline.files import InputError
+from pipeline.hazard.curves import MIN_PGA_M_S2
 from pipeline.userfiles import nesting, number, show
 
 MAX_MEMBERS = 10_000           # parameter sets of a campaign
@@ -33,7 +35,7 @@ MAX_RECORDS = 10_000
 MAX_TEXT = 10_000              # characters of a note, description or record id
 MAX_DEPTH = 32                 # the campaign's files nest about 8 deep
 MAX_PGA_G = 20.0               # as the hazard curves' levels
-MIN_PGA_G = 1e-6               # the lowest PGA a grid may hold (g), as a hazard curve
+MIN_PGA_G = MIN_PGA_M_S2 / STANDARD_GRAVITY   # the lowest PGA a grid may hold (g), a curve's
 MAX_RATIO_S = 10.0             # PGV/PGA (s)
 MIN_RATIO_S = 0.001            # the lowest, as --pgv-pga-median
 MAX_HEADINGS = 360             # directions per parameter set (campaign fragility --headings)
@@ -317,9 +319,10 @@ def _check_set_counts(c: "_Checker", cell: dict, at: str, n: int, overturned: in
                       headings: int | None) -> None:
     """``P_per_set`` against the cell's counts.  Each set listed ran at least once: at
     most n sets, and the pooled P (overturned / n, the sets' P weighted by their runs)
-    lies between the smallest and the largest set's P (within half a run).  With ``headings`` (a set's runs
-    in a cell, at most): n at most sets x headings, and a cell where every set ran
-    every heading has overturned = headings x the sum of the sets' P."""
+    lies between the smallest and the largest set's P (within half a run).  With
+    ``headings`` (a set's runs in a cell, at most): n at most sets x headings, and a
+    cell where every set ran every heading has overturned = headings x the sum of the
+    sets' P."""
     given = cell.get("P_per_set") or ()
     values = [p for p in given if p is not None]
     if not values:

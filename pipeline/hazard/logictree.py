@@ -28,8 +28,9 @@ they sum to 1 to the last bit), curves on different levels, sites or IMTs, a bra
 without a curve, a curve without a branch, a branch twice, OpenQuake curves of different
 investigation times (two calculations' curves), a curve's values as
 :func:`pipeline.hazard.curves.check_curve` refuses them (levels outside 1e-6 g to 100 g,
-rates not finite, negative, above 1e3 per year or rising with the level), more than :data:`MAX_BRANCHES` branches or :data:`MAX_LEVELS`
-levels (and each file at most ``pipeline.userfiles.MAX_FILE_BYTES``).
+rates not finite, negative, above 1e3 per year or rising with the level), more than
+:data:`MAX_BRANCHES` branches or :data:`MAX_LEVELS` levels (and each file at most
+``pipeline.userfiles.MAX_FILE_BYTES``).
 """
 import csv
 import math
