@@ -320,3 +320,29 @@ def test_a_pulse_grids_axes_take_the_hazard_inputs_lower_bounds(axis, values, wo
     with pytest.raises(InputError) as err:
         check_fragility(data, "fragility.json")
     assert words in str(err.value)
+
+
+def test_survival_says_when_its_curves_state_different_investigation_times(tmp_path):
+    """One curve written for 1 yr and for 50 yr (poe = 1 - exp(-50 rate)): the annual
+    rates are the same, so is the survival under each, and the warning says the times
+    differ and how each was converted."""
+    import math
+    levels = [0.05, 0.1, 0.2, 0.4, 0.8]
+    rates = [2e-2, 6e-3, 1.5e-3, 3e-4, 4e-5]
+    paths = []
+    for years in (1.0, 50.0):
+        poe = [-math.expm1(-r * years) for r in rates]
+        path = tmp_path / f"curve_{years:g}.csv"
+        path.write_text(f"#,,\"kind='mean', investigation_time={years}, imt='PGA'\"\n"
+                        "lon,lat," + ",".join(f"poe-{x}" for x in levels) + "\n"
+                        "0.0,0.0," + ",".join(f"{p!r}" for p in poe) + "\n")
+        paths += ["--hazard", str(path)]
+    out = tmp_path / "out"
+    assert main(["survival", *paths, "--median-g", "0.3", "--beta", "0.4", "--age-ka", "2",
+                 "--draws", "0", "--out", str(out)]) == 0
+    summary = json.loads((out / "survival.json").read_text())
+    rows = summary["hazard_curves"]
+    assert [r["investigation_time_yr"] for r in rows] == [1.0, 50.0]
+    assert rows[0]["survival_probability"] == pytest.approx(rows[1]["survival_probability"],
+                                                            rel=1e-9)
+    assert any("investigation times of 1, 50 yr" in w for w in summary["warnings"])
