@@ -11,9 +11,12 @@ import json
 import logging
 import math
 import os
+import shutil
 import signal
 import tempfile
-from contextlib import contextmanager
+import threading
+from collections.abc import Collection, Iterator, Sequence
+from contextlib import contextmanager, suppress
 from pathlib import Path
 
 import numpy as np
@@ -61,8 +64,41 @@ def write_text(path, text):
         tmp.write_text(text)
 
 
+def json_text(obj) -> str:
+    """``obj`` as the JSON text result files hold (indented; ValueError for a NaN or an
+    infinity, which JSON cannot hold: serialised before any file of a set is written)."""
+    return json.dumps(obj, indent=2, allow_nan=False, default=_json_default) + "\n"
+
+
+def result_json_text(obj, name: str) -> str:
+    """:func:`json_text` of a command's result ``name`` (e.g. constrain.json), made before
+    any file of it is written: a NaN or an infinity in it is a ToolError naming its key
+    (one line, nothing written), not a traceback after some files."""
+    try:
+        return json_text(obj)
+    except ValueError:
+        where = _non_finite(obj)
+        if where is None:
+            raise
+        raise ToolError(f"{name}: {where} is not a finite number; nothing written (please "
+                        "report this with the command that gave it)") from None
+
+
+def _non_finite(obj, path="") -> str | None:
+    """The key path of the first NaN or infinity in ``obj``, or None."""
+    if isinstance(obj, dict):
+        items = ((f"{path}.{k}" if path else str(k), v) for k, v in obj.items())
+    elif isinstance(obj, (list, tuple, np.ndarray)):
+        items = ((f"{path}[{k}]", v) for k, v in enumerate(obj))
+    else:
+        is_number = isinstance(obj, (float, np.floating))
+        return (path or "the value") if is_number and not math.isfinite(obj) else None
+    return next((found for key, value in items
+                 if (found := _non_finite(value, key)) is not None), None)
+
+
 def write_json(path, obj):
-    write_text(path, json.dumps(obj, indent=2, allow_nan=False, default=_json_default) + "\n")
+    write_text(path, json_text(obj))
 
 
 def write_npz(path, **arrays):
@@ -82,6 +118,66 @@ def save_figure(fig, path, **kwargs):
     path = Path(path)
     with atomic_path(path) as tmp:
         fig.savefig(tmp, format=path.suffix.lstrip("."), **kwargs)
+
+
+@contextmanager
+def file_set(directory: Path, names: Collection[str],
+             summaries: Sequence[str]) -> Iterator[Path]:
+    """Yield an empty staging directory inside ``directory`` in which a command writes
+    its set of result files (each named in ``names``, every file name the command
+    writes); when the block ends without an exception the set replaces the command's
+    files in ``directory``: those of ``names`` the set does not hold are removed (no
+    earlier result is left beside the new one), the others replaced, and the
+    ``summaries`` (the files that say what the set is) removed first and renamed in
+    last, with Ctrl-C and SIGTERM held until that is done: a reader who finds a summary
+    finds the whole set it names.  Files of other names are left alone.  An exception
+    in the block leaves ``directory`` as it was (removed when the block made it and it
+    is empty)."""
+    directory = Path(directory)
+    made = not directory.exists()
+    directory.mkdir(parents=True, exist_ok=True)
+    stage = Path(tempfile.mkdtemp(prefix=".staging.", suffix=".tmp", dir=directory))
+    try:
+        yield stage
+        written = {p.name for p in stage.iterdir()}
+        if not written <= set(names):
+            raise ValueError(f"files outside the set {sorted(names)}: "
+                             f"{sorted(written - set(names))}")
+        last = [n for n in summaries if n in names]
+        with _signals_held():
+            for name in [*last, *(n for n in names if n not in last)]:
+                if name not in written:
+                    (directory / name).unlink(missing_ok=True)
+            for name in [*(n for n in names if n not in last), *last]:
+                if name in written:
+                    os.replace(stage / name, directory / name)
+    except BaseException:
+        shutil.rmtree(stage, ignore_errors=True)
+        if made:
+            with suppress(OSError):
+                directory.rmdir()
+        raise
+    shutil.rmtree(stage, ignore_errors=True)
+
+
+@contextmanager
+def _signals_held() -> Iterator[None]:
+    """Hold Ctrl-C and SIGTERM for the block (in the main thread; elsewhere nothing to
+    hold): a signal that comes meanwhile is raised again after it, to the handler that
+    was in place."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    pending: list[int] = []
+    held = (signal.SIGINT, signal.SIGTERM)
+    before = {s: signal.signal(s, lambda signum, frame: pending.append(signum)) for s in held}
+    try:
+        yield
+    finally:
+        for signum, handler in before.items():
+            signal.signal(signum, handler)
+        for signum in pending[:1]:
+            signal.raise_signal(signum)
 
 
 def read_run_json(path, what):

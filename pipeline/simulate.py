@@ -140,7 +140,8 @@ def simulate(motion, out_dir, run=None, back_azimuth=None, record=None, motion_f
                           t_max=None if signal_end is None else signal_end + numerics.tail_s)
     params = dataclasses.replace(params, signal_end_s=signal_end)
     out_dir = Path(out_dir)
-    (out_dir / "summary.json").unlink(missing_ok=True)
+    for name in ("summary.json", "trajectory.npz", "yade.log"):   # none of an earlier run
+        (out_dir / name).unlink(missing_ok=True)
     started = time.perf_counter()
     window_s = quiet_window(drive, params.columns, contact, numerics.quiet_lead_s)
     if window_s is not None and numerics.quiet_motion == "skip":

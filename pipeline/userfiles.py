@@ -144,23 +144,34 @@ def show(value, most=80):
     return text if len(text) <= most else text[:most - 3] + "..."
 
 
-def number(value, what, low=None, high=None, unit="", low_open=False):
+def number(value, what, low=None, high=None, unit="", low_open=False, high_open=False):
     """``value`` read from a file as a float: InputError (one line naming ``what``) unless
     it is a finite JSON/YAML number (not a bool) within [low, high] (``low_open``: above
-    low), ``unit`` for the message.  Compared exactly, also for integers beyond a float."""
+    low; ``high_open``: below high), ``unit`` for the message.  Compared exactly, also for
+    integers beyond a float."""
     if isinstance(value, bool) or not isinstance(value, (int, float)) or \
             (isinstance(value, float) and not math.isfinite(value)):
         raise InputError(f"{what} must be a finite number, got {show(value)}")
     if (low is not None and (value <= low if low_open else value < low)) or \
-            (high is not None and value > high):
+            (high is not None and (value >= high if high_open else value > high)):
         bounds = f"{'(' if low_open else '['}{'-inf' if low is None else f'{low:g}'}, " \
-                 f"{'inf' if high is None else f'{high:g}'}]"
-        raise InputError(f"{what} {number_text(value)} outside the allowed range {bounds} {unit}"
-                         .rstrip())
+                 f"{'inf' if high is None else f'{high:g}'}{')' if high_open else ']'}"
+        raise InputError(f"{what} {_beside(value, low, high)} outside the allowed range "
+                         f"{bounds} {unit}".rstrip())
     try:
         return float(value)
     except OverflowError:                        # an integer beyond any float, no bound
         raise InputError(f"{what} {show(value)} is beyond a float's range") from None
+
+
+def _beside(value: float, *bounds: float | None) -> str:
+    """``value`` as :func:`number_text` gives it, or in all its digits where that reads
+    as a bound it is not (10000.001 beside 10000)."""
+    text = number_text(value)
+    for bound in bounds:
+        if bound is not None and text == f"{bound:g}" and value != bound:
+            return repr(float(value))
+    return text
 
 
 def number_text(value):

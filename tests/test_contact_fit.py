@@ -143,7 +143,7 @@ def test_contact_file_values_are_range_checked_and_not_doubled(tmp_path, capsys)
     contact.write_text('{"kn": 1e3, "damping": 0.1}')
     assert cli.main(["run", "--record", "GM20", "--contact-file", str(contact),
                      "--out", str(tmp_path / "a")]) == 2
-    assert "--kn 1000 outside" in capsys.readouterr().err
+    assert "--contact-file contact.json: 'kn' 1000 outside" in capsys.readouterr().err
     contact.write_text('{"kn": 1.2e8, "damping": 0.1}')
     assert cli.main(["run", "--record", "GM20", "--contact-file", str(contact), "--damping",
                      "0.2", "--out", str(tmp_path / "b")]) == 2

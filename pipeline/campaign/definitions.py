@@ -178,6 +178,11 @@ def columns_specs(records, campaign_dir, column_files=None, column="both",
     file's values (its kn too) go over them."""
     names = list(column_files) if column_files else example_names()
     geometries = [ColumnGeometry.load(name) for name in names]
+    described = [g.to_dict() for g in geometries]
+    for k, data in enumerate(described):
+        if data in described[:k]:
+            raise InputError(f"--column-file {names[described.index(data)]} and {names[k]} "
+                             "describe one column: the same specimen twice")
     if column not in COLUMN_KINDS:
         raise InputError(f"--column must be both, monolithic or drums, got {column!r}")
     check_stiffness(stiffness)

@@ -15,10 +15,10 @@ from pipeline.campaign.run_dirs import finished_summary
 from pipeline.campaign.pulse_check import experiments_check
 from pipeline.files import json_safe, write_csv
 from pipeline.hazard.fragility_file import FragilityFile, write_fragility_file
+from pipeline.hazard.fragility_load import BLOCK_MODEL
 from pipeline.simulate import run_code_version
 
 log = logging.getLogger(__name__)
-BLOCK_MODEL = "block2d"
 
 
 def pulse_table(specs, campaign_dir):

@@ -13,11 +13,13 @@ from pathlib import Path
 
 from pipeline.cli._fields import add_arguments, from_args
 from pipeline.constants import STANDARD_GRAVITY
-from pipeline.files import display_path, write_json, write_text
+from pipeline.files import display_path, file_set, result_json_text, write_text
 from pipeline.report.survival_options import ConstrainOptions
 
 NAME = "constrain"
 ORDER = 46
+FILES = ("branch_weights.csv", "prior_curves.csv", "constrained_curves.csv", "constrain.json",
+         "constrain.png")                # every file constrain writes (a run replaces them)
 HELP = "a hazard model's logic tree reweighted by the specimens still standing at its site"
 DESCRIPTION = (
     "Reads a logic tree (OpenQuake's realizations.csv with one hazard curve per realisation, "
@@ -54,19 +56,19 @@ def run(args):
     summary, rows, figure = constrain_tree(tree, specimens, ratio, ages, sds, o.rule,
                                            o.floor, o.draws, o.seed)
     summary["hazard_component"] = o.hazard_component
-    summary["files"] = ["branch_weights.csv", "prior_curves.csv", "constrained_curves.csv",
-                        "constrain.json", "constrain.png"]
+    files = {"branch_weights.csv": _branch_table(rows),
+             "prior_curves.csv": _curve_table(summary, summary["prior"], "prior")}
+    if summary["posterior"] is not None:
+        files["constrained_curves.csv"] = _curve_table(summary, summary["posterior"],
+                                                       f"constrained ({o.rule})")
+    summary["files"] = [*files, "constrain.json", "constrain.png"]
+    files["constrain.json"] = result_json_text(summary, "constrain.json")   # before any file
     from pipeline.figures.constrain import plot_constrain
     out = o.out
-    plot_constrain(figure, out / "constrain.png")
-    write_text(out / "branch_weights.csv", _branch_table(rows))
-    write_text(out / "prior_curves.csv", _curve_table(summary, summary["prior"], "prior"))
-    if summary["posterior"] is not None:
-        write_text(out / "constrained_curves.csv",
-                   _curve_table(summary, summary["posterior"], f"constrained ({o.rule})"))
-    else:
-        summary["files"].remove("constrained_curves.csv")
-    write_json(out / "constrain.json", summary)
+    with file_set(out, FILES, ("constrain.json",)) as stage:
+        plot_constrain(figure, stage / "constrain.png")
+        for name, text in files.items():
+            write_text(stage / name, text)
     _print(summary, out)
     return 0
 

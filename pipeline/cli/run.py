@@ -2,6 +2,7 @@
 
     python -m pipeline run --record GM20 --column both --hd 6 --out results/runs/GM20
 """
+from dataclasses import fields
 from pathlib import Path
 
 from pipeline import RESULTS_DIR
@@ -108,13 +109,15 @@ def _contact(args):
     given in both refused)."""
     if args.contact_file is None:
         return from_args(Contact, args)
-    from pipeline.scenario.contact_file import load_contact_file
+    from pipeline.scenario.contact_file import checked_contact, load_contact_file
     from_file = load_contact_file(args.contact_file)
     both = [f"--{k.replace('_', '-')}" for k in from_file if getattr(args, k) is not None]
     if both:
         raise InputError(f"--contact-file sets {', '.join(both)}: give it there or on the "
                          "command line, not both")
-    return from_args(Contact, args, **from_file)
+    flags = {f.name: getattr(args, f.name) for f in fields(Contact)
+             if getattr(args, f.name, None) is not None}
+    return checked_contact(from_file, args.contact_file, **flags)
 
 
 def _simulated_length(motion, window):

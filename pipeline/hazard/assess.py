@@ -77,6 +77,13 @@ def assess(curve, specimens, ratio_model, age_ka, age_sd_ka=0.0, draws=400, seed
         result = _result(other, probability, members, age, age_sd)
         warnings += [f"hazard curve {k}: {w}" for w in list(other.notes) + result["warnings"]]
         curves.append(_curve_row(other, result, specimens, ratio_model, age, age_sd))
+    times = sorted({c.source.get("investigation_time_yr") for c in (curve, *more_curves)}
+                   - {None})
+    if len(times) > 1:
+        warnings.append(f"the hazard curves state investigation times of "
+                        f"{', '.join(f'{t:g}' for t in times)} yr: each curve's probabilities "
+                        "of exceedance converted to annual rates with its own T, "
+                        "-ln(1 - poe) / T")
     summary = _summary(curve, specimens, entries, headline, ratio_model, warnings,
                        (age_ka, age_sd_ka, draws, seed))
     if more_curves:
@@ -255,6 +262,7 @@ def _curve_row(curve, result, specimens, ratio_model, age, age_sd):
     source = curve.source
     row = {"file": source.get("file"), "format": source.get("format"),
            "kind": source.get("kind"), "site_index": source.get("site_index"),
+           "investigation_time_yr": source.get("investigation_time_yr"),
            **{k: result[k] for k in ("annual_overturning_rate_per_yr", "survival_probability",
                                      "survival_interval", "rate_scale_bound_5pct",
                                      "intensity_scale_bound_5pct")}}

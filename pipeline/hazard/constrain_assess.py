@@ -10,6 +10,7 @@ from pipeline.hazard.constrain import (FLOOR, FRACTILES, TARGET_RATES, bayes, br
                                        motion_at_rate, truncated_ages, weighted_mean,
                                        weighted_quantile)
 from pipeline.hazard.fragility import overturn_probability
+from pipeline.hazard.logictree import LogicTree
 from pipeline.hazard.survival import survival_probability
 from pipeline.provenance import software_versions
 
@@ -74,7 +75,7 @@ def constrain_tree(tree, specimens, ratio_model, ages_ka, age_sds_ka, rule="baye
                                                                            floor)}
     for name, w in posterior.items():
         if w is None:
-            warnings.append(_none_left(name, floor))
+            warnings.append(_none_left(name, floor, tree, p))
     members = _members(tree, specimens, survival_of, floor, warnings)
     carlo = _draws(tree, cells, specimens, survival_of, draws, rng, floor)
     warnings += _end_warnings(tree, cells, specimens, ratio_model, posterior[rule])
@@ -142,7 +143,18 @@ def _log_survival(tree, cells, batch, ratio_model, ages, sds, mode, samples):
     return log_survival_sampled(set_rates, samples)
 
 
-def _none_left(rule, floor):
+def _none_left(rule: str, floor: float, tree: LogicTree, p: np.ndarray) -> str:
+    """Why ``rule`` leaves no branch: every branch's survival probability ``p`` is 0
+    (bayes) or below ``floor`` (eliminate), or only branches of weight 0 have more."""
+    needed = p > 0 if rule == "bayes" else p >= floor
+    spared = [b for b, ok, w in zip(tree.branch_ids, needed, tree.weights) if ok and w == 0]
+    if spared:
+        named = ", ".join(spared[:5]) + (f" and {len(spared) - 5} more" if len(spared) > 5
+                                         else "")
+        what = "above 0" if rule == "bayes" else f"of at least {floor:g}"
+        return (f"only branches of weight 0 ({named}) give a survival probability {what}: "
+                f"{'the Bayesian update' if rule == 'bayes' else 'elimination'} leaves no "
+                "weight on any branch, no constrained curve under that rule")
     if rule == "bayes":
         return ("every branch gives the specimens a survival probability of 0: no Bayesian "
                 "update (check the ages and the fragility)")

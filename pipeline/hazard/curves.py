@@ -23,9 +23,11 @@ Checks (a one-line InputError each): a file that is not a regular file (a named 
 refused before it is read) or is larger than 64 MB, an empty file, a missing IMT or
 investigation time, an IMT other than PGA, an unknown unit, unreadable numbers, a value of
 another type in the USGS JSON (metadata, imt, edition, vs30, coordinates), JSON nested too
-deep, levels not in (0, 100 g] or more than 1000 of them, negative rates or probabilities,
-an infinite or NaN rate (OpenQuake's poe of 1 aside, below), levels not increasing, rates
-rising with the level (non-monotonic), fewer than two levels with a positive rate.  Said in ``notes``, never silent: levels dropped
+deep, levels not in [1e-6 g, 100 g] or more than 1000 of them, negative rates or
+probabilities, an infinite or NaN rate (OpenQuake's poe of 1 aside, below), a rate above
+1e3 per year, levels not increasing, rates rising with the level (non-monotonic)
+(:func:`check_curve`: the one check of a curve's values, the logic tree's too), fewer
+than two levels with a positive rate.  Said in ``notes``, never silent: levels dropped
 because their poe is 1 (an unbounded rate) and the rates of 0 at the top (the curve ends
 at the last positive rate; the first level of rate 0 is kept as ``zero_rate_from_m_s2``).
 """
@@ -47,6 +49,8 @@ OPENQUAKE_PGA_UNIT = "g"               # the engine's unit of PGA (and SA)
 _IMT = r"[A-Za-z]+(?:\([0-9.]+\))?"    # PGA, PGV, SA(0.1), ...
 _OQ_LEVEL = re.compile(rf"^(poe|{_IMT})-([^:]+)(?::\w+)?$")
 MAX_PGA_M_S2 = 100.0 * STANDARD_GRAVITY  # the highest level a curve may state (100 g)
+MIN_PGA_M_S2 = 1e-6 * STANDARD_GRAVITY   # the lowest (1e-6 g: below any felt motion)
+MAX_RATE_PER_YR = 1e3                    # the highest annual rate of exceedance (1/yr)
 MAX_LEVELS = 1_000                       # levels of one curve (engines give 20-50)
 MAX_INVESTIGATION_YR = 1e7
 
@@ -299,30 +303,38 @@ def _float(text, what):
         raise InputError(f"{what}: not a number: {show(text.strip())}") from None
 
 
-def _curve(levels, rates, to_m_s2, unit, where, source, from_poe=False):
-    """HazardCurve from levels (file unit; ``to_m_s2`` converts) and annual rates: the
-    checks and repairs of the module docstring; an infinite rate only ``from_poe`` (a
-    probability of exceedance of 1, dropped with a note), else refused."""
+def check_curve(levels: np.ndarray, rates: np.ndarray, to_m_s2: float, unit: str,
+                where: str, from_poe: bool = False) -> None:
+    """The one check of a hazard curve's values, as a file gives them (``levels`` in the
+    file's ``unit``, ``to_m_s2`` to m/s^2; ``rates`` 1/yr): at least 2 levels, each from
+    MIN_PGA_M_S2 to MAX_PGA_M_S2 and increasing; each rate a number from 0 to
+    MAX_RATE_PER_YR (infinite only ``from_poe``: a probability of exceedance of 1), not
+    rising with the level.  InputError naming ``where`` and the value."""
+    levels, rates = np.asarray(levels, float), np.asarray(rates, float)
     if levels.size < 2:
         raise InputError(f"{where}: {levels.size} level(s); a hazard curve needs at least 2")
-    top = MAX_PGA_M_S2 / to_m_s2
+    low, top = MIN_PGA_M_S2 / to_m_s2, MAX_PGA_M_S2 / to_m_s2
+    in_g = "" if unit == "g" else " (1e-6 g to 100 g)"
     for x in levels:
-        if not (math.isfinite(x) and 0 < x <= top):
-            raise InputError(f"{where}: level {x:g} {unit}: levels must be positive and at "
-                             f"most {top:g} {unit} (100 g)")
-    for x, r in zip(levels, rates):
-        if math.isinf(r) and not from_poe:
-            raise InputError(f"{where}: rate at {x:g} {unit} is infinite")
+        if not (math.isfinite(x) and low <= x <= top):
+            raise InputError(f"{where}: level {x:g} {unit}: levels must be positive, at least "
+                             f"{low:g} and at most {top:g} {unit}{in_g}")
     rising = np.flatnonzero(np.diff(levels) <= 0)
     if rising.size:
         k = rising[0]
         raise InputError(f"{where}: levels not increasing: {levels[k]:g} then "
                          f"{levels[k + 1]:g} {unit}")
     for x, r in zip(levels, rates):
+        if math.isinf(r) and not (from_poe and r > 0):
+            raise InputError(f"{where}: rate at {x:g} {unit} is infinite: rates must be finite")
         if math.isnan(r):
             raise InputError(f"{where}: rate at {x:g} {unit} is not a number")
         if r < 0:
             raise InputError(f"{where}: negative annual rate {r:g} at {x:g} {unit}")
+        if math.isfinite(r) and r > MAX_RATE_PER_YR:
+            raise InputError(f"{where}: annual rate {r:g} at {x:g} {unit}: at most "
+                             f"{MAX_RATE_PER_YR:g} per year (is it a rate of exceedance "
+                             "per year?)")
     with np.errstate(invalid="ignore"):
         up = np.flatnonzero(np.diff(rates) > 0)
     if up.size:
@@ -330,6 +342,13 @@ def _curve(levels, rates, to_m_s2, unit, where, source, from_poe=False):
         raise InputError(f"{where}: non-monotonic: the rate of exceedance rises from "
                          f"{rates[k]:.6g} at {levels[k]:g} {unit} to {rates[k + 1]:.6g} at "
                          f"{levels[k + 1]:g} {unit}")
+
+
+def _curve(levels, rates, to_m_s2, unit, where, source, from_poe=False):
+    """HazardCurve from levels (file unit; ``to_m_s2`` converts) and annual rates: the
+    checks (:func:`check_curve`) and repairs of the module docstring; an infinite rate
+    only ``from_poe`` (a probability of exceedance of 1, dropped with a note)."""
+    check_curve(levels, rates, to_m_s2, unit, where, from_poe)
     notes = []
     unbounded = ~np.isfinite(rates)
     if unbounded.any():

@@ -20,7 +20,9 @@ import math
 
 import numpy as np
 
+from pipeline.constants import STANDARD_GRAVITY
 from pipeline.files import InputError
+from pipeline.hazard.curves import MIN_PGA_M_S2
 from pipeline.userfiles import nesting, number, show
 
 MAX_MEMBERS = 10_000           # parameter sets of a campaign
@@ -33,7 +35,10 @@ MAX_RECORDS = 10_000
 MAX_TEXT = 10_000              # characters of a note, description or record id
 MAX_DEPTH = 32                 # the campaign's files nest about 8 deep
 MAX_PGA_G = 20.0               # as the hazard curves' levels
+MIN_PGA_G = MIN_PGA_M_S2 / STANDARD_GRAVITY   # the lowest PGA a grid may hold (g), a curve's
 MAX_RATIO_S = 10.0             # PGV/PGA (s)
+MIN_RATIO_S = 0.001            # the lowest, as --pgv-pga-median
+MAX_HEADINGS = 360             # directions per parameter set (campaign fragility --headings)
 TOLERANCE = 1e-9               # an estimate "inside" its interval, P = overturned / n
 
 
@@ -225,9 +230,12 @@ def _check_cov(c, cov, where):
 
 def _check_pulse_grid(c, section):
     c.obj(section, "pulse_grid")
-    pga = _axis(c, section.get("pga_g"), "pulse_grid.pga_g", MAX_PGA_G)
-    ratio = _axis(c, section.get("pgv_pga_s"), "pulse_grid.pgv_pga_s", MAX_RATIO_S)
+    pga = _axis(c, section.get("pga_g"), "pulse_grid.pga_g", MIN_PGA_G, MAX_PGA_G)
+    ratio = _axis(c, section.get("pgv_pga_s"), "pulse_grid.pgv_pga_s", MIN_RATIO_S,
+                  MAX_RATIO_S)
     members = c.integer(section.get("members"), "pulse_grid.members", 1, MAX_MEMBERS)
+    headings = c.integer(section.get("headings"), "pulse_grid.headings", 1, MAX_HEADINGS,
+                         optional=True)
     if members * len(pga) * len(ratio) > MAX_SET_VALUES:
         c.fail("pulse_grid", f"of {members} members x {len(pga)} x {len(ratio)} cells is "
                              f"beyond {MAX_SET_VALUES:.0e} values per set and cell")
@@ -241,7 +249,7 @@ def _check_pulse_grid(c, section):
         _counts(c, entry, where, "runs", "overturned")
         if entry.get("logistic") is not None:
             _check_logistic(c, entry["logistic"], f"{where}.logistic")
-        _check_cells(c, entry.get("cells"), f"{where}.cells", pga, ratio, members)
+        _check_cells(c, entry.get("cells"), f"{where}.cells", pga, ratio, members, headings)
     if section.get("block2d") is not None:
         block = c.obj(section["block2d"], "pulse_grid.block2d")
         for key in ("uplift_g_smallest", "uplift_g"):
@@ -250,12 +258,12 @@ def _check_pulse_grid(c, section):
               True, True)
 
 
-def _axis(c, values, where, high):
-    """An axis of the grid: 1 to MAX_AXIS increasing positive numbers, distinct to 9
-    digits (the cells are found by them)."""
+def _axis(c, values, where, low, high):
+    """An axis of the grid: 1 to MAX_AXIS increasing numbers from ``low`` to ``high``,
+    distinct to 9 digits (the cells are found by them)."""
     if values is None:
         c.fail(where, "is missing: the grid's axes are pga_g and pgv_pga_s")
-    values = [c.num(v, where, 0, high, True) for v in c.lst(values, where, MAX_AXIS)]
+    values = [c.num(v, where, low, high) for v in c.lst(values, where, MAX_AXIS)]
     if not values:
         c.fail(where, "is empty")
     for a, b in zip(values, values[1:]):
@@ -264,9 +272,10 @@ def _axis(c, values, where, high):
     return {round(v, 9): k for k, v in enumerate(values)}
 
 
-def _check_cells(c, cells, where, pga, ratio, members):
+def _check_cells(c, cells, where, pga, ratio, members, headings=None):
     """The cells of one model: each on the grid once, overturned of n, P and its interval,
-    P per parameter set (``sets`` indices below ``members``)."""
+    P per parameter set (``sets`` indices below ``members``; agreeing with the cell's
+    counts, :func:`_check_set_counts`)."""
     if cells is None:
         c.fail(where, "is missing: a model holds its cells")
     seen = set()
@@ -288,6 +297,7 @@ def _check_cells(c, cells, where, pga, ratio, members):
             c.fail(f"{at}.P", f"{p:g} is not overturned / n = {k_over}/{n}")
         c.pair(cell.get("ci95"), f"{at}.ci95", 0, 1, k_over / n if n > 0 else None)
         _check_sets(c, cell, at, members)
+        _check_set_counts(c, cell, at, n, k_over, headings)
 
 
 def _check_sets(c, cell, at, members):
@@ -303,3 +313,32 @@ def _check_sets(c, cell, at, members):
         c.fail(f"{at}.sets", "names a parameter set twice")
     if p_sets is not None and len(p_sets) != len(indices):
         c.fail(f"{at}.P_per_set", f"holds {len(p_sets)} values for {len(indices)} sets")
+
+
+def _check_set_counts(c: "_Checker", cell: dict, at: str, n: int, overturned: int,
+                      headings: int | None) -> None:
+    """``P_per_set`` against the cell's counts.  Each set listed ran at least once: at
+    most n sets, and the pooled P (overturned / n, the sets' P weighted by their runs)
+    lies between the smallest and the largest set's P (within half a run).  With
+    ``headings`` (a set's runs in a cell, at most): n at most sets x headings, and a
+    cell where every set ran every heading has overturned = headings x the sum of the
+    sets' P."""
+    given = cell.get("P_per_set") or ()
+    values = [p for p in given if p is not None]
+    if not values:
+        return
+    where = f"{at}.P_per_set"
+    if len(values) > n:
+        c.fail(where, f"holds {len(values)} sets' P for {n} runs (n)")
+    pooled, slack = overturned / n, 0.5 / n + TOLERANCE       # within half a run
+    if not min(values) - slack <= pooled <= max(values) + slack:
+        c.fail(where, f"from {min(values):g} to {max(values):g} contradicts overturned / n "
+                      f"= {overturned}/{n}")
+    if headings is None or len(values) != len(given):
+        return
+    if n > len(given) * headings:
+        c.fail(f"{at}.n", f"{n} is more than {len(given)} sets x {headings} headings")
+    counted = sum(values) * headings
+    if n == len(given) * headings and abs(counted - overturned) > TOLERANCE * max(1, n):
+        c.fail(where, f"gives {counted:g} overturned runs ({headings} headings per set), "
+                      f"the cell {overturned}")

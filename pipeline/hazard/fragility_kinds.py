@@ -23,6 +23,8 @@ from scipy import special, stats
 from pipeline.constants import STANDARD_GRAVITY
 
 Z95 = stats.norm.ppf(0.975)
+MEDIAN_G_RANGE = (0.001, 10.0)   # a lognormal fragility's median PGA (g), stated or from a file
+BETA_RANGE = (0.01, 3.0)         # its dispersion (natural log), stated or from a file
 
 
 class Fragility(ABC):

@@ -11,11 +11,13 @@ import pandas as pd
 from pipeline.constants import STANDARD_GRAVITY
 from pipeline.files import InputError
 from pipeline.hazard.components import on_hazard_measure
-from pipeline.hazard.fragility_file import MAX_MEMBERS, read_fragility_file
+from pipeline.hazard.fragility_file import MAX_MEMBERS, FragilityFile, read_fragility_file
 from pipeline.hazard.fragility_grid import BELOW_GRID, PulseGrid
-from pipeline.hazard.fragility_kinds import Logistic, Lognormal
+from pipeline.hazard.fragility_kinds import BETA_RANGE, MEDIAN_G_RANGE, Logistic, Lognormal
 from pipeline.stats.fragility import fragility_fit, logistic_surface
 from pipeline.userfiles import DATA_FILE_BYTES, Unreadable, number, read_text, show
+
+BLOCK_MODEL = "block2d"          # a pulse grid's 2D rigid block, beside the specimen
 
 
 def load_campaign_fragility(path, column=None, form=None, below="ramp", component=None,
@@ -51,7 +53,10 @@ def _load_campaign_fragility(path, column, form, below):
     entry = columns[column]
     label = f"{column} ({entry.description or ''}) from {path.name}"
     if form == "pga":
-        fit = entry.fits.get("PGA") or {}
+        fit = entry.fits.get("PGA")
+        if fit is None:
+            raise InputError(f"{path}: column {column}: no PGA fit in the file (give "
+                             "--fragility-form pga-pgv for its logistic surface)")
         if fit.get("unit") != "m/s^2":
             raise InputError(f"{path}: column {column}: PGA fit in unknown unit "
                              f"{fit.get('unit')!r} (expected m/s^2)")
@@ -59,8 +64,9 @@ def _load_campaign_fragility(path, column, form, below):
             raise InputError(f"{path}: column {column}: PGA fragility not fitted "
                              f"({fit.get('note') or 'no median'})")
         where = f"{path}: column {column}: PGA"
-        pooled = Lognormal(number(fit["median"], f"{where} median", 0, None, "m/s^2", True),
-                           number(fit.get("beta"), f"{where} beta", 0, None, "", True),
+        low, high = (g * STANDARD_GRAVITY for g in MEDIAN_G_RANGE)
+        pooled = Lognormal(number(fit["median"], f"{where} median", low, high, "m/s^2"),
+                           number(fit.get("beta"), f"{where} beta", *BETA_RANGE),
                            _pair(fit.get("median_ci95"), f"{where} median_ci95"),
                            _pair(fit.get("beta_ci95"), f"{where} beta_ci95"),
                            label=label, note=fit.get("note"))
@@ -111,6 +117,10 @@ def member_fits(runs_path, column, form, block=None):
             if fit["median"] is None:
                 skipped.append(f"{show(member)} ({fit['note']})")
                 continue
+            outside = _lognormal_outside(fit["median"], fit["beta"])
+            if outside:
+                skipped.append(f"{show(member)} ({outside})")
+                continue
             fits.append(Lognormal(float(fit["median"]), float(fit["beta"]), label=label))
         else:
             fit = logistic_surface(pga, ratio, y, alpha=None if block is None else block.alpha_rad,
@@ -124,6 +134,18 @@ def member_fits(runs_path, column, form, block=None):
                                      f"alone, left out of the members' spread: "
                                      f"{'; '.join(skipped)}")
     return (tuple(fits) or None), note
+
+
+def _lognormal_outside(median_m_s2: float, beta: float) -> str | None:
+    """What of a fitted lognormal lies outside the ranges a stated one takes (text), or
+    None."""
+    low, high = MEDIAN_G_RANGE
+    median_g = median_m_s2 / STANDARD_GRAVITY
+    if not low <= median_g <= high:
+        return f"median {median_g:.3g} g outside {low:g}-{high:g} g"
+    if not BETA_RANGE[0] <= beta <= BETA_RANGE[1]:
+        return f"beta {beta:.3g} outside {BETA_RANGE[0]:g}-{BETA_RANGE[1]:g}"
+    return None
 
 
 def _logistic(surface, where, label):
@@ -170,7 +192,7 @@ def load_pulse_grid(file, model=None, form="grid", below="ramp"):
     path, section = file.path, file.pulse_grid
     models = section.models
     if model is None:
-        model = "monolithic" if "monolithic" in models else next(iter(models))
+        model = _specimen_model(file)
     if model not in models:
         raise InputError(f"{path}: pulse_grid has no model {model!r} (has {', '.join(models)})")
     entry = models[model]
@@ -200,6 +222,23 @@ def load_pulse_grid(file, model=None, form="grid", below="ramp"):
     return PulseGrid(tuple(float(v) * STANDARD_GRAVITY for v in section.pga_g),
                      tuple(float(v) for v in section.pgv_pga_s), n, overturned, per_set,
                      logistic, label, note, uplift, below)
+
+
+def _specimen_model(file: FragilityFile) -> str:
+    """The name of a pulse grid's specimen model (monolithic, or the first that is not
+    its 2D block); InputError when it holds only the 2D block's: the rigid block of the
+    specimen's critical angle is not the rock."""
+    section = file.pulse_grid
+    block = {BLOCK_MODEL} | ({section.block2d.model} if section.block2d is not None
+                             and section.block2d.model is not None else set())
+    if "monolithic" in section.models:
+        return "monolithic"
+    specimen = [m for m in section.models if m not in block]
+    if not specimen:
+        raise InputError(f"{file.path}: pulse_grid holds only its 2D rigid block's model "
+                         f"({', '.join(section.models)}), not the specimen's: give --column "
+                         f"{next(iter(section.models))} to take the block for the rock")
+    return specimen[0]
 
 
 def _cells(section, entry):

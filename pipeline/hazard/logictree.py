@@ -25,9 +25,12 @@ interpolated in (ln PGA, ln rate), where neither has a value.
 One-line refusals (InputError): weights negative or not numbers, weights whose sum differs
 from 1 by more than :data:`WEIGHT_TOLERANCE` (then they are divided by their sum, so that
 they sum to 1 to the last bit), curves on different levels, sites or IMTs, a branch
-without a curve, a curve without a branch, a branch twice, rates not finite or negative or
-rising with the level, more than :data:`MAX_BRANCHES` branches or :data:`MAX_LEVELS`
-levels (and each file at most ``pipeline.userfiles.MAX_FILE_BYTES``).
+without a curve, a curve without a branch, a branch twice, OpenQuake curves of different
+investigation times (two calculations' curves), a curve's values as
+:func:`pipeline.hazard.curves.check_curve` refuses them (levels outside 1e-6 g to 100 g,
+rates not finite, negative, above 1e3 per year or rising with the level), more than
+:data:`MAX_BRANCHES` branches or :data:`MAX_LEVELS` levels (and each file at most
+``pipeline.userfiles.MAX_FILE_BYTES``).
 """
 import csv
 import math
@@ -37,7 +40,7 @@ from pathlib import Path
 
 import numpy as np
 
-from pipeline.hazard.curves import MAX_PGA_M_S2, PLAIN_RATE_COLUMN, PLAIN_UNITS, load_hazard
+from pipeline.hazard.curves import PLAIN_RATE_COLUMN, PLAIN_UNITS, check_curve, load_hazard
 from pipeline.files import InputError
 from pipeline.userfiles import DATA_FILE_BYTES, read_user_bytes, read_user_text, show
 
@@ -130,6 +133,7 @@ def _openquake(path, site):
             raise InputError(f"branch {rlz} ({branch_path}) has no PGA hazard curve in "
                              f"{path.parent} (no hazard_curve*.csv of kind rlz-{rlz:03d})")
         loaded.append(load_hazard(curves[rlz], site))
+    _one_investigation_time(loaded, [curves[r[0]].name for r in rows])
     sites = {(c.source.get("lon"), c.source.get("lat")) for c in loaded}
     if len(sites) > 1:
         raise InputError(f"{path.parent}: the curves are of different sites "
@@ -150,6 +154,18 @@ def _openquake(path, site):
     weights, more = _weights([r[2] for r in rows], path)
     return LogicTree(tuple(str(r[0]) for r in rows), tuple(r[1] for r in rows), weights,
                      levels, rates, "PGA", source, tuple(notes + more))
+
+
+def _one_investigation_time(loaded: list, names: list[str]) -> None:
+    """InputError unless every curve states one investigation time: the realisations of
+    one calculation share it, so curves of two are two calculations' (each curve's
+    rates are annual, -ln(1 - poe) / T, but their branches are not one tree's)."""
+    times = [c.source["investigation_time_yr"] for c in loaded]
+    for name, time in zip(names, times):
+        if time != times[0]:
+            raise InputError(f"{name}: investigation_time {time:g} yr, {names[0]}: "
+                             f"{times[0]:g} yr: the realisations of one calculation share "
+                             "one investigation time (curves of two calculations mixed?)")
 
 
 def _realizations(path):
@@ -287,25 +303,7 @@ def _plain_curve(path, name, rows, to_m_s2, unit):
     """(levels m/s^2, rates 1/yr) of one branch of a plain table, checked."""
     levels = np.array([r[0] for r in rows])
     rates = np.array([r[1] for r in rows])
-    where = f"{path}: branch {show(name)}"
-    if levels.size < 2:
-        raise InputError(f"{where}: {levels.size} level(s); a hazard curve needs at least 2")
-    for x, r in zip(levels, rates):
-        if not (math.isfinite(x) and 0 < x * to_m_s2 <= MAX_PGA_M_S2):
-            raise InputError(f"{where}: level {x:g} {unit}: levels must lie in (0, "
-                             f"{MAX_PGA_M_S2 / to_m_s2:g}] {unit} (100 g)")
-        if not math.isfinite(r) or r < 0:
-            raise InputError(f"{where}: rate {r:g} at {x:g} {unit} must be finite and 0 or "
-                             "more")
-    down = np.flatnonzero(np.diff(levels) <= 0)
-    if down.size:
-        raise InputError(f"{where}: levels not increasing: {levels[down[0]]:g} then "
-                         f"{levels[down[0] + 1]:g} {unit}")
-    up = np.flatnonzero(np.diff(rates) > 0)
-    if up.size:
-        k = up[0]
-        raise InputError(f"{where}: non-monotonic: the rate rises from {rates[k]:.6g} at "
-                         f"{levels[k]:g} {unit} to {rates[k + 1]:.6g} at {levels[k + 1]:g}")
+    check_curve(levels, rates, to_m_s2, unit, f"{path}: branch {show(name)}")
     return levels * to_m_s2, rates
 
 

@@ -20,8 +20,9 @@ import math
 
 import numpy as np
 from scipy import optimize
-from scipy.special import log_ndtr
+from scipy.special import erfcx, log_ndtr
 
+MAX_LN_FACTOR = 700.0         # ln of the largest factor on the rates said (exp(709) overflows)
 CELLS_PER_INTERVAL = 200      # integration cells between two levels of the curve
 
 
@@ -95,23 +96,32 @@ def survival_probability(rate_per_yr, age_yr, age_sd_yr=0.0):
     if age_sd_yr == 0:
         return np.exp(-rate * age_yr)
     mu, s = float(age_yr), float(age_sd_yr)
-    log_p = (-rate * mu + 0.5 * (rate * s) ** 2 + log_ndtr((mu - rate * s * s) / s)
-             - log_ndtr(mu / s))
+    a = (mu - rate * s * s) / s
+    with np.errstate(over="ignore", invalid="ignore"):
+        # a < 0: -r mu + r^2 s^2 / 2 + ln Phi(a) = a^2/2 + ln Phi(a) - mu^2 / (2 s^2), and
+        # a^2/2 + ln Phi(a) = ln(erfcx(-a / sqrt 2) / 2): no difference of huge numbers
+        below = np.log(erfcx(-a / math.sqrt(2.0)) / 2.0) - 0.5 * (mu / s) ** 2
+        above = -rate * mu + 0.5 * (rate * s) ** 2 + log_ndtr(a)
+    log_p = np.where(a < 0, below, above) - log_ndtr(mu / s)
     return np.exp(log_p)
 
 
 def rate_scale_bound(rate_per_yr, age_yr, age_sd_yr=0.0, floor=0.05):
     """The largest factor F by which every rate of the hazard curve can be multiplied and
     still leave survival >= ``floor``: -ln(floor) / (rate age) for a known age, else the
-    root of survival(F rate) = floor.  None when the rate is 0 (no bound)."""
+    root of survival(F rate) = floor.  None when the rate is 0 (no bound) or F would pass
+    exp(MAX_LN_FACTOR) (a rate so small that no factor a float holds reaches ``floor``)."""
     if not rate_per_yr > 0:
         return None
-    closed = -math.log(floor) / (rate_per_yr * age_yr)
+    ln_rate = math.log(rate_per_yr)
+    ln_closed = math.log(-math.log(floor)) - ln_rate - math.log(age_yr)
+    if ln_closed > MAX_LN_FACTOR:
+        return None
     if age_sd_yr == 0:
-        return closed
+        return math.exp(ln_closed)
     def excess(ln_f):
-        return float(survival_probability(math.exp(ln_f) * rate_per_yr, age_yr, age_sd_yr)) - floor
-    hi = math.log(closed)
+        return float(survival_probability(math.exp(ln_f + ln_rate), age_yr, age_sd_yr)) - floor
+    hi = ln_closed
     for _ in range(60):                # survival falls to 0 as F grows: a bracket exists
         if excess(hi) <= 0:
             break
@@ -121,7 +131,8 @@ def rate_scale_bound(rate_per_yr, age_yr, age_sd_yr=0.0, floor=0.05):
         if excess(lo) >= 0:
             break
         lo -= math.log(10.0)
-    return math.exp(optimize.brentq(excess, lo, hi, xtol=1e-10))
+    root = optimize.brentq(excess, lo, hi, xtol=1e-10)
+    return None if root > MAX_LN_FACTOR else math.exp(root)
 
 
 def intensity_scale_bound(levels_m_s2, rates_per_yr, probability, age_yr, age_sd_yr=0.0,

@@ -2,7 +2,10 @@
 hazard curves written as ``survival.json`` and ``survival.png``, and the PGA range a
 site's standing and fallen columns allow as ``site_motion.json`` (docs/survival.md).
 The command reads and checks its options and the input files; this writes the results."""
-from pipeline.files import InputError, write_json
+from pipeline.files import InputError, file_set, result_json_text, write_text
+
+FILES = ("survival.json", "survival.png", "site_motion.json")   # every file survival writes
+SUMMARIES = ("survival.json", "site_motion.json")           # what says what the set holds
 
 
 def site_motion_result(observations_path, site_name, fragility_for, at_pgv_pga, pga_measure):
@@ -24,15 +27,18 @@ def site_motion_result(observations_path, site_name, fragility_for, at_pgv_pga, 
 
 
 def write_site_motion(out, result):
-    """Write ``result`` as ``out``/site_motion.json (atomically)."""
-    write_json(out / "site_motion.json", result)
+    """Write ``result`` as ``out``/site_motion.json (atomically; an earlier run's
+    survival.json and survival.png removed: they are not of this run)."""
+    text = result_json_text(result, "site_motion.json")
+    with file_set(out, FILES, SUMMARIES) as stage:
+        write_text(stage / "site_motion.json", text)
 
 
 def survival_files(out, curves, specimens, ratio, age_ka, age_sd_ka, draws, seed,
                    hazard_component, site_motion=None):
     """survival.json's content (:func:`pipeline.hazard.assess.assess` under ``curves``,
-    the first the headline), written with survival.png to ``out`` (and site_motion.json
-    after them when ``site_motion`` is given)."""
+    the first the headline), written with survival.png to ``out`` as one set (with
+    site_motion.json when ``site_motion`` is given; an earlier run's left out removed)."""
     from pipeline.figures.survival import plot_survival
     from pipeline.hazard.assess import assess
     summary, data = assess(curves[0], specimens, ratio, age_ka, age_sd_ka, draws, seed,
@@ -41,8 +47,11 @@ def survival_files(out, curves, specimens, ratio, age_ka, age_sd_ka, draws, seed
     summary["figure"] = "survival.png"
     if site_motion is not None:
         summary["site_motion"] = site_motion
-    plot_survival(data, out / "survival.png")
-    write_json(out / "survival.json", summary)
+    texts = {"survival.json": result_json_text(summary, "survival.json")}   # before any file
     if site_motion is not None:
-        write_site_motion(out, site_motion)
+        texts["site_motion.json"] = result_json_text(site_motion, "site_motion.json")
+    with file_set(out, FILES, SUMMARIES) as stage:
+        plot_survival(data, stage / "survival.png")
+        for name, text in texts.items():
+            write_text(stage / name, text)
     return summary

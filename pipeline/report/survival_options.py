@@ -12,7 +12,9 @@ from pipeline import RESULTS_DIR
 from pipeline.constants import STANDARD_GRAVITY
 from pipeline.files import InputError, display_path
 from pipeline.hazard.components import COMPONENTS
+from pipeline.hazard.constrain import FLOOR
 from pipeline.hazard.fragility import BELOW_GRID, GMM_MECHANISMS
+from pipeline.hazard.fragility_kinds import BETA_RANGE, MEDIAN_G_RANGE
 from pipeline.hazard.fragility_ratio import DEFAULT_VS30_M_S, PGA_PGV_CORRELATION
 from pipeline.scenario.parameters import check_fields, param
 from pipeline.userfiles import number
@@ -48,9 +50,11 @@ class SpecimenOptions:
         "edge's P held down to the uplift acceleration) or logistic (the fitted surface)",
         flag="--below-grid", choices=BELOW_GRID)
     median_g: tuple[float, ...] = param(
-        (), "", "a stated lognormal fragility over PGA: median PGA (g), 0-10; repeat with "
+        (), "", f"a stated lognormal fragility over PGA: median PGA (g), "
+        f"{MEDIAN_G_RANGE[0]:g}-{MEDIAN_G_RANGE[1]:g} (as a file's PGA fit); repeat with "
         "--beta for a set", flag="--median-g", metavar="G")
-    beta: tuple[float, ...] = param((), "", "its dispersion (natural log), 0.01-3",
+    beta: tuple[float, ...] = param((), "", f"its dispersion (natural log), "
+                                    f"{BETA_RANGE[0]:g}-{BETA_RANGE[1]:g}",
                                     flag="--beta", metavar="B")
     logistic: tuple[str, ...] = param(
         (), "", "a stated logistic surface logit P = b0 + b1 ln(PGA / 1 m/s^2) + b2 "
@@ -98,9 +102,9 @@ class SpecimenOptions:
     def check_specimens(self):
         """The fragility, PGV/PGA and draw options range-checked (InputError, one line)."""
         for v in self.median_g:
-            number(v, "--median-g", 0, 10, "g", low_open=True)
+            number(v, "--median-g", *MEDIAN_G_RANGE, "g")
         for v in self.beta:
-            number(v, "--beta", 0.01, 3)
+            number(v, "--beta", *BETA_RANGE)
         if len(self.median_g) != len(self.beta):
             raise InputError(f"give one --beta per --median-g ({len(self.median_g)} medians, "
                              f"{len(self.beta)} betas)")
@@ -109,6 +113,7 @@ class SpecimenOptions:
         if not self.median_g and not self.fragility and not self.logistic:
             raise InputError("no fragility: give --median-g and --beta, --logistic or "
                              "--fragility")
+        _distinct_files(self.fragility, "--fragility", "specimen", "fragility.json")
         self._check_ratio()
         number(self.vs30, "--vs30", 150, 1500, "m/s")
         if self.pga_pgv_correlation is not None:
@@ -229,7 +234,7 @@ class SurvivalOptions(SpecimenOptions):
             number(self.age_ka, "--age-ka", 0, 10000, "ka", low_open=True)
         number(self.age_sd_ka, "--age-sd-ka", 0, 10000, "ka")
         self.check_specimens()
-        _distinct_fragilities(self.fragility)
+        _distinct_files(self.hazard, "--hazard", "curve")
         if self.observations is not None and self.column is not None:
             raise InputError("--column does not apply with --observations (each column's own "
                              "type is read from the file)")
@@ -268,13 +273,13 @@ class ConstrainOptions(SpecimenOptions):
                       "default) or eliminate (branches of survival below --floor dropped); "
                       "both are written", flag="--rule", choices=("bayes", "eliminate"))
     floor: float = param(None, "", "survival probability below which elimination drops a "
-                         "branch (0-1, above 0 and below 1); default 0.05", flag="--floor",
+                         f"branch (0-1, above 0 and below 1); default {FLOOR:g}", flag="--floor",
                          metavar="P")
     out: Path = param(None, "", f"output directory (default {display_path(CONSTRAIN_OUT)})",
                       flag="--out", metavar="DIR")
 
     def __post_init__(self):
-        self._fill(rule="bayes", floor=0.05, out=CONSTRAIN_OUT)
+        self._fill(rule="bayes", floor=FLOOR, out=CONSTRAIN_OUT)
         if self.logic_tree is None:
             raise InputError("give --logic-tree")
         self.check_specimens()
@@ -289,9 +294,7 @@ class ConstrainOptions(SpecimenOptions):
             number(a, "--age-ka", 0, 10000, "ka", low_open=True)
         for s in sds:
             number(s, "--age-sd-ka", 0, 10000, "ka")
-        number(self.floor, "--floor", 0, 1, low_open=True)
-        if self.floor >= 1:
-            raise InputError(f"--floor must be below 1, got {self.floor:g}")
+        number(self.floor, "--floor", 0, 1, low_open=True, high_open=True)
         _check_out(self.out)
 
     def ages(self):
@@ -304,6 +307,12 @@ class ConstrainOptions(SpecimenOptions):
 def _check_column_site(options):
     if options.column is not None and not options.fragility:
         raise InputError("--column applies to --fragility files")
+    if options.fragility_form is not None and not options.fragility:
+        raise InputError("--fragility-form applies to --fragility files (a stated fragility "
+                         "has its own form)")
+    if options.below_grid != "ramp" and not options.fragility:
+        raise InputError("--below-grid applies to a pulse-grid fragility (--fragility of "
+                         "campaign fragility --pulses)")
     if options.site is not None and options.site < 0:
         raise InputError(f"--site must be 0 or more, got {options.site}")
 
@@ -322,20 +331,21 @@ def _per_specimen(values, n, flag):
     return list(values)
 
 
-def _distinct_fragilities(paths):
-    """Refuse the same fragility file named twice (as a file or its directory, by another
-    path or link): one specimen is not a set."""
+def _distinct_files(paths: tuple[Path, ...], flag: str, what: str,
+                   inside: str | None = None) -> None:
+    """Refuse one file named twice by ``flag`` (as a file or, with ``inside``, its
+    directory; by another path or a link): one ``what`` is not two."""
     seen = {}
     for path in paths:
-        file = path / "fragility.json" if path.is_dir() else path
+        file = path / inside if inside is not None and path.is_dir() else path
         try:
             stat = file.stat()
             key = (stat.st_dev, stat.st_ino)
         except OSError:
             key = file.resolve()
         if key in seen:
-            raise InputError(f"--fragility {path} and {seen[key]} are one file: the same "
-                             "specimen twice (a set needs distinct specimens)")
+            raise InputError(f"{flag} {path} and {seen[key]} are one file: the same {what} "
+                             "twice (a set needs distinct ones)")
         seen[key] = path
 
 

@@ -6,6 +6,7 @@ import re
 from pathlib import Path
 
 from pipeline.files import InputError
+from pipeline.scenario.parameters import Contact
 from pipeline.userfiles import keys_text, number, read_json, read_user_bytes
 
 CONTACT_KEYS = ("kn", "damping", "mu_s", "mu_k")
@@ -38,17 +39,27 @@ def contact_values(path):
     """The contact fields a contact file sets, range-checked by
     :class:`~pipeline.scenario.parameters.Contact` (one-line InputError); a file that sets
     mu_s without mu_k gets the kinetic friction a run gives that mu_s."""
-    from pipeline.scenario.parameters import Contact
     values = load_contact_file(path)
-    try:
-        contact = Contact(**values)
-    except InputError as exc:        # the range check names the option: name the file's key
-        message = re.sub(r"^--([a-z][a-z0-9-]*)",
-                         lambda m: repr(m[1].replace("-", "_")), str(exc))
-        raise InputError(f"--contact-file {Path(path).name}: {message}") from None
+    contact = checked_contact(values, path)
     if "mu_s" in values and "mu_k" not in values:
         values["mu_k"] = contact.mu_k
     return values
+
+
+def checked_contact(values: dict[str, float], path: Path, **flags: float) -> Contact:
+    """The :class:`~pipeline.scenario.parameters.Contact` of a contact file's ``values``
+    and the command line's ``flags`` (the other contact fields); a value out of range is
+    one InputError naming the file and its key when the file gave it, the flag when the
+    command line did."""
+    try:
+        return Contact(**flags, **values)
+    except InputError as exc:        # the range check names the option: name the file's key
+        flag = re.match(r"^--([a-z][a-z0-9-]*)", str(exc))
+        if flag is None or (flags and flag[1].replace("-", "_") not in values):
+            raise
+        message = re.sub(r"^--([a-z][a-z0-9-]*)",
+                         lambda m: repr(m[1].replace("-", "_")), str(exc))
+        raise InputError(f"--contact-file {Path(path).name}: {message}") from None
 
 
 def contact_provenance(path):

@@ -402,12 +402,12 @@ def test_a_standing_column_reweights_power_law_branches_in_closed_form(tmp_path)
     lognormal PGA fit, median 3 m/s^2, beta 0.4, on the campaign's own PGA) and an age of
     2.5 ka under three power-law branches lambda_i(x) = k_i x^-K written as a plain table:
     lambda_ov,i = k_i m^-K exp(K^2 beta^2 / 2), w_i' = w_i exp(-lambda_ov,i t) / sum
-    (the curves span 1e-3 to 900 m/s^2, so their ends hold a negligible rate)."""
+    (the curves span 2e-3 to 900 m/s^2, so their ends hold a negligible rate)."""
     from tests.hazard.test_reader_robustness import COLUMN
     fragility = tmp_path / "fragility.json"
     fragility.write_text(json.dumps(COLUMN))
     ks, exponent, weights = (2e-3, 5e-4, 1e-4), 2.0, (0.2, 0.5, 0.3)
-    levels = np.geomspace(1e-3, 900.0, 121)
+    levels = np.geomspace(2e-3, 900.0, 121)
     rows = ["branch,weight,pga_m_s2,annual_rate_per_yr"]
     rows += [f"b{i},{w},{float(x)!r},{float(k * x ** -exponent)!r}"
              for i, (k, w) in enumerate(zip(ks, weights)) for x in levels]
@@ -431,7 +431,7 @@ def test_a_standing_column_reweights_power_law_branches_in_closed_form(tmp_path)
 def test_a_plain_tree_above_100_g_is_refused(tmp_path):
     tree = tmp_path / "tree.csv"
     tree.write_text("branch,weight,pga_g,annual_rate_per_yr\na,1,0.1,0.01\na,1,150,1e-9\n")
-    with pytest.raises(InputError, match=r"level 150 g: levels must lie in \(0, 100\] g"):
+    with pytest.raises(InputError, match=r"level 150 g: levels must be positive, at least 1e-06 and at most 100 g"):
         load_logic_tree(tree)
 
 

@@ -70,6 +70,26 @@ def test_survival_over_an_uncertain_age(rate, mean, sd):
     assert float(survival_probability(rate, mean, 0.0)) == pytest.approx(math.exp(-rate * mean))
 
 
+@pytest.mark.parametrize("rate, mean, sd", [(999.0, 1e7, 1e7), (1.0, 1e4, 1e3),
+                                            (0.1, 2e3, 1.5e3), (50.0, 1e3, 5e3)])
+def test_survival_when_rate_times_sd_is_large(rate, mean, sd):
+    """r s >> 1: the closed form's exp(r^2 s^2 / 2) and Phi((mu - r s^2) / s) would cancel
+    in digits (P above 1 from rounding): against quadrature in u = r t (the young ages,
+    where the survivals lie)."""
+    norm = stats.norm.cdf(mean / sd)
+    value, _ = integrate.quad(lambda u: math.exp(-u) * stats.norm.pdf(u / rate, mean, sd)
+                              / rate, 0, 60, limit=200)
+    p = float(survival_probability(rate, mean, sd))
+    assert 0 <= p <= 1 and p == pytest.approx(value / norm, rel=1e-6)
+
+
+def test_rate_scale_bound_of_a_rate_too_small_for_any_float_factor():
+    """A rate of 1e-317 per year over a day: no factor a float holds brings survival to
+    5 % (None, as for a rate of 0), not a failed root search."""
+    assert rate_scale_bound(1e-317, 1e-3) is None
+    assert rate_scale_bound(1e-317, 1e-3, 1e7) is None
+
+
 def test_rate_scale_bound():
     assert rate_scale_bound(1e-4, 15e3) == pytest.approx(-math.log(0.05) / 1.5)
     factor = rate_scale_bound(1e-4, 15e3, 5e3)

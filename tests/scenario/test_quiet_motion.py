@@ -154,3 +154,14 @@ def test_ready_made_motion_is_cut_at_its_signal_end_like_a_record(tmp_path):
     assert ends[0] == ends[1]
     assert ends[0][0] == 0.0 and 11.5 < ends[0][1] < 12.0       # burst ends at 7 s
     assert signal_window("GM20") is None
+
+
+def test_a_run_not_simulated_leaves_no_trajectory_of_an_earlier_run(tmp_path):
+    """A still motion is not simulated: the directory an earlier run left holds this
+    run's summary, not the earlier trajectory and YADE log beside it."""
+    for name in ("trajectory.npz", "yade.log"):
+        (tmp_path / name).write_text("an earlier run's")
+    summary = simulate(motion_of(np.zeros((200, 3))), tmp_path, RunParams(column=MONOLITH))
+    assert not summary.simulated
+    assert (tmp_path / "summary.json").exists()
+    assert not (tmp_path / "trajectory.npz").exists() and not (tmp_path / "yade.log").exists()
