@@ -98,8 +98,8 @@ class PlacedColumn:
         top = self.bodies()[-1]
         point, outline = top.top
         centre = top.base_world + top.rotation @ point
-        return Face(outline.shifted(centre[0], centre[1]), (centre[0], centre[1]), None,
-                    float(centre[2]))
+        x, y, z = (float(v) for v in centre)
+        return Face(outline.shifted(x, y), (x, y), None, z)
 
     @property
     def mass(self):
@@ -147,7 +147,8 @@ class Colonnade:
     docstring); checked when made: InputError (one line) for a column off the stylobate,
     overlapping columns or beams, a beam longer than the stylobate, an unknown support,
     supports at different levels, a beam end that rests on no support or leaves one, a
-    support named that the beam does not reach or one it rests on without naming it."""
+    support named that the beam does not reach or one it rests on without naming it, a
+    name given twice."""
     name: str
     stylobate: Stylobate
     columns: tuple
@@ -157,6 +158,11 @@ class Colonnade:
     notes: str = None
 
     def __post_init__(self):
+        names = [c.name for c in self.columns] + [b.name for b in self.epistyles + self.frieze]
+        twice = sorted({n for n in names if names.count(n) > 1})
+        if twice:
+            raise InputError(f"the name {twice[0]!r} is given twice; columns and beams need "
+                             "names of their own")
         self._check_columns()
         self.faces()
 

@@ -99,11 +99,6 @@ def from_dict(data, where="colonnade description", base=None):
             else []
         beams[course] = tuple(_beam(b, course, f"{where}: {key}[{k}]", where)
                               for k, b in enumerate(items))
-    names = [c.name for c in placed] + [b.name for v in beams.values() for b in v]
-    twice = sorted({n for n in names if names.count(n) > 1})
-    if twice:
-        raise InputError(f"{where}: the name {twice[0]!r} is given twice; columns and beams "
-                         "need names of their own")
     try:
         return Colonnade(_name(data.get("name"), f"{where}: name"), stylobate, placed,
                          beams[Course.EPISTYLE], beams[Course.FRIEZE], data.get("source"),
