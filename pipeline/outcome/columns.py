@@ -26,6 +26,7 @@ from scipy.spatial.transform import Rotation
 
 from pipeline.constants import LIES_TILT_DEG, MODEL_GRAVITY
 from pipeline.motion import azimuth_deg
+from pipeline.outcome.damage import column_damage
 from pipeline.outcome.summary import ColumnOutcome, RunSummary
 
 CONTACT_TOLERANCE_M = 0.02   # a rim this close to the pedestal top has struck it
@@ -111,9 +112,20 @@ def column_outcomes(trajectory, start_in_file_s=0.0):
         bodies = [entry for j in members
                   if (entry := _body_outcome(trajectory, j, t, axes, origin)) is not None]
         if bodies:
-            results.append(_column_outcome(name, bodies, trajectory.pos[:, members[0], :2],
-                                           first, origin))
+            result = _column_outcome(name, bodies, trajectory.pos[:, members[0], :2],
+                                     first, origin)
+            result["damage"] = _damage(trajectory, members, result["toppled"]).to_dict()
+            results.append(result)
     return results
+
+
+def _damage(trajectory, members, toppled):
+    """The column's :class:`~pipeline.outcome.damage.DamageMeasures` (its bodies
+    ``members``, bottom up)."""
+    members = sorted(members, key=lambda j: trajectory.bodies[j]["index"])
+    bodies = [trajectory.bodies[j] for j in members]
+    return column_damage(trajectory.pos[:, members], trajectory.quat[:, members], bodies,
+                         [body_rims(b) for b in bodies], toppled)
 
 
 def _body_outcome(trajectory, j, t, axes, origin):

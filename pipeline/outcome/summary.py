@@ -8,6 +8,7 @@ from dataclasses import dataclass, field, fields
 from pathlib import Path
 
 from pipeline.files import InputError, read_run_json, write_json
+from pipeline.outcome.damage import DamageMeasures, damage_at_rest
 
 
 def _azimuth_or_none(value, name):
@@ -43,8 +44,9 @@ class ColumnOutcome:
     """One column of a run: toppled or standing, downfall azimuth (deg clockwise from
     North, None when standing), first impact time (s, record's clock) and point (m, pedestal
     frame, mass-weighted), largest tilt (deg), base slip (m), initial position (m), the
-    rule that decided the fall (``toppled_by``) and one dict per body
-    (:mod:`pipeline.outcome.columns`)."""
+    rule that decided the fall (``toppled_by``), one dict per body
+    (:mod:`pipeline.outcome.columns`) and its :class:`~pipeline.outcome.damage.DamageMeasures`
+    (``damage``; None in summaries written before them)."""
     column: str
     toppled: bool
     toppled_by: str = None
@@ -55,6 +57,7 @@ class ColumnOutcome:
     base_slip_m: float = 0.0
     position_m: list = field(default_factory=lambda: [0.0, 0.0])
     bodies: list = field(default_factory=list)
+    damage: DamageMeasures = None
 
     def __post_init__(self):
         if not isinstance(self.column, str) or not self.column:
@@ -69,11 +72,28 @@ class ColumnOutcome:
             self.max_tilt_deg, f"column {self.column}: max_tilt_deg"))
         object.__setattr__(self, "base_slip_m", _non_negative(
             self.base_slip_m, f"column {self.column}: base_slip_m"))
+        if self.damage is not None:
+            try:
+                damage = (self.damage if isinstance(self.damage, DamageMeasures)
+                          else DamageMeasures.from_dict(self.damage))
+            except (TypeError, InputError) as exc:
+                raise InputError(f"column {self.column}: {exc}") from None
+            if damage.toppled != self.toppled:
+                raise InputError(f"column {self.column}: its damage measures say toppled "
+                                 f"{damage.toppled}, the column {self.toppled}")
+            object.__setattr__(self, "damage", damage)
 
     @classmethod
-    def standing(cls, name, x_m, y_m):
-        """A column that never moved, at (x_m, y_m) on the pedestal."""
-        return cls(column=name, toppled=False, position_m=[x_m, y_m])
+    def standing(cls, name, x_m, y_m, bodies=None):
+        """A column that never moved, at (x_m, y_m) on the pedestal (``bodies``: its
+        scene bodies, for its damage measures, all zero)."""
+        return cls(column=name, toppled=False, position_m=[x_m, y_m],
+                   damage=None if bodies is None else damage_at_rest(bodies))
+
+    def to_dict(self):
+        out = {f.name: getattr(self, f.name) for f in fields(self)}
+        out["damage"] = None if self.damage is None else self.damage.to_dict()
+        return out
 
 
 # parameters' names in summaries written before they took the run parameters' spelling
@@ -144,9 +164,9 @@ class RunSummary:
     @classmethod
     def still(cls, record, columns, **values):
         """A run YADE never ran: every column standing (``columns``: scene column dicts
-        with name, x, y)."""
+        with name, x, y, and bodies for the damage measures, all zero)."""
         return cls(record=record, simulated=False,
-                   columns=[ColumnOutcome.standing(c["name"], c["x"], c["y"])
+                   columns=[ColumnOutcome.standing(c["name"], c["x"], c["y"], c.get("bodies"))
                             for c in columns], **values)
 
     def column(self, name):
@@ -162,8 +182,7 @@ class RunSummary:
             value = getattr(self, f.name)
             if f.name in self.OPTIONAL and value is None:
                 continue
-            out[f.name] = ([{g.name: getattr(c, g.name) for g in fields(c)} for c in value]
-                           if f.name == "columns" else value)
+            out[f.name] = ([c.to_dict() for c in value] if f.name == "columns" else value)
         return out
 
     def save(self, path):
