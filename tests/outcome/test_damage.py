@@ -170,3 +170,15 @@ def test_impossible_measures_are_refused(change, message):
                                                    twist_deg=0.0),), toppled=False)
     with pytest.raises(InputError, match=message):
         ColumnOutcome(column="a", toppled=False, damage={**good.to_dict(), **change})
+
+
+def test_run_rows_carry_the_measures_and_state():
+    from pipeline.campaign.tables import DAMAGE_COLUMNS, damage_columns
+    old = damage_columns(None)
+    assert old["damage_state"] == "" and all(math.isnan(old[k]) for k in DAMAGE_COLUMNS)
+    bodies = [drum(0), drum(1)]
+    damage = DamageMeasures.from_dict(column_outcomes(trajectory(
+        [at_rest(bodies), shifted_top(bodies, (0.03, 0.04), 0.0)], bodies))[0]["damage"])
+    row = damage_columns(damage)
+    assert row["max_residual_slide_m"] == pytest.approx(0.05)
+    assert row["damage_state"] == "moderate"
