@@ -8,6 +8,7 @@ from dataclasses import dataclass, field, fields
 from pathlib import Path
 
 from pipeline.files import InputError, read_run_json, write_json
+from pipeline.outcome.colonnade import ColonnadeOutcome
 from pipeline.outcome.damage import DamageMeasures, damage_at_rest
 
 
@@ -110,7 +111,8 @@ class RunSummary:
     one :class:`ColumnOutcome` per column, whether YADE
     ran (``simulated``; ``note`` says why not), the simulated time (s) and window, the
     motion's end, whether the scene stopped early, the time step (s), wall time (s),
-    provenance, ``quiet_after_s`` when the quiet tail was cut, and ``start_in_file_s``.
+    provenance, ``quiet_after_s`` when the quiet tail was cut, ``start_in_file_s``, and for
+    a colonnade its :class:`~pipeline.outcome.colonnade.ColonnadeOutcome` (``colonnade``).
 
     Every time (impact and past-90 times, window, motion end, quiet_after_s) is on the
     record's clock: seconds after the record's first sample.  ``start_in_file_s`` is the
@@ -132,8 +134,9 @@ class RunSummary:
     provenance: dict = field(default_factory=dict)
     quiet_after_s: float = None
     start_in_file_s: float = 0.0
+    colonnade: ColonnadeOutcome = None
 
-    OPTIONAL = ("note", "quiet_after_s")     # written only when set
+    OPTIONAL = ("note", "quiet_after_s", "colonnade")     # written only when set
 
     def __post_init__(self):
         if not isinstance(self.record, str):
@@ -158,6 +161,11 @@ class RunSummary:
         for name in ("motion_end_s", "start_in_file_s"):       # times: may be negative
             object.__setattr__(self, name, _finite(getattr(self, name),
                                                    f"run summary: {name}"))
+        if isinstance(self.colonnade, dict):
+            try:
+                object.__setattr__(self, "colonnade", ColonnadeOutcome(**self.colonnade))
+            except TypeError as exc:
+                raise InputError(f"run summary: colonnade ({exc})") from None
         if not isinstance(self.simulated, bool) or not isinstance(self.stopped_early, bool):
             raise InputError("run summary: simulated and stopped_early must be true or false")
 
@@ -182,7 +190,11 @@ class RunSummary:
             value = getattr(self, f.name)
             if f.name in self.OPTIONAL and value is None:
                 continue
-            out[f.name] = ([c.to_dict() for c in value] if f.name == "columns" else value)
+            if f.name == "columns":
+                value = [c.to_dict() for c in value]
+            elif f.name == "colonnade":
+                value = {g.name: getattr(value, g.name) for g in fields(value)}
+            out[f.name] = value
         return out
 
     def save(self, path):

@@ -50,6 +50,33 @@ def load(name_or_path):
     """The :class:`Colonnade` of a shipped example's name or a file (.json; .yaml/.yml with
     PyYAML); a column given as a file is found beside the colonnade's file.  Any problem
     is one InputError naming the file."""
+    path = _found(name_or_path)
+    return from_dict(_read(path), where=path.name, base=path.resolve().parent)
+
+
+def load_if_colonnade(value):
+    """The :class:`Colonnade` that ``value`` (what a column file option holds: a name, a
+    file or a description dict) describes, or None when it describes no colonnade (a
+    column: no ``stylobate``, or no such file or name here)."""
+    if isinstance(value, dict):
+        return from_dict(value) if "stylobate" in value else None
+    try:
+        path = _found(value)
+    except InputError:
+        return None
+    try:
+        data = _read(path)
+    except InputError:
+        if path.parent == COLONNADES_DIR:
+            raise
+        return None          # the column loader says what is wrong with it
+    if not (isinstance(data, dict) and "stylobate" in data):
+        return None
+    return from_dict(data, where=path.name, base=path.resolve().parent)
+
+
+def _found(name_or_path):
+    """The Path of a shipped colonnade's name or of a file; InputError when neither."""
     text = str(name_or_path)
     path = Path(text)
     shipped = COLONNADES_DIR / f"{text}.json"
@@ -63,6 +90,11 @@ def load(name_or_path):
         shown = text if text.isprintable() and len(text) <= 300 else _show(text)
         raise InputError(f"colonnade {shown}: no such file or shipped colonnade (shipped: "
                          f"{', '.join(shipped_names())})")
+    return path
+
+
+def _read(path):
+    """The parsed content of a colonnade file (JSON or YAML); InputError naming it."""
     yaml_file = path.suffix.lower() in (".yaml", ".yml")
     try:
         raw = read_text(path)
@@ -77,7 +109,7 @@ def load(name_or_path):
                          f"({_one_line(exc.strerror or exc)})") from None
     except _Unreadable as exc:
         raise InputError(f"{path}: not a readable colonnade description ({exc})") from None
-    return from_dict(data, where=path.name, base=path.resolve().parent)
+    return data
 
 
 def from_dict(data, where="colonnade description", base=None):
