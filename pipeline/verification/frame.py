@@ -32,6 +32,7 @@ from pipeline.verification.one_cosine import (MR_BLOCK, TOLERANCE_YADE, YADE_RUN
 
 FRAME_GAMMAS = (0.25, 1.0, 4.0)     # beam mass over the columns' mass
 FRAME_COLUMNS = (2, 4)
+FRAME_PERIOD_S = 1.0                # the verification campaign's pulse (Fig. 11's)
 SPACING_M = 2.0                     # axis to axis
 BEAM_HEIGHT_M = 0.5
 # critical damping: Housner's restitution (as the block's checks); mu 2: no sliding
@@ -147,3 +148,25 @@ def verify_frame(n_columns=2, gamma=1.0, period_s=1.0, runs=YADE_RUNS, run_dir=N
     result["passed"] = bool(result["yade_rel_error"] is not None
                             and abs(result["yade_rel_error"]) <= TOLERANCE_YADE)
     return result
+
+
+def summarise_frames(results):
+    """The frame section of the verification's summary from its checks' results
+    (CheckResult dicts): per frame the rigid and YADE thresholds (g), their relative
+    difference, the single column's threshold and the frame's over it; and a line for
+    the REPORT."""
+    rows = sorted(({"n_columns": r["n_columns"], "gamma": r["gamma"],
+                    "period_s": r["period_s"], "integration_g": r["integration"]["threshold_g"],
+                    "yade_g": r["yade"]["threshold_g"], "rel_error": r["yade_rel_error"],
+                    "single_column_g": r["single_column_threshold_g"],
+                    "over_single": r["integration"]["threshold_g"]
+                    / r["single_column_threshold_g"], "passed": r["passed"]}
+                   for r in results), key=lambda row: (row["n_columns"], row["gamma"]))
+    errors = [abs(row["rel_error"]) for row in rows if row["rel_error"] is not None]
+    ratios = [row["over_single"] for row in rows]
+    line = (f"Rocking frame (Makris & Vassiliou 2013), one-cosine pulse: YADE within "
+            f"{100 * TOLERANCE_YADE:g} % of the rigid frame's smallest overturning amplitude "
+            f"in {sum(row['passed'] for row in rows)}/{len(rows)} frames (largest difference "
+            f"{100 * max(errors, default=math.nan):.1f} %); the frames overturn at "
+            f"{min(ratios):.2f} to {max(ratios):.2f} times the single column's amplitude")
+    return {"frames": rows, "tolerance_yade": TOLERANCE_YADE, "lines": [line]}

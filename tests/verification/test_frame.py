@@ -54,3 +54,17 @@ def test_the_frame_lifts_at_g_tan_alpha_whatever_its_beam(tmp_path, gamma):
         tilts.append(max(o["max_tilt_deg"] for o in outcomes if o["column"] != "B"))
     assert tilts[0] < 0.05           # the contacts' elastic share only
     assert tilts[1] > 0.5
+
+
+def test_the_campaign_runs_the_frames_and_reports_them():
+    from pipeline import verification
+    checks = [c for c in verification.campaign_checks("code") if c.kind == "frame"]
+    assert sorted((c["n_columns"], c["gamma"]) for c in checks) == sorted(
+        (n, g) for n in verification.FRAME_COLUMNS for g in verification.FRAME_GAMMAS)
+    result = {"test": "frame", "passed": True, "n_columns": 2, "gamma": 1.0, "period_s": 1.0,
+              "integration": {"threshold_g": 0.9}, "single_column_threshold_g": 0.6,
+              "yade": {"threshold_g": 0.91}, "yade_rel_error": 0.01 / 0.9}
+    out = verification.summarise_campaign([(checks[0], verification.CheckResult(result))])
+    (row,) = out["frame"]["frames"]
+    assert row["over_single"] == pytest.approx(1.5)
+    assert "1/1 frames" in out["lines"][-1] and "1.50 to 1.50" in out["lines"][-1]
