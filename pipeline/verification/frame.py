@@ -30,7 +30,10 @@ from pipeline.verification.checks import HOUSNER_DAMPING
 from pipeline.verification.one_cosine import (MR_BLOCK, TOLERANCE_YADE, YADE_RUNS,
                                               bracketed_threshold, check_period, check_runs)
 
-FRAME_GAMMAS = (0.25, 1.0, 4.0)     # beam mass over the columns' mass
+# beam mass over the columns' mass: at gamma 4 the rigid frame under the 1 s pulse no
+# longer overturns after an impact, only without one at 4.8 g, beyond any friction (YADE's
+# frame, sliding, overturns at 3.2 g): the check keeps to the lighter beams
+FRAME_GAMMAS = (0.25, 0.5, 1.0)
 FRAME_COLUMNS = (2, 4)
 FRAME_PERIOD_S = 1.0                # the verification campaign's pulse (Fig. 11's)
 SPACING_M = 2.0                     # axis to axis
