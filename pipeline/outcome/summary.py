@@ -172,9 +172,11 @@ class RunSummary:
     @classmethod
     def still(cls, record, columns, **values):
         """A run YADE never ran: every column standing (``columns``: scene column dicts
-        with name, x, y, and bodies for the damage measures, all zero)."""
+        with name, x, y, and bodies for the damage measures, all zero; none for a
+        colonnade's beams, which rest on others)."""
         return cls(record=record, simulated=False,
-                   columns=[ColumnOutcome.standing(c["name"], c["x"], c["y"], c.get("bodies"))
+                   columns=[ColumnOutcome.standing(c["name"], c["x"], c["y"],
+                                                   None if c.get("rests_on") else c.get("bodies"))
                             for c in columns], **values)
 
     def column(self, name):

@@ -71,3 +71,38 @@ def test_a_colonnade_left_alone_stands(tmp_path, scene):
         assert column.damage.damage_state == DamageState.NONE      # off their axis
         assert column.damage.max_residual_slide_m < 0.002
     assert all(c.damage is None for c in summary.columns[4:])
+
+
+def test_a_run_a_yade_never_ran_gives_beams_no_damage(scene):
+    from pipeline.outcome.summary import RunSummary
+    summary = RunSummary.still("quiet", scene.columns, colonnade=None)
+    assert [c.damage is None for c in summary.columns] == [False] * 4 + [True] * 6
+
+
+@pytest.mark.yade
+def test_a_colonnade_run_writes_its_description_and_outcome(tmp_path):
+    """simulate() with the colonnade as the column file: summary.json holds the
+    description (parameters.colonnade) and the colonnade's outcome."""
+    import math
+
+    from pipeline.constants import MODEL_GRAVITY as G
+    from pipeline.motion import Motion
+    from pipeline.outcome.summary import RunSummary
+    from pipeline.scenario import Numerics, RunParams
+    from pipeline.simulate import simulate
+    dt, hz = 0.005, 2.0
+    t = np.arange(0.0, 1.0, dt)
+    w = 2 * math.pi * hz
+    a = 0.3 * G * np.sin(w * t)          # above the pre-check's 0.9 g tan(alpha), 0.17 g
+    zero = 0 * t
+    motion = Motion(dt, np.column_stack([a, zero, zero]),
+                    np.column_stack([0.3 * G / w * (1 - np.cos(w * t)), zero, zero]),
+                    np.column_stack([0.3 * G / w * (t - np.sin(w * t) / w), zero, zero]),
+                    meta={"record_id": "sine"})
+    run = RunParams(Column(column_file=NAME), numerics=Numerics(tail_s=0.5))
+    simulate(motion, tmp_path / "run", run)
+    summary = RunSummary.load(tmp_path / "run")
+    assert summary.simulated
+    assert summary.parameters["colonnade"]["name"] == NAME
+    assert summary.colonnade.name == NAME and summary.colonnade.columns == 4
+    assert len(summary.columns) == 10
