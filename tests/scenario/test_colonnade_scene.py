@@ -106,3 +106,11 @@ def test_a_colonnade_run_writes_its_description_and_outcome(tmp_path):
     assert summary.parameters["colonnade"]["name"] == NAME
     assert summary.colonnade.name == NAME and summary.colonnade.columns == 4
     assert len(summary.columns) == 10
+
+
+def test_a_campaign_refuses_a_colonnade_in_one_line():
+    from pipeline.campaign.column_file import description
+    from pipeline.files import InputError
+    with pytest.raises(InputError, match="a colonnade; the campaigns take one column"):
+        description(NAME)
+    assert description("doric-peristyle")["name"] == "doric-peristyle"
