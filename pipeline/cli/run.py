@@ -73,6 +73,12 @@ def check_run_options(args):
 def run(args):
     check_run_options(args)
     column = from_args(Column, args, centred=True if args.centred else None)
+    if column.colonnade is not None:
+        given = [flag for flag, name in (("--column", "kind"), ("--centred", "centred"))
+                 if getattr(args, name, None)]
+        if given:
+            raise InputError(f"--column-file {column.colonnade.name} is a colonnade, which "
+                             f"places its own columns: drop {', '.join(given)}")
     contact, numerics = _contact(args), from_args(Numerics, args)
     check_time_step(contact, numerics)
     out = args.out
