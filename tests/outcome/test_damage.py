@@ -182,3 +182,25 @@ def test_run_rows_carry_the_measures_and_state():
     row = damage_columns(damage)
     assert row["max_residual_slide_m"] == pytest.approx(0.05)
     assert row["damage_state"] == "moderate"
+
+
+def test_a_colonnade_says_how_many_fell_parallel_and_in_sequence():
+    from pipeline.outcome.colonnade import ColonnadeOutcome
+
+    def column(name, x, azimuth=None, time=None):
+        return ColumnOutcome(column=name, toppled=azimuth is not None,
+                             downfall_azimuth_deg=azimuth, impact_time_s=time,
+                             position_m=[x, 0.5 * x])
+    row = [column("A", 0.0, 88.0, 1.0), column("B", 2.0, 92.0, 1.6),
+           column("C", 4.0, 90.0, 2.2), column("D", 6.0)]
+    beams = [ColumnOutcome(column="E", toppled=True, downfall_azimuth_deg=10.0),
+             ColumnOutcome(column="F", toppled=False)]
+    whole = ColonnadeOutcome.of("row", row, beams)
+    assert (whole.columns, whole.columns_fallen, whole.beams, whole.beams_fallen) == (4, 3, 2, 1)
+    assert whole.fall_azimuth_mean_deg == pytest.approx(90.0, abs=1e-9)
+    assert whole.parallel and whole.fall_azimuth_spread_deg < 3.0
+    assert whole.fall_order == ("A", "B", "C") and whole.in_sequence
+    row[1] = column("B", 2.0, 270.0, 3.0)           # B falls last, the other way
+    whole = ColonnadeOutcome.of("row", row, beams)
+    assert whole.fall_order == ("A", "C", "B") and not whole.in_sequence
+    assert not whole.parallel
