@@ -101,7 +101,8 @@ class JointDislocation:
 class DamageMeasures:
     """A column's damage measures (module docstring): ``peak_capital_displacement_m``,
     ``base_width_m`` (D), ``max_rotation_deg`` (theta_max), ``critical_angle_deg``
-    (alpha; None for a column placed off its rest), one :class:`JointDislocation` per
+    (alpha, from the placement: for a block released tilted the angle left to tip; None
+    when a stack's centre of mass is not above its face), one :class:`JointDislocation` per
     joint bottom up, and whether the column ``toppled`` (its state is then collapse)."""
     peak_capital_displacement_m: float
     base_width_m: float
