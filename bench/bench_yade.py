@@ -35,8 +35,8 @@ One run prints, and writes to results/bench/bench.json (+ convergence.png):
 
 Units: seconds (s), metres, m/s^2; azimuths in degrees clockwise from North.
 ``--quick`` shortens every run and skips the convergence table (for development);
-``--only-rock-fragility`` (section 11) and ``--only-run-wing`` (section 12) run one section
-and add it to an existing bench.json.
+``--only-rock-fragility`` (section 11), ``--only-run-wing`` (section 12) and
+``--only-colonnade`` (section 13) run one section and add it to an existing bench.json.
 """
 import argparse
 import contextlib
@@ -68,6 +68,7 @@ from pipeline.scenario import (Column, Contact, Numerics, RunParams, run_yade, s
 from pipeline.scenario.runner import reuse_processes  # noqa: E402
 from pipeline.scenario.scene_file import Measurement, SceneFile  # noqa: E402
 from pipeline.simulate import can_move  # noqa: E402
+from colonnade_bench import colonnade_cost, print_colonnade_cost  # noqa: E402
 
 STARTUP_T_MAX_S = 1e-3          # a run this short measures YADE's start-up (s)
 PULSE = {"azimuth_deg": 30.0, "amplitude": 5.0, "period": 1.0, "duration": 8.0}   # deg, m/s^2, s, s
@@ -910,10 +911,19 @@ def main(argv=None):
     parser.add_argument("--only-rock-fragility", action="store_true",
                         help="run only section 11 (adaptive against full pulse grid) and add "
                         "it to the bench.json in --out")
+    parser.add_argument("--only-colonnade", action="store_true",
+                        help="run only section 13 (a colonnade beside its columns apart) and "
+                        "add it to the bench.json in --out")
     parser.add_argument("--only-run-wing", action="store_true",
                         help="run only section 12 (the run command against revision "
                         f"{RUN_WING_REFERENCE}) and add it to the bench.json in --out")
     args = parser.parse_args(argv)
+    colonnade_s = args.duration or (1.0 if args.quick else 5.0)
+
+    def colonnade(work):
+        return colonnade_cost(work, shaking_motion(colonnade_s), colonnade_s)
+    if args.only_colonnade:
+        return only_section(args.out, "colonnade", colonnade, print_colonnade_cost)
     if args.only_run_wing:
         return only_section(args.out, "run_wing", run_wing, print_run_wing)
     if args.only_rock_fragility:
@@ -962,6 +972,8 @@ def main(argv=None):
         print_rock_fragility(result["rock_fragility_adaptive"])
         result["run_wing"] = run_wing(work, repeats=1 if args.quick else RUN_WING_REPEATS)
         print_run_wing(result["run_wing"])
+        result["colonnade"] = colonnade(work)
+        print_colonnade_cost(result["colonnade"])
     result["bench_wall_s"] = time.perf_counter() - started
     write_json(args.out / "bench.json", result)
     print(f"\nbench: {result['bench_wall_s']:.0f} s wall; wrote {args.out / 'bench.json'}")

@@ -16,6 +16,7 @@ from pipeline.provenance import software_versions
 from pipeline.outcome.columns import summarise
 from pipeline.outcome.summary import RunSummary
 from pipeline.scenario import RunParams, run_yade, scene_params, write_scenario
+from pipeline.scenario.colonnade_file import to_dict as colonnade_to_dict
 from pipeline.scenario.parameters import MAX_SCALE
 
 
@@ -104,10 +105,15 @@ def quiet_window(drive, columns, contact, lead_s):
 
 def geometry_parameters(column):
     """Summary parameters of a described column (none for the paper's columns): hd,
-    height, drums and density of the description, its name and the description itself."""
+    height, drums and density of the description, its name and the description itself;
+    of a colonnade its name and its description (``colonnade``)."""
     g = column.geometry
     if g is None:
         return {}
+    if column.colonnade is not None:
+        return {"column_file": (column.column_file if isinstance(column.column_file, str)
+                                else column.colonnade.name),
+                "colonnade": colonnade_to_dict(column.colonnade)}
     return {**column.sizes(),
             "column_file": (column.column_file if isinstance(column.column_file, str)
                             else g.name), "geometry": g.to_dict()}
@@ -135,7 +141,8 @@ def simulate(motion, out_dir, run=None, back_azimuth=None, record=None, motion_f
     if signal_end is not None:          # the stop checks treat the motion as over there
         shift = drive.start_in_file_s - motion.start_in_file_s     # the window's start
         signal_end = float(min(max(signal_end - shift, 0.0), drive.duration))
-    params = scene_params(columns=column.specs(), contact=contact, numerics=numerics,
+    params = scene_params(columns=column.specs(), colonnade=column.colonnade,
+                          contact=contact, numerics=numerics,
                           motion_duration=drive.duration,
                           t_max=None if signal_end is None else signal_end + numerics.tail_s)
     params = dataclasses.replace(params, signal_end_s=signal_end)
@@ -168,6 +175,8 @@ def simulate(motion, out_dir, run=None, back_azimuth=None, record=None, motion_f
         summary = summarise(trajectory, record=record, back_azimuth_deg=drive.back_azimuth,
                             parameters=parameters, provenance=provenance,
                             quiet_after_s=params.quiet_after_s,
-                            start_in_file_s=drive.start_in_file_s)
+                            start_in_file_s=drive.start_in_file_s,
+                            colonnade=None if column.colonnade is None
+                            else column.colonnade.name)
     summary.save(out_dir / "summary.json")
     return summary

@@ -140,8 +140,11 @@ def rim_spheres(rim, floor_z=None):
     return np.column_stack([xy + RIM_R * n[:2], z + RIM_R * n[2]])
 
 
-def add_body(body, mask_base, mask_top, material):
-    """Add one rigid body (a params.json body) as a clump; return its clump id."""
+def add_body(body, mask_base, mask_top, material, mask_plate=None):
+    """Add one rigid body (a params.json body) as a clump; return its clump id.  Its base
+    rims' spheres take ``mask_base``, its other rims' ``mask_top``, its top plate
+    ``mask_plate`` (default ``mask_base``)."""
+    mask_plate = mask_base if mask_plate is None else mask_plate
     centre = np.asarray(body["centre"], float)
     R = np.asarray(body["rotation"], float)
     axes = R @ np.asarray(body["principal_axes"], float)          # world
@@ -169,7 +172,7 @@ def add_body(body, mask_base, mask_top, material):
             members.append(utils.box(world((cx, cy, cz - PLATE_HALF_THICKNESS)),
                                      (hx + RIM_R, hy + RIM_R, PLATE_HALF_THICKNESS),
                                      orientation=yade_quaternion(R), material=material,
-                                     mask=mask_base))
+                                     mask=mask_plate))
         members.append(utils.sphere(world((0, 0, 0)), CLUMP["core_radius_m"], material=CORE,
                                     mask=CORE_MASK))
         if frame_spheres:
@@ -222,9 +225,9 @@ def add_pedestal(mask, material):
 
 
 def base_points(body):
-    """Number of contact points of a body's base rim."""
-    rim = next(r for r in body["rims"] if r["role"] == "base")
-    return RIM_POINTS if rim["kind"] == "circle" else len(rim["points"])
+    """Number of contact points of a body's base rims (a beam has one per support)."""
+    return sum(RIM_POINTS if rim["kind"] == "circle" else len(rim["points"])
+               for rim in body["rims"] if rim["role"] == "base")
 
 
 # one material per (mass, base points): the contact damping follows the body resting
@@ -239,11 +242,20 @@ def material_of(body):
     return materials[key]
 
 
+# collision masks: two bits per column (a colonnade's beams are columns of one body),
+# base (its bodies' base rims and top plates) and top (its other rims); the top plates of
+# a column or beam that beams rest on (``rests_on``) also take those beams' base bits, so
+# that the beams' base rims meet them (and two beams on one capital never meet)
+mask_plate = {col["name"]: 1 << (2 * c) for c, col in enumerate(COLUMNS)}
+for c, col in enumerate(COLUMNS):
+    for name in col.get("rests_on", ()):
+        mask_plate[name] |= 1 << (2 * c)
 for c, col in enumerate(COLUMNS):
     mask_base, mask_top = 1 << (2 * c), 1 << (2 * c + 1)
     add_pedestal(mask_base | mask_top, material_of(col["bodies"][0]))
     for body in col["bodies"]:
-        clump_id = add_body(body, mask_base, mask_top, material_of(body))
+        clump_id = add_body(body, mask_base, mask_top, material_of(body),
+                            mask_plate[col["name"]])
         clumps.append(clump_id)
         meta = {k: v for k, v in body.items() if k not in ("centre", "rotation")}
         bodies.append(dict(meta, initial_pos=list(body["centre"]),

@@ -23,6 +23,7 @@ import math
 
 from pipeline import paper
 from pipeline.files import InputError
+from pipeline.scenario.colonnade_file import load_if_colonnade
 from pipeline.scenario.column_format import example_names
 from pipeline.scenario.geometry import ColumnGeometry
 
@@ -45,6 +46,10 @@ def description(column_file, meshes=False):
     campaign that scales or perturbs blocks cannot take one)."""
     if column_file is None:
         return None
+    if (isinstance(column_file, (dict, str))) and load_if_colonnade(column_file) is not None:
+        shown = column_file["name"] if isinstance(column_file, dict) else column_file
+        raise InputError(f"--column-file {shown}: a colonnade; the campaigns take one column "
+                         "(colonnades run with run)")
     if isinstance(column_file, dict):
         data = ColumnGeometry.from_dict(column_file).to_dict()
     elif not isinstance(column_file, str) or not column_file.strip():

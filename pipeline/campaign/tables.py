@@ -74,7 +74,8 @@ def _tables(specs, campaign, campaign_dir):
                 "downfall_azimuth_deg": _nan(col.downfall_azimuth_deg),
                 "impact_time_s": _nan(col.impact_time_s), "impact_x_m": point[0],
                 "impact_y_m": point[1], "max_tilt_deg": col.max_tilt_deg,
-                "base_slip_m": col.base_slip_m, "simulated": summary.simulated,
+                "base_slip_m": col.base_slip_m, **damage_columns(col.damage),
+                "simulated": summary.simulated,
                 "simulated_from_s": _nan((summary.simulated_window_s or [None])[0]),
                 "simulated_s": summary.simulated_s,
                 "start_in_file_s": summary.start_in_file_s,
@@ -95,3 +96,16 @@ def _tables(specs, campaign, campaign_dir):
 
 def _nan(value):
     return math.nan if value is None else value
+
+
+DAMAGE_COLUMNS = ("peak_capital_displacement_m", "capital_displacement_ratio",
+                  "max_residual_slide_m", "max_residual_twist_deg", "rotation_ratio")
+
+
+def damage_columns(damage):
+    """A run row's damage measures and state (:mod:`pipeline.outcome.damage`; NaN and
+    an empty state for a summary written before them)."""
+    if damage is None:
+        return {**dict.fromkeys(DAMAGE_COLUMNS, math.nan), "damage_state": ""}
+    return {**{k: _nan(getattr(damage, k)) for k in DAMAGE_COLUMNS},
+            "damage_state": damage.damage_state.label}

@@ -74,6 +74,12 @@ def check_run_options(args):
 def run(args):
     check_run_options(args)
     column = from_args(Column, args, centred=True if args.centred else None)
+    if column.colonnade is not None:
+        given = [flag for flag, name in (("--column", "kind"), ("--centred", "centred"))
+                 if getattr(args, name, None)]
+        if given:
+            raise InputError(f"--column-file {column.colonnade.name} is a colonnade, which "
+                             f"places its own columns: drop {', '.join(given)}")
     contact, numerics = _contact(args), from_args(Numerics, args)
     check_time_step(contact, numerics)
     out = args.out
@@ -84,7 +90,8 @@ def run(args):
     motion, _ = processed_motion(args.record, back_azimuth=args.back_azimuth, cache_dir=None,
                                  mode=args.processing)
     length = _simulated_length(motion, args.window)
-    check_cost(scene_params(columns=column.specs(), contact=contact, numerics=numerics,
+    check_cost(scene_params(columns=column.specs(), colonnade=column.colonnade,
+                            contact=contact, numerics=numerics,
                             motion_duration=length), wall_limit_s(length + numerics.tail_s))
     with DirectoryLock(out, wait=False):
         summary = simulate(motion, out, RunParams(column, contact, numerics, Drive(
@@ -99,6 +106,12 @@ def run(args):
               f"start at {summary.start_in_file_s:.2f} s)")
     for col in summary.columns:
         print(_outcome_line(col, column.geometry is not None))
+    if summary.colonnade is not None:
+        whole = summary.colonnade
+        spread = ("" if whole.fall_azimuth_spread_deg is None else
+                  f", fall azimuths spread {whole.fall_azimuth_spread_deg:.0f} deg")
+        print(f"colonnade {whole.name}: {whole.columns_fallen} of {whole.columns} columns and "
+              f"{whole.beams_fallen} of {whole.beams} beams fell{spread}")
     print(f"wrote {out / 'summary.json'} ({summary.simulated_s:.1f} s simulated in "
           f"{summary.wall_s:.1f} s)")
     return 0
@@ -151,6 +164,10 @@ def _print_column(column, contact, numerics):
               f"{rock.critical_angle_deg():.1f} deg"
               + (f", settled {rock.settled_by_deg:.2f} deg onto its base"
                  if rock.settled_by_deg > 0.01 else ""))
+    elif column.colonnade is not None:
+        c = column.colonnade
+        print(f"colonnade {c.name!r}: {len(c.columns)} columns, {len(c.epistyles)} epistyles, "
+              f"{len(c.frieze)} frieze blocks")
     elif column.geometry is not None:
         roles = {"drums": "'drums' = as described",
                  "monolithic": "'monolithic' = one stone of its outline"}

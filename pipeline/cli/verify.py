@@ -4,6 +4,7 @@
     python -m pipeline verify sine-pulse --height 3.113 --width 0.795 --amplitude-ratio 6.5
     python -m pipeline verify sliding
     python -m pipeline verify one-cosine --period 1.0 --runs 10
+    python -m pipeline verify frame --columns 2 --gamma 1.0 --runs 10
 """
 from pathlib import Path
 
@@ -13,8 +14,9 @@ from pipeline.scenario.parameters import MU_K_OVER_MU_S
 from pipeline.verification import (MARBLE_BLOCK, PULSE_BLOCK, SLIDING_BELOW, SLIDING_MU,
                                    CheckResult, check_sliding_mus, verify_housner,
                                    verify_one_cosine, verify_sine_pulse, verify_sliding)
+from pipeline.verification.frame import frame_colonnade, verify_frame
 from pipeline.verification.one_cosine import (MR_BLOCK, YADE_RUNS, check_block_sizes,
-                                              check_one_cosine)
+                                              check_one_cosine, check_period, check_runs)
 
 NAME = "verify"
 ORDER = 30
@@ -52,7 +54,14 @@ def setup(p):
     c.add_argument("--depth", type=float, default=MR_BLOCK["depth"], help="m (1.0)")
     c.add_argument("--period", type=float, default=1.0, help="pulse period T_p, s (1.0)")
     c.add_argument("--runs", type=int, default=YADE_RUNS, help=f"YADE runs ({YADE_RUNS})")
-    for q in (h, s, sl, c):
+    f = sub.add_parser("frame", help="smallest overturning amplitude of columns under a beam "
+                       "(one-cosine pulse), rigid frame and YADE (Makris & Vassiliou 2013)")
+    f.add_argument("--columns", type=int, default=2, help="columns under the beam (2)")
+    f.add_argument("--gamma", type=float, default=1.0,
+                   help="beam mass over the columns' mass (1.0)")
+    f.add_argument("--period", type=float, default=1.0, help="pulse period T_p, s (1.0)")
+    f.add_argument("--runs", type=int, default=YADE_RUNS, help=f"YADE runs ({YADE_RUNS})")
+    for q in (h, s, sl, c, f):
         q.add_argument("--kn", type=float, default=None, help="face contact stiffness N/m")
         q.add_argument("--damping", type=float, default=None,
                        help="contact damping ratio (housner: 1.0, critical; others: 0.36)")
@@ -82,6 +91,8 @@ def run(args):
               f"{result['integration']['mode']} (direction {result['integration']['direction']:+d})")
     elif args.test == "one-cosine":
         result = _one_cosine(args, contact)
+    elif args.test == "frame":
+        result = _frame(args, contact)
     else:
         kwargs = {"mu_values": tuple(args.mu_s)} if args.mu_s else {}
         if args.mu_s:
@@ -105,4 +116,16 @@ def _one_cosine(args, contact):
     print(f"2D block overturns from {result['integration']['threshold_g']:.4f} g; YADE stands "
           f"at {y['stands_g']:.4f} g, overturns at {y['overturns_g']:.4f} g ({len(y['runs'])} "
           f"runs); eq. 43: {result['eq43_g']:.4f} g")
+    return result
+
+
+def _frame(args, contact):
+    check_period(args.period)
+    check_runs(args.runs)
+    frame_colonnade(args.columns, args.gamma)       # columns and gamma checked
+    result = verify_frame(args.columns, args.gamma, args.period, args.runs, **contact)
+    y = result["yade"]
+    print(f"rigid frame overturns from {result['integration']['threshold_g']:.4f} g (single "
+          f"column {result['single_column_threshold_g']:.4f} g); YADE stands at "
+          f"{y['stands_g']:.4f} g, overturns at {y['overturns_g']:.4f} g ({len(y['runs'])} runs)")
     return result

@@ -26,6 +26,8 @@ from scipy.spatial.transform import Rotation
 
 from pipeline.constants import LIES_TILT_DEG, MODEL_GRAVITY
 from pipeline.motion import azimuth_deg
+from pipeline.outcome.colonnade import ColonnadeOutcome
+from pipeline.outcome.damage import column_damage
 from pipeline.outcome.summary import ColumnOutcome, RunSummary
 
 CONTACT_TOLERANCE_M = 0.02   # a rim this close to the pedestal top has struck it
@@ -111,9 +113,21 @@ def column_outcomes(trajectory, start_in_file_s=0.0):
         bodies = [entry for j in members
                   if (entry := _body_outcome(trajectory, j, t, axes, origin)) is not None]
         if bodies:
-            results.append(_column_outcome(name, bodies, trajectory.pos[:, members[0], :2],
-                                           first, origin))
+            result = _column_outcome(name, bodies, trajectory.pos[:, members[0], :2],
+                                     first, origin)
+            result["damage"] = None if first.get("rests_on") is not None else \
+                _damage(trajectory, members, result["toppled"]).to_dict()   # not for beams
+            results.append(result)
     return results
+
+
+def _damage(trajectory, members, toppled):
+    """The column's :class:`~pipeline.outcome.damage.DamageMeasures` (its bodies
+    ``members``, bottom up)."""
+    members = sorted(members, key=lambda j: trajectory.bodies[j]["index"])
+    bodies = [trajectory.bodies[j] for j in members]
+    return column_damage(trajectory.pos[:, members], trajectory.quat[:, members], bodies,
+                         [body_rims(b) for b in bodies], toppled)
 
 
 def _body_outcome(trajectory, j, t, axes, origin):
@@ -210,15 +224,21 @@ def total_energy(trajectory, g=MODEL_GRAVITY):
 
 
 def summarise(trajectory, record, back_azimuth_deg=None, parameters=None, provenance=None,
-              quiet_after_s=None, start_in_file_s=0.0):
+              quiet_after_s=None, start_in_file_s=0.0, colonnade=None):
     """The :class:`~pipeline.outcome.summary.RunSummary` of a simulated run, its times on
     the record's clock: the trajectory's clock (and ``quiet_after_s``'s, the scene's) +
-    ``start_in_file_s`` (s, the record time of the motion's first sample)."""
+    ``start_in_file_s`` (s, the record time of the motion's first sample); ``colonnade``:
+    the name of the colonnade the scene holds (its per-colonnade outcome), or None."""
     offset = float(start_in_file_s)
+    columns = [ColumnOutcome(**c) for c in column_outcomes(trajectory, offset)]
+    beams = {b["column"] for b in trajectory.bodies if b.get("rests_on") is not None}
+    whole = None if colonnade is None else ColonnadeOutcome.of(
+        colonnade, [c for c in columns if c.column not in beams],
+        [c for c in columns if c.column in beams])
     end = float(trajectory.t[-1]) if len(trajectory.t) else trajectory.start_s
     return RunSummary(
         record=record, back_azimuth_deg=back_azimuth_deg, parameters=parameters or {},
-        columns=[ColumnOutcome(**c) for c in column_outcomes(trajectory, offset)],
+        columns=columns, colonnade=whole,
         simulated_s=trajectory.simulated_s,
         simulated_window_s=[trajectory.start_s + offset, end + offset],
         motion_end_s=trajectory.motion_end + offset,

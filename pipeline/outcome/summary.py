@@ -8,6 +8,8 @@ from dataclasses import dataclass, field, fields
 from pathlib import Path
 
 from pipeline.files import InputError, read_run_json, write_json
+from pipeline.outcome.colonnade import ColonnadeOutcome
+from pipeline.outcome.damage import DamageMeasures, damage_at_rest
 
 
 def _azimuth_or_none(value, name):
@@ -43,8 +45,9 @@ class ColumnOutcome:
     """One column of a run: toppled or standing, downfall azimuth (deg clockwise from
     North, None when standing), first impact time (s, record's clock) and point (m, pedestal
     frame, mass-weighted), largest tilt (deg), base slip (m), initial position (m), the
-    rule that decided the fall (``toppled_by``) and one dict per body
-    (:mod:`pipeline.outcome.columns`)."""
+    rule that decided the fall (``toppled_by``), one dict per body
+    (:mod:`pipeline.outcome.columns`) and its :class:`~pipeline.outcome.damage.DamageMeasures`
+    (``damage``; None in summaries written before them)."""
     column: str
     toppled: bool
     toppled_by: str = None
@@ -55,6 +58,7 @@ class ColumnOutcome:
     base_slip_m: float = 0.0
     position_m: list = field(default_factory=lambda: [0.0, 0.0])
     bodies: list = field(default_factory=list)
+    damage: DamageMeasures = None
 
     def __post_init__(self):
         if not isinstance(self.column, str) or not self.column:
@@ -69,11 +73,28 @@ class ColumnOutcome:
             self.max_tilt_deg, f"column {self.column}: max_tilt_deg"))
         object.__setattr__(self, "base_slip_m", _non_negative(
             self.base_slip_m, f"column {self.column}: base_slip_m"))
+        if self.damage is not None:
+            try:
+                damage = (self.damage if isinstance(self.damage, DamageMeasures)
+                          else DamageMeasures.from_dict(self.damage))
+            except (TypeError, InputError) as exc:
+                raise InputError(f"column {self.column}: {exc}") from None
+            if damage.toppled != self.toppled:
+                raise InputError(f"column {self.column}: its damage measures say toppled "
+                                 f"{damage.toppled}, the column {self.toppled}")
+            object.__setattr__(self, "damage", damage)
 
     @classmethod
-    def standing(cls, name, x_m, y_m):
-        """A column that never moved, at (x_m, y_m) on the pedestal."""
-        return cls(column=name, toppled=False, position_m=[x_m, y_m])
+    def standing(cls, name, x_m, y_m, bodies=None):
+        """A column that never moved, at (x_m, y_m) on the pedestal (``bodies``: its
+        scene bodies, for its damage measures, all zero)."""
+        return cls(column=name, toppled=False, position_m=[x_m, y_m],
+                   damage=None if bodies is None else damage_at_rest(bodies))
+
+    def to_dict(self):
+        out = {f.name: getattr(self, f.name) for f in fields(self)}
+        out["damage"] = None if self.damage is None else self.damage.to_dict()
+        return out
 
 
 # parameters' names in summaries written before they took the run parameters' spelling
@@ -90,7 +111,8 @@ class RunSummary:
     one :class:`ColumnOutcome` per column, whether YADE
     ran (``simulated``; ``note`` says why not), the simulated time (s) and window, the
     motion's end, whether the scene stopped early, the time step (s), wall time (s),
-    provenance, ``quiet_after_s`` when the quiet tail was cut, and ``start_in_file_s``.
+    provenance, ``quiet_after_s`` when the quiet tail was cut, ``start_in_file_s``, and for
+    a colonnade its :class:`~pipeline.outcome.colonnade.ColonnadeOutcome` (``colonnade``).
 
     Every time (impact and past-90 times, window, motion end, quiet_after_s) is on the
     record's clock: seconds after the record's first sample.  ``start_in_file_s`` is the
@@ -112,8 +134,9 @@ class RunSummary:
     provenance: dict = field(default_factory=dict)
     quiet_after_s: float = None
     start_in_file_s: float = 0.0
+    colonnade: ColonnadeOutcome = None
 
-    OPTIONAL = ("note", "quiet_after_s")     # written only when set
+    OPTIONAL = ("note", "quiet_after_s", "colonnade")     # written only when set
 
     def __post_init__(self):
         if not isinstance(self.record, str):
@@ -138,15 +161,22 @@ class RunSummary:
         for name in ("motion_end_s", "start_in_file_s"):       # times: may be negative
             object.__setattr__(self, name, _finite(getattr(self, name),
                                                    f"run summary: {name}"))
+        if isinstance(self.colonnade, dict):
+            try:
+                object.__setattr__(self, "colonnade", ColonnadeOutcome(**self.colonnade))
+            except TypeError as exc:
+                raise InputError(f"run summary: colonnade ({exc})") from None
         if not isinstance(self.simulated, bool) or not isinstance(self.stopped_early, bool):
             raise InputError("run summary: simulated and stopped_early must be true or false")
 
     @classmethod
     def still(cls, record, columns, **values):
         """A run YADE never ran: every column standing (``columns``: scene column dicts
-        with name, x, y)."""
+        with name, x, y, and bodies for the damage measures, all zero; none for a
+        colonnade's beams, which rest on others)."""
         return cls(record=record, simulated=False,
-                   columns=[ColumnOutcome.standing(c["name"], c["x"], c["y"])
+                   columns=[ColumnOutcome.standing(c["name"], c["x"], c["y"],
+                                                   None if c.get("rests_on") else c.get("bodies"))
                             for c in columns], **values)
 
     def column(self, name):
@@ -162,8 +192,11 @@ class RunSummary:
             value = getattr(self, f.name)
             if f.name in self.OPTIONAL and value is None:
                 continue
-            out[f.name] = ([{g.name: getattr(c, g.name) for g in fields(c)} for c in value]
-                           if f.name == "columns" else value)
+            if f.name == "columns":
+                value = [c.to_dict() for c in value]
+            elif f.name == "colonnade":
+                value = {g.name: getattr(value, g.name) for g in fields(value)}
+            out[f.name] = value
         return out
 
     def save(self, path):

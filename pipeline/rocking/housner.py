@@ -14,6 +14,7 @@ slender-block form eta ~ 1 - 1.5 (b/h)^2 ~ 1 - 1.5 alpha^2; we use the exact
 sin^2(alpha) form everywhere (for alpha = 0.25: 0.9082 vs 0.9063).
 """
 import math
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -57,6 +58,47 @@ def cylinder_constants(height, diameter, g=MODEL_GRAVITY):
 
 
 SHAPES = {"block": block_constants, "cylinder": cylinder_constants}
+
+
+@dataclass(frozen=True)
+class RockingBody:
+    """What Housner's equation theta'' = -p^2 [sin(alpha sgn theta - theta) + a_g / g
+    cos(alpha sgn theta - theta)] needs of a body rocking in a plane: the critical angle
+    ``alpha`` (rad, in (0, pi/2)), the frequency parameter ``p`` (1/s), the coefficient of
+    restitution of the angular velocity at an impact ``restitution`` (in [0, 1]) and
+    gravity ``g`` (m/s^2).  A block or a cylinder (:meth:`of_shape`), or a rocking frame
+    of columns under a beam (:mod:`pipeline.rocking.frame`)."""
+    alpha: float
+    p: float
+    restitution: float
+    g: float = MODEL_GRAVITY
+
+    def __post_init__(self):
+        if not 0.0 < self.alpha < 0.5 * math.pi:
+            raise InputError(f"critical angle alpha must lie in (0, pi/2) rad, got {self.alpha}")
+        if not (self.p > 0 and self.g > 0 and math.isfinite(self.p) and math.isfinite(self.g)):
+            raise InputError(f"frequency parameter p {self.p} and g {self.g} must be positive")
+        if not 0.0 <= self.restitution <= 1.0:
+            raise InputError("coefficient of restitution must lie in [0, 1], got "
+                             f"{self.restitution}")
+
+    @classmethod
+    def of_shape(cls, height, width, shape="block", g=MODEL_GRAVITY, restitution=None):
+        """A homogeneous block or cylinder (``shape``, a key of :data:`SHAPES`) of height and
+        width (diameter) in m, with its own restitution unless ``restitution`` is given."""
+        if shape not in SHAPES:
+            raise InputError(f"rocking shape must be one of {', '.join(SHAPES)}, got {shape!r}")
+        c = SHAPES[shape](height, width, g)
+        return cls(c["alpha"], c["p"], c["restitution"], g).with_restitution(restitution)
+
+    def with_restitution(self, restitution):
+        """This body with another restitution (None: unchanged)."""
+        return self if restitution is None else replace(self, restitution=float(restitution))
+
+    @property
+    def uplift_acc(self):
+        """Ground acceleration (m/s^2) that lifts the body from rest: g tan(alpha)."""
+        return self.g * math.tan(self.alpha)
 
 
 def housner_closed_form(theta0_ratio, r, n):

@@ -7,8 +7,8 @@ import numpy as np
 
 from pipeline.constants import MODEL_GRAVITY
 from pipeline.files import InputError
-from pipeline.rocking.housner import block_constants
-from pipeline.rocking.response import _integrate, _restitution
+from pipeline.rocking.housner import RockingBody
+from pipeline.rocking.response import _integrate
 
 MODE_NO_OVERTURN = 0
 MODE_OVERTURN_AFTER_IMPACT = 1
@@ -31,29 +31,36 @@ def sine_pulse(amplitude, omega, psi):
 
 def sine_pulse_response(height, width, amplitude_ratio, omega_ratio, psi=None,
                         restitution=None, g=MODEL_GRAVITY, t_after=30.0, dt_out=0.005):
-    """Block under a one-sine pulse a_g = A sin(omega t + psi) (Zhang & Makris 2000).
+    """Block (height, width in m) under a one-sine pulse; see :func:`body_sine_pulse_response`."""
+    body = RockingBody.of_shape(height, width, "block", g, restitution)
+    return body_sine_pulse_response(body, amplitude_ratio, omega_ratio, psi, t_after, dt_out)
+
+
+def body_sine_pulse_response(body, amplitude_ratio, omega_ratio, psi=None, t_after=30.0,
+                             dt_out=0.005):
+    """A :class:`~pipeline.rocking.housner.RockingBody` under a one-sine pulse
+    a_g = A sin(omega t + psi) (Zhang & Makris 2000).
 
     A = amplitude_ratio * alpha * g (m/s^2, > 0: the first half-cycle pushes the
-    block West, theta < 0), omega = omega_ratio * p (rad/s).  psi (rad) defaults
+    body West, theta < 0), omega = omega_ratio * p (rad/s).  psi (rad) defaults
     to asin(g tan(alpha) / A), the phase at which uplift starts, placed at t = 0;
     the pulse runs to phase 2 pi (the part before uplift moves nothing).  If
-    A <= g tan(alpha) the block never uplifts (psi = 0).
+    A <= g tan(alpha) the body never uplifts (psi = 0).
 
     Returns the rocking_response dict plus: mode (int, MODE_*), mode_name,
     relative_direction (+1 overturned towards the side of the first push,
     -1 away from it, 0 not overturned), psi (rad), pulse_end (s),
     amplitude (m/s^2), omega (rad/s).
     """
-    c = block_constants(height, width, g)
-    amplitude = amplitude_ratio * c["alpha"] * g
-    omega = omega_ratio * c["p"]
+    amplitude = amplitude_ratio * body.alpha * body.g
+    omega = omega_ratio * body.p
     if not (amplitude > 0 and omega > 0):
         raise InputError("sine pulse amplitude and frequency ratios must be positive")
     if psi is None:
-        psi = math.asin(c["uplift_acc"] / amplitude) if amplitude > c["uplift_acc"] else 0.0
+        psi = math.asin(body.uplift_acc / amplitude) if amplitude > body.uplift_acc else 0.0
     acc, t_pulse = sine_pulse(amplitude, omega, psi)
-    out = _integrate(c, acc, t_pulse + t_after, 0.0, 0.0, _restitution(c, restitution), g,
-                     max_impacts=None, still_after=t_pulse, linearised=False, dt_out=dt_out,
+    out = _integrate(body, acc, t_pulse + t_after, 0.0, 0.0, max_impacts=None,
+                     still_after=t_pulse, linearised=False, dt_out=dt_out,
                      rest_max_step=min(1e-3, t_pulse / 200.0))
     if not out["overturned"]:
         mode = MODE_NO_OVERTURN

@@ -31,7 +31,7 @@ from scipy.integrate import solve_ivp
 
 from pipeline.constants import MODEL_GRAVITY
 from pipeline.files import InputError
-from pipeline.rocking.housner import SHAPES, block_constants
+from pipeline.rocking.housner import RockingBody
 
 _RTOL = 1e-10
 _ATOL = 1e-12
@@ -44,7 +44,14 @@ def housner_free_rocking(height, width, theta0, n_impacts=10, restitution=None, 
                          linearised=False, dt_out=0.001, shape="block"):
     """Free rocking released from rest at theta0 (rad, != 0), Housner's equation; of a
     block, or with ``shape`` "cylinder" of a cylinder of diameter ``width``
-    (:func:`~pipeline.rocking.housner.cylinder_constants`).
+    (:func:`~pipeline.rocking.housner.cylinder_constants`).  See :func:`free_rocking`."""
+    body = RockingBody.of_shape(height, width, shape, g, restitution)
+    return free_rocking(body, theta0, n_impacts, linearised, dt_out)
+
+
+def free_rocking(body, theta0, n_impacts=10, linearised=False, dt_out=0.001):
+    """Free rocking of a :class:`~pipeline.rocking.housner.RockingBody` released from rest
+    at theta0 (rad, != 0).
 
     ``linearised`` uses theta'' = p^2 (theta - alpha sgn theta) instead of the
     full nonlinear equation.  Integrates up to the peak after impact n_impacts.
@@ -54,14 +61,10 @@ def housner_free_rocking(height, width, theta0, n_impacts=10, restitution=None, 
     (rad, signed; index k = amplitude after k impacts, index 0 = theta0),
     peak_ratio (|peak| / alpha); alpha, p, restitution, overturned (bool).
     """
-    if shape not in SHAPES:
-        raise InputError(f"rocking shape must be one of {', '.join(SHAPES)}, got {shape!r}")
-    c = SHAPES[shape](height, width, g)
     if theta0 == 0:
         raise InputError("free rocking needs a non-zero initial tilt theta0")
-    out = _integrate(c, None, _FREE_ROCKING_T_MAX, theta0, 0.0, _restitution(c, restitution), g,
-                     max_impacts=n_impacts, still_after=None, linearised=linearised,
-                     dt_out=dt_out)
+    out = _integrate(body, None, _FREE_ROCKING_T_MAX, theta0, 0.0, max_impacts=n_impacts,
+                     still_after=None, linearised=linearised, dt_out=dt_out)
     peak_t = np.concatenate([[0.0], out["peak_times"]])
     peak_theta = np.concatenate([[float(theta0)], out["peak_theta"]])
     return dict(t=out["t"], theta=out["theta"], omega=out["omega"],
@@ -69,19 +72,29 @@ def housner_free_rocking(height, width, theta0, n_impacts=10, restitution=None, 
                 impact_omega_before=out["impact_omega_before"],
                 impact_omega_after=out["impact_omega_after"],
                 peak_times=peak_t, peak_theta=peak_theta,
-                peak_ratio=np.abs(peak_theta) / c["alpha"], alpha=c["alpha"], p=c["p"],
+                peak_ratio=np.abs(peak_theta) / body.alpha, alpha=body.alpha, p=body.p,
                 restitution=out["restitution"], overturned=out["overturned"])
 
 
 def rocking_response(height, width, acc_func, t_end, restitution=None, g=MODEL_GRAVITY, theta0=0.0,
                      omega0=0.0, still_after=None, dt_out=0.005, rest_max_step=1e-3):
-    """Rocking of the rigid block under a horizontal ground acceleration.
+    """Rocking of the rigid block (height, width in m) under a horizontal ground
+    acceleration; see :func:`body_response`."""
+    body = RockingBody.of_shape(height, width, "block", g, restitution)
+    return body_response(body, acc_func, t_end, theta0, omega0, still_after, dt_out,
+                         rest_max_step)
+
+
+def body_response(body, acc_func, t_end, theta0=0.0, omega0=0.0, still_after=None,
+                  dt_out=0.005, rest_max_step=1e-3):
+    """Rocking of a :class:`~pipeline.rocking.housner.RockingBody` (a block, a cylinder or
+    a frame) under a horizontal ground acceleration.
 
     acc_func(t) -> a_g (m/s^2, positive East), called with scalar t (s).
-    Integrates from t = 0 to t_end (s) or until the block overturns.  If
+    Integrates from t = 0 to t_end (s) or until the body overturns.  If
     ``still_after`` (s) is given, a_g is taken as 0 from then on and the run
     stops early once the outcome is certain (a swing peaks below alpha, or the
-    block rests).  While resting, the uplift condition |a_g| > g tan(alpha) is
+    body rests).  While resting, the uplift condition |a_g| > g tan(alpha) is
     watched with steps of at most rest_max_step (s).
 
     Returns dict: t (s), theta (rad), omega (rad/s) samples; impact_times (s);
@@ -91,19 +104,11 @@ def rocking_response(height, width, acc_func, t_end, restitution=None, g=MODEL_G
     first uplift, 0 if none); max_abs_theta (rad); stop_reason (str);
     alpha, p, restitution.
     """
-    c = block_constants(height, width, g)
     if not t_end > 0:
         raise InputError(f"t_end must be positive, got {t_end}")
-    return _integrate(c, acc_func, t_end, theta0, omega0, _restitution(c, restitution), g,
-                      max_impacts=None, still_after=still_after, linearised=False,
-                      dt_out=dt_out, rest_max_step=rest_max_step)
-
-
-def _restitution(c, restitution):
-    eta = c["restitution"] if restitution is None else float(restitution)
-    if not 0.0 <= eta <= 1.0:
-        raise InputError(f"coefficient of restitution must lie in [0, 1], got {eta}")
-    return eta
+    return _integrate(body, acc_func, t_end, theta0, omega0, max_impacts=None,
+                      still_after=still_after, linearised=False, dt_out=dt_out,
+                      rest_max_step=rest_max_step)
 
 
 def _event(func, direction, terminal):
@@ -112,11 +117,12 @@ def _event(func, direction, terminal):
     return func
 
 
-def _integrate(c, acc_func, t_end, theta0, omega0, eta, g, max_impacts, still_after,
-               linearised, dt_out, rest_max_step=1e-3):
-    """Hybrid integration: rest / rocking segments joined at impacts and uplifts."""
-    alpha, p2 = c["alpha"], c["p"] ** 2
-    omega_rest = _REST_OMEGA_FRACTION * c["p"] * alpha
+def _integrate(body, acc_func, t_end, theta0, omega0, max_impacts, still_after, linearised,
+               dt_out, rest_max_step=1e-3):
+    """Hybrid integration of ``body`` (a RockingBody): rest / rocking segments joined at
+    impacts and uplifts."""
+    alpha, p2, eta, g = body.alpha, body.p ** 2, body.restitution, body.g
+    omega_rest = _REST_OMEGA_FRACTION * body.p * alpha
 
     def acc(t):
         if acc_func is None or (still_after is not None and t >= still_after):
@@ -138,10 +144,10 @@ def _integrate(c, acc_func, t_end, theta0, omega0, eta, g, max_impacts, still_af
             break
         if resting:
             if still_after is not None and t >= still_after \
-                    and abs(acc(t)) < c["uplift_acc"] * (1.0 - 1e-12):
+                    and abs(acc(t)) < body.uplift_acc * (1.0 - 1e-12):
                 stop_reason = "rest"
                 break
-            t, side = _rest(t, t_end, still_after, acc, c["uplift_acc"], rest_max_step, samples)
+            t, side = _rest(t, t_end, still_after, acc, body.uplift_acc, rest_max_step, samples)
             if side:
                 resting = False
                 events["uplift_times"].append(t)
@@ -183,7 +189,7 @@ def _integrate(c, acc_func, t_end, theta0, omega0, eta, g, max_impacts, still_af
                 overturn_direction=int(np.sign(theta)) if overturned else 0,
                 overturn_time=overturn_time, n_impacts=len(events["impact_times"]),
                 first_side=_first_side(events["uplift_times"], theta0, omega0, acc),
-                max_abs_theta=max_abs, stop_reason=stop_reason, alpha=alpha, p=c["p"],
+                max_abs_theta=max_abs, stop_reason=stop_reason, alpha=alpha, p=body.p,
                 restitution=eta)
 
 

@@ -13,6 +13,7 @@ from pipeline.constants import COLUMN_KINDS, COLUMN_TYPES, RIM_POINTS
 from pipeline import paper
 from pipeline.files import InputError
 from pipeline.scenario.bodies import ColumnSpec
+from pipeline.scenario.colonnade_file import load_if_colonnade
 from pipeline.scenario.column_format import DENSITY_RANGE
 from pipeline.scenario.geometry import ColumnGeometry
 from pipeline.scenario.time_step import CONVERGED_DT_FACTOR
@@ -139,7 +140,9 @@ class Column:
     """The column model: the paper's twin model (both), or one column; with
     ``column_file`` (a shipped example's name or a JSON/YAML file, see
     :mod:`pipeline.scenario.geometry`) the described column takes the drums' place and a
-    monolith of the same outline the monolith's."""
+    monolith of the same outline the monolith's; a colonnade's description there
+    (:mod:`pipeline.scenario.colonnade_file`) puts the colonnade in the scene instead
+    (``colonnade``; ``geometry`` its first column's)."""
     kind: str = param("both", "", "both = drums at x = -1.5 m and monolith at +1.5 m",
                       choices=COLUMN_KINDS, flag="--column")
     hd: float = param(paper.COLUMN_HD, "", "slenderness h/d", 1.0, 30.0, "--hd")
@@ -152,9 +155,15 @@ class Column:
         "help": "column description: a shipped example's name, a .json/.yaml file or the "
         "description as a dict"})
     geometry: object = field(default=None, init=False, repr=False, compare=False)
+    colonnade: object = field(default=None, init=False, repr=False, compare=False)
 
     def __post_init__(self):
         check_fields(self)
+        colonnade = None if self.column_file is None else load_if_colonnade(self.column_file)
+        if colonnade is not None:         # a colonnade: its columns and beams, not a column
+            object.__setattr__(self, "colonnade", colonnade)
+            object.__setattr__(self, "geometry", colonnade.columns[0].column)
+            return
         if self.column_file is not None:
             geometry = (ColumnGeometry.from_dict(self.column_file)
                         if isinstance(self.column_file, dict)
@@ -197,6 +206,8 @@ class Column:
         """The columns of the scene (:class:`~pipeline.scenario.geometry.ColumnSpec`):
         'both' puts the drums (or the described column) at x = -1.5 m and the monolith at
         +1.5 m; one column stands at the centre unless centred=False."""
+        if self.colonnade is not None:
+            return []                      # the scene takes the colonnade whole
         kinds = list(COLUMN_TYPES) if self.kind == "both" else [self.kind]
         centred = self.kind != "both" if self.centred is None else self.centred
         drums, monolith = self.geometries()

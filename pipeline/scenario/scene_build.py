@@ -7,6 +7,7 @@ import math
 
 from pipeline import paper
 from pipeline.files import InputError
+from pipeline.scenario import colonnade_scene
 from pipeline.scenario.bodies import ColumnSpec
 from pipeline.scenario.geometry import ColumnGeometry
 from pipeline.scenario.parameters import Contact, Numerics
@@ -20,19 +21,21 @@ PEDESTAL = {"size": paper.PEDESTAL_SIZE_M, "thickness": paper.PEDESTAL_THICKNESS
             "contact_half_size": 12.0}
 
 def scene_params(columns=(), block=None, contact=None, numerics=None, motion_duration=0.0,
-                 t_max=None):
+                 t_max=None, colonnade=None):
     """The scene file (:class:`~pipeline.scenario.scene_file.SceneFile`) of a scene.
 
     columns: list of :class:`~pipeline.scenario.geometry.ColumnSpec` (from
     :meth:`~pipeline.scenario.parameters.Column.specs`); block: a
     :class:`~pipeline.scenario.parameters.Block` (placed as a column named "block" at the
     centre) or None; contact, numerics: :class:`~pipeline.scenario.parameters.Contact`,
-    :class:`~pipeline.scenario.parameters.Numerics` (defaults when None).
+    :class:`~pipeline.scenario.parameters.Numerics` (defaults when None); colonnade: a
+    :class:`~pipeline.scenario.colonnade.Colonnade` whose columns and beams join the
+    scene (:mod:`pipeline.scenario.colonnade_scene`).
     """
     contact = contact or Contact()
     numerics = numerics or Numerics()
     check_time_step(contact, numerics)
-    if not columns and block is None:
+    if not columns and block is None and colonnade is None:
         raise InputError("a scene needs at least one column or a block")
     if t_max is None:
         t_max = motion_duration + numerics.tail_s
@@ -50,6 +53,15 @@ def scene_params(columns=(), block=None, contact=None, numerics=None, motion_dur
         if reach > pedestal["contact_half_size"]:
             pedestal["contact_half_size"] = float(math.ceil(reach))
     scene_columns = [spec.scene(numerics.rim_points) for spec in specs]
+    if colonnade is not None:
+        placed = colonnade_scene.scene_columns(colonnade, numerics.rim_points)
+        for column in colonnade.columns:
+            column.column.check_rims(numerics.rim_sphere_radius)
+        for entry in placed:
+            reach = colonnade_scene.reach_m(entry)
+            if reach > pedestal["contact_half_size"]:
+                pedestal["contact_half_size"] = float(math.ceil(reach))
+        scene_columns += [entry.to_dict() for entry in placed]
     dt_factor = dt_factor_for(contact, numerics)
     return SceneFile(
         columns=scene_columns, block=None if block is None else dataclasses.asdict(block),

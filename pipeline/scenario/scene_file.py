@@ -31,7 +31,8 @@ class SceneBody:
     (columns); ``centre``, ``rotation``: world placement (body -> world); ``rims``: the
     outlines that carry contact spheres ({role base|edge, kind circle|polygon|points,
     ...}); ``plate``: the top face a body above stands on ({centre, half_size}) or None;
-    ``overturn_tilt_deg``: a mesh specimen's critical angle (None for blocks)."""
+    ``overturn_tilt_deg``: a mesh specimen's critical angle (None for blocks);
+    ``rests_on``: a colonnade's beam's supports (names; None for a column's bodies)."""
     name: str
     column: str
     index: int
@@ -49,14 +50,16 @@ class SceneBody:
     rims: list
     plate: dict = None
     overturn_tilt_deg: float = None
+    rests_on: list = None
 
 
 @dataclass(frozen=True)
 class SceneColumn:
     """A column placed on the pedestal (position m): its bodies, bottom up, and its
     statics: rocking threshold / g (``uplift_ratio``), smallest rocking lever (m), the
-    smallest energy (J) that tips a stack over (None: never stop on energy) and whether
-    the scene may stop once no stack can tip (``settles``)."""
+    smallest energy (J) that tips a stack over (None: never stop on energy), whether
+    the scene may stop once no stack can tip (``settles``) and, for a beam of a
+    colonnade, the columns or beams whose top plates it rests on (``rests_on``)."""
     name: str
     kind: str
     x: float
@@ -69,6 +72,7 @@ class SceneColumn:
     overturning_barrier_j: float
     settles: bool
     bodies: list            # of SceneBody
+    rests_on: list = field(default_factory=list)
 
     def to_dict(self):
         return dataclasses.asdict(self)

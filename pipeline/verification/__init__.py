@@ -8,6 +8,8 @@ from pipeline.verification.check import KINDS, Check, CheckResult
 from pipeline.verification.checks import (HOUSNER_DAMPING, MARBLE_BLOCK, PULSE_BLOCK,
                                           SLIDING_BELOW, SLIDING_MU, check_sliding_mus,
                                           verify_housner, verify_sine_pulse, verify_sliding)
+from pipeline.verification.frame import (FRAME_COLUMNS, FRAME_GAMMAS, FRAME_PERIOD_S,
+                                         summarise_frames)
 from pipeline.verification.one_cosine import (YADE_PERIODS_S, summarise_one_cosine,
                                               verify_one_cosine)
 
@@ -19,13 +21,16 @@ CAMPAIGN_PULSE_OMEGAS = (3.0, 5.0, 8.0)
 
 def campaign_checks(code_version):
     """The verification campaign's :class:`Check` s (theta0/alpha x damping, the pulse
-    grid, mu_s, the one-cosine pulse's periods), their run ids from ``code_version``."""
+    grid, mu_s, the one-cosine pulse's periods, the rocking frames), their run ids from
+    ``code_version``."""
     settings = [("housner", {"theta0_ratio": r, "damping": z})
                 for z in CAMPAIGN_DAMPING for r in CAMPAIGN_THETA0]
     settings += [("sine-pulse", {"amplitude_ratio": a, "omega_ratio": w})
                  for w in CAMPAIGN_PULSE_OMEGAS for a in CAMPAIGN_PULSE_AMPLITUDES]
     settings += [("sliding", {"mu_s": mu}) for mu in SLIDING_MU]
     settings += [("one-cosine", {"period_s": t}) for t in YADE_PERIODS_S]
+    settings += [("frame", {"n_columns": n, "gamma": g, "period_s": FRAME_PERIOD_S})
+                 for n in FRAME_COLUMNS for g in FRAME_GAMMAS]
     return [Check.create(kind, code_version, **setting) for kind, setting in settings]
 
 
@@ -74,6 +79,10 @@ def summarise_campaign(results):
             f"Rock-sliding: pure rocking down to mu_s = {out['sliding']['lowest_mu_pure_rocking']}, "
             f"sliding from {out['sliding']['highest_mu_sliding']}; Augusti & Sinopoli (eq 8): "
             f"{slides[0]['mu_min']:.3f}")
+    frames = [r for s, r in results if s.kind == "frame"]
+    if frames:
+        out["frame"] = summarise_frames(frames)
+        out["lines"] += out["frame"]["lines"]
     cosines = [r for s, r in results if s.kind == "one-cosine"]
     if cosines:
         out["one_cosine"] = summarise_one_cosine(cosines)

@@ -13,6 +13,7 @@ from pipeline.scenario import Contact
 from pipeline.userfiles import number
 from pipeline.verification.checks import (check_pulse_ratios, check_theta0_ratio,
                                           verify_housner, verify_sine_pulse, verify_sliding)
+from pipeline.verification.frame import frame_colonnade, verify_frame
 from pipeline.verification.one_cosine import check_period, verify_one_cosine
 
 # kind: its setting's names (theta0/alpha and the contact damping ratio; the pulse's
@@ -21,13 +22,16 @@ from pipeline.verification.one_cosine import check_period, verify_one_cosine
 KINDS = {"housner": ("theta0_ratio", "damping"),
          "sine-pulse": ("amplitude_ratio", "omega_ratio"),
          "sliding": ("mu_s",),
-         "one-cosine": ("period_s",)}
+         "one-cosine": ("period_s",),
+         "frame": ("n_columns", "gamma", "period_s")}
 # kind: the keys of its result that the campaign's summary and figures read
 RESULT_KEYS = {"housner": ("max_rel_error_impact_times", "max_rel_error_peaks",
                            "effective_restitution", "housner_restitution", "yade"),
                "sine-pulse": ("yade",),
                "sliding": ("runs", "augusti_sinopoli_mu_min"),
-               "one-cosine": ("yade", "integration", "eq43_g", "omega_ratio", "alpha_rad")}
+               "one-cosine": ("yade", "integration", "eq43_g", "omega_ratio", "alpha_rad"),
+               "frame": ("yade", "integration", "single_column_threshold_g", "gamma",
+                         "n_columns")}
 SLIDING_ROW_KEYS = ("mu_s", "pure_rocking", "t", "base_x_m")
 
 
@@ -59,6 +63,12 @@ class Check(Mapping):
             check_pulse_ratios(values["amplitude_ratio"], values["omega_ratio"])
         elif self.kind == "one-cosine":
             check_period(values["period_s"])
+        elif self.kind == "frame":
+            check_period(values["period_s"])
+            if values["n_columns"] != int(values["n_columns"]):
+                raise InputError(f"verification check: n_columns {values['n_columns']:g} is "
+                                 "not a whole number")
+            frame_colonnade(int(values["n_columns"]), values["gamma"])
         else:
             Contact(mu_s=values["mu_s"])
 
@@ -106,6 +116,9 @@ class Check(Mapping):
                                        omega_ratio=s["omega_ratio"], run_dir=run_dir / "yade")
         elif self.kind == "one-cosine":
             values = verify_one_cosine(period_s=s["period_s"], run_dir=run_dir / "yade")
+        elif self.kind == "frame":
+            values = verify_frame(int(s["n_columns"]), s["gamma"], s["period_s"],
+                                  run_dir=run_dir / "yade")
         else:
             values = verify_sliding(mu_values=(s["mu_s"],), run_dir=run_dir)
         return CheckResult(values)

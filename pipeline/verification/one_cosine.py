@@ -267,13 +267,23 @@ def overturns_yade(a_p_g, period_s, run_dir, height=MR_BLOCK["height"],
 
 def yade_threshold(period_s, guess_g, run_dir, runs=YADE_RUNS, **block):
     """The YADE block's smallest overturning amplitude (g) by bisection from a bracket
-    of +-2 tolerances around ``guess_g``, ``runs`` YADE runs in all.  Returns
-    {stands_g, overturns_g, threshold_g, runs: [[a_p_g, mode], ...]}."""
+    of +-2 tolerances around ``guess_g``, ``runs`` YADE runs in all
+    (:func:`bracketed_threshold`)."""
+    return bracketed_threshold(
+        lambda a, k: overturns_yade(a, period_s, Path(run_dir) / f"a{k:02d}", **block),
+        guess_g, runs)
+
+
+def bracketed_threshold(overturns, guess_g, runs=YADE_RUNS):
+    """The smallest overturning amplitude (g) by bisection from a bracket of +-2
+    tolerances around ``guess_g``, ``runs`` runs of ``overturns(a_g, k)`` -> (bool, mode
+    name) in all (k: the run's number).  Returns {stands_g, overturns_g, threshold_g,
+    runs: [[a_p_g, mode], ...]}."""
     check_runs(runs)
     done = []
 
     def over(a):
-        out, mode = overturns_yade(a, period_s, Path(run_dir) / f"a{len(done):02d}", **block)
+        out, mode = overturns(a, len(done))
         done.append([a, mode])
         return out
     lo, hi = guess_g * (1 - 2 * TOLERANCE_YADE), guess_g * (1 + 2 * TOLERANCE_YADE)

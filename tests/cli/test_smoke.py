@@ -60,6 +60,8 @@ def test_chain_on_pulse_excerpt(tmp_path, capsys):
     (["--record", "no/such/file.mseed"], "no such file"),
     (["--record", "GM20", "--hd", "-6"], "--hd"),
     (["--record", "GM20", "--mu-s", "0.5", "--mu-k", "0.6"], "mu_k"),
+    (["--record", "GM20", "--column-file", "parthenon-north-flank", "--column", "monolithic"],
+     "a colonnade, which places its own columns: drop --column"),
 ])
 def test_run_bad_input_one_line_and_nothing_written(tmp_path, args, message):
     out = tmp_path / "out"
