@@ -13,7 +13,7 @@ from pipeline.campaign.fragility_tables import level_table, scaled_runs, summari
 from pipeline.campaign.pulse_outputs import pulse_outputs
 from pipeline.campaign.run_dirs import finished_summary
 from pipeline.files import write_csv
-from pipeline.hazard.fragility_file import FragilityFile, write_fragility_file
+from pipeline.hazard.fragility.file import FragilityFile, write_fragility_file
 from pipeline.simulate import run_code_version
 
 log = logging.getLogger(__name__)

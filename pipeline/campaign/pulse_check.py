@@ -4,8 +4,8 @@ SP1's outcomes are read).  The tests' motions are table records, not pulses: the
 say how far the pulse fragility carries over to them.
 
 Scores of the observed outcomes under: the fragility (P interpolated between the grid's
-cells, bilinear in PGA and PGV/PGA; tests outside the grid take the nearest edge, counted
-in ``outside_grid``), its logistic surface, "overturns when PGA >= g tan alpha" (the 2D
+cells by their one interpolation, bilinear in ln PGA and ln PGV/PGA, as survival reads
+them; tests outside the grid take the nearest edge, counted in ``outside_grid``), its logistic surface, "overturns when PGA >= g tan alpha" (the 2D
 block's critical angle) and a logistic surface fitted to the observations themselves
 (the ceiling a smooth surface in these two measures reaches).  Log-likelihood per test
 (probabilities clipped to [0.01, 0.99], so that a certain wrong prediction costs
@@ -48,7 +48,7 @@ def grid_probability(cells, pga_g, ratio):
 
 def experiments_check(section, specimen, experiments=EXPERIMENTS):
     """The ``experiments`` entry of ``pulse_grid`` (``section``, a
-    :class:`~pipeline.hazard.fragility_file.PulseGridSection`) for a specimen with shipped
+    :class:`~pipeline.hazard.fragility.file.PulseGridSection`) for a specimen with shipped
     tests (None for others)."""
     outcome = SPECIMENS_WITH_TESTS.get(specimen)
     if outcome is None:

@@ -14,8 +14,8 @@ from pipeline.campaign.column_file import summary_entry
 from pipeline.campaign.run_dirs import finished_summary
 from pipeline.campaign.pulse_check import experiments_check
 from pipeline.files import json_safe, write_csv
-from pipeline.hazard.fragility_file import FragilityFile, write_fragility_file
-from pipeline.hazard.fragility_load import BLOCK_MODEL
+from pipeline.hazard.fragility.file import FragilityFile, write_fragility_file
+from pipeline.hazard.fragility.load import BLOCK_MODEL
 from pipeline.simulate import run_code_version
 
 log = logging.getLogger(__name__)

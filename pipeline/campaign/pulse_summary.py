@@ -168,7 +168,7 @@ def summarise_grid(table, specs, grid, sets, azimuths, azimuth, ranges_text):
 
 def contour_difference(reference, other, level="0.5"):
     """How far the P = ``level`` contour of ``other`` lies from that of ``reference`` (two
-    :class:`~pipeline.hazard.fragility_file.FragilityFile` of the same pulse grid, e.g.
+    :class:`~pipeline.hazard.fragility.file.FragilityFile` of the same pulse grid, e.g.
     the adaptive surface and the full
     grid): per PGV/PGA of the specimen model (not the 2D block) both PGAs (g), their
     difference and the reference's Monte Carlo band (the PGAs where its Wilson bounds

@@ -39,7 +39,7 @@ def _plain_log_ticks(axis):
 def plot_fragility(table, summary, out_dir):
     """``fragility_curves.png``, ``fragility_2d_vs_3d.png``, ``fragility_surface.png`` of
     a column campaign's runs ``table`` and its
-    :class:`~pipeline.hazard.fragility_file.FragilityFile` ``summary``."""
+    :class:`~pipeline.hazard.fragility.file.FragilityFile` ``summary``."""
     out_dir = Path(out_dir)
     return [plot_curves(table, summary, out_dir / "fragility_curves.png"),
             plot_levels(table, out_dir / "fragility_2d_vs_3d.png"),
@@ -179,7 +179,7 @@ def plot_surface(table, summary, path):
 
 
 def plot_pulse_grid(summary, path):
-    """The pulse-grid fragility (a :class:`~pipeline.hazard.fragility_file.FragilityFile`)
+    """The pulse-grid fragility (a :class:`~pipeline.hazard.fragility.file.FragilityFile`)
     of each 3D specimen model: P per cell (colour), its contours at the P of
     :data:`~pipeline.hazard.pulse_cells.CONTOUR_LEVELS` (lines; the Monte Carlo band of
     the 0.5 contour shaded), the 2D rigid block's (same critical angle and pivot distance; the toolkit's

@@ -28,7 +28,7 @@ CONTOUR_LEVELS = (0.16, 0.5, 0.84)   # P of a pulse grid's contours: median and 
 
 def cell_table(cells):
     """The axes and P of a pulse grid's cells
-    (:class:`~pipeline.hazard.fragility_file.GridCell`): (pga, ratio, values n_pga x
+    (:class:`~pipeline.hazard.fragility.file.GridCell`): (pga, ratio, values n_pga x
     n_ratio) in the cells' units; values NaN where no cell is given."""
     pgas = sorted({c.pga_g for c in cells})
     ratios = sorted({c.pgv_pga_s for c in cells})

@@ -4,7 +4,7 @@ import math
 
 import pandas as pd
 
-from pipeline.hazard.fragility_file import read_fragility_file
+from pipeline.hazard.fragility.file import read_fragility_file
 from pipeline.report.common import _figure, _fmt, _table
 
 

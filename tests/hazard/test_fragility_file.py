@@ -13,7 +13,7 @@ from pipeline.constants import STANDARD_GRAVITY as G
 from pipeline.files import InputError
 from pipeline.hazard.fragility import load_campaign_fragility
 from pipeline.campaign.pulse_summary import contours
-from pipeline.hazard.fragility_file import (ContourRow, FragilityFile, GridCell,
+from pipeline.hazard.fragility.file import (ContourRow, FragilityFile, GridCell,
                                             read_fragility_file, write_fragility_file)
 from tests.hazard.test_reader_robustness import COLUMN, grid_document
 

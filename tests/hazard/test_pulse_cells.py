@@ -7,7 +7,7 @@ import pytest
 from pipeline.campaign.pulse_check import grid_probability
 from pipeline.constants import STANDARD_GRAVITY as G
 from pipeline.hazard.fragility import PulseGrid
-from pipeline.hazard.fragility_file import GridCell
+from pipeline.hazard.fragility.file import GridCell
 from pipeline.hazard.pulse_cells import cell_table, interpolate
 
 PGA_G = np.round(np.linspace(0.2, 1.1, 10), 9)           # the Virtual Shake Robot's grid

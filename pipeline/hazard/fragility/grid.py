@@ -9,7 +9,7 @@ import numpy as np
 from scipy.special import expit, logit
 
 from pipeline.constants import STANDARD_GRAVITY
-from pipeline.hazard.fragility_kinds import Fragility, Logistic
+from pipeline.hazard.fragility.kinds import Fragility, Logistic
 from pipeline.hazard.pulse_cells import interpolate
 
 BELOW_GRID = ("ramp", "zero", "edge", "logistic")   # P below a pulse grid: see PulseGrid

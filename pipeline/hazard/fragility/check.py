@@ -6,7 +6,7 @@ as integers) and what would contradict itself (a duplicated cell, overturned out
 0..n, a P outside 0-1, an interval that does not hold its estimate, a covariance that is
 not symmetric positive semi-definite).  Each refusal is one InputError naming the file
 and the key path, e.g. ``fragility.json: columns.monolithic.logistic.cov must be a 3x3
-list of numbers``.  The file's one reader (:func:`pipeline.hazard.fragility_file.
+list of numbers``.  The file's one reader (:func:`pipeline.hazard.fragility.file.
 read_fragility_file`) runs them.
 
 Two layouts, as the campaign writes them: a column campaign (``columns``: per column type

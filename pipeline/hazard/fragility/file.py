@@ -1,7 +1,7 @@
 """``fragility.json``, the file of ``campaign fragility``, as one type
 (:class:`FragilityFile`) with one writer (:func:`write_fragility_file`, atomic) and one
 reader (:func:`read_fragility_file`: bounded, strict UTF-8, JSON, every value its readers
-use checked by :func:`pipeline.hazard.fragility_check.check_fragility`).  The campaigns
+use checked by :func:`pipeline.hazard.fragility.check.check_fragility`).  The campaigns
 that write it, survival, the shake-table check, the figures and the report share it.
 
 Two layouts: a column campaign (``columns``: per column type its lognormal fits per
@@ -20,7 +20,7 @@ from dataclasses import dataclass, field, fields, replace
 from pathlib import Path
 
 from pipeline.files import write_json
-from pipeline.hazard.fragility_check import MAX_MEMBERS, check_fragility
+from pipeline.hazard.fragility.check import MAX_MEMBERS, check_fragility
 from pipeline.userfiles import DATA_FILE_BYTES, read_json
 
 __all__ = ["MAX_MEMBERS", "Block2d", "ColumnFits", "ContourRow", "FragilityFile",

@@ -1,5 +1,5 @@
 """Loading a campaign's fragility (``campaign fragility``'s ``fragility.json``) as a
-:class:`~pipeline.hazard.fragility_kinds.Fragility`: a column campaign's lognormal PGA
+:class:`~pipeline.hazard.fragility.kinds.Fragility`: a column campaign's lognormal PGA
 fit or logistic surface with its members' own fits (:func:`load_campaign_fragility`,
 :func:`member_fits`), or a pulse grid (:func:`load_pulse_grid`)."""
 import io
@@ -11,9 +11,9 @@ import pandas as pd
 from pipeline.constants import STANDARD_GRAVITY
 from pipeline.files import InputError
 from pipeline.hazard.components import on_hazard_measure
-from pipeline.hazard.fragility_file import MAX_MEMBERS, FragilityFile, read_fragility_file
-from pipeline.hazard.fragility_grid import BELOW_GRID, PulseGrid
-from pipeline.hazard.fragility_kinds import BETA_RANGE, MEDIAN_G_RANGE, Logistic, Lognormal
+from pipeline.hazard.fragility.file import MAX_MEMBERS, FragilityFile, read_fragility_file
+from pipeline.hazard.fragility.grid import BELOW_GRID, PulseGrid
+from pipeline.hazard.fragility.kinds import BETA_RANGE, MEDIAN_G_RANGE, Logistic, Lognormal
 from pipeline.stats.fragility import fragility_fit, logistic_surface
 from pipeline.userfiles import DATA_FILE_BYTES, Unreadable, number, read_text, show
 
@@ -85,7 +85,7 @@ def member_fits(runs_path, column, form, block=None):
     lognormal PGA fit (form "pga") or the logistic surface ("pga-pgv") of
     :mod:`pipeline.stats.fragility`, as the campaign fits the pooled runs; (None, note)
     when the runs table is absent or no member's fit is determined.  ``block``: the
-    file's :class:`~pipeline.hazard.fragility_file.Block2d` (the surface's alpha and p)
+    file's :class:`~pipeline.hazard.fragility.file.Block2d` (the surface's alpha and p)
     or None."""
     if not runs_path.is_file():
         return None, f"no {runs_path.name} beside the file: the members' spread not available"
@@ -183,7 +183,7 @@ def _pair(value, what):
 
 
 def load_pulse_grid(file, model=None, form="grid", below="ramp"):
-    """One model of a pulse-grid :class:`~pipeline.hazard.fragility_file.FragilityFile`
+    """One model of a pulse-grid :class:`~pipeline.hazard.fragility.file.FragilityFile`
     (``models``: monolithic, block2d; read and checked by its reader): ``form`` "grid"
     (:class:`PulseGrid`, ``below`` what P is below it; a grid of one row or column
     interpolated along the other axis) or "pga-pgv" (its logistic surface)."""
