@@ -9,7 +9,7 @@ from scipy import stats
 
 from pipeline.figures.style import COLUMN_COLOURS, COLUMN_LABELS, COLUMN_MARKERS, figure
 from pipeline.files import save_figure
-from pipeline.hazard.pulse_cells import CONTOUR_LEVELS
+from pipeline.hazard.pulse_cells import CONTOUR_LEVELS, lay_cells
 from pipeline.stats.ensemble import wilson_interval
 from pipeline.stats.fragility import logistic_probability
 
@@ -192,10 +192,8 @@ def plot_pulse_grid(summary, path):
     ratios, pgas = np.array(section.pgv_pga_s), np.array(section.pga_g)
     for ax, name in zip(axes, names):
         cells = section.models[name].cells
-        P = np.full((len(ratios), len(pgas)), np.nan)
-        for c in cells:
-            P[np.argmin(abs(ratios - c.pgv_pga_s)), np.argmin(abs(pgas - c.pga_g))] = c.P
-        image = ax.pcolormesh(_edges(ratios), _edges(pgas), P.T, cmap="Greys", vmin=0, vmax=1,
+        _, _, P, _ = lay_cells(pgas, ratios, cells)             # NaN: no run, left blank
+        image = ax.pcolormesh(_edges(ratios), _edges(pgas), P, cmap="Greys", vmin=0, vmax=1,
                               shading="flat")
         for model, colour in ((name, "C3"), (block, "C0")):
             contours = section.models[model].contours if model in section.models else {}

@@ -87,7 +87,8 @@ def test_survival_and_the_shake_table_check_read_one_p_from_the_cells(tmp_path):
     file = read_fragility_file(tmp_path)
     grid = load_campaign_fragility(tmp_path)
     pga_g, ratio = np.array([0.15, 0.33, 0.7]), np.array([0.2, 0.5, 0.12])
-    checked, outside = grid_probability(file.pulse_grid.models["monolithic"].cells, pga_g,
-                                        ratio)
+    checked, outside, _ = grid_probability(file.pulse_grid,
+                                           file.pulse_grid.models["monolithic"].cells, pga_g,
+                                           ratio)
     assert not outside.any()
     np.testing.assert_allclose(grid.probability(pga_g * G, ratio), checked, atol=1e-12)

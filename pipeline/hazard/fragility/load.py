@@ -14,6 +14,7 @@ from pipeline.hazard.components import on_hazard_measure
 from pipeline.hazard.fragility.file import MAX_MEMBERS, FragilityFile, read_fragility_file
 from pipeline.hazard.fragility.grid import BELOW_GRID, PulseGrid
 from pipeline.hazard.fragility.kinds import BETA_RANGE, MEDIAN_G_RANGE, Logistic, Lognormal
+from pipeline.hazard.pulse_cells import lay_cells
 from pipeline.stats.fragility import fragility_fit, logistic_surface
 from pipeline.userfiles import DATA_FILE_BYTES, Unreadable, number, read_text, show
 
@@ -210,7 +211,8 @@ def load_pulse_grid(file, model=None, form="grid", below="ramp"):
     if form != "grid":
         raise InputError(f"--fragility-form for a pulse grid must be grid or pga-pgv, got "
                          f"{form!r}")
-    n, overturned, per_set = _cells(section, entry)
+    n, overturned, _, per_set = lay_cells(section.pga_g, section.pgv_pga_s, entry.cells,
+                                          section.members)
     empty = int((n == 0).sum())
     if empty == n.size:
         raise InputError(f"{where}: no cell with runs (every n is 0)")
@@ -239,22 +241,3 @@ def _specimen_model(file: FragilityFile) -> str:
                          f"({', '.join(section.models)}), not the specimen's: give --column "
                          f"{next(iter(section.models))} to take the block for the rock")
     return specimen[0]
-
-
-def _cells(section, entry):
-    """(n, overturned, P per set) arrays (n_pga x n_ratio; sets x n_pga x n_ratio, NaN
-    where a set has no run) of one model's cells, checked on the grid once each."""
-    pga_g = [float(v) for v in section.pga_g]        # checked: increasing, positive
-    ratios = [float(v) for v in section.pgv_pga_s]
-    n = np.zeros((len(pga_g), len(ratios)), int)
-    overturned = np.zeros_like(n)
-    per_set = np.full((section.members, len(pga_g), len(ratios)), np.nan)
-    index_a = {round(v, 9): i for i, v in enumerate(pga_g)}
-    index_r = {round(v, 9): j for j, v in enumerate(ratios)}
-    for cell in entry.cells:
-        i, j = index_a[round(cell.pga_g, 9)], index_r[round(cell.pgv_pga_s, 9)]
-        n[i, j], overturned[i, j] = cell.n, cell.overturned
-        for s, p in zip(cell.sets or (), cell.P_per_set or ()):
-            if p is not None:
-                per_set[s, i, j] = float(p)
-    return n, overturned, per_set
