@@ -79,7 +79,7 @@ def experiments_check(section, specimen, experiments=EXPERIMENTS):
         result = {"grid": {**scores(y, p), "outside_grid": int(outside.sum())}}
         if filled:
             result["grid"]["empty_cells_filled"] = filled
-        coef = (entry.logistic or {}).get("coefficients")
+        coef = None if entry.logistic is None else entry.logistic.coefficients
         if coef is not None:
             result["logistic"] = scores(y[keep], logistic_probability(
                 coef, pga[keep] * G, ratio[keep]))

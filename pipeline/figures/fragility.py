@@ -66,7 +66,7 @@ def plot_curves(table, summary, path):
             for k, name in enumerate(([column] if column else []) + blocks):
                 entry = summary.columns[name].fits[im]
                 st = _style(name)
-                bins = entry["bins"]
+                bins = entry.bins
                 if bins:
                     x = np.array([b["im"] for b in bins]) * (1.0 + 0.025 * (k - 1))
                     y = np.array([b["fraction"] for b in bins])
@@ -74,11 +74,11 @@ def plot_curves(table, summary, path):
                                     for b in bins]).T
                     ax.errorbar(x, y, yerr=err, fmt=st["marker"], color=st["color"], ms=5,
                                 capsize=2, lw=0.8, alpha=0.85)
-                if entry["median"] is not None:
-                    curve = stats.norm.cdf(np.log(grid / entry["median"]) / entry["beta"])
+                if entry.median is not None:
+                    curve = stats.norm.cdf(np.log(grid / entry.median) / entry.beta)
                     ax.plot(grid, curve, color=st["color"], ls=st["ls"], lw=1.8,
-                            label=f"{st['label']}: median {entry['median']:.3g}, "
-                                  f"β {entry['beta']:.2f}")
+                            label=f"{st['label']}: median {entry.median:.3g}, "
+                                  f"β {entry.beta:.2f}")
                 else:
                     ax.plot([], [], color=st["color"], ls=st["ls"], marker=st["marker"],
                             label=f"{st['label']}: not fitted")

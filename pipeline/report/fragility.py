@@ -24,11 +24,11 @@ def fragility_section(results):
         row = {"model": name if entry.description is None else entry.description,
                "runs (toppled)": f"{entry.runs} ({entry.toppled})"}
         for im, fit in entry.fits.items():
-            lo_hi = fit.get("median_ci95") or [None, None]
-            row[f"{im} median [95 %] {fit.get('unit', '')}".strip()] = (
-                "-" if fit["median"] is None else
-                f"{fit['median']:.3g} [{_fmt(lo_hi[0], 2)}, {_fmt(lo_hi[1], 2)}], "
-                f"beta {_fmt(fit.get('beta'), 2)}")
+            lo_hi = fit.median_ci95 or [None, None]
+            row[f"{im} median [95 %] {fit.unit or ''}".strip()] = (
+                "-" if fit.median is None else
+                f"{fit.median:.3g} [{_fmt(lo_hi[0], 2)}, {_fmt(lo_hi[1], 2)}], "
+                f"beta {_fmt(fit.beta, 2)}")
         rows.append(row)
     lines = ["## Fragility (campaign fragility)\n",
              f"Records {', '.join(map(str, summary.records))}; "
@@ -100,12 +100,12 @@ def rock_fragility_section(results, name="rock-fragility"):
         lines.append(f"Spread of P across the parameter sets (sd per cell): up to "
                      f"{max(spread):.2f}, mean {sum(spread) / len(spread):.2f}.\n")
     for model, entry in section.models.items():
-        d = (entry.logistic or {}).get("dimensionless")
+        d = None if entry.logistic is None else entry.logistic.dimensionless
         if d:
             lines.append(f"Logistic surface ({model}): logit P = {d['c0']:.2f} + "
                          f"{d['b1']:.2f} ln(PGA / (g tan alpha)) + {d['b2']:.2f} ln(p PGV/PGA)"
                          + (" (Firth-penalised: separable outcomes)"
-                            if entry.logistic.get("separated") else "") + ".\n")
+                            if entry.logistic.separated else "") + ".\n")
     check = section.experiments
     if check:
         def score_row(label, score):

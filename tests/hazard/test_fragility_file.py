@@ -30,7 +30,7 @@ def test_written_then_read_is_the_same_file_and_the_same_json(tmp_path, document
 def test_sections_are_typed():
     columns = FragilityFile.of(copy.deepcopy(COLUMN))
     entry = columns.columns["monolithic"]
-    assert entry.fits["PGA"]["median"] == 3.0 and entry.logistic["coefficients"]["b1"] == 3.0
+    assert entry.fits["PGA"].median == 3.0 and entry.logistic.b[1] == 3.0
     assert columns.records == ("R1", "R2") and columns.block2d.alpha_rad == 0.2
     grid = FragilityFile.of(grid_document()).pulse_grid
     assert grid.pga_g == (0.1, 0.2, 0.4) and grid.members == 2

@@ -1,6 +1,7 @@
 """The checks of ``campaign fragility``'s ``fragility.json`` as a user passes it around:
 :func:`check_fragility` checks every value a reader of it uses before any of them
-allocates or computes: types (object, list, number, string), finite numbers within their
+allocates or computes, but for the fits, which check themselves on construction
+(:mod:`pipeline.hazard.fragility.fits`, with :class:`_Checker` and these bounds): types (object, list, number, string), finite numbers within their
 ranges, sizes (a 3 x 3 covariance; axes, cells, members and runs within bounds, counts
 as integers) and what would contradict itself (a duplicated cell, overturned outside
 0..n, a P outside 0-1, an interval that does not hold its estimate, a covariance that is
@@ -17,8 +18,6 @@ absent or written as nulls (a singular information matrix), cells without ``sets
 2D block without ``uplift_g_smallest``.  Keys that no reader uses are not checked.
 """
 import math
-
-import numpy as np
 
 from pipeline.constants import STANDARD_GRAVITY
 from pipeline.files import InputError
@@ -69,7 +68,7 @@ class _Checker:
         self.name = name
 
     def fail(self, where, what):
-        raise InputError(f"{self.name}: {where} {what}")
+        raise InputError(f"{self.name}: {where} {what}" if self.name else f"{where} {what}")
 
     def obj(self, value, where, most=None):
         if not isinstance(value, dict):
@@ -88,7 +87,8 @@ class _Checker:
     def num(self, value, where, low=None, high=None, low_open=False, optional=False):
         if value is None and optional:
             return None
-        return number(value, f"{self.name}: {where}", low, high, "", low_open)
+        return number(value, f"{self.name}: {where}" if self.name else where, low, high, "",
+                      low_open)
 
     def integer(self, value, where, low, high, optional=False):
         if value is None and optional:
@@ -145,10 +145,10 @@ def _check_columns(c, data):
         c.obj(entry, where)
         c.text(entry.get("description"), f"{where}.description")
         _counts(c, entry, where, "runs", "toppled")
-        if entry.get("PGA") is not None:
+        if entry.get("PGA") is not None:           # survival reads it: bounded further
             _check_lognormal(c, entry["PGA"], f"{where}.PGA")
-        if entry.get("logistic") is not None:
-            _check_logistic(c, entry["logistic"], f"{where}.logistic")
+        if entry.get("logistic") is not None:      # its values: LogisticSurface
+            c.obj(entry["logistic"], f"{where}.logistic")
     if data.get("records") is not None:
         for k, record in enumerate(c.lst(data["records"], "records", MAX_RECORDS)):
             if not isinstance(record, str) or not record or len(record) > MAX_TEXT:
@@ -161,8 +161,10 @@ def _check_columns(c, data):
 
 
 def _check_lognormal(c, fit, where):
-    """A lognormal fit of the PGA: {unit, median, beta, median_ci95, beta_ci95, n, toppled,
-    note}, its intervals holding their estimates."""
+    """The lognormal fit of the PGA, as survival reads it: {unit, median, beta (at most
+    100), median_ci95, beta_ci95 (both bounds given), n, toppled, note}, its intervals
+    holding their estimates (any fit's checks: :class:`~pipeline.hazard.fragility.fits.
+    LognormalFit`)."""
     c.obj(fit, where)
     c.text(fit.get("unit"), f"{where}.unit")
     c.text(fit.get("note"), f"{where}.note")
@@ -175,57 +177,9 @@ def _check_lognormal(c, fit, where):
 
 def _counts(c, entry, where, total, part):
     """Two counts of runs (integers, or absent), ``part`` of ``total``."""
-    n = c.integer(entry.get(total), f"{where}.{total}", 0, MAX_TOTAL, optional=True)
-    c.integer(entry.get(part), f"{where}.{part}", 0, MAX_TOTAL if n is None else n,
-              optional=True)
-
-
-def _check_logistic(c, surface, where):
-    """A logistic surface: coefficients {b0, b1, b2}, se and ci95 per coefficient (a number
-    or null, an interval holding its coefficient), cov 3 x 3 (null, or nulls where the
-    information matrix was singular), n, toppled, note."""
-    c.obj(surface, where)
-    c.text(surface.get("note"), f"{where}.note")
-    _counts(c, surface, where, "n", "toppled")
-    names = ("b0", "b1", "b2")
-    b = dict.fromkeys(names)
-    if surface.get("coefficients") is not None:
-        coefficients = c.obj(surface["coefficients"], f"{where}.coefficients")
-        b = {k: c.num(coefficients.get(k), f"{where}.coefficients.{k}") for k in names}
-    if surface.get("se") is not None:
-        se = c.obj(surface["se"], f"{where}.se")
-        for k in names:
-            c.num(se.get(k), f"{where}.se.{k}", 0, None, optional=True)
-    if surface.get("ci95") is not None:
-        ci = c.obj(surface["ci95"], f"{where}.ci95")
-        for k in names:
-            c.pair(ci.get(k), f"{where}.ci95.{k}", holds=b[k])
-    _check_cov(c, surface.get("cov"), f"{where}.cov")
-
-
-def _check_cov(c, cov, where):
-    """A 3 x 3 covariance: null, a matrix holding nulls (not used), or numbers: finite,
-    symmetric and positive semi-definite."""
-    if cov is None:
-        return
-    if not (isinstance(cov, list) and len(cov) == 3
-            and all(isinstance(row, list) and len(row) == 3 for row in cov)
-            and all(v is None or (isinstance(v, (int, float)) and not isinstance(v, bool))
-                    for row in cov for v in row)):
-        c.fail(where, f"must be a 3x3 list of numbers, got {show(cov)}")
-    if any(v is None for row in cov for v in row):
-        return
-    try:
-        matrix = np.array(cov, float)
-    except OverflowError:
-        c.fail(where, "holds a number beyond a float's range")
-    if not np.isfinite(matrix).all():
-        c.fail(where, "must hold finite numbers")
-    scale = max(float(np.abs(matrix).max()), 1e-300)
-    if not np.allclose(matrix, matrix.T, rtol=0.0, atol=TOLERANCE * scale):
-        c.fail(where, "is not symmetric")
-    if np.linalg.eigvalsh(matrix).min() < -TOLERANCE * scale:
-        c.fail(where, "is not positive semi-definite (a variance cannot be negative)")
+    at = f"{where}." if where else ""
+    n = c.integer(entry.get(total), f"{at}{total}", 0, MAX_TOTAL, optional=True)
+    c.integer(entry.get(part), f"{at}{part}", 0, MAX_TOTAL if n is None else n, optional=True)
 
 
 def _check_pulse_grid(c, section):
@@ -247,8 +201,8 @@ def _check_pulse_grid(c, section):
         where = f"pulse_grid.models.{_key(model)}"
         c.obj(entry, where)
         _counts(c, entry, where, "runs", "overturned")
-        if entry.get("logistic") is not None:
-            _check_logistic(c, entry["logistic"], f"{where}.logistic")
+        if entry.get("logistic") is not None:      # its values: LogisticSurface
+            c.obj(entry["logistic"], f"{where}.logistic")
         _check_cells(c, entry.get("cells"), f"{where}.cells", pga, ratio, members, headings)
     if section.get("block2d") is not None:
         block = c.obj(section["block2d"], "pulse_grid.block2d")

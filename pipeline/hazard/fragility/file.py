@@ -16,18 +16,20 @@ covariance written as nulls (a singular information matrix) is none, and a pulse
 critical angle) or, without that, from ``alpha_rad`` (g tan alpha), in that order.
 """
 import math
-from dataclasses import dataclass, field, fields, replace
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from pipeline.files import write_json
-from pipeline.hazard.fragility.check import MAX_MEMBERS, check_fragility
+from pipeline.hazard.fragility.check import MAX_MEMBERS, _key, check_fragility
+from pipeline.hazard.fragility.fits import LognormalFit, LogisticSurface, leaf
+from pipeline.hazard.fragility.keyed import build as _build
+from pipeline.hazard.fragility.keyed import join as _join
 from pipeline.userfiles import DATA_FILE_BYTES, read_json
 
 __all__ = ["MAX_MEMBERS", "Block2d", "ColumnFits", "ContourRow", "FragilityFile",
-           "GridCell", "GridModel",
+           "GridCell", "GridModel", "LogisticSurface", "LognormalFit",
            "PulseGridSection", "check_fragility", "read_fragility_file",
            "write_fragility_file"]
-_KEPT = ("extra", "order", "path")     # fields that are not keys of the file
 
 
 @dataclass(frozen=True)
@@ -87,12 +89,11 @@ class ContourRow:
 @dataclass(frozen=True)
 class GridModel:
     """One model of a pulse grid: ``cells`` (:class:`GridCell`), ``contours`` (level,
-    e.g. "0.5", -> :class:`ContourRow` per PGV/PGA), ``logistic`` (the surface as
-    :func:`pipeline.stats.fragility.logistic_surface` writes it), ``runs`` and
-    ``overturned`` (counts)."""
+    e.g. "0.5", -> :class:`ContourRow` per PGV/PGA), ``logistic``
+    (:class:`LogisticSurface`), ``runs`` and ``overturned`` (counts)."""
     cells: tuple = ()
     contours: dict = field(default_factory=dict)
-    logistic: dict | None = None
+    logistic: LogisticSurface | None = None
     runs: int | None = None
     overturned: int | None = None
     extra: dict = field(default_factory=dict)
@@ -129,14 +130,14 @@ class PulseGridSection:
 class ColumnFits:
     """One column type of a column campaign: ``description``, ``model`` ("3D" or "2D"),
     ``runs`` and ``toppled`` (counts), ``fits`` (intensity measure, e.g. "PGA", -> its
-    lognormal fit: median, beta, median_ci95, beta_ci95, unit, note, bins) and
-    ``logistic`` (the surface in PGA and PGV/PGA)."""
+    :class:`LognormalFit`) and ``logistic`` (:class:`LogisticSurface`, in PGA and
+    PGV/PGA)."""
     description: str | None = None
     model: str | None = None
     runs: int | None = None
     toppled: int | None = None
     fits: dict = field(default_factory=dict)
-    logistic: dict | None = None
+    logistic: LogisticSurface | None = None
     extra: dict = field(default_factory=dict)
     order: tuple = field(default=(), compare=False)
 
@@ -160,14 +161,16 @@ class FragilityFile:
 
     @classmethod
     def of(cls, data, path=None):
-        """The file of ``data``, a dict as the campaign writes it (not checked: the
-        reader checks)."""
+        """The file of ``data``, a dict as the campaign writes it, its fits checked (each
+        refusal naming ``path``, or fragility.json, and the key path); the reader checks
+        the rest (:func:`pipeline.hazard.fragility.check.check_fragility`)."""
+        name = str(path) if path is not None else "fragility.json"
         return _build(cls, data, {
             "columns": lambda v: None if v is None else {
-                k: _column(e) for k, e in v.items()},
+                k: _column(e, name, f"columns.{_key(k)}") for k, e in v.items()},
             "records": lambda v: tuple(v or ()),
             "block2d": lambda v: None if v is None else _build(Block2d, v),
-            "pulse_grid": lambda v: None if v is None else _section(v)}, path=path)
+            "pulse_grid": lambda v: None if v is None else _section(v, name)}, path=path)
 
     def to_json(self):
         """The dict written to ``fragility.json``."""
@@ -191,31 +194,16 @@ def read_fragility_file(path):
 
 
 def _current(file):
-    """``file`` in today's spelling: a logistic surface's covariance written as nulls (a
-    singular information matrix) made None; a pulse grid's 2D block without
-    ``uplift_g_smallest`` given it from ``uplift_g``, else from g tan(``alpha_rad``)."""
-    if file.columns is not None:
-        file = replace(file, columns={k: replace(e, logistic=_surface(e.logistic))
-                                      for k, e in file.columns.items()})
+    """``file`` in today's spelling: a pulse grid's 2D block without ``uplift_g_smallest``
+    given it from ``uplift_g``, else from g tan(``alpha_rad``)."""
     grid = file.pulse_grid
-    if grid is None:
+    block = None if grid is None else grid.block2d
+    if block is None or block.uplift_g_smallest is not None:
         return file
-    grid = replace(grid, models={k: replace(m, logistic=_surface(m.logistic))
-                                 for k, m in grid.models.items()})
-    block = grid.block2d
-    if block is not None and block.uplift_g_smallest is None:
-        least = block.uplift_g if block.uplift_g is not None else \
-            None if block.alpha_rad is None else math.tan(block.alpha_rad)
-        grid = replace(grid, block2d=replace(block, uplift_g_smallest=least))
-    return replace(file, pulse_grid=grid)
-
-
-def _surface(surface):
-    """A logistic surface with a covariance of nulls made None (checked: 3 x 3)."""
-    cov = None if surface is None else surface.get("cov")
-    if cov is None or not any(v is None for row in cov for v in row):
-        return surface
-    return {**surface, "cov": None}
+    least = block.uplift_g if block.uplift_g is not None else \
+        None if block.alpha_rad is None else math.tan(block.alpha_rad)
+    return replace(file, pulse_grid=replace(grid, block2d=replace(block,
+                                                                  uplift_g_smallest=least)))
 
 
 def write_fragility_file(directory, file):
@@ -226,52 +214,37 @@ def write_fragility_file(directory, file):
 
 
 # ---------------------------------------------------------------- dict <-> type
-def _build(cls, data, convert=None, **more):
-    """``cls`` of a dict: its named keys (through ``convert``), the rest in ``extra``,
-    the keys' order kept."""
-    convert = convert or {}
-    names = {f.name for f in fields(cls)} - set(_KEPT)
-    known = {k: convert.get(k, _same)(v) for k, v in data.items() if k in names}
-    extra = {k: v for k, v in data.items() if k not in names}
-    return cls(**known, extra=extra, order=tuple(data), **more)
+def _is_fit(key, value):
+    """A lognormal fit of an intensity measure in a column's entry (its PGA fit always)."""
+    return isinstance(value, dict) and ("median" in value or key == "PGA")
 
 
-def _join(obj, convert=None):
-    """The dict of a :func:`_build` object: the keys as read, in their order, then keys
-    set since (not None)."""
-    convert = convert or {}
-    values = {f.name: getattr(obj, f.name) for f in fields(obj) if f.name not in _KEPT}
-    values.update(obj.extra)
-    keys = [k for k in obj.order if k in values]
-    keys += [k for k, v in values.items() if k not in obj.order and v is not None
-             and v != () and v != {}]
-    return {k: convert.get(k, _same)(values[k]) for k in keys}
+def _surface(value, name, where):
+    return None if value is None else leaf(LogisticSurface, value, name, where)
 
 
-def _same(value):
-    return value
-
-
-def _is_fit(value):
-    """A lognormal fit of an intensity measure in a column's entry."""
-    return isinstance(value, dict) and "median" in value
-
-
-def _column(entry):
-    fits = {k: v for k, v in entry.items() if _is_fit(v)}
-    column = _build(ColumnFits, {k: v for k, v in entry.items() if k not in fits})
+def _column(entry, name, where):
+    fits = {k: leaf(LognormalFit, v, name, f"{where}.{_key(k)}")
+            for k, v in entry.items() if _is_fit(k, v)}
+    column = _build(ColumnFits, {k: v for k, v in entry.items() if k not in fits},
+                    {"logistic": lambda v: _surface(v, name, f"{where}.logistic")})
     return replace(column, fits=fits, order=tuple(entry))
 
 
 def _column_json(column):
-    return _join(replace(column, extra={**column.extra, **column.fits}, fits={}))
+    fits = {k: v.to_json() for k, v in column.fits.items()}
+    return _join(replace(column, extra={**column.extra, **fits}, fits={}), _SURFACE_JSON)
 
 
-def _section(section):
+_SURFACE_JSON = {"logistic": lambda v: None if v is None else v.to_json()}
+
+
+def _section(section, name):
     return _build(PulseGridSection, section, {
         "pga_g": tuple, "pgv_pga_s": tuple, "warnings": tuple,
         "block2d": lambda v: None if v is None else _build(Block2d, v),
-        "models": lambda v: {k: _model(m) for k, m in v.items()}})
+        "models": lambda v: {k: _model(m, name, f"pulse_grid.models.{_key(k)}")
+                             for k, m in v.items()}})
 
 
 def _section_json(section):
@@ -286,15 +259,17 @@ _ROW_TUPLES = dict.fromkeys(_ROW_LISTS, lambda v: None if v is None else tuple(v
 _ROW_JSON = dict.fromkeys(_ROW_LISTS, lambda v: None if v is None else list(v))
 
 
-def _model(model):
+def _model(model, name, where):
     return _build(GridModel, model, {
         "cells": lambda v: tuple(_build(GridCell, c, _ROW_TUPLES) for c in v or ()),
         "contours": lambda v: {level: tuple(_build(ContourRow, r, _ROW_TUPLES) for r in rows)
-                               for level, rows in (v or {}).items()}})
+                               for level, rows in (v or {}).items()},
+        "logistic": lambda v: _surface(v, name, f"{where}.logistic")})
 
 
 def _model_json(model):
     return _join(model, {
         "cells": lambda v: [_join(c, _ROW_JSON) for c in v],
         "contours": lambda v: {level: [_join(r, _ROW_JSON) for r in rows]
-                               for level, rows in v.items()}})
+                               for level, rows in v.items()},
+        **_SURFACE_JSON})
