@@ -3,9 +3,10 @@ PGA, PGV/PGA and SP1's outcome of every test, the 92 without a motion included; 
 SP1's outcomes are read).  The tests' motions are table records, not pulses: the scores
 say how far the pulse fragility carries over to them.
 
-Scores of the observed outcomes under: the fragility (P interpolated between the grid's
-cells by their one interpolation, bilinear in ln PGA and ln PGV/PGA, as survival reads
-them; tests outside the grid take the nearest edge, counted in ``outside_grid``), its logistic surface, "overturns when PGA >= g tan alpha" (the 2D
+Scores of the observed outcomes under: the fragility (P between the grid's cells by
+their one interpolation, bilinear in ln PGA and ln PGV/PGA, empty cells filled, as
+survival reads them; tests outside the grid take the nearest edge, counted in
+``outside_grid``), its logistic surface, "overturns when PGA >= g tan alpha" (the 2D
 block's critical angle) and a logistic surface fitted to the observations themselves
 (the ceiling a smooth surface in these two measures reaches).  Log-likelihood per test
 (probabilities clipped to [0.01, 0.99], so that a certain wrong prediction costs

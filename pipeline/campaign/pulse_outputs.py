@@ -98,7 +98,7 @@ def pulse_outputs(specs, campaign_dir, figures=True):
         written = plot_pulse_grid(summary, campaign_dir / "fragility_pulse_grid.png")
     grid = summary.pulse_grid
     for model, entry in grid.models.items():
-        half = [c.pga_g for c in entry.contours["0.5"]]
+        half = [c.pga_g for c in entry.contour(0.5)]
         shown = ", ".join("-" if v is None else f"{v:.2f}" for v in half)
         log.info(f"{model:>14}: {entry.overturned}/{entry.runs} overturned; P = 0.5 at "
                  f"PGA (g) {shown} for PGV/PGA "

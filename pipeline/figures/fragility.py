@@ -196,14 +196,15 @@ def plot_pulse_grid(summary, path):
         image = ax.pcolormesh(_edges(ratios), _edges(pgas), P, cmap="Greys", vmin=0, vmax=1,
                               shading="flat")
         for model, colour in ((name, "C3"), (block, "C0")):
-            contours = section.models[model].contours if model in section.models else {}
-            for level, ls in zip((f"{p:g}" for p in CONTOUR_LEVELS), (":", "-", "--")):
-                rows = [r for r in contours.get(level, ()) if r.pga_g is not None]
+            entry = section.models.get(model)
+            for level, ls in zip(CONTOUR_LEVELS, (":", "-", "--")):
+                rows = [r for r in (entry.contour(level) if entry else ()) if r.pga_g is not None]
                 if rows:
                     who = "2D rigid block (Housner integrator)" if model == block else name
                     ax.plot([r.pgv_pga_s for r in rows], [r.pga_g for r in rows],
-                            color=colour, ls=ls, lw=1.6, label=f"{who} P = {level}")
-            band = [r for r in contours.get("0.5", ()) if None not in r.pga_g_band]
+                            color=colour, ls=ls, lw=1.6, label=f"{who} P = {level:g}")
+            band = [r for r in (entry.contour(0.5) if entry else ())
+                    if None not in r.pga_g_band]
             if band and model == name:
                 ax.fill_between([r.pgv_pga_s for r in band],
                                 [r.pga_g_band[0] for r in band],

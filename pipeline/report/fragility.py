@@ -87,7 +87,7 @@ def rock_fragility_section(results, name="rock-fragility"):
     lines.append(_table(pd.DataFrame(rows)) + "\n")
     lines += [f"Warning: {w}.\n" for w in section.warnings]
     for model, entry in section.models.items():
-        per_set = [r for r in entry.contours.get("0.5", ()) if r.pga_g_per_set]
+        per_set = [r for r in entry.contour(0.5) if r.pga_g_per_set]
         shown = [f"{r.pgv_pga_s:g} s: " + ", ".join(_fmt(v, 2) for v in
                                                     r.pga_g_per_set.values())
                  for r in per_set]

@@ -212,7 +212,7 @@ def test_what_the_pulse_campaign_writes_agrees_with_the_counts_check():
     import pandas as pd
 
     from pipeline.campaign.pulse_summary import cell_table
-    from pipeline.hazard.fragility.check import _Checker, _check_set_counts
+    from pipeline.hazard.fragility.check import Checker, _check_set_counts
     rng = np.random.default_rng(3)
     for full in (False, True):
         rows = [{"model": "monolithic", "pgv_pga_s": 0.1, "pga_g": a, "member": m,
@@ -220,7 +220,7 @@ def test_what_the_pulse_campaign_writes_agrees_with_the_counts_check():
                 for a in (0.2, 0.5, 0.8) for m in range(4) for h in range(6)
                 if full or rng.random() < 0.6]
         for k, cell in enumerate(cell_table(pd.DataFrame(rows), "monolithic")):
-            _check_set_counts(_Checker("fragility.json"), cell, f"cells[{k}]", cell["n"],
+            _check_set_counts(Checker("fragility.json"), cell, f"cells[{k}]", cell["n"],
                               cell["overturned"], 6)
 
 

@@ -1,14 +1,14 @@
 """The checks of ``campaign fragility``'s ``fragility.json`` as a user passes it around:
 :func:`check_fragility` checks every value a reader of it uses before any of them
-allocates or computes, but for the fits, which check themselves on construction
-(:mod:`pipeline.hazard.fragility.fits`, with :class:`_Checker` and these bounds): types (object, list, number, string), finite numbers within their
-ranges, sizes (a 3 x 3 covariance; axes, cells, members and runs within bounds, counts
-as integers) and what would contradict itself (a duplicated cell, overturned outside
-0..n, a P outside 0-1, an interval that does not hold its estimate, a covariance that is
-not symmetric positive semi-definite).  Each refusal is one InputError naming the file
-and the key path, e.g. ``fragility.json: columns.monolithic.logistic.cov must be a 3x3
-list of numbers``.  The file's one reader (:func:`pipeline.hazard.fragility.file.
-read_fragility_file`) runs them.
+allocates or computes (the fits check themselves on construction too,
+:mod:`pipeline.hazard.fragility.fits`, with :class:`Checker`): types (object, list,
+number, string), finite numbers within their ranges, sizes (a 3 x 3 covariance; axes,
+cells, members and runs within bounds, counts as integers) and what would contradict
+itself (a duplicated cell, overturned outside 0..n, a P outside 0-1, an interval that
+does not hold its estimate, a covariance that is not symmetric positive semi-definite).
+Each refusal is one InputError naming the file and the key path, e.g.
+``fragility.json: columns.monolithic.logistic.cov must be a 3x3 list of numbers``.  The
+file's one reader (:func:`pipeline.hazard.fragility.file.read_fragility_file`) runs them.
 
 Two layouts, as the campaign writes them: a column campaign (``columns``: per column type
 its lognormal PGA fit and logistic surface; ``records``, ``members``, ``block2d``) and a
@@ -45,10 +45,10 @@ def check_fragility(data, name="fragility.json"):
     """``data`` (a parsed fragility.json) when every value its readers use is of the
     right type, size and range (see the module); else InputError naming ``name`` and the
     key path."""
-    c = _Checker(name)
+    c = Checker(name)
     if not isinstance(data, dict):
         c.fail("the file", f"must hold a JSON object (campaign fragility's fragility.json), "
-                           f"got {_kind(data)}")
+                           f"got {kind_of(data)}")
     if nesting(data, MAX_DEPTH) > MAX_DEPTH:
         c.fail("the file", f"is nested deeper than {MAX_DEPTH} levels")
     c.text(data.get("specimen"), "specimen")
@@ -61,7 +61,7 @@ def check_fragility(data, name="fragility.json"):
     return data
 
 
-class _Checker:
+class Checker:
     """Typed reads of one file's values; each failure one line naming the key path."""
 
     def __init__(self, name):
@@ -72,14 +72,14 @@ class _Checker:
 
     def obj(self, value, where, most=None):
         if not isinstance(value, dict):
-            self.fail(where, f"must be an object, got {_kind(value)}")
+            self.fail(where, f"must be an object, got {kind_of(value)}")
         if most is not None and len(value) > most:
             self.fail(where, f"holds {len(value)} entries (at most {most})")
         return value
 
     def lst(self, value, where, most):
         if not isinstance(value, list):
-            self.fail(where, f"must be a list, got {_kind(value)}")
+            self.fail(where, f"must be a list, got {kind_of(value)}")
         if len(value) > most:
             self.fail(where, f"holds {len(value)} values (at most {most})")
         return value
@@ -102,7 +102,7 @@ class _Checker:
     def text(self, value, where):
         if value is not None and not (isinstance(value, str) and len(value) <= MAX_TEXT):
             self.fail(where, f"must be a text of at most {MAX_TEXT} characters, got "
-                             f"{_kind(value)}")
+                             f"{kind_of(value)}")
         return value
 
     def pair(self, value, where, low=None, high=None, holds=None, low_open=False):
@@ -123,14 +123,14 @@ def _slack(a, b):
     return TOLERANCE * max(1.0, abs(a), abs(b))
 
 
-def _kind(value):
+def kind_of(value):
     """What a JSON value is, for messages."""
     names = {dict: "an object", list: "a list", str: "a text", bool: "true/false",
              type(None): "null", int: "a number", float: "a number"}
     return f"{names.get(type(value), type(value).__name__)} {show(value, 40)}"
 
 
-def _key(name):
+def key_text(name):
     """A key of the file as it appears in a key path."""
     return name if name.isidentifier() and len(name) <= 40 else show(name, 40)
 
@@ -141,10 +141,10 @@ def _check_columns(c, data):
     if not columns:
         c.fail("columns", "is empty: not a fragility.json of campaign fragility (no 'columns')")
     for column, entry in columns.items():
-        where = f"columns.{_key(column)}"
+        where = f"columns.{key_text(column)}"
         c.obj(entry, where)
         c.text(entry.get("description"), f"{where}.description")
-        _counts(c, entry, where, "runs", "toppled")
+        counts(c, entry, where, "runs", "toppled")
         if entry.get("PGA") is not None:           # survival reads it: bounded further
             _check_lognormal(c, entry["PGA"], f"{where}.PGA")
         if entry.get("logistic") is not None:      # its values: LogisticSurface
@@ -152,7 +152,7 @@ def _check_columns(c, data):
     if data.get("records") is not None:
         for k, record in enumerate(c.lst(data["records"], "records", MAX_RECORDS)):
             if not isinstance(record, str) or not record or len(record) > MAX_TEXT:
-                c.fail(f"records[{k}]", f"must be a record id (a text), got {_kind(record)}")
+                c.fail(f"records[{k}]", f"must be a record id (a text), got {kind_of(record)}")
     c.integer(data.get("members"), "members", 1, MAX_MEMBERS, optional=True)
     if data.get("block2d") is not None:
         block = c.obj(data["block2d"], "block2d")
@@ -172,10 +172,10 @@ def _check_lognormal(c, fit, where):
     beta = c.num(fit.get("beta"), f"{where}.beta", 0, 100, True, True)
     c.pair(fit.get("median_ci95"), f"{where}.median_ci95", 0, None, median, True)
     c.pair(fit.get("beta_ci95"), f"{where}.beta_ci95", 0, None, beta, True)
-    _counts(c, fit, where, "n", "toppled")
+    counts(c, fit, where, "n", "toppled")
 
 
-def _counts(c, entry, where, total, part):
+def counts(c, entry, where, total, part):
     """Two counts of runs (integers, or absent), ``part`` of ``total``."""
     at = f"{where}." if where else ""
     n = c.integer(entry.get(total), f"{at}{total}", 0, MAX_TOTAL, optional=True)
@@ -198,9 +198,9 @@ def _check_pulse_grid(c, section):
         c.fail("pulse_grid", "has no 'models'")
     c.obj(models, "pulse_grid.models", MAX_ENTRIES)
     for model, entry in models.items():
-        where = f"pulse_grid.models.{_key(model)}"
+        where = f"pulse_grid.models.{key_text(model)}"
         c.obj(entry, where)
-        _counts(c, entry, where, "runs", "overturned")
+        counts(c, entry, where, "runs", "overturned")
         if entry.get("logistic") is not None:      # its values: LogisticSurface
             c.obj(entry["logistic"], f"{where}.logistic")
         _check_cells(c, entry.get("cells"), f"{where}.cells", pga, ratio, members, headings)
@@ -269,7 +269,7 @@ def _check_sets(c, cell, at, members):
         c.fail(f"{at}.P_per_set", f"holds {len(p_sets)} values for {len(indices)} sets")
 
 
-def _check_set_counts(c: "_Checker", cell: dict, at: str, n: int, overturned: int,
+def _check_set_counts(c: "Checker", cell: dict, at: str, n: int, overturned: int,
                       headings: int | None) -> None:
     """``P_per_set`` against the cell's counts.  Each set listed ran at least once: at
     most n sets, and the pooled P (overturned / n, the sets' P weighted by their runs)

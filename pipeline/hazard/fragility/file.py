@@ -20,7 +20,7 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from pipeline.files import write_json
-from pipeline.hazard.fragility.check import MAX_MEMBERS, _key, check_fragility
+from pipeline.hazard.fragility.check import MAX_MEMBERS, key_text, check_fragility
 from pipeline.hazard.fragility.fits import LognormalFit, LogisticSurface, leaf
 from pipeline.hazard.fragility.keyed import build as _build
 from pipeline.hazard.fragility.keyed import join as _join
@@ -99,6 +99,11 @@ class GridModel:
     extra: dict = field(default_factory=dict)
     order: tuple = field(default=(), compare=False)
 
+    def contour(self, level):
+        """The :class:`ContourRow` per PGV/PGA of the contour at P = ``level`` (a number,
+        e.g. 0.5; the file's key is it as text), () where the model has none."""
+        return self.contours.get(f"{float(level):g}", ())
+
 
 @dataclass(frozen=True)
 class PulseGridSection:
@@ -167,7 +172,7 @@ class FragilityFile:
         name = str(path) if path is not None else "fragility.json"
         return _build(cls, data, {
             "columns": lambda v: None if v is None else {
-                k: _column(e, name, f"columns.{_key(k)}") for k, e in v.items()},
+                k: _column(e, name, f"columns.{key_text(k)}") for k, e in v.items()},
             "records": lambda v: tuple(v or ()),
             "block2d": lambda v: None if v is None else _build(Block2d, v),
             "pulse_grid": lambda v: None if v is None else _section(v, name)}, path=path)
@@ -224,7 +229,7 @@ def _surface(value, name, where):
 
 
 def _column(entry, name, where):
-    fits = {k: leaf(LognormalFit, v, name, f"{where}.{_key(k)}")
+    fits = {k: leaf(LognormalFit, v, name, f"{where}.{key_text(k)}")
             for k, v in entry.items() if _is_fit(k, v)}
     column = _build(ColumnFits, {k: v for k, v in entry.items() if k not in fits},
                     {"logistic": lambda v: _surface(v, name, f"{where}.logistic")})
@@ -243,7 +248,7 @@ def _section(section, name):
     return _build(PulseGridSection, section, {
         "pga_g": tuple, "pgv_pga_s": tuple, "warnings": tuple,
         "block2d": lambda v: None if v is None else _build(Block2d, v),
-        "models": lambda v: {k: _model(m, name, f"pulse_grid.models.{_key(k)}")
+        "models": lambda v: {k: _model(m, name, f"pulse_grid.models.{key_text(k)}")
                              for k, m in v.items()}})
 
 

@@ -9,7 +9,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from pipeline.files import InputError
-from pipeline.hazard.fragility.check import TOLERANCE, _Checker, _counts, _kind
+from pipeline.hazard.fragility.check import TOLERANCE, Checker, counts, kind_of
 from pipeline.hazard.fragility.keyed import build as _build
 from pipeline.hazard.fragility.keyed import join as _join
 from pipeline.userfiles import show
@@ -22,7 +22,7 @@ def leaf(cls, data, name, where):
     """``cls`` (a fit type) of ``data`` as read at key path ``where`` of the file ``name``:
     an object, else InputError; a refusal of its values named by file and key path."""
     if not isinstance(data, dict):
-        raise InputError(f"{name}: {where} must be an object, got {_kind(data)}")
+        raise InputError(f"{name}: {where} must be an object, got {kind_of(data)}")
     try:
         return cls.of(data)
     except InputError as exc:
@@ -52,14 +52,14 @@ class LognormalFit:
         """Any fit the campaign writes (a degenerate one too: a beta of 1e6, an interval
         open where it overflowed); the PGA fit survival reads is checked further by the
         file's reader (:func:`pipeline.hazard.fragility.check.check_fragility`)."""
-        c = _Checker("")
+        c = Checker("")
         c.text(self.unit, "unit")
         c.text(self.note, "note")
         median = c.num(self.median, "median", 0, None, True, True)
         beta = c.num(self.beta, "beta", 0, None, True, True)
         _open_pair(c, self.median_ci95, "median_ci95", median)
         _open_pair(c, self.beta_ci95, "beta_ci95", beta)
-        _counts(c, {"n": self.n, "toppled": self.toppled}, "", "n", "toppled")
+        counts(c, {"n": self.n, "toppled": self.toppled}, "", "n", "toppled")
 
     @classmethod
     def of(cls, data):
@@ -91,9 +91,9 @@ class LogisticSurface:
     order: tuple = field(default=(), compare=False)
 
     def __post_init__(self):
-        c = _Checker("")
+        c = Checker("")
         c.text(self.note, "note")
-        _counts(c, {"n": self.n, "toppled": self.toppled}, "", "n", "toppled")
+        counts(c, {"n": self.n, "toppled": self.toppled}, "", "n", "toppled")
         b = dict.fromkeys(B)
         if self.coefficients is not None:
             c.obj(self.coefficients, "coefficients")
