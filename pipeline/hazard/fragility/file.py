@@ -120,12 +120,13 @@ class PulseGridSection:
     block2d: Block2d | None = None
     direction: str | None = None
     ranges: str | None = None
-    runs: int | None = None
+    warnings: tuple = ()
+    # set by the campaign after the cells, written in this order after the keys above
     runs_finished: int | None = None
+    yade_wall_s_total: float | None = None
+    runs: int | None = None
     full_grid_runs: int | None = None
     sampling: str | None = None
-    yade_wall_s_total: float | None = None
-    warnings: tuple = ()
     experiments: dict | None = None
     extra: dict = field(default_factory=dict)
     order: tuple = field(default=(), compare=False)
