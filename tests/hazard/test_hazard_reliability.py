@@ -213,6 +213,7 @@ def test_what_the_pulse_campaign_writes_agrees_with_the_counts_check():
 
     from pipeline.campaign.pulse_summary import cell_table
     from pipeline.hazard.fragility.check import Checker, _check_set_counts
+    from pipeline.hazard.fragility.rows import GridCell
     rng = np.random.default_rng(3)
     for full in (False, True):
         rows = [{"model": "monolithic", "pgv_pga_s": 0.1, "pga_g": a, "member": m,
@@ -220,8 +221,7 @@ def test_what_the_pulse_campaign_writes_agrees_with_the_counts_check():
                 for a in (0.2, 0.5, 0.8) for m in range(4) for h in range(6)
                 if full or rng.random() < 0.6]
         for k, cell in enumerate(cell_table(pd.DataFrame(rows), "monolithic")):
-            _check_set_counts(Checker("fragility.json"), cell, f"cells[{k}]", cell["n"],
-                              cell["overturned"], 6)
+            _check_set_counts(Checker("fragility.json"), GridCell.of(cell), f"cells[{k}]", 6)
 
 
 def test_curves_of_two_investigation_times_are_not_one_tree(tmp_path):

@@ -20,8 +20,10 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from pipeline.files import write_json
-from pipeline.hazard.fragility.check import MAX_MEMBERS, key_text, check_fragility
-from pipeline.hazard.fragility.fits import LognormalFit, LogisticSurface, leaf
+from pipeline.hazard.fragility.check import MAX_MEMBERS, check_fragility, key_text
+from pipeline.hazard.fragility.checker import leaf
+from pipeline.hazard.fragility.fits import LognormalFit, LogisticSurface
+from pipeline.hazard.fragility.rows import ContourRow, GridCell
 from pipeline.hazard.fragility.keyed import build as _build
 from pipeline.hazard.fragility.keyed import join as _join
 from pipeline.userfiles import DATA_FILE_BYTES, read_json
@@ -44,44 +46,6 @@ class Block2d:
     uplift_g: float | None = None
     uplift_g_smallest: float | None = None
     model: str | None = None
-    extra: dict = field(default_factory=dict)
-    order: tuple = field(default=(), compare=False)
-
-
-@dataclass(frozen=True)
-class GridCell:
-    """One cell of a pulse grid's model: at ``pga_g`` (g) and ``pgv_pga_s`` (s), ``n``
-    runs of which ``overturned`` overturned, ``P`` their fraction with its Wilson 95 %
-    interval ``ci95``; ``sets`` (indices of the parameter sets run there), ``P_per_set``
-    (each set's P over its headings, None where it has no run), ``set_sd`` (their
-    standard deviation) and ``set_spread_sd`` (with each set's binomial variance
-    removed)."""
-    pga_g: float
-    pgv_pga_s: float
-    n: int = 0
-    overturned: int = 0
-    P: float | None = None
-    ci95: tuple | None = None
-    sets: tuple | None = None
-    P_per_set: tuple | None = None
-    set_sd: float | None = None
-    set_spread_sd: float | None = None
-    extra: dict = field(default_factory=dict)
-    order: tuple = field(default=(), compare=False)
-
-
-@dataclass(frozen=True)
-class ContourRow:
-    """Where one PGV/PGA row (``pgv_pga_s``, s) of a model's cells crosses a contour's
-    level: ``pga_g`` (g; None where the row does not cross), ``pga_g_band`` (where the
-    cells' Wilson bounds cross it, g; an open side None), ``outside_grid`` ("below" or
-    "above" where the crossing lies beyond the grid, else None) and ``pga_g_per_set``
-    (parameter set index, as text, -> its own crossing, g)."""
-    pgv_pga_s: float
-    pga_g: float | None = None
-    pga_g_band: tuple | None = None
-    outside_grid: str | None = None
-    pga_g_per_set: dict | None = None
     extra: dict = field(default_factory=dict)
     order: tuple = field(default=(), compare=False)
 
@@ -260,22 +224,18 @@ def _section_json(section):
         "models": lambda v: {k: _model_json(m) for k, m in v.items()}})
 
 
-_ROW_LISTS = ("ci95", "sets", "P_per_set", "pga_g_band")   # tuples in a row's type
-_ROW_TUPLES = dict.fromkeys(_ROW_LISTS, lambda v: None if v is None else tuple(v))
-_ROW_JSON = dict.fromkeys(_ROW_LISTS, lambda v: None if v is None else list(v))
-
-
 def _model(model, name, where):
     return _build(GridModel, model, {
-        "cells": lambda v: tuple(_build(GridCell, c, _ROW_TUPLES) for c in v or ()),
-        "contours": lambda v: {level: tuple(_build(ContourRow, r, _ROW_TUPLES) for r in rows)
-                               for level, rows in (v or {}).items()},
+        "cells": lambda v: tuple(leaf(GridCell, c, name, f"{where}.cells[{k}]")
+                                 for k, c in enumerate(v or ())),
+        "contours": lambda v: {
+            level: tuple(leaf(ContourRow, r, name, f"{where}.contours.{key_text(level)}[{k}]")
+                         for k, r in enumerate(rows)) for level, rows in (v or {}).items()},
         "logistic": lambda v: _surface(v, name, f"{where}.logistic")})
 
 
 def _model_json(model):
     return _join(model, {
-        "cells": lambda v: [_join(c, _ROW_JSON) for c in v],
-        "contours": lambda v: {level: [_join(r, _ROW_JSON) for r in rows]
-                               for level, rows in v.items()},
+        "cells": lambda v: [c.to_json() for c in v],
+        "contours": lambda v: {level: [r.to_json() for r in rows] for level, rows in v.items()},
         **_SURFACE_JSON})

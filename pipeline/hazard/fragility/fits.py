@@ -1,32 +1,20 @@
 """The fits inside ``fragility.json``, each a type that checks itself on construction:
 a lognormal fit of one intensity measure (:class:`LognormalFit`) and a logistic surface
 in PGA and PGV/PGA (:class:`LogisticSurface`).  A refusal is one InputError naming the
-value (``median must be ...``); read from a file, :func:`leaf` names the file and the
-key path before it (``fragility.json: columns.monolithic.logistic.cov must be a 3x3
+value (``median must be ...``); read from a file,
+:func:`~pipeline.hazard.fragility.checker.leaf` names the file and the key path before it (``fragility.json: columns.monolithic.logistic.cov must be a 3x3
 list of numbers``).  Keys a fit does not name are kept, in their order, in ``extra``."""
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from pipeline.files import InputError
-from pipeline.hazard.fragility.check import TOLERANCE, Checker, counts, kind_of
+from pipeline.hazard.fragility.checker import TOLERANCE, Checker, counts
 from pipeline.hazard.fragility.keyed import build as _build
 from pipeline.hazard.fragility.keyed import join as _join
 from pipeline.userfiles import show
 
 B = ("b0", "b1", "b2")           # a logistic surface's coefficients: logit P = b0 + b1 ln PGA
                                  # + b2 ln PGV/PGA (PGA m/s^2, PGV/PGA s)
-
-
-def leaf(cls, data, name, where):
-    """``cls`` (a fit type) of ``data`` as read at key path ``where`` of the file ``name``:
-    an object, else InputError; a refusal of its values named by file and key path."""
-    if not isinstance(data, dict):
-        raise InputError(f"{name}: {where} must be an object, got {kind_of(data)}")
-    try:
-        return cls.of(data)
-    except InputError as exc:
-        raise InputError(f"{name}: {where}.{exc}") from None
 
 
 @dataclass(frozen=True)
