@@ -11,7 +11,11 @@ with each PGA level.  The package of the fragility wing; each concern in its mod
   (:func:`load_campaign_fragility`, :func:`load_pulse_grid`, :func:`member_fits`);
 - :mod:`pipeline.hazard.fragility.file`: ``fragility.json`` as one type
   (:class:`~pipeline.hazard.fragility.file.FragilityFile`), its writer and its reader;
-- :mod:`pipeline.hazard.fragility.check`: the checks of its values, run by its reader.
+  its leaves in :mod:`~pipeline.hazard.fragility.fits` (a lognormal fit, a logistic
+  surface) and :mod:`~pipeline.hazard.fragility.rows` (a cell, a contour's row), each
+  checking itself on construction (:mod:`~pipeline.hazard.fragility.checker`);
+- :mod:`pipeline.hazard.fragility.check`: the checks a part cannot make alone, run by
+  the reader.
 """
 from pipeline.hazard.fragility.grid import BELOW_GRID, PulseGrid
 from pipeline.hazard.fragility.kinds import Fragility, Logistic, Lognormal
