@@ -14,6 +14,7 @@ from pipeline.campaign.column_file import summary_entry
 from pipeline.campaign.run_dirs import finished_summary
 from pipeline.campaign.pulse_check import experiments_check
 from pipeline.files import json_safe, write_csv
+from pipeline.hazard.fragility.experiments import Experiments
 from pipeline.hazard.fragility.file import FragilityFile, write_fragility_file
 from pipeline.hazard.fragility.load import BLOCK_MODEL
 from pipeline.simulate import run_code_version
@@ -89,7 +90,7 @@ def pulse_outputs(specs, campaign_dir, figures=True):
         sampling=SAMPLING[first.get("sampling") == "adaptive"])
     observed = experiments_check(section, name)
     if observed is not None:
-        section = replace(section, experiments=json_safe(observed))
+        section = replace(section, experiments=Experiments.of(json_safe(observed)))
     summary = replace(summary, pulse_grid=section)
     write_fragility_file(campaign_dir, summary)
     written = []

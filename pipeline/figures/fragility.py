@@ -211,7 +211,8 @@ def plot_pulse_grid(summary, path):
                                 [r.pga_g_band[1] for r in band], color=colour, alpha=0.2,
                                 lw=0, label="P = 0.5, Monte Carlo 95 %")
         _mark_outside(ax, section, name, ratios, pgas)
-        observed = (section.experiments or {}).get("models", {}).get(name, {}).get("bins")
+        check = None if section.experiments is None else section.experiments.models.get(name)
+        observed = None if check is None else check.bins
         if observed:
             x = [np.mean(b["pgv_pga_s"]) for b in observed]
             y = [np.mean(b["pga_g"]) for b in observed]

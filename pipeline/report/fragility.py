@@ -110,17 +110,17 @@ def rock_fragility_section(results, name="rock-fragility"):
     if check:
         def score_row(label, score):
             return {"prediction": label,
-                    "log-likelihood per test": _fmt(score["log_likelihood_per_test"], 3),
-                    "Brier": _fmt(score["brier"], 3), "tests": score["n"]}
+                    "log-likelihood per test": _fmt(score.log_likelihood_per_test, 3),
+                    "Brier": _fmt(score.brier, 3), "tests": score.n}
 
-        rows = [score_row(label, s) for label, s in check["baselines"].items()]
-        for model, result in check["models"].items():
-            rows.append(score_row(f"{model}: pulse fragility (grid; {result['grid']['outside_grid']}"
-                                  " tests outside it, nearest edge)", result["grid"]))
-            if "logistic" in result:
-                rows.append(score_row(f"{model}: its logistic surface", result["logistic"]))
-        lines.append(f"Against the {check['tests']} shake-table tests ({check['overturned']} "
-                     f"overturned; {check['note']}):\n")
+        rows = [score_row(label, s) for label, s in check.baselines.items()]
+        for model, result in check.models.items():
+            rows.append(score_row(f"{model}: pulse fragility (grid; {result.grid.outside_grid}"
+                                  " tests outside it, nearest edge)", result.grid))
+            if result.logistic is not None:
+                rows.append(score_row(f"{model}: its logistic surface", result.logistic))
+        lines.append(f"Against the {check.tests} shake-table tests ({check.overturned} "
+                     f"overturned; {check.note}):\n")
         lines.append(_table(pd.DataFrame(rows)) + "\n")
     lines.append(_figure(results, results / name / "fragility_pulse_grid.png",
                          "P(overturn) over the pulse grid, contours, 2D block, observed rates"))

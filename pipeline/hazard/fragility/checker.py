@@ -17,12 +17,13 @@ def leaf(cls, data, name, where):
     """``cls`` (a type of the file that checks itself) of ``data`` as read at key path
     ``where`` of the file ``name``: an object, else InputError; a refusal of its values
     named by file and key path."""
+    at = f"{name}: {where}" if name else where
     if not isinstance(data, dict):
-        raise InputError(f"{name}: {where} must be an object, got {kind_of(data)}")
+        raise InputError(f"{at} must be an object, got {kind_of(data)}")
     try:
         return cls.of(data)
     except InputError as exc:
-        raise InputError(f"{name}: {where}.{exc}") from None
+        raise InputError(f"{at}.{exc}") from None
 
 
 class Checker:

@@ -22,6 +22,7 @@ from pathlib import Path
 from pipeline.files import write_json
 from pipeline.hazard.fragility.check import MAX_MEMBERS, check_fragility, key_text
 from pipeline.hazard.fragility.checker import leaf
+from pipeline.hazard.fragility.experiments import Experiments
 from pipeline.hazard.fragility.fits import LognormalFit, LogisticSurface
 from pipeline.hazard.fragility.rows import ContourRow, GridCell
 from pipeline.hazard.fragility.keyed import build as _build
@@ -75,7 +76,8 @@ class PulseGridSection:
     (parameter sets), ``headings`` (directions per set), ``models`` (name ->
     :class:`GridModel`), ``block2d``, ``direction`` and ``ranges`` (text), the runs
     (``runs``, ``runs_finished``, ``full_grid_runs``, ``sampling``, ``yade_wall_s_total``
-    in s), ``warnings`` and ``experiments`` (the shake-table check, or None)."""
+    in s), ``warnings`` and ``experiments`` (the shake-table check,
+    :class:`~pipeline.hazard.fragility.experiments.Experiments`, or None)."""
     pga_g: tuple = ()
     pgv_pga_s: tuple = ()
     members: int | None = None
@@ -91,7 +93,7 @@ class PulseGridSection:
     runs: int | None = None
     full_grid_runs: int | None = None
     sampling: str | None = None
-    experiments: dict | None = None
+    experiments: Experiments | None = None
     extra: dict = field(default_factory=dict)
     order: tuple = field(default=(), compare=False)
 
@@ -214,14 +216,17 @@ def _section(section, name):
         "pga_g": tuple, "pgv_pga_s": tuple, "warnings": tuple,
         "block2d": lambda v: None if v is None else _build(Block2d, v),
         "models": lambda v: {k: _model(m, name, f"pulse_grid.models.{key_text(k)}")
-                             for k, m in v.items()}})
+                             for k, m in v.items()},
+        "experiments": lambda v: None if v is None else
+        leaf(Experiments, v, name, "pulse_grid.experiments")})
 
 
 def _section_json(section):
     return _join(section, {
         "pga_g": list, "pgv_pga_s": list, "warnings": list,
         "block2d": lambda v: None if v is None else _join(v),
-        "models": lambda v: {k: _model_json(m) for k, m in v.items()}})
+        "models": lambda v: {k: _model_json(m) for k, m in v.items()},
+        "experiments": lambda v: None if v is None else v.to_json()})
 
 
 def _model(model, name, where):

@@ -1,17 +1,20 @@
 """The types of ``fragility.json`` to and from the dicts its JSON holds: the keys a type
 names become its fields, the others stay in its ``extra``, and the keys' order is kept
 (``order``), so that a file read and written again is the same file."""
-from dataclasses import fields
+from dataclasses import MISSING, fields
 
 KEPT = ("extra", "order", "path")     # fields that are not keys of the file
 
 
 def build(cls, data, convert=None, **more):
-    """``cls`` of a dict: its named keys (through ``convert``), the rest in ``extra``,
-    the keys' order kept."""
+    """``cls`` of a dict: its named keys (through ``convert``; a key ``cls`` requires and
+    the dict lacks as None, for ``cls`` to refuse by name), the rest in ``extra``, the
+    keys' order kept."""
     convert = convert or {}
     names = {f.name for f in fields(cls)} - set(KEPT)
     known = {k: convert.get(k, same)(v) for k, v in data.items() if k in names}
+    known.update({f.name: None for f in fields(cls) if f.name in names and f.name not in known
+                  and f.default is MISSING and f.default_factory is MISSING})
     extra = {k: v for k, v in data.items() if k not in names}
     return cls(**known, extra=extra, order=tuple(data), **more)
 
