@@ -1,8 +1,11 @@
 """``fragility.json``, the file of ``campaign fragility``, as one type
 (:class:`FragilityFile`) with one writer (:func:`write_fragility_file`, atomic) and one
-reader (:func:`read_fragility_file`: bounded, strict UTF-8, JSON, every value its readers
-use checked by :func:`pipeline.hazard.fragility.check.check_fragility`).  The campaigns
-that write it, survival, the shake-table check, the figures and the report share it.
+reader (:func:`read_fragility_file`: bounded, strict UTF-8, JSON, what a part cannot
+check alone checked by :func:`pipeline.hazard.fragility.check.check_fragility`, each part
+typed to its leaves and checking itself on construction: :mod:`~pipeline.hazard.
+fragility.fits`, :mod:`~pipeline.hazard.fragility.rows`, :mod:`~pipeline.hazard.
+fragility.experiments`).  The campaigns that write it, survival, the shake-table check,
+the figures and the report share it.
 
 Two layouts: a column campaign (``columns``: per column type its lognormal fits per
 intensity measure and logistic surface, :class:`ColumnFits`; ``records``, ``members``,
@@ -10,9 +13,8 @@ intensity measure and logistic surface, :class:`ColumnFits`; ``records``, ``memb
 ``pga_g`` (g) x ``pgv_pga_s`` (s), ``members``, ``models`` (:class:`GridModel`) with
 their cells, contours and logistic surface, the 2D block :class:`Block2d`).  Keys a
 section does not name are kept as written in its ``extra`` (and written back in their
-place).  Older files load, brought to today's spelling here and nowhere else: a
-covariance written as nulls (a singular information matrix) is none, and a pulse grid's
-2D block without ``uplift_g_smallest`` takes it from ``uplift_g`` (the runs' median
+place).  Older files load, brought to today's spelling here and nowhere else: a pulse
+grid's 2D block without ``uplift_g_smallest`` takes it from ``uplift_g`` (the runs' median
 critical angle) or, without that, from ``alpha_rad`` (g tan alpha), in that order.
 """
 import math
