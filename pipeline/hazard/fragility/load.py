@@ -11,6 +11,7 @@ import pandas as pd
 from pipeline.constants import STANDARD_GRAVITY
 from pipeline.files import InputError
 from pipeline.hazard.components import on_hazard_measure
+from pipeline.hazard.fragility.checker import key_text
 from pipeline.hazard.fragility.file import MAX_MEMBERS, FragilityFile, read_fragility_file
 from pipeline.hazard.fragility.grid import BELOW_GRID, PulseGrid
 from pipeline.hazard.fragility.kinds import BETA_RANGE, MEDIAN_G_RANGE, Logistic, Lognormal
@@ -52,28 +53,29 @@ def _load_campaign_fragility(path, column, form, below, members):
     if column is None:
         column = next((c for c in ("monolithic", "drums") if c in columns), next(iter(columns)))
     if column not in columns:
-        raise InputError(f"{path}: no column {column!r} (has {', '.join(columns)})")
+        raise InputError(f"{path}: no column {column!r} (has {', '.join(map(key_text, columns))})")
     entry = columns[column]
+    named = key_text(column)                 # as a key path names it: one line
     label = f"{column} ({entry.description or ''}) from {path.name}"
     if form == "pga":
         fit = entry.fits.get("PGA")
         if fit is None:
-            raise InputError(f"{path}: column {column}: no PGA fit in the file (give "
+            raise InputError(f"{path}: column {named}: no PGA fit in the file (give "
                              "--fragility-form pga-pgv for its logistic surface)")
         if fit.unit != "m/s^2":
-            raise InputError(f"{path}: column {column}: PGA fit in unknown unit "
+            raise InputError(f"{path}: column {named}: PGA fit in unknown unit "
                              f"{fit.unit!r} (expected m/s^2)")
         if fit.median is None:
-            raise InputError(f"{path}: column {column}: PGA fragility not fitted "
+            raise InputError(f"{path}: column {named}: PGA fragility not fitted "
                              f"({fit.note or 'no median'})")
-        where = f"{path}: column {column}: PGA"
+        where = f"{path}: column {named}: PGA"
         low, high = (g * STANDARD_GRAVITY for g in MEDIAN_G_RANGE)
         pooled = Lognormal(number(fit.median, f"{where} median", low, high, "m/s^2"),
                            number(fit.beta, f"{where} beta", *BETA_RANGE),
                            _floats(fit.median_ci95), _floats(fit.beta_ci95), label=label,
                            note=fit.note)
     elif form == "pga-pgv":
-        pooled = _logistic(entry.logistic, f"{path}: column {column}", label)
+        pooled = _logistic(entry.logistic, f"{path}: column {named}", label)
     else:
         raise InputError(f"--fragility-form must be pga or pga-pgv, got {form!r}")
     if not members:
@@ -185,9 +187,9 @@ def load_pulse_grid(file, model=None, form="grid", below="ramp"):
     if model is None:
         model = _specimen_model(file)
     if model not in models:
-        raise InputError(f"{path}: pulse_grid has no model {model!r} (has {', '.join(models)})")
+        raise InputError(f"{path}: pulse_grid has no model {model!r} (has {', '.join(map(key_text, models))})")
     entry = models[model]
-    where = f"{path}: pulse_grid model {model}"
+    where = f"{path}: pulse_grid model {key_text(model)}"
     label = f"{file.specimen or 'specimen'} {model} pulse grid from {path.name}"
     surface = entry.logistic
     logistic = None if surface is None or surface.b is None else \
