@@ -53,7 +53,8 @@ def _load_campaign_fragility(path, column, form, below, members):
     if column is None:
         column = next((c for c in ("monolithic", "drums") if c in columns), next(iter(columns)))
     if column not in columns:
-        raise InputError(f"{path}: no column {column!r} (has {', '.join(map(key_text, columns))})")
+        raise InputError(f"{path}: no column {column!r} (has "
+                         f"{', '.join(map(key_text, columns))})")
     entry = columns[column]
     named = key_text(column)                 # as a key path names it: one line
     label = f"{column} ({entry.description or ''}) from {path.name}"
@@ -187,7 +188,8 @@ def load_pulse_grid(file, model=None, form="grid", below="ramp"):
     if model is None:
         model = _specimen_model(file)
     if model not in models:
-        raise InputError(f"{path}: pulse_grid has no model {model!r} (has {', '.join(map(key_text, models))})")
+        raise InputError(f"{path}: pulse_grid has no model {model!r} (has "
+                         f"{', '.join(map(key_text, models))})")
     entry = models[model]
     where = f"{path}: pulse_grid model {key_text(model)}"
     label = f"{file.specimen or 'specimen'} {model} pulse grid from {path.name}"
