@@ -2,8 +2,9 @@
 a lognormal fit of one intensity measure (:class:`LognormalFit`) and a logistic surface
 in PGA and PGV/PGA (:class:`LogisticSurface`).  A refusal is one InputError naming the
 value (``median must be ...``); read from a file,
-:func:`~pipeline.hazard.fragility.checker.leaf` names the file and the key path before it (``fragility.json: columns.monolithic.logistic.cov must be a 3x3
-list of numbers``).  Keys a fit does not name are kept, in their order, in ``extra``."""
+:func:`~pipeline.hazard.fragility.checker.leaf` names the file and the key path before
+it (``fragility.json: columns.monolithic.logistic.cov must be a 3x3 list of numbers``).
+Keys a fit does not name are kept, in their order, in ``extra``."""
 from dataclasses import dataclass, field
 
 import numpy as np
