@@ -57,7 +57,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))       # bench/mujoco_tw
 sys.path.insert(1, str(Path(__file__).resolve().parent.parent))  # this checkout's pipeline
 from pipeline import PROJECT_ROOT as PROJECT, RESULTS_DIR  # noqa: E402
 from pipeline.campaign.pulse_summary import contour_difference  # noqa: E402
-from pipeline.hazard.fragility_file import read_fragility_file  # noqa: E402
+from pipeline.hazard.fragility.file import read_fragility_file  # noqa: E402
 from pipeline.files import save_figure, write_json  # noqa: E402
 from pipeline.motion import Motion  # noqa: E402
 from pipeline.motion.pulses import one_sine_pulse  # noqa: E402

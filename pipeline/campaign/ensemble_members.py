@@ -42,7 +42,7 @@ from pipeline.constants import RIM_POINTS
 from pipeline.files import InputError
 from pipeline.scenario import Contact, Numerics
 from pipeline.scenario.column_format import MAX_OFFSET_M
-from pipeline.scenario.contact_file import refuse_set_twice
+from pipeline.scenario.contact_file import ranges_left
 from pipeline.scenario.geometry import ColumnGeometry
 from pipeline.scenario.parameters import kinetic_friction
 from pipeline.scenario.time_step import check_time_step
@@ -187,19 +187,11 @@ def paper_drums(height, diameter):
             "blocks": [dict(drum) for _ in range(paper.N_DRUMS)]}
 
 
-SAMPLED_CONTACT = {"mu_s": ("mu_s", "mu_k"), "damping": ("damping",)}   # range: file fields
-
-
 def contact_ranges(ranges, contact, vary=None):
     """The ranges without those a contact file fixes (``contact``: its values, or None):
     its damping and friction replace the sampled ones; its kn is what kn_factor
     multiplies.  A ``vary`` range of a field the file sets is refused (one line)."""
-    if not contact:
-        return ranges
-    refuse_set_twice(contact, [f for name in (vary or {}) for f in SAMPLED_CONTACT.get(name, ())
-                               if name in SAMPLED_CONTACT], "--vary")
-    return {k: v for k, v in ranges.items()
-            if not any(f in contact for f in SAMPLED_CONTACT.get(k, ()))}
+    return ranges_left(ranges, contact, vary or {}, "--vary")
 
 
 def with_fixed_contact(rows, contact):

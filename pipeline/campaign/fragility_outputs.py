@@ -13,7 +13,7 @@ from pipeline.campaign.fragility_tables import level_table, scaled_runs, summari
 from pipeline.campaign.pulse_outputs import pulse_outputs
 from pipeline.campaign.run_dirs import finished_summary
 from pipeline.files import write_csv
-from pipeline.hazard.fragility_file import FragilityFile, write_fragility_file
+from pipeline.hazard.fragility.file import FragilityFile, write_fragility_file
 from pipeline.simulate import run_code_version
 
 log = logging.getLogger(__name__)
@@ -52,9 +52,9 @@ def fragility_outputs(specs, campaign_dir, failures, animations, figures=True):
     for name, entry in summary.columns.items():
         fit = entry.fits["PGA"]
         log.info(f"{name:>14}: {entry.toppled}/{entry.runs} toppled; PGA median "
-                 + ("-" if fit["median"] is None else
-                    f"{fit['median']:.2f} m/s^2 [{fit['median_ci95'][0]:.2f}, "
-                    f"{fit['median_ci95'][1]:.2f}], beta {fit['beta']:.2f}"))
+                 + ("-" if fit.median is None else
+                    f"{fit.median:.2f} m/s^2 [{fit.median_ci95[0]:.2f}, "
+                    f"{fit.median_ci95[1]:.2f}], beta {fit.beta:.2f}"))
     log.info(f"2D block: {cost['block2d_cases']} cases in {cost['block2d_wall_s']:.1f} s; "
              f"YADE: {cost['yade_runs']} runs, {cost['yade_wall_s_total']:.0f} s")
     return {"code_version": run_code_version(), **summary_entry(specs),

@@ -3,9 +3,10 @@ PGA, PGV/PGA and SP1's outcome of every test, the 92 without a motion included; 
 SP1's outcomes are read).  The tests' motions are table records, not pulses: the scores
 say how far the pulse fragility carries over to them.
 
-Scores of the observed outcomes under: the fragility (P interpolated between the grid's
-cells, bilinear in PGA and PGV/PGA; tests outside the grid take the nearest edge, counted
-in ``outside_grid``), its logistic surface, "overturns when PGA >= g tan alpha" (the 2D
+Scores of the observed outcomes under: the fragility (P between the grid's cells by
+their one interpolation, bilinear in ln PGA and ln PGV/PGA, empty cells filled, as
+survival reads them; tests outside the grid take the nearest edge, counted in
+``outside_grid``), its logistic surface, "overturns when PGA >= g tan alpha" (the 2D
 block's critical angle) and a logistic surface fitted to the observations themselves
 (the ceiling a smooth surface in these two measures reaches).  Log-likelihood per test
 (probabilities clipped to [0.01, 0.99], so that a certain wrong prediction costs
@@ -18,7 +19,7 @@ import numpy as np
 from pipeline.campaign.shake_table_experiments import (EXPERIMENTS, OUTCOME, PGA_EDGES_G, PGV_PGA_EDGES_S,
                                            load_experiments)
 from pipeline.constants import STANDARD_GRAVITY as G
-from pipeline.hazard.pulse_cells import cell_table, interpolate
+from pipeline.hazard.pulse_cells import fill_empty, interpolate, lay_cells
 from pipeline.stats.ensemble import wilson_interval
 from pipeline.stats.fragility import logistic_probability, logistic_surface
 
@@ -35,20 +36,23 @@ def scores(observed, probability):
             "n": int(y.size)}
 
 
-def grid_probability(cells, pga_g, ratio):
-    """P of the cells (a full PGV/PGA x PGA grid) at the tests by the pulse grid's one
-    interpolation (:func:`pipeline.hazard.pulse_cells.interpolate`: bilinear in ln PGA,
-    ln PGV/PGA, as survival reads it), the nearest edge cell's P outside the grid;
-    (P, outside), or (None, None) when the grid lacks a cell."""
-    pgas, ratios, values = cell_table(cells)
-    if np.isnan(values).any():
-        return None, None
-    return interpolate(pgas, ratios, values, pga_g, ratio)
+def grid_probability(section, cells, pga_g, ratio):
+    """P of a model's ``cells`` on the axes of ``section`` (its pulse grid) at the tests
+    by the pulse grid's one interpolation (:func:`pipeline.hazard.pulse_cells.interpolate`:
+    bilinear in ln PGA, ln PGV/PGA, as survival reads it), the nearest edge cell's P
+    outside the grid, empty cells filled by survival's rule
+    (:func:`pipeline.hazard.pulse_cells.fill_empty`); (P, outside, cells filled), or
+    (None, None, 0) when no cell holds a P."""
+    _, _, values, _ = lay_cells(section.pga_g, section.pgv_pga_s, cells)
+    if np.isnan(values).all():
+        return None, None, 0
+    values, filled = fill_empty(values)
+    return (*interpolate(section.pga_g, section.pgv_pga_s, values, pga_g, ratio), filled)
 
 
 def experiments_check(section, specimen, experiments=EXPERIMENTS):
     """The ``experiments`` entry of ``pulse_grid`` (``section``, a
-    :class:`~pipeline.hazard.fragility_file.PulseGridSection`) for a specimen with shipped
+    :class:`~pipeline.hazard.fragility.file.PulseGridSection`) for a specimen with shipped
     tests (None for others)."""
     outcome = SPECIMENS_WITH_TESTS.get(specimen)
     if outcome is None:
@@ -70,11 +74,13 @@ def experiments_check(section, specimen, experiments=EXPERIMENTS):
                                           ratio[keep]))
     models = {}
     for model, entry in section.models.items():
-        p, outside = grid_probability(entry.cells, pga, ratio)
+        p, outside, filled = grid_probability(section, entry.cells, pga, ratio)
         if p is None:
             continue
         result = {"grid": {**scores(y, p), "outside_grid": int(outside.sum())}}
-        coef = (entry.logistic or {}).get("coefficients")
+        if filled:
+            result["grid"]["empty_cells_filled"] = filled
+        coef = None if entry.logistic is None else entry.logistic.coefficients
         if coef is not None:
             result["logistic"] = scores(y[keep], logistic_probability(
                 coef, pga[keep] * G, ratio[keep]))

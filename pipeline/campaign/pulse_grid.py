@@ -26,6 +26,7 @@ from pipeline.campaign.shake_table_experiments import GRID_CONTACT, GRID_SPECIME
 from pipeline.constants import STANDARD_GRAVITY
 from pipeline.files import InputError
 from pipeline.motion.pulses import one_cosine_pulse
+from pipeline.scenario.contact_file import ranges_left
 from pipeline.scenario.parameters import kinetic_friction
 
 G = STANDARD_GRAVITY               # m/s^2 per g (the grid's PGA is in g)
@@ -171,14 +172,7 @@ def pulse_runs(data, column, pulses, members, headings, azimuth, seed, ranges,
     refused)."""
     mesh = data is not None and "mesh" in data
     grid = parse_pulses(pulses)
-    if contact:
-        from pipeline.scenario.contact_file import refuse_set_twice
-        given = parse_ranges(ranges, mesh=False)           # those --ranges names
-        refuse_set_twice(contact, [f for name in given
-                                   for f in ((name, "mu_k") if name == "mu_s" else (name,))],
-                         "--ranges")
-    ranges = {k: v for k, v in parse_ranges(ranges, mesh).items()
-              if not (contact and (k in contact or (k == "mu_s" and "mu_k" in contact)))}
+    ranges = drawn_ranges(ranges, mesh, contact)
 
     if not (isinstance(headings, int) and 1 <= headings <= 360):
         raise InputError(f"--headings must be an integer in [1, 360], got {headings!r}")
@@ -214,6 +208,13 @@ def pulse_runs(data, column, pulses, members, headings, azimuth, seed, ranges,
                                   "pgv_pga_s": float(ratio), "member": m, "heading": h,
                                   "azimuth_deg": float(azimuths[m, h]), "point": point}))
     return grid, sets, azimuths, runs
+
+
+def drawn_ranges(text, mesh, contact=None):
+    """The ranges drawn (:func:`parse_ranges` of ``text``) without those a contact file
+    fixes (``contact``: its values, or None); a --ranges of a field it sets is refused."""
+    given = parse_ranges(text, mesh=False) if contact else {}    # the names --ranges gives
+    return ranges_left(parse_ranges(text, mesh), contact, given, "--ranges")
 
 
 def run_core_s(pgv_pga_s):

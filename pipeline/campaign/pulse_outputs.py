@@ -14,12 +14,18 @@ from pipeline.campaign.column_file import summary_entry
 from pipeline.campaign.run_dirs import finished_summary
 from pipeline.campaign.pulse_check import experiments_check
 from pipeline.files import json_safe, write_csv
-from pipeline.hazard.fragility_file import FragilityFile, write_fragility_file
-from pipeline.hazard.fragility_load import BLOCK_MODEL
+from pipeline.hazard.fragility.experiments import Experiments
+from pipeline.hazard.fragility.file import FragilityFile, write_fragility_file
+from pipeline.hazard.fragility.load import BLOCK_MODEL
 from pipeline.simulate import run_code_version
 
 log = logging.getLogger(__name__)
 
+SAMPLING = {True: "adaptive: each cell run until its Wilson interval excludes P = 0.5 (up to "
+                  "the full grid's runs), starting from a few runs near the 2D block's "
+                  "threshold and one probe run elsewhere, more where a probe disagreed with "
+                  "the block or a neighbour; a cell's n is the runs it had",
+            False: "full grid: every cell x member x direction"}   # by "adaptive"
 
 def pulse_table(specs, campaign_dir):
     """One row per finished run and specimen model, then the 2D block of every such run."""
@@ -71,26 +77,21 @@ def pulse_outputs(specs, campaign_dir, figures=True):
                                         or pulse_grid.DEFAULT_RANGES)
     described = summary_entry(specs)
     name = described["column_file"]["name"] if described else "the paper's column"
-    section["block2d"]["model"] = BLOCK_MODEL
-    section["runs_finished"] = len(done)
-    section["yade_wall_s_total"] = round(float(sum(
-        finished_summary(campaign_dir, s.run_id).wall_s or 0.0 for s in done)), 1)
-    section["runs"] = len(specs)
-    section["full_grid_runs"] = (len(grid["pga_g"]) * len(grid["pgv_pga_s"]) * first["members"]
-                                 * first["headings"])
-    section["sampling"] = ("adaptive: each cell run until its Wilson interval excludes "
-                           "P = 0.5 (up to the full grid's runs), starting from a few runs "
-                           "near the 2D block's threshold and one probe run elsewhere, "
-                           "more where a probe disagreed with the block or a neighbour; "
-                           "a cell's n is the runs it had"
-                           if first.get("sampling") == "adaptive"
-                           else "full grid: every cell x member x direction")
     summary = FragilityFile.of(json_safe({"mode": "pulses", "specimen": name,
                                           "seed": first["seed"], "pulse_grid": section}))
-    observed = experiments_check(summary.pulse_grid, name)
+    section = summary.pulse_grid
+    section = replace(
+        section, block2d=replace(section.block2d, model=BLOCK_MODEL),
+        runs_finished=len(done), runs=len(specs),
+        yade_wall_s_total=round(float(sum(
+            finished_summary(campaign_dir, s.run_id).wall_s or 0.0 for s in done)), 1),
+        full_grid_runs=(len(grid["pga_g"]) * len(grid["pgv_pga_s"]) * first["members"]
+                        * first["headings"]),
+        sampling=SAMPLING[first.get("sampling") == "adaptive"])
+    observed = experiments_check(section, name)
     if observed is not None:
-        summary = replace(summary, pulse_grid=replace(summary.pulse_grid,
-                                                      experiments=json_safe(observed)))
+        section = replace(section, experiments=Experiments.of(json_safe(observed)))
+    summary = replace(summary, pulse_grid=section)
     write_fragility_file(campaign_dir, summary)
     written = []
     if figures:
@@ -98,7 +99,7 @@ def pulse_outputs(specs, campaign_dir, figures=True):
         written = plot_pulse_grid(summary, campaign_dir / "fragility_pulse_grid.png")
     grid = summary.pulse_grid
     for model, entry in grid.models.items():
-        half = [c.pga_g for c in entry.contours["0.5"]]
+        half = [c.pga_g for c in entry.contour(0.5)]
         shown = ", ".join("-" if v is None else f"{v:.2f}" for v in half)
         log.info(f"{model:>14}: {entry.overturned}/{entry.runs} overturned; P = 0.5 at "
                  f"PGA (g) {shown} for PGV/PGA "

@@ -166,9 +166,9 @@ def summarise_grid(table, specs, grid, sets, azimuths, azimuth, ranges_text):
         "models": models}
 
 
-def contour_difference(reference, other, level="0.5"):
+def contour_difference(reference, other, level=0.5):
     """How far the P = ``level`` contour of ``other`` lies from that of ``reference`` (two
-    :class:`~pipeline.hazard.fragility_file.FragilityFile` of the same pulse grid, e.g.
+    :class:`~pipeline.hazard.fragility.file.FragilityFile` of the same pulse grid, e.g.
     the adaptive surface and the full
     grid): per PGV/PGA of the specimen model (not the 2D block) both PGAs (g), their
     difference and the reference's Monte Carlo band (the PGAs where its Wilson bounds
@@ -180,7 +180,7 @@ def contour_difference(reference, other, level="0.5"):
         specimen = [m for m in models if m != "block2d"]
         if len(specimen) != 1:
             raise ValueError(f"expected one specimen model beside block2d, got {specimen}")
-        return {r.pgv_pga_s: r for r in models[specimen[0]].contours[level]}
+        return {r.pgv_pga_s: r for r in models[specimen[0]].contour(level)}
     ref, oth = rows(reference), rows(other)
     if set(ref) != set(oth):
         raise ValueError("the two fragility.json files are not of the same pulse grid")

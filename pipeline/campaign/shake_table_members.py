@@ -38,7 +38,7 @@ from pipeline.campaign.run_dirs import finished_runs, finished_summary
 from pipeline.campaign.runs import column_specs
 from pipeline.campaign.shake_table_scores import load_providers, write_scores
 from pipeline.files import InputError, duration_text, write_csv
-from pipeline.scenario.contact_file import contact_values, refuse_set_twice
+from pipeline.scenario.contact_file import contact_values
 from pipeline.scenario.geometry import ColumnGeometry
 from pipeline.stats.ensemble import wilson_interval
 from pipeline.stats.forecast import forecast_scores
@@ -92,13 +92,7 @@ def single_set(grid):
 def member_sets(specimen, members, seed, ranges, contact=None):
     """(parameter sets, ranges drawn): the fragility's draws for this specimen."""
     mesh = "mesh" in specimen
-    if contact:
-        given = pulse_grid.parse_ranges(ranges, mesh=False)
-        refuse_set_twice(contact, [f for name in given
-                                   for f in ((name, "mu_k") if name == "mu_s" else (name,))],
-                         "--ranges")
-    drawn = {k: v for k, v in pulse_grid.parse_ranges(ranges, mesh).items()
-             if not (contact and (k in contact or (k == "mu_s" and "mu_k" in contact)))}
+    drawn = pulse_grid.drawn_ranges(ranges, mesh, contact)
     if members > 1 and all(lo == hi for lo, hi in drawn.values()):
         raise InputError(f"--members {members} with nothing drawn (give --ranges: a column "
                          "description draws nothing by default) would repeat one run")

@@ -233,7 +233,7 @@ def _check_site_motion(args):
         if column not in cache:
             cache[column] = load_campaign_fragility(
                 args.site_fragility, column, args.site_fragility_form, component="rotd50",
-                record_fraction=rotd50_fraction)
+                record_fraction=rotd50_fraction, members=False)
         return cache[column]
     for column in load_observations(args.observations).column_types():
         fragility_for(column)                  # a missing column type refused before work

@@ -9,7 +9,7 @@ from scipy import stats
 
 from pipeline.figures.style import COLUMN_COLOURS, COLUMN_LABELS, COLUMN_MARKERS, figure
 from pipeline.files import save_figure
-from pipeline.hazard.pulse_cells import CONTOUR_LEVELS
+from pipeline.hazard.pulse_cells import CONTOUR_LEVELS, lay_cells
 from pipeline.stats.ensemble import wilson_interval
 from pipeline.stats.fragility import logistic_probability
 
@@ -39,7 +39,7 @@ def _plain_log_ticks(axis):
 def plot_fragility(table, summary, out_dir):
     """``fragility_curves.png``, ``fragility_2d_vs_3d.png``, ``fragility_surface.png`` of
     a column campaign's runs ``table`` and its
-    :class:`~pipeline.hazard.fragility_file.FragilityFile` ``summary``."""
+    :class:`~pipeline.hazard.fragility.file.FragilityFile` ``summary``."""
     out_dir = Path(out_dir)
     return [plot_curves(table, summary, out_dir / "fragility_curves.png"),
             plot_levels(table, out_dir / "fragility_2d_vs_3d.png"),
@@ -66,7 +66,7 @@ def plot_curves(table, summary, path):
             for k, name in enumerate(([column] if column else []) + blocks):
                 entry = summary.columns[name].fits[im]
                 st = _style(name)
-                bins = entry["bins"]
+                bins = entry.bins
                 if bins:
                     x = np.array([b["im"] for b in bins]) * (1.0 + 0.025 * (k - 1))
                     y = np.array([b["fraction"] for b in bins])
@@ -74,11 +74,11 @@ def plot_curves(table, summary, path):
                                     for b in bins]).T
                     ax.errorbar(x, y, yerr=err, fmt=st["marker"], color=st["color"], ms=5,
                                 capsize=2, lw=0.8, alpha=0.85)
-                if entry["median"] is not None:
-                    curve = stats.norm.cdf(np.log(grid / entry["median"]) / entry["beta"])
+                if entry.median is not None:
+                    curve = stats.norm.cdf(np.log(grid / entry.median) / entry.beta)
                     ax.plot(grid, curve, color=st["color"], ls=st["ls"], lw=1.8,
-                            label=f"{st['label']}: median {entry['median']:.3g}, "
-                                  f"β {entry['beta']:.2f}")
+                            label=f"{st['label']}: median {entry.median:.3g}, "
+                                  f"β {entry.beta:.2f}")
                 else:
                     ax.plot([], [], color=st["color"], ls=st["ls"], marker=st["marker"],
                             label=f"{st['label']}: not fitted")
@@ -179,7 +179,7 @@ def plot_surface(table, summary, path):
 
 
 def plot_pulse_grid(summary, path):
-    """The pulse-grid fragility (a :class:`~pipeline.hazard.fragility_file.FragilityFile`)
+    """The pulse-grid fragility (a :class:`~pipeline.hazard.fragility.file.FragilityFile`)
     of each 3D specimen model: P per cell (colour), its contours at the P of
     :data:`~pipeline.hazard.pulse_cells.CONTOUR_LEVELS` (lines; the Monte Carlo band of
     the 0.5 contour shaded), the 2D rigid block's (same critical angle and pivot distance; the toolkit's
@@ -192,27 +192,27 @@ def plot_pulse_grid(summary, path):
     ratios, pgas = np.array(section.pgv_pga_s), np.array(section.pga_g)
     for ax, name in zip(axes, names):
         cells = section.models[name].cells
-        P = np.full((len(ratios), len(pgas)), np.nan)
-        for c in cells:
-            P[np.argmin(abs(ratios - c.pgv_pga_s)), np.argmin(abs(pgas - c.pga_g))] = c.P
-        image = ax.pcolormesh(_edges(ratios), _edges(pgas), P.T, cmap="Greys", vmin=0, vmax=1,
+        _, _, P, _ = lay_cells(pgas, ratios, cells)             # NaN: no run, left blank
+        image = ax.pcolormesh(_edges(ratios), _edges(pgas), P, cmap="Greys", vmin=0, vmax=1,
                               shading="flat")
         for model, colour in ((name, "C3"), (block, "C0")):
-            contours = section.models[model].contours if model in section.models else {}
-            for level, ls in zip((f"{p:g}" for p in CONTOUR_LEVELS), (":", "-", "--")):
-                rows = [r for r in contours.get(level, ()) if r.pga_g is not None]
+            entry = section.models.get(model)
+            for level, ls in zip(CONTOUR_LEVELS, (":", "-", "--")):
+                rows = [r for r in (entry.contour(level) if entry else ()) if r.pga_g is not None]
                 if rows:
                     who = "2D rigid block (Housner integrator)" if model == block else name
                     ax.plot([r.pgv_pga_s for r in rows], [r.pga_g for r in rows],
-                            color=colour, ls=ls, lw=1.6, label=f"{who} P = {level}")
-            band = [r for r in contours.get("0.5", ()) if None not in r.pga_g_band]
+                            color=colour, ls=ls, lw=1.6, label=f"{who} P = {level:g}")
+            band = [r for r in (entry.contour(0.5) if entry else ())
+                    if None not in r.pga_g_band]
             if band and model == name:
                 ax.fill_between([r.pgv_pga_s for r in band],
                                 [r.pga_g_band[0] for r in band],
                                 [r.pga_g_band[1] for r in band], color=colour, alpha=0.2,
                                 lw=0, label="P = 0.5, Monte Carlo 95 %")
         _mark_outside(ax, section, name, ratios, pgas)
-        observed = (section.experiments or {}).get("models", {}).get(name, {}).get("bins")
+        check = None if section.experiments is None else section.experiments.models.get(name)
+        observed = None if check is None else check.bins
         if observed:
             x = [np.mean(b["pgv_pga_s"]) for b in observed]
             y = [np.mean(b["pga_g"]) for b in observed]

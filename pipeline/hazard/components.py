@@ -30,7 +30,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from pipeline.files import InputError
-from pipeline.hazard.fragility_kinds import Fragility
+from pipeline.hazard.fragility.kinds import Fragility
 
 COMPONENTS = ("rotd50", "rotd100")          # the hazard curve's PGA: RotD50 or vector peak
 LINE_ROTD50_FRACTION = math.cos(math.pi / 4)
@@ -84,7 +84,7 @@ def records_fraction(records, fraction_of=None, magnitude=None, distance_km=None
 
 @dataclass(frozen=True)
 class OnHazardMeasure(Fragility):
-    """A fragility (``inner``, a :class:`~pipeline.hazard.fragility_kinds.Fragility` over its
+    """A fragility (``inner``, a :class:`~pipeline.hazard.fragility.kinds.Fragility` over its
     own PGA) read on the hazard curve's PGA:
     P(x) = inner P(x / ``fraction``); ``measure``: what each PGA is and where the fraction
     comes from (said in the output)."""

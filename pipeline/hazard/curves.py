@@ -48,6 +48,7 @@ PLAIN_RATE_COLUMN = "annual_rate_per_yr"
 OPENQUAKE_PGA_UNIT = "g"               # the engine's unit of PGA (and SA)
 _IMT = r"[A-Za-z]+(?:\([0-9.]+\))?"    # PGA, PGV, SA(0.1), ...
 _OQ_LEVEL = re.compile(rf"^(poe|{_IMT})-([^:]+)(?::\w+)?$")
+OQ_HEADER_IMT = re.compile(rf"\bimt\s*=\s*['\"]?({_IMT})")   # imt=... in an OpenQuake header
 MAX_PGA_M_S2 = 100.0 * STANDARD_GRAVITY  # the highest level a curve may state (100 g)
 MIN_PGA_M_S2 = 1e-6 * STANDARD_GRAVITY   # the lowest (1e-6 g: below any felt motion)
 MAX_RATE_PER_YR = 1e3                    # the highest annual rate of exceedance (1/yr)
@@ -97,11 +98,11 @@ def _openquake(path, lines, site):
     found = re.search(r"investigation_time\s*=\s*([^,\"'\s]+)", header)
     if not found:
         raise InputError(f"{path}: no investigation_time in the first line")
-    time_yr = _float(found.group(1), f"{path}: investigation_time")
+    time_yr = parse_number(found.group(1), f"{path}: investigation_time")
     if not (math.isfinite(time_yr) and 0 < time_yr <= MAX_INVESTIGATION_YR):
         raise InputError(f"{path}: investigation_time must be a positive number of years "
                          f"(at most {MAX_INVESTIGATION_YR:g}), got {show(found.group(1))}")
-    found = re.search(rf"\bimt\s*=\s*['\"]?({_IMT})", header)
+    found = OQ_HEADER_IMT.search(header)
     imt = found.group(1) if found else None
     first = 3 if len(columns) > 2 and columns[2].lower() == "depth" else 2
     levels = []
@@ -114,7 +115,7 @@ def _openquake(path, lines, site):
                 raise InputError(f"{path}: the first line says imt {imt}, column {name} "
                                  f"says {match.group(1)}")
             imt = match.group(1)
-        levels.append(_float(match.group(2), f"{path}: level of column {show(name)}"))
+        levels.append(parse_number(match.group(2), f"{path}: level of column {show(name)}"))
     if imt is None:
         raise InputError(f"{path}: missing IMT (no imt=... in the first line, poe-<level> "
                          "columns)")
@@ -136,7 +137,7 @@ def _openquake(path, lines, site):
     if len(cells) != len(columns):
         raise InputError(f"{path}: site row {site} has {len(cells)} values for "
                          f"{len(columns)} columns")
-    values = [_float(c, f"{path}: site row {site}, column {columns[k]}")
+    values = [parse_number(c, f"{path}: site row {site}, column {columns[k]}")
               for k, c in enumerate(cells)]
     poe = np.array(values[first:])
     where = f"{path} (site {site})"
@@ -167,20 +168,11 @@ def _openquake(path, lines, site):
 
 
 def _plain(path, lines):
-    body = [(k + 1, line) for k, line in enumerate(lines) if line and not line.startswith("#")]
+    body = plain_body(lines)
     if not body:
         raise InputError(f"hazard file {path} is empty (comment lines only)")
     names = [n.strip() for n in body[0][1].split(",")]
-    first = names[0].lower()
-    match = re.fullmatch(r"(pga|pgv|sa\([0-9.]+\)|sa)_(.+)", first)
-    if not match:
-        raise InputError(f"{path}: missing IMT: the first column must be pga_<unit> "
-                         f"(pga_g, pga_m_s2 or pga_cm_s2), got {show(names[0])}")
-    _check_imt(match.group(1).upper(), path)
-    unit = match.group(2)
-    if unit not in PLAIN_UNITS:
-        raise InputError(f"{path}: unknown unit {show(unit)} of column {show(names[0])} "
-                         f"(known: {', '.join(PLAIN_UNITS)})")
+    unit = level_unit(names[0], path, "first")
     if len(names) != 2 or names[1].lower() != PLAIN_RATE_COLUMN:
         raise InputError(f"{path}: expected the two columns pga_{unit},{PLAIN_RATE_COLUMN}, "
                          f"got {show(body[0][1])}")
@@ -191,11 +183,34 @@ def _plain(path, lines):
         cells = line.split(",")
         if len(cells) != 2:
             raise InputError(f"{path}, line {number}: expected 2 values, got {len(cells)}")
-        levels.append(_float(cells[0], f"{path}, line {number}: level"))
-        rates.append(_float(cells[1], f"{path}, line {number}: rate"))
+        levels.append(parse_number(cells[0], f"{path}, line {number}: level"))
+        rates.append(parse_number(cells[1], f"{path}, line {number}: rate"))
     source = {"format": "plain table", "file": str(path), "imt": "PGA", "unit_in_file": unit}
     return _curve(np.array(levels), np.array(rates), PLAIN_UNITS[unit],
                   unit.replace("_s2", "/s^2"), str(path), source)
+
+
+def plain_body(lines):
+    """(line number from 1, line) of a plain table's lines that are not empty or comments."""
+    return [(k + 1, line) for k, line in enumerate(lines) if line and not line.startswith("#")]
+
+
+def level_unit(name, path, column, imt="PGA"):
+    """The unit of a plain table's level column ``name`` (``<imt>_<unit>``, its
+    ``column``: "first", "third"), its IMT ``imt`` and its unit (:data:`PLAIN_UNITS`)
+    checked: InputError naming ``path`` otherwise."""
+    match = re.fullmatch(rf"({_IMT})_(.+)", name.strip().lower())
+    if not match:
+        raise InputError(f"{path}: missing IMT: the {column} column must be pga_<unit> "
+                         f"({', '.join(f'pga_{u}' for u in PLAIN_UNITS)}), got {show(name)}")
+    if match.group(1) != imt.lower():
+        if imt.upper() != "PGA":
+            raise InputError(f"{path}: IMT {match.group(1).upper()}, expected {imt.upper()}")
+        _check_imt(match.group(1).upper(), path)
+    if match.group(2) not in PLAIN_UNITS:
+        raise InputError(f"{path}: unknown unit {show(match.group(2))} of column {show(name)} "
+                         f"(known: {', '.join(PLAIN_UNITS)})")
+    return match.group(2)
 
 
 def _usgs(path, text):
@@ -292,11 +307,13 @@ def _usgs_coordinate(meta, key, bound, where):
 
 def _check_imt(imt, path):
     if imt.upper() != "PGA":
-        raise InputError(f"{path}: IMT {imt}: survival uses PGA hazard curves (the "
-                         "fragility is over PGA and PGV/PGA)")
+        raise InputError(f"{path}: IMT {imt}: the fragility is over PGA and PGV/PGA (give PGA "
+                         "hazard curves)")
 
 
-def _float(text, what):
+def parse_number(text, what):
+    """``text`` (a value of a table) as a float; InputError naming ``what`` when it is not
+    a number."""
     try:
         return float(text)
     except ValueError:

@@ -2,7 +2,7 @@
 to the joint hazard of PGA and PGV (Kohrangi, Bazzurro & Vamvatsikos): the scalar PGA
 curve, and at each PGA level a mixture over the disaggregation's bins of PGV given PGA
 from the ground-motion model at each bin's magnitude and distance
-(:class:`~pipeline.hazard.fragility_ratio.RatioFromGmm`).  One bin is today's one
+(:class:`~pipeline.hazard.fragility.ratio.RatioFromGmm`).  One bin is today's one
 scenario.
 
 The bins' shares at a PGA level a (:func:`bin_shares`) are those of the events with PGA
@@ -20,7 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from pipeline.files import InputError
-from pipeline.hazard.fragility_ratio import (DEFAULT_VS30_M_S, RatioFromGmm,
+from pipeline.hazard.fragility.ratio import (DEFAULT_VS30_M_S, RatioFromGmm,
                                              overturn_probability)
 from pipeline.hazard.pga_pgv_correlation import BAKER_BRADLEY_2017
 

@@ -2,7 +2,7 @@
 
 Units: PGA in m/s^2, PGV in m/s, PGV/PGA in s, rates in 1/yr.  ``probability(pga_m_s2,
 pgv_pga_s)`` is P(overturn) in one event of that motion, an array of the broadcast shape
-(:meth:`pipeline.hazard.fragility_kinds.Fragility.probability`).
+(:meth:`pipeline.hazard.fragility.kinds.Fragility.probability`).
 
 The joint hazard gives the annual rate r_ij of events with PGA in cell i and PGV in cell
 j (:class:`pipeline.hazard.joint_hazard.JointHazard`).  The rate of overturning is

@@ -40,18 +40,18 @@ from pathlib import Path
 
 import numpy as np
 
-from pipeline.hazard.curves import PLAIN_RATE_COLUMN, PLAIN_UNITS, check_curve, load_hazard
+from pipeline.hazard.curves import (MAX_LEVELS, OQ_HEADER_IMT, PLAIN_RATE_COLUMN, PLAIN_UNITS,
+                                    check_curve, level_unit, load_hazard, parse_number,
+                                    plain_body)
 from pipeline.files import InputError
 from pipeline.userfiles import DATA_FILE_BYTES, read_user_bytes, read_user_text, show
 
 MAX_BRANCHES = 10_000
-MAX_LEVELS = 1_000
 ROUNDING = 1e-15                 # per weight: a sum this close to 1 is 1 written in decimals
 WEIGHT_TOLERANCE = 1e-6          # |sum of weights - 1| allowed (the sum is 1: absolute = relative)
 MAX_CURVE_FILES = 4 * MAX_BRANCHES   # hazard_curve*.csv files looked at in one directory
 REALIZATIONS_COLUMNS = ("rlz_id", "branch_path", "weight")
 _KIND = re.compile(r"\bkind\s*=\s*['\"]?rlz-(\d+)")
-_IMT = re.compile(r"\bimt\s*=\s*['\"]?([A-Za-z]+(?:\([0-9.]+\))?)")
 
 
 @dataclass(frozen=True)
@@ -196,7 +196,8 @@ def _realizations(path):
         if rlz in seen:
             raise InputError(f"{path}: realisation {rlz} twice (rows {seen[rlz]} and {number})")
         seen[rlz] = number
-        rows.append((rlz, cells[1].strip(), _number(cells[2], f"{path}, row {number}: weight")))
+        rows.append((rlz, cells[1].strip(),
+                     parse_number(cells[2], f"{path}, row {number}: weight")))
     return rows
 
 
@@ -210,7 +211,7 @@ def _curve_files(directory):
     for path in files:
         head = read_user_bytes(path, "hazard curve file", DATA_FILE_BYTES)[:4096]
         first = head.decode("utf-8", errors="replace").split("\n", 1)[0]
-        kind, imt = _KIND.search(first), _IMT.search(first)
+        kind, imt = _KIND.search(first), OQ_HEADER_IMT.search(first)
         if kind is None:
             continue                      # a statistic (mean, quantile) or not a curve
         if imt is not None and imt.group(1).upper() != "PGA":
@@ -229,7 +230,7 @@ def _curve_files(directory):
 
 # ---------------------------------------------------------------- plain table
 def _plain(path, lines, imt="PGA"):
-    body = [(k + 1, line) for k, line in enumerate(lines) if line and not line.startswith("#")]
+    body = plain_body(lines)
     names = [n.strip().lower() for n in body[0][1].split(",")]
     unit = _plain_header(path, names, imt)
     with_path = len(names) == 5
@@ -247,13 +248,14 @@ def _plain(path, lines, imt="PGA"):
                                            else name, "rows": [], "line": number})
         if len(branches) > MAX_BRANCHES:
             raise InputError(f"{path}: more than {MAX_BRANCHES} branches")
-        if cells[1] != entry["weight"] and _number(cells[1], "") != _number(entry["weight"], ""):
+        if cells[1] != entry["weight"] \
+                and parse_number(cells[1], "") != parse_number(entry["weight"], ""):
             raise InputError(f"{path}, line {number}: branch {show(name)} has weight "
                              f"{cells[1]} here and {entry['weight']} on line {entry['line']}")
         if with_path and cells[4] != entry["path"]:
             raise InputError(f"{path}, line {number}: branch {show(name)} has two paths")
-        entry["rows"].append((_number(cells[2], f"{path}, line {number}: level"),
-                              _number(cells[3], f"{path}, line {number}: rate")))
+        entry["rows"].append((parse_number(cells[2], f"{path}, line {number}: level"),
+                              parse_number(cells[3], f"{path}, line {number}: rate")))
         if len(entry["rows"]) > MAX_LEVELS:
             raise InputError(f"{path}: branch {show(name)} has more than {MAX_LEVELS} levels")
     if not branches:
@@ -270,7 +272,8 @@ def _plain(path, lines, imt="PGA"):
     ids = list(branches)
     levels, rates, notes = _common_levels([(lv[r > 0], r[r > 0], None) for lv, r in curves],
                                           ids)
-    weights, more = _weights([_number(branches[n]["weight"], f"{path}: branch {show(n)} weight")
+    weights, more = _weights([parse_number(branches[n]["weight"],
+                                           f"{path}: branch {show(n)} weight")
                               for n in ids], path)
     source = {"format": "plain logic-tree table", "file": str(path), "imt": imt.upper(),
               "unit_in_file": unit}
@@ -284,19 +287,7 @@ def _plain_header(path, names, imt="PGA"):
             or names[3] != PLAIN_RATE_COLUMN or (len(names) == 5 and names[4] != "path"):
         raise InputError(f"{path}: expected the header branch,weight,pga_<unit>,"
                          f"{PLAIN_RATE_COLUMN}[,path], got {show(','.join(names))}")
-    match = re.fullmatch(r"([a-z]+(?:\([0-9.]+\))?)_(.+)", names[2])
-    if not match:
-        raise InputError(f"{path}: missing IMT: the third column must be pga_<unit>, got "
-                         f"{show(names[2])}")
-    if match.group(1) != imt.lower():
-        if imt.upper() != "PGA":
-            raise InputError(f"{path}: IMT {match.group(1).upper()}, expected {imt.upper()}")
-        raise InputError(f"{path}: IMT {match.group(1).upper()}: the fragility is over PGA "
-                         "(give PGA hazard curves)")
-    if match.group(2) not in PLAIN_UNITS:
-        raise InputError(f"{path}: unknown unit {show(match.group(2))} of column "
-                         f"{show(names[2])} (known: {', '.join(PLAIN_UNITS)})")
-    return match.group(2)
+    return level_unit(names[2], path, "third", imt)
 
 
 def _plain_curve(path, name, rows, to_m_s2, unit):
@@ -308,14 +299,6 @@ def _plain_curve(path, name, rows, to_m_s2, unit):
 
 
 # ---------------------------------------------------------------- shared
-def _number(text, what):
-    try:
-        value = float(text)
-    except ValueError:
-        raise InputError(f"{what}: not a number: {show(text.strip())}") from None
-    return value
-
-
 def _levels_text(levels):
     return f"{levels[0]:.6g}-{levels[-1]:.6g}" if levels.size else "none"
 

@@ -26,16 +26,46 @@ from scipy.interpolate import RegularGridInterpolator
 CONTOUR_LEVELS = (0.16, 0.5, 0.84)   # P of a pulse grid's contours: median and +-1 sigma
 
 
-def cell_table(cells):
-    """The axes and P of a pulse grid's cells
-    (:class:`~pipeline.hazard.fragility_file.GridCell`): (pga, ratio, values n_pga x
-    n_ratio) in the cells' units; values NaN where no cell is given."""
-    pgas = sorted({c.pga_g for c in cells})
-    ratios = sorted({c.pgv_pga_s for c in cells})
-    values = np.full((len(pgas), len(ratios)), np.nan)
-    for c in cells:
-        values[pgas.index(c.pga_g), ratios.index(c.pgv_pga_s)] = c.P
-    return np.array(pgas, float), np.array(ratios, float), values
+def lay_cells(pga_axis, ratio_axis, cells, members=0):
+    """The one layout of a pulse grid's cells
+    (:class:`~pipeline.hazard.fragility.file.GridCell`) on its axes ``pga_axis`` (g) x
+    ``ratio_axis`` (s), each cell found by its values to 9 digits (the axes are distinct
+    to 9 digits and every cell on them, checked by the file's reader): (n, overturned,
+    P, P per set) as arrays n_pga x n_ratio (``members`` x n_pga x n_ratio per set, none
+    without ``members``); n
+    and overturned 0, P NaN where no cell is given or a set has no run."""
+    index_a = {round(float(v), 9): i for i, v in enumerate(pga_axis)}
+    index_r = {round(float(v), 9): j for j, v in enumerate(ratio_axis)}
+    n = np.zeros((len(index_a), len(index_r)), int)
+    overturned = np.zeros_like(n)
+    p = np.full(n.shape, np.nan)
+    per_set = np.full((members, *n.shape), np.nan)
+    for cell in cells:
+        i, j = index_a[round(cell.pga_g, 9)], index_r[round(cell.pgv_pga_s, 9)]
+        n[i, j], overturned[i, j] = cell.n, cell.overturned
+        p[i, j] = np.nan if cell.P is None else cell.P
+        for s, value in zip(cell.sets or (), cell.P_per_set or ()):
+            if members and value is not None:
+                per_set[s, i, j] = float(value)
+    return n, overturned, p, per_set
+
+
+def fill_empty(values):
+    """The one rule for a grid's empty cells (NaN: no run): P interpolated along PGA
+    between the nearest cells with runs of its PGV/PGA row (the nearest one's beyond
+    them), a row without any the mean of all.  Survival and the shake-table check score
+    the same filled cells.  Returns (filled values, number of cells filled)."""
+    cells = np.array(values, float)
+    empty = np.isnan(cells)
+    if not empty.any():
+        return cells, 0
+    for j in range(cells.shape[1]):
+        column = cells[:, j]
+        good = ~np.isnan(column)
+        if good.any():
+            idx = np.arange(len(column))
+            cells[:, j] = np.interp(idx, idx[good], column[good])
+    return np.where(np.isnan(cells), np.nanmean(cells), cells), int(empty.sum())
 
 
 def interpolate(pga_axis, ratio_axis, values, pga, ratio):

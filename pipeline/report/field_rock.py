@@ -5,7 +5,7 @@ import json
 
 import pandas as pd
 
-from pipeline.hazard.fragility_file import read_fragility_file
+from pipeline.hazard.fragility.file import read_fragility_file
 from pipeline.report.fragility import rock_fragility_section
 from pipeline.report.common import _figure, _fmt, _table
 from pipeline.report.hazard import survival_section

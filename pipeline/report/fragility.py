@@ -4,7 +4,7 @@ import math
 
 import pandas as pd
 
-from pipeline.hazard.fragility_file import read_fragility_file
+from pipeline.hazard.fragility.file import read_fragility_file
 from pipeline.report.common import _figure, _fmt, _table
 
 
@@ -24,11 +24,11 @@ def fragility_section(results):
         row = {"model": name if entry.description is None else entry.description,
                "runs (toppled)": f"{entry.runs} ({entry.toppled})"}
         for im, fit in entry.fits.items():
-            lo_hi = fit.get("median_ci95") or [None, None]
-            row[f"{im} median [95 %] {fit.get('unit', '')}".strip()] = (
-                "-" if fit["median"] is None else
-                f"{fit['median']:.3g} [{_fmt(lo_hi[0], 2)}, {_fmt(lo_hi[1], 2)}], "
-                f"beta {_fmt(fit.get('beta'), 2)}")
+            lo_hi = fit.median_ci95 or [None, None]
+            row[f"{im} median [95 %] {fit.unit or ''}".strip()] = (
+                "-" if fit.median is None else
+                f"{fit.median:.3g} [{_fmt(lo_hi[0], 2)}, {_fmt(lo_hi[1], 2)}], "
+                f"beta {_fmt(fit.beta, 2)}")
         rows.append(row)
     lines = ["## Fragility (campaign fragility)\n",
              f"Records {', '.join(map(str, summary.records))}; "
@@ -87,7 +87,7 @@ def rock_fragility_section(results, name="rock-fragility"):
     lines.append(_table(pd.DataFrame(rows)) + "\n")
     lines += [f"Warning: {w}.\n" for w in section.warnings]
     for model, entry in section.models.items():
-        per_set = [r for r in entry.contours.get("0.5", ()) if r.pga_g_per_set]
+        per_set = [r for r in entry.contour(0.5) if r.pga_g_per_set]
         shown = [f"{r.pgv_pga_s:g} s: " + ", ".join(_fmt(v, 2) for v in
                                                     r.pga_g_per_set.values())
                  for r in per_set]
@@ -100,27 +100,27 @@ def rock_fragility_section(results, name="rock-fragility"):
         lines.append(f"Spread of P across the parameter sets (sd per cell): up to "
                      f"{max(spread):.2f}, mean {sum(spread) / len(spread):.2f}.\n")
     for model, entry in section.models.items():
-        d = (entry.logistic or {}).get("dimensionless")
+        d = None if entry.logistic is None else entry.logistic.dimensionless
         if d:
             lines.append(f"Logistic surface ({model}): logit P = {d['c0']:.2f} + "
                          f"{d['b1']:.2f} ln(PGA / (g tan alpha)) + {d['b2']:.2f} ln(p PGV/PGA)"
                          + (" (Firth-penalised: separable outcomes)"
-                            if entry.logistic.get("separated") else "") + ".\n")
+                            if entry.logistic.separated else "") + ".\n")
     check = section.experiments
     if check:
         def score_row(label, score):
             return {"prediction": label,
-                    "log-likelihood per test": _fmt(score["log_likelihood_per_test"], 3),
-                    "Brier": _fmt(score["brier"], 3), "tests": score["n"]}
+                    "log-likelihood per test": _fmt(score.log_likelihood_per_test, 3),
+                    "Brier": _fmt(score.brier, 3), "tests": score.n}
 
-        rows = [score_row(label, s) for label, s in check["baselines"].items()]
-        for model, result in check["models"].items():
-            rows.append(score_row(f"{model}: pulse fragility (grid; {result['grid']['outside_grid']}"
-                                  " tests outside it, nearest edge)", result["grid"]))
-            if "logistic" in result:
-                rows.append(score_row(f"{model}: its logistic surface", result["logistic"]))
-        lines.append(f"Against the {check['tests']} shake-table tests ({check['overturned']} "
-                     f"overturned; {check['note']}):\n")
+        rows = [score_row(label, s) for label, s in check.baselines.items()]
+        for model, result in check.models.items():
+            rows.append(score_row(f"{model}: pulse fragility (grid; {result.grid.outside_grid}"
+                                  " tests outside it, nearest edge)", result.grid))
+            if result.logistic is not None:
+                rows.append(score_row(f"{model}: its logistic surface", result.logistic))
+        lines.append(f"Against the {check.tests} shake-table tests ({check.overturned} "
+                     f"overturned; {check.note}):\n")
         lines.append(_table(pd.DataFrame(rows)) + "\n")
     lines.append(_figure(results, results / name / "fragility_pulse_grid.png",
                          "P(overturn) over the pulse grid, contours, 2D block, observed rates"))

@@ -14,8 +14,8 @@ from pipeline.files import InputError, display_path
 from pipeline.hazard.components import COMPONENTS
 from pipeline.hazard.constrain import FLOOR
 from pipeline.hazard.fragility import BELOW_GRID, GMM_MECHANISMS
-from pipeline.hazard.fragility_kinds import BETA_RANGE, MEDIAN_G_RANGE
-from pipeline.hazard.fragility_ratio import DEFAULT_VS30_M_S, PGA_PGV_CORRELATION
+from pipeline.hazard.fragility.kinds import BETA_RANGE, MEDIAN_G_RANGE
+from pipeline.hazard.fragility.ratio import DEFAULT_VS30_M_S, PGA_PGV_CORRELATION
 from pipeline.scenario.parameters import check_fields, param
 from pipeline.userfiles import number
 

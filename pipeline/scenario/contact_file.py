@@ -86,3 +86,20 @@ def refuse_set_twice(values, fields, what):
     if both:
         raise InputError(f"--contact-file sets {', '.join(both)}, which {what} sets too: "
                          "give it in one place, not both")
+
+
+def file_fields(name):
+    """The contact file's fields a sampled range ``name`` stands for: ``mu_s`` the friction
+    pair (mu_s, mu_k), any other name its own field."""
+    return ("mu_s", "mu_k") if name == "mu_s" else (name,)
+
+
+def ranges_left(ranges, contact, given, what):
+    """``ranges`` (name -> range) without those a contact file fixes (``contact``: its
+    values, or None: all kept): a range is not drawn when the file sets one of its
+    :func:`file_fields`.  A range named in ``given`` (the names the flag ``what`` gives)
+    whose field the file sets is refused (one line, :func:`refuse_set_twice`)."""
+    if not contact:
+        return dict(ranges)
+    refuse_set_twice(contact, [f for name in given for f in file_fields(name)], what)
+    return {k: v for k, v in ranges.items() if not any(f in contact for f in file_fields(k))}

@@ -14,7 +14,7 @@ import pytest
 from pipeline.campaign import (CAMPAIGNS, get, pulse_adaptive, pulse_block, pulse_grid,
                                pulse_summary, run_campaign)
 from pipeline.campaign.fragility import FragilityOptions, drive
-from pipeline.hazard.fragility_file import FragilityFile, read_fragility_file
+from pipeline.hazard.fragility.file import FragilityFile, read_fragility_file
 from pipeline.motion.pulses import one_cosine_pulse
 from pipeline.outcome.summary import ColumnOutcome, RunSummary
 from pipeline.rocking.sampled import rocking_response_sampled

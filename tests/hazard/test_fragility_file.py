@@ -2,6 +2,7 @@
 older spellings of a pulse grid's 2D block load, and the same file read by survival and
 by the shake-table check gives both one P."""
 import copy
+import re
 import json
 import math
 
@@ -13,8 +14,10 @@ from pipeline.constants import STANDARD_GRAVITY as G
 from pipeline.files import InputError
 from pipeline.hazard.fragility import load_campaign_fragility
 from pipeline.campaign.pulse_summary import contours
-from pipeline.hazard.fragility_file import (ContourRow, FragilityFile, GridCell,
-                                            read_fragility_file, write_fragility_file)
+from pipeline.hazard.fragility.experiments import Experiments, Scores
+from pipeline.hazard.fragility.file import (ContourRow, FragilityFile, GridCell, LogisticSurface,
+                                            LognormalFit, read_fragility_file,
+                                            write_fragility_file)
 from tests.hazard.test_reader_robustness import COLUMN, grid_document
 
 
@@ -30,7 +33,7 @@ def test_written_then_read_is_the_same_file_and_the_same_json(tmp_path, document
 def test_sections_are_typed():
     columns = FragilityFile.of(copy.deepcopy(COLUMN))
     entry = columns.columns["monolithic"]
-    assert entry.fits["PGA"]["median"] == 3.0 and entry.logistic["coefficients"]["b1"] == 3.0
+    assert entry.fits["PGA"].median == 3.0 and entry.logistic.b[1] == 3.0
     assert columns.records == ("R1", "R2") and columns.block2d.alpha_rad == 0.2
     grid = FragilityFile.of(grid_document()).pulse_grid
     assert grid.pga_g == (0.1, 0.2, 0.4) and grid.members == 2
@@ -87,7 +90,34 @@ def test_survival_and_the_shake_table_check_read_one_p_from_the_cells(tmp_path):
     file = read_fragility_file(tmp_path)
     grid = load_campaign_fragility(tmp_path)
     pga_g, ratio = np.array([0.15, 0.33, 0.7]), np.array([0.2, 0.5, 0.12])
-    checked, outside = grid_probability(file.pulse_grid.models["monolithic"].cells, pga_g,
-                                        ratio)
+    checked, outside, _ = grid_probability(file.pulse_grid,
+                                           file.pulse_grid.models["monolithic"].cells, pga_g,
+                                           ratio)
     assert not outside.any()
     np.testing.assert_allclose(grid.probability(pga_g * G, ratio), checked, atol=1e-12)
+
+
+@pytest.mark.parametrize("build, words", [
+    (lambda: LognormalFit(median=2.0, beta=0.5, median_ci95=(3.0, 4.0)),
+     "median_ci95 [3, 4] does not hold its estimate 2"),
+    (lambda: LognormalFit(median=-1.0), "median"),
+    (lambda: LogisticSurface(coefficients={"b0": 0.0, "b1": 1.0, "b2": 0.0},
+                             cov=((1.0, 2.0, 0.0), (2.0, 1.0, 0.0), (0.0, 0.0, 1.0))),
+     "cov is not positive semi-definite"),
+    (lambda: GridCell(pga_g=0.2, pgv_pga_s=0.1, n=10, overturned=11), "overturned must be"),
+    (lambda: GridCell(pga_g=0.2, pgv_pga_s=0.1, n=10, overturned=5, P=0.4),
+     "P 0.4 is not overturned / n = 5/10"),
+    (lambda: ContourRow(pgv_pga_s=0.1, outside_grid="left"), "outside_grid must be one of"),
+    (lambda: Scores(log_likelihood_per_test=-0.3, brier=1.5, n=4), "brier"),
+    (lambda: Experiments(tests=3, overturned=4), "overturned must be 0 to 3"),
+])
+def test_each_part_of_the_file_refuses_what_contradicts_itself_when_built(build, words):
+    with pytest.raises(InputError, match=re.escape(words)):
+        build()
+
+
+def test_a_singular_covariance_written_as_nulls_reads_as_none_and_writes_back_as_nulls():
+    data = {"coefficients": {"b0": -1.0, "b1": 2.0, "b2": 0.5}, "cov": [[None] * 3] * 3}
+    surface = LogisticSurface.of(copy.deepcopy(data))
+    assert surface.covariance is None and surface.b == (-1.0, 2.0, 0.5)
+    assert surface.to_json() == data

@@ -198,7 +198,7 @@ def _grid(cells_p_per_set, overturned, n=20, headings=None):
 ])
 def test_sets_p_that_contradict_the_cells_counts_are_refused(tmp_path, data, words):
     from pipeline.files import InputError
-    from pipeline.hazard.fragility_file import check_fragility
+    from pipeline.hazard.fragility.file import check_fragility
     with pytest.raises(InputError, match=r"cells\[0\]") as err:
         check_fragility(data, "fragility.json")
     assert words in str(err.value)
@@ -212,7 +212,8 @@ def test_what_the_pulse_campaign_writes_agrees_with_the_counts_check():
     import pandas as pd
 
     from pipeline.campaign.pulse_summary import cell_table
-    from pipeline.hazard.fragility_check import _Checker, _check_set_counts
+    from pipeline.hazard.fragility.check import Checker, _check_set_counts
+    from pipeline.hazard.fragility.rows import GridCell
     rng = np.random.default_rng(3)
     for full in (False, True):
         rows = [{"model": "monolithic", "pgv_pga_s": 0.1, "pga_g": a, "member": m,
@@ -220,8 +221,7 @@ def test_what_the_pulse_campaign_writes_agrees_with_the_counts_check():
                 for a in (0.2, 0.5, 0.8) for m in range(4) for h in range(6)
                 if full or rng.random() < 0.6]
         for k, cell in enumerate(cell_table(pd.DataFrame(rows), "monolithic")):
-            _check_set_counts(_Checker("fragility.json"), cell, f"cells[{k}]", cell["n"],
-                              cell["overturned"], 6)
+            _check_set_counts(Checker("fragility.json"), GridCell.of(cell), f"cells[{k}]", 6)
 
 
 def test_curves_of_two_investigation_times_are_not_one_tree(tmp_path):
@@ -309,7 +309,7 @@ def test_a_weight_0_branch_that_survives_is_named_not_called_below_the_floor(tmp
 ])
 def test_a_pulse_grids_axes_take_the_hazard_inputs_lower_bounds(axis, values, words):
     from pipeline.files import InputError
-    from pipeline.hazard.fragility_file import check_fragility
+    from pipeline.hazard.fragility.file import check_fragility
     from tests.hazard.test_reader_robustness import grid_document
     data = grid_document()
     old = data["pulse_grid"][axis]

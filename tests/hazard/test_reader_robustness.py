@@ -17,7 +17,7 @@ from pipeline.constants import STANDARD_GRAVITY
 from pipeline.files import InputError
 from pipeline.hazard import load_hazard
 from pipeline.hazard.fragility import Lognormal, load_campaign_fragility
-from pipeline.hazard.fragility_file import check_fragility
+from pipeline.hazard.fragility.file import check_fragility
 
 G = STANDARD_GRAVITY
 BK = math.exp(-0.185774509051029)        # RotD50 / RotD100 of PGA, Boore & Kishida (2017)

@@ -5,7 +5,7 @@ states, the same at every level) or :class:`RatioFromGmm` (the median and sigma 
 PGA from Boore et al. 2014 (pygmm) at a magnitude and distance, for example the mode of
 the hazard's disaggregation; ln PGV given ln PGA by their correlation).
 :func:`overturn_probability` averages fragilities
-(:class:`~pipeline.hazard.fragility_kinds.Fragility`) over it.
+(:class:`~pipeline.hazard.fragility.kinds.Fragility`) over it.
 """
 import importlib.metadata
 import math

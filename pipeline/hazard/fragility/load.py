@@ -1,5 +1,5 @@
 """Loading a campaign's fragility (``campaign fragility``'s ``fragility.json``) as a
-:class:`~pipeline.hazard.fragility_kinds.Fragility`: a column campaign's lognormal PGA
+:class:`~pipeline.hazard.fragility.kinds.Fragility`: a column campaign's lognormal PGA
 fit or logistic surface with its members' own fits (:func:`load_campaign_fragility`,
 :func:`member_fits`), or a pulse grid (:func:`load_pulse_grid`)."""
 import io
@@ -11,9 +11,11 @@ import pandas as pd
 from pipeline.constants import STANDARD_GRAVITY
 from pipeline.files import InputError
 from pipeline.hazard.components import on_hazard_measure
-from pipeline.hazard.fragility_file import MAX_MEMBERS, FragilityFile, read_fragility_file
-from pipeline.hazard.fragility_grid import BELOW_GRID, PulseGrid
-from pipeline.hazard.fragility_kinds import BETA_RANGE, MEDIAN_G_RANGE, Logistic, Lognormal
+from pipeline.hazard.fragility.checker import key_text
+from pipeline.hazard.fragility.file import MAX_MEMBERS, FragilityFile, read_fragility_file
+from pipeline.hazard.fragility.grid import BELOW_GRID, PulseGrid
+from pipeline.hazard.fragility.kinds import BETA_RANGE, MEDIAN_G_RANGE, Logistic, Lognormal
+from pipeline.hazard.pulse_cells import lay_cells
 from pipeline.stats.fragility import fragility_fit, logistic_surface
 from pipeline.userfiles import DATA_FILE_BYTES, Unreadable, number, read_text, show
 
@@ -21,24 +23,26 @@ BLOCK_MODEL = "block2d"          # a pulse grid's 2D rigid block, beside the spe
 
 
 def load_campaign_fragility(path, column=None, form=None, below="ramp", component=None,
-                            magnitude=None, distance_km=None, record_fraction=None):
+                            magnitude=None, distance_km=None, record_fraction=None,
+                            members=True):
     """The fragility of one column entry of ``campaign fragility``'s ``fragility.json``:
     ``form`` "pga" (its lognormal PGA fit) or "pga-pgv" (its logistic surface; default);
     ``column``: monolithic, drums, block2d or block2d_worst (default: the first 3D one).
     A pulse-grid file (``--pulses``): :func:`load_pulse_grid` (``form`` default "grid";
     ``below``: P below the grid, :class:`PulseGrid`).  Each member's own fit of the same
-    form (from ``fragility_runs.csv`` beside the file, when there) in ``member_fits``.
+    form (from ``fragility_runs.csv`` beside the file, when there) in ``member_fits``,
+    refitted only when ``members`` asks for them (survival's members' spread).
     ``component`` (rotd50 or rotd100, the hazard curve's PGA): the fragility put on it
     (:func:`pipeline.hazard.components.on_hazard_measure`, ``record_fraction(record)``
     the RotD50 / vector peak of a record's motion); None: as in the file."""
-    fragility, kind, records = _load_campaign_fragility(path, column, form, below)
+    fragility, kind, records = _load_campaign_fragility(path, column, form, below, members)
     if component is None:
         return fragility
     return on_hazard_measure(fragility, kind, component, records, record_fraction,
                              magnitude, distance_km)
 
 
-def _load_campaign_fragility(path, column, form, below):
+def _load_campaign_fragility(path, column, form, below, members):
     """(fragility, "line" | "records", record ids) of :func:`load_campaign_fragility`."""
     file = read_fragility_file(path)          # every value below checked
     path = file.path
@@ -49,31 +53,34 @@ def _load_campaign_fragility(path, column, form, below):
     if column is None:
         column = next((c for c in ("monolithic", "drums") if c in columns), next(iter(columns)))
     if column not in columns:
-        raise InputError(f"{path}: no column {column!r} (has {', '.join(columns)})")
+        raise InputError(f"{path}: no column {column!r} (has "
+                         f"{', '.join(map(key_text, columns))})")
     entry = columns[column]
+    named = key_text(column)                 # as a key path names it: one line
     label = f"{column} ({entry.description or ''}) from {path.name}"
     if form == "pga":
         fit = entry.fits.get("PGA")
         if fit is None:
-            raise InputError(f"{path}: column {column}: no PGA fit in the file (give "
+            raise InputError(f"{path}: column {named}: no PGA fit in the file (give "
                              "--fragility-form pga-pgv for its logistic surface)")
-        if fit.get("unit") != "m/s^2":
-            raise InputError(f"{path}: column {column}: PGA fit in unknown unit "
-                             f"{fit.get('unit')!r} (expected m/s^2)")
-        if fit.get("median") is None:
-            raise InputError(f"{path}: column {column}: PGA fragility not fitted "
-                             f"({fit.get('note') or 'no median'})")
-        where = f"{path}: column {column}: PGA"
+        if fit.unit != "m/s^2":
+            raise InputError(f"{path}: column {named}: PGA fit in unknown unit "
+                             f"{fit.unit!r} (expected m/s^2)")
+        if fit.median is None:
+            raise InputError(f"{path}: column {named}: PGA fragility not fitted "
+                             f"({fit.note or 'no median'})")
+        where = f"{path}: column {named}: PGA"
         low, high = (g * STANDARD_GRAVITY for g in MEDIAN_G_RANGE)
-        pooled = Lognormal(number(fit["median"], f"{where} median", low, high, "m/s^2"),
-                           number(fit.get("beta"), f"{where} beta", *BETA_RANGE),
-                           _pair(fit.get("median_ci95"), f"{where} median_ci95"),
-                           _pair(fit.get("beta_ci95"), f"{where} beta_ci95"),
-                           label=label, note=fit.get("note"))
+        pooled = Lognormal(number(fit.median, f"{where} median", low, high, "m/s^2"),
+                           number(fit.beta, f"{where} beta", *BETA_RANGE),
+                           _floats(fit.median_ci95), _floats(fit.beta_ci95), label=label,
+                           note=fit.note)
     elif form == "pga-pgv":
-        pooled = _logistic(entry.logistic or {}, f"{path}: column {column}", label)
+        pooled = _logistic(entry.logistic, f"{path}: column {named}", label)
     else:
         raise InputError(f"--fragility-form must be pga or pga-pgv, got {form!r}")
+    if not members:
+        return pooled, "records", file.records
     fits, note = member_fits(path.parent / "fragility_runs.csv", column, form, file.block2d)
     pooled = replace(pooled, member_fits=fits,
                      note="; ".join(filter(None, [pooled.note, note])) or None)
@@ -85,7 +92,7 @@ def member_fits(runs_path, column, form, block=None):
     lognormal PGA fit (form "pga") or the logistic surface ("pga-pgv") of
     :mod:`pipeline.stats.fragility`, as the campaign fits the pooled runs; (None, note)
     when the runs table is absent or no member's fit is determined.  ``block``: the
-    file's :class:`~pipeline.hazard.fragility_file.Block2d` (the surface's alpha and p)
+    file's :class:`~pipeline.hazard.fragility.file.Block2d` (the surface's alpha and p)
     or None."""
     if not runs_path.is_file():
         return None, f"no {runs_path.name} beside the file: the members' spread not available"
@@ -148,42 +155,29 @@ def _lognormal_outside(median_m_s2: float, beta: float) -> str | None:
     return None
 
 
+def _floats(pair):
+    """An interval of a checked fit as floats (None stays None)."""
+    return None if pair is None else tuple(float(v) for v in pair)
+
+
 def _logistic(surface, where, label):
-    """The :class:`Logistic` of a fragility.json's ``logistic`` entry."""
-    coefficients = surface.get("coefficients")
-    if coefficients is None:
-        raise InputError(f"{where}: logistic surface not fitted "
-                         f"({surface.get('note') or 'no coefficients'})")
-    b = tuple(number(coefficients.get(k), f"{where}: logistic {k}") for k in ("b0", "b1", "b2"))
-    if not b[1] > 0:
+    """The :class:`Logistic` of a fragility.json's ``logistic`` surface (a
+    :class:`~pipeline.hazard.fragility.fits.LogisticSurface`, checked, or None)."""
+    if surface is None or surface.b is None:
+        note = None if surface is None else surface.note
+        raise InputError(f"{where}: logistic surface not fitted ({note or 'no coefficients'})")
+    if not surface.b[1] > 0:
         raise InputError(f"{where}: the logistic surface does not grow with PGA "
-                         f"(b1 = {b[1]:g})")
-    cov = surface.get("cov")             # None too where the file wrote nulls (singular)
-    se = surface.get("se") or {}
-    note = surface.get("note")
-    if cov is None:
+                         f"(b1 = {surface.b[1]:g})")
+    note = surface.note
+    if surface.covariance is None:   # none given, or nulls (a singular information matrix)
         note = "; ".join(filter(None, [note, "no covariance in the file: coefficients drawn "
                                        "independently (their correlation ignored)"]))
-    return Logistic(b, tuple(map(tuple, cov)) if cov is not None else None,
-                    tuple(se.get(k) for k in ("b0", "b1", "b2")) if se else None,
-                    label=label, note=note)
-
-
-def _pair(value, what):
-    """A 95 % interval (lo, hi) from a file: positive numbers, lo <= hi; None stays None."""
-    if value is None:
-        return None
-    if not (isinstance(value, list) and len(value) == 2):
-        raise InputError(f"{what} must be a pair [lo, hi], got {show(value)}")
-    lo, hi = (number(v, what, 0, None, "", True) for v in value)
-    if lo > hi:
-        raise InputError(f"{what}: {lo:g} above {hi:g}")
-    return lo, hi
-
+    return Logistic(surface.b, surface.covariance, surface.se_b, label=label, note=note)
 
 
 def load_pulse_grid(file, model=None, form="grid", below="ramp"):
-    """One model of a pulse-grid :class:`~pipeline.hazard.fragility_file.FragilityFile`
+    """One model of a pulse-grid :class:`~pipeline.hazard.fragility.file.FragilityFile`
     (``models``: monolithic, block2d; read and checked by its reader): ``form`` "grid"
     (:class:`PulseGrid`, ``below`` what P is below it; a grid of one row or column
     interpolated along the other axis) or "pga-pgv" (its logistic surface)."""
@@ -194,23 +188,23 @@ def load_pulse_grid(file, model=None, form="grid", below="ramp"):
     if model is None:
         model = _specimen_model(file)
     if model not in models:
-        raise InputError(f"{path}: pulse_grid has no model {model!r} (has {', '.join(models)})")
+        raise InputError(f"{path}: pulse_grid has no model {model!r} (has "
+                         f"{', '.join(map(key_text, models))})")
     entry = models[model]
-    where = f"{path}: pulse_grid model {model}"
+    where = f"{path}: pulse_grid model {key_text(model)}"
     label = f"{file.specimen or 'specimen'} {model} pulse grid from {path.name}"
-    logistic = None
-    surface = entry.logistic or {}
-    if surface.get("coefficients") is not None:
-        logistic = _logistic(surface, where, label)
+    surface = entry.logistic
+    logistic = None if surface is None or surface.b is None else \
+        _logistic(surface, where, label)
     if form == "pga-pgv":
         if logistic is None:
-            raise InputError(f"{where}: logistic surface not fitted "
-                             f"({surface.get('note') or 'no coefficients'})")
+            _logistic(surface, where, label)          # says why not
         return logistic
     if form != "grid":
         raise InputError(f"--fragility-form for a pulse grid must be grid or pga-pgv, got "
                          f"{form!r}")
-    n, overturned, per_set = _cells(section, entry)
+    n, overturned, _, per_set = lay_cells(section.pga_g, section.pgv_pga_s, entry.cells,
+                                          section.members)
     empty = int((n == 0).sum())
     if empty == n.size:
         raise InputError(f"{where}: no cell with runs (every n is 0)")
@@ -239,22 +233,3 @@ def _specimen_model(file: FragilityFile) -> str:
                          f"({', '.join(section.models)}), not the specimen's: give --column "
                          f"{next(iter(section.models))} to take the block for the rock")
     return specimen[0]
-
-
-def _cells(section, entry):
-    """(n, overturned, P per set) arrays (n_pga x n_ratio; sets x n_pga x n_ratio, NaN
-    where a set has no run) of one model's cells, checked on the grid once each."""
-    pga_g = [float(v) for v in section.pga_g]        # checked: increasing, positive
-    ratios = [float(v) for v in section.pgv_pga_s]
-    n = np.zeros((len(pga_g), len(ratios)), int)
-    overturned = np.zeros_like(n)
-    per_set = np.full((section.members, len(pga_g), len(ratios)), np.nan)
-    index_a = {round(v, 9): i for i, v in enumerate(pga_g)}
-    index_r = {round(v, 9): j for j, v in enumerate(ratios)}
-    for cell in entry.cells:
-        i, j = index_a[round(cell.pga_g, 9)], index_r[round(cell.pgv_pga_s, 9)]
-        n[i, j], overturned[i, j] = cell.n, cell.overturned
-        for s, p in zip(cell.sets or (), cell.P_per_set or ()):
-            if p is not None:
-                per_set[s, i, j] = float(p)
-    return n, overturned, per_set

@@ -9,7 +9,7 @@ covariance between them), the logistic coefficients multivariate normal with the
 covariance (each only its standard error when the file holds no covariance: ``note``
 says so).  A column campaign's fragility is one of these two with its members' own fits
 (``member_fits``); the other kinds are
-:class:`~pipeline.hazard.fragility_grid.PulseGrid` (a pulse grid's cells) and
+:class:`~pipeline.hazard.fragility.grid.PulseGrid` (a pulse grid's cells) and
 :class:`~pipeline.hazard.components.OnHazardMeasure` (any kind read on the hazard
 curve's PGA).
 """

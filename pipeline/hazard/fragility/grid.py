@@ -9,8 +9,8 @@ import numpy as np
 from scipy.special import expit, logit
 
 from pipeline.constants import STANDARD_GRAVITY
-from pipeline.hazard.fragility_kinds import Fragility, Logistic
-from pipeline.hazard.pulse_cells import interpolate
+from pipeline.hazard.fragility.kinds import Fragility, Logistic
+from pipeline.hazard.pulse_cells import fill_empty, interpolate
 
 BELOW_GRID = ("ramp", "zero", "edge", "logistic")   # P below a pulse grid: see PulseGrid
 
@@ -105,7 +105,7 @@ class PulseGrid(Fragility):
         continuous at the edge and a cell of P 0 or 1 stays so; the raw surface, with its
         steps, for ``below`` "logistic"), or without a surface the edge cell's P."""
         pga, ratio = np.broadcast_arrays(np.asarray(pga, float), np.asarray(ratio, float))
-        held, beyond = interpolate(self.pga_m_s2, self.pgv_pga_s, _fill_empty(cells),
+        held, beyond = interpolate(self.pga_m_s2, self.pgv_pga_s, fill_empty(cells)[0],
                                    pga, ratio)               # the edge cell's P outside
         p = np.array(held, float)
         if self.outside is not None and beyond.any():      # the surface only where needed
@@ -153,7 +153,7 @@ class PulseGrid(Fragility):
     def describe_above(self):
         """What P is above the grid's last PGA: how it is extended, the top row's P per
         PGV/PGA and (``summary``) one line of it for the warnings."""
-        top = _fill_empty(self.p)[-1]
+        top = fill_empty(self.p)[0][-1]
         a_n = self.pga_m_s2[-1] / STANDARD_GRAVITY
         span = f"{top.min():.3g}" if top.min() == top.max() else \
             f"{top.min():.3g}-{top.max():.3g} over its PGV/PGA"
@@ -220,18 +220,3 @@ def _carried(p_edge, surface, surface_at_edge):
              - logit(np.clip(surface_at_edge, tiny, 1 - tiny)))
     with np.errstate(divide="ignore"):
         return expit(logit(np.clip(p_edge, 0.0, 1.0)) + shift)
-
-
-def _fill_empty(cells):
-    """A grid's NaN cells (no run) filled from the nearest cell with runs (along PGA)."""
-    cells = np.array(cells, float)
-    if not np.isnan(cells).any():
-        return cells
-    for j in range(cells.shape[1]):
-        column = cells[:, j]
-        good = ~np.isnan(column)
-        if good.any():
-            idx = np.arange(len(column))
-            cells[:, j] = np.interp(idx, idx[good], column[good])
-    return np.where(np.isnan(cells), np.nanmean(cells), cells)
-
