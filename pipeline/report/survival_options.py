@@ -16,6 +16,7 @@ from pipeline.hazard.constrain import FLOOR
 from pipeline.hazard.fragility import BELOW_GRID, GMM_MECHANISMS
 from pipeline.hazard.fragility_kinds import BETA_RANGE, MEDIAN_G_RANGE
 from pipeline.hazard.fragility_ratio import DEFAULT_VS30_M_S, PGA_PGV_CORRELATION
+from pipeline.hazard.pga_pgv_correlation import BRADLEY_2012
 from pipeline.scenario.parameters import check_fields, param
 from pipeline.userfiles import number
 
@@ -76,7 +77,9 @@ class SpecimenOptions:
                            choices=GMM_MECHANISMS)
     pga_pgv_correlation: float = param(
         None, "", f"correlation of ln PGA and ln PGV residuals (0-0.99); default "
-        f"{PGA_PGV_CORRELATION:g} (Bradley 2012)", flag="--pga-pgv-correlation",
+        f"{PGA_PGV_CORRELATION:g}, observed in the NGA-West2 residuals (Baker & Bradley "
+        f"2017); {BRADLEY_2012.value:g} is Bradley's (2012) prediction",
+        flag="--pga-pgv-correlation",
         metavar="RHO")
     draws: int = param(None, "", "fragility parameter draws for the survival interval "
                        "(0-20000; 0: none); default 400", flag="--draws", metavar="N")
