@@ -14,7 +14,7 @@ from pathlib import Path
 from pipeline.cli._fields import add_arguments, from_args
 from pipeline.constants import STANDARD_GRAVITY
 from pipeline.files import display_path, file_set, result_json_text, write_text
-from pipeline.report.survival_options import ConstrainOptions
+from pipeline.assessment.options import AGE_FLAGS, ConstrainOptions
 
 NAME = "constrain"
 ORDER = 46
@@ -32,7 +32,7 @@ DESCRIPTION = (
 
 
 def setup(p):
-    """The flags of :class:`~pipeline.report.survival_options.ConstrainOptions`, in the
+    """The flags of :class:`~pipeline.assessment.options.ConstrainOptions`, in the
     order of the help; ``--logic-tree`` by hand (a required flag)."""
     o = ConstrainOptions
     field = o.__dataclass_fields__["logic_tree"]
@@ -40,20 +40,21 @@ def setup(p):
                    metavar=field.metadata["metavar"], help=field.metadata["help"])
     add_arguments(p, o, ("site",))
     add_arguments(p, o, o.FRAGILITY_FLAGS)
-    add_arguments(p, o, ("age_ka", "age_sd_ka", "rule", "floor"))
+    add_arguments(p.add_argument_group(o.AGE_GROUP), o, AGE_FLAGS)
+    add_arguments(p, o, ("rule", "floor"))
     add_arguments(p.add_argument_group(o.RATIO_GROUP), o, o.RATIO_FLAGS)
     add_arguments(p, o, (*o.DRAW_FLAGS, "out"))
 
 
 def run(args):
     o = from_args(ConstrainOptions, args)
-    ages, sds = o.ages()
+    ages = o.age_models()
     from pipeline.hazard.constrain_assess import constrain_tree
     from pipeline.hazard.logictree import load_logic_tree
     tree = load_logic_tree(o.logic_tree, o.site)
     specimens = o.specimens()
     ratio = o.ratio_model(specimens)
-    summary, rows, figure = constrain_tree(tree, specimens, ratio, ages, sds, o.rule,
+    summary, rows, figure = constrain_tree(tree, specimens, ratio, ages, o.rule,
                                            o.floor, o.draws, o.seed)
     summary["hazard_component"] = o.hazard_component
     files = {"branch_weights.csv": _branch_table(rows),

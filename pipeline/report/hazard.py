@@ -31,7 +31,7 @@ def survival_section(results, name=ROCK_SURVIVAL):
              + (f"; PGV/PGA from {ratio.get('model', ratio.get('source'))} at M "
                 f"{ratio['magnitude']:g}, {ratio['distance_jb_km']:g} km"
                 if "magnitude" in ratio else "")
-             + f". Age {s['age_ka']:g} +- {s['age_sd_ka']:g} ka.\n",
+             + f". Age {_age(s)}.\n",
              f"Annual overturning rate {s['annual_overturning_rate_per_yr']:.3g} /yr; "
              f"survival probability {s['survival_probability']:.3g}"
              + ("" if interval is None else
@@ -68,3 +68,10 @@ def survival_section(results, name=ROCK_SURVIVAL):
                          "hazard curve and fragility, fragility-weighted rate density, "
                          "survival against age"))
     return "\n".join(lines)
+
+
+def _age(summary):
+    """survival.json's age in words: mean +- sd (ka), or its distribution."""
+    if summary.get("age_ka") is not None:
+        return f"{summary['age_ka']:g} +- {summary['age_sd_ka']:g} ka"
+    return summary["age_distribution"]

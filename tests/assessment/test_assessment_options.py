@@ -1,6 +1,6 @@
 """survival's and constrain's options as declared fields: made in code they are checked as
 on the command line (the same one line), repeated flags are typed per value, and the
-defaults the help states are the ones taken (Bradley's 2012 correlation, rock Vs30)."""
+defaults the help states are the ones taken (the observed correlation, rock Vs30)."""
 import argparse
 
 import pytest
@@ -10,7 +10,7 @@ from pipeline.cli import constrain as constrain_command
 from pipeline.cli import survival as survival_command
 from pipeline.cli._fields import from_args
 from pipeline.files import InputError
-from pipeline.report.survival_options import ConstrainOptions, SurvivalOptions
+from pipeline.assessment.options import ConstrainOptions, SurvivalOptions
 
 HAZARD = "records/hazard/usgs_nshm2014r1_curves_-118_34_vs760.json"
 TREE = "records/hazard/openquake_logictree_case_11"

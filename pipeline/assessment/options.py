@@ -1,16 +1,18 @@
 """What ``survival`` and ``constrain`` are asked, declared as
-:func:`~pipeline.scenario.parameters.param` fields (the commands build their flags from
-them: :mod:`pipeline.cli._fields`), every one checked when the options are made, before
-any work: the fragility and PGV/PGA options both share (:class:`SpecimenOptions`, read
-by :meth:`SpecimenOptions.specimens` and :meth:`SpecimenOptions.ratio_model`), and each
-command's own (:class:`SurvivalOptions`, :class:`ConstrainOptions`)."""
+:func:`~pipeline.scenario.parameters.param` fields (name, type, default, range, unit, help;
+the commands build their flags from them: :mod:`pipeline.cli._fields`), every one checked
+when the options are made, before any work: the fragility and PGV/PGA options both share
+(:class:`SpecimenOptions`, read by :meth:`SpecimenOptions.specimens` and
+:meth:`SpecimenOptions.ratio_model`), and each command's own (:class:`SurvivalOptions`,
+:class:`ConstrainOptions`), the ages among them as :mod:`pipeline.hazard.ages` models."""
 import math
 from dataclasses import dataclass
 from pathlib import Path
 
 from pipeline import RESULTS_DIR
 from pipeline.constants import STANDARD_GRAVITY
-from pipeline.files import InputError, display_path
+from pipeline.files import InputError
+from pipeline.hazard.ages import LowerBound, TruncatedNormal, UniformInterval, load_age_samples
 from pipeline.hazard.components import COMPONENTS
 from pipeline.hazard.constrain import FLOOR
 from pipeline.hazard.fragility import BELOW_GRID, GMM_MECHANISMS
@@ -18,12 +20,15 @@ from pipeline.hazard.fragility_kinds import BETA_RANGE, MEDIAN_G_RANGE
 from pipeline.hazard.fragility_ratio import DEFAULT_VS30_M_S, PGA_PGV_CORRELATION
 from pipeline.hazard.pga_pgv_correlation import BRADLEY_2012
 from pipeline.scenario.parameters import check_fields, param
-from pipeline.userfiles import number
 
 COLUMNS = ("monolithic", "drums", "block2d", "block2d_worst")
 SURVIVAL_OUT = RESULTS_DIR / "survival"
 CONSTRAIN_OUT = RESULTS_DIR / "constrain"
 MAX_SPECIMENS = 20
+MAX_AGE_KA = 10000.0
+KA = 1000.0                 # years in a thousand years
+AGE_FLAGS = ("age_ka", "age_sd_ka", "age_min_ka", "age_range_ka", "age_samples",
+             "age_column")
 
 
 @dataclass(frozen=True)
@@ -31,59 +36,55 @@ class SpecimenOptions:
     """The fragilities of the specimens, the PGV/PGA at each PGA level and the draws of
     the survival interval (``--fragility`` ... ``--seed``)."""
     hazard_component: str = param(
-        None, "", "the horizontal component of the hazard curve's PGA: rotd50 (NGA-West2 "
-        "models, the USGS 2014 model; default) or rotd100 (the peak of the horizontal "
-        "vector, campaign fragility's PGA); a campaign's fragility is put on it",
+        "rotd50", "", "the horizontal component of the hazard curve's PGA: rotd50 (NGA-West2 "
+        "models, the USGS 2014 model) or rotd100 (the peak of the horizontal vector, "
+        "campaign fragility's PGA); a campaign's fragility is put on it",
         flag="--hazard-component", choices=COMPONENTS)
     fragility: tuple[Path, ...] = param(
         (), "", "fragility.json of campaign fragility (or its directory); repeat for a set "
         "of specimens at the site", flag="--fragility", metavar="FILE")
-    column: str = param(None, "", "which column entry of fragility.json (default: the first "
+    column: str = param(None, "", "which column entry of fragility.json (unset: the first "
                         "3D one)", flag="--column", choices=COLUMNS)
     fragility_form: str = param(
         None, "", "from fragility.json: pga (its lognormal PGA fit), pga-pgv (its logistic "
-        "surface in PGA and PGV/PGA; default for columns) or grid (a pulse grid's cells, "
-        "bilinear in ln PGA and ln PGV/PGA, the logistic surface outside; default for a "
+        "surface in PGA and PGV/PGA; unset: for columns) or grid (a pulse grid's cells, "
+        "bilinear in ln PGA and ln PGV/PGA, the logistic surface outside; unset: for a "
         "pulse grid)", flag="--fragility-form", choices=("pga", "pga-pgv", "grid"))
     below_grid: str = param(
-        None, "", "a pulse grid's P below its first PGA: ramp (0 at the uplift acceleration "
-        "g tan(alpha), rising linearly in ln PGA to the edge's P; default), zero, edge (the "
+        "ramp", "", "a pulse grid's P below its first PGA: ramp (0 at the uplift acceleration "
+        "g tan(alpha), rising linearly in ln PGA to the edge's P), zero, edge (the "
         "edge's P held down to the uplift acceleration) or logistic (the fitted surface)",
         flag="--below-grid", choices=BELOW_GRID)
     median_g: tuple[float, ...] = param(
-        (), "", f"a stated lognormal fragility over PGA: median PGA (g), "
-        f"{MEDIAN_G_RANGE[0]:g}-{MEDIAN_G_RANGE[1]:g} (as a file's PGA fit); repeat with "
-        "--beta for a set", flag="--median-g", metavar="G")
-    beta: tuple[float, ...] = param((), "", f"its dispersion (natural log), "
-                                    f"{BETA_RANGE[0]:g}-{BETA_RANGE[1]:g}",
+        (), "g", "a stated lognormal fragility over PGA: median PGA (as a file's PGA fit); "
+        "repeat with --beta for a set", *MEDIAN_G_RANGE, flag="--median-g", metavar="G")
+    beta: tuple[float, ...] = param((), "", "its dispersion (natural log)", *BETA_RANGE,
                                     flag="--beta", metavar="B")
     logistic: tuple[str, ...] = param(
         (), "", "a stated logistic surface logit P = b0 + b1 ln(PGA / 1 m/s^2) + b2 "
         "ln(PGV/PGA / 1 s) (b1 > 0); repeat for a set", flag="--logistic",
         metavar="B0,B1,B2")
-    pgv_pga_median: float = param(None, "", "stated lognormal PGV/PGA: median (s), 0.001-10",
+    pgv_pga_median: float = param(None, "s", "stated lognormal PGV/PGA: median", 0.001, 10,
                                   flag="--pgv-pga-median", metavar="S")
-    pgv_pga_sigma: float = param(None, "", "its sigma (natural log), 0-3",
+    pgv_pga_sigma: float = param(None, "", "its sigma (natural log)", 0, 3,
                                  flag="--pgv-pga-sigma", metavar="LN")
-    magnitude: float = param(None, "", "or from Boore et al. (2014) at this moment magnitude "
-                             "(3-8.5), e.g. the mode of the hazard's disaggregation",
+    magnitude: float = param(None, "", "or from Boore et al. (2014) at this moment "
+                             "magnitude, e.g. the mode of the hazard's disaggregation", 3, 8.5,
                              flag="--magnitude", metavar="M")
-    distance_km: float = param(None, "", "and this Joyner-Boore distance (km, 0-300)",
+    distance_km: float = param(None, "km", "and this Joyner-Boore distance", 0, 300,
                                flag="--distance-km", metavar="KM")
-    vs30: float = param(None, "", f"Vs30 for the model (m/s, 150-1500); default "
-                        f"{DEFAULT_VS30_M_S:g}", flag="--vs30", metavar="M_S")
-    mechanism: str = param(None, "", "fault mechanism for the model (SS strike-slip, NS "
-                           "normal, RS reverse); default SS", flag="--mechanism",
-                           choices=GMM_MECHANISMS)
+    vs30: float = param(DEFAULT_VS30_M_S, "m/s", "Vs30 for the model", 150, 1500,
+                        flag="--vs30", metavar="M_S")
+    mechanism: str = param("SS", "", "fault mechanism for the model (SS strike-slip, NS "
+                           "normal, RS reverse)", flag="--mechanism", choices=GMM_MECHANISMS)
     pga_pgv_correlation: float = param(
-        None, "", f"correlation of ln PGA and ln PGV residuals (0-0.99); default "
-        f"{PGA_PGV_CORRELATION:g}, observed in the NGA-West2 residuals (Baker & Bradley "
-        f"2017); {BRADLEY_2012.value:g} is Bradley's (2012) prediction",
-        flag="--pga-pgv-correlation",
-        metavar="RHO")
-    draws: int = param(None, "", "fragility parameter draws for the survival interval "
-                       "(0-20000; 0: none); default 400", flag="--draws", metavar="N")
-    seed: int = param(None, "", "seed of the draws (>= 0); default 0", flag="--seed")
+        PGA_PGV_CORRELATION, "", "correlation of ln PGA and ln PGV residuals; the default is "
+        "observed in the NGA-West2 residuals (Baker & Bradley 2017), "
+        f"{BRADLEY_2012.value:g} is Bradley's (2012) prediction", 0, 0.99,
+        flag="--pga-pgv-correlation", metavar="RHO")
+    draws: int = param(400, "", "fragility parameter draws for the survival interval "
+                       "(0: none)", 0, 20000, flag="--draws", metavar="N")
+    seed: int = param(0, "", "seed of the draws", 0, None, flag="--seed")
 
     FRAGILITY_FLAGS = ("hazard_component", "fragility", "column", "fragility_form",
                        "below_grid", "median_g", "beta", "logistic")
@@ -91,23 +92,12 @@ class SpecimenOptions:
                    "mechanism", "pga_pgv_correlation")
     RATIO_GROUP = "PGV/PGA at each PGA level (for a pga-pgv fragility)"
     DRAW_FLAGS = ("draws", "seed")
-
-    def _fill(self, **defaults):
-        """Fields left None take ``defaults`` (their defaults, stated in their help)."""
-        check_fields(self)
-        defaults = {"hazard_component": "rotd50", "below_grid": "ramp",
-                    "vs30": DEFAULT_VS30_M_S, "mechanism": "SS", "draws": 400, "seed": 0,
-                    **defaults}
-        for name, value in defaults.items():
-            if getattr(self, name) is None:
-                object.__setattr__(self, name, value)
+    AGE_GROUP = "the specimens' age, as it is dated (one of --age-ka, --age-min-ka, " \
+        "--age-range-ka, --age-samples)"
 
     def check_specimens(self):
-        """The fragility, PGV/PGA and draw options range-checked (InputError, one line)."""
-        for v in self.median_g:
-            number(v, "--median-g", *MEDIAN_G_RANGE, "g")
-        for v in self.beta:
-            number(v, "--beta", *BETA_RANGE)
+        """The fragility, PGV/PGA and draw options checked (InputError, one line)."""
+        check_fields(self)
         if len(self.median_g) != len(self.beta):
             raise InputError(f"give one --beta per --median-g ({len(self.median_g)} medians, "
                              f"{len(self.beta)} betas)")
@@ -118,13 +108,6 @@ class SpecimenOptions:
                              "--fragility")
         _distinct_files(self.fragility, "--fragility", "specimen", "fragility.json")
         self._check_ratio()
-        number(self.vs30, "--vs30", 150, 1500, "m/s")
-        if self.pga_pgv_correlation is not None:
-            number(self.pga_pgv_correlation, "--pga-pgv-correlation", 0, 0.99)
-        if not 0 <= self.draws <= 20000:
-            raise InputError(f"--draws must be 0 to 20000, got {self.draws}")
-        if self.seed < 0:
-            raise InputError(f"--seed must be 0 or more, got {self.seed}")
 
     def _check_ratio(self):
         stated = (self.pgv_pga_median, self.pgv_pga_sigma)
@@ -132,17 +115,12 @@ class SpecimenOptions:
         if any(v is not None for v in stated) and any(v is not None for v in modelled):
             raise InputError("PGV/PGA: give either --pgv-pga-median/--pgv-pga-sigma or "
                              "--magnitude/--distance-km, not both")
-        if any(v is not None for v in stated):
-            if None in stated:
-                raise InputError("give both --pgv-pga-median and --pgv-pga-sigma")
-            number(self.pgv_pga_median, "--pgv-pga-median", 0.001, 10, "s")
-            number(self.pgv_pga_sigma, "--pgv-pga-sigma", 0, 3)
-        if any(v is not None for v in modelled):
-            if None in modelled:
-                raise InputError("give both --magnitude and --distance-km")
-            number(self.magnitude, "--magnitude", 3, 8.5)
-            number(self.distance_km, "--distance-km", 0, 300, "km")
-        elif self.pga_pgv_correlation is not None:
+        if any(v is not None for v in stated) and None in stated:
+            raise InputError("give both --pgv-pga-median and --pgv-pga-sigma")
+        if any(v is not None for v in modelled) and None in modelled:
+            raise InputError("give both --magnitude and --distance-km")
+        if self.magnitude is None and self.pga_pgv_correlation != _default(
+                "pga_pgv_correlation"):
             raise InputError("--pga-pgv-correlation applies with --magnitude and "
                              "--distance-km")
 
@@ -182,10 +160,8 @@ class SpecimenOptions:
         if self.pgv_pga_median is not None:
             ratio = RatioLognormal(self.pgv_pga_median, self.pgv_pga_sigma)
         elif self.magnitude is not None:
-            rho = PGA_PGV_CORRELATION if self.pga_pgv_correlation is None \
-                else self.pga_pgv_correlation
             ratio = RatioFromGmm(self.magnitude, self.distance_km, self.vs30, self.mechanism,
-                                 rho)
+                                 self.pga_pgv_correlation)
         if ratio is None and any(f.uses_ratio for f in specimens):
             raise InputError("the fragility is over PGA and PGV/PGA: give --pgv-pga-median "
                              "and --pgv-pga-sigma, or --magnitude and --distance-km (or "
@@ -202,41 +178,50 @@ class SurvivalOptions(SpecimenOptions):
         "several curves of the site (e.g. an engine's mean and quantile curves): the first "
         "gives the headline, survival.json's hazard_curves the result under each",
         flag="--hazard", metavar="FILE")
-    site: int = param(None, "", "row (0-based) of an OpenQuake file with several sites",
-                      flag="--site", metavar="N")
-    age_ka: float = param(None, "", "the specimen's age in thousand years (above 0, at most "
-                          "10000); needed with --hazard", flag="--age-ka", metavar="KA")
-    age_sd_ka: float = param(None, "", "its standard deviation (ka; normal truncated at 0); "
-                             "default 0", flag="--age-sd-ka", metavar="KA")
+    site: int = param(None, "", "row (0-based) of an OpenQuake file with several sites", 0,
+                      None, flag="--site", metavar="N")
+    age_ka: float = param(None, "ka", "the specimen's age (a mean with --age-sd-ka)", 0,
+                          MAX_AGE_KA, low_open=True, flag="--age-ka", metavar="KA")
+    age_sd_ka: float = param(0.0, "ka", "its standard deviation (normal truncated at 0)", 0,
+                             MAX_AGE_KA, flag="--age-sd-ka", metavar="KA")
+    age_min_ka: float = param(None, "ka", "or the age known as a lower bound only (survival "
+                              "exp(-rate min) is then an upper bound)", 0, MAX_AGE_KA,
+                              low_open=True, flag="--age-min-ka", metavar="KA")
+    age_range_ka: tuple[float, float] = param(
+        None, "ka", "or an interval the age lies in, uniform over it (e.g. from "
+        "deglaciation)", 0, MAX_AGE_KA, flag="--age-range-ka", metavar=("LO", "HI"))
+    age_samples: Path = param(None, "", "or samples of the age's distribution: a CSV file "
+                              "(a header line; # comments) with the ages in ka in the column "
+                              "--age-column", flag="--age-samples", metavar="FILE")
+    age_column: str = param(None, "", "the column of --age-samples", flag="--age-column",
+                            metavar="NAME")
     observations: Path = param(
         None, "", "an observations file of invert (sites with fallen and standing columns): "
         "writes site_motion.json, the PGA range consistent with the site's outcome; "
         "fragility per column type from --fragility (a column fragility.json) or one stated "
         "--median-g/--beta or --logistic for all", flag="--observations", metavar="FILE")
-    observation_site: str = param(None, "", "the site's name in --observations (default: its "
+    observation_site: str = param(None, "", "the site's name in --observations (unset: its "
                                   "only site)", flag="--observation-site", metavar="NAME")
-    at_pgv_pga: float = param(None, "", "the PGV/PGA (s, 0.001-10) at which the PGA range is "
-                              "stated (for a fragility over PGA and PGV/PGA)",
+    at_pgv_pga: float = param(None, "s", "the PGV/PGA at which the PGA range is stated (for "
+                              "a fragility over PGA and PGV/PGA)", 0.001, 10,
                               flag="--at-pgv-pga", metavar="S")
-    out: Path = param(None, "", f"output directory (default {display_path(SURVIVAL_OUT)})",
-                      flag="--out", metavar="DIR")
+    out: Path = param(SURVIVAL_OUT, "", "output directory", flag="--out", metavar="DIR")
 
     OBSERVATION_GROUP = "the motion at a site from its standing and fallen columns"
 
     def __post_init__(self):
-        self._fill(age_sd_ka=0.0, out=SURVIVAL_OUT)
+        self.check_specimens()
         if not self.hazard and self.observations is None:
             raise InputError("give --hazard (survival under a hazard curve) or --observations "
                              "(the motion at a site from its columns), or both")
-        if self.hazard and self.age_ka is None:
-            raise InputError("--hazard needs --age-ka (the specimen's age)")
-        if not self.hazard and self.age_ka is not None:
-            raise InputError("--age-ka applies with --hazard")
+        given = _age_kinds(self)
+        if self.hazard and not given:
+            raise InputError("--hazard needs the specimen's age: --age-ka, --age-min-ka, "
+                             "--age-range-ka or --age-samples")
+        if not self.hazard and given:
+            raise InputError(f"{given[0]} applies with --hazard")
+        _check_age_kinds(self, given)
         self._check_observations()
-        if self.age_ka is not None:
-            number(self.age_ka, "--age-ka", 0, 10000, "ka", low_open=True)
-        number(self.age_sd_ka, "--age-sd-ka", 0, 10000, "ka")
-        self.check_specimens()
         _distinct_files(self.hazard, "--hazard", "curve")
         if self.observations is not None and self.column is not None:
             raise InputError("--column does not apply with --observations (each column's own "
@@ -248,11 +233,20 @@ class SurvivalOptions(SpecimenOptions):
         if self.observations is None and (self.observation_site is not None
                                           or self.at_pgv_pga is not None):
             raise InputError("--observation-site and --at-pgv-pga apply with --observations")
-        if self.at_pgv_pga is not None:
-            number(self.at_pgv_pga, "--at-pgv-pga", 0.001, 10, "s")
         if self.observations is not None and self.specimen_count != 1:
             raise InputError("--observations: give one fragility (--fragility, one "
                              "--median-g/--beta or one --logistic), used by column type")
+
+    def age_model(self):
+        """The specimen's age (:class:`~pipeline.hazard.ages.AgeModel`, years) as the
+        options date it (an --age-samples file read here)."""
+        if self.age_ka is not None:
+            return TruncatedNormal(self.age_ka * KA, self.age_sd_ka * KA)
+        if self.age_min_ka is not None:
+            return LowerBound(self.age_min_ka * KA)
+        if self.age_range_ka is not None:
+            return UniformInterval(self.age_range_ka[0] * KA, self.age_range_ka[1] * KA)
+        return load_age_samples(self.age_samples, self.age_column, KA)
 
 
 @dataclass(frozen=True)
@@ -263,26 +257,37 @@ class ConstrainOptions(SpecimenOptions):
         "hazard_curve CSV per realisation) or a plain table branch,weight,"
         "pga_<g|m_s2|cm_s2>,annual_rate_per_yr (one row per branch and level)",
         metavar="PATH")
-    site: int = param(None, "", "row (0-based) of OpenQuake curves with several sites",
-                      flag="--site", metavar="N")
+    site: int = param(None, "", "row (0-based) of OpenQuake curves with several sites", 0,
+                      None, flag="--site", metavar="N")
     age_ka: tuple[float, ...] = param(
-        (), "", "a specimen's age in thousand years (above 0, at most 10000): one per "
-        "specimen, in the order of the fragilities, or one for all", flag="--age-ka",
-        metavar="KA")
+        (), "ka", "a specimen's age (a mean with --age-sd-ka): one per specimen, in the "
+        "order of the fragilities, or one for all", 0, MAX_AGE_KA, low_open=True,
+        flag="--age-ka", metavar="KA")
     age_sd_ka: tuple[float, ...] = param(
-        (), "", "its standard deviation (ka, 0-10000; normal truncated at 0): one per "
-        "specimen or one for all; default 0", flag="--age-sd-ka", metavar="KA")
-    rule: str = param(None, "", "the headline's rule: bayes (weights x survival probability; "
-                      "default) or eliminate (branches of survival below --floor dropped); "
-                      "both are written", flag="--rule", choices=("bayes", "eliminate"))
-    floor: float = param(None, "", "survival probability below which elimination drops a "
-                         f"branch (0-1, above 0 and below 1); default {FLOOR:g}", flag="--floor",
+        (0.0,), "ka", "its standard deviation (normal truncated at 0): one per specimen or "
+        "one for all", 0, MAX_AGE_KA, flag="--age-sd-ka", metavar="KA")
+    age_min_ka: tuple[float, ...] = param(
+        (), "ka", "or a lower bound only on a specimen's age: one per specimen or one for "
+        "all", 0, MAX_AGE_KA, low_open=True, flag="--age-min-ka", metavar="KA")
+    age_range_ka: tuple[tuple[float, float], ...] = param(
+        (), "ka", "or an interval a specimen's age lies in, uniform over it: one per "
+        "specimen or one for all", 0, MAX_AGE_KA, flag="--age-range-ka",
+        metavar=("LO", "HI"))
+    age_samples: tuple[Path, ...] = param(
+        (), "", "or samples of a specimen's age (ka) in the column --age-column of a CSV "
+        "file: one file per specimen or one for all", flag="--age-samples", metavar="FILE")
+    age_column: str = param(None, "", "the column of --age-samples", flag="--age-column",
+                            metavar="NAME")
+    rule: str = param("bayes", "", "the headline's rule: bayes (weights x survival "
+                      "probability) or eliminate (branches of survival below --floor "
+                      "dropped); both are written", flag="--rule",
+                      choices=("bayes", "eliminate"))
+    floor: float = param(FLOOR, "", "survival probability below which elimination drops a "
+                         "branch", 0, 1, low_open=True, high_open=True, flag="--floor",
                          metavar="P")
-    out: Path = param(None, "", f"output directory (default {display_path(CONSTRAIN_OUT)})",
-                      flag="--out", metavar="DIR")
+    out: Path = param(CONSTRAIN_OUT, "", "output directory", flag="--out", metavar="DIR")
 
     def __post_init__(self):
-        self._fill(rule="bayes", floor=FLOOR, out=CONSTRAIN_OUT)
         if self.logic_tree is None:
             raise InputError("give --logic-tree")
         self.check_specimens()
@@ -290,21 +295,79 @@ class ConstrainOptions(SpecimenOptions):
         if n > MAX_SPECIMENS:
             raise InputError(f"{n} specimens (at most {MAX_SPECIMENS})")
         _check_column_site(self)
-        if not self.age_ka:
-            raise InputError("give --age-ka (one per specimen, or one for all)")
-        ages, sds = self.ages()
-        for a in ages:
-            number(a, "--age-ka", 0, 10000, "ka", low_open=True)
-        for s in sds:
-            number(s, "--age-sd-ka", 0, 10000, "ka")
-        number(self.floor, "--floor", 0, 1, low_open=True, high_open=True)
+        given = _age_kinds(self)
+        if not given:
+            raise InputError("give the specimens' ages: --age-ka, --age-min-ka, "
+                             "--age-range-ka or --age-samples (one per specimen, or one "
+                             "for all)")
+        _check_age_kinds(self, given)
+        flag, values = _AGE_VALUES[given[0]](self)
+        _per_specimen(values, n, flag)
+        if self.age_ka:
+            _per_specimen(self.age_sd_ka, n, "--age-sd-ka")
         _check_out(self.out)
 
     def ages(self):
-        """The ages and their sds (ka), one per specimen."""
+        """The ages and their sds (ka), one per specimen (of --age-ka)."""
         n = self.specimen_count
         return (_per_specimen(self.age_ka, n, "--age-ka"),
-                _per_specimen(self.age_sd_ka or (0.0,), n, "--age-sd-ka"))
+                _per_specimen(self.age_sd_ka, n, "--age-sd-ka"))
+
+    def age_models(self):
+        """One :class:`~pipeline.hazard.ages.AgeModel` (years) per specimen (an
+        --age-samples file read here, each once)."""
+        n = self.specimen_count
+        if self.age_ka:
+            return [TruncatedNormal(a * KA, s * KA) for a, s in zip(*self.ages())]
+        if self.age_min_ka:
+            return [LowerBound(a * KA) for a in _per_specimen(self.age_min_ka, n, "")]
+        if self.age_range_ka:
+            return [UniformInterval(lo * KA, hi * KA)
+                    for lo, hi in _per_specimen(self.age_range_ka, n, "")]
+        read = {path: load_age_samples(path, self.age_column, KA)
+                for path in dict.fromkeys(self.age_samples)}
+        return [read[path] for path in _per_specimen(self.age_samples, n, "")]
+
+
+_AGE_VALUES = {"--age-ka": lambda o: ("--age-ka", o.age_ka),
+               "--age-min-ka": lambda o: ("--age-min-ka", o.age_min_ka),
+               "--age-range-ka": lambda o: ("--age-range-ka", o.age_range_ka),
+               "--age-samples": lambda o: ("--age-samples", o.age_samples)}
+
+
+def _default(name):
+    """The declared default of the field ``name`` of :class:`SpecimenOptions`."""
+    return SpecimenOptions.__dataclass_fields__[name].default
+
+
+def _age_kinds(options):
+    """The age flags given (one kind of age is asked for)."""
+    return [flag for flag, value in (("--age-ka", options.age_ka),
+                                     ("--age-min-ka", options.age_min_ka),
+                                     ("--age-range-ka", options.age_range_ka),
+                                     ("--age-samples", options.age_samples))
+            if value is not None and value != ()]
+
+
+def _check_age_kinds(options, given):
+    """One kind of age; --age-sd-ka with --age-ka only, --age-column with --age-samples;
+    an interval the right way up."""
+    if len(given) > 1:
+        raise InputError(f"give one kind of age: {' or '.join(given)}, not both")
+    sd = options.age_sd_ka
+    if "--age-ka" not in given and sd not in (0.0, (0.0,)):
+        raise InputError("--age-sd-ka applies with --age-ka")
+    if given == ["--age-samples"] and options.age_column is None:
+        raise InputError("--age-samples needs --age-column (the column holding the ages)")
+    if given != ["--age-samples"] and options.age_column is not None:
+        raise InputError("--age-column applies with --age-samples")
+    ranges = options.age_range_ka
+    for lo, hi in ([ranges] if ranges and not isinstance(ranges[0], tuple) else ranges or ()):
+        if hi < lo:
+            raise InputError(f"--age-range-ka {lo:g} {hi:g}: the interval is upside down "
+                             "(the lower end first)")
+        if hi == 0:
+            raise InputError("--age-range-ka 0 0: an age of 0 (the upper end above 0)")
 
 
 def _check_column_site(options):
@@ -316,8 +379,6 @@ def _check_column_site(options):
     if options.below_grid != "ramp" and not options.fragility:
         raise InputError("--below-grid applies to a pulse-grid fragility (--fragility of "
                          "campaign fragility --pulses)")
-    if options.site is not None and options.site < 0:
-        raise InputError(f"--site must be 0 or more, got {options.site}")
 
 
 def _check_out(out):

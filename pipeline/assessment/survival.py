@@ -34,15 +34,15 @@ def write_site_motion(out, result):
         write_text(stage / "site_motion.json", text)
 
 
-def survival_files(out, curves, specimens, ratio, age_ka, age_sd_ka, draws, seed,
-                   hazard_component, site_motion=None):
+def survival_files(out, curves, specimens, ratio, age, draws, seed, hazard_component,
+                   site_motion=None):
     """survival.json's content (:func:`pipeline.hazard.assess.assess` under ``curves``,
-    the first the headline), written with survival.png to ``out`` as one set (with
-    site_motion.json when ``site_motion`` is given; an earlier run's left out removed)."""
+    the first the headline; ``age`` an :class:`~pipeline.hazard.ages.AgeModel`), written
+    with survival.png to ``out`` as one set (with site_motion.json when ``site_motion`` is
+    given; an earlier run's left out removed)."""
     from pipeline.figures.survival import plot_survival
     from pipeline.hazard.assess import assess
-    summary, data = assess(curves[0], specimens, ratio, age_ka, age_sd_ka, draws, seed,
-                           curves[1:])
+    summary, data = assess(curves[0], specimens, ratio, age, draws, seed, curves[1:])
     summary["hazard_component"] = hazard_component
     summary["figure"] = "survival.png"
     if site_motion is not None:
