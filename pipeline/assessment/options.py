@@ -12,6 +12,7 @@ from pathlib import Path
 from pipeline import RESULTS_DIR
 from pipeline.constants import STANDARD_GRAVITY
 from pipeline.files import InputError
+from pipeline.assessment.age_options import AGE_VALUES, age_kinds, check_age_kinds
 from pipeline.hazard.ages import LowerBound, TruncatedNormal, UniformInterval, load_age_samples
 from pipeline.hazard.components import COMPONENTS
 from pipeline.hazard.constrain import FLOOR
@@ -214,13 +215,13 @@ class SurvivalOptions(SpecimenOptions):
         if not self.hazard and self.observations is None:
             raise InputError("give --hazard (survival under a hazard curve) or --observations "
                              "(the motion at a site from its columns), or both")
-        given = _age_kinds(self)
+        given = age_kinds(self)
         if self.hazard and not given:
             raise InputError("--hazard needs the specimen's age: --age-ka, --age-min-ka, "
                              "--age-range-ka or --age-samples")
         if not self.hazard and given:
             raise InputError(f"{given[0]} applies with --hazard")
-        _check_age_kinds(self, given)
+        check_age_kinds(self, given)
         self._check_observations()
         _distinct_files(self.hazard, "--hazard", "curve")
         if self.observations is not None and self.column is not None:
@@ -295,13 +296,13 @@ class ConstrainOptions(SpecimenOptions):
         if n > MAX_SPECIMENS:
             raise InputError(f"{n} specimens (at most {MAX_SPECIMENS})")
         _check_column_site(self)
-        given = _age_kinds(self)
+        given = age_kinds(self)
         if not given:
             raise InputError("give the specimens' ages: --age-ka, --age-min-ka, "
                              "--age-range-ka or --age-samples (one per specimen, or one "
                              "for all)")
-        _check_age_kinds(self, given)
-        flag, values = _AGE_VALUES[given[0]](self)
+        check_age_kinds(self, given)
+        flag, values = AGE_VALUES[given[0]](self)
         _per_specimen(values, n, flag)
         if self.age_ka:
             _per_specimen(self.age_sd_ka, n, "--age-sd-ka")
@@ -329,45 +330,9 @@ class ConstrainOptions(SpecimenOptions):
         return [read[path] for path in _per_specimen(self.age_samples, n, "")]
 
 
-_AGE_VALUES = {"--age-ka": lambda o: ("--age-ka", o.age_ka),
-               "--age-min-ka": lambda o: ("--age-min-ka", o.age_min_ka),
-               "--age-range-ka": lambda o: ("--age-range-ka", o.age_range_ka),
-               "--age-samples": lambda o: ("--age-samples", o.age_samples)}
-
-
 def _default(name):
     """The declared default of the field ``name`` of :class:`SpecimenOptions`."""
     return SpecimenOptions.__dataclass_fields__[name].default
-
-
-def _age_kinds(options):
-    """The age flags given (one kind of age is asked for)."""
-    return [flag for flag, value in (("--age-ka", options.age_ka),
-                                     ("--age-min-ka", options.age_min_ka),
-                                     ("--age-range-ka", options.age_range_ka),
-                                     ("--age-samples", options.age_samples))
-            if value is not None and value != ()]
-
-
-def _check_age_kinds(options, given):
-    """One kind of age; --age-sd-ka with --age-ka only, --age-column with --age-samples;
-    an interval the right way up."""
-    if len(given) > 1:
-        raise InputError(f"give one kind of age: {' or '.join(given)}, not both")
-    sd = options.age_sd_ka
-    if "--age-ka" not in given and sd not in (0.0, (0.0,)):
-        raise InputError("--age-sd-ka applies with --age-ka")
-    if given == ["--age-samples"] and options.age_column is None:
-        raise InputError("--age-samples needs --age-column (the column holding the ages)")
-    if given != ["--age-samples"] and options.age_column is not None:
-        raise InputError("--age-column applies with --age-samples")
-    ranges = options.age_range_ka
-    for lo, hi in ([ranges] if ranges and not isinstance(ranges[0], tuple) else ranges or ()):
-        if hi < lo:
-            raise InputError(f"--age-range-ka {lo:g} {hi:g}: the interval is upside down "
-                             "(the lower end first)")
-        if hi == 0:
-            raise InputError("--age-range-ka 0 0: an age of 0 (the upper end above 0)")
 
 
 def _check_column_site(options):

@@ -2,6 +2,8 @@
 on the command line (the same one line), repeated flags are typed per value, and the
 defaults the help states are the ones taken (the observed correlation, rock Vs30)."""
 import argparse
+import json
+import math
 
 import pytest
 
@@ -56,3 +58,61 @@ def test_the_defaults_taken_are_those_the_help_states():
     ratio = options.ratio_model(options.specimens())
     assert ratio.correlation == 0.654            # Baker & Bradley (2017), observed
     assert ratio.vs30_m_s == 760.0
+
+
+def _survival(tmp_path, capsys, *age):
+    out = tmp_path / "out"
+    argv = ["survival", "--hazard", HAZARD, "--median-g", "0.3", "--beta", "0.4",
+            "--draws", "0", "--out", str(out), *age]
+    code = cli.main(argv)
+    said = capsys.readouterr().err.strip().splitlines()
+    if code != 0:
+        return code, said[-1]
+    return code, json.loads((out / "survival.json").read_text())
+
+
+def test_ages_as_dated_give_their_closed_forms(tmp_path, capsys):
+    """A lower bound: exp(-r min); an interval: (exp(-r lo) - exp(-r hi)) / (r (hi -
+    lo)); samples from a file: the mean of exp(-r t); the rate the same under each."""
+    _, bound = _survival(tmp_path, capsys, "--age-min-ka", "15")
+    rate = bound["annual_overturning_rate_per_yr"]
+    assert bound["survival_probability"] == pytest.approx(math.exp(-rate * 15e3), rel=1e-12)
+    assert bound["age"]["kind"] == "lower_bound" and bound["age_ka"] is None
+    assert bound["rate_scale_bound_5pct"] == pytest.approx(-math.log(0.05) / (rate * 15e3))
+    _, interval = _survival(tmp_path, capsys, "--age-range-ka", "13", "22")
+    assert interval["annual_overturning_rate_per_yr"] == rate
+    lo, hi = 13e3, 22e3
+    assert interval["survival_probability"] == pytest.approx(
+        (math.exp(-rate * lo) - math.exp(-rate * hi)) / (rate * (hi - lo)), rel=1e-9)
+    ages = tmp_path / "ages.csv"
+    ages.write_text("# exposure ages\nsample,age_ka\n1,12\n2,15\n3,21\n")
+    _, sampled = _survival(tmp_path, capsys, "--age-samples", str(ages), "--age-column",
+                           "age_ka")
+    assert sampled["survival_probability"] == pytest.approx(
+        sum(math.exp(-rate * t * 1e3) for t in (12, 15, 21)) / 3, rel=1e-12)
+
+
+@pytest.mark.parametrize("age, words", [
+    (("--age-range-ka", "22", "13"), "--age-range-ka 22 13: the interval is upside down"),
+    (("--age-ka", "15", "--age-min-ka", "10"), "give one kind of age: --age-ka or "
+     "--age-min-ka"),
+    (("--age-min-ka", "15", "--age-sd-ka", "2"), "--age-sd-ka applies with --age-ka"),
+    (("--age-samples", "ages.csv"), "--age-samples needs --age-column"),
+    (("--age-min-ka", "0"), "--age-min-ka 0 outside the allowed range (0, 10000] ka"),
+])
+def test_an_age_badly_given_is_one_line_and_nothing_written(tmp_path, capsys, age, words):
+    code, said = _survival(tmp_path, capsys, *age)
+    assert code == 2 and said.startswith(f"error: {words}")
+    assert not (tmp_path / "out").exists()
+
+
+def test_constrain_takes_an_interval_age_for_every_specimen():
+    args = _parsed(constrain_command, ["--logic-tree", TREE, "--median-g", "0.3", "--beta",
+                                       "0.4", "--median-g", "0.5", "--beta", "0.3",
+                                       "--age-range-ka", "1", "3"])
+    options = from_args(ConstrainOptions, args)
+    assert [(a.lo_yr, a.hi_yr) for a in options.age_models()] == [(1e3, 3e3)] * 2
+    with pytest.raises(InputError, match="one --age-range-ka per specimen"):
+        from_args(ConstrainOptions, _parsed(constrain_command, [
+            "--logic-tree", TREE, "--median-g", "0.3", "--beta", "0.4", "--age-range-ka",
+            "1", "3", "--age-range-ka", "2", "4"]))
