@@ -97,8 +97,8 @@ class SpecimenOptions:
         "--age-range-ka, --age-samples)"
 
     def check_specimens(self):
-        """The fragility, PGV/PGA and draw options checked (InputError, one line)."""
-        check_fields(self)
+        """The fragility and PGV/PGA options checked together (InputError, one line; each
+        alone by :func:`~pipeline.scenario.parameters.check_fields`)."""
         if len(self.median_g) != len(self.beta):
             raise InputError(f"give one --beta per --median-g ({len(self.median_g)} medians, "
                              f"{len(self.beta)} betas)")
@@ -179,6 +179,11 @@ class SurvivalOptions(SpecimenOptions):
         "several curves of the site (e.g. an engine's mean and quantile curves): the first "
         "gives the headline, survival.json's hazard_curves the result under each",
         flag="--hazard", metavar="FILE")
+    joint_hazard: Path = param(
+        None, "", "or the joint hazard of PGA and PGV: an OpenQuake datastore (or its "
+        "extract) holding the mean rate density mrd of PGA and PGV; PGV/PGA then comes "
+        "from each event (no --pgv-pga-median, --magnitude)", flag="--joint-hazard",
+        metavar="FILE")
     site: int = param(None, "", "row (0-based) of an OpenQuake file with several sites", 0,
                       None, flag="--site", metavar="N")
     age_ka: float = param(None, "ka", "the specimen's age (a mean with --age-sd-ka)", 0,
@@ -211,24 +216,46 @@ class SurvivalOptions(SpecimenOptions):
     OBSERVATION_GROUP = "the motion at a site from its standing and fallen columns"
 
     def __post_init__(self):
-        self.check_specimens()
-        if not self.hazard and self.observations is None:
+        check_fields(self)
+        if not self.hazard and self.joint_hazard is None and self.observations is None:
             raise InputError("give --hazard (survival under a hazard curve) or --observations "
                              "(the motion at a site from its columns), or both")
+        self._check_joint()
         given = age_kinds(self)
-        if self.hazard and not given:
-            raise InputError("--hazard needs the specimen's age: --age-ka, --age-min-ka, "
+        hazard = "--hazard" if self.hazard else "--joint-hazard" if self.joint_hazard else None
+        if hazard is not None and not given:
+            raise InputError(f"{hazard} needs the specimen's age: --age-ka, --age-min-ka, "
                              "--age-range-ka or --age-samples")
-        if not self.hazard and given:
+        if hazard is None and given:
             raise InputError(f"{given[0]} applies with --hazard")
         check_age_kinds(self, given)
         self._check_observations()
+        self.check_specimens()
         _distinct_files(self.hazard, "--hazard", "curve")
         if self.observations is not None and self.column is not None:
             raise InputError("--column does not apply with --observations (each column's own "
                              "type is read from the file)")
         _check_column_site(self)
         _check_out(self.out)
+
+    def _check_joint(self):
+        """--joint-hazard: alone as the hazard, its PGV/PGA its own."""
+        if self.joint_hazard is None:
+            return
+        if self.hazard:
+            raise InputError("give --hazard or --joint-hazard, not both")
+        ratio = [flag for flag, given in (
+            ("--pgv-pga-median", self.pgv_pga_median is not None),
+            ("--pgv-pga-sigma", self.pgv_pga_sigma is not None),
+            ("--magnitude", self.magnitude is not None),
+            ("--distance-km", self.distance_km is not None),
+            ("--vs30", self.vs30 != _default("vs30")),
+            ("--mechanism", self.mechanism != _default("mechanism"))) if given]
+        if ratio:
+            raise InputError(f"{ratio[0]} does not apply with --joint-hazard (its events "
+                             "hold their PGV/PGA)")
+        if self.observations is not None:
+            raise InputError("--observations applies with --hazard or alone")
 
     def _check_observations(self):
         if self.observations is None and (self.observation_site is not None
@@ -291,6 +318,7 @@ class ConstrainOptions(SpecimenOptions):
     def __post_init__(self):
         if self.logic_tree is None:
             raise InputError("give --logic-tree")
+        check_fields(self)
         self.check_specimens()
         n = self.specimen_count
         if n > MAX_SPECIMENS:

@@ -40,9 +40,23 @@ def survival_files(out, curves, specimens, ratio, age, draws, seed, hazard_compo
     the first the headline; ``age`` an :class:`~pipeline.hazard.ages.AgeModel`), written
     with survival.png to ``out`` as one set (with site_motion.json when ``site_motion`` is
     given; an earlier run's left out removed)."""
-    from pipeline.figures.survival import plot_survival
     from pipeline.hazard.assess import assess
     summary, data = assess(curves[0], specimens, ratio, age, draws, seed, curves[1:])
+    return _write(out, summary, data, hazard_component, site_motion)
+
+
+def joint_survival_files(out, joint, specimens, age, draws, seed, hazard_component):
+    """survival.json's content under the joint hazard ``joint`` of one site
+    (:func:`pipeline.hazard.joint_assess.assess_joint`), written with survival.png to
+    ``out`` as one set."""
+    from pipeline.hazard.joint_assess import assess_joint
+    summary, data = assess_joint(joint, specimens, age, draws, seed)
+    return _write(out, summary, data, hazard_component, None)
+
+
+def _write(out, summary, data, hazard_component, site_motion):
+    """survival.json (and site_motion.json) checked, then written with survival.png."""
+    from pipeline.figures.survival import plot_survival
     summary["hazard_component"] = hazard_component
     summary["figure"] = "survival.png"
     if site_motion is not None:

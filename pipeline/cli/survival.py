@@ -12,9 +12,10 @@ import math
 
 from pipeline.cli._fields import add_arguments, from_args
 from pipeline.constants import STANDARD_GRAVITY
-from pipeline.files import display_path
+from pipeline.files import InputError, display_path
 from pipeline.hazard.ages import AgeKind
-from pipeline.assessment.survival import site_motion_result, survival_files, write_site_motion
+from pipeline.assessment.survival import (joint_survival_files, site_motion_result,
+                                         survival_files, write_site_motion)
 from pipeline.assessment.options import AGE_FLAGS, SurvivalOptions, parse_logistic
 
 NAME = "survival"
@@ -33,7 +34,7 @@ def setup(p):
     """The flags of :class:`~pipeline.assessment.options.SurvivalOptions`, in the
     order of the help."""
     o = SurvivalOptions
-    add_arguments(p, o, ("hazard", "site"))
+    add_arguments(p, o, ("hazard", "joint_hazard", "site"))
     add_arguments(p, o, o.FRAGILITY_FLAGS)
     add_arguments(p.add_argument_group(o.AGE_GROUP), o, AGE_FLAGS)
     add_arguments(p.add_argument_group(o.RATIO_GROUP), o, o.RATIO_FLAGS)
@@ -47,18 +48,22 @@ def run(args):
     site_motion = None
     if o.observations is not None:
         site_motion = _site_motion(o)
-    if not o.hazard:
+    if not o.hazard and o.joint_hazard is None:
         write_site_motion(o.out, site_motion)
         _print_site_motion(site_motion)
         print(f"wrote {display_path(o.out / 'site_motion.json')}")
         return 0
     age = o.age_model()
-    from pipeline.hazard import load_hazard
-    curves = [load_hazard(path, o.site) for path in o.hazard]
     specimens = o.specimens()
-    ratio = o.ratio_model(specimens)
-    summary = survival_files(o.out, curves, specimens, ratio, age, o.draws, o.seed,
-                             o.hazard_component, site_motion)
+    if o.joint_hazard is not None:
+        summary = joint_survival_files(o.out, _joint_site(o), specimens, age, o.draws,
+                                       o.seed, o.hazard_component)
+    else:
+        from pipeline.hazard import load_hazard
+        curves = [load_hazard(path, o.site) for path in o.hazard]
+        ratio = o.ratio_model(specimens)
+        summary = survival_files(o.out, curves, specimens, ratio, age, o.draws, o.seed,
+                                 o.hazard_component, site_motion)
     for line in summary["warnings"]:
         print(f"warning: {line}")
     interval = summary["survival_interval"]
@@ -75,6 +80,15 @@ def run(args):
         _print_site_motion(site_motion)
     print(f"wrote {display_path(o.out / 'survival.json')} and survival.png")
     return 0
+
+
+def _joint_site(o):
+    """The joint hazard of --joint-hazard at --site (unset: the file's only site)."""
+    from pipeline.hazard.joint_hazard import load_joint_hazard
+    joint = load_joint_hazard(o.joint_hazard)
+    if o.site is None and len(joint.sites) != 1:
+        raise InputError(f"{o.joint_hazard}: {len(joint.sites)} sites: name one with --site")
+    return joint.site(0 if o.site is None else o.site)
 
 
 def _site_motion(o):

@@ -149,6 +149,8 @@ def _summary(curve, specimens, entries, headline, ratio_model, warnings, run):
     age, draws, seed = run
     one = len(specimens) == 1
     return {
+        "hazard_route": {"route": "curve", "what": "the PGA hazard curve, PGV/PGA at each PGA "
+                         "level lognormal (stated, or one scenario's ground-motion model)"},
         "annual_overturning_rate_per_yr": headline["annual_overturning_rate_per_yr"],
         "survival_probability": headline["survival_probability"],
         "survival_interval": headline["survival_interval"],
@@ -163,7 +165,7 @@ def _summary(curve, specimens, entries, headline, ratio_model, warnings, run):
         "contribution_by_intensity": headline["contribution_by_intensity"],
         "curve_ends": headline["curve_ends"],
         "headline": "the specimen" if one else "the set under common shaking (all survive)",
-        **_age_keys(age),
+        **age_keys(age),
         "definitions": _definitions(draws),
         "specimens": entries,
         "hazard": {**curve.source, "levels_m_s2": curve.levels_m_s2.tolist(),
@@ -372,7 +374,7 @@ def _figure_data(curve, probability, headline, drawn, age, specimens, ratio_mode
             "set": len(specimens) > 1, "pgv_pga_used": any(f.uses_ratio for f in specimens)}
 
 
-def _age_keys(age):
+def age_keys(age):
     """survival.json's age: age_ka and age_sd_ka (a normal's; null for other kinds),
     age_distribution in words and age (:meth:`AgeModel.describe`)."""
     normal = age.kind is AgeKind.NORMAL
