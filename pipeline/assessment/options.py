@@ -287,6 +287,11 @@ class ConstrainOptions(SpecimenOptions):
         metavar="PATH")
     site: int = param(None, "", "row (0-based) of OpenQuake curves with several sites", 0,
                       None, flag="--site", metavar="N")
+    specimen_site: tuple[int, ...] = param(
+        (), "", "the site (0-based row of OpenQuake curves with several sites) of each "
+        "specimen, in the order of the fragilities, or one for all; sites taken as far "
+        "apart (the set's survival the product over sites); unset: every specimen at "
+        "--site", 0, None, flag="--specimen-site", metavar="N")
     age_ka: tuple[float, ...] = param(
         (), "ka", "a specimen's age (a mean with --age-sd-ka): one per specimen, in the "
         "order of the fragilities, or one for all", 0, MAX_AGE_KA, low_open=True,
@@ -334,7 +339,14 @@ class ConstrainOptions(SpecimenOptions):
         _per_specimen(values, n, flag)
         if self.age_ka:
             _per_specimen(self.age_sd_ka, n, "--age-sd-ka")
+        self.specimen_sites()
         _check_out(self.out)
+
+    def specimen_sites(self):
+        """The site of each specimen (--specimen-site), or None (all at --site)."""
+        if not self.specimen_site:
+            return None
+        return _per_specimen(self.specimen_site, self.specimen_count, "--specimen-site")
 
     def ages(self):
         """The ages and their sds (ka), one per specimen (of --age-ka)."""

@@ -12,6 +12,8 @@ from pipeline.hazard.constrain import (FRACTILES, TARGET_RATES, bayes, branch_ra
                                        log_survival_fixed, log_survival_sampled,
                                        motion_at_rate, weighted_mean,
                                        weighted_quantile)
+from pipeline.hazard.constrain_sites import (SITE_ASSUMPTION, SiteGroup, branch_test,
+                                             check_same_branches, combined)
 from pipeline.hazard.fragility import overturn_probability
 from pipeline.hazard.logictree import LogicTree
 from pipeline.provenance import software_versions
@@ -53,19 +55,30 @@ ASSUMPTIONS = [
 ]
 
 
-def constrain_tree(tree, specimens, ratio_model, ages, rule, floor, draws, seed):
+def constrain_tree(tree, specimens, ratio_model, ages, rule, floor, draws, seed,
+                   groups=None):
     """(summary dict, branch rows, figure data) for the
     :class:`~pipeline.hazard.logictree.LogicTree` ``tree`` and ``specimens`` (fragility
     objects, one per specimen) of ages ``ages`` (:class:`~pipeline.hazard.ages.AgeModel`,
-    years, one per specimen)."""
+    years, one per specimen).  ``groups``: the specimens by site
+    (:class:`~pipeline.hazard.constrain_sites.SiteGroup`; None: all at ``tree``'s site);
+    ``tree`` gives the curves reported."""
+    groups = groups or [SiteGroup(tree, tuple(range(len(specimens))))]
+    check_same_branches(groups)
     rng = np.random.default_rng(seed)
     cells = cell_matrix(tree.levels_m_s2, tree.rates_per_yr)
-    mode, samples = _age_mode(ages, rng)
+    sites = [(g.members, g.tree, cells if g.tree is tree else
+              cell_matrix(g.tree.levels_m_s2, g.tree.rates_per_yr),
+              *_age_mode([ages[j] for j in g.members], rng)) for g in groups]
+    mode = sites[0][3] if len(sites) == 1 else \
+        max((s[3] for s in sites), key=list(AgeIntegration).index)
     warnings = list(tree.notes)
 
     def survival_of(batch, sampled=True):
-        return _log_survival(tree, cells, batch, ratio_model, ages, mode,
-                             samples if sampled else None)
+        return combined([_log_survival(t, c, [[chosen[j] for j in m] for chosen in batch],
+                                       ratio_model, [ages[j] for j in m], how,
+                                       samples if sampled else None)
+                         for m, t, c, how, samples in sites])
 
     log_p, age_se = (None if v is None else v[0] for v in survival_of([specimens]))
     p = np.exp(log_p)
@@ -76,7 +89,11 @@ def constrain_tree(tree, specimens, ratio_model, ages, rule, floor, draws, seed)
             warnings.append(_none_left(name, floor, tree, p))
     members = _members(tree, specimens, survival_of, floor, warnings)
     carlo = _draws(tree, cells, specimens, survival_of, draws, rng, floor)
-    warnings += _end_warnings(tree, cells, specimens, ratio_model, posterior[rule])
+    for m, t, c, _, _ in sites:
+        warnings += _end_warnings(t, c, [specimens[j] for j in m], ratio_model,
+                                  posterior[rule])
+    test_rows, test = branch_test(groups, specimens, _singles(sites, specimens, ratio_model,
+                                                              ages), p, tree, floor)
     prior_stats = _statistics(tree, tree.weights)
     post_stats = None if posterior[rule] is None else _statistics(tree, posterior[rule])
     other = "eliminate" if rule == "bayes" else "bayes"
@@ -96,11 +113,14 @@ def constrain_tree(tree, specimens, ratio_model, ages, rule, floor, draws, seed)
         else _statistics(tree, posterior[other]),
         "ground_motion_at_rates": _motions(tree, prior_stats, post_stats),
         "members": members, "monte_carlo": carlo,
+        "sites": [{"site": g.site, "specimens": list(g.members)} for g in groups],
+        "branch_test": {**test, "branches": test_rows},
         "hazard": {**tree.source, "notes": list(tree.notes),
                    "interpolation": "linear in (ln PGA, ln rate)",
                    "cells_per_interval": cells[2]},
         "pgv_pga": None if ratio_model is None else ratio_model.describe(),
-        "warnings": warnings, "assumptions": ASSUMPTIONS,
+        "warnings": warnings,
+        "assumptions": ASSUMPTIONS + ([SITE_ASSUMPTION] if len(groups) > 1 else []),
         "draws": draws, "seed": seed, "software": software_versions()}
     figure = {"levels_m_s2": tree.levels_m_s2, "rates_per_yr": tree.rates_per_yr,
               "prior_weights": tree.weights, "posterior_weights": posterior[rule],
@@ -115,6 +135,17 @@ class AgeIntegration(Enum):
     KNOWN = "known ages"
     ONE_FOR_ALL = "one uncertain age for all: integrated in closed form"
     MONTE_CARLO = f"differing uncertain ages: Monte Carlo over {AGE_SAMPLES} samples"
+
+
+def _singles(sites, specimens, ratio_model, ages):
+    """ln P_s of each specimen alone at its site (n x B): one age each, no sampling."""
+    out = np.empty((len(specimens), sites[0][1].size))
+    for members, t, c, _, _ in sites:
+        for j in members:
+            how, _ = _age_mode([ages[j]], None)
+            out[j] = _log_survival(t, c, [[specimens[j]]], ratio_model, [ages[j]], how,
+                                   None)[0][0]
+    return out
 
 
 def _age_mode(ages, rng):
