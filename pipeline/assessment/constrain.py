@@ -15,7 +15,7 @@ FILES = ("branch_weights.csv", "branch_test.csv", "prior_curves.csv",
 
 def constrain_files(o):
     """constrain.json's content for the options ``o``
-    (:class:`~pipeline.assessment.options.ConstrainOptions`), its files written to
+    (:class:`~pipeline.assessment.constrain_options.ConstrainOptions`), its files written to
     ``o.out``."""
     from pipeline.figures.constrain import plot_constrain
     from pipeline.hazard.constrain_assess import constrain_tree

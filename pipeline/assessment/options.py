@@ -4,7 +4,7 @@ the commands build their flags from them: :mod:`pipeline.cli._fields`), every on
 when the options are made, before any work: the fragility and PGV/PGA options both share
 (:class:`SpecimenOptions`, read by :meth:`SpecimenOptions.specimens` and
 :meth:`SpecimenOptions.ratio_model`), and each command's own (:class:`SurvivalOptions`,
-:class:`ConstrainOptions`), the ages among them as :mod:`pipeline.hazard.ages` models."""
+:class:`~pipeline.assessment.constrain_options.ConstrainOptions`), the ages among them as :mod:`pipeline.hazard.ages` models."""
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -12,10 +12,9 @@ from pathlib import Path
 from pipeline import RESULTS_DIR
 from pipeline.constants import STANDARD_GRAVITY
 from pipeline.files import InputError
-from pipeline.assessment.age_options import AGE_VALUES, age_kinds, check_age_kinds
+from pipeline.assessment.age_options import age_kinds, check_age_kinds
 from pipeline.hazard.ages import LowerBound, TruncatedNormal, UniformInterval, load_age_samples
 from pipeline.hazard.components import COMPONENTS
-from pipeline.hazard.constrain import FLOOR
 from pipeline.hazard.fragility import BELOW_GRID, GMM_MECHANISMS
 from pipeline.hazard.fragility_kinds import BETA_RANGE, MEDIAN_G_RANGE
 from pipeline.hazard.fragility_ratio import DEFAULT_VS30_M_S, PGA_PGV_CORRELATION
@@ -120,8 +119,8 @@ class SpecimenOptions:
             raise InputError("give both --pgv-pga-median and --pgv-pga-sigma")
         if any(v is not None for v in modelled) and None in modelled:
             raise InputError("give both --magnitude and --distance-km")
-        if self.magnitude is None and self.pga_pgv_correlation != _default(
-                "pga_pgv_correlation"):
+        if self.magnitude is None and getattr(self, "disaggregation", None) is None and \
+                self.pga_pgv_correlation != _default("pga_pgv_correlation"):
             raise InputError("--pga-pgv-correlation applies with --magnitude and "
                              "--distance-km")
 
@@ -211,8 +210,18 @@ class SurvivalOptions(SpecimenOptions):
     at_pgv_pga: float = param(None, "s", "the PGV/PGA at which the PGA range is stated (for "
                               "a fragility over PGA and PGV/PGA)", 0.001, 10,
                               flag="--at-pgv-pga", metavar="S")
+    disaggregation: Path = param(
+        None, "", "or PGV/PGA at each PGA level a mixture over OpenQuake's magnitude-distance "
+        "disaggregation of the first --hazard curve (its Mag_Dist CSV export): the "
+        "ground-motion model at each bin, weighted by the bin's share of the events near "
+        "that level (with --vs30, --mechanism, --pga-pgv-correlation)",
+        flag="--disaggregation", metavar="FILE")
+    disaggregation_column: str = param(
+        "mean", "", "the column of --disaggregation: mean, or rlzK for realisation K (that "
+        "of the first --hazard curve)", flag="--disaggregation-column", metavar="NAME")
     out: Path = param(SURVIVAL_OUT, "", "output directory", flag="--out", metavar="DIR")
 
+    RATIO_FLAGS = (*SpecimenOptions.RATIO_FLAGS, "disaggregation", "disaggregation_column")
     OBSERVATION_GROUP = "the motion at a site from its standing and fallen columns"
 
     def __post_init__(self):
@@ -221,6 +230,7 @@ class SurvivalOptions(SpecimenOptions):
             raise InputError("give --hazard (survival under a hazard curve) or --observations "
                              "(the motion at a site from its columns), or both")
         self._check_joint()
+        self._check_disaggregation()
         given = age_kinds(self)
         hazard = "--hazard" if self.hazard else "--joint-hazard" if self.joint_hazard else None
         if hazard is not None and not given:
@@ -256,6 +266,33 @@ class SurvivalOptions(SpecimenOptions):
                              "hold their PGV/PGA)")
         if self.observations is not None:
             raise InputError("--observations applies with --hazard or alone")
+        if self.disaggregation is not None:
+            raise InputError("--disaggregation does not apply with --joint-hazard (its "
+                             "events hold their PGV/PGA)")
+
+    def _check_disaggregation(self):
+        """--disaggregation: the one source of PGV/PGA, with a hazard curve."""
+        if self.disaggregation is None:
+            if self.disaggregation_column != _default_of(SurvivalOptions,
+                                                        "disaggregation_column"):
+                raise InputError("--disaggregation-column applies with --disaggregation")
+            return
+        if self.pgv_pga_median is not None or self.magnitude is not None:
+            raise InputError("PGV/PGA: give --disaggregation, --pgv-pga-median/"
+                             "--pgv-pga-sigma or --magnitude/--distance-km, one of them")
+        if not self.hazard:
+            raise InputError("--disaggregation needs --hazard (the curve it disaggregates)")
+
+    def disaggregation_ratio(self, curve):
+        """PGV/PGA as a mixture over --disaggregation's bins
+        (:class:`~pipeline.hazard.disagg_ratio.RatioMixture`), its bins first checked to
+        add up to ``curve``'s rate at each level."""
+        from pipeline.hazard.disagg_ratio import ratio_mixture
+        from pipeline.hazard.disaggregation import load_mag_dist
+        disaggregation = load_mag_dist(self.disaggregation)
+        disaggregation.check_curve(self.disaggregation_column, curve)
+        return ratio_mixture(disaggregation, self.disaggregation_column, self.vs30,
+                             self.mechanism, self.pga_pgv_correlation)
 
     def _check_observations(self):
         if self.observations is None and (self.observation_site is not None
@@ -277,102 +314,14 @@ class SurvivalOptions(SpecimenOptions):
         return load_age_samples(self.age_samples, self.age_column, KA)
 
 
-@dataclass(frozen=True)
-class ConstrainOptions(SpecimenOptions):
-    """What ``constrain`` is asked (see ``python -m pipeline constrain --help``)."""
-    logic_tree: Path = param(
-        None, "", "OpenQuake's export (the directory, or its realizations.csv, with one "
-        "hazard_curve CSV per realisation) or a plain table branch,weight,"
-        "pga_<g|m_s2|cm_s2>,annual_rate_per_yr (one row per branch and level)",
-        metavar="PATH")
-    site: int = param(None, "", "row (0-based) of OpenQuake curves with several sites", 0,
-                      None, flag="--site", metavar="N")
-    specimen_site: tuple[int, ...] = param(
-        (), "", "the site (0-based row of OpenQuake curves with several sites) of each "
-        "specimen, in the order of the fragilities, or one for all; sites taken as far "
-        "apart (the set's survival the product over sites); unset: every specimen at "
-        "--site", 0, None, flag="--specimen-site", metavar="N")
-    age_ka: tuple[float, ...] = param(
-        (), "ka", "a specimen's age (a mean with --age-sd-ka): one per specimen, in the "
-        "order of the fragilities, or one for all", 0, MAX_AGE_KA, low_open=True,
-        flag="--age-ka", metavar="KA")
-    age_sd_ka: tuple[float, ...] = param(
-        (0.0,), "ka", "its standard deviation (normal truncated at 0): one per specimen or "
-        "one for all", 0, MAX_AGE_KA, flag="--age-sd-ka", metavar="KA")
-    age_min_ka: tuple[float, ...] = param(
-        (), "ka", "or a lower bound only on a specimen's age: one per specimen or one for "
-        "all", 0, MAX_AGE_KA, low_open=True, flag="--age-min-ka", metavar="KA")
-    age_range_ka: tuple[tuple[float, float], ...] = param(
-        (), "ka", "or an interval a specimen's age lies in, uniform over it: one per "
-        "specimen or one for all", 0, MAX_AGE_KA, flag="--age-range-ka",
-        metavar=("LO", "HI"))
-    age_samples: tuple[Path, ...] = param(
-        (), "", "or samples of a specimen's age (ka) in the column --age-column of a CSV "
-        "file: one file per specimen or one for all", flag="--age-samples", metavar="FILE")
-    age_column: str = param(None, "", "the column of --age-samples", flag="--age-column",
-                            metavar="NAME")
-    rule: str = param("bayes", "", "the headline's rule: bayes (weights x survival "
-                      "probability) or eliminate (branches of survival below --floor "
-                      "dropped); both are written", flag="--rule",
-                      choices=("bayes", "eliminate"))
-    floor: float = param(FLOOR, "", "survival probability below which elimination drops a "
-                         "branch", 0, 1, low_open=True, high_open=True, flag="--floor",
-                         metavar="P")
-    out: Path = param(CONSTRAIN_OUT, "", "output directory", flag="--out", metavar="DIR")
-
-    def __post_init__(self):
-        if self.logic_tree is None:
-            raise InputError("give --logic-tree")
-        check_fields(self)
-        self.check_specimens()
-        n = self.specimen_count
-        if n > MAX_SPECIMENS:
-            raise InputError(f"{n} specimens (at most {MAX_SPECIMENS})")
-        _check_column_site(self)
-        given = age_kinds(self)
-        if not given:
-            raise InputError("give the specimens' ages: --age-ka, --age-min-ka, "
-                             "--age-range-ka or --age-samples (one per specimen, or one "
-                             "for all)")
-        check_age_kinds(self, given)
-        flag, values = AGE_VALUES[given[0]](self)
-        _per_specimen(values, n, flag)
-        if self.age_ka:
-            _per_specimen(self.age_sd_ka, n, "--age-sd-ka")
-        self.specimen_sites()
-        _check_out(self.out)
-
-    def specimen_sites(self):
-        """The site of each specimen (--specimen-site), or None (all at --site)."""
-        if not self.specimen_site:
-            return None
-        return _per_specimen(self.specimen_site, self.specimen_count, "--specimen-site")
-
-    def ages(self):
-        """The ages and their sds (ka), one per specimen (of --age-ka)."""
-        n = self.specimen_count
-        return (_per_specimen(self.age_ka, n, "--age-ka"),
-                _per_specimen(self.age_sd_ka, n, "--age-sd-ka"))
-
-    def age_models(self):
-        """One :class:`~pipeline.hazard.ages.AgeModel` (years) per specimen (an
-        --age-samples file read here, each once)."""
-        n = self.specimen_count
-        if self.age_ka:
-            return [TruncatedNormal(a * KA, s * KA) for a, s in zip(*self.ages())]
-        if self.age_min_ka:
-            return [LowerBound(a * KA) for a in _per_specimen(self.age_min_ka, n, "")]
-        if self.age_range_ka:
-            return [UniformInterval(lo * KA, hi * KA)
-                    for lo, hi in _per_specimen(self.age_range_ka, n, "")]
-        read = {path: load_age_samples(path, self.age_column, KA)
-                for path in dict.fromkeys(self.age_samples)}
-        return [read[path] for path in _per_specimen(self.age_samples, n, "")]
-
-
 def _default(name):
     """The declared default of the field ``name`` of :class:`SpecimenOptions`."""
-    return SpecimenOptions.__dataclass_fields__[name].default
+    return _default_of(SpecimenOptions, name)
+
+
+def _default_of(cls, name):
+    """The declared default of the field ``name`` of the options class ``cls``."""
+    return cls.__dataclass_fields__[name].default
 
 
 def _check_column_site(options):

@@ -38,8 +38,9 @@ def _bounds(meta):
         return f"; {'above' if meta.get('low_open') else 'at least'} {low:g}"
     if low is None:
         return f"; {'below' if meta.get('high_open') else 'at most'} {high:g}"
-    ends = [w for w, is_open in (("above", meta.get("low_open")),
-                                 ("below", meta.get("high_open"))) if is_open]
+    ends = [f"{w} {v:g}" for w, v, is_open in (("above", low, meta.get("low_open")),
+                                                ("below", high, meta.get("high_open")))
+            if is_open]
     return f"; {low:g}-{high:g}" + (f" ({' and '.join(ends)})" if ends else "")
 
 

@@ -13,7 +13,8 @@ from pathlib import Path
 from pipeline.cli._fields import add_arguments, from_args
 from pipeline.assessment.constrain import constrain_files
 from pipeline.files import display_path
-from pipeline.assessment.options import AGE_FLAGS, ConstrainOptions
+from pipeline.assessment.constrain_options import ConstrainOptions
+from pipeline.assessment.options import AGE_FLAGS
 
 NAME = "constrain"
 ORDER = 46
@@ -29,7 +30,7 @@ DESCRIPTION = (
 
 
 def setup(p):
-    """The flags of :class:`~pipeline.assessment.options.ConstrainOptions`, in the
+    """The flags of :class:`~pipeline.assessment.constrain_options.ConstrainOptions`, in the
     order of the help; ``--logic-tree`` by hand (a required flag)."""
     o = ConstrainOptions
     field = o.__dataclass_fields__["logic_tree"]

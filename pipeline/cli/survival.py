@@ -61,7 +61,8 @@ def run(args):
     else:
         from pipeline.hazard import load_hazard
         curves = [load_hazard(path, o.site) for path in o.hazard]
-        ratio = o.ratio_model(specimens)
+        ratio = o.ratio_model(specimens) if o.disaggregation is None \
+            else o.disaggregation_ratio(curves[0])
         summary = survival_files(o.out, curves, specimens, ratio, age, o.draws, o.seed,
                                  o.hazard_component, site_motion)
     for line in summary["warnings"]:

@@ -4,7 +4,7 @@ import numpy as np
 
 from pipeline.constants import STANDARD_GRAVITY
 from pipeline.hazard.ages import AgeKind
-from pipeline.hazard.fragility import overturn_probability
+from pipeline.hazard.disagg_ratio import overturn_probability_over
 from pipeline.hazard.survival import (contribution_by_intensity, intensity_scale_bound,
                                       overturning_rate, rate_density, rate_outside,
                                       rate_exceeding, rate_scale_bound,
@@ -101,9 +101,9 @@ def _specimen_entry(curve, fragility, drawn, ratio_model, age, draws):
     """One specimen's entry of ``specimens``: its result, parameter sets and what comes
     from outside its grid, with its ``warnings`` (a list the caller takes out)."""
     def probability(x):
-        return overturn_probability([fragility], ratio_model, x)[0]
+        return overturn_probability_over([fragility], ratio_model, x)[0]
     members = None if drawn is None else [
-        (lambda x, f=d: overturn_probability([f], ratio_model, x)[0]) for d in drawn]
+        (lambda x, f=d: overturn_probability_over([f], ratio_model, x)[0]) for d in drawn]
     entry = _result(curve, probability, members, age)
     entry = {"fragility": fragility.describe(), **entry,
              **_per_parameter_set(curve, fragility, ratio_model, age),
@@ -215,7 +215,7 @@ def _definitions(draws):
 
 def _combined(specimens, ratio_model, combine):
     def probability(x):
-        p = overturn_probability(specimens, ratio_model, x, combine)
+        p = overturn_probability_over(specimens, ratio_model, x, combine)
         return p[0] if combine == "each" else p
     return probability
 
@@ -282,7 +282,7 @@ def _per_parameter_set(curve, fragility, ratio_model, age):
         return {}
     zero = curve.zero_rate_from_m_s2
     rates = [overturning_rate(curve.levels_m_s2, curve.rates_per_yr,
-                              lambda x, f=m: overturn_probability([f], ratio_model, x)[0],
+                              lambda x, f=m: overturn_probability_over([f], ratio_model, x)[0],
                               zero)["rate_per_yr"] for m in members]
     survival = age.survival(np.array(rates)).tolist()
     return {"rate_per_parameter_set_per_yr": rates, "survival_per_parameter_set": survival,
@@ -300,7 +300,7 @@ def _outside_grid(curve, fragility, ratio_model, probability, rate):
     zero = curve.zero_rate_from_m_s2
     bounds = {name: overturning_rate(
         curve.levels_m_s2, curve.rates_per_yr,
-        lambda x, f=variant: overturn_probability([f], ratio_model, x)[0], zero)["rate_per_yr"]
+        lambda x, f=variant: overturn_probability_over([f], ratio_model, x)[0], zero)["rate_per_yr"]
         for name, variant in fragility.variants().items()}
     last = float(curve.levels_m_s2[-1])
     beyond = rate_exceeding(curve.levels_m_s2, curve.rates_per_yr, hi)

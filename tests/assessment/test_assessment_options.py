@@ -12,7 +12,8 @@ from pipeline.cli import constrain as constrain_command
 from pipeline.cli import survival as survival_command
 from pipeline.cli._fields import from_args
 from pipeline.files import InputError
-from pipeline.assessment.options import ConstrainOptions, SurvivalOptions
+from pipeline.assessment.constrain_options import ConstrainOptions
+from pipeline.assessment.options import SurvivalOptions
 
 HAZARD = "records/hazard/usgs_nshm2014r1_curves_-118_34_vs760.json"
 TREE = "records/hazard/openquake_logictree_case_11"

@@ -6,6 +6,7 @@ import math
 
 import pytest
 
+from pipeline import RECORDS_DIR
 from pipeline.cli import main
 from pipeline.hazard.joint_hazard import load_joint_hazard
 from pipeline.hazard.joint_survival import joint_overturning_rate
@@ -70,4 +71,49 @@ def test_bad_joint_input_is_one_line_and_nothing_written(tmp_path, capsys, argv,
     code, said = _run(tmp_path, capsys, *argv, "--median-g", "0.05", "--beta", "0.5",
                       "--age-ka", "15")
     assert code == 2 and words in said and said.startswith("error: ")
+    assert not (tmp_path / "out").exists()
+
+
+def _one_bin(tmp_path, curve_csv, magnitude, distance_km):
+    """A Mag_Dist export of one bin (magnitude, distance) holding the whole rate of the
+    curve at three of its levels (its probabilities of exceedance in 1 year)."""
+    lines = [line for line in curve_csv.read_text().splitlines() if line.strip()]
+    names, values = lines[1].split(","), lines[2].split(",")
+    picks = [k for k, n in enumerate(names) if n.startswith("poe-")][10:25:7]
+    rows = [f"PGA,{names[k][4:]},{float(values[k]):.6E},{magnitude:.5E},{distance_km:.5E},"
+            f"{float(values[k]):.6E}" for k in picks]
+    path = tmp_path / "Mag_Dist-mean-0_1.csv"
+    path.write_text(
+        '#,,,,,"generated_by=\'OpenQuake engine 3.26.2\', investigation_time=1.0, '
+        f"mag_bin_edges=[{magnitude - 0.25}, {magnitude + 0.25}], dist_bin_edges=[0.0, "
+        f"{2 * distance_km}], lon=11.202, lat=42.424\"\nimt,iml,poe,mag,dist,mean\n"
+        + "\n".join(rows) + "\n")
+    return path
+
+
+def test_one_disaggregation_bin_is_todays_one_scenario(tmp_path, capsys):
+    """--disaggregation of one bin at (M, R): at every PGA level the mixture is the one
+    model at M, R, so the survival is --magnitude M --distance-km R's."""
+    curve = RECORDS_DIR / "hazard" / "openquake_postproc_case_mrd" / \
+        "hazard_curve-mean-PGA_6.csv"
+    base = ("--hazard", str(curve), "--logistic=-1,3,1.5", "--age-ka", "15", "--draws", "0")
+    _, mixed = _run(tmp_path, capsys, *base, "--disaggregation",
+                    str(_one_bin(tmp_path, curve, 6.25, 10.0)), out="mixed")
+    _, today = _run(tmp_path, capsys, *base, "--magnitude", "6.25", "--distance-km", "10",
+                    out="today")
+    assert mixed["annual_overturning_rate_per_yr"] == pytest.approx(
+        today["annual_overturning_rate_per_yr"], rel=1e-9)
+    assert mixed["pgv_pga"]["source"] == "magnitude-distance disaggregation"
+
+
+def test_a_disaggregation_that_does_not_add_up_is_one_line(tmp_path, capsys):
+    """Bins whose rates do not sum to the curve's rate at their level: refused."""
+    curve = RECORDS_DIR / "hazard" / "openquake_postproc_case_mrd" / \
+        "hazard_curve-mean-PGA_6.csv"
+    other = RECORDS_DIR / "hazard" / "openquake_postproc_case_mrd" / \
+        "hazard_curve-rlz-000-PGA_6.csv"
+    code, said = _run(tmp_path, capsys, "--hazard", str(other), "--logistic=-1,3,1.5",
+                      "--age-ka", "15", "--disaggregation",
+                      str(_one_bin(tmp_path, curve, 6.25, 10.0)))
+    assert code == 2 and "add up to" in said and said.startswith("error: ")
     assert not (tmp_path / "out").exists()
