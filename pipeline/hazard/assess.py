@@ -205,10 +205,11 @@ def _definitions(draws):
         "survival_parameter_set_range": "min and max of survival_per_parameter_set: "
         "the members' spread, reported apart from the Monte Carlo error",
         "rate_scale_bound_5pct": "largest factor F on every rate of the hazard curve "
-        "with survival >= 0.05 (-ln 0.05 / (rate t) for a fixed age)",
+        f"with survival >= {BOUND_SURVIVAL:g} (-ln {BOUND_SURVIVAL:g} / (rate t) for a "
+        "fixed age)",
         "intensity_scale_bound_5pct": "largest factor c on the curve's PGA levels "
-        "(lambda_c(x) = lambda(x / c)) with survival >= 0.05; null with a note when "
-        "outside 0.001-1000",
+        f"(lambda_c(x) = lambda(x / c)) with survival >= {BOUND_SURVIVAL:g}; null with a "
+        "note when outside 0.001-1000",
         "contribution_by_intensity": "the rate of overturning by PGA interval of the "
         "curve (m/s^2; the last row: exceedances of the last level) and its share"}
 
