@@ -117,3 +117,23 @@ def test_constrain_takes_an_interval_age_for_every_specimen():
         from_args(ConstrainOptions, _parsed(constrain_command, [
             "--logic-tree", TREE, "--median-g", "0.3", "--beta", "0.4", "--age-range-ka",
             "1", "3", "--age-range-ka", "2", "4"]))
+
+
+def test_each_default_and_range_is_declared_once_and_the_help_says_it():
+    """The help states the declared default and range (from the field, not prose); an
+    open end is refused at the end itself."""
+    parser = argparse.ArgumentParser()
+    constrain_command.setup(parser)
+    text = " ".join(parser.format_help().split())
+    assert "--floor P survival probability below which elimination drops a branch; " \
+        "default 0.05; 0-1 (above 0 and below 1)" in text
+    assert "--draws N fragility parameter draws for the survival interval (0: none); " \
+        "default 400; 0-20000" in text
+    with pytest.raises(InputError, match=r"--floor 1 outside the allowed range \(0, 1\)"):
+        from_args(ConstrainOptions, _parsed(constrain_command, [
+            "--logic-tree", TREE, "--median-g", "0.3", "--beta", "0.4", "--age-ka", "2",
+            "--floor", "1"]))
+    with pytest.raises(InputError, match=r"--median-g 20 outside the allowed range \[0.001, 10\] g"):
+        from_args(ConstrainOptions, _parsed(constrain_command, [
+            "--logic-tree", TREE, "--median-g", "0.3", "--beta", "0.4", "--median-g", "20",
+            "--beta", "0.4", "--age-ka", "2"]))
