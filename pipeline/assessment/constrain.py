@@ -19,7 +19,7 @@ def constrain_files(o):
     ``o.out``."""
     from pipeline.figures.constrain import plot_constrain
     from pipeline.hazard.constrain_assess import constrain_tree
-    from pipeline.hazard.constrain_sites import SiteGroup, branch_test_csv
+    from pipeline.hazard.constrain_sites import SiteGroup
     from pipeline.hazard.logictree import load_logic_tree
     ages = o.age_models()
     sites = o.specimen_sites()
@@ -36,7 +36,7 @@ def constrain_files(o):
                                            o.draws, o.seed, groups)
     summary["hazard_component"] = o.hazard_component
     files = {"branch_weights.csv": _branch_table(rows),
-             "branch_test.csv": branch_test_csv(summary["branch_test"]["branches"]),
+             "branch_test.csv": figure["branch_test"].csv(),
              "prior_curves.csv": _curve_table(summary, summary["prior"], "prior")}
     if summary["posterior"] is not None:
         files["constrained_curves.csv"] = _curve_table(summary, summary["posterior"],

@@ -92,8 +92,7 @@ def constrain_tree(tree, specimens, ratio_model, ages, rule, floor, draws, seed,
     for m, t, c, _, _ in sites:
         warnings += _end_warnings(t, c, [specimens[j] for j in m], ratio_model,
                                   posterior[rule])
-    test_rows, test = branch_test(groups, specimens, _singles(sites, specimens, ratio_model,
-                                                              ages), p, tree, floor)
+    test = branch_test(groups, _singles(sites, specimens, ratio_model, ages), p, tree, floor)
     prior_stats = _statistics(tree, tree.weights)
     post_stats = None if posterior[rule] is None else _statistics(tree, posterior[rule])
     other = "eliminate" if rule == "bayes" else "bayes"
@@ -114,7 +113,7 @@ def constrain_tree(tree, specimens, ratio_model, ages, rule, floor, draws, seed,
         "ground_motion_at_rates": _motions(tree, prior_stats, post_stats),
         "members": members, "monte_carlo": carlo,
         "sites": [{"site": g.site, "specimens": list(g.members)} for g in groups],
-        "branch_test": {**test, "branches": test_rows},
+        "branch_test": test.as_json(),
         "hazard": {**tree.source, "notes": list(tree.notes),
                    "interpolation": "linear in (ln PGA, ln rate)",
                    "cells_per_interval": cells[2]},
@@ -127,6 +126,7 @@ def constrain_tree(tree, specimens, ratio_model, ages, rule, floor, draws, seed,
               "prior": prior_stats, "posterior": post_stats, "rule": rule,
               "ages": list(ages),
               "target_rates": TARGET_RATES, "branch_ids": tree.branch_ids}
+    figure["branch_test"] = test
     return summary, summary["branches"], figure
 
 

@@ -48,40 +48,78 @@ def combined(parts):
     return log_p, np.sqrt(sum(se ** 2 for se in ses)) if ses else None
 
 
-def branch_test(groups, specimens, single_log_p, p_all, tree, level):
-    """Per branch: P(every specimen survived) ``p_all``, each specimen's own survival
-    (``single_log_p``: n x B), the specimens below ``level`` under it (that carry the
-    test) and the lowest; and the branches whose ``p_all`` falls below ``level``."""
+@dataclass(frozen=True)
+class BranchTestRow:
+    """One branch of the branch test: P(every specimen survived) ``survival_all``, the
+    specimens whose own survival is below the level, the lowest specimen, its site and
+    its survival."""
+    branch: str
+    prior_weight: float
+    survival_all: float
+    below_level: bool
+    specimens_below_level: tuple
+    lowest_specimen: int
+    lowest_specimen_site: int | None
+    lowest_specimen_survival: float
+
+    def csv_line(self):
+        site = "" if self.lowest_specimen_site is None else self.lowest_specimen_site
+        return (f"{self.branch},{self.prior_weight:.9g},{self.survival_all:.9g},"
+                f"{str(self.below_level).lower()},"
+                f"{';'.join(str(j) for j in self.specimens_below_level)},"
+                f"{self.lowest_specimen},{site},{self.lowest_specimen_survival:.9g}")
+
+
+@dataclass(frozen=True)
+class BranchTest:
+    """The branch test at ``level`` (in the manner of Rood et al. 2023): its ``rows``, one
+    per branch; the one writer of branch_test.csv and constrain.json's branch_test."""
+    level: float
+    rows: tuple
+
+    def __post_init__(self):
+        if not 0 < self.level < 1:
+            raise ValueError(f"a branch test's level lies in (0, 1), got {self.level}")
+
+    @property
+    def branches_below_level(self):
+        return [r.branch for r in self.rows if r.below_level]
+
+    @property
+    def prior_weight_below_level(self):
+        return float(sum(r.prior_weight for r in self.rows if r.below_level))
+
+    def as_json(self):
+        """constrain.json's ``branch_test``."""
+        return {"level": self.level, "branches_below_level": self.branches_below_level,
+                "prior_weight_below_level": self.prior_weight_below_level,
+                "definition": DEFINITION,
+                "branches": [{**r.__dict__,
+                              "specimens_below_level": list(r.specimens_below_level)}
+                             for r in self.rows]}
+
+    def csv(self):
+        """branch_test.csv: one row per branch."""
+        return "\n".join([",".join(BranchTestRow.__dataclass_fields__)]
+                         + [r.csv_line() for r in self.rows]) + "\n"
+
+
+DEFINITION = ("per branch the probability that every specimen survived (survival_all), "
+              "each specimen's own survival, the specimens whose own survival is below the "
+              "level (they carry the test) and the branches under which survival_all is "
+              "below the level (--floor)")
+
+
+def branch_test(groups, single_log_p, p_all, tree, level):
+    """The :class:`BranchTest` of ``p_all`` (P(every specimen survived) per branch) and
+    ``single_log_p`` (each specimen's own ln survival at its site, n x B) at ``level``."""
     single = np.exp(single_log_p)
     site_of = {j: g.site for g in groups for j in g.members}
     rows = []
     for k, branch in enumerate(tree.branch_ids):
         low = int(np.argmin(single[:, k]))
-        rows.append({"branch": branch, "prior_weight": float(tree.weights[k]),
-                     "survival_all": float(p_all[k]),
-                     "below_level": bool(p_all[k] < level),
-                     "specimens_below_level": [j for j in range(len(specimens))
-                                               if single[j, k] < level],
-                     "lowest_specimen": low, "lowest_specimen_site": site_of[low],
-                     "lowest_specimen_survival": float(single[low, k])})
-    below = [r["branch"] for r in rows if r["below_level"]]
-    return rows, {"level": level, "branches_below_level": below,
-                  "prior_weight_below_level": float(sum(r["prior_weight"] for r in rows
-                                                        if r["below_level"])),
-                  "definition": "per branch the probability that every specimen survived "
-                  "(survival_all), each specimen's own survival, the specimens whose own "
-                  "survival is below the level (they carry the test) and the branches "
-                  "under which survival_all is below the level (--floor)"}
-
-
-def branch_test_csv(rows):
-    """branch_test.csv: one row per branch."""
-    lines = ["branch,prior_weight,survival_all,below_level,specimens_below_level,"
-             "lowest_specimen,lowest_specimen_site,lowest_specimen_survival"]
-    for r in rows:
-        site = "" if r["lowest_specimen_site"] is None else r["lowest_specimen_site"]
-        lines.append(f"{r['branch']},{r['prior_weight']:.9g},{r['survival_all']:.9g},"
-                     f"{str(r['below_level']).lower()},"
-                     f"{';'.join(str(j) for j in r['specimens_below_level'])},"
-                     f"{r['lowest_specimen']},{site},{r['lowest_specimen_survival']:.9g}")
-    return "\n".join(lines) + "\n"
+        rows.append(BranchTestRow(
+            branch, float(tree.weights[k]), float(p_all[k]), bool(p_all[k] < level),
+            tuple(j for j in range(single.shape[0]) if single[j, k] < level), low,
+            site_of[low], float(single[low, k])))
+    return BranchTest(level, tuple(rows))
