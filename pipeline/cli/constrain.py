@@ -26,7 +26,9 @@ DESCRIPTION = (
     "updates the branches' weights: Bayes (w P_s, the headline) and elimination (branches "
     "with P_s below --floor dropped).  Writes the prior and the constrained mean and "
     "fractile curves, the ground motion at 1e-3, 4e-4 and 1e-4 per year before and after, "
-    "the weights per branch and a figure.  See docs/constrained-hazard.md.")
+    "the weights per branch, the branch test (P that every specimen survived per branch, "
+    "the branches below --floor) and a figure.  Specimens may stand at several sites of "
+    "the tree (--specimen-site).  See docs/constrained-hazard.md.")
 
 
 def setup(p):

@@ -27,7 +27,9 @@ DESCRIPTION = (
     "and the largest factor on the hazard's rates (and intensities) that leaves survival "
     ">= 5 %. Fragility: a stated lognormal over PGA (--median-g, --beta) or campaign "
     "fragility's fragility.json (--fragility) or a stated logistic surface in PGA and PGV/PGA "
-    "(--logistic). See docs/survival.md.")
+    "(--logistic). The hazard: a PGA curve with PGV/PGA from one scenario or a "
+    "disaggregation (--disaggregation), or OpenQuake's joint rate density of PGA and PGV "
+    "(--joint-hazard). See docs/survival.md.")
 
 
 def setup(p):
