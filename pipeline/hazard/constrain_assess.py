@@ -64,14 +64,9 @@ def constrain_tree(tree, specimens, ratio_model, ages, rule, floor, draws, seed,
     (:class:`~pipeline.hazard.constrain_sites.SiteGroup`; None: all at ``tree``'s site);
     ``tree`` gives the curves reported."""
     groups = groups or [SiteGroup(tree, tuple(range(len(specimens))))]
-    check_same_branches(groups)
     rng = np.random.default_rng(seed)
     cells = cell_matrix(tree.levels_m_s2, tree.rates_per_yr)
-    sites = [(g.members, g.tree, cells if g.tree is tree else
-              cell_matrix(g.tree.levels_m_s2, g.tree.rates_per_yr),
-              *_age_mode([ages[j] for j in g.members], rng)) for g in groups]
-    mode = sites[0][3] if len(sites) == 1 else \
-        max((s[3] for s in sites), key=list(AgeIntegration).index)
+    sites, mode = _sites(tree, cells, groups, ages, rng)
     warnings = list(tree.notes)
 
     def survival_of(batch, sampled=True):
@@ -135,6 +130,16 @@ class AgeIntegration(Enum):
     KNOWN = "known ages"
     ONE_FOR_ALL = "one uncertain age for all: integrated in closed form"
     MONTE_CARLO = f"differing uncertain ages: Monte Carlo over {AGE_SAMPLES} samples"
+
+
+def _sites(tree, cells, groups, ages, rng):
+    """(per site: members, its tree, its cells, its age integration and samples; the age
+    integration reported: the most demanding of the sites')."""
+    check_same_branches(groups)
+    sites = [(g.members, g.tree, cells if g.tree is tree else
+              cell_matrix(g.tree.levels_m_s2, g.tree.rates_per_yr),
+              *_age_mode([ages[j] for j in g.members], rng)) for g in groups]
+    return sites, max((s[3] for s in sites), key=list(AgeIntegration).index)
 
 
 def _singles(sites, specimens, ratio_model, ages):
