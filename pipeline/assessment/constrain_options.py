@@ -22,11 +22,12 @@ class ConstrainOptions(SpecimenOptions):
         "hazard_curve CSV per realisation) or a plain table branch,weight,"
         "pga_<g|m_s2|cm_s2>,annual_rate_per_yr (one row per branch and level)",
         metavar="PATH")
-    site: int = param(None, "", "row (0-based) of OpenQuake curves with several sites", 0,
+    site: int = param(None, "", "the site of the curves (0-based: the row of OpenQuake "
+                      "curves with several sites, or the site column of a plain table)", 0,
                       None, flag="--site", metavar="N")
     specimen_site: tuple[int, ...] = param(
-        (), "", "the site (0-based row of OpenQuake curves with several sites) of each "
-        "specimen, in the order of the fragilities, or one for all; sites taken as far "
+        (), "", "the site of each specimen (0-based: the row of OpenQuake curves with "
+        "several sites, or the site column of a plain table), in the order of the fragilities, or one for all; sites taken as far "
         "apart (the set's survival the product over sites); unset: every specimen at "
         "--site", 0, None, flag="--specimen-site", metavar="N")
     age_ka: tuple[float, ...] = param(

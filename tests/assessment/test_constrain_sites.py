@@ -76,3 +76,36 @@ def test_a_specimen_site_beyond_the_file_is_one_line(tmp_path, capsys):
     err = capsys.readouterr().err.strip().splitlines()
     assert code == 2 and len(err) == 1 and err[0].startswith("error: ") and "2" in err[0]
     assert not (tmp_path / "out").exists()
+
+
+def test_a_plain_table_with_a_site_column_is_read_site_by_site(tmp_path, capsys):
+    """A plain table of two sites (site column): two far sites multiply as with
+    OpenQuake's curves, and each site alone is the table of that site without the
+    column."""
+    rows = {0: (1e-3, 2e-4, 1e-5), 1: (5e-4, 1e-4, 2e-6)}
+    levels = (0.1, 0.3, 0.8)
+    table = ["branch,weight,pga_g,annual_rate_per_yr,site"]
+    alone = {s: ["branch,weight,pga_g,annual_rate_per_yr"] for s in rows}
+    for s, rates in rows.items():
+        for b, (w, k) in enumerate(((0.4, 1.0), (0.6, 2.0))):
+            for x, r in zip(levels, rates):
+                table.append(f"b{b},{w},{x},{r * k:.6g},{s}")
+                alone[s].append(f"b{b},{w},{x},{r * k:.6g}")
+    (tmp_path / "tree.csv").write_text("\n".join(table) + "\n")
+    for s in rows:
+        (tmp_path / f"site{s}.csv").write_text("\n".join(alone[s]) + "\n")
+    args = ("--median-g", "0.3", "--beta", "0.4", "--age-ka", "2")
+    both, _ = _constrain(tmp_path, capsys, tmp_path / "tree.csv", "both", *args,
+                         "--median-g", "0.2", "--beta", "0.3", "--specimen-site", "0",
+                         "--specimen-site", "1")
+    first, _ = _constrain(tmp_path, capsys, tmp_path / "site0.csv", "first", *args)
+    second, _ = _constrain(tmp_path, capsys, tmp_path / "site1.csv", "second",
+                           "--median-g", "0.2", "--beta", "0.3", "--age-ka", "2")
+    p = [np.array([b["survival_probability"] for b in run["branches"]])
+         for run in (both, first, second)]
+    np.testing.assert_allclose(p[0], p[1] * p[2], rtol=1e-12)
+    code = main(["constrain", "--logic-tree", str(tmp_path / "tree.csv"), *args,
+                 "--out", str(tmp_path / "none")])
+    said = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and said == [f"error: {tmp_path / 'tree.csv'}: 2 sites in the table: "
+                                  "name one (--site, --specimen-site)"]
