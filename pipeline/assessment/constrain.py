@@ -8,6 +8,9 @@ import io
 
 from pipeline.constants import STANDARD_GRAVITY
 from pipeline.files import file_set, result_json_text, write_text
+from pipeline.hazard.constrain_assess import constrain_tree
+from pipeline.hazard.constrain_sites import SiteGroup
+from pipeline.hazard.logictree import load_logic_tree
 
 FILES = ("branch_weights.csv", "branch_test.csv", "prior_curves.csv",
          "constrained_curves.csv", "constrain.json", "constrain.png")  # a run replaces them
@@ -17,10 +20,7 @@ def constrain_files(o):
     """constrain.json's content for the options ``o``
     (:class:`~pipeline.assessment.constrain_options.ConstrainOptions`), its files written to
     ``o.out``."""
-    from pipeline.figures.constrain import plot_constrain
-    from pipeline.hazard.constrain_assess import constrain_tree
-    from pipeline.hazard.constrain_sites import SiteGroup
-    from pipeline.hazard.logictree import load_logic_tree
+    from pipeline.figures.constrain import plot_constrain  # noqa: PLC0415  (matplotlib: lazy)
     ages = o.age_models()
     sites = o.specimen_sites()
     tree = load_logic_tree(o.logic_tree, o.site if o.site is not None or sites is None

@@ -15,7 +15,10 @@ from pipeline.files import InputError
 from pipeline.assessment.age_options import age_kinds, check_age_kinds
 from pipeline.hazard.ages import LowerBound, TruncatedNormal, UniformInterval, load_age_samples
 from pipeline.hazard.components import COMPONENTS
-from pipeline.hazard.fragility import BELOW_GRID, GMM_MECHANISMS
+from pipeline.hazard.disagg_ratio import ratio_mixture
+from pipeline.hazard.disaggregation import load_mag_dist
+from pipeline.hazard.fragility import (BELOW_GRID, GMM_MECHANISMS, Logistic, Lognormal,
+                                      RatioFromGmm, RatioLognormal, load_campaign_fragility)
 from pipeline.hazard.fragility_kinds import BETA_RANGE, MEDIAN_G_RANGE
 from pipeline.hazard.fragility_ratio import DEFAULT_VS30_M_S, PGA_PGV_CORRELATION
 from pipeline.hazard.pga_pgv_correlation import BRADLEY_2012
@@ -131,7 +134,6 @@ class SpecimenOptions:
     def campaign_fragility(self, path, column):
         """The fragility of ``column`` in the campaign's file ``path``, as the options
         ask for it (form, below the grid, the hazard's component)."""
-        from pipeline.hazard.fragility import load_campaign_fragility
         from pipeline.records import rotd50_fraction
         return load_campaign_fragility(path, column, self.fragility_form, self.below_grid,
                                        self.hazard_component, self.magnitude,
@@ -140,7 +142,6 @@ class SpecimenOptions:
     def specimens(self):
         """The fragilities of the options, in order: --fragility files, --median-g/--beta,
         --logistic."""
-        from pipeline.hazard.fragility import Logistic, Lognormal
         specimens = [self.campaign_fragility(path, self.column) for path in self.fragility]
         if self.below_grid != "ramp" and all(f.grid_range() is None for f in specimens):
             raise InputError("--below-grid applies to a pulse-grid fragility (--fragility of "
@@ -155,7 +156,6 @@ class SpecimenOptions:
     def ratio_model(self, specimens):
         """The PGV/PGA model of the options, or None; InputError when a fragility needs
         one."""
-        from pipeline.hazard.fragility import RatioFromGmm, RatioLognormal
         ratio = None
         if self.pgv_pga_median is not None:
             ratio = RatioLognormal(self.pgv_pga_median, self.pgv_pga_sigma)
@@ -287,8 +287,6 @@ class SurvivalOptions(SpecimenOptions):
         """PGV/PGA as a mixture over --disaggregation's bins
         (:class:`~pipeline.hazard.disagg_ratio.RatioMixture`), its bins first checked to
         add up to ``curve``'s rate at each level."""
-        from pipeline.hazard.disagg_ratio import ratio_mixture
-        from pipeline.hazard.disaggregation import load_mag_dist
         disaggregation = load_mag_dist(self.disaggregation)
         disaggregation.check_curve(self.disaggregation_column, curve)
         return ratio_mixture(disaggregation, self.disaggregation_column, self.vs30,

@@ -3,6 +3,10 @@ hazard curves written as ``survival.json`` and ``survival.png``, and the PGA ran
 site's standing and fallen columns allow as ``site_motion.json`` (docs/survival.md).
 The command reads and checks its options and the input files; this writes the results."""
 from pipeline.files import InputError, file_set, result_json_text, write_text
+from pipeline.hazard.assess import assess
+from pipeline.hazard.joint_assess import assess_joint
+from pipeline.hazard.site_motion import site_motion
+from pipeline.inversion.observations import load_observations
 
 FILES = ("survival.json", "survival.png", "site_motion.json")   # every file survival writes
 SUMMARIES = ("survival.json", "site_motion.json")           # what says what the set holds
@@ -12,8 +16,6 @@ def site_motion_result(observations_path, site_name, fragility_for, at_pgv_pga, 
     """site_motion.json's content: the PGA range consistent with one site's columns
     (``site_name`` None: the file's only site; ``fragility_for(column type)`` its
     fragility; ``pga_measure``: what the PGA is, in words)."""
-    from pipeline.hazard.site_motion import site_motion
-    from pipeline.inversion.observations import load_observations
     observations = load_observations(observations_path)
     name = site_name
     if name is None:
@@ -40,7 +42,6 @@ def survival_files(out, curves, specimens, ratio, age, draws, seed, hazard_compo
     the first the headline; ``age`` an :class:`~pipeline.hazard.ages.AgeModel`), written
     with survival.png to ``out`` as one set (with site_motion.json when ``site_motion`` is
     given; an earlier run's left out removed)."""
-    from pipeline.hazard.assess import assess
     summary, data = assess(curves[0], specimens, ratio, age, draws, seed, curves[1:])
     return _write(out, summary, data, hazard_component, site_motion)
 
@@ -49,14 +50,13 @@ def joint_survival_files(out, joint, specimens, age, draws, seed, hazard_compone
     """survival.json's content under the joint hazard ``joint`` of one site
     (:func:`pipeline.hazard.joint_assess.assess_joint`), written with survival.png to
     ``out`` as one set."""
-    from pipeline.hazard.joint_assess import assess_joint
     summary, data = assess_joint(joint, specimens, age, draws, seed)
     return _write(out, summary, data, hazard_component, None)
 
 
 def _write(out, summary, data, hazard_component, site_motion):
     """survival.json (and site_motion.json) checked, then written with survival.png."""
-    from pipeline.figures.survival import plot_survival
+    from pipeline.figures.survival import plot_survival  # noqa: PLC0415  (matplotlib: lazy)
     summary["hazard_component"] = hazard_component
     summary["figure"] = "survival.png"
     if site_motion is not None:

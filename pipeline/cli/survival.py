@@ -14,6 +14,8 @@ from pipeline.cli._fields import add_arguments, from_args
 from pipeline.constants import STANDARD_GRAVITY
 from pipeline.files import InputError, display_path
 from pipeline.hazard.ages import AgeKind
+from pipeline.hazard.curves import load_hazard
+from pipeline.hazard.fragility import Logistic, Lognormal
 from pipeline.assessment.survival import (joint_survival_files, site_motion_result,
                                          survival_files, write_site_motion)
 from pipeline.assessment.options import AGE_FLAGS, SurvivalOptions, parse_logistic
@@ -61,7 +63,6 @@ def run(args):
         summary = joint_survival_files(o.out, _joint_site(o), specimens, age, o.draws,
                                        o.seed, o.hazard_component)
     else:
-        from pipeline.hazard import load_hazard
         curves = [load_hazard(path, o.site) for path in o.hazard]
         ratio = o.ratio_model(specimens) if o.disaggregation is None \
             else o.disaggregation_ratio(curves[0])
@@ -87,7 +88,7 @@ def run(args):
 
 def _joint_site(o):
     """The joint hazard of --joint-hazard at --site (unset: the file's only site)."""
-    from pipeline.hazard.joint_hazard import load_joint_hazard
+    from pipeline.hazard.joint_hazard import load_joint_hazard  # noqa: PLC0415  (h5py: lazy)
     joint = load_joint_hazard(o.joint_hazard)
     if o.site is None and len(joint.sites) != 1:
         raise InputError(f"{o.joint_hazard}: {len(joint.sites)} sites: name one with --site")
@@ -97,7 +98,6 @@ def _joint_site(o):
 def _site_motion(o):
     """site_motion.json's content: the PGA range consistent with one site's columns, each
     column type's fragility from the options ``o``."""
-    from pipeline.hazard.fragility import Logistic, Lognormal
     if o.fragility:
         def fragility_for(column):
             return o.campaign_fragility(o.fragility[0], column)
