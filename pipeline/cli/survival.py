@@ -11,14 +11,10 @@ Writes ``survival.json`` and ``survival.png`` to ``--out`` (the workflow:
 import math
 
 from pipeline.cli._fields import add_arguments, from_args
-from pipeline.constants import STANDARD_GRAVITY
-from pipeline.files import InputError, display_path
+from pipeline.files import display_path
 from pipeline.hazard.ages import AgeKind
-from pipeline.hazard.curves import load_hazard
-from pipeline.hazard.fragility import Logistic, Lognormal
-from pipeline.assessment.survival import (joint_survival_files, site_motion_result,
-                                         survival_files, write_site_motion)
-from pipeline.assessment.options import AGE_FLAGS, SurvivalOptions, parse_logistic
+from pipeline.assessment.survival import survival_outputs
+from pipeline.assessment.options import AGE_FLAGS, SurvivalOptions
 
 NAME = "survival"
 ORDER = 45
@@ -49,25 +45,11 @@ def setup(p):
 
 def run(args):
     o = from_args(SurvivalOptions, args)
-    site_motion = None
-    if o.observations is not None:
-        site_motion = _site_motion(o)
-    if not o.hazard and o.joint_hazard is None:
-        write_site_motion(o.out, site_motion)
+    summary, site_motion, age = survival_outputs(o)
+    if summary is None:
         _print_site_motion(site_motion)
         print(f"wrote {display_path(o.out / 'site_motion.json')}")
         return 0
-    age = o.age_model()
-    specimens = o.specimens()
-    if o.joint_hazard is not None:
-        summary = joint_survival_files(o.out, _joint_site(o), specimens, age, o.draws,
-                                       o.seed, o.hazard_component)
-    else:
-        curves = [load_hazard(path, o.site) for path in o.hazard]
-        ratio = o.ratio_model(specimens) if o.disaggregation is None \
-            else o.disaggregation_ratio(curves[0])
-        summary = survival_files(o.out, curves, specimens, ratio, age, o.draws, o.seed,
-                                 o.hazard_component, site_motion)
     for line in summary["warnings"]:
         print(f"warning: {line}")
     interval = summary["survival_interval"]
@@ -84,39 +66,6 @@ def run(args):
         _print_site_motion(site_motion)
     print(f"wrote {display_path(o.out / 'survival.json')} and survival.png")
     return 0
-
-
-def _joint_site(o):
-    """The joint hazard of --joint-hazard at --site (unset: the file's only site)."""
-    from pipeline.hazard.joint_hazard import load_joint_hazard  # noqa: PLC0415  (h5py: lazy)
-    joint = load_joint_hazard(o.joint_hazard)
-    if o.site is None and len(joint.sites) != 1:
-        raise InputError(f"{o.joint_hazard}: {len(joint.sites)} sites: name one with --site")
-    return joint.site(0 if o.site is None else o.site)
-
-
-def _site_motion(o):
-    """site_motion.json's content: the PGA range consistent with one site's columns, each
-    column type's fragility from the options ``o``."""
-    if o.fragility:
-        def fragility_for(column):
-            return o.campaign_fragility(o.fragility[0], column)
-    elif o.median_g:
-        stated = Lognormal(o.median_g[0] * STANDARD_GRAVITY, o.beta[0],
-                           label=f"stated lognormal: median {o.median_g[0]:g} g, "
-                           f"beta {o.beta[0]:g} (every column)")
-        def fragility_for(column):
-            return stated
-    else:
-        stated = Logistic(parse_logistic(o.logistic[0]),
-                          label=f"stated logistic surface {o.logistic[0]} (every column)")
-        def fragility_for(column):
-            return stated
-    return site_motion_result(
-        o.observations, o.observation_site, fragility_for, o.at_pgv_pga,
-        f"{o.hazard_component}: a campaign's fragility put on it "
-        "(fragilities.*.pga_measure)" if o.fragility else
-        "the stated fragility's own PGA")
 
 
 def _print_site_motion(result):
