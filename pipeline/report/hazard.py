@@ -58,7 +58,8 @@ def survival_section(results, name=ROCK_SURVIVAL):
     rows = [{"PGA (g)": f"{r['lo_g']:.3g}-" + ("" if r["hi_g"] is None else f"{r['hi_g']:.3g}"),
              "rate (1/yr)": f"{r['rate_per_yr']:.3g}",
              "share": "-" if r["share"] is None else f"{100 * r['share']:.1f} %"}
-            for r in s["contribution_by_intensity"] if (r["share"] or 0) >= 0.01]
+            for r in s.get("contribution_by_intensity", ())   # none on the joint route
+            if (r["share"] or 0) >= 0.01]
     if rows:
         lines.append("Contribution by PGA (intervals holding 1 % or more of the rate):\n")
         lines.append(_table(pd.DataFrame(rows)) + "\n")
