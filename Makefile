@@ -7,7 +7,7 @@ JOBS ?= $(shell nproc)
 
 .PHONY: setup test run-all records campaigns bench clean invert-demo shake-table rock-fragility rock-survival docs \
 	convergence paper-question invert-study invert-study-table contact-convergence \
-	shake-table-scores shake-table-scores-quick field-rock
+	shake-table-scores shake-table-scores-quick field-rock oq-case-mrd
 
 setup: .venv/.installed
 	@command -v yade >/dev/null || { echo "installing YADE (apt-get install yade)"; \
@@ -236,6 +236,19 @@ invert-study: setup
 invert-study-table: setup
 	$(PY) -m pipeline invert --member-study --jobs $(JOBS) --allow-long $(INVERT_ARGS)
 	$(PY) -m pipeline report
+
+# The OpenQuake engine on its small QA case postproc/case_mrd (the data shipped in
+# records/hazard/openquake_postproc_case_mrd, computed again into results/oq_case_mrd),
+# stating the engine's wall time of each step.  The engine is an optional extra with pins
+# of its own: it goes into an environment of its own, $(OQ_VENV), made when missing
+# (records/tools/oq_engine_requirements.txt: its requirements but GDAL, which has no wheel).
+OQ_VENV ?= .venv-oq
+oq-case-mrd:
+	@test -x $(OQ_VENV)/bin/python || { echo "installing the OpenQuake engine into $(OQ_VENV)"; \
+	  python3 -m venv $(OQ_VENV) && \
+	  $(OQ_VENV)/bin/pip install -q -r records/tools/oq_engine_requirements.txt && \
+	  $(OQ_VENV)/bin/pip install -q --no-deps openquake-engine==3.26.2; }
+	records/tools/run_oq_case_mrd.sh $(OQ_VENV)/bin/python results/oq_case_mrd
 
 clean:
 	rm -rf results/*/ results/REPORT.md

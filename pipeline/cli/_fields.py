@@ -6,18 +6,42 @@ import dataclasses
 import typing
 from pathlib import Path
 
+from pipeline.files import display_path
+
 
 def _help(f):
     meta = f.metadata
     unit = f" ({meta['unit']})" if meta.get("unit") else ""
-    if f.default is None or f.default == () or isinstance(f.default, bool):
-        default = ""
-    elif isinstance(f.default, (int, float)):
-        default = f"; default {f.default:g}"
-    else:
-        default = f"; default {f.default}"
-    bounds = "" if meta.get("low") is None else f"; {meta['low']:g}-{meta['high']:g}"
-    return f"{meta['help']}{unit}{default}{bounds}".replace("%", "%%")
+    return f"{meta['help']}{unit}{_default(f.default)}{_bounds(meta)}".replace("%", "%%")
+
+
+def _default(value):
+    """'; default ...' of a declared default, or '' (None, (), a switch)."""
+    if value is None or value == () or isinstance(value, bool):
+        return ""
+    if isinstance(value, tuple):
+        return "; default " + " ".join(f"{v:g}" if isinstance(v, float) else str(v)
+                                       for v in value)
+    if isinstance(value, (int, float)):
+        return f"; default {value:g}"
+    if isinstance(value, Path):
+        return f"; default {display_path(value)}"
+    return f"; default {value}"
+
+
+def _bounds(meta):
+    """'; low-high' of declared bounds ('above low', 'below high' when open), or ''."""
+    low, high = meta.get("low"), meta.get("high")
+    if low is None and high is None:
+        return ""
+    if high is None:
+        return f"; {'above' if meta.get('low_open') else 'at least'} {low:g}"
+    if low is None:
+        return f"; {'below' if meta.get('high_open') else 'at most'} {high:g}"
+    ends = [f"{w} {v:g}" for w, v, is_open in (("above", low, meta.get("low_open")),
+                                                ("below", high, meta.get("high_open")))
+            if is_open]
+    return f"; {low:g}-{high:g}" + (f" ({' and '.join(ends)})" if ends else "")
 
 
 def add_arguments(parser, cls, names=None):
@@ -40,19 +64,37 @@ def add_arguments(parser, cls, names=None):
             kwargs["action"] = "store_const"
             kwargs["const"] = True
         elif kind is tuple or typing.get_origin(kind) is tuple:
-            kwargs["action"] = "append"
-            if typing.get_args(kind):
-                kwargs["type"] = typing.get_args(kind)[0]
+            kwargs.update(_tuple_kwargs(typing.get_args(kind)))
         else:
             kwargs["type"] = kind
         parser.add_argument(meta["flag"], **kwargs)
+
+
+def _tuple_kwargs(args):
+    """argparse keywords of a tuple field: ``tuple[float, ...]`` a repeatable flag,
+    ``tuple[float, float]`` one flag of two values, ``tuple[tuple[float, float], ...]`` a
+    repeatable flag of two values."""
+    if not args:
+        return {"action": "append"}
+    if args[-1] is not Ellipsis:
+        return {"nargs": len(args), "type": args[0]}
+    inner = args[0]
+    if typing.get_origin(inner) is tuple:
+        return {"action": "append", "nargs": len(typing.get_args(inner)),
+                "type": typing.get_args(inner)[0]}
+    return {"action": "append", "type": inner}
+
+
+def _tuples(value):
+    """Lists of parsed arguments as tuples (nested too)."""
+    return tuple(_tuples(v) for v in value) if isinstance(value, list) else value
 
 
 def from_args(cls, args, **fixed):
     """An instance of ``cls`` from parsed arguments (fields left None keep defaults)."""
     values = {f.name: getattr(args, f.name) for f in dataclasses.fields(cls)
               if getattr(args, f.name, None) is not None}
-    values = {k: tuple(v) if isinstance(v, list) else v for k, v in values.items()}
+    values = {k: _tuples(v) for k, v in values.items()}
     return cls(**{**values, **fixed})
 
 

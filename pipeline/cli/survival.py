@@ -6,15 +6,15 @@
         --column monolithic --pgv-pga-median 0.1 --pgv-pga-sigma 0.4 --age-ka 2.5
 
 Writes ``survival.json`` and ``survival.png`` to ``--out`` (the workflow:
-:mod:`pipeline.report.survival`).
+:mod:`pipeline.assessment.survival`).
 """
 import math
 
 from pipeline.cli._fields import add_arguments, from_args
-from pipeline.constants import STANDARD_GRAVITY
 from pipeline.files import display_path
-from pipeline.report.survival import site_motion_result, survival_files, write_site_motion
-from pipeline.report.survival_options import SurvivalOptions, parse_logistic
+from pipeline.hazard.ages import AgeKind
+from pipeline.assessment.survival import survival_outputs
+from pipeline.assessment.options import AGE_FLAGS, SurvivalOptions
 
 NAME = "survival"
 ORDER = 45
@@ -25,16 +25,18 @@ DESCRIPTION = (
     "and the largest factor on the hazard's rates (and intensities) that leaves survival "
     ">= 5 %. Fragility: a stated lognormal over PGA (--median-g, --beta) or campaign "
     "fragility's fragility.json (--fragility) or a stated logistic surface in PGA and PGV/PGA "
-    "(--logistic). See docs/survival.md.")
+    "(--logistic). The hazard: a PGA curve with PGV/PGA from one scenario or a "
+    "disaggregation (--disaggregation), or OpenQuake's joint rate density of PGA and PGV "
+    "(--joint-hazard). See docs/survival.md.")
 
 
 def setup(p):
-    """The flags of :class:`~pipeline.report.survival_options.SurvivalOptions`, in the
+    """The flags of :class:`~pipeline.assessment.options.SurvivalOptions`, in the
     order of the help."""
     o = SurvivalOptions
-    add_arguments(p, o, ("hazard", "site"))
+    add_arguments(p, o, ("hazard", "joint_hazard", "site"))
     add_arguments(p, o, o.FRAGILITY_FLAGS)
-    add_arguments(p, o, ("age_ka", "age_sd_ka"))
+    add_arguments(p.add_argument_group(o.AGE_GROUP), o, AGE_FLAGS)
     add_arguments(p.add_argument_group(o.RATIO_GROUP), o, o.RATIO_FLAGS)
     add_arguments(p.add_argument_group(o.OBSERVATION_GROUP), o,
                   ("observations", "observation_site", "at_pgv_pga"))
@@ -43,26 +45,17 @@ def setup(p):
 
 def run(args):
     o = from_args(SurvivalOptions, args)
-    site_motion = None
-    if o.observations is not None:
-        site_motion = _site_motion(o)
-    if not o.hazard:
-        write_site_motion(o.out, site_motion)
+    summary, site_motion, age = survival_outputs(o)
+    if summary is None:
         _print_site_motion(site_motion)
         print(f"wrote {display_path(o.out / 'site_motion.json')}")
         return 0
-    from pipeline.hazard import load_hazard
-    curves = [load_hazard(path, o.site) for path in o.hazard]
-    specimens = o.specimens()
-    ratio = o.ratio_model(specimens)
-    summary = survival_files(o.out, curves, specimens, ratio, o.age_ka, o.age_sd_ka,
-                             o.draws, o.seed, o.hazard_component, site_motion)
     for line in summary["warnings"]:
         print(f"warning: {line}")
     interval = summary["survival_interval"]
     bound = summary["intensity_scale_bound_5pct"]
     print(f"overturning rate {summary['annual_overturning_rate_per_yr']:.3g} /yr; survived "
-          f"{o.age_ka:g} ka with P = {summary['survival_probability']:.3g}"
+          f"{_age_words(age)} with P = {summary['survival_probability']:.3g}"
           + ("" if interval is None else f" [{interval[0]:.3g}, {interval[1]:.3g}]")
           + f"; hazard rates x {_g(summary['rate_scale_bound_5pct'])} or intensities x "
           f"{_g(bound)} leave 5 %")
@@ -73,31 +66,6 @@ def run(args):
         _print_site_motion(site_motion)
     print(f"wrote {display_path(o.out / 'survival.json')} and survival.png")
     return 0
-
-
-def _site_motion(o):
-    """site_motion.json's content: the PGA range consistent with one site's columns, each
-    column type's fragility from the options ``o``."""
-    from pipeline.hazard.fragility import Logistic, Lognormal
-    if o.fragility:
-        def fragility_for(column):
-            return o.campaign_fragility(o.fragility[0], column)
-    elif o.median_g:
-        stated = Lognormal(o.median_g[0] * STANDARD_GRAVITY, o.beta[0],
-                           label=f"stated lognormal: median {o.median_g[0]:g} g, "
-                           f"beta {o.beta[0]:g} (every column)")
-        def fragility_for(column):
-            return stated
-    else:
-        stated = Logistic(parse_logistic(o.logistic[0]),
-                          label=f"stated logistic surface {o.logistic[0]} (every column)")
-        def fragility_for(column):
-            return stated
-    return site_motion_result(
-        o.observations, o.observation_site, fragility_for, o.at_pgv_pga,
-        f"{o.hazard_component}: a campaign's fragility put on it "
-        "(fragilities.*.pga_measure)" if o.fragility else
-        "the stated fragility's own PGA")
 
 
 def _print_site_motion(result):
@@ -111,3 +79,14 @@ def _print_site_motion(result):
 
 def _g(value):
     return "-" if value is None or not math.isfinite(value) else f"{value:.3g}"
+
+
+def _age_words(age):
+    """The age as the command line gave it (ka)."""
+    if age.kind is AgeKind.NORMAL:
+        return f"{age.mean_yr / 1000:g} ka"
+    if age.kind is AgeKind.LOWER_BOUND:
+        return f"at least {age.min_yr / 1000:g} ka"
+    if age.kind is AgeKind.INTERVAL:
+        return f"{age.lo_yr / 1000:g}-{age.hi_yr / 1000:g} ka"
+    return f"{len(age.ages_yr)} sampled ages (mean {age.typical_yr / 1000:.3g} ka)"

@@ -4,6 +4,7 @@ ground motion is stated, and the specimens' ages; beside it the weights before a
 import numpy as np
 
 from pipeline.constants import STANDARD_GRAVITY
+from pipeline.hazard.ages import AgeKind
 from pipeline.figures.style import DPI, figure
 from pipeline.files import save_figure
 
@@ -36,8 +37,7 @@ def plot_constrain(data, path):
     ax.set_xlabel("PGA (g)")
     ax.set_ylabel("annual rate of exceedance (1/yr)")
     ax.grid(True, which="both", alpha=0.3)
-    ages = ", ".join(f"{a:g}" + (f" $\\pm$ {s:g}" if s > 0 else "")
-                     for a, s in zip(data["ages_ka"], data["age_sds_ka"]))
+    ages = ", ".join(_age(a) for a in data["ages"])
     ax.set_title(f"hazard constrained by specimens of age {ages} ka", fontsize=10)
     ax.legend(fontsize=8, loc="upper right")
     _weights(ax_w, data)
@@ -71,3 +71,15 @@ def _weights(ax, data):
     ax.set_ylabel("weight")
     ax.set_title("branch weights", fontsize=10)
     ax.legend(fontsize=8)
+
+
+def _age(age):
+    """A specimen's age (an AgeModel, years) in ka as the title gives it."""
+    if age.kind is AgeKind.NORMAL:
+        return f"{age.mean_yr / 1000:g}" + (f" $\\pm$ {age.sd_yr / 1000:g}"
+                                            if age.sd_yr > 0 else "")
+    if age.kind is AgeKind.LOWER_BOUND:
+        return f"> {age.min_yr / 1000:g}"
+    if age.kind is AgeKind.INTERVAL:
+        return f"{age.lo_yr / 1000:g}-{age.hi_yr / 1000:g}"
+    return f"~{age.typical_yr / 1000:.3g}"

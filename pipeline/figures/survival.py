@@ -36,9 +36,9 @@ def plot_survival(data, path):
 
     ages_ka = data["ages_yr"] / 1000.0
     ax_s.plot(ages_ka, data["survival"], color="k", label="survival at a known age")
-    age_ka, sd_ka = data["age_yr"] / 1000.0, data["age_sd_yr"] / 1000.0
-    if sd_ka > 0:
-        ax_s.axvspan(age_ka - sd_ka, age_ka + sd_ka, color="0.85", label="age $\\pm$ 1 sd")
+    age_ka, band = data["age_yr"] / 1000.0, data["age_band"]
+    if band is not None:
+        ax_s.axvspan(band[0] / 1000.0, band[1] / 1000.0, color="0.85", label=band[2])
     p = data["survival_probability"]
     interval = data["survival_interval"]
     err = None if interval is None else np.array([[p - max(interval[0], p * 1e-6)],

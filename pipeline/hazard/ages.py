@@ -23,9 +23,9 @@ from enum import Enum
 
 import numpy as np
 from scipy import stats
-from scipy.special import log_ndtr
 
 from pipeline.files import InputError
+from pipeline.hazard.survival import survival_probability
 from pipeline.userfiles import DATA_FILE_BYTES, read_user_text, show
 
 MAX_AGE_YR = 1e8               # older than any rock at the surface is a typo
@@ -59,6 +59,21 @@ class AgeModel(ABC):
     def describe(self):
         """A JSON-ready dict: the kind, its values (years) and what survival means."""
 
+    @property
+    def fixed_yr(self):
+        """The age (years) when survival is exp(-rate age) exactly, else None."""
+        return None
+
+    @property
+    @abstractmethod
+    def typical_yr(self):
+        """A representative age (years, above 0 unless the age is 0): the mean, the bound."""
+
+    @property
+    def band_yr(self):
+        """(low, high, what it is) of the age to shade in a figure, or None."""
+        return None
+
     @abstractmethod
     def draw(self, n, rng):
         """``n`` ages (years) drawn from the age's distribution (``rng`` a numpy
@@ -76,6 +91,14 @@ class LowerBound(AgeModel):
 
     def survival(self, rate_per_yr):
         return np.exp(-np.asarray(rate_per_yr, float) * self.min_yr)
+
+    @property
+    def fixed_yr(self):
+        return self.min_yr
+
+    @property
+    def typical_yr(self):
+        return self.min_yr
 
     def draw(self, n, rng):
         """The bound itself: survival's upper bound, as :meth:`survival` gives it."""
@@ -107,6 +130,18 @@ class UniformInterval(AgeModel):
             mean = np.where(x > 0, -np.expm1(-x) / np.where(x > 0, x, 1.0), 1.0)
         return np.exp(-rate * self.lo_yr) * mean
 
+    @property
+    def fixed_yr(self):
+        return self.lo_yr if self.lo_yr == self.hi_yr else None
+
+    @property
+    def typical_yr(self):
+        return 0.5 * (self.lo_yr + self.hi_yr)
+
+    @property
+    def band_yr(self):
+        return None if self.lo_yr == self.hi_yr else (self.lo_yr, self.hi_yr, "age interval")
+
     def draw(self, n, rng):
         return rng.uniform(self.lo_yr, self.hi_yr, n)
 
@@ -135,6 +170,15 @@ class AgeSamples(AgeModel):
         ages = np.asarray(self.ages_yr, float)
         return np.exp(-rate[..., None] * ages).mean(axis=-1)
 
+    @property
+    def typical_yr(self):
+        return float(np.mean(self.ages_yr))
+
+    @property
+    def band_yr(self):
+        lo, hi = np.percentile(np.asarray(self.ages_yr, float), [2.5, 97.5])
+        return None if lo == hi else (float(lo), float(hi), "age samples, 95 %")
+
     def draw(self, n, rng):
         """The samples drawn with replacement."""
         return rng.choice(np.asarray(self.ages_yr, float), n, replace=True)
@@ -161,12 +205,23 @@ class TruncatedNormal(AgeModel):
             raise InputError("an age of mean 0 with a spread: give a positive mean")
 
     def survival(self, rate_per_yr):
-        rate = np.asarray(rate_per_yr, float)
+        """In closed form, without a difference of huge numbers
+        (:func:`pipeline.hazard.survival.survival_probability`)."""
+        return survival_probability(rate_per_yr, self.mean_yr, self.sd_yr)
+
+    @property
+    def fixed_yr(self):
+        return self.mean_yr if self.sd_yr == 0 else None
+
+    @property
+    def typical_yr(self):
+        return self.mean_yr
+
+    @property
+    def band_yr(self):
         if self.sd_yr == 0:
-            return np.exp(-rate * self.mean_yr)
-        mu, s = self.mean_yr, self.sd_yr
-        return np.exp(-rate * mu + 0.5 * (rate * s) ** 2 + log_ndtr((mu - rate * s * s) / s)
-                      - log_ndtr(mu / s))
+            return None
+        return (self.mean_yr - self.sd_yr, self.mean_yr + self.sd_yr, "age $\\pm$ 1 sd")
 
     def draw(self, n, rng):
         if self.sd_yr == 0:

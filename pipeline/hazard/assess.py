@@ -3,14 +3,15 @@ and the arrays its figure draws (:func:`assess`)."""
 import numpy as np
 
 from pipeline.constants import STANDARD_GRAVITY
-from pipeline.hazard.fragility import overturn_probability
+from pipeline.hazard.ages import AgeKind
+from pipeline.hazard.disagg_ratio import overturn_probability_over
 from pipeline.hazard.survival import (contribution_by_intensity, intensity_scale_bound,
                                       overturning_rate, rate_density, rate_outside,
                                       rate_exceeding, rate_scale_bound,
                                       survival_probability)
 from pipeline.provenance import software_versions
 
-FLOOR = 0.05                  # survival probability the bounds keep (5 %)
+BOUND_SURVIVAL = 0.05         # survival probability the bounds keep (the keys' 5pct)
 INTERVAL = (2.5, 97.5)        # percentiles of the survival interval
 END_SHARE_WARNING = 0.1       # warn when a curve's end holds more of the rate than this
 REACH_WARNING = 2.0           # and beyond this x a grid's top PGA, when P above the grid
@@ -53,30 +54,29 @@ ASSUMPTIONS = [
 ]
 
 
-def assess(curve, specimens, ratio_model, age_ka, age_sd_ka=0.0, draws=400, seed=0,
-           more_curves=()):
+def assess(curve, specimens, ratio_model, age, draws, seed, more_curves=()):
     """(summary dict for survival.json, figure data dict) for ``specimens``
-    (:class:`~pipeline.hazard.fragility_kinds.Fragility` objects) at the site of ``curve``
+    (:class:`~pipeline.hazard.fragility.kinds.Fragility` objects) at the site of ``curve``
     (:class:`~pipeline.hazard.curves.HazardCurve`); ``ratio_model``: the PGV/PGA model or
-    None; ages in ka (thousand years).  ``more_curves``: further hazard curves of the
-    site (e.g. quantiles): the headline again under each (``hazard_curves``)."""
-    age, age_sd = age_ka * 1000.0, age_sd_ka * 1000.0
+    None; ``age``: the specimens' age (:class:`~pipeline.hazard.ages.AgeModel`, years).
+    ``more_curves``: further hazard curves of the site (e.g. quantiles): the headline
+    again under each (``hazard_curves``)."""
     rng = np.random.default_rng(seed)
     drawn = [f.draws(draws, rng) if draws else None for f in specimens]
     warnings = list(curve.notes)
     entries = []
     for k, fragility in enumerate(specimens):
-        entry = _specimen_entry(curve, fragility, drawn[k], ratio_model, age, age_sd, draws)
+        entry = _specimen_entry(curve, fragility, drawn[k], ratio_model, age, draws)
         entries.append(entry)
         warnings += [f"specimen {k}: {w}" for w in entry.pop("warnings")]
     headline, probability, members = _headline(curve, specimens, drawn, entries, ratio_model,
-                                               age, age_sd, warnings)
-    curves = [_curve_row(curve, headline, specimens, ratio_model, age, age_sd)] \
+                                               age, warnings)
+    curves = [_curve_row(curve, headline, specimens, ratio_model, age)] \
         if more_curves else []
     for k, other in enumerate(more_curves, start=1):
-        result = _result(other, probability, members, age, age_sd)
+        result = _result(other, probability, members, age)
         warnings += [f"hazard curve {k}: {w}" for w in list(other.notes) + result["warnings"]]
-        curves.append(_curve_row(other, result, specimens, ratio_model, age, age_sd))
+        curves.append(_curve_row(other, result, specimens, ratio_model, age))
     times = sorted({c.source.get("investigation_time_yr") for c in (curve, *more_curves)}
                    - {None})
     if len(times) > 1:
@@ -85,28 +85,28 @@ def assess(curve, specimens, ratio_model, age_ka, age_sd_ka=0.0, draws=400, seed
                         "of exceedance converted to annual rates with its own T, "
                         "-ln(1 - poe) / T")
     summary = _summary(curve, specimens, entries, headline, ratio_model, warnings,
-                       (age_ka, age_sd_ka, draws, seed))
+                       (age, draws, seed))
     if more_curves:
         survivals = [row["survival_probability"] for row in curves]
         summary["hazard_curves"] = curves
         summary["survival_range_over_curves"] = [min(survivals), max(survivals)]
     if len(specimens) > 1:
-        summary["site_set"] = _site_set(curve, specimens, ratio_model, entries, age, age_sd)
-    figure = _figure_data(curve, probability, headline, drawn, age, age_sd, specimens,
+        summary["site_set"] = _site_set(curve, specimens, ratio_model, entries, age)
+    figure = _figure_data(curve, probability, headline, drawn, age, specimens,
                           ratio_model)
     return summary, figure
 
 
-def _specimen_entry(curve, fragility, drawn, ratio_model, age, age_sd, draws):
+def _specimen_entry(curve, fragility, drawn, ratio_model, age, draws):
     """One specimen's entry of ``specimens``: its result, parameter sets and what comes
     from outside its grid, with its ``warnings`` (a list the caller takes out)."""
     def probability(x):
-        return overturn_probability([fragility], ratio_model, x)[0]
+        return overturn_probability_over([fragility], ratio_model, x)[0]
     members = None if drawn is None else [
-        (lambda x, f=d: overturn_probability([f], ratio_model, x)[0]) for d in drawn]
-    entry = _result(curve, probability, members, age, age_sd)
+        (lambda x, f=d: overturn_probability_over([f], ratio_model, x)[0]) for d in drawn]
+    entry = _result(curve, probability, members, age)
     entry = {"fragility": fragility.describe(), **entry,
-             **_per_parameter_set(curve, fragility, ratio_model, age, age_sd),
+             **_per_parameter_set(curve, fragility, ratio_model, age),
              **_outside_grid(curve, fragility, ratio_model, probability,
                              entry["annual_overturning_rate_per_yr"])}
     if drawn is None:
@@ -127,7 +127,7 @@ def _specimen_entry(curve, fragility, drawn, ratio_model, age, age_sd, draws):
     return entry
 
 
-def _headline(curve, specimens, drawn, entries, ratio_model, age, age_sd, warnings):
+def _headline(curve, specimens, drawn, entries, ratio_model, age, warnings):
     """(headline result, its probability function, its draws' functions or None): the
     specimen's entry, or the set's under common shaking (its warnings added)."""
     if len(specimens) == 1:
@@ -138,17 +138,19 @@ def _headline(curve, specimens, drawn, entries, ratio_model, age, age_sd, warnin
     members = None
     if all(d is not None for d in drawn):
         members = [_combined(list(group), ratio_model, "any_common") for group in zip(*drawn)]
-    headline = _result(curve, probability, members, age, age_sd)
+    headline = _result(curve, probability, members, age)
     warnings += [f"set: {w}" for w in headline.pop("warnings")]
     return headline, probability, members
 
 
 def _summary(curve, specimens, entries, headline, ratio_model, warnings, run):
-    """survival.json's content but for hazard_curves and site_set; ``run``: (age_ka,
-    age_sd_ka, draws, seed)."""
-    age_ka, age_sd_ka, draws, seed = run
+    """survival.json's content but for hazard_curves and site_set; ``run``: (age model,
+    draws, seed)."""
+    age, draws, seed = run
     one = len(specimens) == 1
     return {
+        "hazard_route": {"route": "curve", "what": "the PGA hazard curve, PGV/PGA at each PGA "
+                         "level lognormal (stated, or one scenario's ground-motion model)"},
         "annual_overturning_rate_per_yr": headline["annual_overturning_rate_per_yr"],
         "survival_probability": headline["survival_probability"],
         "survival_interval": headline["survival_interval"],
@@ -163,8 +165,7 @@ def _summary(curve, specimens, entries, headline, ratio_model, warnings, run):
         "contribution_by_intensity": headline["contribution_by_intensity"],
         "curve_ends": headline["curve_ends"],
         "headline": "the specimen" if one else "the set under common shaking (all survive)",
-        "age_ka": age_ka, "age_sd_ka": age_sd_ka,
-        "age_distribution": "fixed" if age_sd_ka == 0 else "normal truncated at 0",
+        **age_keys(age),
         "definitions": _definitions(draws),
         "specimens": entries,
         "hazard": {**curve.source, "levels_m_s2": curve.levels_m_s2.tolist(),
@@ -204,34 +205,35 @@ def _definitions(draws):
         "survival_parameter_set_range": "min and max of survival_per_parameter_set: "
         "the members' spread, reported apart from the Monte Carlo error",
         "rate_scale_bound_5pct": "largest factor F on every rate of the hazard curve "
-        "with survival >= 0.05 (-ln 0.05 / (rate t) for a fixed age)",
+        f"with survival >= {BOUND_SURVIVAL:g} (-ln {BOUND_SURVIVAL:g} / (rate t) for a "
+        "fixed age)",
         "intensity_scale_bound_5pct": "largest factor c on the curve's PGA levels "
-        "(lambda_c(x) = lambda(x / c)) with survival >= 0.05; null with a note when "
-        "outside 0.001-1000",
+        f"(lambda_c(x) = lambda(x / c)) with survival >= {BOUND_SURVIVAL:g}; null with a "
+        "note when outside 0.001-1000",
         "contribution_by_intensity": "the rate of overturning by PGA interval of the "
         "curve (m/s^2; the last row: exceedances of the last level) and its share"}
 
 
 def _combined(specimens, ratio_model, combine):
     def probability(x):
-        p = overturn_probability(specimens, ratio_model, x, combine)
+        p = overturn_probability_over(specimens, ratio_model, x, combine)
         return p[0] if combine == "each" else p
     return probability
 
 
-def _result(curve, probability, members, age, age_sd):
+def _result(curve, probability, members, age):
     """Rate, survival, interval, bounds and contributions of one probability function."""
     zero = curve.zero_rate_from_m_s2
     rate = overturning_rate(curve.levels_m_s2, curve.rates_per_yr, probability, zero)
     total = rate["rate_per_yr"]
-    survival = float(survival_probability(total, age, age_sd))
+    survival = float(age.survival(total))
     interval = None
     if members:
         rates = np.array([overturning_rate(curve.levels_m_s2, curve.rates_per_yr, p,
                                            zero)["rate_per_yr"] for p in members])
-        interval = np.percentile(survival_probability(rates, age, age_sd), INTERVAL).tolist()
+        interval = np.percentile(age.survival(rates), INTERVAL).tolist()
     bound_c, bound_note = intensity_scale_bound(curve.levels_m_s2, curve.rates_per_yr,
-                                                probability, age, age_sd, FLOOR, zero)
+                                                probability, age, BOUND_SURVIVAL, zero)
     contribution = contribution_by_intensity(curve.levels_m_s2, curve.rates_per_yr,
                                              probability)
     for row in contribution:
@@ -249,7 +251,7 @@ def _result(curve, probability, members, age, age_sd):
                         f"{total:.3g} /yr: extend the hazard curve")
     return {"annual_overturning_rate_per_yr": total, "survival_probability": survival,
             "survival_interval": interval,
-            "rate_scale_bound_5pct": rate_scale_bound(total, age, age_sd, FLOOR),
+            "rate_scale_bound_5pct": rate_scale_bound(total, age, BOUND_SURVIVAL),
             "intensity_scale_bound_5pct": bound_c,
             **({"intensity_scale_bound_note": bound_note} if bound_note else {}),
             "contribution_by_intensity": contribution,
@@ -257,7 +259,7 @@ def _result(curve, probability, members, age, age_sd):
             "warnings": warnings}
 
 
-def _curve_row(curve, result, specimens, ratio_model, age, age_sd):
+def _curve_row(curve, result, specimens, ratio_model, age):
     """One hazard curve's row of ``hazard_curves``: the curve and the headline under it."""
     source = curve.source
     row = {"file": source.get("file"), "format": source.get("format"),
@@ -267,13 +269,13 @@ def _curve_row(curve, result, specimens, ratio_model, age, age_sd):
                                      "survival_interval", "rate_scale_bound_5pct",
                                      "intensity_scale_bound_5pct")}}
     if len(specimens) == 1:
-        sets = _per_parameter_set(curve, specimens[0], ratio_model, age, age_sd)
+        sets = _per_parameter_set(curve, specimens[0], ratio_model, age)
         if sets:
             row["survival_parameter_set_range"] = sets["survival_parameter_set_range"]
     return row
 
 
-def _per_parameter_set(curve, fragility, ratio_model, age, age_sd):
+def _per_parameter_set(curve, fragility, ratio_model, age):
     """Survival with each parameter set's own fragility (a pulse grid's sets, a column
     campaign's members), else nothing."""
     members = fragility.members()
@@ -281,9 +283,9 @@ def _per_parameter_set(curve, fragility, ratio_model, age, age_sd):
         return {}
     zero = curve.zero_rate_from_m_s2
     rates = [overturning_rate(curve.levels_m_s2, curve.rates_per_yr,
-                              lambda x, f=m: overturn_probability([f], ratio_model, x)[0],
+                              lambda x, f=m: overturn_probability_over([f], ratio_model, x)[0],
                               zero)["rate_per_yr"] for m in members]
-    survival = survival_probability(np.array(rates), age, age_sd).tolist()
+    survival = age.survival(np.array(rates)).tolist()
     return {"rate_per_parameter_set_per_yr": rates, "survival_per_parameter_set": survival,
             "survival_parameter_set_range": [min(survival), max(survival)]}
 
@@ -299,7 +301,7 @@ def _outside_grid(curve, fragility, ratio_model, probability, rate):
     zero = curve.zero_rate_from_m_s2
     bounds = {name: overturning_rate(
         curve.levels_m_s2, curve.rates_per_yr,
-        lambda x, f=variant: overturn_probability([f], ratio_model, x)[0], zero)["rate_per_yr"]
+        lambda x, f=variant: overturn_probability_over([f], ratio_model, x)[0], zero)["rate_per_yr"]
         for name, variant in fragility.variants().items()}
     last = float(curve.levels_m_s2[-1])
     beyond = rate_exceeding(curve.levels_m_s2, curve.rates_per_yr, hi)
@@ -339,7 +341,7 @@ def _above_grid_warning(outside, described, rate):
             f"{outside['rate_per_yr_one_above_grid']:.3g} /yr)"]
 
 
-def _site_set(curve, specimens, ratio_model, entries, age, age_sd):
+def _site_set(curve, specimens, ratio_model, entries, age):
     """Survival of all specimens of a set under the three assumptions of ASSUMPTIONS."""
     zero = curve.zero_rate_from_m_s2
     out = {}
@@ -351,21 +353,35 @@ def _site_set(curve, specimens, ratio_model, entries, age, age_sd):
                                        zero)["rate_per_yr"]
     for name, rate in rates.items():
         out[name] = {"annual_rate_any_overturns_per_yr": rate,
-                     "survival_probability_all": float(survival_probability(rate, age, age_sd)),
-                     "rate_scale_bound_5pct": rate_scale_bound(rate, age, age_sd, FLOOR)}
+                     "survival_probability_all": float(age.survival(rate)),
+                     "rate_scale_bound_5pct": rate_scale_bound(rate, age, BOUND_SURVIVAL)}
     return out
 
 
-def _figure_data(curve, probability, headline, drawn, age, age_sd, specimens, ratio_model):
+def _figure_data(curve, probability, headline, drawn, age, specimens, ratio_model):
     """Arrays for :func:`pipeline.figures.survival.plot_survival`."""
     x, density = rate_density(curve.levels_m_s2, curve.rates_per_yr, probability)
-    ages = np.linspace(0.0, 2.0 * (age + 2.0 * age_sd), 200)
+    band = age.band_yr
+    ages = np.linspace(0.0, 2.0 * (age.typical_yr if band is None
+                                   else age.typical_yr + 2.0 * (band[1] - age.typical_yr)), 200)
     rate = headline["annual_overturning_rate_per_yr"]
     survival = np.array([survival_probability(rate, a) for a in ages])
     return {"levels_m_s2": curve.levels_m_s2, "rates_per_yr": curve.rates_per_yr,
             "probability_x": x, "probability": probability(x), "density_x": x,
             "density": density, "contribution": headline["contribution_by_intensity"],
-            "ages_yr": ages, "survival": survival, "age_yr": age, "age_sd_yr": age_sd,
+            "ages_yr": ages, "survival": survival, "age_yr": age.typical_yr, "age_band": band,
             "survival_probability": headline["survival_probability"],
             "survival_interval": headline["survival_interval"],
             "set": len(specimens) > 1, "pgv_pga_used": any(f.uses_ratio for f in specimens)}
+
+
+def age_keys(age):
+    """survival.json's age: age_ka and age_sd_ka (a normal's; null for other kinds),
+    age_distribution in words and age (:meth:`AgeModel.describe`)."""
+    normal = age.kind is AgeKind.NORMAL
+    words = {AgeKind.NORMAL: "fixed" if normal and age.sd_yr == 0 else "normal truncated at 0",
+             AgeKind.LOWER_BOUND: "a lower bound (survival an upper bound)",
+             AgeKind.INTERVAL: "uniform on an interval", AgeKind.SAMPLES: "samples"}
+    return {"age_ka": age.mean_yr / 1000.0 if normal else None,
+            "age_sd_ka": age.sd_yr / 1000.0 if normal else None,
+            "age_distribution": words[age.kind], "age": age.describe()}

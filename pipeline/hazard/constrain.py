@@ -88,18 +88,6 @@ def log_survival_fixed(set_rates, ages_yr):
     return -sum(dt * set_rates(members) for members, dt in age_chain(ages_yr))
 
 
-def truncated_ages(ages_yr, sds_yr, samples, rng):
-    """``samples`` x n ages (yr), each normal (mean, sd) truncated at 0 (sd 0: the mean)."""
-    from scipy.stats import truncnorm  # noqa: PLC0415
-    mean = np.asarray(ages_yr, float)
-    sd = np.asarray(sds_yr, float)
-    out = np.tile(mean, (samples, 1))
-    for j in np.flatnonzero(sd > 0):
-        out[:, j] = truncnorm.rvs(-mean[j] / sd[j], np.inf, loc=mean[j], scale=sd[j],
-                                  size=samples, random_state=rng)
-    return out
-
-
 def log_survival_sampled(set_rates, age_samples):
     """(ln P_s per branch, its standard error relative to P_s per branch): the mean of
     exp(-sum dt lambda) over sampled ages (Monte Carlo over uncertain, differing ages)."""

@@ -1,20 +1,23 @@
 """What ``constrain`` says for a logic tree and the specimens standing at its site:
 ``constrain.json``'s content, the tables and the arrays of its figure
 (:func:`constrain_tree`)."""
+from enum import Enum
+
 import numpy as np
 
 from pipeline.constants import STANDARD_GRAVITY
-from pipeline.hazard.constrain import (FLOOR, FRACTILES, TARGET_RATES, bayes, branch_rates,
+from pipeline.hazard.ages import AgeKind
+from pipeline.hazard.constrain import (FRACTILES, TARGET_RATES, bayes, branch_rates,
                                        cell_matrix, change_percent, draw_chunk, eliminate,
                                        log_survival_fixed, log_survival_sampled,
-                                       motion_at_rate, truncated_ages, weighted_mean,
+                                       motion_at_rate, weighted_mean,
                                        weighted_quantile)
+from pipeline.hazard.constrain_sites import (SITE_ASSUMPTION, SiteGroup, branch_test,
+                                             check_same_branches, combined)
 from pipeline.hazard.fragility import overturn_probability
 from pipeline.hazard.logictree import LogicTree
-from pipeline.hazard.survival import survival_probability
 from pipeline.provenance import software_versions
 
-RULES = ("bayes", "eliminate")
 AGE_SAMPLES = 2000           # Monte Carlo samples of differing, uncertain ages
 INTERVAL = (2.5, 97.5)       # percentiles of the intervals over fragility draws
 END_SHARE_WARNING = 0.1
@@ -52,22 +55,25 @@ ASSUMPTIONS = [
 ]
 
 
-def constrain_tree(tree, specimens, ratio_model, ages_ka, age_sds_ka, rule="bayes",
-                   floor=FLOOR, draws=400, seed=0):
+def constrain_tree(tree, specimens, ratio_model, ages, rule, floor, draws, seed,
+                   groups=None):
     """(summary dict, branch rows, figure data) for the
     :class:`~pipeline.hazard.logictree.LogicTree` ``tree`` and ``specimens`` (fragility
-    objects, one per specimen) of ages ``ages_ka`` (ka, one per specimen) with sds
-    ``age_sds_ka``."""
-    ages = np.asarray(ages_ka, float) * 1000.0
-    sds = np.asarray(age_sds_ka, float) * 1000.0
+    objects, one per specimen) of ages ``ages`` (:class:`~pipeline.hazard.ages.AgeModel`,
+    years, one per specimen).  ``groups``: the specimens by site
+    (:class:`~pipeline.hazard.constrain_sites.SiteGroup`; None: all at ``tree``'s site);
+    ``tree`` gives the curves reported."""
+    groups = groups or [SiteGroup(tree, tuple(range(len(specimens))))]
     rng = np.random.default_rng(seed)
     cells = cell_matrix(tree.levels_m_s2, tree.rates_per_yr)
-    mode, samples = _age_mode(ages, sds, rng)
+    sites, mode = _sites(tree, cells, groups, ages, rng)
     warnings = list(tree.notes)
 
     def survival_of(batch, sampled=True):
-        return _log_survival(tree, cells, batch, ratio_model, ages, sds, mode,
-                             samples if sampled else None)
+        return combined([_log_survival(t, c, [[chosen[j] for j in m] for chosen in batch],
+                                       ratio_model, [ages[j] for j in m], how,
+                                       samples if sampled else None)
+                         for m, t, c, how, samples in sites])
 
     log_p, age_se = (None if v is None else v[0] for v in survival_of([specimens]))
     p = np.exp(log_p)
@@ -78,16 +84,19 @@ def constrain_tree(tree, specimens, ratio_model, ages_ka, age_sds_ka, rule="baye
             warnings.append(_none_left(name, floor, tree, p))
     members = _members(tree, specimens, survival_of, floor, warnings)
     carlo = _draws(tree, cells, specimens, survival_of, draws, rng, floor)
-    warnings += _end_warnings(tree, cells, specimens, ratio_model, posterior[rule])
+    for m, t, c, _, _ in sites:
+        warnings += _end_warnings(t, c, [specimens[j] for j in m], ratio_model,
+                                  posterior[rule])
+    test = branch_test(groups, _singles(sites, specimens, ratio_model, ages), p, tree, floor)
     prior_stats = _statistics(tree, tree.weights)
     post_stats = None if posterior[rule] is None else _statistics(tree, posterior[rule])
     other = "eliminate" if rule == "bayes" else "bayes"
     summary = {
         "rule": rule, "headline": WHY_BAYES, "floor": floor,
         "branch_count": tree.size, "specimen_count": len(specimens),
-        "specimens": [{"fragility": f.describe(), "age_ka": float(a), "age_sd_ka": float(s)}
-                      for f, a, s in zip(specimens, ages_ka, age_sds_ka)],
-        "age_model": mode,
+        "specimens": [{"fragility": f.describe(), **_age_keys(a)}
+                      for f, a in zip(specimens, ages)],
+        "age_model": mode.value,
         "age_integration_se_max": None if age_se is None else float(np.nanmax(age_se)),
         "branches": _branch_rows(tree, p, posterior, carlo, age_se),
         "levels_m_s2": tree.levels_m_s2.tolist(),
@@ -98,34 +107,75 @@ def constrain_tree(tree, specimens, ratio_model, ages_ka, age_sds_ka, rule="baye
         else _statistics(tree, posterior[other]),
         "ground_motion_at_rates": _motions(tree, prior_stats, post_stats),
         "members": members, "monte_carlo": carlo,
+        "sites": [{"site": g.site, "specimens": list(g.members)} for g in groups],
+        "branch_test": test.as_json(),
         "hazard": {**tree.source, "notes": list(tree.notes),
                    "interpolation": "linear in (ln PGA, ln rate)",
                    "cells_per_interval": cells[2]},
         "pgv_pga": None if ratio_model is None else ratio_model.describe(),
-        "warnings": warnings, "assumptions": ASSUMPTIONS,
+        "warnings": warnings,
+        "assumptions": ASSUMPTIONS + ([SITE_ASSUMPTION] if len(groups) > 1 else []),
         "draws": draws, "seed": seed, "software": software_versions()}
     figure = {"levels_m_s2": tree.levels_m_s2, "rates_per_yr": tree.rates_per_yr,
               "prior_weights": tree.weights, "posterior_weights": posterior[rule],
               "prior": prior_stats, "posterior": post_stats, "rule": rule,
-              "ages_ka": list(ages_ka), "age_sds_ka": list(age_sds_ka),
+              "ages": list(ages),
               "target_rates": TARGET_RATES, "branch_ids": tree.branch_ids}
+    figure["branch_test"] = test
     return summary, summary["branches"], figure
 
 
-def _age_mode(ages, sds, rng):
-    """(how ages are treated, age samples or None)."""
-    if not (sds > 0).any():
-        return "known ages", None
-    if np.all(ages == ages[0]) and np.all(sds == sds[0]):
-        return "one uncertain age for all: integrated in closed form", None
-    return (f"differing uncertain ages: Monte Carlo over {AGE_SAMPLES} samples",
-            truncated_ages(ages, sds, AGE_SAMPLES, rng))
+class AgeIntegration(Enum):
+    """How the specimens' ages are integrated over (constrain.json's age_model)."""
+    KNOWN = "known ages"
+    ONE_FOR_ALL = "one uncertain age for all: integrated in closed form"
+    MONTE_CARLO = f"differing uncertain ages: Monte Carlo over {AGE_SAMPLES} samples"
 
 
-def _log_survival(tree, cells, batch, ratio_model, ages, sds, mode, samples):
+def _sites(tree, cells, groups, ages, rng):
+    """(per site: members, its tree, its cells, its age integration and samples; the age
+    integration reported: the most demanding of the sites')."""
+    check_same_branches(groups)
+    sites = [(g.members, g.tree, cells if g.tree is tree else
+              cell_matrix(g.tree.levels_m_s2, g.tree.rates_per_yr),
+              *_age_mode([ages[j] for j in g.members], rng)) for g in groups]
+    return sites, max((s[3] for s in sites), key=list(AgeIntegration).index)
+
+
+def _singles(sites, specimens, ratio_model, ages):
+    """ln P_s of each specimen alone at its site (n x B): one age each, no sampling."""
+    out = np.empty((len(specimens), sites[0][1].size))
+    for members, t, c, _, _ in sites:
+        for j in members:
+            how, _ = _age_mode([ages[j]], None)
+            out[j] = _log_survival(t, c, [[specimens[j]]], ratio_model, [ages[j]], how,
+                                   None)[0][0]
+    return out
+
+
+def _age_mode(ages, rng):
+    """(how ages are integrated, age samples (AGE_SAMPLES x n, years) or None)."""
+    if all(a.fixed_yr is not None for a in ages):
+        return AgeIntegration.KNOWN, None
+    if all(a == ages[0] for a in ages):
+        return AgeIntegration.ONE_FOR_ALL, None
+    return (AgeIntegration.MONTE_CARLO,
+            np.column_stack([a.draw(AGE_SAMPLES, rng) for a in ages]))
+
+
+def _age_keys(age):
+    """A specimen's age in constrain.json: age_ka and age_sd_ka (a normal's; null for
+    other kinds) and age (:meth:`~pipeline.hazard.ages.AgeModel.describe`)."""
+    normal = age.kind is AgeKind.NORMAL
+    return {"age_ka": age.mean_yr / 1000.0 if normal else None,
+            "age_sd_ka": age.sd_yr / 1000.0 if normal else None, "age": age.describe()}
+
+
+def _log_survival(tree, cells, batch, ratio_model, ages, mode, samples):
     """(ln P_s, D x B, of each of the D fragility sets in ``batch`` (lists, one fragility
     per specimen), all integrated by one matrix product; its relative standard error
-    (D x B) or None)."""
+    (D x B) or None).  ``samples`` None: each age at its fixed or typical value (the
+    fragility draws)."""
     def set_rates(members):
         def probability(x):
             out = np.empty((len(batch), np.size(x)))     # filled in place: one copy held
@@ -134,12 +184,13 @@ def _log_survival(tree, cells, batch, ratio_model, ages, sds, mode, samples):
                                               "any_common")
             return out
         return branch_rates(cells, tree.levels_m_s2, tree.rates_per_yr, probability)
-    if mode.startswith("one uncertain age"):
+    if mode is AgeIntegration.ONE_FOR_ALL:
         rate = set_rates(tuple(range(len(batch[0]))))
         with np.errstate(divide="ignore"):
-            return np.log(survival_probability(rate, ages[0], sds[0])), None
+            return np.log(ages[0].survival(rate)), None
     if samples is None:
-        return log_survival_fixed(set_rates, ages), None
+        return log_survival_fixed(set_rates, np.array(
+            [a.typical_yr if a.fixed_yr is None else a.fixed_yr for a in ages])), None
     return log_survival_sampled(set_rates, samples)
 
 

@@ -97,3 +97,20 @@ def mixture_probability(fragility, mixture, pga_m_s2):
         if model is not None and shares[:, b].max() > 0:
             total += shares[:, b] * overturn_probability([fragility], model, pga)[0]
     return total
+
+
+def overturn_probability_over(fragilities, ratio_model, pga_m_s2, combine="each"):
+    """:func:`~pipeline.hazard.fragility_ratio.overturn_probability` under any PGV/PGA
+    model: a :class:`RatioMixture` the mixture over its bins (each bin's share at the PGA
+    level times the probability under its model: every ``combine`` is an expectation,
+    linear in the mixture), any other model as it is."""
+    if not isinstance(ratio_model, RatioMixture):
+        return overturn_probability(fragilities, ratio_model, pga_m_s2, combine)
+    pga = np.asarray(pga_m_s2, float)
+    shares = bin_shares(ratio_model.anchors, ratio_model.shares, pga)
+    total = 0.0
+    for b, model in enumerate(ratio_model.models):
+        if model is not None and shares[:, b].max() > 0:
+            total = total + shares[:, b] * overturn_probability(fragilities, model, pga,
+                                                                combine)
+    return total

@@ -14,7 +14,8 @@ Two formats (:func:`load_logic_tree`):
 - A plain table: comment lines starting with ``#`` anywhere, the header
   ``branch,weight,pga_<g|m_s2|cm_s2>,annual_rate_per_yr`` (an optional fifth column
   ``path``: the branch's path in the tree), then one row per branch and level (long
-  format); a branch's weight is repeated on each of its rows.  The IMT must be PGA (the
+  format); a branch's weight is repeated on each of its rows; a last column ``site``
+  (0-based integers) holds several sites' curves, one read at a time.  The IMT must be PGA (the
   fragility's); another (``sa(1.0)_g``) only when the caller asks for it by name.
 
 Every branch's curve is on the same levels.  Levels where a curve has no finite positive
@@ -43,6 +44,7 @@ import numpy as np
 from pipeline.hazard.curves import (MAX_LEVELS, OQ_HEADER_IMT, PLAIN_RATE_COLUMN, PLAIN_UNITS,
                                     check_curve, level_unit, load_hazard, parse_number,
                                     plain_body)
+from pipeline.hazard.logictree_sites import plain_site_rows
 from pipeline.files import InputError
 from pipeline.userfiles import DATA_FILE_BYTES, read_user_bytes, read_user_text, show
 
@@ -94,10 +96,7 @@ def load_logic_tree(path, site=None, imt="PGA"):
     lines = _lines(path, "logic tree file")
     if _header(lines).replace(" ", "").lower().startswith("rlz_id,"):
         return _openquake(path, site)
-    if site is not None:
-        raise InputError(f"--site applies to OpenQuake curves with several sites; {path} is "
-                         "a plain table")
-    return _plain(path, lines, imt)
+    return _plain(path, plain_site_rows(path, lines, site), imt)
 
 
 def _header(lines):

@@ -106,21 +106,25 @@ def survival_probability(rate_per_yr, age_yr, age_sd_yr=0.0):
     return np.exp(log_p)
 
 
-def rate_scale_bound(rate_per_yr, age_yr, age_sd_yr=0.0, floor=0.05):
+def rate_scale_bound(rate_per_yr, age, floor):
     """The largest factor F by which every rate of the hazard curve can be multiplied and
     still leave survival >= ``floor``: -ln(floor) / (rate age) for a known age, else the
-    root of survival(F rate) = floor.  None when the rate is 0 (no bound) or F would pass
-    exp(MAX_LN_FACTOR) (a rate so small that no factor a float holds reaches ``floor``)."""
+    root of survival(F rate) = floor over the age ``age`` (an
+    :class:`~pipeline.hazard.ages.AgeModel`).  None when the rate is 0 (no bound) or F would
+    pass exp(MAX_LN_FACTOR) (a rate so small that no factor a float holds reaches
+    ``floor``)."""
     if not rate_per_yr > 0:
         return None
     ln_rate = math.log(rate_per_yr)
-    ln_closed = math.log(-math.log(floor)) - ln_rate - math.log(age_yr)
+    known = age.fixed_yr
+    ln_closed = math.log(-math.log(floor)) - ln_rate - math.log(
+        age.typical_yr if known is None else known)
     if ln_closed > MAX_LN_FACTOR:
         return None
-    if age_sd_yr == 0:
+    if known is not None:
         return math.exp(ln_closed)
     def excess(ln_f):
-        return float(survival_probability(math.exp(ln_f + ln_rate), age_yr, age_sd_yr)) - floor
+        return float(age.survival(math.exp(ln_f + ln_rate))) - floor
     hi = ln_closed
     for _ in range(60):                # survival falls to 0 as F grows: a bracket exists
         if excess(hi) <= 0:
@@ -135,18 +139,19 @@ def rate_scale_bound(rate_per_yr, age_yr, age_sd_yr=0.0, floor=0.05):
     return None if root > MAX_LN_FACTOR else math.exp(root)
 
 
-def intensity_scale_bound(levels_m_s2, rates_per_yr, probability, age_yr, age_sd_yr=0.0,
-                          floor=0.05, zero_rate_from_m_s2=None, limits=(1e-3, 1e3)):
+def intensity_scale_bound(levels_m_s2, rates_per_yr, probability, age, floor,
+                          zero_rate_from_m_s2=None, limits=(1e-3, 1e3)):
     """The largest factor c by which the curve's intensities can be multiplied
-    (lambda_c(x) = lambda(x / c)) and still leave survival >= ``floor``; (c, note): c None
-    with a note when survival stays on one side of ``floor`` over ``limits``."""
+    (lambda_c(x) = lambda(x / c)) and still leave survival >= ``floor`` over the age
+    ``age`` (an :class:`~pipeline.hazard.ages.AgeModel`); (c, note): c None with a note
+    when survival stays on one side of ``floor`` over ``limits``."""
     levels = np.asarray(levels_m_s2, float)
 
     def excess(ln_c):
         c = math.exp(ln_c)
         zero = None if zero_rate_from_m_s2 is None else zero_rate_from_m_s2 * c
         rate = overturning_rate(levels * c, rates_per_yr, probability, zero)["rate_per_yr"]
-        return float(survival_probability(rate, age_yr, age_sd_yr)) - floor
+        return float(age.survival(rate)) - floor
 
     lo, hi = math.log(limits[0]), math.log(limits[1])
     if excess(hi) >= 0:

@@ -31,7 +31,7 @@ def survival_section(results, name=ROCK_SURVIVAL):
              + (f"; PGV/PGA from {ratio.get('model', ratio.get('source'))} at M "
                 f"{ratio['magnitude']:g}, {ratio['distance_jb_km']:g} km"
                 if "magnitude" in ratio else "")
-             + f". Age {s['age_ka']:g} +- {s['age_sd_ka']:g} ka.\n",
+             + f". Age {_age(s)}.\n",
              f"Annual overturning rate {s['annual_overturning_rate_per_yr']:.3g} /yr; "
              f"survival probability {s['survival_probability']:.3g}"
              + ("" if interval is None else
@@ -58,7 +58,8 @@ def survival_section(results, name=ROCK_SURVIVAL):
     rows = [{"PGA (g)": f"{r['lo_g']:.3g}-" + ("" if r["hi_g"] is None else f"{r['hi_g']:.3g}"),
              "rate (1/yr)": f"{r['rate_per_yr']:.3g}",
              "share": "-" if r["share"] is None else f"{100 * r['share']:.1f} %"}
-            for r in s["contribution_by_intensity"] if (r["share"] or 0) >= 0.01]
+            for r in s.get("contribution_by_intensity", ())   # none on the joint route
+            if (r["share"] or 0) >= 0.01]
     if rows:
         lines.append("Contribution by PGA (intervals holding 1 % or more of the rate):\n")
         lines.append(_table(pd.DataFrame(rows)) + "\n")
@@ -68,3 +69,10 @@ def survival_section(results, name=ROCK_SURVIVAL):
                          "hazard curve and fragility, fragility-weighted rate density, "
                          "survival against age"))
     return "\n".join(lines)
+
+
+def _age(summary):
+    """survival.json's age in words: mean +- sd (ka), or its distribution."""
+    if summary.get("age_ka") is not None:
+        return f"{summary['age_ka']:g} +- {summary['age_sd_ka']:g} ka"
+    return summary["age_distribution"]

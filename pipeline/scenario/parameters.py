@@ -17,6 +17,7 @@ from pipeline.scenario.colonnade_file import load_if_colonnade
 from pipeline.scenario.column_format import DENSITY_RANGE
 from pipeline.scenario.geometry import ColumnGeometry
 from pipeline.scenario.time_step import CONVERGED_DT_FACTOR
+from pipeline.userfiles import number
 
 RIM_SPHERE_RADIUS_M = 0.005   # rim contact spheres of the columns
 MIN_BODY_SIZE_M = 10 * RIM_SPHERE_RADIUS_M   # a drum must hold its two rims of spheres
@@ -31,13 +32,15 @@ def kinetic_friction(mu_s):
 
 
 def param(default, unit, help, low=None, high=None, flag=None, low_open=False, choices=None,
-          metavar=None):
+          metavar=None, high_open=False):
     """A dataclass field with unit, help text, bounds [low, high] (low excluded when
-    ``low_open``), its command-line flag and the flag's metavar (the command line builds
-    the flags: :mod:`pipeline.cli._fields`)."""
+    ``low_open``, high when ``high_open``; either may be None: unbounded), its command-line
+    flag and the flag's metavar (the command line builds the flags:
+    :mod:`pipeline.cli._fields`).  A tuple field's bounds hold for each of its values."""
     return field(default=default, metadata={"unit": unit, "help": help, "low": low, "high": high,
-                                            "low_open": low_open, "flag": flag,
-                                            "choices": choices, "metavar": metavar})
+                                            "low_open": low_open, "high_open": high_open,
+                                            "flag": flag, "choices": choices,
+                                            "metavar": metavar})
 
 
 def check_fields(obj):
@@ -54,17 +57,21 @@ def check_fields(obj):
             continue
         if value is None and f.default is None:      # unset: decided where it is used
             continue
-        if isinstance(value, bool) or not isinstance(value, (int, float)) or \
-                not math.isfinite(value):
-            raise InputError(f"{name} must be a finite number, got {value!r}")
-        if f.type in (int, "int") and int(value) != value:
-            raise InputError(f"{name} must be an integer, got {value!r}")
-        low, high = meta.get("low"), meta.get("high")
-        too_low = low is not None and (value <= low if meta.get("low_open") else value < low)
-        if too_low or (high is not None and value > high):
-            bracket = "(" if meta.get("low_open") else "["
-            raise InputError(f"{name} {value:g} outside the allowed range "
-                             f"{bracket}{low:g}, {high:g}] {meta['unit']}".rstrip())
+        for v in _leaves(value):
+            if isinstance(v, bool) or not isinstance(v, (int, float)) or \
+                    not math.isfinite(v):
+                raise InputError(f"{name} must be a finite number, got {v!r}")
+            if f.type in (int, "int") and int(v) != v:
+                raise InputError(f"{name} must be an integer, got {v!r}")
+            number(v, name, meta.get("low"), meta.get("high"), meta["unit"],
+                   meta.get("low_open", False), meta.get("high_open", False))
+
+
+def _leaves(value):
+    """The numbers of a field's value: itself, or each of a tuple (of tuples)."""
+    if not isinstance(value, tuple):
+        return (value,)
+    return tuple(v for item in value for v in _leaves(item))
 
 
 @dataclass(frozen=True)

@@ -33,6 +33,8 @@ from pipeline import RECORDS_DIR
 from pipeline.constants import STANDARD_GRAVITY as G
 from pipeline.files import InputError
 from pipeline.hazard.constrain import branch_rates, cell_matrix, motion_at_rate
+from pipeline.hazard.ages import TruncatedNormal
+from pipeline.hazard.constrain import FLOOR
 from pipeline.hazard.constrain_assess import FRACTILES, constrain_tree
 from pipeline.hazard.fragility import Lognormal
 from pipeline.hazard.logictree import load_logic_tree
@@ -55,8 +57,8 @@ def tree():
 
 
 def _prior(tree):
-    summary, _, _ = constrain_tree(tree, [Lognormal(0.4 * G, 0.4)], None, [1.0], [0.0],
-                                   draws=0)
+    summary, _, _ = constrain_tree(tree, [Lognormal(0.4 * G, 0.4)], None,
+                                   [TruncatedNormal(1e3)], "bayes", FLOOR, 0, 0)
     return summary["prior"]
 
 
@@ -196,8 +198,8 @@ def test_bayes_weights_with_the_books_fragility(tree):
                  + _book_failure_rates(fine_x, fine_rates, fragility, right=True)) \
         + fragility(LEVELS_G[-1]) * tree.rates_per_yr[:, -1]
     expected = tree.weights * np.exp(-lam * 1000.0)
-    summary, rows, _ = constrain_tree(tree, [Lognormal(0.4 * G, 0.4)], None, [1.0], [0.0],
-                                      draws=0)
+    summary, rows, _ = constrain_tree(tree, [Lognormal(0.4 * G, 0.4)], None,
+                                   [TruncatedNormal(1e3)], "bayes", FLOOR, 0, 0)
     got = np.array([r["posterior_bayes"] for r in rows])
     np.testing.assert_allclose(got, expected / expected.sum(), rtol=2e-3)
     np.testing.assert_allclose([r["survival_probability"] for r in rows],

@@ -17,9 +17,10 @@ from pipeline import RECORDS_DIR
 from pipeline.cli import main
 from pipeline.files import InputError
 from pipeline.hazard import load_hazard
-from pipeline.hazard.constrain import (bayes, branch_rates, cell_matrix, eliminate,
+from pipeline.hazard.ages import TruncatedNormal
+from pipeline.hazard.constrain import (FLOOR, bayes, branch_rates, cell_matrix, eliminate,
                                        log_survival_fixed, log_survival_sampled,
-                                       motion_at_rate, truncated_ages, weighted_mean,
+                                       motion_at_rate, weighted_mean,
                                        weighted_quantile)
 from pipeline.hazard.constrain_assess import constrain_tree
 from pipeline.hazard.fragility import Fragility, Lognormal, overturn_probability
@@ -109,7 +110,9 @@ def test_uncertain_differing_ages_against_quadrature():
     step = Step(tree.levels_m_s2[5])
     cells = cell_matrix(tree.levels_m_s2, tree.rates_per_yr)
     means, sds = np.array([8000.0, 12000.0]), np.array([3000.0, 2000.0])
-    samples = truncated_ages(means, sds, 4000, np.random.default_rng(3))
+    rng = np.random.default_rng(3)
+    samples = np.column_stack([TruncatedNormal(m, sd).draw(4000, rng)
+                               for m, sd in zip(means, sds)])
     log_p, se = log_survival_sampled(_set_rates(tree, cells, [step, step]), samples)
     dists = [stats.truncnorm(-m / s, np.inf, loc=m, scale=s) for m, s in zip(means, sds)]
 
@@ -192,7 +195,8 @@ def test_lognormal_under_power_law_branches(exponent, median, beta):
     closed = ks * median ** -exponent * math.exp(exponent ** 2 * beta ** 2 / 2)
     np.testing.assert_allclose(rates, closed, rtol=2e-4)
     age = 0.5 / closed[1]
-    summary, rows, _ = constrain_tree(tree, [fragility], None, [age / 1000], [0.0], draws=0)
+    summary, rows, _ = constrain_tree(tree, [fragility], None, [TruncatedNormal(age)], "bayes",
+                                      FLOOR, 0, 0)
     p = np.exp(-closed * age)
     expected = tree.weights * p / (tree.weights @ p)
     np.testing.assert_allclose([r["posterior_bayes"] for r in rows], expected, rtol=1e-3)
@@ -219,8 +223,9 @@ def test_draws_in_one_matrix_product_equal_the_per_draw_loop(monkeypatch):
     assert batched.shape == (25, tree.size)
     np.testing.assert_allclose(batched, loop, rtol=1e-12)
     monkeypatch.setattr("pipeline.hazard.constrain_assess.draw_chunk", lambda cells: 7)
-    summary, _, _ = constrain_tree(tree, [first, second], None, [3.0, 9.0], [0.0, 0.0],
-                                   draws=25, seed=2)
+    summary, _, _ = constrain_tree(tree, [first, second], None,
+                                   [TruncatedNormal(3e3), TruncatedNormal(9e3)], "bayes",
+                                   FLOOR, 25, 2)
     rng = np.random.default_rng(2)                  # known ages: only the draws use it
     pairs = list(zip(first.draws(25, rng), second.draws(25, rng)))
     survival = np.exp([log_survival_fixed(_set_rates(tree, cells, list(pair)),
@@ -374,7 +379,8 @@ def test_monte_carlo_interval_holds_the_headline():
     holds the survival of the estimate itself."""
     tree = load_logic_tree(CASE_11)
     fragility = Lognormal(3.0, 0.4, median_ci95=(2.5, 3.6), beta_ci95=(0.3, 0.5))
-    summary, rows, _ = constrain_tree(tree, [fragility], None, [2.0], [0.0], draws=200)
+    summary, rows, _ = constrain_tree(tree, [fragility], None, [TruncatedNormal(2e3)],
+                                      "bayes", FLOOR, 200, 0)
     for row in rows:
         lo, hi = row["survival_interval"]
         assert lo < row["survival_probability"] < hi

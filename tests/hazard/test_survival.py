@@ -15,6 +15,7 @@ from pipeline.files import json_safe
 from pipeline.cli import main
 from pipeline.files import InputError
 from pipeline.hazard import load_hazard
+from pipeline.hazard.ages import LowerBound, TruncatedNormal, UniformInterval
 from pipeline.hazard.fragility import (Logistic, Lognormal, RatioFromGmm, RatioLognormal,
                                        load_campaign_fragility, overturn_probability)
 from pipeline.hazard.survival import (contribution_by_intensity, intensity_scale_bound,
@@ -86,15 +87,15 @@ def test_survival_when_rate_times_sd_is_large(rate, mean, sd):
 def test_rate_scale_bound_of_a_rate_too_small_for_any_float_factor():
     """A rate of 1e-317 per year over a day: no factor a float holds brings survival to
     5 % (None, as for a rate of 0), not a failed root search."""
-    assert rate_scale_bound(1e-317, 1e-3) is None
-    assert rate_scale_bound(1e-317, 1e-3, 1e7) is None
+    assert rate_scale_bound(1e-317, TruncatedNormal(1e-3), 0.05) is None
+    assert rate_scale_bound(1e-317, TruncatedNormal(1e-3, 1e7), 0.05) is None
 
 
 def test_rate_scale_bound():
-    assert rate_scale_bound(1e-4, 15e3) == pytest.approx(-math.log(0.05) / 1.5)
-    factor = rate_scale_bound(1e-4, 15e3, 5e3)
+    assert rate_scale_bound(1e-4, TruncatedNormal(15e3), 0.05) == pytest.approx(-math.log(0.05) / 1.5)
+    factor = rate_scale_bound(1e-4, TruncatedNormal(15e3, 5e3), 0.05)
     assert _age_quadrature(factor * 1e-4, 15e3, 5e3) == pytest.approx(0.05, rel=1e-6)
-    assert rate_scale_bound(0.0, 15e3) is None
+    assert rate_scale_bound(0.0, TruncatedNormal(15e3), 0.05) is None
 
 
 def test_intensity_scale_bound_under_a_power_law():
@@ -104,10 +105,12 @@ def test_intensity_scale_bound_under_a_power_law():
     fragility = Lognormal(median, beta)
     rate = overturning_rate(levels, rates, fragility.probability)["rate_per_yr"]
     for age, sd in ((15e3, 0.0), (15e3, 3e3)):
-        c, note = intensity_scale_bound(levels, rates, fragility.probability, age, sd)
+        c, note = intensity_scale_bound(levels, rates, fragility.probability,
+                                        TruncatedNormal(age, sd), 0.05)
         assert note is None
-        assert c == pytest.approx(rate_scale_bound(rate, age, sd) ** (1 / k), rel=1e-3)
-    c, note = intensity_scale_bound(levels, rates, fragility.probability, 1.0)
+        assert c == pytest.approx(rate_scale_bound(rate, TruncatedNormal(age, sd), 0.05) ** (1 / k), rel=1e-3)
+    c, note = intensity_scale_bound(levels, rates, fragility.probability,
+                                    TruncatedNormal(1.0), 0.05)
     assert c is None and "stays" in note
 
 
@@ -310,3 +313,14 @@ def test_reads_what_campaign_fragility_writes(tmp_path):
     written = columns["monolithic"]["PGA"]
     assert lognormal.median_m_s2 == written["median"] and lognormal.beta == written["beta"]
     assert lognormal.median_ci95 == tuple(written["median_ci95"])
+
+
+def test_rate_scale_bound_of_dated_ages():
+    """A lower bound is a known age's closed form; an interval's factor brings its closed
+    form (exp(-r lo) - exp(-r hi)) / (r (hi - lo)) to 5 %."""
+    assert rate_scale_bound(1e-4, LowerBound(15e3), 0.05) == \
+        pytest.approx(-math.log(0.05) / 1.5)
+    factor = rate_scale_bound(1e-4, UniformInterval(13e3, 22e3), 0.05)
+    r = factor * 1e-4
+    assert (math.exp(-r * 13e3) - math.exp(-r * 22e3)) / (r * 9e3) == \
+        pytest.approx(0.05, rel=1e-6)

@@ -15,9 +15,10 @@ import numpy as np
 
 from pipeline.constants import STANDARD_GRAVITY
 from pipeline.files import InputError
+from pipeline.hazard.pga_pgv_correlation import BAKER_BRADLEY_2017
 
 RATIO_NODES = 24                  # Gauss-Hermite nodes over ln(PGV/PGA)
-PGA_PGV_CORRELATION = 0.733       # ln PGA, ln PGV residuals: Bradley (2012), Earthq. Spectra 28(1)
+PGA_PGV_CORRELATION = BAKER_BRADLEY_2017.value   # ln PGA, ln PGV residuals, observed
 DEFAULT_VS30_M_S = 760.0          # the model's site: rock (B/C), the USGS hazard curves' Vs30
 GMM_MECHANISMS = ("SS", "NS", "RS")
 

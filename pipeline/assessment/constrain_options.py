@@ -1,0 +1,108 @@
+"""What ``constrain`` is asked, declared as :func:`~pipeline.scenario.parameters.param`
+fields beside the fragility and PGV/PGA options it shares with ``survival``
+(:class:`~pipeline.assessment.options.SpecimenOptions`)."""
+from dataclasses import dataclass
+from pathlib import Path
+
+from pipeline.assessment.age_options import AGE_VALUES, age_kinds, check_age_kinds
+from pipeline.assessment.options import (CONSTRAIN_OUT, KA, MAX_AGE_KA, MAX_SPECIMENS,
+                                         SpecimenOptions, _check_column_site, _check_out,
+                                         _per_specimen)
+from pipeline.files import InputError
+from pipeline.hazard.ages import LowerBound, TruncatedNormal, UniformInterval, load_age_samples
+from pipeline.hazard.constrain import FLOOR
+from pipeline.scenario.parameters import check_fields, param
+
+
+@dataclass(frozen=True)
+class ConstrainOptions(SpecimenOptions):
+    """What ``constrain`` is asked (see ``python -m pipeline constrain --help``)."""
+    logic_tree: Path = param(
+        None, "", "OpenQuake's export (the directory, or its realizations.csv, with one "
+        "hazard_curve CSV per realisation) or a plain table branch,weight,"
+        "pga_<g|m_s2|cm_s2>,annual_rate_per_yr (one row per branch and level)",
+        metavar="PATH")
+    site: int = param(None, "", "the site of the curves (0-based: the row of OpenQuake "
+                      "curves with several sites, or the site column of a plain table)", 0,
+                      None, flag="--site", metavar="N")
+    specimen_site: tuple[int, ...] = param(
+        (), "", "the site of each specimen (0-based: the row of OpenQuake curves with "
+        "several sites, or the site column of a plain table), in the order of the fragilities, or one for all; sites taken as far "
+        "apart (the set's survival the product over sites); unset: every specimen at "
+        "--site", 0, None, flag="--specimen-site", metavar="N")
+    age_ka: tuple[float, ...] = param(
+        (), "ka", "a specimen's age (a mean with --age-sd-ka): one per specimen, in the "
+        "order of the fragilities, or one for all", 0, MAX_AGE_KA, low_open=True,
+        flag="--age-ka", metavar="KA")
+    age_sd_ka: tuple[float, ...] = param(
+        (0.0,), "ka", "its standard deviation (normal truncated at 0): one per specimen or "
+        "one for all", 0, MAX_AGE_KA, flag="--age-sd-ka", metavar="KA")
+    age_min_ka: tuple[float, ...] = param(
+        (), "ka", "or a lower bound only on a specimen's age: one per specimen or one for "
+        "all", 0, MAX_AGE_KA, low_open=True, flag="--age-min-ka", metavar="KA")
+    age_range_ka: tuple[tuple[float, float], ...] = param(
+        (), "ka", "or an interval a specimen's age lies in, uniform over it: one per "
+        "specimen or one for all", 0, MAX_AGE_KA, flag="--age-range-ka",
+        metavar=("LO", "HI"))
+    age_samples: tuple[Path, ...] = param(
+        (), "", "or samples of a specimen's age (ka) in the column --age-column of a CSV "
+        "file: one file per specimen or one for all", flag="--age-samples", metavar="FILE")
+    age_column: str = param(None, "", "the column of --age-samples", flag="--age-column",
+                            metavar="NAME")
+    rule: str = param("bayes", "", "the headline's rule: bayes (weights x survival "
+                      "probability) or eliminate (branches of survival below --floor "
+                      "dropped); both are written", flag="--rule",
+                      choices=("bayes", "eliminate"))
+    floor: float = param(FLOOR, "", "survival probability below which elimination drops a "
+                         "branch", 0, 1, low_open=True, high_open=True, flag="--floor",
+                         metavar="P")
+    out: Path = param(CONSTRAIN_OUT, "", "output directory", flag="--out", metavar="DIR")
+
+    def __post_init__(self):
+        if self.logic_tree is None:
+            raise InputError("give --logic-tree")
+        check_fields(self)
+        self.check_specimens()
+        n = self.specimen_count
+        if n > MAX_SPECIMENS:
+            raise InputError(f"{n} specimens (at most {MAX_SPECIMENS})")
+        _check_column_site(self)
+        given = age_kinds(self)
+        if not given:
+            raise InputError("give the specimens' ages: --age-ka, --age-min-ka, "
+                             "--age-range-ka or --age-samples (one per specimen, or one "
+                             "for all)")
+        check_age_kinds(self, given)
+        flag, values = AGE_VALUES[given[0]](self)
+        _per_specimen(values, n, flag)
+        if self.age_ka:
+            _per_specimen(self.age_sd_ka, n, "--age-sd-ka")
+        self.specimen_sites()
+        _check_out(self.out)
+
+    def specimen_sites(self):
+        """The site of each specimen (--specimen-site), or None (all at --site)."""
+        if not self.specimen_site:
+            return None
+        return _per_specimen(self.specimen_site, self.specimen_count, "--specimen-site")
+
+    def ages(self):
+        """The ages and their sds (ka), one per specimen (of --age-ka)."""
+        n = self.specimen_count
+        return (_per_specimen(self.age_ka, n, "--age-ka"),
+                _per_specimen(self.age_sd_ka, n, "--age-sd-ka"))
+
+    def age_models(self):
+        """One :class:`~pipeline.hazard.ages.AgeModel` (years) per specimen (an
+        --age-samples file read here, each once)."""
+        n = self.specimen_count
+        if self.age_ka:
+            return [TruncatedNormal(a * KA, s * KA) for a, s in zip(*self.ages())]
+        if self.age_min_ka:
+            return [LowerBound(a * KA) for a in _per_specimen(self.age_min_ka, n, "")]
+        if self.age_range_ka:
+            return [UniformInterval(lo * KA, hi * KA)
+                    for lo, hi in _per_specimen(self.age_range_ka, n, "")]
+        read = {path: load_age_samples(path, self.age_column, KA)
+                for path in dict.fromkeys(self.age_samples)}
+        return [read[path] for path in _per_specimen(self.age_samples, n, "")]
