@@ -153,8 +153,8 @@ def plot_surface(table, summary, path):
         ax.scatter(sub.loc[fell, "pga_m_s2"] * jitter[fell], sub.loc[fell, "pgv_pga_s"],
                    color=st["color"], s=18, label="toppled")
         surface = summary.columns[name].logistic
-        if surface["coefficients"] is not None:
-            P = logistic_probability(surface["coefficients"], X, Y)
+        if surface.coefficients is not None:
+            P = logistic_probability(surface.coefficients, X, Y)
             cs = ax.contour(X, Y, P, levels=list(CONTOUR_LEVELS), colors=[st["color"]],
                             linestyles=[":", "-", "--"], linewidths=1.2)
             ax.clabel(cs, fmt="%.2f", fontsize=7)
@@ -165,10 +165,10 @@ def plot_surface(table, summary, path):
         ax.set_xlabel("PGA (m/s$^2$)")
         ax.set_ylabel("PGV/PGA (s)")
         title = st["label"]
-        if surface["coefficients"] is not None:
-            b = surface["coefficients"]
+        if surface.coefficients is not None:
+            b = surface.coefficients
             title += (f"\nlogit P = {b['b0']:.2f} + {b['b1']:.2f} ln PGA + {b['b2']:.2f} "
-                      f"ln(PGV/PGA)" + (" (Firth)" if surface["separated"] else ""))
+                      f"ln(PGV/PGA)" + (" (Firth)" if surface.separated else ""))
         ax.set_title(title, fontsize=8)
         ax.grid(alpha=0.3, which="both")
         ax.legend(fontsize=7, loc="lower right")
