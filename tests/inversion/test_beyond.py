@@ -73,7 +73,9 @@ def test_a_source_well_within_the_reach_is_not(table):
 
 def test_the_shell_lies_beyond_the_last_ring_of_some_site_and_within_twice_it(table):
     observations = hidden_source((3.0, 4.0), {"A": (0.0, 0.0), "B": (6.0, 0.0)})
-    east, north = shell_lattice(observations, CandidateGrid(radius_km=30, step_km=1), 10.0)
+    east, north, step = shell_lattice(observations, CandidateGrid(radius_km=30, step_km=1),
+                                      10.0)
+    assert step == 2.0
     farthest = np.maximum(np.hypot(east, north), np.hypot(east - 6.0, north))
     assert east.size and (farthest > 10.0).all() and (farthest <= 20.0 + 1e-9).all()
 
