@@ -24,8 +24,8 @@ from pipeline.inversion.grid import TableGrid
 from pipeline.inversion.likelihood import SITE_COLUMNS
 from pipeline.inversion.observations import load_observations, parse_observations
 from pipeline.inversion.paper_scenario import paper_grid, paper_nodes
-from pipeline.inversion.study_summary import placement_summary, study_answer, study_summary, \
-    warning_rates
+from pipeline.inversion.study_summary import beyond_hypothesis, placement_summary, \
+    study_answer, study_summary, warning_rates
 from pipeline.inversion.table import ForwardTable
 from pipeline.inversion.truth import check_hidden, load_truth
 from pipeline.scenario.column_format import example_names
@@ -217,6 +217,7 @@ def member_study(options, grid, candidates):
         "forward_table": info, "figure": figure.name, "source_figure": source_figure.name,
         "toppled_fraction_by_slice": table.toppled_fraction_by_slice(),
         "reach_warning": warning_rates(placements),
+        "beyond_hypothesis": beyond_hypothesis(rows),
         "elapsed_s": round(time.monotonic() - started, 1)})
     for text in answer.values():
         log.info(text)
