@@ -45,10 +45,11 @@ EXTRAPOLATED = ("the shell's likelihood extrapolates the forward table past its 
                 "(the last ring's fall directions, its P carried on by the decay between "
                 "the last two rings)")
 ONE_SITE_NOTE = ("one site: its falls cannot tell a source beyond the reach from a nearer "
-                 "one of smaller magnitude (nor can the test of the sources beyond it), so "
-                 "the distance interval and the epicentre region hold only if the source "
-                 "lies within {reach:g} km; the direction does not depend on it (the "
-                 "candidates are a disk about the site)")
+                 "one of smaller magnitude, so P(beyond the reach) says little more than "
+                 "the prior's even odds, and the distance interval and the epicentre "
+                 "region hold a source beyond {reach:g} km only through the table's "
+                 "extrapolated decay; the direction does not depend on it (the candidates "
+                 "are a disk about the site)")
 
 
 @dataclass(frozen=True, eq=False)
