@@ -31,8 +31,6 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.special import expit, logsumexp
 
-from pipeline.files import InputError
-
 SHELL_FACTOR = 2.0          # the shell reaches this many times the table's last ring
 SHELL_STEP = 2              # the shell's lattice step in candidate steps
 PRIOR_BEYOND = 0.5          # prior probability that the source lies in the shell
@@ -57,7 +55,8 @@ class Beyond:
     """The shell beyond the reach in the posterior: its cells (km East/North of the first
     site, lattice step ``step_km``), their posterior given the source lies in the shell
     (``probability``: sources x strikes x cells, summing to 1), and ln of the Bayes
-    factor of the shell against the candidates (None: no shell, P(beyond) 0)."""
+    factor of the shell against the candidates (None: no shell, P(beyond) 0); ValueError
+    when these disagree (a defect, not an input)."""
     shell_km: tuple                    # (last ring, SHELL_FACTOR x last ring): farthest site
     sites_km: tuple                    # ((east, north) km of each site)
     radius_km: float                   # the candidates' --radius
@@ -70,15 +69,15 @@ class Beyond:
     def __post_init__(self):
         lo, hi = self.shell_km
         if not (0 < lo < hi and self.step_km > 0 and self.radius_km > 0):
-            raise InputError(f"beyond the reach: shell {self.shell_km} km, step "
+            raise ValueError(f"beyond the reach: shell {self.shell_km} km, step "
                              f"{self.step_km:g} km, radius {self.radius_km:g} km")
         cells = self.east_km.size
         if self.north_km.shape != (cells,) or self.probability.shape[-1:] != (cells,):
-            raise InputError("beyond the reach: cells and posterior disagree in shape")
+            raise ValueError("beyond the reach: cells and posterior disagree in shape")
         if cells and not math.isclose(float(self.probability.sum()), 1.0, abs_tol=1e-9):
-            raise InputError("beyond the reach: the shell's posterior does not sum to 1")
+            raise ValueError("beyond the reach: the shell's posterior does not sum to 1")
         if (self.log_bayes_factor is None) != (cells == 0):
-            raise InputError("beyond the reach: a Bayes factor needs shell cells")
+            raise ValueError("beyond the reach: a Bayes factor needs shell cells")
 
     @property
     def bayes_factor(self):

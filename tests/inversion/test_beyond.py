@@ -221,3 +221,19 @@ def test_the_mass_beyond_adds_up_in_the_frame_and_the_region():
         mask[:n].sum() * 1.0 + mask[n:].sum() * (SHELL_STEP * 1.0) ** 2)
     assert mass[in_shell].sum() == pytest.approx(summary["p_beyond"])
     assert sum(summary["magnitude_posterior"].values()) == pytest.approx(1.0)
+
+
+def test_the_shells_result_checks_itself_on_construction():
+    """A shell's posterior that does not sum to 1, or a Bayes factor without shell cells,
+    is refused when built."""
+    from pipeline.inversion.beyond import Beyond
+    cells = {"shell_km": (10.0, 20.0), "sites_km": ((0.0, 0.0),), "radius_km": 30.0,
+             "step_km": 2.0, "east_km": np.array([11.0]), "north_km": np.array([1.0])}
+    with pytest.raises(ValueError, match="does not sum to 1"):
+        Beyond(**cells, probability=np.full((1, 1, 1), 0.5), log_bayes_factor=0.0)
+    with pytest.raises(ValueError, match="needs shell cells"):
+        Beyond(**{**cells, "east_km": np.zeros(0), "north_km": np.zeros(0)},
+               probability=np.zeros((1, 1, 0)), log_bayes_factor=0.0)
+    shell = Beyond(**cells, probability=np.ones((1, 1, 1)), log_bayes_factor=math.log(2.0))
+    assert shell.p_beyond == pytest.approx(2.0 / 3.0) and not shell.warning
+    assert shell.cell_of(11.5, 0.2) == 0 and shell.cell_of(25.0, 0.0) is None
