@@ -12,11 +12,16 @@ by the table's own decay with distance
 table, flagged as such in the summary.
 
 The prior: uniform over area within each set (and the candidates' prior over magnitude,
-mechanism and strike in both), the two hypotheses "within the reach" and "beyond it"
-equally likely (``PRIOR_BEYOND``).  The shell stands for "somewhere beyond", whose extent
-the table cannot bound (``SHELL_FACTOR`` is a choice): odds in proportion to area would
-make P(beyond) follow that choice.  So P(beyond) = B / (1 + B), with B the Bayes factor
-of the shell against the candidates (their mean likelihoods, ``beyond_bayes_factor``).
+mechanism and strike in both), and "beyond the reach" given ``PRIOR_BEYOND``, one less
+the level of the 95 % region: P(beyond) = r B / (1 + r B), r = 0.05 / 0.95, with B the
+Bayes factor of the shell against the candidates (their mean likelihoods,
+``beyond_bayes_factor``), passes 0.05, and the 95 % region must take in the shell,
+exactly when the falls are likelier from the shell than from the candidates (B > 1).
+The shell stands for "somewhere beyond", whose extent the table cannot bound
+(``SHELL_FACTOR`` is a choice), so odds in proportion to area would make P(beyond)
+follow that choice; and with the predictive likelihood B seldom departs far from 1 (a
+site's columns count as a few), so even odds would put about a third of the posterior
+of a source well within the reach beyond it (measured in the member study).
 Above ``BEYOND_BAYES_FACTOR`` the summary warns that the source may lie beyond the reach
 (and gives no direction, as for the other reach warnings); below it the regions still
 hold the shell where it carries mass.  One site cannot tell: the shell about it and the
@@ -33,7 +38,9 @@ from scipy.special import expit, logsumexp
 
 SHELL_FACTOR = 2.0          # the shell reaches this many times the table's last ring
 SHELL_STEP = 2              # the shell's lattice step in candidate steps
-PRIOR_BEYOND = 0.5          # prior probability that the source lies in the shell
+PRIOR_BEYOND = 0.05         # prior probability that the source lies in the shell: one
+#                             less the 95 % level, so that the 95 % region takes the shell
+#                             in when the falls favour it over the candidates (B > 1)
 BEYOND_BAYES_FACTOR = 3.0   # the falls favour the shell this much over the candidates:
 #   chosen once on draws the reported member study never uses (its trials with seed 1, the
 #   predictive likelihood, 48 members): 3 sites x 1-30 fallen columns gave false alarms
@@ -44,7 +51,7 @@ EXTRAPOLATED = ("the shell's likelihood extrapolates the forward table past its 
                 "the last two rings)")
 ONE_SITE_NOTE = ("one site: its falls cannot tell a source beyond the reach from a nearer "
                  "one of smaller magnitude, so P(beyond the reach) says little more than "
-                 "the prior's even odds, and the distance interval and the epicentre "
+                 "its prior, and the distance interval and the epicentre "
                  "region hold a source beyond {reach:g} km only through the table's "
                  "extrapolated decay; the direction does not depend on it (the candidates "
                  "are a disk about the site)")

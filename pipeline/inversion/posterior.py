@@ -118,14 +118,17 @@ class Posterior:
         """[lo, hi] km from the first site: the shortest interval of distances holding
         ``level`` of the posterior (on the sub-grid; it reaches the candidates' last
         distance when the posterior piles there, where equal tails would stop short);
-        ``open_above``: [lo, None], lo the distance below which 1 - ``level`` lies."""
+        ``open_above``: [lo, None], lo the distance of the nearest point of the cells of
+        the epicentre's HPD region at ``level`` (which holds the shell's cells)."""
         e, n, mass = self._subsamples()
         d = np.hypot(e, n)
         order = np.argsort(d, kind="stable")
         d = d[order]
         before = np.concatenate([[0.0], np.cumsum(mass[order]) / mass.sum()])
-        if open_above:
-            return [float(d[max(int(np.searchsorted(before, 1.0 - level)) - 1, 0)]), None]
+        if open_above:          # the nearest point of the epicentre region's cells
+            east, north, area, _, _ = self.cells()
+            near = np.hypot(east, north) - np.sqrt(area / 2.0)
+            return [float(max(near[self.region(level)[0]].min(), 0.0)), None]
         ends = np.searchsorted(before, before[:-1] + level - 1e-12)   # one past the last
         starts = np.flatnonzero(ends < len(before))
         widths = d[ends[starts] - 1] - d[starts]

@@ -169,15 +169,15 @@ def test_a_larger_source_beyond_the_reach_is_held_by_the_shell_and_its_magnitude
     sites = {"A": (0.0, 13.0), "B": (9.0, 9.0), "C": (-9.0, 9.0)}
     post, summary, found = posterior_of(magnitudes_table(), (0.0, 0.0), sites, 7.0)
     assert not found["within_reach"]
-    assert summary["p_beyond"] > 0.5 and summary["beyond_in_95"]
+    assert summary["p_beyond"] > 0.3 and summary["beyond_in_95"]
     assert summary["reach_warning"].startswith(f"P(beyond the reach) {summary['p_beyond']:.2f}")
     assert found["epicentre_in_95"] and found["distance_in_95"] and found["mw_in_95"]
     assert summary["distance_ci95_km"][1] is None and summary["distance_ci95_unbounded"]
     assert summary["magnitude_ci95"][1] == 7.0 and summary["magnitude_ci95_open_above"]
-    assert summary["beyond_extrapolated"] and summary["beyond_prior"] == 0.5
-    # P(beyond) is the test's Bayes factor B as odds against equal prior odds
-    factor = summary["beyond_bayes_factor"]
-    assert summary["p_beyond"] == pytest.approx(factor / (1.0 + factor), rel=1e-12)
+    assert summary["beyond_extrapolated"] and summary["beyond_prior"] == 0.05
+    # P(beyond) is the test's Bayes factor B times the prior odds 0.05 : 0.95, as odds
+    odds = summary["beyond_bayes_factor"] * 0.05 / 0.95
+    assert summary["p_beyond"] == pytest.approx(odds / (1.0 + odds), rel=1e-12)
 
 
 def test_a_source_well_within_the_reach_keeps_its_regions():
@@ -234,6 +234,6 @@ def test_the_shells_result_checks_itself_on_construction():
     with pytest.raises(ValueError, match="needs shell cells"):
         Beyond(**{**cells, "east_km": np.zeros(0), "north_km": np.zeros(0)},
                probability=np.zeros((1, 1, 0)), log_bayes_factor=0.0)
-    shell = Beyond(**cells, probability=np.ones((1, 1, 1)), log_bayes_factor=math.log(2.0))
-    assert shell.p_beyond == pytest.approx(2.0 / 3.0) and not shell.warning
+    shell = Beyond(**cells, probability=np.ones((1, 1, 1)), log_bayes_factor=math.log(19.0))
+    assert shell.p_beyond == pytest.approx(0.5) and shell.warning
     assert shell.cell_of(11.5, 0.2) == 0 and shell.cell_of(25.0, 0.0) is None

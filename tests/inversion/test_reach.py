@@ -102,7 +102,7 @@ def test_a_source_beyond_the_last_ring_is_said_to_lie_beyond(table):
     assert summary["back_azimuth_within_reach"]["back_azimuth_ci95_width_deg"] < 360.0
     assert found["distance_in_95_or_warned"] and found["epicentre_in_95_or_warned"]
     # no candidate can hold it; the shell beyond the reach does, and says how likely it is
-    assert summary["beyond_in_95"] and summary["p_beyond"] > 0.5
+    assert summary["beyond_in_95"] and summary["p_beyond"] > 0.1
     assert found["distance_in_95"] and found["epicentre_in_95"]
 
 
