@@ -6,6 +6,7 @@ from pathlib import Path
 
 import pandas as pd
 
+from pipeline.inversion.beyond import PRIOR_BEYOND, SHELL_FACTOR
 from pipeline.report.common import _figure, _fmt, _table
 from pipeline.report.inversion import _table_provenance, _toppled_by_slice
 
@@ -160,9 +161,9 @@ def _beyond_lines(study):
                            "shell in 95 % region": r["beyond_in_95"]})
     if not rows:
         return []
-    return ["The posterior carries the sources beyond the reach (a shell of epicentres out "
-            "to twice the last ring, its likelihood extrapolated by the table's decay, "
-            "prior odds 1:1 against the candidates).  Sources beyond the reach, by number "
+    return [f"The posterior carries the sources beyond the reach (a shell of epicentres out "
+            f"to {SHELL_FACTOR:g} times the last ring, its likelihood extrapolated by the "
+            f"table's decay, prior {PRIOR_BEYOND:g}).  Sources beyond the reach, by number "
             "of sites and of those beyond the reach (covered: the 95 % region holds the "
             "truth, the distance interval open above and the magnitude's reaching the "
             "table's largest where the shell lies in the region, or the inversion refuses):",
