@@ -156,7 +156,9 @@ def plot_marginals(post, path, truth=None):
     d, pd_ = post.distance_marginal()
     ax1.bar(d, pd_, width=d[1] - d[0] if len(d) > 1 else 1.0, color="tab:green", alpha=0.7)
     lo, hi = summary["distance_ci95_km"]
-    ax1.axvspan(lo, hi, color="0.85", zorder=0, label=f"95 %: {lo:.1f}-{hi:.1f} km")
+    ax1.axvspan(lo, d[-1] if hi is None else hi, color="0.85", zorder=0,
+                label=f"95 %: {lo:.1f} km to " + ("unbounded (beyond the reach)" if hi is None
+                                                  else f"{hi:.1f} km"))
     if truth and truth.get("distance_km") is not None:
         ax1.axvline(truth["distance_km"], color="red", lw=2, label="true")
     ax1.set_xlabel("epicentral distance from the first site (km)")

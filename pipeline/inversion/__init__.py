@@ -93,7 +93,8 @@ def truth_check(post, truth, summary=None):
     in the inversion's frame, back_azimuth_deg, distance_km, mechanism, mw), whether the
     source lies within the inversion's reach, and whether the outputs warn that it may lie
     beyond (``*_or_warned``: the region holds the truth or the warning is there).  The
-    magnitude: in the 95 % interval (``mw_in_95``), a table slice's (``mw_in_table``),
+    magnitude: in the 95 % interval (``mw_in_95``; above it when the interval is open above:
+    the shell beyond the reach in the 95 % region), a table slice's (``mw_in_table``),
     within the table's range of magnitudes (``mw_in_table_range``: beyond it the
     inversion cannot answer).
     ``summary``: ``post.summary()`` when computed already."""
@@ -106,7 +107,7 @@ def truth_check(post, truth, summary=None):
     low, high = summary["magnitude_range"]
     warned = summary["reach_warning"] is not None
     epicentre_in_95 = post.contains(east, north, level=0.95)
-    distance_in_95 = bool(lo <= truth["distance_km"] <= hi)
+    distance_in_95 = bool(lo <= truth["distance_km"] <= (math.inf if hi is None else hi))
     return {"within_reach": post.within_reach(east, north),
             "reach_warning": warned,
             "epicentre_in_95_or_warned": epicentre_in_95 or warned,
@@ -119,7 +120,9 @@ def truth_check(post, truth, summary=None):
             "map_epicentre_error_km": float(math.hypot(map_e - east, map_n - north)),
             "reach_edge_fraction": summary["reach_edge_fraction"],
             "reach_edge_bayes_factor": summary["reach_edge_bayes_factor"],
-            "mw_in_95": bool(mw_lo - 1e-9 <= mw <= mw_hi + 1e-9),
+            "mw_in_95": bool(mw_lo - 1e-9 <= mw and (
+                mw <= mw_hi + 1e-9 or summary["magnitude_ci95_open_above"])),
+            "p_beyond": summary["p_beyond"],
             "mw_in_table": f"{mw:g}" in {f"{s['mw']:g}" for s in post.info.get(
                 "table_slices", post.slices)},
             "mw_in_table_range": bool(low - 1e-9 <= mw <= high + 1e-9),

@@ -19,7 +19,7 @@ sum_nodes w (1 - P_n): the sub-density of "fell toward psi" and the probability 
 standing are interpolated as mixtures of the four surrounding nodes, bilinearly in
 log distance (clamped at the first ring) and in node azimuth (periodic).  The inversion's
 candidates never lie beyond the last ring of a site
-(:func:`pipeline.inversion.posterior.invert`); only its test of the sources beyond
+(:func:`pipeline.inversion.posterior.invert`); only its shell of the sources beyond
 (:mod:`pipeline.inversion.beyond`) reads there: the last ring's direction density, its
 P carried on by the decay of log-odds P with log distance between the last two rings
 (never rising: a node whose P rises between them keeps its last P).  Interpolating in

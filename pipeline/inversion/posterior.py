@@ -1,6 +1,16 @@
 """The posterior over the candidates (:mod:`pipeline.inversion.candidates`): marginals,
 credible regions (:mod:`pipeline.inversion.credible`) and the outputs.
 
+The posterior carries the sources beyond the reach too: a shell of epicentres whose
+likelihood extrapolates the table past its last ring (:mod:`pipeline.inversion.beyond`,
+``beyond``), with probability ``p_beyond``.  ``probability`` and ``epicentre`` are the
+candidates' posterior given the source lies within the reach; the marginals, the regions
+and the summary are of the whole (candidates and shell).  Where the shell's cells lie in
+the 95 % epicentre region, the distance interval is open above (``None``) and the
+magnitude interval reaches the table's largest magnitude, or more
+(``magnitude_ci95_open_above``: the shell's falls are those of sources farther out, the
+larger the farther).
+
 The posterior's mass in the outermost cells of the candidates (``reach_edge_fraction``,
 f) against the prior's there (p) says when the answer is "farther than the candidates
 reach": the Bayes factor of "the source lies in the outermost cells" against "inside
@@ -25,7 +35,7 @@ import numpy as np
 import pandas as pd
 from scipy.special import logsumexp
 
-from pipeline.inversion.beyond import BEYOND_BAYES_FACTOR, ONE_SITE_NOTE, beyond_test
+from pipeline.inversion.beyond import ONE_SITE_NOTE, Beyond, beyond_shell
 from pipeline.inversion.candidates import reached_lattice, within_reach
 from pipeline.inversion.credible import arc_width, circular_credible, magnitude_interval
 from pipeline.inversion.fit import fit_check
@@ -52,23 +62,40 @@ class Posterior:
     log_likelihood: np.ndarray
     info: dict = field(default_factory=dict)
     edge: np.ndarray = None           # bool per epicentre: the outermost candidate cells
+    beyond: Beyond = None             # the shell beyond the reach (None: P(beyond) 0)
 
     def __post_init__(self):
         log_post = self.log_prior + self.log_likelihood
         self.log_evidence = float(logsumexp(log_post))
         self.probability = np.exp(log_post - self.log_evidence)
         self.epicentre = self.probability.sum(axis=(0, 1))
+        self.p_beyond = 0.0 if self.beyond is None else self.beyond.p_beyond
         self._sub = None
 
     # -------------------------------------------------------------- marginals
+    def cells(self):
+        """(east km, north km, area km^2, posterior mass, in the shell) of every cell: the
+        candidates' and then the shell's (:mod:`pipeline.inversion.beyond`)."""
+        p = self.p_beyond
+        n = self.east_km.size
+        parts = [(self.east_km, self.north_km, np.full(n, self.step_km ** 2),
+                  self.epicentre * (1.0 - p), np.zeros(n, bool))]
+        if self.beyond is not None and self.beyond.east_km.size:
+            shell = self.beyond
+            m = shell.east_km.size
+            parts.append((shell.east_km, shell.north_km, np.full(m, shell.step_km ** 2),
+                          shell.cell_mass * p, np.ones(m, bool)))
+        return tuple(np.concatenate(column) for column in zip(*parts))
+
     def _subsamples(self):
         if self._sub is None:
-            offsets = ((np.arange(SUBGRID) + 0.5) / SUBGRID - 0.5) * self.step_km
-            oe, on = np.meshgrid(offsets, offsets)
-            e = (self.east_km[:, None] + oe.ravel()[None, :]).ravel()
-            n = (self.north_km[:, None] + on.ravel()[None, :]).ravel()
-            mass = np.repeat(self.epicentre / SUBGRID ** 2, SUBGRID ** 2)
-            self._sub = (e, n, mass)
+            east, north, area, mass, _ = self.cells()
+            unit = (np.arange(SUBGRID) + 0.5) / SUBGRID - 0.5
+            oe, on = (o.ravel() for o in np.meshgrid(unit, unit))
+            side = np.sqrt(area)[:, None]
+            self._sub = ((east[:, None] + side * oe[None, :]).ravel(),
+                         (north[:, None] + side * on[None, :]).ravel(),
+                         np.repeat(mass / SUBGRID ** 2, SUBGRID ** 2))
         return self._sub
 
     def back_azimuth_marginal(self):
@@ -87,59 +114,85 @@ class Posterior:
         hist, _ = np.histogram(d, bins=edges, weights=mass)
         return edges[:-1] + bin_km / 2, hist / hist.sum()
 
-    def distance_interval(self, level=0.95):
+    def distance_interval(self, level=0.95, open_above=False):
         """[lo, hi] km from the first site: the shortest interval of distances holding
         ``level`` of the posterior (on the sub-grid; it reaches the candidates' last
-        distance when the posterior piles there, where equal tails would stop short)."""
+        distance when the posterior piles there, where equal tails would stop short);
+        ``open_above``: [lo, None], lo the distance of the nearest point of the cells of
+        the epicentre's HPD region at ``level`` (which holds the shell's cells)."""
         e, n, mass = self._subsamples()
         d = np.hypot(e, n)
         order = np.argsort(d, kind="stable")
         d = d[order]
         before = np.concatenate([[0.0], np.cumsum(mass[order]) / mass.sum()])
+        if open_above:          # the nearest point of the epicentre region's cells
+            east, north, area, _, _ = self.cells()
+            near = np.hypot(east, north) - np.sqrt(area / 2.0)
+            return [float(max(near[self.region(level)[0]].min(), 0.0)), None]
         ends = np.searchsorted(before, before[:-1] + level - 1e-12)   # one past the last
         starts = np.flatnonzero(ends < len(before))
         widths = d[ends[starts] - 1] - d[starts]
         k = starts[int(np.argmin(widths))]
         return [float(d[k]), float(d[ends[k] - 1])]
 
+    def _mixed(self, axis):
+        """The posterior over sources (axis (1, 2)) or strikes (axis (0, 2)), shell in."""
+        out = self.probability.sum(axis=axis) * (1.0 - self.p_beyond)
+        if self.beyond is not None and self.beyond.east_km.size:
+            out = out + self.beyond.probability.sum(axis=axis) * self.p_beyond
+        return out
+
     def marginal(self, key):
         """{value: probability} over slices' ``key`` (mechanism, depth_km, mw)."""
-        per_slice = self.probability.sum(axis=(1, 2))
         out = {}
-        for s, p in zip(self.slices, per_slice):
+        for s, p in zip(self.slices, self._mixed((1, 2))):
             out[s[key]] = out.get(s[key], 0.0) + float(p)
         return out
 
     def strike_marginal(self):
-        return self.strikes_deg, self.probability.sum(axis=(0, 2))
+        return self.strikes_deg, self._mixed((0, 2))
 
     # -------------------------------------------------------------- regions
-    def epicentre_region(self, level):
-        """Bool mask of the cells of the HPD region and the density threshold."""
-        order = np.argsort(-self.epicentre, kind="stable")
-        cum = np.cumsum(self.epicentre[order])
-        count = int(np.searchsorted(cum, level - 1e-12) + 1)
-        mask = np.zeros(self.epicentre.shape, bool)
+    def region(self, level):
+        """(bool over :meth:`cells`: the HPD region of the epicentre, the fewest cells of
+        the highest density holding ``level``; its least density, per km^2)."""
+        _, _, area, mass, _ = self.cells()
+        density = mass / area
+        order = np.argsort(-density, kind="stable")
+        cum = np.cumsum(mass[order])
+        count = min(int(np.searchsorted(cum, level * cum[-1] - 1e-12) + 1), order.size)
+        mask = np.zeros(mass.shape, bool)
         mask[order[:count]] = True
-        return mask, float(self.epicentre[order[count - 1]])
+        return mask, float(density[order[count - 1]])
+
+    def epicentre_region(self, level):
+        """Bool mask of the candidate cells of the HPD region and its threshold as a
+        candidate cell's ``epicentre`` (the shell's cells: :meth:`region`)."""
+        mask, density = self.region(level)
+        scale = self.step_km ** 2 / max(1.0 - self.p_beyond, 1e-300)
+        return mask[:self.east_km.size], density * scale
 
     def cell_of(self, east_km, north_km):
         return int(np.argmin(np.hypot(self.east_km - east_km, self.north_km - north_km)))
 
     def contains(self, east_km, north_km, level=0.95):
-        """Whether the cell holding (east, north) lies in the HPD region.  A point within
+        """Whether a cell holding (east, north) lies in the HPD region.  A point within
         the reach whose lattice cell is not a candidate (its centre beyond the last ring
         of a site: a sliver between the outermost centres and the reach's boundary)
-        belongs to the nearest candidate cell; a point beyond the reach or off the
-        lattice is in no cell (False)."""
+        belongs to the nearest candidate cell; a point beyond the reach to the shell's
+        cell holding it (:meth:`pipeline.inversion.beyond.Beyond.cell_of`); a point
+        beyond both, or off the lattice, is in no cell (False)."""
+        mask, _ = self.region(level)
         k = self.cell_of(east_km, north_km)
-        if max(abs(self.east_km[k] - east_km), abs(self.north_km[k] - north_km)) > \
-                self.step_km / 2 + 1e-9 and not (
-                    self.within_reach(east_km, north_km)
-                    and math.hypot(self.east_km[k] - east_km, self.north_km[k] - north_km)
-                    <= 2.0 * self.step_km + 1e-9):
-            return False
-        return bool(self.epicentre_region(level)[0][k])
+        held = max(abs(self.east_km[k] - east_km), abs(self.north_km[k] - north_km)) <= \
+            self.step_km / 2 + 1e-9 or (
+                self.within_reach(east_km, north_km)
+                and math.hypot(self.east_km[k] - east_km, self.north_km[k] - north_km)
+                <= 2.0 * self.step_km + 1e-9)
+        if held and mask[k]:
+            return True
+        j = None if self.beyond is None else self.beyond.cell_of(east_km, north_km)
+        return j is not None and bool(mask[self.east_km.size + j])
 
     def within_reach(self, east_km, north_km):
         """Whether (east, north) km lies where candidates may lie (:func:`within_reach`;
@@ -152,11 +205,15 @@ class Posterior:
     # -------------------------------------------------------------- outputs
     def summary(self):
         centres, mass = self.back_azimuth_marginal()
-        best = int(np.argmax(self.epicentre))
+        east, north, area, cell_mass, shell = self.cells()
+        best = int(np.argmax(cell_mass / area))
         joint = np.unravel_index(int(np.argmax(self.probability)), self.probability.shape)
         s = self.slices[joint[0]]
+        in_95, _ = self.region(0.95)
+        open_above = bool((in_95 & shell).any())       # the shell in the 95 % region
         out = {
-            "map_epicentre_km": [float(self.east_km[best]), float(self.north_km[best])],
+            "map_epicentre_km": [float(east[best]), float(north[best])],
+            "map_beyond_reach": bool(shell[best]),
             "back_azimuth_map_deg": float(centres[int(np.argmax(mass))]),
         }
         for level in LEVELS:
@@ -165,19 +222,22 @@ class Posterior:
             out[f"back_azimuth_ci{tag}_deg"] = arc
             out[f"back_azimuth_ci{tag}_width_deg"] = arc_width(arc)
             out[f"back_azimuth_hpd{tag}_arcs_deg"] = arcs
-        out["distance_ci95_km"] = self.distance_interval(0.95)
+        out["distance_ci95_km"] = self.distance_interval(0.95, open_above)
+        out["distance_ci95_unbounded"] = open_above
         out["mechanism_posterior"] = self.marginal("mechanism")
         out["depth_posterior"] = {f"{k:g}": v for k, v in self.marginal("depth_km").items()}
         out["magnitude_posterior"] = {f"{k:g}": v for k, v in self.marginal("mw").items()}
-        out["magnitude_ci95"] = magnitude_interval(self.marginal("mw"), 0.95)
         mws = [s["mw"] for s in self.slices]
+        lo, hi = magnitude_interval(self.marginal("mw"), 0.95)
+        out["magnitude_ci95"] = [lo, float(max(mws)) if open_above else hi]
+        out["magnitude_ci95_open_above"] = open_above
         out["magnitude_range"] = [float(min(mws)), float(max(mws))]
         strikes, pstrike = self.strike_marginal()
         out["strike_posterior"] = {f"{k:g}": float(v) for k, v in zip(strikes, pstrike)}
         for level in LEVELS:
-            mask, _ = self.epicentre_region(level)
-            out[f"credible_area_{int(round(level * 100))}_km2"] = float(
-                mask.sum() * self.step_km ** 2)
+            mask, _ = self.region(level)
+            out[f"credible_area_{int(round(level * 100))}_km2"] = float(area[mask].sum())
+        out["beyond_in_95"] = open_above
         out["map_candidate"] = {"mechanism": s["mechanism"], "dip_deg": s["dip_deg"],
                                 "rake_deg": s["rake_deg"], "depth_km": s["depth_km"],
                                 "mw": s["mw"], "strike_deg": float(self.strikes_deg[joint[1]]),
@@ -204,13 +264,11 @@ class Posterior:
         factor, the fit check's p-value (:mod:`pipeline.inversion.fit`) and a warning line
         (None) when the factor passes EDGE_BAYES_FACTOR or the fit check warns."""
         reach = self.info.get("reach_km")
-        beyond = self.info.get("beyond") or {}
-        beyond_factor = beyond.get("beyond_bayes_factor")
-        beyond_warning = beyond_factor is not None and beyond_factor > BEYOND_BAYES_FACTOR
         one_site = len(self.info.get("sites_km") or ()) == 1 and reach is not None
-        tested = {"beyond_bayes_factor": beyond_factor,
-                  "beyond_shell_km": beyond.get("beyond_shell_km"),
-                  "beyond_warning": bool(beyond_warning),
+        tested = {**(self.beyond.summary() if self.beyond is not None else
+                     {"beyond_bayes_factor": None, "beyond_shell_km": None,
+                      "beyond_warning": False, "p_beyond": 0.0, "beyond_cells": 0,
+                      "beyond_prior": None, "beyond_extrapolated": None}),
                   "reach_note": ONE_SITE_NOTE.format(reach=reach) if one_site else None}
         if self.edge is None or reach is None:
             return {"reach_km": reach, "reach_limit": None, "reach_edge_fraction": None,
@@ -228,17 +286,20 @@ class Posterior:
                        f"against {prior_fraction:.0%} of the prior (odds {factor:.3g} times "
                        "the prior's): the source may lie farther than this inversion can "
                        "tell, and its direction from the first site is not known either")
-        if beyond_warning:
-            lo, hi = beyond["beyond_shell_km"]
-            said = (f"the falls are {beyond_factor:.3g} times as likely from a source beyond "
-                    f"the reach (farthest site {lo:g}-{hi:g} km, the table's decay with "
-                    "distance carried on) as from one within it: the source may lie farther "
-                    "than this inversion can tell, and its direction from the first site is "
-                    "not known either")
+        if tested["beyond_warning"]:
+            lo, hi = tested["beyond_shell_km"]
+            said = (f"the falls are {tested['beyond_bayes_factor']:.3g} times as likely from "
+                    f"a source beyond the reach (farthest site {lo:g}-{hi:g} km, the table's "
+                    "decay with distance carried on) as from one within it: the source may "
+                    "lie farther than this inversion can tell, and its direction from the "
+                    "first site is not known either")
             warning = said if warning is None else f"{warning}; and {said}"
         if fit.get("fit_warning"):
             warning = fit["fit_warning"] if warning is None else \
                 f"{warning}; and {fit['fit_warning']}"
+        if warning is not None and self.beyond is not None and self.beyond.east_km.size:
+            warning = (f"P(beyond the reach) {self.p_beyond:.2f} (the posterior's mass "
+                       f"beyond the last ring): {warning}")
         return {"reach_km": float(reach), "reach_limit": self.info.get("reach_limit"),
                 "reach_edge_fraction": fraction,
                 "reach_edge_prior_fraction": prior_fraction,
@@ -248,26 +309,35 @@ class Posterior:
                 "fit_warning": fit.get("fit_warning"), **tested, "reach_warning": warning}
 
     def frame(self):
-        """One row per candidate: posterior.csv."""
-        ns, nphi, ne = self.probability.shape
-        s_idx, f_idx, e_idx = np.meshgrid(np.arange(ns), np.arange(nphi), np.arange(ne),
-                                          indexing="ij")
-        s_idx, f_idx, e_idx = s_idx.ravel(), f_idx.ravel(), e_idx.ravel()
-        east, north = self.east_km[e_idx], self.north_km[e_idx]
-        return pd.DataFrame({
-            "mechanism": [self.slices[k]["mechanism"] for k in s_idx],
-            "dip_deg": [self.slices[k]["dip_deg"] for k in s_idx],
-            "rake_deg": [self.slices[k]["rake_deg"] for k in s_idx],
-            "depth_km": [self.slices[k]["depth_km"] for k in s_idx],
-            "mw": [self.slices[k]["mw"] for k in s_idx],
-            "strike_deg": self.strikes_deg[f_idx],
-            "east_km": np.round(east, 6), "north_km": np.round(north, 6),
-            "distance_km": np.round(np.hypot(east, north), 6),
-            "back_azimuth_deg": np.round(azimuth_deg(east, north), 4),
-            "log_prior": self.log_prior.ravel() if self.log_prior.size == s_idx.size else
-            np.broadcast_to(self.log_prior, self.probability.shape).ravel(),
-            "log_likelihood": self.log_likelihood.ravel(),
-            "posterior": self.probability.ravel()})
+        """One row per candidate and per cell of the shell beyond the reach (``beyond_reach``,
+        its likelihood extrapolated, its log prior and likelihood not written): the
+        posterior of the whole (summing to 1 over both): posterior.csv."""
+        log_prior = np.broadcast_to(self.log_prior, self.probability.shape)
+        parts = [_rows(self, self.probability * (1.0 - self.p_beyond), self.east_km,
+                       self.north_km, log_prior, self.log_likelihood, False)]
+        if self.beyond is not None and self.beyond.east_km.size:
+            shell = self.beyond
+            nan = np.full(shell.probability.shape, np.nan)
+            parts.append(_rows(self, shell.probability * self.p_beyond, shell.east_km,
+                               shell.north_km, nan, nan, True))
+        return pd.concat(parts, ignore_index=True)
+
+
+def _rows(post, probability, east_km, north_km, log_prior, log_likelihood, beyond):
+    ns, nphi, ne = probability.shape
+    s_idx, f_idx, e_idx = (i.ravel() for i in np.meshgrid(
+        np.arange(ns), np.arange(nphi), np.arange(ne), indexing="ij"))
+    east, north = east_km[e_idx], north_km[e_idx]
+    return pd.DataFrame({
+        **{key: [post.slices[k][key] for k in s_idx]
+           for key in ("mechanism", "dip_deg", "rake_deg", "depth_km", "mw")},
+        "strike_deg": post.strikes_deg[f_idx],
+        "east_km": np.round(east, 6), "north_km": np.round(north, 6),
+        "distance_km": np.round(np.hypot(east, north), 6),
+        "back_azimuth_deg": np.round(azimuth_deg(east, north), 4),
+        "beyond_reach": np.full(s_idx.size, beyond),
+        "log_prior": log_prior.ravel(), "log_likelihood": log_likelihood.ravel(),
+        "posterior": probability.ravel()})
 
 
 def edge_bayes_factor(fraction, prior_fraction):
@@ -314,9 +384,9 @@ def invert(model, observations, grid):
             "sites_km": [[s.east_km, s.north_km] for s in observations.sites],
             "table_slices": model.table.slices}
     post = Posterior(model.sources, strikes, east, north, grid.step_km, log_prior,
-                     loglike, info=info, edge=grid.edge_cells(east, north))
+                     loglike, info=info, edge=grid.edge_cells(east, north),
+                     beyond=beyond_shell(model, observations, grid, log_prior_slice, loglike))
     post.info["fit"] = fit_check(model, observations, post)
-    post.info["beyond"] = beyond_test(model, observations, grid, log_prior_slice, loglike)
     return post
 
 

@@ -36,7 +36,10 @@ whether the true Mw lies in the smallest set of table magnitudes holding 95 % of
 posterior, and the posterior probability of the true Mw.  Per placement
 (:func:`placement_summary`): the coverages of back azimuth, distance, epicentre and
 magnitude and how often the reach warning is given; over the trials within the reach its
-false alarms, beyond the reach its hits.
+false alarms, beyond the reach its hits.  The shell beyond the reach in the posterior
+(:mod:`pipeline.inversion.beyond`): each trial's P(beyond) (``p_beyond``), whether the
+shell lies in the 95 % epicentre region (``beyond_in_95``) and how many of its sites lie
+beyond the likelihood's last ring from the source (``sites_beyond``).
 """
 
 import os
@@ -193,6 +196,9 @@ def study_trial(models, pool, n_sites, fallen, candidates, rng):
            "site_distances_km": " ".join(f"{np.hypot(e, n):g}" for _, e, n, _ in sites),
            "standing_observed": sum(not c.fallen for *_, cols in sites for c in cols),
            "no_candidate": False,
+           # sites farther from the source than the likelihood's last ring
+           "sites_beyond": int(sum(pool.distances_km[i] > model.table.distances_km[-1] + 1e-9
+                                   for i, _ in [start] + [rest[p] for p in picks])),
            # a site as far as the likelihood's last ring: the source at the reach's edge
            "at_reach_edge": bool(max(np.hypot(e, n) for _, e, n, _ in sites)
                                  >= model.table.distances_km[-1] - candidates.step_km)}
@@ -207,7 +213,7 @@ def study_trial(models, pool, n_sites, fallen, candidates, rng):
                 "mw_ci95_width": np.nan, "reach_edge_bayes_factor": np.nan,
                 "reach_edge_warning": False, "fit_warning": False, "fit_p_value": np.nan,
                 "beyond_bayes_factor": np.nan, "beyond_warning": False,
-                "p_true_mechanism": np.nan}
+                "p_beyond": np.nan, "beyond_in_95": False, "p_true_mechanism": np.nan}
     summary = post.summary()
     check = truth_check(post, {"epicentre_km": truth, "back_azimuth_deg": true_baz,
                                "distance_km": row["true_distance_km"],
@@ -227,6 +233,7 @@ def study_trial(models, pool, n_sites, fallen, candidates, rng):
             "fit_p_value": summary["fit_p_value"],
             "beyond_bayes_factor": summary["beyond_bayes_factor"],
             "beyond_warning": summary["beyond_warning"],
+            "p_beyond": summary["p_beyond"], "beyond_in_95": summary["beyond_in_95"],
             "mw_in_95": check["mw_in_95"], "mw_ci95_width": hi - lo,
             "p_true_mw": summary["magnitude_posterior"][nearest],
             "p_true_mechanism": summary["mechanism_posterior"].get(row["mechanism"], 0.0)}

@@ -216,3 +216,50 @@ def _directed(widths_deg):
             else float("nan"),
             "width_median_directed_deg": float(directed.median()) if len(directed)
             else float("nan")}
+
+
+REGIONS = ("distance_in_95", "epicentre_in_95", "mw_in_95")
+
+
+def beyond_hypothesis(trials):
+    """{likelihood: {likelihood_members, beyond: {sites: {sites beyond the reach: ...}},
+    well_within: {sites: ...}}} at each likelihood's largest member count: for the sources
+    beyond the reach, the coverage of the distance, epicentre and magnitude regions (a
+    region holds the truth or the inversion refuses: ``coverage_*``, Wilson intervals),
+    per number of sites and per number of those beyond the reach (``all`` pooled); for the
+    sources well within it, the posterior's mass put beyond (``p_beyond_*``, refusals
+    left out), the share whose 95 % region holds the shell and the same coverages."""
+    if "p_beyond" not in trials.columns:
+        return {}
+    out = {}
+    for kind, g in trials.groupby("likelihood"):
+        g = g[g["likelihood_members"] == g["likelihood_members"].max()]
+        inside = g["within_reach"].astype(bool)
+        well = g[inside & ~g["at_reach_edge"].astype(bool)]
+        beyond = {}
+        for sites, part in g[~inside].groupby("sites"):
+            beyond[str(int(sites))] = {"all": _covered(part), **{
+                str(int(n)): _covered(q) for n, q in part.groupby("sites_beyond")}}
+        within = {}
+        for sites, part in well.groupby("sites"):
+            p = part["p_beyond"].dropna()
+            within[str(int(sites))] = {
+                **_covered(part), "p_beyond_mean": float(p.mean()) if len(p) else None,
+                "p_beyond_median": float(p.median()) if len(p) else None,
+                "p_beyond_p90": float(p.quantile(0.9)) if len(p) else None,
+                "beyond_in_95": float(part["beyond_in_95"].astype(bool).mean())}
+        out[kind] = {"likelihood_members": int(g["likelihood_members"].iloc[0]),
+                     "beyond": beyond, "well_within": within}
+    return out
+
+
+def _covered(part):
+    """Trials, the share refused, and each region's coverage (held or refused)."""
+    refused = part["no_candidate"].astype(bool)
+    entry = {"trials": len(part), "refused": float(refused.mean())}
+    for column in REGIONS:
+        hits = int((part[column].astype(bool) | refused).sum())
+        name = "coverage_" + column.replace("_in_", "_")
+        entry[name] = hits / len(part)
+        entry[f"{name}_ci95"] = list(wilson_interval(hits, len(part)))
+    return entry

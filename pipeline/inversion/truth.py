@@ -122,6 +122,10 @@ def parse_truth(data, source="truth"):
         if not 0.05 <= distance <= 100.0:
             raise InputError(f"{where}: {distance:.2f} km from the epicentre; the generator "
                              "takes 0.05-100 km")
+        for other, oe, on, _ in parsed:        # the observations file's rule, before any run
+            if math.hypot(e - oe, n - on) < 1e-6:
+                raise InputError(f"{source}: sites {other} and {name} are at the same place; "
+                                 "give one site with more twins")
         parsed.append((name, e, n, twins))
     seed = data.get("seed", TRUTH_SEED)
     if isinstance(seed, bool) or not isinstance(seed, int) or not 0 <= seed < 2 ** 62:

@@ -24,8 +24,8 @@ from pipeline.inversion.grid import TableGrid
 from pipeline.inversion.likelihood import SITE_COLUMNS
 from pipeline.inversion.observations import load_observations, parse_observations
 from pipeline.inversion.paper_scenario import paper_grid, paper_nodes
-from pipeline.inversion.study_summary import placement_summary, study_answer, study_summary, \
-    warning_rates
+from pipeline.inversion.study_summary import beyond_hypothesis, placement_summary, \
+    study_answer, study_summary, warning_rates
 from pipeline.inversion.table import ForwardTable
 from pipeline.inversion.truth import check_hidden, load_truth
 from pipeline.scenario.column_format import example_names
@@ -217,6 +217,7 @@ def member_study(options, grid, candidates):
         "forward_table": info, "figure": figure.name, "source_figure": source_figure.name,
         "toppled_fraction_by_slice": table.toppled_fraction_by_slice(),
         "reach_warning": warning_rates(placements),
+        "beyond_hypothesis": beyond_hypothesis(rows),
         "elapsed_s": round(time.monotonic() - started, 1)})
     for text in answer.values():
         log.info(text)
@@ -309,12 +310,16 @@ def invert_file(observations_file, options, grid, candidates, site_fragility=Non
                  if summary["back_azimuth_map_deg"] is None else
                  f"MAP {summary['back_azimuth_map_deg']:.0f} deg, 95 % arc [{lo:.0f}, {hi:.0f}] "
                  f"({summary['back_azimuth_ci95_width_deg']:.0f} deg)")
+    lo_km, hi_km = summary["distance_ci95_km"]
+    far = "unbounded" if hi_km is None else f"{hi_km:.1f} km"
+    more = " or more (extrapolated)" if summary["magnitude_ci95_open_above"] else ""
     log.info(f"back azimuth from {summary['first_site']}: {direction}; distance 95 % "
-             f"{summary['distance_ci95_km'][0]:.1f}-{summary['distance_ci95_km'][1]:.1f} km; "
-             f"95 % area {summary['credible_area_95_km2']:.0f} km^2; Mw 95 % "
-             f"{summary['magnitude_ci95'][0]:g}-{summary['magnitude_ci95'][1]:g} (the table's "
-             f"{summary['magnitude_range'][0]:g}-{summary['magnitude_range'][1]:g}); most "
-             f"probable mechanism {mech} ({summary['mechanism_posterior'][mech]:.2f})")
+             f"{lo_km:.1f} km to {far}; 95 % area {summary['credible_area_95_km2']:.0f} km^2; "
+             f"Mw 95 % {summary['magnitude_ci95'][0]:g}-{summary['magnitude_ci95'][1]:g}"
+             f"{more} (the table's {summary['magnitude_range'][0]:g}-"
+             f"{summary['magnitude_range'][1]:g}); P(beyond the reach) "
+             f"{summary['p_beyond']:.2f}; most probable mechanism {mech} "
+             f"({summary['mechanism_posterior'][mech]:.2f})")
     _say_reach(summary)
     for site in (motions or {}).get("sites", []):
         lo_g, hi_g = site["pga_interval95_g"]

@@ -21,7 +21,8 @@ from pipeline.report.ensembles import (convergence_section, ensemble_section,
 from pipeline.report.fragility import fragility_section, rock_fragility_section
 from pipeline.report.field_rock import FIELD_ROCK_QUICK, field_rock_section
 from pipeline.report.hazard import survival_section
-from pipeline.report.inversion import inversion_section, member_study_section
+from pipeline.report.inversion import inversion_section
+from pipeline.report.member_study import member_study_section
 from pipeline.report.shake_table_scores import QUICK as SCORES_QUICK
 from pipeline.report.shake_table_scores import shake_table_scores_section
 from pipeline.report.records import (back_azimuth_table, correlation_table, per_record_table,

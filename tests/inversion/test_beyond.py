@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 from scipy.special import expit, logit
 
-from pipeline.inversion.beyond import BEYOND_BAYES_FACTOR, SHELL_FACTOR, shell_lattice
+from pipeline.inversion.beyond import BEYOND_BAYES_FACTOR, SHELL_FACTOR, SHELL_STEP, shell_lattice
 from pipeline.inversion.candidates import CandidateGrid
 from pipeline.inversion.likelihood import ForwardModel
 from pipeline.inversion.posterior import invert
@@ -73,7 +73,9 @@ def test_a_source_well_within_the_reach_is_not(table):
 
 def test_the_shell_lies_beyond_the_last_ring_of_some_site_and_within_twice_it(table):
     observations = hidden_source((3.0, 4.0), {"A": (0.0, 0.0), "B": (6.0, 0.0)})
-    east, north = shell_lattice(observations, CandidateGrid(radius_km=30, step_km=1), 10.0)
+    east, north, step = shell_lattice(observations, CandidateGrid(radius_km=30, step_km=1),
+                                      10.0)
+    assert step == 2.0
     farthest = np.maximum(np.hypot(east, north), np.hypot(east - 6.0, north))
     assert east.size and (farthest > 10.0).all() and (farthest <= 20.0 + 1e-9).all()
 
@@ -111,3 +113,127 @@ def test_invert_prints_the_one_site_note_and_writes_the_tests_keys(table, tmp_pa
     assert f"note: {summary['reach_note']}" in capsys.readouterr().out
     assert summary["beyond_shell_km"] == [10.0, 20.0] and summary["beyond_warning"] is False
     assert 0 < summary["beyond_bayes_factor"] < BEYOND_BAYES_FACTOR
+
+
+# ---------------------------------------------------------------- the shell in the posterior
+REACH_KM = {6.0: 2.5, 7.0: 5.0}     # the toy's share that falls: min(1, R(Mw) / r)
+
+
+def magnitudes_table(members=16):
+    """Two magnitudes of one mechanism: a share min(1, R / r) of the columns falls away
+    from the source, R 2.5 km at Mw 6 and 5 km at Mw 7 (the larger reaches twice as far:
+    its falls at 2 r are the smaller one's at r); rings 2.5, 5 and 10 km."""
+    from pipeline.inversion.table import ForwardTable
+    slices = [("strike-slip", 90.0, 180.0, 10.0, mw) for mw in REACH_KM]
+    azimuths = tuple(np.arange(0.0, 360.0, 30.0))
+    falls = [[[[[theta if k < round(members * min(1.0, REACH_KM[mw] / r)) else None
+                 for k in range(members)] for _ in range(2)] for theta in azimuths]
+              for r in RINGS] for *_, mw in slices]
+    return ForwardTable.toy(slices, RINGS, azimuths, falls)
+
+
+def magnitude_source(truth, sites, mw, columns=12):
+    """Observations of ``columns`` columns a site of a source of ``mw`` at ``truth``."""
+    from pipeline.inversion.observations import parse_observations
+    out = []
+    for name, (e, n) in sites.items():
+        r = math.hypot(e - truth[0], n - truth[1])
+        away = math.degrees(math.atan2(e - truth[0], n - truth[1])) % 360.0
+        fallen = round(columns * min(1.0, REACH_KM[mw] / r))
+        out.append({"name": name, "east_km": e, "north_km": n, "columns": [
+            {"column": "drums" if k % 2 else "monolithic", "state": "fallen",
+             "downfall_azimuth_deg": away, "uncertainty_deg": 10} if k < fallen else
+            {"column": "drums" if k % 2 else "monolithic", "state": "standing"}
+            for k in range(columns)]})
+    return parse_observations({"sites": out})
+
+
+def posterior_of(table, truth, sites, mw):
+    from pipeline.inversion import truth_check
+    observations = magnitude_source(truth, sites, mw)
+    post = invert(ForwardModel(table), observations, CandidateGrid(radius_km=30, step_km=1))
+    e0, n0 = next(iter(sites.values()))
+    e, n = truth[0] - e0, truth[1] - n0
+    summary = post.summary()
+    return post, summary, truth_check(post, {
+        "epicentre_km": [e, n], "distance_km": math.hypot(e, n),
+        "back_azimuth_deg": math.degrees(math.atan2(e, n)) % 360.0,
+        "mechanism": "strike-slip", "mw": mw}, summary)
+
+
+def test_a_larger_source_beyond_the_reach_is_held_by_the_shell_and_its_magnitudes():
+    """An Mw 7 source 12.7-13 km from three sites (every site beyond the 10 km ring; its
+    falls those of an Mw 6 at 6-7 km, inside the reach): most of the posterior lies
+    beyond, and the 95 % regions hold the source: its cell, its distance (open above) and
+    its magnitude (the table's largest, or more)."""
+    sites = {"A": (0.0, 13.0), "B": (9.0, 9.0), "C": (-9.0, 9.0)}
+    post, summary, found = posterior_of(magnitudes_table(), (0.0, 0.0), sites, 7.0)
+    assert not found["within_reach"]
+    assert summary["p_beyond"] > 0.3 and summary["beyond_in_95"]
+    assert summary["reach_warning"].startswith(f"P(beyond the reach) {summary['p_beyond']:.2f}")
+    assert found["epicentre_in_95"] and found["distance_in_95"] and found["mw_in_95"]
+    assert summary["distance_ci95_km"][1] is None and summary["distance_ci95_unbounded"]
+    assert summary["magnitude_ci95"][1] == 7.0 and summary["magnitude_ci95_open_above"]
+    assert summary["beyond_extrapolated"] and summary["beyond_prior"] == 0.05
+    # P(beyond) is the test's Bayes factor B times the prior odds 0.05 : 0.95, as odds
+    odds = summary["beyond_bayes_factor"] * 0.05 / 0.95
+    assert summary["p_beyond"] == pytest.approx(odds / (1.0 + odds), rel=1e-12)
+
+
+def test_a_source_well_within_the_reach_keeps_its_regions():
+    """An Mw 6 source 3-5 km from three sites: almost nothing beyond, and the regions, the
+    intervals and the magnitudes are those of the candidates alone (a posterior built
+    without the shell)."""
+    from pipeline.inversion.posterior import Posterior
+    sites = {"A": (4.0, 0.0), "B": (-2.0, -3.0), "C": (0.0, 5.0)}
+    post, summary, found = posterior_of(magnitudes_table(), (0.0, 0.0), sites, 6.0)
+    assert found["within_reach"] and summary["p_beyond"] < 1e-3
+    assert not summary["beyond_in_95"] and summary["reach_warning"] is None
+    alone = Posterior(post.slices, post.strikes_deg, post.east_km, post.north_km,
+                      post.step_km, post.log_prior, post.log_likelihood, info=post.info,
+                      edge=post.edge)
+    expected = alone.summary()
+    for key in ("credible_area_95_km2", "credible_area_68_km2", "magnitude_ci95",
+                "back_azimuth_ci95_deg", "map_epicentre_km"):
+        assert summary[key] == expected[key]
+    assert summary["distance_ci95_km"] == pytest.approx(expected["distance_ci95_km"], abs=0.05)
+    assert (post.epicentre_region(0.95)[0] == alone.epicentre_region(0.95)[0]).all()
+    assert found["epicentre_in_95"] and found["distance_in_95"] and found["mw_in_95"]
+
+
+def test_the_mass_beyond_adds_up_in_the_frame_and_the_region():
+    """posterior.csv's rows sum to 1, the shell's to P(beyond); the 95 % region holds 95 %
+    of the whole, and its area is its candidate cells' and its shell cells' (the shell's
+    cells SHELL_STEP times the candidates' step)."""
+    sites = {"A": (0.0, 14.0), "B": (8.0, 15.0)}
+    post, summary, _ = posterior_of(magnitudes_table(), (0.0, 0.0), sites, 7.0)
+    frame = post.frame()
+    assert frame["posterior"].sum() == pytest.approx(1.0, abs=1e-9)
+    shell = frame[frame["beyond_reach"]]
+    assert shell["posterior"].sum() == pytest.approx(summary["p_beyond"], abs=1e-9)
+    assert len(shell) == summary["beyond_cells"] * len(post.slices) * len(post.strikes_deg)
+    mask, _ = post.region(0.95)
+    _, _, area, mass, in_shell = post.cells()
+    assert mass.sum() == pytest.approx(1.0) and mass[mask].sum() >= 0.95 - 1e-9
+    assert mass[mask].sum() - mass[mask].min() < 0.95          # the fewest cells
+    n = post.east_km.size
+    assert summary["credible_area_95_km2"] == pytest.approx(
+        mask[:n].sum() * 1.0 + mask[n:].sum() * (SHELL_STEP * 1.0) ** 2)
+    assert mass[in_shell].sum() == pytest.approx(summary["p_beyond"])
+    assert sum(summary["magnitude_posterior"].values()) == pytest.approx(1.0)
+
+
+def test_the_shells_result_checks_itself_on_construction():
+    """A shell's posterior that does not sum to 1, or a Bayes factor without shell cells,
+    is refused when built."""
+    from pipeline.inversion.beyond import Beyond
+    cells = {"shell_km": (10.0, 20.0), "sites_km": ((0.0, 0.0),), "radius_km": 30.0,
+             "step_km": 2.0, "east_km": np.array([11.0]), "north_km": np.array([1.0])}
+    with pytest.raises(ValueError, match="does not sum to 1"):
+        Beyond(**cells, probability=np.full((1, 1, 1), 0.5), log_bayes_factor=0.0)
+    with pytest.raises(ValueError, match="needs shell cells"):
+        Beyond(**{**cells, "east_km": np.zeros(0), "north_km": np.zeros(0)},
+               probability=np.zeros((1, 1, 0)), log_bayes_factor=0.0)
+    shell = Beyond(**cells, probability=np.ones((1, 1, 1)), log_bayes_factor=math.log(19.0))
+    assert shell.p_beyond == pytest.approx(0.5) and shell.warning
+    assert shell.cell_of(11.5, 0.2) == 0 and shell.cell_of(25.0, 0.0) is None

@@ -86,8 +86,9 @@ def test_no_candidate_lies_beyond_the_last_ring_of_a_site(table):
 
 def test_a_source_beyond_the_last_ring_is_said_to_lie_beyond(table):
     """Two sites 14 and 17 km from the source, 4 km apart: the table's rings end at 10 km,
-    so no candidate holds the truth; few columns fell, the posterior piles against the
-    reach's edge and the summary says the source may lie farther."""
+    so no candidate holds the truth; few columns fell, the candidates' posterior piles
+    against the reach's edge and the summary says the source may lie farther; the shell
+    beyond the reach holds it."""
     truth = (0.0, 0.0)
     sites = {"A": (0.0, 14.0), "B": (8.0, 15.0)}
     post, summary, found = check(table, truth, sites)
@@ -100,7 +101,9 @@ def test_a_source_beyond_the_last_ring_is_said_to_lie_beyond(table):
     assert summary["back_azimuth_ci95_deg"] == [0.0, 360.0] and found["back_azimuth_in_95"]
     assert summary["back_azimuth_within_reach"]["back_azimuth_ci95_width_deg"] < 360.0
     assert found["distance_in_95_or_warned"] and found["epicentre_in_95_or_warned"]
-    assert not (found["distance_in_95"] or found["epicentre_in_95"])   # nothing can hold it
+    # no candidate can hold it; the shell beyond the reach does, and says how likely it is
+    assert summary["beyond_in_95"] and summary["p_beyond"] > 0.1
+    assert found["distance_in_95"] and found["epicentre_in_95"]
 
 
 def test_a_source_between_the_rings_is_held_by_the_regions(table):
@@ -174,6 +177,32 @@ def test_a_hidden_truth_out_of_reach_is_refused_before_any_run(table, tmp_path, 
     assert not out.exists()
 
 
+def test_a_hidden_truth_with_two_sites_at_one_place_is_refused_before_any_run(
+        table, tmp_path, capsys, monkeypatch):
+    """Two sites of a truth file at one place: one line, exit 2, no campaign run (pyprop8
+    or YADE) and nothing written."""
+    import json
+
+    import pipeline.inversion.workflows as workflows
+
+    def no_run(*args, **kwargs):
+        raise AssertionError("a campaign ran")
+    monkeypatch.setattr(workflows, "run_campaign", no_run)
+    path = table.save(tmp_path / "toy.npz")
+    truth = tmp_path / "truth.json"
+    truth.write_text(json.dumps({
+        "source": {"mechanism": "strike-slip", "strike_deg": 30, "depth_km": 10, "mw": 6.5,
+                   "east_km": 0, "north_km": 0},
+        "sites": [{"name": "A", "east_km": 3, "north_km": 1, "twins": 1},
+                  {"name": "B", "east_km": 3, "north_km": 1, "twins": 2}]}))
+    out = tmp_path / "out"
+    assert cli.main(["invert", "--hidden-truth", str(truth), "--table", str(path),
+                     "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert "sites A and B are at the same place" in err and len(err.strip().splitlines()) == 1
+    assert not out.exists()
+
+
 def test_edge_bayes_factor_is_a_finite_number_at_the_ends():
     """All the posterior in the outermost cells: a large finite factor (JSON holds it);
     every candidate an outermost cell: the data cannot favour them, factor 1."""
@@ -192,12 +221,15 @@ def test_a_point_on_the_reachs_edge_belongs_to_its_nearest_candidate_cell(table)
     (7.05, 7.03) km lies 9.96 km from the site, inside the reach, but its cell's centre
     (7.5, 7.5) lies 10.6 km away and is no candidate; it belongs to the nearest candidate,
     (7.5, 6.5) (9.92 km).
-    The point (7.2, 7.2), 10.18 km away, lies beyond the reach: in no cell.  With the
-    whole posterior as the region (level 1) the first is held, the second is not."""
+    The point (7.2, 7.2), 10.18 km away, lies beyond the reach: in no candidate cell, but
+    in the shell beyond it (10-20 km).  With the whole posterior as the region (level 1)
+    both are held; a point 30 km away, beyond the shell too, is not."""
     observations = hidden_source((0.0, 3.0), {"A": (0.0, 0.0)})
     post = invert(ForwardModel(table), observations, CandidateGrid(radius_km=12, step_km=1))
     cells = set(zip(np.round(post.east_km, 3), np.round(post.north_km, 3)))
     assert (7.5, 7.5) not in cells and {(6.5, 7.5), (7.5, 6.5)} <= cells
     assert post.contains(7.05, 7.03, level=1.0)
-    assert not post.contains(7.2, 7.2, level=1.0)
-    assert not post.contains(30.0, 0.0, level=1.0)              # off the lattice
+    k = post.cell_of(7.2, 7.2)
+    assert max(abs(post.east_km[k] - 7.2), abs(post.north_km[k] - 7.2)) > 0.5
+    assert post.beyond.cell_of(7.2, 7.2) is not None and post.contains(7.2, 7.2, level=1.0)
+    assert not post.contains(30.0, 0.0, level=1.0)              # beyond the shell

@@ -102,6 +102,7 @@ def test_member_study_command_on_a_table_file(make_away_table, tmp_path, capsys)
     result = json.loads((out / "member_study.json").read_text())
     assert result["likelihood_members"] == [3, 6]          # 24 - 16 observed: 8 usable
     assert set(result["answer"]) == {"independent", "predictive"}
+    assert set(result["beyond_hypothesis"]) == {"independent", "predictive"}
     assert "members per node" in capsys.readouterr().out
     assert cli.main(["invert", "--member-study", "--demo"]) == 2
     from pipeline.report import member_study_section
@@ -180,3 +181,45 @@ def test_truths_lie_off_the_likelihoods_nodes_too(make_away_table):
     spokes = rows[rows["placement"] == "between_spokes"]
     from_strike = (spokes["true_back_azimuth_deg"] + 180.0 - spokes["strike_deg"]) % 360.0
     assert np.allclose((from_strike + 1e-6) % 60.0, 30.0 + 1e-6, atol=1e-6)
+
+
+def test_the_shell_beyond_the_reach_is_summed_by_sites_and_sites_beyond():
+    """Hand-made trials: beyond the reach a refusal counts as covered, a region holding
+    the truth too, and the rest not; well within, P(beyond) is averaged without the
+    refusals; only the largest likelihood size counts."""
+    import pandas as pd
+
+    from pipeline.inversion.study_summary import beyond_hypothesis
+    base = {"likelihood": "predictive", "likelihood_members": 48, "at_reach_edge": False,
+            "mw_in_95": True}
+    rows = [  # beyond the reach, 3 sites: 1 beyond (held), 1 beyond (missed), 2 (refused)
+        {**base, "within_reach": False, "sites": 3, "sites_beyond": 1, "no_candidate": False,
+         "distance_in_95": True, "epicentre_in_95": True, "p_beyond": 0.8,
+         "beyond_in_95": True},
+        {**base, "within_reach": False, "sites": 3, "sites_beyond": 1, "no_candidate": False,
+         "distance_in_95": False, "epicentre_in_95": False, "p_beyond": 0.01,
+         "beyond_in_95": False, "mw_in_95": False},
+        {**base, "within_reach": False, "sites": 3, "sites_beyond": 2, "no_candidate": True,
+         "distance_in_95": False, "epicentre_in_95": False, "p_beyond": float("nan"),
+         "beyond_in_95": False, "mw_in_95": False},
+        # well within, 3 sites: P(beyond) 0.02 and 0.04, and a refusal (left out)
+        {**base, "within_reach": True, "sites": 3, "sites_beyond": 0, "no_candidate": False,
+         "distance_in_95": True, "epicentre_in_95": True, "p_beyond": 0.02,
+         "beyond_in_95": False},
+        {**base, "within_reach": True, "sites": 3, "sites_beyond": 0, "no_candidate": False,
+         "distance_in_95": True, "epicentre_in_95": False, "p_beyond": 0.04,
+         "beyond_in_95": True},
+        # a smaller likelihood size: not counted
+        {**base, "likelihood_members": 3, "within_reach": True, "sites": 3, "sites_beyond": 0,
+         "no_candidate": False, "distance_in_95": False, "epicentre_in_95": False,
+         "p_beyond": 0.9, "beyond_in_95": True}]
+    out = beyond_hypothesis(pd.DataFrame(rows))["predictive"]
+    assert out["likelihood_members"] == 48
+    pooled = out["beyond"]["3"]["all"]
+    assert pooled["trials"] == 3 and pooled["refused"] == 1 / 3
+    assert pooled["coverage_distance_95"] == 2 / 3 and pooled["coverage_mw_95"] == 2 / 3
+    assert out["beyond"]["3"]["1"]["coverage_epicentre_95"] == 0.5
+    assert out["beyond"]["3"]["2"]["coverage_epicentre_95"] == 1.0
+    well = out["well_within"]["3"]
+    assert well["trials"] == 2 and well["p_beyond_mean"] == 0.03
+    assert well["beyond_in_95"] == 0.5 and well["coverage_epicentre_95"] == 0.5
