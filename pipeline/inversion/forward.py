@@ -30,12 +30,12 @@ import logging
 import time
 from pathlib import Path
 
-from pipeline import RESULTS_DIR
 from pipeline.campaign import Campaign, register
 from pipeline.campaign.options import CampaignOptions
 from pipeline.scenario.parameters import param
 from pipeline.campaign.runs import column_specs, run_column_spec
 from pipeline.files import InputError, write_csv
+from pipeline.inversion.options import DEFAULT_FORWARD_DIR
 from pipeline.inversion.grid import GRIDS, TableGrid, node_positions, slice_motions
 from pipeline.inversion.table import ForwardTable
 from pipeline.campaign.column_file import column_kn
@@ -44,7 +44,6 @@ from pipeline.campaign import run_campaign
 
 log = logging.getLogger(__name__)
 
-DEFAULT_FORWARD_DIR = RESULTS_DIR / "inversion-forward"
 
 
 # ---------------------------------------------------------------- runs (campaign)

@@ -23,7 +23,6 @@ from pipeline.userfiles import DATA_FILE_BYTES, read_user_text
 
 MAX_ROWS = 1_000_000
 TILT_COLUMNS = {"tilt_rad": 1.0, "tilt_deg": math.pi / 180.0}
-DEFAULT_OUT = Path("contact.json")
 
 
 @dataclass(frozen=True)
@@ -31,9 +30,10 @@ class ContactOptions:
     """What ``contact`` is asked (see ``python -m pipeline contact --help``)."""
     free_rocking: Path = param(None, "", "recorded decay: columns time_s and tilt_rad or "
                                "tilt_deg", flag="--free-rocking", metavar="CSV")
-    frequency_hz: float = param(None, "", "instead of a record: the rocking frequency (full "
+    frequency_hz: float = param(None, "Hz", "instead of a record: the rocking frequency (full "
                                 "cycles per s) at the amplitudes whose ratios "
-                                "--amplitude-ratio gives", flag="--frequency-hz", metavar="HZ")
+                                "--amplitude-ratio gives", 0.01, 100.0, "--frequency-hz",
+                                metavar="HZ")
     amplitude_ratio: str = param(None, "", "ratios of successive amplitudes (the next over "
                                  "the previous), in (0, 1)", flag="--amplitude-ratio",
                                  metavar="R,R")
@@ -60,13 +60,10 @@ class ContactOptions:
     kn: float = param(None, "", f"contact stiffness per point of the map (default the "
                       f"paper's block {paper.MARBLE_BLOCK_KN_N_M:g} N/m; with --column-file "
                       f"the model's {paper.COLUMN_KN_N_M:g} N/m)", flag="--kn", metavar="N_M")
-    out: Path = param(None, "", "contact file written (JSON; default contact.json)",
-                      flag="--out")
+    out: Path = param(Path("contact.json"), "", "contact file written (JSON)", flag="--out")
 
     def __post_init__(self):
         check_fields(self)
-        if self.out is None:
-            object.__setattr__(self, "out", DEFAULT_OUT)
         if (self.block is None) == (self.column_file is None):
             raise InputError("give either --block HEIGHT,WIDTH or --column-file")
         if self.column_file is not None:
@@ -115,9 +112,6 @@ class ContactOptions:
                 raise InputError("--amplitude-ratio goes with --frequency-hz, not "
                                  "--free-rocking")
             return
-        if not (math.isfinite(self.frequency_hz) and 0.01 <= self.frequency_hz <= 100.0):
-            raise InputError(f"--frequency-hz must be in [0.01, 100] Hz, got "
-                             f"{self.frequency_hz:g}")
         if self.amplitude_ratio is None:
             raise InputError("--frequency-hz needs --amplitude-ratio")
         self.ratios()
