@@ -118,7 +118,8 @@ def run_campaign(name, jobs=None, records=None, campaign_dir=None, animations=1,
         if allow_long is not None and jobs is not None and not allowed:
             runs_dir = campaign_dir / "runs"
             todo = [s for s in specs if not (runs_dir / s.run_id / "summary.json").exists()]
-            core_s = [s.tags.get("core_s", campaign.run_core_s) for s in todo]   # a run's own
+            core_s = [campaign.run_core_s if s.core_s is None else s.core_s   # a run's own
+                      for s in todo]
             check_long(f"campaign {name}", len(todo), sum(core_s) / max(len(todo), 1), jobs,
                        allow_long, "fewer records, members or parameter values")
         provenance = {}

@@ -42,6 +42,7 @@ from pipeline.constants import RIM_POINTS
 from pipeline.files import InputError, write_csv, write_json
 from pipeline.stats.circular import circular_summary
 from pipeline.stats.ensemble import compare_ensembles, holm_reject, wilson_interval
+from pipeline.campaign.tags import ConvergenceTags
 
 log = logging.getLogger(__name__)
 
@@ -74,8 +75,9 @@ def convergence_specs(records, campaign_dir, members=DEFAULT_MEMBERS, seed=DEFAU
             for m, p in enumerate(params):
                 runs.append((record, {**p, **numerics}))
                 tags.append((name, m))
-    return column_specs(runs, campaign_dir, [{"variant": name, "member": m} for name, m in tags],
-                        seed=seed, keep_trajectory=False)
+    return column_specs(runs, campaign_dir,
+                        [ConvergenceTags(name, m, seed) for name, m in tags],
+                        keep_trajectory=False)
 
 
 def convergence_outputs(specs, campaign_dir, failures, animations, figures=True):
@@ -83,7 +85,7 @@ def convergence_outputs(specs, campaign_dir, failures, animations, figures=True)
     runs, _ = collect(specs, "convergence", campaign_dir)
     if runs.empty:
         return {"code_version": run_code_version(), "figures": []}
-    variant_of = {s.run_id: s.tags["variant"] for s in specs}
+    variant_of = {s.run_id: s.tags.variant for s in specs}
     runs.insert(1, "variant", runs["run_id"].map(variant_of))
     write_csv(campaign_dir / "members.csv", runs)
     result = compare_variants(runs, wall_per_member(specs, campaign_dir))
@@ -102,7 +104,7 @@ def wall_per_member(specs, campaign_dir):
     """{variant: mean wall time (s) of its finished YADE runs} from their summary.json."""
     times = {}
     for spec, summary in finished_runs(campaign_dir, specs):
-        times.setdefault(spec.tags["variant"], []).append(summary.wall_s)
+        times.setdefault(spec.tags.variant, []).append(summary.wall_s)
     return {name: float(np.mean(times[name])) for name in VARIANTS if name in times}
 
 

@@ -31,6 +31,7 @@ from pipeline.stats.location import locate_source_from_falls
 from pipeline.scenario.column_format import example_names
 from pipeline.scenario.geometry import ColumnGeometry
 from pipeline import verification
+from pipeline.campaign.tags import ColumnsTags
 
 log = logging.getLogger(__name__)
 
@@ -193,7 +194,7 @@ def columns_specs(records, campaign_dir, column_files=None, column="both",
         runs += [(r, twin(column=column, column_file=g.to_dict(), kn=kn)) for r in recs]
     runs = with_contact(runs, _contact(contact_file))
     return column_specs(runs, campaign_dir,
-                        tags=[{"description": p["column_file"]["name"]} for _, p in runs])
+                        tags=[ColumnsTags(p["column_file"]["name"]) for _, p in runs])
 
 
 COLUMNS_TABLE = ["description", "record_id", "column", "toppled", "downfall_azimuth_deg",
@@ -240,7 +241,7 @@ def columns_outputs(specs, campaign_dir, failures, animations, figures=True):
     campaign_dir = Path(campaign_dir)
     runs, impacts = collect(specs, "columns", campaign_dir)
     if not runs.empty:
-        names = {s.run_id: s.tags["description"] for s in specs}
+        names = {s.run_id: s.tags.description for s in specs}
         runs.insert(1, "description", runs["run_id"].map(names))
     write_tables(campaign_dir, runs, impacts)
     table = columns_table(specs, campaign_dir)

@@ -36,6 +36,7 @@ from pipeline.campaign.sizing import (DEFAULT_ARC_DEG, DEFAULT_MAX_MEMBERS, DEFA
                                       run_sized, write_summaries)
 from pipeline.stats.ensemble import record_summary
 from pipeline.stats.pooled import pooled_summary
+from pipeline.campaign.tags import EnsembleTags
 
 log = logging.getLogger(__name__)
 
@@ -77,8 +78,8 @@ def ensemble_specs(records, campaign_dir, record=None, column="both", members=DE
         runs += [(rec, p) for p in member_params[:counts[rec]]]
         member_numbers += range(-1, counts[rec])        # -1: the nominal run
     # trajectories of the first members only: summaries for all
-    tags = [{"member": m, "keep_trajectory": m < KEPT_TRAJECTORIES} for m in member_numbers]
-    return mark(column_specs(runs, campaign_dir, tags, seed=seed), data)
+    return mark(column_specs(runs, campaign_dir, [EnsembleTags(m, seed) for m in member_numbers],
+                             [m < KEPT_TRAJECTORIES for m in member_numbers]), data)
 
 
 def ensemble_outputs(specs, campaign_dir, failures, animations, figures=True):
@@ -87,7 +88,7 @@ def ensemble_outputs(specs, campaign_dir, failures, animations, figures=True):
     runs, _ = collect(specs, "ensemble", campaign_dir)
     if runs.empty:
         return {"code_version": run_code_version(), **summary_entry(specs), "figures": []}
-    member_of = {s.run_id: s.tags["member"] for s in specs}
+    member_of = {s.run_id: s.tags.member for s in specs}
     runs.insert(1, "member", runs["run_id"].map(member_of))
     described = summary_entry(specs)
     if described:
@@ -99,7 +100,7 @@ def ensemble_outputs(specs, campaign_dir, failures, animations, figures=True):
         sub = runs[runs["record_id"] == record_id].sort_values(["member", "column"])
         write_csv(out / "members.csv", sub)
         write_parquet(out / "members.parquet", sub)
-        summary = record_summary(sub, record_id, specs[0].tags["seed"])
+        summary = record_summary(sub, record_id, specs[0].tags.seed)
         summary["record_input"] = next(sp.record for sp in specs
                                        if sp.record_id == record_id)
         if described:

@@ -33,9 +33,9 @@ def pulse_table(specs, campaign_dir):
         described = spec.params.column.column_file or {}
         for column in summary.columns:
             rows.append({"run_id": spec.run_id, "model": column.column,
-                         "pga_g": spec.tags["pga_g"], "pgv_pga_s": spec.tags["pgv_pga_s"],
-                         "member": spec.tags["member"], "heading": spec.tags["heading"],
-                         "azimuth_deg": spec.tags["azimuth_deg"], "toppled": column.toppled,
+                         "pga_g": spec.tags.pga_g, "pgv_pga_s": spec.tags.pgv_pga_s,
+                         "member": spec.tags.member, "heading": spec.tags.heading,
+                         "azimuth_deg": spec.tags.azimuth_deg, "toppled": column.toppled,
                          "max_tilt_deg": column.max_tilt_deg,
                          "downfall_azimuth_deg": column.downfall_azimuth_deg,
                          "kn": contact.kn, "damping": contact.damping, "mu_s": contact.mu_s,
@@ -45,9 +45,9 @@ def pulse_table(specs, campaign_dir):
         fell = pulse_block.block_outcomes(done)
         for spec, toppled in zip(done, fell):
             rows.append({"run_id": spec.run_id, "model": BLOCK_MODEL,
-                         "pga_g": spec.tags["pga_g"], "pgv_pga_s": spec.tags["pgv_pga_s"],
-                         "member": spec.tags["member"], "heading": spec.tags["heading"],
-                         "azimuth_deg": spec.tags["azimuth_deg"], "toppled": bool(toppled)})
+                         "pga_g": spec.tags.pga_g, "pgv_pga_s": spec.tags.pgv_pga_s,
+                         "member": spec.tags.member, "heading": spec.tags.heading,
+                         "azimuth_deg": spec.tags.azimuth_deg, "toppled": bool(toppled)})
     return pd.DataFrame(rows), done
 
 
@@ -58,16 +58,16 @@ def pulse_outputs(specs, campaign_dir, figures=True):
         return {"code_version": run_code_version(), **summary_entry(specs), "figures": []}
     write_csv(campaign_dir / "fragility_runs.csv", table)
     first = specs[0].tags
-    grid = pulse_grid.parse_pulses(first["pulses"])
-    sets = [None] * first["members"]
+    grid = pulse_grid.parse_pulses(first.pulses)
+    sets = [None] * first.members
     azimuths = {}
     for spec in specs:
-        sets[spec.tags["member"]] = spec.tags["point"]
-        azimuths[(spec.tags["member"], spec.tags["heading"])] = spec.tags["azimuth_deg"]
-    azimuth_array = np.array([[azimuths.get((m, h), np.nan) for h in range(first["headings"])]
-                              for m in range(first["members"])])
+        sets[spec.tags.member] = spec.tags.point
+        azimuths[(spec.tags.member, spec.tags.heading)] = spec.tags.azimuth_deg
+    azimuth_array = np.array([[azimuths.get((m, h), np.nan) for h in range(first.headings)]
+                              for m in range(first.members)])
     section = pulse_summary.summarise_grid(table, done, grid, sets, azimuth_array,
-                                        first["azimuth"], first["ranges"]
+                                        first.azimuth, first.ranges
                                         or pulse_grid.DEFAULT_RANGES)
     described = summary_entry(specs)
     name = described["column_file"]["name"] if described else "the paper's column"
@@ -76,17 +76,17 @@ def pulse_outputs(specs, campaign_dir, figures=True):
     section["yade_wall_s_total"] = round(float(sum(
         finished_summary(campaign_dir, s.run_id).wall_s or 0.0 for s in done)), 1)
     section["runs"] = len(specs)
-    section["full_grid_runs"] = (len(grid["pga_g"]) * len(grid["pgv_pga_s"]) * first["members"]
-                                 * first["headings"])
+    section["full_grid_runs"] = (len(grid["pga_g"]) * len(grid["pgv_pga_s"]) * first.members
+                                 * first.headings)
     section["sampling"] = ("adaptive: each cell run until its Wilson interval excludes "
                            "P = 0.5 (up to the full grid's runs), starting from a few runs "
                            "near the 2D block's threshold and one probe run elsewhere, "
                            "more where a probe disagreed with the block or a neighbour; "
                            "a cell's n is the runs it had"
-                           if first.get("sampling") == "adaptive"
+                           if first.adaptive
                            else "full grid: every cell x member x direction")
     summary = FragilityFile.of(json_safe({"mode": "pulses", "specimen": name,
-                                          "seed": first["seed"], "pulse_grid": section}))
+                                          "seed": first.seed, "pulse_grid": section}))
     observed = experiments_check(summary.pulse_grid, name)
     if observed is not None:
         summary = replace(summary, pulse_grid=replace(summary.pulse_grid,

@@ -42,6 +42,7 @@ from pipeline.campaign.shake_table_experiments import (AXIS_DEG, DEFAULT_GRID, E
                                                        PGV_PGA_EDGES_S, SPECIMEN,
                                                        VALIDATE_FROM, grid_run_params,
                                                        load_experiments, parse_grid)
+from pipeline.campaign.tags import ShakeTableTags
 
 log = logging.getLogger(__name__)
 
@@ -80,30 +81,30 @@ def specs(records, campaign_dir, experiments=EXPERIMENTS, specimen=SPECIMEN, out
         params = grid_run_params(description, point, base)
         for row in frame.itertuples():
             runs.append((str(row.motion_path), params))
-            meta.append({"test": row.test, "observed": bool(row.observed), "stage": stage,
-                         "grid_point": _label(point), "point": point})
+            meta.append(ShakeTableTags(row.test, bool(row.observed), stage, _label(point),
+                                       point))
     return column_specs(runs, campaign_dir, meta)
 
 def outputs(specs_, campaign_dir, failures, animations, figures=True):
     """Per-run table of this stage and its scores per grid point."""
-    if specs_ and specs_[0].tags["stage"] == "members":
+    if specs_ and specs_[0].tags.stage == "members":
         return MODES["members"].outputs(specs_, campaign_dir, failures, animations, figures)
     campaign_dir = Path(campaign_dir)
     rows = []
     for spec, summary in finished_runs(campaign_dir, specs_):
         column = summary.columns[0]
-        rows.append({"test": spec.tags["test"], "stage": spec.tags["stage"],
-                     "grid_point": spec.tags["grid_point"], "observed": spec.tags["observed"],
+        rows.append({"test": spec.tags.test, "stage": spec.tags.stage,
+                     "grid_point": spec.tags.grid_point, "observed": spec.tags.observed,
                      "predicted": column.toppled, "max_tilt_deg": column.max_tilt_deg,
                      "run_id": spec.run_id})
     table = pd.DataFrame(rows)
     per_point = {}
     if len(table):
-        stage = specs_[0].tags["stage"]
+        stage = specs_[0].tags.stage
         write_csv(campaign_dir / f"{stage}.csv", table)
         for label, group in table.groupby("grid_point", sort=False):
             per_point[label] = scores(group["observed"], group["predicted"])
-    points = {spec.tags["grid_point"]: spec.tags["point"] for spec in specs_}
+    points = {spec.tags.grid_point: spec.tags.point for spec in specs_}
     return {"scores": per_point, "points": points, "runs_done": len(rows)}
 
 def best_point(result):

@@ -100,14 +100,14 @@ def write_scores(per_test, campaign_dir, options, full, settled, choice=None):
                                   scored[scored["split"] == split], threshold_g, providers)
               for split in SPLITS}
     splits = {split: scores for split, scores in splits.items() if scores is not None}
-    member_specs = [s for s in full if s.tags["member"] >= 0]
-    sets = sorted({s.tags["member"]: s.tags["point"] for s in member_specs}.items())
+    member_specs = [s for s in full if s.tags.member >= 0]
+    sets = sorted({s.tags.member: s.tags.point for s in member_specs}.items())
     result = {
         "specimen": specimen.name, "experiments": str(options["experiments"]),
         "outcome": options["outcome"], "validate_from": options["validate_from"],
         "members": options["members"], "seed": options.get("seed"),
         "ranges": options.get("ranges"), "parameter_sets": [p for _, p in sets],
-        "single_set": next(s.tags["point"] for s in full if s.tags["member"] < 0),
+        "single_set": next(s.tags.point for s in full if s.tags.member < 0),
         "providers": None if path is None else str(path),
         "pga_threshold_g": threshold_g, "critical_angle_deg": critical, "axis_deg": axis,
         "runs": int(per_test["runs"].sum()) + int(per_test["single_set_predicted"].notna()
