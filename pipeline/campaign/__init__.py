@@ -25,6 +25,8 @@ from pipeline.files import (LONG_RUN_S, DirectoryLock, InputError, ToolError, ch
                             check_long, write_json)
 from pipeline.campaign.executor import EXECUTORS, RUN_CORE_S, execute
 from pipeline.campaign.run_dirs import count_finished
+from pipeline.scenario.contact_file import contact_provenance
+import json
 
 log = logging.getLogger(__name__)
 
@@ -124,7 +126,6 @@ def run_campaign(name, jobs=None, records=None, campaign_dir=None, animations=1,
                        allow_long, "fewer records, members or parameter values")
         provenance = {}
         if (options or {}).get("contact_file") is not None:     # which file, its values
-            from pipeline.scenario.contact_file import contact_provenance
             provenance["contact_file"] = contact_provenance(options["contact_file"])
         return _run_specs(campaign, name, specs, campaign_dir, jobs, animations, executor,
                           scheduler, provenance)
@@ -157,7 +158,6 @@ def reuse_finished(specs, campaign_dir, worker):
     project's campaigns live; one elsewhere, e.g. ``--out /data/x``, runs everything): the run id hashes the motion, the parameters and the model code,
     so a run computed once is not computed again.  A spec that keeps its trajectory takes
     only a run that kept one.  Returns how many runs were copied."""
-    import json
     here = Path(campaign_dir).resolve()
     sources = []
     for meta in sorted(here.parent.glob("*/campaign.json")):

@@ -43,6 +43,7 @@ from pipeline.files import InputError, write_csv, write_json
 from pipeline.stats.circular import circular_summary
 from pipeline.stats.ensemble import compare_ensembles, holm_reject, wilson_interval
 from pipeline.campaign.tags import ConvergenceTags
+import pandas as pd
 
 log = logging.getLogger(__name__)
 
@@ -94,7 +95,7 @@ def convergence_outputs(specs, campaign_dir, failures, animations, figures=True)
     log.info(result["verdict"])
     written = []
     if figures:
-        from pipeline.figures.ensemble import plot_convergence
+        from pipeline.figures.ensemble import plot_convergence  # lazy: matplotlib, not imported by a run or after Ctrl-C
         written.append(plot_convergence(runs, result, campaign_dir))
     return {"code_version": run_code_version(), "verdict": result["verdict"],
             "figures": [str(Path(p).relative_to(campaign_dir)) for p in written]}
@@ -157,7 +158,6 @@ def compare_variants(runs, cost_per_member=None):
 
 
 def _rows(result):
-    import pandas as pd
     frame = pd.DataFrame(result["rows"])
     for key in ("p_toppled_ci95", "falls"):
         if key in frame:

@@ -83,7 +83,7 @@ def ensemble_specs(records, campaign_dir, record=None, column="both", members=DE
 
 
 def ensemble_outputs(specs, campaign_dir, failures, animations, figures=True):
-    from pipeline.figures.ensemble import plot_ensemble
+    from pipeline.figures.ensemble import plot_ensemble  # lazy: matplotlib, not imported by a run or after Ctrl-C
     campaign_dir = Path(campaign_dir)
     runs, _ = collect(specs, "ensemble", campaign_dir)
     if runs.empty:
@@ -121,7 +121,7 @@ def ensemble_outputs(specs, campaign_dir, failures, animations, figures=True):
             pooled["cost"] = yade_cost(campaign_dir, runs["run_id"])
             write_json(campaign_dir / POOLED_FILE, pooled)
             if figures:
-                from pipeline.figures.ensemble import plot_pooled
+                from pipeline.figures.ensemble import plot_pooled  # lazy: matplotlib, not imported by a run or after Ctrl-C
                 written.append(plot_pooled(runs, pooled, campaign_dir))
             for col in pooled["columns"]:
                 st = col["statistics"]

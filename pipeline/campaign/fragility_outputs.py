@@ -48,7 +48,7 @@ def fragility_outputs(specs, campaign_dir, failures, animations, figures=True):
     write_csv(campaign_dir / "fragility_levels.csv", level_table(table))
     written = []
     if figures:
-        from pipeline.figures.fragility import plot_fragility
+        from pipeline.figures.fragility import plot_fragility  # lazy: matplotlib, not imported by a run or after Ctrl-C
         written = plot_fragility(table, summary, campaign_dir)
     for name, entry in summary.columns.items():
         fit = entry.fits["PGA"]

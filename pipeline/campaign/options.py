@@ -9,6 +9,7 @@ from pipeline.campaign.column_file import STIFFNESS_CHOICES, column_file_help, p
 from pipeline.files import InputError
 from pipeline.scenario.contact_file import refuse_set_twice
 from pipeline.scenario.parameters import check_fields, param
+from pipeline.scenario.contact_file import contact_values
 
 CAMPAIGN_NOTE = ("the described column stands in the drums' place and a monolith of its "
                  "outline in the monolith's")
@@ -44,7 +45,6 @@ def contact_of(options):
     checked before any run."""
     if options.contact_file is None:
         return None
-    from pipeline.scenario.contact_file import contact_values
     return contact_values(options.contact_file)
 
 

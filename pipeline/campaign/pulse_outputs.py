@@ -94,7 +94,7 @@ def pulse_outputs(specs, campaign_dir, figures=True):
     write_fragility_file(campaign_dir, summary)
     written = []
     if figures:
-        from pipeline.figures.fragility import plot_pulse_grid
+        from pipeline.figures.fragility import plot_pulse_grid  # lazy: matplotlib, not imported by a run or after Ctrl-C
         written = plot_pulse_grid(summary, campaign_dir / "fragility_pulse_grid.png")
     grid = summary.pulse_grid
     for model, entry in grid.models.items():

@@ -106,7 +106,7 @@ def column_outputs(name, size_by=None):
         if not runs.empty:
             write_csv(campaign_dir / "direction_statistics.csv", direction_statistics(runs))
             if figures:
-                from pipeline import figures as figure_module   # matplotlib: not after Ctrl-C
+                from pipeline import figures as figure_module  # lazy: matplotlib, not imported by a run or after Ctrl-C
                 written = figure_module.campaign_figures(name, runs, impacts, campaign_dir,
                                                          size_by, animations)
         toppled = runs.groupby("column")["toppled"].agg(["sum", "count"]) if not runs.empty \

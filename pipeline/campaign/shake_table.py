@@ -157,7 +157,7 @@ def drive(run, records, campaign_dir, options, gate=None):
     write_csv(campaign_dir / "experiments.csv", table.drop(columns=["day", "motion_path"]))
     result = summarise(table, specimen, calibration, label, point, options)
     write_json(campaign_dir / "shake_table.json", result)
-    from pipeline.figures.shake_table import plot_rates
+    from pipeline.figures.shake_table import plot_rates  # lazy: matplotlib, not imported by a run or after Ctrl-C
     plot_rates(table, campaign_dir / "shake_table_rates.png", result, PGA_EDGES_G,
                PGV_PGA_EDGES_S)
     for line in result["lines"]:

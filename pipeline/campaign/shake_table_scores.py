@@ -116,7 +116,7 @@ def write_scores(per_test, campaign_dir, options, full, settled, choice=None):
         "rules": CLIP_RULE, "bin_edges": [float(e) for e in BIN_EDGES],
         "ranges_choice": choice, "splits": splits, "lines": choice_lines(choice) + lines_of(splits)}
     write_json(campaign_dir / "shake_table_members.json", result)
-    from pipeline.figures.reliability import plot_reliability
+    from pipeline.figures.reliability import plot_reliability  # lazy: matplotlib, not imported by a run or after Ctrl-C
     plot_reliability({s: v["members"]["reliability_diagram"] for s, v in splits.items()},
                      campaign_dir / "shake_table_reliability.png",
                      f"{specimen.name}: {options['members']} members per test at most")

@@ -111,7 +111,7 @@ def _frame_indices(t, fps, max_seconds):
 
 def animate_run(run, path, fps=20, max_seconds=None, max_frames=600):
     """Write a 3-D animation of a run to ``path`` (.gif, or .mp4 with ffmpeg)."""
-    from matplotlib import animation
+    from matplotlib import animation  # lazy: matplotlib, not imported by a run or after Ctrl-C
 
     traj = load(run)
     offset = start_in_file_s(run)
@@ -162,7 +162,7 @@ def animate_run(run, path, fps=20, max_seconds=None, max_frames=600):
     if path.suffix == ".gif":
         # frames drawn here and quantised with Pillow's fast octree (its default
         # median cut took a third of the time of matplotlib's PillowWriter)
-        from PIL import Image
+        from PIL import Image  # lazy: Pillow with matplotlib's animation, only when animating
         images = []
         for k in frames:
             draw(k)

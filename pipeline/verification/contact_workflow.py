@@ -20,6 +20,10 @@ from pipeline import paper
 from pipeline.files import InputError, write_json
 from pipeline.scenario.parameters import check_fields, param
 from pipeline.userfiles import DATA_FILE_BYTES, read_user_text
+from pipeline.scenario import Block, ColumnGeometry, Contact, Numerics
+from pipeline.rocking.decay import fit_free_rocking
+from pipeline.verification.contact_map import _scene, equivalent_block, weakest_azimuth
+from pipeline.verification import contact_map
 
 MAX_ROWS = 1_000_000
 TILT_COLUMNS = {"tilt_rad": 1.0, "tilt_deg": math.pi / 180.0}
@@ -91,7 +95,6 @@ class ContactOptions:
     def _check_map(self):
         """The map's block and contact in their ranges; its options only with it."""
         if self.damping_map:
-            from pipeline.scenario import Block, Contact
             if self.block is not None:
                 height, width = self.block_size()
                 Block(height=height, width=width, depth=self.block_depth(width),
@@ -180,7 +183,6 @@ def fit_contact(options):
     ``options.out``: the restitution fitted to the decay, the block or specimen, and with
     ``damping_map`` the damping that gives it in YADE and its interval.  The bisection's
     lines are printed as it goes; what the result says is the caller's to print."""
-    from pipeline.rocking.decay import fit_free_rocking
     if options.column_file is not None:
         geometry, azimuth, alpha, (height, width) = _specimen(options)
     else:
@@ -228,8 +230,6 @@ def _specimen(options):
     """(geometry, azimuth deg, critical angle rad, (height m, width m) of the equivalent
     block: the same critical angle and distance from the support line to the centre of
     mass) of ``--column-file``."""
-    from pipeline.scenario import ColumnGeometry, Contact, Numerics
-    from pipeline.verification.contact_map import _scene, equivalent_block, weakest_azimuth
     geometry = ColumnGeometry.load(options.column_file)
     _, column = _scene(geometry, Contact(), Numerics())
     azimuth = weakest_azimuth(column) if options.azimuth is None else options.azimuth
@@ -240,7 +240,6 @@ def _specimen(options):
 def _damping_map(options, fit, height, width, geometry, azimuth):
     """The contact file's kn, damping, damping_interval and damping_map: the damping that
     gives the fitted restitution in YADE (free-rocking runs, bisection)."""
-    from pipeline.verification import contact_map
     kn = options.map_kn()
     if options.block is not None:
         depth, density = options.block_depth(width), options.block_density()
