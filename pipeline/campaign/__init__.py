@@ -50,7 +50,7 @@ class Campaign:
     driver: Callable = None        # driver(run, records, campaign_dir, options, gate):
     #                                runs it (several times: ensembles sized by their error)
     run_core_s: float = RUN_CORE_S
-    estimate: Callable = None      # estimate(records, **options) -> (runs, core-s a run) or
+    estimate: Callable = None      # estimate(records, options) -> (runs, core-s a run) or
     #                                None: the gate's count from the options alone, asked
     #                                before any spec is built (a grid of hours takes minutes)
 
@@ -116,7 +116,9 @@ def run_campaign(name, jobs=None, records=None, campaign_dir=None, animations=1,
     try:
         allowed = allow_long is not None and jobs is not None and _gate_from_options(
             campaign, records, options, campaign_dir, jobs, allow_long)
-        specs = campaign.specs(records, campaign_dir, **(options or {}))
+        driver_only = () if campaign.options is None else campaign.options.DRIVER_ONLY
+        specs = campaign.specs(records, campaign_dir, **{
+            k: v for k, v in (options or {}).items() if k not in driver_only})
         if allow_long is not None and jobs is not None and not allowed:
             runs_dir = campaign_dir / "runs"
             todo = [s for s in specs if not (runs_dir / s.run_id / "summary.json").exists()]
@@ -142,7 +144,7 @@ def _gate_from_options(campaign, records, options, campaign_dir, jobs, allow_lon
     (a resumed campaign: a lower bound, so the gate on the specs has the last word when
     this one passes).  True when it was over the hour and allowed (warned)."""
     estimate = None if campaign.estimate is None else \
-        campaign.estimate(records, **(options or {}))
+        campaign.estimate(records, options or {})
     if estimate is None:
         return False
     runs, core_s = estimate

@@ -65,7 +65,7 @@ def variant_ranges(numerics):
     return dict(ENSEMBLE_RANGES, rim_phase_deg=(0.0, 360.0 / points, "uniform"))
 
 
-def convergence_specs(records, campaign_dir, members=DEFAULT_MEMBERS, seed=DEFAULT_SEED, **_):
+def convergence_specs(records, campaign_dir, members=DEFAULT_MEMBERS, seed=DEFAULT_SEED):
     """Specs of ``members`` twin-model members per record and variant (variant k sampled
     with seed + k)."""
     records = list(records or DEFAULT_RECORDS)

@@ -45,7 +45,7 @@ KEPT_TRAJECTORIES = 2          # the nominal run and the first members keep traj
 
 def ensemble_specs(records, campaign_dir, record=None, column="both", members=DEFAULT_MEMBERS,
                    seed=DEFAULT_SEED, vary=None, column_file=None, stiffness="matched",
-                   batch=None, record_members=None, contact_file=None, **_):
+                   batch=None, record_members=None, contact_file=None):
     """Specs of the nominal run and ``members`` members per record (``record_members``:
     {record: members} overrides it per record), sampled in batches of ``batch``; a
     contact file fixes what it sets (:func:`contact_ranges`)."""
@@ -173,6 +173,7 @@ class EnsembleOptions(CampaignOptions):
     contact_file: str = contact_file_param(
         "its damping and friction for every member (not sampled), its kn what kn_factor "
         "multiplies (replacing --stiffness's)")
+    DRIVER_ONLY = ("precision", "arc_deg", "max_members")   # the sizing driver reads these
 
     def check(self):
         contact = contact_of(self)

@@ -116,14 +116,17 @@ def parse_grid(text):
     return grid
 
 
-def planned_runs(records, column_file=None, pulses=None, members=DEFAULT_MEMBERS,
-                 headings=DEFAULT_HEADINGS, levels=None, only_runs=None, **_):
-    """(runs, core-s a run) of the campaign from its options alone, the long-run gate's
+def planned_runs(records, options):
+    """(runs, core-s a run) of the campaign from its ``options`` (the keyword options of
+    :class:`FragilityOptions`, with ``only_runs`` in an adaptive stage) alone, the long-run gate's
     count before any spec is built: cells x members x headings on the pulse grid (its
     runs' cost, :func:`pipeline.campaign.pulse_grid.run_core_s`), records x levels x
     members on scaled records; None for the runs of an adaptive stage."""
-    if only_runs is not None:
+    if options.get("only_runs") is not None:
         return None
+    column_file, pulses = options.get("column_file"), options.get("pulses")
+    members = options.get("members", DEFAULT_MEMBERS)
+    headings, levels = options.get("headings", DEFAULT_HEADINGS), options.get("levels")
     if pulses is None and not records and column_file is not None:
         if "mesh" in column_file_description(column_file, meshes=True):
             pulses = "vsr"
@@ -140,7 +143,7 @@ def fragility_specs(records, campaign_dir, levels=None, members=DEFAULT_MEMBERS,
                     column="both", seed=None, azimuths=DEFAULT_AZIMUTHS, column_file=None,
                     stiffness="matched", pulses=None, azimuth=None,
                     headings=DEFAULT_HEADINGS, ranges=None, jobs=None, only_runs=None,
-                    adaptive=False, contact_file=None, grid_specs=None, **_):
+                    adaptive=False, contact_file=None, grid_specs=None):
     """Run specs: every record x level x member; ``scale`` = level / PGA of the record.
     With ``column_file`` every member is the described column with the sampled height
     and diameter tolerances (its own tilt and offsets as described), and the 2D block
@@ -331,7 +334,7 @@ def drive(run, records, campaign_dir, options, gate=None):
     if not options.get("adaptive"):
         return run(options)
     if gate is not None:          # before the specs: a grid of hours takes minutes to build
-        runs, core_s = planned_runs(records, **options)
+        runs, core_s = planned_runs(records, options)
         gate("campaign fragility (adaptive; at most the full grid)", runs, core_s,
              "a smaller --pulses grid")
     full = fragility_specs(records, campaign_dir, **options)

@@ -57,13 +57,16 @@ def _label(point):
 
 def specs(records, campaign_dir, experiments=EXPERIMENTS, specimen=SPECIMEN, outcome=OUTCOME,
           validate_from=VALIDATE_FROM, grid=DEFAULT_GRID, stage="calibration", chosen=None,
-          tests=None, axis_deg=AXIS_DEG, contact_file=None, **mode):
+          tests=None, axis_deg=AXIS_DEG, contact_file=None, members=None, seed=None,
+          ranges=None, only_runs=None, full=None):
     """Run specs of one stage: every grid point on the calibration tests, or the chosen
     point on the validation tests; a contact file's values are the base the points
-    override.  Stage "members": the members mode's (``mode``: its options)."""
+    override.  Stage "members": the members mode's (``members``, ``seed``, ``ranges``,
+    ``only_runs`` of ``full``)."""
     if stage == "members":
         return MODES["members"].specs(records, campaign_dir, experiments, specimen, outcome,
-                                      validate_from, grid, tests, contact_file, **mode)
+                                      validate_from, grid, tests, contact_file, members,
+                                      seed, ranges, only_runs, full)
     if records:
         raise InputError("the shake-table campaign takes its motions from --experiments, "
                          "not --records")
@@ -263,6 +266,7 @@ class ShakeTableOptions(CampaignOptions):
                             "records/shake_table/sp1_numerical.csv)", flag="--providers",
                             metavar="CSV")
     TAKES_JOBS = True
+    DRIVER_ONLY = ("candidates", "providers", "jobs")
 
     def check(self):
         contact_of(self)

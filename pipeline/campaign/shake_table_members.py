@@ -164,8 +164,7 @@ def tests_of(experiments, outcome, tests, validate_from):
 
 
 def specs(records, campaign_dir, experiments, specimen, outcome, validate_from, grid, tests,
-          contact_file, members=None, seed=None, ranges=None, only_runs=None, full=None,
-          **_):
+          contact_file, members=None, seed=None, ranges=None, only_runs=None, full=None):
     """Every test x (N members and the single set); ``only_runs`` keeps those run ids (of
     ``full``, the specs made already)."""
     if full is None:

@@ -91,12 +91,6 @@ def body_surfaces(body, centre, quat_wxyz):
     return out
 
 
-def body_surface(body, centre, quat_wxyz):
-    """Vertices (2 x k x 3) of a single-part body's bottom and top outline, world frame
-    (m); bodies of several parts: the first part (see :func:`body_surfaces`)."""
-    return body_surfaces(body, centre, quat_wxyz)[0]
-
-
 def body_top_m(body):
     """Initial height (m) of a body's highest face (upright bodies)."""
     z = body["initial_pos"][2] if "initial_pos" in body else body["height"] / 2

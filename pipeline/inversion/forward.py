@@ -81,7 +81,7 @@ class ForwardTags:
     grid: TableGrid
 
 
-def forward_specs(records, campaign_dir, grid=None, jobs=None, **_):
+def forward_specs(records, campaign_dir, grid=None, jobs=None):
     """Run specs of a forward table: every node x (nominal + members), twin model."""
     if records:
         raise InputError("the inversion-forward campaign takes no --records (see --grid)")

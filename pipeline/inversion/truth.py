@@ -161,7 +161,7 @@ class TruthTags:
     strike_deg: float
 
 
-def truth_specs(records, campaign_dir, truth=None, grid=None, jobs=None, **_):
+def truth_specs(records, campaign_dir, truth=None, grid=None, jobs=None):
     """Run specs: at every site its ``twins`` hidden members on the site's motion."""
     if records:
         raise InputError("the inversion-truth campaign takes no --records")
