@@ -45,7 +45,7 @@ from pipeline.stats.classification import scores
 from pipeline.stats.ensemble import wilson_interval
 from pipeline.verification.stiffness import free_rocking_table
 from pipeline.scenario import ColumnGeometry
-from pipeline.verification.contact_map import specimen_measure
+from pipeline.verification import contact_map
 
 PGA_SPLIT_G = 0.15
 KN = re.compile(r"kn=([0-9.eE+-]+)")
@@ -227,7 +227,7 @@ def rock_restitution(rock, specimen=None, log=print):
     options = {k: v for k, v in point.items() if k in ("mu_s", "mu_k")}
 
     def measured(kn, d):
-        value = specimen_measure(geometry, kn, ROCK_AZIMUTH_DEG, **options)[0](d)
+        value = contact_map.specimen_measure(geometry, kn, ROCK_AZIMUTH_DEG, **options)[0](d)
         log(f"rock free rocking: kn {kn:g}, damping {d:g}: restitution {value:.4f}")
         return value
 
