@@ -295,11 +295,17 @@ def plot_convergence(rows, path):
 
 
 # ---------------------------------------------------------------- 6. parallel runs
+@dataclasses.dataclass(frozen=True)
+class ParallelTags:
+    """A parallel-bench run's tags: simulated time ``t_max`` (s)."""
+    t_max: float
+
+
 def parallel_run(spec, run_dir):
     """Campaign worker of the parallel bench: the twin model under the spec's pulse for
     exactly ``t_max`` s (no early stop); summary.json holds YADE's wall time."""
     traj = run_yade(prepare(run_dir, "both", Motion.load(spec.motion_file),
-                            spec.tags["t_max"]))
+                            spec.tags.t_max))
     write_json(Path(run_dir) / "summary.json", {"wall_s": traj.wall_s})
 
 
@@ -334,7 +340,7 @@ def parallel(work, n_runs, t_max, n_noop=40):
     motions = [one_sine_pulse(30.0 * k, PULSE["amplitude"], PULSE["period"], t_max).save(
         work / f"parallel_motion_{k}.npz") for k in range(n_runs)]
     specs = [RunSpec(f"parallel_{k}", f"parallel_{k}", str(m), RunParams(), f"parallel_{k}",
-                     {"t_max": t_max}) for k, m in enumerate(motions)]
+                     ParallelTags(t_max)) for k, m in enumerate(motions)]
     code = code_hash(*WORKER_CODE)
     for jobs in (1, 2):
         start = time.perf_counter()

@@ -17,7 +17,7 @@ def console():
     pending = []
     for signum in (signal.SIGINT, signal.SIGTERM):
         signal.signal(signum, lambda signum, frame: pending.append(signum))
-    from pipeline.cli import main
+    from pipeline.cli import main  # lazy: after the signal handlers are set (a stop during imports is acted on later)
     stop_on_signals()
     try:
         if pending:

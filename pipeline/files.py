@@ -244,7 +244,7 @@ class DirectoryLock:
         self.directory, self.wait, self.fd = Path(directory), wait, None
 
     def __enter__(self):
-        import fcntl
+        import fcntl  # lazy: POSIX only
         try:
             self.directory.mkdir(parents=True, exist_ok=True)
         except (FileExistsError, NotADirectoryError):

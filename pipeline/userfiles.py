@@ -7,6 +7,8 @@ import reprlib
 import stat
 
 from pipeline.files import InputError
+import json
+from pathlib import Path
 
 MAX_FILE_BYTES = 1_000_000   # a column description or an observations file is a few kB
 DATA_FILE_BYTES = 64_000_000  # a hazard curve, a campaign's fragility.json or runs table
@@ -115,8 +117,6 @@ def read_json(path, what, limit=MAX_FILE_BYTES):
     bytes); InputError (one line) "``what`` not found: path", "``what`` path is a
     directory" or "name: not readable JSON (why)", a nesting too deep for the parser
     included."""
-    import json
-    from pathlib import Path
     path = Path(path)
     if not path.exists():
         raise InputError(f"{what} not found: {path}")

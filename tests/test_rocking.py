@@ -6,15 +6,58 @@ import pytest
 
 from pipeline.rocking.decay import restitution_from_peaks
 from pipeline.rocking.housner import (augusti_sinopoli_mu_min, block_constants, cylinder_constants,
-                                      housner_closed_form, housner_half_periods,
-                                      impact_friction_demand)
-from pipeline.rocking.pulse import (MODE_NO_OVERTURN, MODE_OVERTURN_WITHOUT_IMPACT, mode_edges,
+                                      housner_closed_form, impact_friction_demand)
+from pipeline.rocking.pulse import (MODE_NAMES, MODE_NO_OVERTURN, MODE_OVERTURN_WITHOUT_IMPACT,
                                     overturning_map, sine_pulse_response)
 from pipeline.rocking.response import housner_free_rocking, rocking_response
 from pipeline.files import InputError
 
 G = 9.81
 PAPER_H, PAPER_B = 3.113, 0.795          # Hinzen (2009) Fig. 5 block: alpha 0.25, p 2.14
+
+
+def housner_half_periods(height, width, theta0_ratio, n, r=None, g=G):
+    """Paper eq 7 (linearised block): duration (s) of half-cycles k = 0..n.
+
+    T_k / 2 = (2 / p) artanh( sqrt(r^k (1 - (1 - theta0/alpha)^2)) ), the time
+    the block needs to swing from theta = 0 out to amplitude theta_k and back.
+    Released from rest at theta0, the first impact comes after T_0 / 4; impact
+    k + 1 follows impact k after T_k / 2.  r defaults to Housner's eta^2.
+    """
+    c = block_constants(height, width, g)
+    r = c["energy_ratio"] if r is None else r
+    k = np.arange(n + 1)
+    return 2.0 / c["p"] * np.arctanh(np.sqrt(r ** k * (1.0 - (1.0 - theta0_ratio) ** 2)))
+
+
+def mode_edges(height, width, omega_ratio, amplitude_ratios, restitution=None, g=G,
+               tol=1e-3):
+    """Amplitude ratios (A / (alpha g)) where the one-sine-pulse mode changes.
+
+    Scans ``amplitude_ratios`` (increasing) and bisects every change of mode to
+    ``tol``.  Returns a list of dicts: lower (ratio just below the edge),
+    upper (just above), mode_below, mode_above (names).
+    """
+    def mode_at(a):
+        return sine_pulse_response(height, width, a, omega_ratio, restitution=restitution,
+                                   g=g, dt_out=None)["mode"]
+
+    amps = np.asarray(amplitude_ratios, float)
+    modes = [mode_at(a) for a in amps]
+    edges = []
+    for k in range(len(amps) - 1):
+        lo, hi, m_lo, m_hi = amps[k], amps[k + 1], modes[k], modes[k + 1]
+        if m_lo == m_hi:
+            continue
+        while hi - lo > tol:
+            mid = 0.5 * (lo + hi)
+            if mode_at(mid) == m_lo:
+                lo = mid
+            else:
+                hi = mid
+        edges.append(dict(lower=float(lo), upper=float(hi), mode_below=MODE_NAMES[m_lo],
+                          mode_above=MODE_NAMES[mode_at(hi)]))
+    return edges
 
 
 def energy_per_mass(c, theta, omega):

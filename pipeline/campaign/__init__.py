@@ -25,6 +25,8 @@ from pipeline.files import (LONG_RUN_S, DirectoryLock, InputError, ToolError, ch
                             check_long, write_json)
 from pipeline.campaign.executor import EXECUTORS, RUN_CORE_S, execute
 from pipeline.campaign.run_dirs import count_finished
+from pipeline.scenario.contact_file import contact_provenance
+import json
 
 log = logging.getLogger(__name__)
 
@@ -48,7 +50,7 @@ class Campaign:
     driver: Callable = None        # driver(run, records, campaign_dir, options, gate):
     #                                runs it (several times: ensembles sized by their error)
     run_core_s: float = RUN_CORE_S
-    estimate: Callable = None      # estimate(records, **options) -> (runs, core-s a run) or
+    estimate: Callable = None      # estimate(records, options) -> (runs, core-s a run) or
     #                                None: the gate's count from the options alone, asked
     #                                before any spec is built (a grid of hours takes minutes)
 
@@ -114,16 +116,18 @@ def run_campaign(name, jobs=None, records=None, campaign_dir=None, animations=1,
     try:
         allowed = allow_long is not None and jobs is not None and _gate_from_options(
             campaign, records, options, campaign_dir, jobs, allow_long)
-        specs = campaign.specs(records, campaign_dir, **(options or {}))
+        driver_only = () if campaign.options is None else campaign.options.DRIVER_ONLY
+        specs = campaign.specs(records, campaign_dir, **{
+            k: v for k, v in (options or {}).items() if k not in driver_only})
         if allow_long is not None and jobs is not None and not allowed:
             runs_dir = campaign_dir / "runs"
             todo = [s for s in specs if not (runs_dir / s.run_id / "summary.json").exists()]
-            core_s = [s.tags.get("core_s", campaign.run_core_s) for s in todo]   # a run's own
+            core_s = [campaign.run_core_s if s.core_s is None else s.core_s   # a run's own
+                      for s in todo]
             check_long(f"campaign {name}", len(todo), sum(core_s) / max(len(todo), 1), jobs,
                        allow_long, "fewer records, members or parameter values")
         provenance = {}
         if (options or {}).get("contact_file") is not None:     # which file, its values
-            from pipeline.scenario.contact_file import contact_provenance
             provenance["contact_file"] = contact_provenance(options["contact_file"])
         return _run_specs(campaign, name, specs, campaign_dir, jobs, animations, executor,
                           scheduler, provenance)
@@ -140,7 +144,7 @@ def _gate_from_options(campaign, records, options, campaign_dir, jobs, allow_lon
     (a resumed campaign: a lower bound, so the gate on the specs has the last word when
     this one passes).  True when it was over the hour and allowed (warned)."""
     estimate = None if campaign.estimate is None else \
-        campaign.estimate(records, **(options or {}))
+        campaign.estimate(records, options or {})
     if estimate is None:
         return False
     runs, core_s = estimate
@@ -156,7 +160,6 @@ def reuse_finished(specs, campaign_dir, worker):
     project's campaigns live; one elsewhere, e.g. ``--out /data/x``, runs everything): the run id hashes the motion, the parameters and the model code,
     so a run computed once is not computed again.  A spec that keeps its trajectory takes
     only a run that kept one.  Returns how many runs were copied."""
-    import json
     here = Path(campaign_dir).resolve()
     sources = []
     for meta in sorted(here.parent.glob("*/campaign.json")):

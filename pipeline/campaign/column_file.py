@@ -20,6 +20,7 @@ What a campaign varies and the description fixes:
 - fragility: the 2D block has the described column's overall height and base width.
 """
 import math
+from dataclasses import replace
 
 from pipeline import paper
 from pipeline.files import InputError
@@ -141,14 +142,14 @@ def mark(specs, data):
     """Name the description in each spec (``description``; outputs and tables show it)."""
     if data is None:
         return specs
-    return [s.tagged(description=data["name"], column_description=data) for s in specs]
+    return [replace(s, column_description=data) for s in specs]
 
 
 def summary_entry(specs):
     """``{"column_file": description}`` for campaign.json when the specs carry one."""
     for spec in specs:
-        if spec.tags.get("column_description") is not None:
-            return {"column_file": spec.tags["column_description"]}
+        if spec.column_description is not None:
+            return {"column_file": spec.column_description}
     return {}
 
 

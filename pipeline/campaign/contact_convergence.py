@@ -44,6 +44,8 @@ from pipeline.stats.circular import circular_summary
 from pipeline.stats.classification import scores
 from pipeline.stats.ensemble import wilson_interval
 from pipeline.verification.stiffness import free_rocking_table
+from pipeline.scenario import ColumnGeometry
+from pipeline.verification import contact_map
 
 PGA_SPLIT_G = 0.15
 KN = re.compile(r"kn=([0-9.eE+-]+)")
@@ -214,8 +216,6 @@ def rock_restitution(rock, specimen=None, log=print):
     """The rock's rocking restitution in YADE at the rock part's footprint and damping
     per stiffness factor, and at its x1 kn per damping ratio (ROCK_DAMPINGS and its
     own); Housner's for a block of its critical angle beside (1 - 1.5 sin^2 alpha)."""
-    from pipeline.scenario import ColumnGeometry
-    from pipeline.verification.contact_map import specimen_measure
 
     point = {k: v for k, v in _grid_point(rock["grid_point"]).items()
              if k not in ("kn", "rotate_deg")}
@@ -227,7 +227,7 @@ def rock_restitution(rock, specimen=None, log=print):
     options = {k: v for k, v in point.items() if k in ("mu_s", "mu_k")}
 
     def measured(kn, d):
-        value = specimen_measure(geometry, kn, ROCK_AZIMUTH_DEG, **options)[0](d)
+        value = contact_map.specimen_measure(geometry, kn, ROCK_AZIMUTH_DEG, **options)[0](d)
         log(f"rock free rocking: kn {kn:g}, damping {d:g}: restitution {value:.4f}")
         return value
 

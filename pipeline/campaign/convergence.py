@@ -42,6 +42,8 @@ from pipeline.constants import RIM_POINTS
 from pipeline.files import InputError, write_csv, write_json
 from pipeline.stats.circular import circular_summary
 from pipeline.stats.ensemble import compare_ensembles, holm_reject, wilson_interval
+from pipeline.campaign.tags import ConvergenceTags
+import pandas as pd
 
 log = logging.getLogger(__name__)
 
@@ -63,7 +65,7 @@ def variant_ranges(numerics):
     return dict(ENSEMBLE_RANGES, rim_phase_deg=(0.0, 360.0 / points, "uniform"))
 
 
-def convergence_specs(records, campaign_dir, members=DEFAULT_MEMBERS, seed=DEFAULT_SEED, **_):
+def convergence_specs(records, campaign_dir, members=DEFAULT_MEMBERS, seed=DEFAULT_SEED):
     """Specs of ``members`` twin-model members per record and variant (variant k sampled
     with seed + k)."""
     records = list(records or DEFAULT_RECORDS)
@@ -74,8 +76,9 @@ def convergence_specs(records, campaign_dir, members=DEFAULT_MEMBERS, seed=DEFAU
             for m, p in enumerate(params):
                 runs.append((record, {**p, **numerics}))
                 tags.append((name, m))
-    return column_specs(runs, campaign_dir, [{"variant": name, "member": m} for name, m in tags],
-                        seed=seed, keep_trajectory=False)
+    return column_specs(runs, campaign_dir,
+                        [ConvergenceTags(name, m, seed) for name, m in tags],
+                        keep_trajectory=False)
 
 
 def convergence_outputs(specs, campaign_dir, failures, animations, figures=True):
@@ -83,7 +86,7 @@ def convergence_outputs(specs, campaign_dir, failures, animations, figures=True)
     runs, _ = collect(specs, "convergence", campaign_dir)
     if runs.empty:
         return {"code_version": run_code_version(), "figures": []}
-    variant_of = {s.run_id: s.tags["variant"] for s in specs}
+    variant_of = {s.run_id: s.tags.variant for s in specs}
     runs.insert(1, "variant", runs["run_id"].map(variant_of))
     write_csv(campaign_dir / "members.csv", runs)
     result = compare_variants(runs, wall_per_member(specs, campaign_dir))
@@ -92,7 +95,7 @@ def convergence_outputs(specs, campaign_dir, failures, animations, figures=True)
     log.info(result["verdict"])
     written = []
     if figures:
-        from pipeline.figures.ensemble import plot_convergence
+        from pipeline.figures.ensemble import plot_convergence  # lazy: matplotlib, not imported by a run or after Ctrl-C
         written.append(plot_convergence(runs, result, campaign_dir))
     return {"code_version": run_code_version(), "verdict": result["verdict"],
             "figures": [str(Path(p).relative_to(campaign_dir)) for p in written]}
@@ -102,7 +105,7 @@ def wall_per_member(specs, campaign_dir):
     """{variant: mean wall time (s) of its finished YADE runs} from their summary.json."""
     times = {}
     for spec, summary in finished_runs(campaign_dir, specs):
-        times.setdefault(spec.tags["variant"], []).append(summary.wall_s)
+        times.setdefault(spec.tags.variant, []).append(summary.wall_s)
     return {name: float(np.mean(times[name])) for name in VARIANTS if name in times}
 
 
@@ -155,7 +158,6 @@ def compare_variants(runs, cost_per_member=None):
 
 
 def _rows(result):
-    import pandas as pd
     frame = pd.DataFrame(result["rows"])
     for key in ("p_toppled_ci95", "falls"):
         if key in frame:

@@ -22,7 +22,7 @@ CLOSE_TIMEOUT_S = 1.0           # closing the local cluster after Ctrl-C
 
 def execute_dask(todo, runs_dir, jobs, worker, bar, scheduler):
     try:
-        from distributed import Client, as_completed
+        from distributed import Client, as_completed  # lazy: distributed, only on a Dask cluster
     except ImportError:
         raise ToolError("the dask executor needs dask.distributed: "
                         ".venv/bin/python -m pip install 'dask[distributed]'") from None
@@ -87,7 +87,7 @@ def local_cluster(jobs):
     dashboard is off) and per worker its nanny, its comm and its HTTP server:
     2 + 3 x jobs ports, closed with the cluster.
     """
-    from distributed import LocalCluster
+    from distributed import LocalCluster  # lazy: distributed, only on a Dask cluster
     return LocalCluster(n_workers=jobs, threads_per_worker=1, processes=True,
                         host="127.0.0.1", scheduler_port=0, dashboard_address=None,
                         scheduler_kwargs={"dashboard": False,

@@ -83,7 +83,7 @@ def _scratch_directory():
     """The Dask worker's local directory (its scratch space, which Dask purges when a
     killed worker's successor starts), else the system's temporary directory."""
     try:
-        from distributed import get_worker
+        from distributed import get_worker  # lazy: distributed, only on a Dask cluster
         return get_worker().local_directory
     except (ImportError, ValueError, AttributeError):
         return None

@@ -31,6 +31,8 @@ from pipeline.stats.location import locate_source_from_falls
 from pipeline.scenario.column_format import example_names
 from pipeline.scenario.geometry import ColumnGeometry
 from pipeline import verification
+from pipeline.campaign.tags import ColumnsTags
+import pandas as pd
 
 log = logging.getLogger(__name__)
 
@@ -147,7 +149,7 @@ def synthetic_specs(records, campaign_dir, column_file=None, stiffness="matched"
 
 
 def synthetic_outputs(specs, campaign_dir, failures, animations, figures=True):
-    from pipeline.figures.synthetic_map import plot_downfall_map
+    from pipeline.figures.synthetic_map import plot_downfall_map  # lazy: matplotlib, not imported by a run or after Ctrl-C
     result = column_outputs("synthetic")(specs, campaign_dir, failures, animations, figures)
     runs, _ = collect(specs, "synthetic", campaign_dir)
     if runs.empty or "source" not in runs.columns:
@@ -193,7 +195,7 @@ def columns_specs(records, campaign_dir, column_files=None, column="both",
         runs += [(r, twin(column=column, column_file=g.to_dict(), kn=kn)) for r in recs]
     runs = with_contact(runs, _contact(contact_file))
     return column_specs(runs, campaign_dir,
-                        tags=[{"description": p["column_file"]["name"]} for _, p in runs])
+                        tags=[ColumnsTags(p["column_file"]["name"]) for _, p in runs])
 
 
 COLUMNS_TABLE = ["description", "record_id", "column", "toppled", "downfall_azimuth_deg",
@@ -206,7 +208,6 @@ def columns_table(specs, campaign_dir):
     """One row per description, record and column (described or monolith): toppled,
     direction and which block struck the pedestal first, with the column's rocking
     threshold (g units, statics) beside them."""
-    import pandas as pd
 
     rows = []
     for spec, summary in finished_runs(campaign_dir, specs):
@@ -240,7 +241,7 @@ def columns_outputs(specs, campaign_dir, failures, animations, figures=True):
     campaign_dir = Path(campaign_dir)
     runs, impacts = collect(specs, "columns", campaign_dir)
     if not runs.empty:
-        names = {s.run_id: s.tags["description"] for s in specs}
+        names = {s.run_id: s.tags.description for s in specs}
         runs.insert(1, "description", runs["run_id"].map(names))
     write_tables(campaign_dir, runs, impacts)
     table = columns_table(specs, campaign_dir)
@@ -253,7 +254,7 @@ def columns_outputs(specs, campaign_dir, failures, animations, figures=True):
     log.info(text)
     written = []
     if figures and animations and not runs.empty:
-        from pipeline.figures import animate_examples
+        from pipeline.figures import animate_examples  # lazy: matplotlib, not imported by a run or after Ctrl-C
         written = animate_examples(runs, campaign_dir, animations)
     return {"code_version": run_code_version(),
             "figures": [str(p.relative_to(campaign_dir)) for p in written]}
@@ -293,7 +294,7 @@ def verification_specs(records, campaign_dir):
 
 
 def verification_outputs(specs, campaign_dir, failures, animations, figures=True):
-    from pipeline.figures.verification import plot_verification
+    from pipeline.figures.verification import plot_verification  # lazy: matplotlib, not imported by a run or after Ctrl-C
     runs = Path(campaign_dir) / "runs"
     results = [(check, verification.CheckResult.load(runs / check.run_id))
                for check in specs if (runs / check.run_id / "summary.json").exists()]

@@ -36,6 +36,7 @@ from pipeline.campaign.sizing import (DEFAULT_ARC_DEG, DEFAULT_MAX_MEMBERS, DEFA
                                       run_sized, write_summaries)
 from pipeline.stats.ensemble import record_summary
 from pipeline.stats.pooled import pooled_summary
+from pipeline.campaign.tags import EnsembleTags
 
 log = logging.getLogger(__name__)
 
@@ -44,7 +45,7 @@ KEPT_TRAJECTORIES = 2          # the nominal run and the first members keep traj
 
 def ensemble_specs(records, campaign_dir, record=None, column="both", members=DEFAULT_MEMBERS,
                    seed=DEFAULT_SEED, vary=None, column_file=None, stiffness="matched",
-                   batch=None, record_members=None, contact_file=None, **_):
+                   batch=None, record_members=None, contact_file=None):
     """Specs of the nominal run and ``members`` members per record (``record_members``:
     {record: members} overrides it per record), sampled in batches of ``batch``; a
     contact file fixes what it sets (:func:`contact_ranges`)."""
@@ -77,17 +78,17 @@ def ensemble_specs(records, campaign_dir, record=None, column="both", members=DE
         runs += [(rec, p) for p in member_params[:counts[rec]]]
         member_numbers += range(-1, counts[rec])        # -1: the nominal run
     # trajectories of the first members only: summaries for all
-    tags = [{"member": m, "keep_trajectory": m < KEPT_TRAJECTORIES} for m in member_numbers]
-    return mark(column_specs(runs, campaign_dir, tags, seed=seed), data)
+    return mark(column_specs(runs, campaign_dir, [EnsembleTags(m, seed) for m in member_numbers],
+                             [m < KEPT_TRAJECTORIES for m in member_numbers]), data)
 
 
 def ensemble_outputs(specs, campaign_dir, failures, animations, figures=True):
-    from pipeline.figures.ensemble import plot_ensemble
+    from pipeline.figures.ensemble import plot_ensemble  # lazy: matplotlib, not imported by a run or after Ctrl-C
     campaign_dir = Path(campaign_dir)
     runs, _ = collect(specs, "ensemble", campaign_dir)
     if runs.empty:
         return {"code_version": run_code_version(), **summary_entry(specs), "figures": []}
-    member_of = {s.run_id: s.tags["member"] for s in specs}
+    member_of = {s.run_id: s.tags.member for s in specs}
     runs.insert(1, "member", runs["run_id"].map(member_of))
     described = summary_entry(specs)
     if described:
@@ -99,7 +100,7 @@ def ensemble_outputs(specs, campaign_dir, failures, animations, figures=True):
         sub = runs[runs["record_id"] == record_id].sort_values(["member", "column"])
         write_csv(out / "members.csv", sub)
         write_parquet(out / "members.parquet", sub)
-        summary = record_summary(sub, record_id, specs[0].tags["seed"])
+        summary = record_summary(sub, record_id, specs[0].tags.seed)
         summary["record_input"] = next(sp.record for sp in specs
                                        if sp.record_id == record_id)
         if described:
@@ -120,7 +121,7 @@ def ensemble_outputs(specs, campaign_dir, failures, animations, figures=True):
             pooled["cost"] = yade_cost(campaign_dir, runs["run_id"])
             write_json(campaign_dir / POOLED_FILE, pooled)
             if figures:
-                from pipeline.figures.ensemble import plot_pooled
+                from pipeline.figures.ensemble import plot_pooled  # lazy: matplotlib, not imported by a run or after Ctrl-C
                 written.append(plot_pooled(runs, pooled, campaign_dir))
             for col in pooled["columns"]:
                 st = col["statistics"]
@@ -172,6 +173,7 @@ class EnsembleOptions(CampaignOptions):
     contact_file: str = contact_file_param(
         "its damping and friction for every member (not sampled), its kn what kn_factor "
         "multiplies (replacing --stiffness's)")
+    DRIVER_ONLY = ("precision", "arc_deg", "max_members")   # the sizing driver reads these
 
     def check(self):
         contact = contact_of(self)

@@ -44,7 +44,7 @@ summary :mod:`pipeline.campaign.pulse_summary`, adaptive sampling
 """
 import logging
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -67,6 +67,7 @@ from pipeline.files import InputError, duration_text
 from pipeline.motion.measures import horizontal_peak
 from pipeline.records import processed_motion
 from pipeline.scenario.parameters import param
+from pipeline.campaign.tags import LevelTags, PulseTags
 
 log = logging.getLogger(__name__)
 
@@ -115,14 +116,17 @@ def parse_grid(text):
     return grid
 
 
-def planned_runs(records, column_file=None, pulses=None, members=DEFAULT_MEMBERS,
-                 headings=DEFAULT_HEADINGS, levels=None, only_runs=None, **_):
-    """(runs, core-s a run) of the campaign from its options alone, the long-run gate's
+def planned_runs(records, options):
+    """(runs, core-s a run) of the campaign from its ``options`` (the keyword options of
+    :class:`FragilityOptions`, with ``only_runs`` in an adaptive stage) alone, the long-run gate's
     count before any spec is built: cells x members x headings on the pulse grid (its
     runs' cost, :func:`pipeline.campaign.pulse_grid.run_core_s`), records x levels x
     members on scaled records; None for the runs of an adaptive stage."""
-    if only_runs is not None:
+    if options.get("only_runs") is not None:
         return None
+    column_file, pulses = options.get("column_file"), options.get("pulses")
+    members = options.get("members", DEFAULT_MEMBERS)
+    headings, levels = options.get("headings", DEFAULT_HEADINGS), options.get("levels")
     if pulses is None and not records and column_file is not None:
         if "mesh" in column_file_description(column_file, meshes=True):
             pulses = "vsr"
@@ -139,7 +143,7 @@ def fragility_specs(records, campaign_dir, levels=None, members=DEFAULT_MEMBERS,
                     column="both", seed=None, azimuths=DEFAULT_AZIMUTHS, column_file=None,
                     stiffness="matched", pulses=None, azimuth=None,
                     headings=DEFAULT_HEADINGS, ranges=None, jobs=None, only_runs=None,
-                    adaptive=False, contact_file=None, grid_specs=None, **_):
+                    adaptive=False, contact_file=None, grid_specs=None):
     """Run specs: every record x level x member; ``scale`` = level / PGA of the record.
     With ``column_file`` every member is the described column with the sampled height
     and diameter tolerances (its own tilt and offsets as described), and the 2D block
@@ -165,7 +169,8 @@ def fragility_specs(records, campaign_dir, levels=None, members=DEFAULT_MEMBERS,
             ranges, stiffness, jobs, quiet=only_runs is not None, contact=contact)
         if only_runs is not None:
             keep = set(only_runs)
-            specs = [s.tagged(sampling="adaptive") for s in specs if s.run_id in keep]
+            specs = [replace(s, tags=replace(s.tags, adaptive=True)) for s in specs
+                     if s.run_id in keep]
         return specs
     if adaptive:
         raise InputError("--adaptive belongs to the pulse grid: add --pulses")
@@ -205,10 +210,8 @@ def fragility_specs(records, campaign_dir, levels=None, members=DEFAULT_MEMBERS,
             scale = round(level / pga, 6)
             for mi, params in enumerate(member_params):
                 runs.append((record, {**params, "scale": scale}))
-                extra.append({"level_m_s2": level, "level_index": li, "member": mi,
-                              "scale": scale})
-    return mark(column_specs(runs, campaign_dir, extra, seed=seed, azimuths=azimuths,
-                             levels=list(levels)), data)
+                extra.append(LevelTags(level, li, mi, scale, seed, azimuths, list(levels)))
+    return mark(column_specs(runs, campaign_dir, extra), data)
 
 
 def _pulse_specs(records, campaign_dir, data, column, pulses, members, headings, azimuth,
@@ -225,20 +228,22 @@ def _pulse_specs(records, campaign_dir, data, column, pulses, members, headings,
     grid, sets, azimuths, runs = pulse_grid.pulse_runs(
         data, column, pulses, members, headings, azimuth, seed, ranges, stiffness, contact)
     cache = motion_cache(campaign_dir)
-    pairs, tags = [], []
+    pairs, tags, costs = [], [], []
     for pga, ratio, params, tag in runs:
         pairs.append((str(pulse_grid.pulse_file(cache, pga, ratio)), params))
-        tags.append({"mode": "pulses", "core_s": round(pulse_grid.run_core_s(ratio), 3), **tag})
+        costs.append(round(pulse_grid.run_core_s(ratio), 3))
+        tags.append(PulseTags(**{**tag, "cell": tuple(tag["cell"])}, seed=seed, pulses=pulses,
+                              ranges=ranges, azimuth=azimuth, headings=headings,
+                              members=members))
     n_cells = len(grid["pga_g"]) * len(grid["pgv_pga_s"])
-    core_s = sum(t["core_s"] for t in tags)
+    core_s = sum(costs)
     if not quiet:
         log.info(f"fragility: {n_cells} pulse cells x {len(sets)} parameter sets x "
                  f"{azimuths.shape[1]} heading(s) = {len(runs)} YADE runs, at most about "
                  f"{duration_text(core_s / max(jobs or 1, 1))} on {jobs or 1} core(s) (a run "
                  "stops early once the specimen has fallen or settled; finished runs are "
                  "kept and not run again)")
-    specs = column_specs(pairs, campaign_dir, tags, seed=seed, pulses=pulses,
-                         ranges=ranges, azimuth=azimuth, headings=headings, members=members)
+    specs = column_specs(pairs, campaign_dir, tags, core_s=costs)
     return mark(specs, data)
 
 
@@ -329,7 +334,7 @@ def drive(run, records, campaign_dir, options, gate=None):
     if not options.get("adaptive"):
         return run(options)
     if gate is not None:          # before the specs: a grid of hours takes minutes to build
-        runs, core_s = planned_runs(records, **options)
+        runs, core_s = planned_runs(records, options)
         gate("campaign fragility (adaptive; at most the full grid)", runs, core_s,
              "a smaller --pulses grid")
     full = fragility_specs(records, campaign_dir, **options)
@@ -338,9 +343,9 @@ def drive(run, records, campaign_dir, options, gate=None):
     for spec, fell in zip(full, guide):
         by_cell.setdefault(pulse_adaptive.cell_key(spec), []).append(spec)
         guide_by_cell.setdefault(pulse_adaptive.cell_key(spec), []).append(fell)
-    headings = full[0].tags["headings"]
+    headings = full[0].tags.headings
     for rows in by_cell.values():
-        rows.sort(key=lambda s: pulse_adaptive.run_order(s.tags["member"], s.tags["heading"],
+        rows.sort(key=lambda s: pulse_adaptive.run_order(s.tags.member, s.tags.heading,
                                                          headings))
     guide_p = {cell: float(np.mean(fell)) for cell, fell in guide_by_cell.items()}
     per_cell = len(full) // len(by_cell)

@@ -32,7 +32,7 @@ def block_runs(specs, azimuths=None, max_step=BLOCK_MAX_STEP_S, t_after=BLOCK_T_
     for motion_file, specs_of_motion in by_motion.items():
         motion = Motion.load(motion_file)
         rp = record_parameters(motion)
-        n_az = int(azimuths or specs_of_motion[0].tags.get("azimuths", DEFAULT_AZIMUTHS))
+        n_az = int(azimuths or specs_of_motion[0].tags.azimuths)
         strongest = float(rp["az_max_acc_deg"])
         directions = (strongest + np.arange(n_az) * 180.0 / n_az) % 360.0
         rad = np.radians(directions)
@@ -68,8 +68,8 @@ def _block_batch(group, motion_file, rp, along, directions, dt, max_step, t_afte
     for i, spec in enumerate(group):
         s, tags, column = spec.params.drive.scale, spec.tags, spec.params.column
         base = {"campaign": "fragility", "run_id": spec.run_id, "model": "2D",
-                "scale": s, "member": tags["member"], "level_index": tags["level_index"],
-                "level_m_s2": tags["level_m_s2"], "record_id": spec.record_id,
+                "scale": s, "member": tags.member, "level_index": tags.level_index,
+                "level_m_s2": tags.level_m_s2, "record_id": spec.record_id,
                 "hd": round(heights[i] / widths[i], 6) if column.column_file is not None
                 else column.hd, "height_m": float(heights[i]),
                 "pga_m_s2": rp["pga_h"] * s, "pgv_m_s": rp["pgv_h"] * s,

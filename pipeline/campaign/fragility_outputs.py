@@ -15,6 +15,7 @@ from pipeline.campaign.run_dirs import finished_summary
 from pipeline.files import write_csv
 from pipeline.hazard.fragility.file import FragilityFile, write_fragility_file
 from pipeline.simulate import run_code_version
+from pipeline.campaign.tags import PulseTags
 
 log = logging.getLogger(__name__)
 
@@ -23,7 +24,7 @@ def fragility_outputs(specs, campaign_dir, failures, animations, figures=True):
     """Write the campaign's files from its finished runs (the pulse grid's:
     :func:`pulse_outputs`) and say the fits; returns the campaign summary's entry."""
     campaign_dir = Path(campaign_dir)
-    if specs and specs[0].tags.get("mode") == "pulses":
+    if specs and isinstance(specs[0].tags, PulseTags):
         return pulse_outputs(specs, campaign_dir, figures)
     runs = scaled_runs(specs, campaign_dir)
     if runs.empty:
@@ -47,7 +48,7 @@ def fragility_outputs(specs, campaign_dir, failures, animations, figures=True):
     write_csv(campaign_dir / "fragility_levels.csv", level_table(table))
     written = []
     if figures:
-        from pipeline.figures.fragility import plot_fragility
+        from pipeline.figures.fragility import plot_fragility  # lazy: matplotlib, not imported by a run or after Ctrl-C
         written = plot_fragility(table, summary, campaign_dir)
     for name, entry in summary.columns.items():
         fit = entry.fits["PGA"]

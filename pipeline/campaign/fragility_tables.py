@@ -35,7 +35,7 @@ def scaled_runs(specs, campaign_dir):
         return runs
     by_id = {s.run_id: s.tags for s in specs}
     for key in ("level_m_s2", "level_index", "member", "scale"):
-        runs.insert(2, key, runs["run_id"].map(lambda r, k=key: by_id[r][k]))
+        runs.insert(2, key, runs["run_id"].map(lambda r, k=key: getattr(by_id[r], k)))
     runs.insert(2, "model", "3D")
     scale = runs["scale"].astype(float)
     runs["record_pga_h"] = runs["pga_h"]
@@ -99,16 +99,16 @@ def summarise(table, specs, cost):
         "drums": "3D YADE multi-drum column" if column_file is None
         else f"3D YADE column as described in {column_file}",
         "block2d": "2D rigid block (Housner), shaken along the strongest azimuth",
-        "block2d_worst": f"2D rigid block, worst of {first['azimuths']} azimuths over 180 deg"}
+        "block2d_worst": f"2D rigid block, worst of {first.azimuths} azimuths over 180 deg"}
     columns = _column_fits(table, descriptions, alpha, p)
     comparison = _comparison(columns)
     levels = level_table(table)
     return json_safe({
         "records": list(dict.fromkeys(s.record_id for s in specs)),
-        "levels_m_s2": first["levels"], "members": 1 + max(s.tags["member"] for s in specs),
-        "seed": first["seed"], "column": specs[0].params.column.kind,
+        "levels_m_s2": first.levels, "members": 1 + max(s.tags.member for s in specs),
+        "seed": first.seed, "column": specs[0].params.column.kind,
         **({"column_file": column_file} if column_file else {}),
-        "azimuths": first["azimuths"],
+        "azimuths": first.azimuths,
         "intensity_measures": {im: {"column": key, "unit": unit,
                                     "definition": _IM_DEFINITIONS[im]}
                                for im, (key, unit, _) in INTENSITY_MEASURES.items()},

@@ -9,6 +9,7 @@ from pipeline.campaign.column_file import STIFFNESS_CHOICES, column_file_help, p
 from pipeline.files import InputError
 from pipeline.scenario.contact_file import refuse_set_twice
 from pipeline.scenario.parameters import check_fields, param
+from pipeline.scenario.contact_file import contact_values
 
 CAMPAIGN_NOTE = ("the described column stands in the drums' place and a monolith of its "
                  "outline in the monolith's")
@@ -44,7 +45,6 @@ def contact_of(options):
     checked before any run."""
     if options.contact_file is None:
         return None
-    from pipeline.scenario.contact_file import contact_values
     return contact_values(options.contact_file)
 
 
@@ -64,6 +64,7 @@ def refuse_ignored_stiffness(options, contact, described=True):
 class CampaignOptions:
     """No options of its own.  Subclasses declare fields and may add :meth:`check`."""
     TAKES_JOBS = False          # the specs want the command's --jobs (keyword ``jobs``)
+    DRIVER_ONLY = ()            # options only the campaign's driver reads, not its specs
 
     def __post_init__(self):
         check_fields(self)
@@ -73,7 +74,8 @@ class CampaignOptions:
         """Checks across fields (InputError)."""
 
     def kwargs(self):
-        """Keyword options of the campaign's ``specs``."""
+        """Keyword options of the campaign (its driver's; its ``specs`` take them less
+        :attr:`DRIVER_ONLY`, every other one by name)."""
         return {f.name: getattr(self, f.name) for f in fields(self)}
 
 

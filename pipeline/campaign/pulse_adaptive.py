@@ -15,7 +15,7 @@ ADAPTIVE_FIRST_RUNS = 4
 
 
 def cell_key(spec):
-    return tuple(spec.tags["cell"])
+    return spec.tags.cell
 
 
 def run_order(member, heading, headings):

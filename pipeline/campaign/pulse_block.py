@@ -62,10 +62,10 @@ def block_outcomes(specs, t_after=BLOCK_T_AFTER_S, max_step=BLOCK_MAX_STEP_S):
     out = np.zeros(len(specs), bool)
     by_cell = {}
     for k, spec in enumerate(specs):
-        by_cell.setdefault((spec.tags["pga_g"], spec.tags["pgv_pga_s"]), []).append(k)
+        by_cell.setdefault((spec.tags.pga_g, spec.tags.pgv_pga_s), []).append(k)
     for (pga_g, ratio), idx in by_cell.items():
         pulse = one_cosine_pulse(pga_g * G, ratio, 0.0, PULSE_DT_S, 0.0)
-        sizes = np.array([block_of(specs[k].params, specs[k].tags["azimuth_deg"])
+        sizes = np.array([block_of(specs[k].params, specs[k].tags.azimuth_deg)
                           for k in idx], float)
         acc = np.repeat(pulse.acc[:, 1:2], len(idx), axis=1)       # (n, cases)
         result = rocking_response_sampled(sizes[:, 0], sizes[:, 1], acc, pulse.dt,
@@ -77,7 +77,7 @@ def block_outcomes(specs, t_after=BLOCK_T_AFTER_S, max_step=BLOCK_MAX_STEP_S):
 def block_reference(specs):
     """alpha (rad), R (m), p (1/s) of the 2D block: medians over the runs; and
     ``alpha_smallest`` (rad), the smallest critical angle of any run's block."""
-    sizes = np.array([block_of(s.params, s.tags["azimuth_deg"]) for s in specs], float)
+    sizes = np.array([block_of(s.params, s.tags.azimuth_deg) for s in specs], float)
     c = block_constants(float(np.median(sizes[:, 0])), float(np.median(sizes[:, 1])))
     return {**c, "alpha_smallest": float(np.min(np.arctan2(sizes[:, 1], sizes[:, 0])))}
 

@@ -39,9 +39,9 @@ def pulse_table(specs, campaign_dir):
         described = spec.params.column.column_file or {}
         for column in summary.columns:
             rows.append({"run_id": spec.run_id, "model": column.column,
-                         "pga_g": spec.tags["pga_g"], "pgv_pga_s": spec.tags["pgv_pga_s"],
-                         "member": spec.tags["member"], "heading": spec.tags["heading"],
-                         "azimuth_deg": spec.tags["azimuth_deg"], "toppled": column.toppled,
+                         "pga_g": spec.tags.pga_g, "pgv_pga_s": spec.tags.pgv_pga_s,
+                         "member": spec.tags.member, "heading": spec.tags.heading,
+                         "azimuth_deg": spec.tags.azimuth_deg, "toppled": column.toppled,
                          "max_tilt_deg": column.max_tilt_deg,
                          "downfall_azimuth_deg": column.downfall_azimuth_deg,
                          "kn": contact.kn, "damping": contact.damping, "mu_s": contact.mu_s,
@@ -51,9 +51,9 @@ def pulse_table(specs, campaign_dir):
         fell = pulse_block.block_outcomes(done)
         for spec, toppled in zip(done, fell):
             rows.append({"run_id": spec.run_id, "model": BLOCK_MODEL,
-                         "pga_g": spec.tags["pga_g"], "pgv_pga_s": spec.tags["pgv_pga_s"],
-                         "member": spec.tags["member"], "heading": spec.tags["heading"],
-                         "azimuth_deg": spec.tags["azimuth_deg"], "toppled": bool(toppled)})
+                         "pga_g": spec.tags.pga_g, "pgv_pga_s": spec.tags.pgv_pga_s,
+                         "member": spec.tags.member, "heading": spec.tags.heading,
+                         "azimuth_deg": spec.tags.azimuth_deg, "toppled": bool(toppled)})
     return pd.DataFrame(rows), done
 
 
@@ -64,30 +64,30 @@ def pulse_outputs(specs, campaign_dir, figures=True):
         return {"code_version": run_code_version(), **summary_entry(specs), "figures": []}
     write_csv(campaign_dir / "fragility_runs.csv", table)
     first = specs[0].tags
-    grid = pulse_grid.parse_pulses(first["pulses"])
-    sets = [None] * first["members"]
+    grid = pulse_grid.parse_pulses(first.pulses)
+    sets = [None] * first.members
     azimuths = {}
     for spec in specs:
-        sets[spec.tags["member"]] = spec.tags["point"]
-        azimuths[(spec.tags["member"], spec.tags["heading"])] = spec.tags["azimuth_deg"]
-    azimuth_array = np.array([[azimuths.get((m, h), np.nan) for h in range(first["headings"])]
-                              for m in range(first["members"])])
+        sets[spec.tags.member] = spec.tags.point
+        azimuths[(spec.tags.member, spec.tags.heading)] = spec.tags.azimuth_deg
+    azimuth_array = np.array([[azimuths.get((m, h), np.nan) for h in range(first.headings)]
+                              for m in range(first.members)])
     section = pulse_summary.summarise_grid(table, done, grid, sets, azimuth_array,
-                                        first["azimuth"], first["ranges"]
+                                        first.azimuth, first.ranges
                                         or pulse_grid.DEFAULT_RANGES)
     described = summary_entry(specs)
     name = described["column_file"]["name"] if described else "the paper's column"
     summary = FragilityFile.of(json_safe({"mode": "pulses", "specimen": name,
-                                          "seed": first["seed"], "pulse_grid": section}))
+                                          "seed": first.seed, "pulse_grid": section}))
     section = summary.pulse_grid
     section = replace(
         section, block2d=replace(section.block2d, model=BLOCK_MODEL),
         runs_finished=len(done), runs=len(specs),
         yade_wall_s_total=round(float(sum(
             finished_summary(campaign_dir, s.run_id).wall_s or 0.0 for s in done)), 1),
-        full_grid_runs=(len(grid["pga_g"]) * len(grid["pgv_pga_s"]) * first["members"]
-                        * first["headings"]),
-        sampling=SAMPLING[first.get("sampling") == "adaptive"])
+        full_grid_runs=(len(grid["pga_g"]) * len(grid["pgv_pga_s"]) * first.members
+                        * first.headings),
+        sampling=SAMPLING[first.adaptive])
     observed = experiments_check(section, name)
     if observed is not None:
         section = replace(section, experiments=Experiments.of(json_safe(observed)))
@@ -95,7 +95,7 @@ def pulse_outputs(specs, campaign_dir, figures=True):
     write_fragility_file(campaign_dir, summary)
     written = []
     if figures:
-        from pipeline.figures.fragility import plot_pulse_grid
+        from pipeline.figures.fragility import plot_pulse_grid  # lazy: matplotlib, not imported by a run or after Ctrl-C
         written = plot_pulse_grid(summary, campaign_dir / "fragility_pulse_grid.png")
     grid = summary.pulse_grid
     for model, entry in grid.models.items():

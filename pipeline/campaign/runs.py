@@ -29,10 +29,12 @@ def motion_cache(campaign_dir):
     return campaign_dir / "motions"
 
 
-def column_specs(runs, campaign_dir, tags=None, **common):
+def column_specs(runs, campaign_dir, tags=None, keep_trajectory=True, core_s=None):
     """Resolve (record, parameters) pairs into :class:`~pipeline.campaign.spec.RunSpec`:
     each record processed once, record ids unique, run id = hash(code, motion content,
-    parameters); ``tags``: one dict per run, ``common``: tags of every run."""
+    parameters); ``tags``: one campaign tags dataclass per run (:mod:`pipeline.campaign.tags`);
+    ``keep_trajectory``: a bool for every run or one per run; ``core_s``: None (the
+    campaign's estimate) or one core-seconds estimate per run."""
     version = run_code_version()
     cache = motion_cache(campaign_dir)
     resolved, ids = {}, {}
@@ -48,17 +50,20 @@ def column_specs(runs, campaign_dir, tags=None, **common):
             record_id = f"{record_id}-{path.stem[:6]}"      # two files with one stem
         ids[record_id] = path
         resolved[record] = (record_id, path)
-    tags = [{}] * len(runs) if tags is None else list(tags)
-    if len(tags) != len(runs):
-        raise ValueError("column_specs: one tags dict per run")
+    tags = [None] * len(runs) if tags is None else list(tags)
+    keep = [keep_trajectory] * len(runs) if isinstance(keep_trajectory, bool) \
+        else list(keep_trajectory)
+    core_s = [None] * len(runs) if core_s is None else list(core_s)
+    if not len(tags) == len(keep) == len(core_s) == len(runs):
+        raise ValueError("column_specs: one tags, keep_trajectory and core_s per run")
     built = {}        # id of a parameters dict shared by many runs -> (it, its RunParams)
     for _, params in runs:
         if not isinstance(params, RunParams) and id(params) not in built:
             built[id(params)] = (params, RunParams.from_dict(params))   # checked once
     return [RunSpec.create(record, resolved[record][0], resolved[record][1],
                            built[id(params)][1] if id(params) in built else params, version,
-                           **common, **more)
-            for (record, params), more in zip(runs, tags)]
+                           tag, keep_trajectory=kept, core_s=cost)
+            for (record, params), tag, kept, cost in zip(runs, tags, keep, core_s)]
 
 
 def run_column_spec(spec, run_dir):
@@ -101,7 +106,7 @@ def column_outputs(name, size_by=None):
         if not runs.empty:
             write_csv(campaign_dir / "direction_statistics.csv", direction_statistics(runs))
             if figures:
-                from pipeline import figures as figure_module   # matplotlib: not after Ctrl-C
+                from pipeline import figures as figure_module  # lazy: matplotlib, not imported by a run or after Ctrl-C
                 written = figure_module.campaign_figures(name, runs, impacts, campaign_dir,
                                                          size_by, animations)
         toppled = runs.groupby("column")["toppled"].agg(["sum", "count"]) if not runs.empty \

@@ -42,6 +42,7 @@ from pipeline.campaign.shake_table_experiments import (AXIS_DEG, DEFAULT_GRID, E
                                                        PGV_PGA_EDGES_S, SPECIMEN,
                                                        VALIDATE_FROM, grid_run_params,
                                                        load_experiments, parse_grid)
+from pipeline.campaign.tags import ShakeTableTags
 
 log = logging.getLogger(__name__)
 
@@ -56,13 +57,16 @@ def _label(point):
 
 def specs(records, campaign_dir, experiments=EXPERIMENTS, specimen=SPECIMEN, outcome=OUTCOME,
           validate_from=VALIDATE_FROM, grid=DEFAULT_GRID, stage="calibration", chosen=None,
-          tests=None, axis_deg=AXIS_DEG, contact_file=None, **mode):
+          tests=None, axis_deg=AXIS_DEG, contact_file=None, members=None, seed=None,
+          ranges=None, only_runs=None, full=None):
     """Run specs of one stage: every grid point on the calibration tests, or the chosen
     point on the validation tests; a contact file's values are the base the points
-    override.  Stage "members": the members mode's (``mode``: its options)."""
+    override.  Stage "members": the members mode's (``members``, ``seed``, ``ranges``,
+    ``only_runs`` of ``full``)."""
     if stage == "members":
         return MODES["members"].specs(records, campaign_dir, experiments, specimen, outcome,
-                                      validate_from, grid, tests, contact_file, **mode)
+                                      validate_from, grid, tests, contact_file, members,
+                                      seed, ranges, only_runs, full)
     if records:
         raise InputError("the shake-table campaign takes its motions from --experiments, "
                          "not --records")
@@ -80,30 +84,30 @@ def specs(records, campaign_dir, experiments=EXPERIMENTS, specimen=SPECIMEN, out
         params = grid_run_params(description, point, base)
         for row in frame.itertuples():
             runs.append((str(row.motion_path), params))
-            meta.append({"test": row.test, "observed": bool(row.observed), "stage": stage,
-                         "grid_point": _label(point), "point": point})
+            meta.append(ShakeTableTags(row.test, bool(row.observed), stage, _label(point),
+                                       point))
     return column_specs(runs, campaign_dir, meta)
 
 def outputs(specs_, campaign_dir, failures, animations, figures=True):
     """Per-run table of this stage and its scores per grid point."""
-    if specs_ and specs_[0].tags["stage"] == "members":
+    if specs_ and specs_[0].tags.stage == "members":
         return MODES["members"].outputs(specs_, campaign_dir, failures, animations, figures)
     campaign_dir = Path(campaign_dir)
     rows = []
     for spec, summary in finished_runs(campaign_dir, specs_):
         column = summary.columns[0]
-        rows.append({"test": spec.tags["test"], "stage": spec.tags["stage"],
-                     "grid_point": spec.tags["grid_point"], "observed": spec.tags["observed"],
+        rows.append({"test": spec.tags.test, "stage": spec.tags.stage,
+                     "grid_point": spec.tags.grid_point, "observed": spec.tags.observed,
                      "predicted": column.toppled, "max_tilt_deg": column.max_tilt_deg,
                      "run_id": spec.run_id})
     table = pd.DataFrame(rows)
     per_point = {}
     if len(table):
-        stage = specs_[0].tags["stage"]
+        stage = specs_[0].tags.stage
         write_csv(campaign_dir / f"{stage}.csv", table)
         for label, group in table.groupby("grid_point", sort=False):
             per_point[label] = scores(group["observed"], group["predicted"])
-    points = {spec.tags["grid_point"]: spec.tags["point"] for spec in specs_}
+    points = {spec.tags.grid_point: spec.tags.point for spec in specs_}
     return {"scores": per_point, "points": points, "runs_done": len(rows)}
 
 def best_point(result):
@@ -156,7 +160,7 @@ def drive(run, records, campaign_dir, options, gate=None):
     write_csv(campaign_dir / "experiments.csv", table.drop(columns=["day", "motion_path"]))
     result = summarise(table, specimen, calibration, label, point, options)
     write_json(campaign_dir / "shake_table.json", result)
-    from pipeline.figures.shake_table import plot_rates
+    from pipeline.figures.shake_table import plot_rates  # lazy: matplotlib, not imported by a run or after Ctrl-C
     plot_rates(table, campaign_dir / "shake_table_rates.png", result, PGA_EDGES_G,
                PGV_PGA_EDGES_S)
     for line in result["lines"]:
@@ -262,6 +266,7 @@ class ShakeTableOptions(CampaignOptions):
                             "records/shake_table/sp1_numerical.csv)", flag="--providers",
                             metavar="CSV")
     TAKES_JOBS = True
+    DRIVER_ONLY = ("candidates", "providers", "jobs")
 
     def check(self):
         contact_of(self)

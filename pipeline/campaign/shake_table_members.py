@@ -42,6 +42,7 @@ from pipeline.scenario.contact_file import contact_values
 from pipeline.scenario.geometry import ColumnGeometry
 from pipeline.stats.ensemble import wilson_interval
 from pipeline.stats.forecast import forecast_scores
+from pipeline.campaign.tags import ShakeMemberTags
 
 log = logging.getLogger(__name__)
 
@@ -157,8 +158,7 @@ def tests_of(experiments, outcome, tests, validate_from):
 
 
 def specs(records, campaign_dir, experiments, specimen, outcome, validate_from, grid, tests,
-          contact_file, members=None, seed=None, ranges=None, only_runs=None, full=None,
-          **_):
+          contact_file, members=None, seed=None, ranges=None, only_runs=None, full=None):
     """Every test x (N members and the single set); ``only_runs`` keeps those run ids (of
     ``full``, the specs made already)."""
     if full is None:
@@ -170,15 +170,14 @@ def specs(records, campaign_dir, experiments, specimen, outcome, validate_from, 
         base = None if contact_file is None else contact_values(contact_file)
         sets, _ = member_sets(description, members, seed, ranges, base)
         points = [(m, p) for m, p in enumerate(sets)] + [(-1, single_set(grid))]
-        runs, tags = [], []
+        runs, tags, costs = [], [], []
         for m, point in points:
             params = run_params(description, point, base)
             for row in frame.itertuples():
                 runs.append((str(row.motion_path), params))
-                tags.append({"test": row.test, "observed": bool(row.observed),
-                             "stage": "members", "member": m, "point": point,
-                             "core_s": round(core_s(params), 3)})
-        full = column_specs(runs, campaign_dir, tags)
+                tags.append(ShakeMemberTags(row.test, bool(row.observed), "members", m, point))
+                costs.append(round(core_s(params), 3))
+        full = column_specs(runs, campaign_dir, tags, core_s=costs)
     if only_runs is None:
         return full
     keep = set(only_runs)
@@ -190,8 +189,8 @@ def outputs(specs_, campaign_dir, failures, animations, figures=True):
     :func:`drive` once every stage has run."""
     rows = []
     for spec, summary in finished_runs(Path(campaign_dir), specs_):
-        rows.append({"test": spec.tags["test"], "member": spec.tags["member"],
-                     "observed": spec.tags["observed"],
+        rows.append({"test": spec.tags.test, "member": spec.tags.member,
+                     "observed": spec.tags.observed,
                      "predicted": summary.columns[0].toppled,
                      "max_tilt_deg": summary.columns[0].max_tilt_deg,
                      "run_id": spec.run_id})
@@ -249,10 +248,10 @@ def _members(run, campaign_dir, options, full, frame):
     n = options["members"]
     by_test = {}
     for spec in full:
-        by_test.setdefault(spec.tags["test"], []).append(spec)
-    order = {t: sorted([s for s in rows if s.tags["member"] >= 0],
-                       key=lambda s: s.tags["member"]) for t, rows in by_test.items()}
-    single = [s.run_id for rows in by_test.values() for s in rows if s.tags["member"] < 0]
+        by_test.setdefault(spec.tags.test, []).append(spec)
+    order = {t: sorted([s for s in rows if s.tags.member >= 0],
+                       key=lambda s: s.tags.member) for t, rows in by_test.items()}
+    single = [s.run_id for rows in by_test.values() for s in rows if s.tags.member < 0]
     cells = {t: (i, 0) for i, t in enumerate(order)}
     guide = {cell: pulse_adaptive.ADAPTIVE_LEVEL for cell in cells.values()}    # no guide
 
@@ -325,7 +324,7 @@ def _per_test(frame, order, by_test, campaign_dir, targets, cells):
         done = [summary.columns[0].toppled for _, summary in
                 finished_runs(Path(campaign_dir), order[row.test][:targets[cells[row.test]]])]
         single = [finished_summary(Path(campaign_dir), s.run_id)
-                  for s in by_test[row.test] if s.tags["member"] < 0][0]
+                  for s in by_test[row.test] if s.tags.member < 0][0]
         k, m = int(sum(done)), len(done)
         lo, hi = wilson_interval(k, m)
         rows.append({"test": row.test, "date": row.date, "split": row.split,

@@ -100,14 +100,14 @@ def write_scores(per_test, campaign_dir, options, full, settled, choice=None):
                                   scored[scored["split"] == split], threshold_g, providers)
               for split in SPLITS}
     splits = {split: scores for split, scores in splits.items() if scores is not None}
-    member_specs = [s for s in full if s.tags["member"] >= 0]
-    sets = sorted({s.tags["member"]: s.tags["point"] for s in member_specs}.items())
+    member_specs = [s for s in full if s.tags.member >= 0]
+    sets = sorted({s.tags.member: s.tags.point for s in member_specs}.items())
     result = {
         "specimen": specimen.name, "experiments": str(options["experiments"]),
         "outcome": options["outcome"], "validate_from": options["validate_from"],
         "members": options["members"], "seed": options.get("seed"),
         "ranges": options.get("ranges"), "parameter_sets": [p for _, p in sets],
-        "single_set": next(s.tags["point"] for s in full if s.tags["member"] < 0),
+        "single_set": next(s.tags.point for s in full if s.tags.member < 0),
         "providers": None if path is None else str(path),
         "pga_threshold_g": threshold_g, "critical_angle_deg": critical, "axis_deg": axis,
         "runs": int(per_test["runs"].sum()) + int(per_test["single_set_predicted"].notna()
@@ -116,7 +116,7 @@ def write_scores(per_test, campaign_dir, options, full, settled, choice=None):
         "rules": CLIP_RULE, "bin_edges": [float(e) for e in BIN_EDGES],
         "ranges_choice": choice, "splits": splits, "lines": choice_lines(choice) + lines_of(splits)}
     write_json(campaign_dir / "shake_table_members.json", result)
-    from pipeline.figures.reliability import plot_reliability
+    from pipeline.figures.reliability import plot_reliability  # lazy: matplotlib, not imported by a run or after Ctrl-C
     plot_reliability({s: v["members"]["reliability_diagram"] for s, v in splits.items()},
                      campaign_dir / "shake_table_reliability.png",
                      f"{specimen.name}: {options['members']} members per test at most")

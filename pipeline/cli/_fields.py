@@ -101,7 +101,7 @@ def from_args(cls, args, **fixed):
 def add_column_file_argument(parser, note=""):
     """``--column-file NAME_OR_FILE`` of a single run; ``note``: what the command does
     with it (campaigns declare theirs as fields: :mod:`pipeline.campaign.options`)."""
-    from pipeline.campaign.column_file import column_file_help
+    from pipeline.campaign.column_file import column_file_help  # lazy: the stage runs only with the command (light start-up and --help)
     parser.add_argument("--column-file", dest="column_file", default=None,
                         metavar="NAME_OR_FILE",
                         help=column_file_help() + (f"; {note}" if note else ""))

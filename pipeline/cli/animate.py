@@ -20,7 +20,7 @@ def setup(p):
 
 
 def run(args):
-    from pipeline.figures.animation import animate_run, export_vtk
+    from pipeline.figures.animation import animate_run, export_vtk  # lazy: the stage runs only with the command (light start-up and --help)
     out = animate_run(args.run_dir, args.out or args.run_dir / "animation.gif", fps=args.fps,
                       max_seconds=args.max_seconds)
     print(f"wrote {out}")

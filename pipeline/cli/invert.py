@@ -55,7 +55,7 @@ def _weights(text):
 
 
 def setup(p):
-    from pipeline.inversion.grid import GRIDS, MECHANISMS
+    from pipeline.inversion.grid import GRIDS, MECHANISMS  # lazy: the stage runs only with the command (light start-up and --help)
     _what_to_run(p, GRIDS)
     _forward_grid(p.add_argument_group("forward grid (the table: one ensemble per node)"),
                   GRIDS["full"], MECHANISMS)
@@ -157,9 +157,9 @@ def _candidates(c):
 
 def build_grids(args):
     """(preset name, TableGrid, CandidateGrid) from the options; InputError if impossible."""
-    from pipeline.inversion.grid import GRIDS, parse_mechanisms
-    from pipeline.campaign.ensemble_members import check_seed
-    from pipeline.inversion.candidates import CandidateGrid
+    from pipeline.inversion.grid import GRIDS, parse_mechanisms  # lazy: the stage runs only with the command (light start-up and --help)
+    from pipeline.campaign.ensemble_members import check_seed  # lazy: the stage runs only with the command (light start-up and --help)
+    from pipeline.inversion.candidates import CandidateGrid  # lazy: the stage runs only with the command (light start-up and --help)
     if args.quick and args.grid not in (None, "quick"):
         raise InputError("--quick is --grid quick: give one of them")
     preset = "quick" if args.quick else (
@@ -186,14 +186,13 @@ def build_grids(args):
 
 
 def run(args):
-    from pipeline.inversion import workflows
+    from pipeline.inversion import workflows  # lazy: the stage runs only with the command (light start-up and --help)
     if (args.demo + args.member_study + (args.observations is not None)
             + (args.hidden_truth is not None)) != 1:
         raise InputError("give one of an OBSERVATIONS.json file, --demo, --member-study or "
                          "--hidden-truth TRUTH.json")
-    if args.trials is not None and not ((args.demo or args.member_study)
-                                        and 1 <= args.trials <= 1000):
-        raise InputError("--trials (1-1000) goes with --demo or --member-study")
+    if args.trials is not None and not (args.demo or args.member_study):
+        raise InputError("--trials goes with --demo or --member-study")
     options = from_args(InversionOptions, args)
     site_fragility = _check_site_motion(args)
     preset, grid, candidates = build_grids(args)
@@ -224,9 +223,9 @@ def _check_site_motion(args):
                          "which the PGA range is stated)")
     if args.site_fragility_form == "pga" and args.at_pgv_pga is not None:
         raise InputError("--at-pgv-pga goes with --site-fragility-form pga-pgv")
-    from pipeline.hazard.fragility import load_campaign_fragility
-    from pipeline.inversion.observations import load_observations
-    from pipeline.records import rotd50_fraction
+    from pipeline.hazard.fragility import load_campaign_fragility  # lazy: the stage runs only with the command (light start-up and --help)
+    from pipeline.inversion.observations import load_observations  # lazy: the stage runs only with the command (light start-up and --help)
+    from pipeline.records import rotd50_fraction  # lazy: the stage runs only with the command (light start-up and --help)
     cache = {}
 
     def fragility_for(column):

@@ -122,7 +122,7 @@ def plot_motions(figures, jobs):
 
 
 def _plot_motion(figure):
-    from pipeline.figures.records import plot_motion      # matplotlib: not for --help
+    from pipeline.figures.records import plot_motion  # lazy: the stage runs only with the command (light start-up and --help)
     plot_motion(*figure)
 
 

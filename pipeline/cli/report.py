@@ -13,6 +13,6 @@ def setup(p):
 
 
 def run(args):
-    from pipeline.report import build_report
+    from pipeline.report import build_report  # lazy: the stage runs only with the command (light start-up and --help)
     print(f"wrote {build_report(args.results)}")
     return 0

@@ -122,7 +122,7 @@ def _contact(args):
     given in both refused)."""
     if args.contact_file is None:
         return from_args(Contact, args)
-    from pipeline.scenario.contact_file import checked_contact, load_contact_file
+    from pipeline.scenario.contact_file import checked_contact, load_contact_file  # lazy: the stage runs only with the command (light start-up and --help)
     from_file = load_contact_file(args.contact_file)
     both = [f"--{k.replace('_', '-')}" for k in from_file if getattr(args, k) is not None]
     if both:

@@ -11,7 +11,7 @@ def campaign_figures(name, runs, impacts, campaign_dir, size_by=None, animations
     """A column campaign's figures: impact maps per record for sweeps (``size_by`` the
     swept parameter), a rose, toppling vs parameters and downfall vs directions for
     record sets, and GIF animations of the first ``animations`` toppled runs."""
-    from pipeline.figures import campaign as cf
+    from pipeline.figures import campaign as cf  # lazy: matplotlib, not imported by a run or after Ctrl-C
     campaign_dir = Path(campaign_dir)
     written = []
     if size_by:
@@ -35,7 +35,7 @@ def campaign_figures(name, runs, impacts, campaign_dir, size_by=None, animations
 
 def animate_examples(runs, campaign_dir, count=1):
     """GIF animations of the first toppled runs (the paper's online movies)."""
-    from pipeline.figures.animation import animate_run
+    from pipeline.figures.animation import animate_run  # lazy: matplotlib, not imported by a run or after Ctrl-C
     written = []
     toppled = runs[runs["toppled"].astype(bool)].drop_duplicates("run_id").head(count)
     for _, row in toppled.iterrows():

@@ -91,12 +91,6 @@ def body_surfaces(body, centre, quat_wxyz):
     return out
 
 
-def body_surface(body, centre, quat_wxyz):
-    """Vertices (2 x k x 3) of a single-part body's bottom and top outline, world frame
-    (m); bodies of several parts: the first part (see :func:`body_surfaces`)."""
-    return body_surfaces(body, centre, quat_wxyz)[0]
-
-
 def body_top_m(body):
     """Initial height (m) of a body's highest face (upright bodies)."""
     z = body["initial_pos"][2] if "initial_pos" in body else body["height"] / 2
@@ -111,7 +105,7 @@ def _frame_indices(t, fps, max_seconds):
 
 def animate_run(run, path, fps=20, max_seconds=None, max_frames=600):
     """Write a 3-D animation of a run to ``path`` (.gif, or .mp4 with ffmpeg)."""
-    from matplotlib import animation
+    from matplotlib import animation  # lazy: matplotlib, not imported by a run or after Ctrl-C
 
     traj = load(run)
     offset = start_in_file_s(run)
@@ -162,7 +156,7 @@ def animate_run(run, path, fps=20, max_seconds=None, max_frames=600):
     if path.suffix == ".gif":
         # frames drawn here and quantised with Pillow's fast octree (its default
         # median cut took a third of the time of matplotlib's PillowWriter)
-        from PIL import Image
+        from PIL import Image  # lazy: Pillow with matplotlib's animation, only when animating
         images = []
         for k in frames:
             draw(k)

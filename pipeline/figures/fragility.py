@@ -12,6 +12,7 @@ from pipeline.files import save_figure
 from pipeline.hazard.pulse_cells import CONTOUR_LEVELS, lay_cells
 from pipeline.stats.ensemble import wilson_interval
 from pipeline.stats.fragility import logistic_probability
+from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
 
 BLOCK_STYLE = {"block2d": {"color": "0.35", "ls": "--", "marker": "D",
                            "label": "2D block, strongest azimuth"},
@@ -30,7 +31,6 @@ def _style(name):
 
 def _plain_log_ticks(axis):
     """Decimal labels on a log axis (0.5, 1, 2, 5 ...), no crowded minor labels."""
-    from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
     axis.set_major_locator(LogLocator(base=10.0, subs=(1.0, 2.0, 5.0)))
     axis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
     axis.set_minor_formatter(NullFormatter())

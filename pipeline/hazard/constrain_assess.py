@@ -213,19 +213,36 @@ def _none_left(rule: str, floor: float, tree: LogicTree, p: np.ndarray) -> str:
             "them all, no constrained curve under that rule")
 
 
+BAND = (0.05, 0.95)            # the fractiles whose curves bound the band reported
+
+
+def fractile_key(q):
+    """The key of fractile ``q`` in a statistics' ``fractiles`` (constrain.json): ``%g``."""
+    return f"{q:g}"
+
+
+def fractile_curve(q):
+    """The ``curve`` name of fractile ``q`` in ``ground_motion_at_rates``."""
+    return f"fractile {fractile_key(q)}"
+
+
+MEAN_CURVE = "mean"
+BAND_CURVE = f"range {fractile_key(BAND[0])}-{fractile_key(BAND[1])}"
+
+
 def _statistics(tree, weights):
     """Mean and fractile curves (annual rates) under ``weights``."""
     rates = tree.rates_per_yr
     return {"mean_rates_per_yr": weighted_mean(rates, weights).tolist(),
-            "fractiles": {f"{q:g}": weighted_quantile(rates, weights, q).tolist()
+            "fractiles": {fractile_key(q): weighted_quantile(rates, weights, q).tolist()
                           for q in FRACTILES}}
 
 
 def _motions(tree, prior, posterior):
     """PGA at TARGET_RATES on the mean and each fractile curve, before and after."""
     rows = []
-    curves = [("mean", "mean_rates_per_yr", None)] + \
-        [(f"fractile {q:g}", "fractiles", f"{q:g}") for q in FRACTILES]
+    curves = [(MEAN_CURVE, "mean_rates_per_yr", None)] + \
+        [(fractile_curve(q), "fractiles", fractile_key(q)) for q in FRACTILES]
     for rate in TARGET_RATES:
         for name, key, q in curves:
             before = _pga(tree, prior, key, q, rate)
@@ -234,12 +251,13 @@ def _motions(tree, prior, posterior):
                          "prior_m_s2": before, "posterior_m_s2": after,
                          "prior_g": _g(before), "posterior_g": _g(after),
                          "change_percent": change_percent(before, after)})
-        lo_b, hi_b = (_pga(tree, prior, "fractiles", q, rate) for q in ("0.05", "0.95"))
+        band = [fractile_key(q) for q in BAND]
+        lo_b, hi_b = (_pga(tree, prior, "fractiles", q, rate) for q in band)
         lo_a, hi_a = (None, None) if posterior is None else \
-            (_pga(tree, posterior, "fractiles", q, rate) for q in ("0.05", "0.95"))
+            (_pga(tree, posterior, "fractiles", q, rate) for q in band)
         width_b = None if None in (lo_b, hi_b) else hi_b - lo_b
         width_a = None if None in (lo_a, hi_a) else hi_a - lo_a
-        rows.append({"annual_rate_per_yr": rate, "curve": "range 0.05-0.95",
+        rows.append({"annual_rate_per_yr": rate, "curve": BAND_CURVE,
                      "prior_m_s2": width_b, "posterior_m_s2": width_a,
                      "prior_g": _g(width_b), "posterior_g": _g(width_a),
                      "change_percent": change_percent(width_b, width_a)})

@@ -32,7 +32,7 @@ def write_outputs(post, observations, out_dir, forward_info=None, truth=None, ti
     """posterior.csv, inversion_summary.json, posterior_map.png and marginals.png in
     ``out_dir`` (and site_motion.json with ``site_motion``, also under the summary's
     ``site_motion``); returns the summary dict."""
-    from pipeline.figures.inversion import plot_marginals, plot_posterior_map
+    from pipeline.figures.inversion import plot_marginals, plot_posterior_map  # lazy: matplotlib, not imported by a run or after Ctrl-C
     out_dir = Path(out_dir)
     write_csv(out_dir / "posterior.csv", post.frame())
     figures = [plot_posterior_map(post, observations, out_dir / "posterior_map.png",

@@ -27,18 +27,6 @@ def magnitude_interval(posterior, level=0.95):
     return [round(float(lo), 4), round(float(hi), 4)]
 
 
-def magnitude_set(posterior, level=0.95):
-    """The smallest set of magnitudes (strings as in the summary) holding ``level`` of the
-    magnitude posterior ({"6.5": p, ...})."""
-    chosen, total = [], 0.0
-    for mw, p in sorted(posterior.items(), key=lambda kv: -kv[1]):
-        chosen.append(mw)
-        total += p
-        if total >= level - 1e-12:
-            break
-    return chosen
-
-
 def circular_credible(mass, bin_deg, level):
     """(shortest arc [lo, hi] holding ``level``, HPD arcs [[lo, hi], ...]) of a circular
     histogram (bins from 0, width ``bin_deg``).  Whole circle: [0, 360]."""

@@ -38,6 +38,7 @@ from pipeline.inversion.posterior import invert
 from pipeline.inversion.sites import OBS_UNCERTAINTY_DEG, draw_site_columns, map_azimuth_error, \
     site_frame, site_position
 from pipeline.stats.circular import azimuth_deg
+from pipeline.inversion import write_outputs
 
 FALLEN_PER_SITE = (1, 3, 10, 30)
 SITE_COUNTS = (1, 3)
@@ -247,8 +248,7 @@ def _truth_test_outputs(likelihood_half, pool, candidates, trials, kernel_deg, f
                         likelihoods, out_dir, forward_info):
     """The truth tests with each likelihood: truth_tests.csv, narrowing.csv and its figure,
     the example inversions; returns (trials, narrowing, figure paths)."""
-    from pipeline.figures.inversion import plot_interval_widths
-    from pipeline.inversion import write_outputs
+    from pipeline.figures.inversion import plot_interval_widths  # lazy: matplotlib, not imported by a run or after Ctrl-C
     examples, frames = {}, []
     for kind in likelihoods:
         model = ForwardModel(likelihood_half, kernel_deg, floor, kind)

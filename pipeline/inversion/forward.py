@@ -30,12 +30,12 @@ import logging
 import time
 from pathlib import Path
 
-from pipeline import RESULTS_DIR
 from pipeline.campaign import Campaign, register
 from pipeline.campaign.options import CampaignOptions
 from pipeline.scenario.parameters import param
 from pipeline.campaign.runs import column_specs, run_column_spec
 from pipeline.files import InputError, write_csv
+from pipeline.inversion.options import DEFAULT_FORWARD_DIR
 from pipeline.inversion.grid import GRIDS, TableGrid, node_positions, slice_motions
 from pipeline.inversion.table import ForwardTable
 from pipeline.campaign.column_file import column_kn
@@ -44,7 +44,6 @@ from pipeline.campaign import run_campaign
 
 log = logging.getLogger(__name__)
 
-DEFAULT_FORWARD_DIR = RESULTS_DIR / "inversion-forward"
 
 
 # ---------------------------------------------------------------- runs (campaign)
@@ -69,7 +68,20 @@ def member_parameters(grid):
     return [(m, {**p, "tail_s": float(grid.tail_s)}) for m, p in runs]
 
 
-def forward_specs(records, campaign_dir, grid=None, jobs=None, **_):
+@dataclass(frozen=True)
+class ForwardTags:
+    """A forward-table run: its magnitude ``slice``, table ``node`` (at ``distance_km`` and
+    ``azimuth_deg`` from strike), ensemble ``member`` (-1 nominal) and the table's ``grid``
+    (:class:`~pipeline.inversion.grid.TableGrid`)."""
+    slice: int
+    node: int
+    member: int
+    distance_km: float
+    azimuth_deg: float
+    grid: TableGrid
+
+
+def forward_specs(records, campaign_dir, grid=None, jobs=None):
     """Run specs of a forward table: every node x (nominal + members), twin model."""
     if records:
         raise InputError("the inversion-forward campaign takes no --records (see --grid)")
@@ -82,9 +94,8 @@ def forward_specs(records, campaign_dir, grid=None, jobs=None, **_):
         for node, path in enumerate(motions[sl]):
             for member, p in params:
                 runs.append((str(path), p))
-                info.append({"slice": s, "node": node, "member": member,
-                             "distance_km": float(r[node]), "azimuth_deg": float(a[node])})
-    return column_specs(runs, campaign_dir, info, keep_trajectory=False, grid=grid.as_dict())
+                info.append(ForwardTags(s, node, member, float(r[node]), float(a[node]), grid))
+    return column_specs(runs, campaign_dir, info, keep_trajectory=False)
 
 
 def table_path(campaign_dir, grid):
@@ -94,7 +105,7 @@ def table_path(campaign_dir, grid):
 def forward_outputs(specs, campaign_dir, failures, animations, figures=True):
     """Collect the finished runs of ``specs`` into the table file (tables/forward_table_<grid
     key>.npz) and its per-node summary (tables/forward_cells_<grid key>.csv)."""
-    grid = TableGrid(**specs[0].tags["grid"])
+    grid = specs[0].tags.grid
     table = ForwardTable.from_runs(specs, campaign_dir, grid)
     path = table_path(campaign_dir, grid)
     table.save(path)

@@ -19,6 +19,7 @@ from pipeline.motion import Motion
 from pipeline.motion.synthetics import CRUST_LAYERS, LEAD_TIME_S, SOURCES, moment_from_mw, numerics
 from pipeline.motion.synthetics.compute import _point_source_task
 from pipeline.campaign.column_file import description
+from pipeline.motion.synthetics import band_limited_motion
 
 log = logging.getLogger(__name__)
 
@@ -250,7 +251,6 @@ def slice_motions(grid, motion_dir, jobs=None, positions=None):
 
 
 def _write_slice(grid, sl, key, directory, paths, total, num, r, a, seconds):
-    from pipeline.motion.synthetics import LEAD_TIME_S, band_limited_motion
     (directory / "manifest.json").unlink(missing_ok=True)
     name, dip, rake, depth, mw = sl
     for i, path in enumerate(paths):

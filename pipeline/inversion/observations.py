@@ -226,7 +226,7 @@ def _local_sites(raw):
         for name, (_, e, n), cols in raw:
             out.append(Site(name, e - e0, n - n0, cols))
     else:
-        from obspy.geodetics import gps2dist_azimuth
+        from obspy.geodetics import gps2dist_azimuth  # lazy: obspy is slow to import
         _, lat0, lon0 = raw[0][1]
         for name, (_, lat, lon), cols in raw:
             if (lat, lon) == (lat0, lon0):

@@ -5,10 +5,13 @@ start-up, the workflows (:mod:`pipeline.inversion.workflows`) only when it runs.
 from dataclasses import dataclass
 from pathlib import Path
 
+from pipeline import RESULTS_DIR
 from pipeline.files import LONG_RUN_S, check_jobs
 from pipeline.inversion.likelihood import DEFAULT_FLOOR, DEFAULT_KERNEL_DEG, DEFAULT_LIKELIHOOD, \
-    check_model_options
+    LIKELIHOODS, check_model_options
 from pipeline.scenario.parameters import check_fields, param
+
+DEFAULT_FORWARD_DIR = RESULTS_DIR / "inversion-forward"   # the forward runs' campaign
 
 
 @dataclass(frozen=True)
@@ -28,27 +31,22 @@ class InversionOptions:
     table: Path = param(None, "", "use this forward table file (tables/forward_table_<key>.npz) "
                         "as it is: no pyprop8, no YADE (its code version is reported, not "
                         "checked)", flag="--table", metavar="FILE")
-    forward_dir: Path = param(None, "", "campaign directory of the forward runs (default "
-                              "results/inversion-forward)", flag="--forward-dir", metavar="DIR")
-    kernel_deg: float = param(None, "", f"width of the von Mises kernel on ensemble falls "
-                              f"(default {DEFAULT_KERNEL_DEG:g})", flag="--kernel-deg")
-    floor: float = param(None, "", f"fraction of uniform density mixed into every direction "
-                         f"density (default {DEFAULT_FLOOR:g})", flag="--floor")
-    likelihood: str = param(None, "", "predictive (default): columns of one site share its "
-                            "motion and the ensemble is finite (Polya urn: a site's own falls "
-                            "inform its next column; calibrated in the member study); "
+    forward_dir: Path = param(DEFAULT_FORWARD_DIR, "", "campaign directory of the forward runs",
+                              flag="--forward-dir", metavar="DIR")
+    kernel_deg: float = param(DEFAULT_KERNEL_DEG, "deg", "width of the von Mises kernel on "
+                              "ensemble falls", 0.0, 90.0, "--kernel-deg", low_open=True)
+    floor: float = param(DEFAULT_FLOOR, "", "fraction of uniform density mixed into every "
+                         "direction density (below 1)", 0.0, 1.0, "--floor", low_open=True)
+    likelihood: str = param(DEFAULT_LIKELIHOOD, "", "predictive: columns of one site share "
+                            "its motion and the ensemble is finite (Polya urn: a site's own "
+                            "falls inform its next column; calibrated in the member study); "
                             "independent: the product over columns (too sure when a site has "
-                            "several columns)", flag="--likelihood",
-                            choices=("independent", "predictive"))
+                            "several columns)", flag="--likelihood", choices=LIKELIHOODS)
     trials: int = param(None, "", "trials per configuration (--demo: default 20; "
-                        "--member-study: default 200)", flag="--trials")
+                        "--member-study: default 200)", 1, 1000, "--trials")
 
     def __post_init__(self):
         check_fields(self)
-        for name, default in (("kernel_deg", DEFAULT_KERNEL_DEG), ("floor", DEFAULT_FLOOR),
-                              ("likelihood", DEFAULT_LIKELIHOOD)):
-            if getattr(self, name) is None:
-                object.__setattr__(self, name, default)
         check_model_options(self.kernel_deg, self.floor, self.likelihood)
         check_jobs(self.jobs)
 

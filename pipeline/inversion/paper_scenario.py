@@ -13,6 +13,7 @@ from pipeline.inversion.sites import OBS_UNCERTAINTY_DEG, map_azimuth_error, sit
     site_position
 from pipeline.motion.synthetics import SOURCES
 from pipeline.stats.circular import azimuth_deg
+from pipeline.inversion import write_outputs
 
 PAPER_RINGS_KM = (5.0, 10.0, 20.0)
 PAPER_MECHANISMS = {"strike_slip": "strike-slip", "thrust": "thrust"}
@@ -115,7 +116,6 @@ def paper_scenario(model, obs_table, source_name, candidates):
 def paper_outputs(full_model, paper_tables, candidates, out_dir, forward_info):
     """The paper's sources inverted site by site and all sites together:
     paper_scenario_sites.csv and the maps; returns (per-site rows, joint rows, figures)."""
-    from pipeline.inversion import write_outputs
     paper_rows, paper_joint, figures = [], [], []
     for source_name, obs_table in (paper_tables or {}).items():
         if obs_table is None or paper_nodes(obs_table, source_name) is None:

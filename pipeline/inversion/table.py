@@ -80,18 +80,18 @@ class ForwardTable:
         for spec, summary in finished_runs(campaign_dir, specs):
             wall += summary.wall_s
             simulated += summary.simulated
-            i, j = divmod(spec.tags["node"], na)
+            i, j = divmod(spec.tags.node, na)
             for col in summary.columns:
                 c = columns.index(col.column)
                 fell = col.toppled and col.downfall_azimuth_deg is not None
                 value = col.downfall_azimuth_deg if fell else np.nan
-                index = (spec.tags["slice"], i, j, c)
-                if spec.tags["member"] < 0:
+                index = (spec.tags.slice, i, j, c)
+                if spec.tags.member < 0:
                     ntop[index], naz[index], nval[index] = fell, value, True
                 else:
-                    top[index + (spec.tags["member"],)] = fell
-                    az[index + (spec.tags["member"],)] = value
-                    valid[index + (spec.tags["member"],)] = True
+                    top[index + (spec.tags.member,)] = fell
+                    az[index + (spec.tags.member,)] = value
+                    valid[index + (spec.tags.member,)] = True
         slices = [{"mechanism": s[0], "dip_deg": s[1], "rake_deg": s[2], "depth_km": s[3],
                    "mw": s[4]} for s in sl]
         return cls(slices, grid.distances_km, grid.azimuths_deg, members, top, az, valid,

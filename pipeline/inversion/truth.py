@@ -157,7 +157,15 @@ def check_hidden(truth, table_grid):
                          "table would have seen these runs; choose another seed")
 
 
-def truth_specs(records, campaign_dir, truth=None, grid=None, jobs=None, **_):
+@dataclass(frozen=True)
+class TruthTags:
+    """A hidden-truth run: the ``site`` and its twin ``member``; the source's ``strike_deg``."""
+    site: str
+    member: int
+    strike_deg: float
+
+
+def truth_specs(records, campaign_dir, truth=None, grid=None, jobs=None):
     """Run specs: at every site its ``twins`` hidden members on the site's motion."""
     if records:
         raise InputError("the inversion-truth campaign takes no --records")
@@ -172,20 +180,19 @@ def truth_specs(records, campaign_dir, truth=None, grid=None, jobs=None, **_):
     for (name, _, _, twins), path in zip(truth.sites, paths):
         for member in range(twins):
             runs.append((str(path), params[member]))
-            info.append({"site": name, "member": member})
-    return column_specs(runs, campaign_dir, info, keep_trajectory=False,
-                        strike_deg=truth.strike_deg)
+            info.append(TruthTags(name, member, truth.strike_deg))
+    return column_specs(runs, campaign_dir, info, keep_trajectory=False)
 
 
 def truth_observations(specs, campaign_dir):
     """The observations dict of the finished runs: per site its columns fallen (downfall
     azimuth turned from the strike frame by the strike) or standing."""
     runs, _ = collect(specs, "inversion-truth", campaign_dir)
-    site_of = {s.run_id: s.tags["site"] for s in specs}
-    strike = specs[0].tags["strike_deg"]
+    site_of = {s.run_id: s.tags.site for s in specs}
+    strike = specs[0].tags.strike_deg
     sites = {}
     for spec in specs:
-        sites.setdefault(spec.tags["site"], [])
+        sites.setdefault(spec.tags.site, [])
     for _, row in runs.iterrows():
         cols = sites[site_of[row["run_id"]]]
         if row["toppled"] and math.isfinite(row["downfall_azimuth_deg"]):

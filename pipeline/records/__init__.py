@@ -26,6 +26,7 @@ from pipeline.records import processing
 from pipeline.records.catalog import catalog, catalog_row
 from pipeline.records.readers import is_pattern, read_record
 from pipeline.userfiles import check_regular, read_user_bytes
+from pipeline.motion.measures import rotd_peak
 
 log = logging.getLogger(__name__)
 
@@ -135,7 +136,6 @@ def rotd50_fraction(record):
     """RotD50 / RotD100 of the horizontal PGA of ``record``'s processed motion (RotD100 =
     the peak of the horizontal vector; :func:`pipeline.motion.measures.rotd_peak`, 0.5 deg
     steps); unchanged by scaling the record."""
-    from pipeline.motion.measures import rotd_peak  # noqa: PLC0415
     motion, _ = processed_motion(record, cache_dir=None)
     peak = rotd_peak(motion.acc, 100.0, 0.5)
     if not peak > 0:
@@ -214,7 +214,7 @@ def to_east_north_up(stream, name, needs_vertical=True):
     vertical = verticals[0] if verticals else None
     z = np.asarray(vertical.data[:n], dtype=float) if vertical else np.zeros(n)
     z_dip = vertical.stats.dip if vertical else -90.0
-    from obspy.signal.rotate import rotate2zne   # here: obspy.signal takes 2 s to import
+    from obspy.signal.rotate import rotate2zne  # lazy: obspy is slow to import
     try:
         up, north, east = rotate2zne(z, 0.0, z_dip,
                                      h1, horizontals[0].stats.azimuth, 0.0,

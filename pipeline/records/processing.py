@@ -36,6 +36,7 @@ from obspy import Stream, Trace
 from scipy.integrate import cumulative_trapezoid
 
 from pipeline.files import InputError
+from scipy.signal import butter, sosfiltfilt
 
 STEPS = {}
 
@@ -109,7 +110,6 @@ def trim_to_signal(work, arias_fractions=(0.001, 0.995), margin_s=5.0, highpass_
     the given fractions.  Runs of exact zeros at either end (no data) are dropped first.
     Where the window reaches beyond the data, ``pad_to_window`` later adds zeros, so the
     processed motion spans the same window whatever surrounds the signal in the file."""
-    from scipy.signal import butter, sosfiltfilt
     npts = len(work.acc)
     nonzero = np.flatnonzero(np.any(work.acc != 0.0, axis=1))
     if nonzero.size == 0:

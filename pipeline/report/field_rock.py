@@ -5,6 +5,7 @@ import json
 
 import pandas as pd
 
+from pipeline.hazard.constrain_assess import BAND_CURVE, MEAN_CURVE, fractile_curve
 from pipeline.hazard.fragility.file import read_fragility_file
 from pipeline.report.fragility import rock_fragility_section
 from pipeline.report.common import _figure, _fmt, _table
@@ -12,7 +13,7 @@ from pipeline.report.hazard import survival_section
 
 FIELD_ROCK = "field-rock"
 FIELD_ROCK_QUICK = "field-rock-quick"
-MOTION_ROWS = ("mean", "fractile 0.5", "range 0.05-0.95")
+MOTION_ROWS = (MEAN_CURVE, fractile_curve(0.5), BAND_CURVE)   # the rows REPORT shows
 HEADINGS = {FIELD_ROCK: "Field rock: Double Rock",
             FIELD_ROCK_QUICK: "Field rock at a reduced size: Double Rock"}
 NO_PUBLISHED = ("No published fragility exists for this rock to compare with: its providers "

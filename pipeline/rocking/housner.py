@@ -111,20 +111,6 @@ def housner_closed_form(theta0_ratio, r, n):
     return 1.0 - np.sqrt(1.0 - r ** k * (1.0 - (1.0 - theta0_ratio) ** 2))
 
 
-def housner_half_periods(height, width, theta0_ratio, n, r=None, g=MODEL_GRAVITY):
-    """Paper eq 7 (linearised block): duration (s) of half-cycles k = 0..n.
-
-    T_k / 2 = (2 / p) artanh( sqrt(r^k (1 - (1 - theta0/alpha)^2)) ), the time
-    the block needs to swing from theta = 0 out to amplitude theta_k and back.
-    Released from rest at theta0, the first impact comes after T_0 / 4; impact
-    k + 1 follows impact k after T_k / 2.  r defaults to Housner's eta^2.
-    """
-    c = block_constants(height, width, g)
-    r = c["energy_ratio"] if r is None else r
-    k = np.arange(n + 1)
-    return 2.0 / c["p"] * np.arctanh(np.sqrt(r ** k * (1.0 - (1.0 - theta0_ratio) ** 2)))
-
-
 def augusti_sinopoli_mu_min(width, height):
     """Paper eq 8 (Augusti & Sinopoli 1992): static friction needed for pure rocking.
 

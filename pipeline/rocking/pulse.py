@@ -98,32 +98,3 @@ def overturning_map(height, width, amplitude_ratios, omega_ratios, restitution=N
     return dict(mode=mode, n_impacts=impacts, relative_direction=direction,
                 amplitude_ratios=amps, omega_ratios=omegas, mode_names=dict(MODE_NAMES))
 
-
-def mode_edges(height, width, omega_ratio, amplitude_ratios, restitution=None, g=MODEL_GRAVITY,
-               tol=1e-3):
-    """Amplitude ratios (A / (alpha g)) where the one-sine-pulse mode changes.
-
-    Scans ``amplitude_ratios`` (increasing) and bisects every change of mode to
-    ``tol``.  Returns a list of dicts: lower (ratio just below the edge),
-    upper (just above), mode_below, mode_above (names).
-    """
-    def mode_at(a):
-        return sine_pulse_response(height, width, a, omega_ratio, restitution=restitution,
-                                   g=g, dt_out=None)["mode"]
-
-    amps = np.asarray(amplitude_ratios, float)
-    modes = [mode_at(a) for a in amps]
-    edges = []
-    for k in range(len(amps) - 1):
-        lo, hi, m_lo, m_hi = amps[k], amps[k + 1], modes[k], modes[k + 1]
-        if m_lo == m_hi:
-            continue
-        while hi - lo > tol:
-            mid = 0.5 * (lo + hi)
-            if mode_at(mid) == m_lo:
-                lo = mid
-            else:
-                hi = mid
-        edges.append(dict(lower=float(lo), upper=float(hi), mode_below=MODE_NAMES[m_lo],
-                          mode_above=MODE_NAMES[mode_at(hi)]))
-    return edges

@@ -64,8 +64,8 @@ def _yaml_loader():
     standard tag's bad value (``!!bool maybe``, a 13th month) at its line and column."""
     global _YAML_LOADER
     if _YAML_LOADER is None:
-        import yaml
-        from yaml.constructor import ConstructorError
+        import yaml  # lazy: PyYAML, optional (YAML column files only)
+        from yaml.constructor import ConstructorError  # lazy: PyYAML, optional (YAML column files only)
 
         class Loader(yaml.SafeLoader):
             def construct_object(self, node, deep=False):
@@ -92,7 +92,7 @@ def _yaml_loader():
 
 
 def _parse_yaml(text):
-    import yaml
+    import yaml  # lazy: PyYAML, optional (YAML column files only)
     try:
         return yaml.load(text, Loader=_yaml_loader())
     except yaml.MarkedYAMLError as exc:

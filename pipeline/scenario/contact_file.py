@@ -8,6 +8,7 @@ from pathlib import Path
 from pipeline.files import InputError
 from pipeline.scenario.parameters import Contact
 from pipeline.userfiles import keys_text, number, read_json, read_user_bytes
+import hashlib
 
 CONTACT_KEYS = ("kn", "damping", "mu_s", "mu_k")
 INFORMATION_KEYS = ("restitution", "restitution_sd", "restitution_se", "impacts",
@@ -65,7 +66,6 @@ def checked_contact(values: dict[str, float], path: Path, **flags: float) -> Con
 def contact_provenance(path):
     """What a campaign records of the contact file it ran with: the file, its SHA-256
     and the contact values taken from it."""
-    import hashlib
     path = Path(path)
     return {"file": str(path), "sha256": hashlib.sha256(read_user_bytes(path, "--contact-file")).hexdigest(),
             "values": contact_values(path)}

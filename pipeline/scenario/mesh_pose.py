@@ -9,6 +9,8 @@ import numpy as np
 
 from pipeline.files import InputError
 from pipeline.scenario.mesh_surface import read_solid
+from scipy.spatial.transform import Rotation
+from scipy.spatial import ConvexHull, QhullError
 
 MAX_POSE_HULL_FACES = 20_000      # the rest pose is found on a hull of at most this many
 
@@ -18,7 +20,6 @@ def _posed(path, digest, scale, rotation_wxyz, rest_pose, heading_deg, tolerance
            where):
     """Mass properties (per kg), footprint and hull of the mesh in its rest pose, and what
     was repaired to read it (``close_base`` in metres)."""
-    from scipy.spatial.transform import Rotation
     name = Path(path).name
     w, x, y, z = rotation_wxyz
     mesh, repairs, cap_area, _ = read_solid(path, scale, _matrix(Rotation.from_quat([x, y, z, w])),
@@ -46,7 +47,6 @@ def _posed(path, digest, scale, rotation_wxyz, rest_pose, heading_deg, tolerance
 def _settled(mesh, hull, rest_pose, repairs, name, where):
     """The rotation (scipy) from the given orientation to the rest pose: none for "given",
     else onto the stable pose whose up direction is nearest (rolled there on a large hull)."""
-    from scipy.spatial.transform import Rotation
     if rest_pose != "nearest":
         return Rotation.identity()
     if len(hull.faces) > MAX_POSE_HULL_FACES:
@@ -66,7 +66,7 @@ def _settled(mesh, hull, rest_pose, repairs, name, where):
 def _placed(mesh, hull, matrix):
     """Turn ``mesh`` by ``matrix`` and move it onto the table, its centre of mass above
     the origin (in place); the hull's vertices moved with it, (n, 3)."""
-    import trimesh
+    import trimesh  # lazy: trimesh, only for mesh specimens
     mesh.apply_transform(matrix)
     hull = trimesh.transform_points(hull.vertices, matrix)
     lowest = mesh.vertices[:, 2].min()
@@ -79,8 +79,7 @@ def _placed(mesh, hull, matrix):
 def _footprint(hull, com, tolerance, where):
     """The (k, 2) outline of the hull points within ``tolerance`` (m) of the table;
     InputError when they do not hold the centre of mass up."""
-    from matplotlib.path import Path as Polygon
-    from scipy.spatial import ConvexHull, QhullError
+    from matplotlib.path import Path as Polygon  # lazy: matplotlib, only for mesh specimens' footprints
     near = hull[hull[:, 2] <= tolerance + 1e-9]
     try:
         outline = near[ConvexHull(near[:, :2]).vertices][:, :2] if len(near) >= 3 else None
@@ -118,7 +117,6 @@ def _rolled(hull, com):
     hull, trimesh; com: its centre of mass, (3,)): from the hull face below the centre of
     mass, it tips over the edge of each face the centre of mass lies beyond onto the
     neighbouring face, until the centre of mass lies above the face it stands on."""
-    from scipy.spatial.transform import Rotation
     normals, corners = hull.face_normals, hull.vertices[hull.faces]
     down = normals[:, 2] < 0          # the face a vertical line down from com leaves by
     drop = np.full(len(normals), np.inf)

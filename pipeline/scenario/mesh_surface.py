@@ -13,6 +13,9 @@ import numpy as np
 
 from pipeline.files import InputError
 from pipeline.userfiles import read_user_bytes, show
+from scipy.sparse import coo_matrix
+from scipy.sparse.csgraph import connected_components
+from scipy.spatial import cKDTree
 
 MAX_FACES = 1_000_000             # triangles of a mesh (a scan decimated for simulation)
 ZERO_VOLUME = 1e-9                # volumes below this fraction of size^3 are flat surfaces
@@ -43,7 +46,7 @@ def read_solid(path, scale, rotation, close_base, where):
 
 def _read(path, scale, name, where):
     """The mesh file as its geometry (:func:`_geometry`), its repairs and its size (m)."""
-    import trimesh
+    import trimesh  # lazy: trimesh, only for mesh specimens
     content = read_user_bytes(path, f"{where}: mesh")
     suffix = Path(path).suffix.lower()
     _check_ply_lines(content, suffix, name, where)
@@ -110,10 +113,7 @@ def _merged_near(mesh, size, repairs):
     """``mesh`` with its vertices closer than NEAR_VERTICES x ``size`` (m) merged, each
     group to its mean, when its surface is open and that closes edges of it (said in
     ``repairs``); else ``mesh`` as it is."""
-    import trimesh
-    from scipy.sparse import coo_matrix
-    from scipy.sparse.csgraph import connected_components
-    from scipy.spatial import cKDTree
+    import trimesh  # lazy: trimesh, only for mesh specimens
     if mesh.is_watertight:
         return mesh
     tolerance = NEAR_VERTICES * size
@@ -137,13 +137,13 @@ def _merged_near(mesh, size, repairs):
 
 def _open_edges(mesh):
     """How many edges of ``mesh`` belong to one face only."""
-    import trimesh
+    import trimesh  # lazy: trimesh, only for mesh specimens
     return len(trimesh.grouping.group_rows(mesh.edges_sorted, require_count=1))
 
 
 def _fix_winding(mesh, repairs):
     """Faces turned to the winding of their neighbours (said in ``repairs``)."""
-    import trimesh
+    import trimesh  # lazy: trimesh, only for mesh specimens
     if not mesh.is_winding_consistent:
         before = mesh.faces.copy()
         trimesh.repair.fix_winding(mesh)
@@ -205,7 +205,7 @@ def _geometry(mesh, scale):
     position (texture coordinates and normals do not split it) and sorted (their order in
     the file does not matter), degenerate and duplicate faces dropped; with what was
     repaired."""
-    import trimesh
+    import trimesh  # lazy: trimesh, only for mesh specimens
     mesh = trimesh.Trimesh(vertices=np.asarray(mesh.vertices, float) * scale,
                            faces=mesh.faces, process=False)
     mesh.remove_unreferenced_vertices()
@@ -236,7 +236,7 @@ def _count(n, one, many=None):
 def _boundary_loops(mesh):
     """The open edges of a surface as loops: lists of vertex indices in order (the
     direction of the faces' winding), one list per hole."""
-    import trimesh
+    import trimesh  # lazy: trimesh, only for mesh specimens
     edges = mesh.edges[trimesh.grouping.group_rows(mesh.edges_sorted, require_count=1)]
     following = dict(zip(edges[:, 1], edges[:, 0]))   # walk against the faces' edges
     loops = []
@@ -274,7 +274,7 @@ def _close_base(mesh, loops, close_base, name):
     """The surface with its lowest hole closed by a planar cap at the ground plane
     (``close_base``: "fit", a plane fitted to that hole's edge, or the plane's height z
     in metres), and the cap's area (m^2).  The edge is joined to the plane by a skirt."""
-    import trimesh
+    import trimesh  # lazy: trimesh, only for mesh specimens
     loop = min(loops, key=lambda lp: mesh.vertices[lp, 2].mean())
     edge = mesh.vertices[loop]
     if close_base == "fit":

@@ -20,6 +20,8 @@ from pipeline.constants import (
     STANDS_AXIS_Z,
 )
 from pipeline.files import write_json
+import numpy as np
+from scipy.spatial.transform import Rotation
 
 FILE_NAME = "params.json"
 
@@ -181,7 +183,6 @@ class SceneFile:
 def base_points(body, circle_points=720):
     """Points (n, 3; m, body frame about the centre of mass) of the outline a scene body
     (a :class:`SceneBody` as a dict) stands on: its base rim, in the rim's face."""
-    import numpy as np
     rim = next(r for r in body["rims"] if r["role"] == "base")
     if rim["kind"] == "points":
         return np.asarray(rim["points"], float)
@@ -201,7 +202,6 @@ def support_line(column, azimuth_deg):
     positive rotation about it leans the column that way), com (3,) (the column's centre
     of mass, world m), critical_angle_rad (the tilt about that line at which the centre
     of mass stands above it)."""
-    import numpy as np
     a = np.radians(azimuth_deg)
     u = np.array([np.sin(a), np.cos(a), 0.0])
     bottom = column["bodies"][0]
@@ -220,8 +220,6 @@ def released(column, azimuth_deg, tilt_rad):
     toward ``azimuth_deg`` (:func:`support_line`): a free-rocking release from rest, on
     the edge of its footprint.  It never stops on energy (``settles`` False: it is
     raised above its rest)."""
-    import numpy as np
-    from scipy.spatial.transform import Rotation
     line = support_line(column, azimuth_deg)
     turn = Rotation.from_rotvec(line["axis"] * tilt_rad).as_matrix()
     pivot = line["pivot"]

@@ -60,10 +60,6 @@ class Specimen(abc.ABC):
         """Smallest rocking threshold of any stack / g (tan of the critical angle)."""
         return min(j["ratio"] for j in self.statics())
 
-    def overturning_barrier(self, g=MODEL_GRAVITY):
-        """Smallest energy (J) that tips any stack of bodies over its edge."""
-        return min(j["barrier_j"] for j in self.statics(g))
-
     def critical_angle_along_deg(self, azimuth_deg):
         """Critical angle (deg) for tipping along a horizontal line (azimuth, deg
         clockwise from North); here the smallest in any direction."""

@@ -3,6 +3,7 @@ of the outcomes (Konis 2007) and maximum-likelihood or Firth-penalised logit and
 fits with Wald intervals."""
 import numpy as np
 from scipy import optimize, stats
+import warnings
 
 
 def separated(X, y):
@@ -58,11 +59,10 @@ def binary_regression(X, y, link="logit", firth=False):
     method = None
     if link == "logit" and not firth:
         try:
-            import statsmodels.api as sm
+            import statsmodels.api as sm  # lazy: statsmodels is slow to import
         except ImportError:
             sm = None
         if sm is not None:
-            import warnings
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
                 fit = sm.Logit(y, X).fit(disp=0, maxiter=200)

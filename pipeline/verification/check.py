@@ -78,12 +78,12 @@ class Check(Mapping):
         return self.kind
 
     motion_file = None          # a check runs no recorded motion
+    # a campaign run's bookkeeping (:class:`~pipeline.campaign.spec.RunSpec`): no tags, the
+    # trajectory kept, the campaign's cost estimate, no column description
+    tags = None
     keep_trajectory = True
-
-    @property
-    def tags(self):
-        """A campaign run's bookkeeping (:class:`~pipeline.campaign.spec.RunSpec`): none."""
-        return {}
+    core_s = None
+    column_description = None
 
     @classmethod
     def create(cls, kind, code_version, **setting):

@@ -137,19 +137,6 @@ def block_measure(height, width, depth, kn=paper.MARBLE_BLOCK_KN_N_M,
         f"{height:.6g},{width:.6g},{depth:.6g},{density:.6g},{kn:.6g}", cache)
 
 
-def damping_for_restitution(restitution, height, width, depth, kn=paper.MARBLE_BLOCK_KN_N_M,
-                            density=paper.MARBLE_DENSITY_KG_M3, log=print, cache=CACHE):
-    """(damping, measured restitution, YADE runs made) for the stated ``restitution`` of
-    this block at ``kn``: bisection on the damping ratio in [0, 1], each step one YADE
-    free-rocking run unless ``cache`` (a JSON file, or None) holds it.  InputError (one
-    line, naming the reachable range) when the restitution lies outside what damping 0-1
-    gives."""
-    measured, runs = block_measure(height, width, depth, kn, density, cache)
-    damping, found = bisect_damping(restitution, measured,
-                                    f"this block (kn {kn:g} N/m)", log)
-    return damping, found, runs()
-
-
 # ---------------------------------------------------------------- any specimen
 def _scene(geometry, contact, numerics):
     """(scene file, its one column dict) of the specimen (a column description as the

@@ -20,10 +20,13 @@ from pipeline import paper
 from pipeline.files import InputError, write_json
 from pipeline.scenario.parameters import check_fields, param
 from pipeline.userfiles import DATA_FILE_BYTES, read_user_text
+from pipeline.scenario import Block, ColumnGeometry, Contact, Numerics
+from pipeline.rocking.decay import fit_free_rocking
+from pipeline.verification.contact_map import _scene, equivalent_block, weakest_azimuth
+from pipeline.verification import contact_map
 
 MAX_ROWS = 1_000_000
 TILT_COLUMNS = {"tilt_rad": 1.0, "tilt_deg": math.pi / 180.0}
-DEFAULT_OUT = Path("contact.json")
 
 
 @dataclass(frozen=True)
@@ -31,9 +34,10 @@ class ContactOptions:
     """What ``contact`` is asked (see ``python -m pipeline contact --help``)."""
     free_rocking: Path = param(None, "", "recorded decay: columns time_s and tilt_rad or "
                                "tilt_deg", flag="--free-rocking", metavar="CSV")
-    frequency_hz: float = param(None, "", "instead of a record: the rocking frequency (full "
+    frequency_hz: float = param(None, "Hz", "instead of a record: the rocking frequency (full "
                                 "cycles per s) at the amplitudes whose ratios "
-                                "--amplitude-ratio gives", flag="--frequency-hz", metavar="HZ")
+                                "--amplitude-ratio gives", 0.01, 100.0, "--frequency-hz",
+                                metavar="HZ")
     amplitude_ratio: str = param(None, "", "ratios of successive amplitudes (the next over "
                                  "the previous), in (0, 1)", flag="--amplitude-ratio",
                                  metavar="R,R")
@@ -60,13 +64,10 @@ class ContactOptions:
     kn: float = param(None, "", f"contact stiffness per point of the map (default the "
                       f"paper's block {paper.MARBLE_BLOCK_KN_N_M:g} N/m; with --column-file "
                       f"the model's {paper.COLUMN_KN_N_M:g} N/m)", flag="--kn", metavar="N_M")
-    out: Path = param(None, "", "contact file written (JSON; default contact.json)",
-                      flag="--out")
+    out: Path = param(Path("contact.json"), "", "contact file written (JSON)", flag="--out")
 
     def __post_init__(self):
         check_fields(self)
-        if self.out is None:
-            object.__setattr__(self, "out", DEFAULT_OUT)
         if (self.block is None) == (self.column_file is None):
             raise InputError("give either --block HEIGHT,WIDTH or --column-file")
         if self.column_file is not None:
@@ -94,7 +95,6 @@ class ContactOptions:
     def _check_map(self):
         """The map's block and contact in their ranges; its options only with it."""
         if self.damping_map:
-            from pipeline.scenario import Block, Contact
             if self.block is not None:
                 height, width = self.block_size()
                 Block(height=height, width=width, depth=self.block_depth(width),
@@ -115,9 +115,6 @@ class ContactOptions:
                 raise InputError("--amplitude-ratio goes with --frequency-hz, not "
                                  "--free-rocking")
             return
-        if not (math.isfinite(self.frequency_hz) and 0.01 <= self.frequency_hz <= 100.0):
-            raise InputError(f"--frequency-hz must be in [0.01, 100] Hz, got "
-                             f"{self.frequency_hz:g}")
         if self.amplitude_ratio is None:
             raise InputError("--frequency-hz needs --amplitude-ratio")
         self.ratios()
@@ -186,7 +183,6 @@ def fit_contact(options):
     ``options.out``: the restitution fitted to the decay, the block or specimen, and with
     ``damping_map`` the damping that gives it in YADE and its interval.  The bisection's
     lines are printed as it goes; what the result says is the caller's to print."""
-    from pipeline.rocking.decay import fit_free_rocking
     if options.column_file is not None:
         geometry, azimuth, alpha, (height, width) = _specimen(options)
     else:
@@ -234,8 +230,6 @@ def _specimen(options):
     """(geometry, azimuth deg, critical angle rad, (height m, width m) of the equivalent
     block: the same critical angle and distance from the support line to the centre of
     mass) of ``--column-file``."""
-    from pipeline.scenario import ColumnGeometry, Contact, Numerics
-    from pipeline.verification.contact_map import _scene, equivalent_block, weakest_azimuth
     geometry = ColumnGeometry.load(options.column_file)
     _, column = _scene(geometry, Contact(), Numerics())
     azimuth = weakest_azimuth(column) if options.azimuth is None else options.azimuth
@@ -246,7 +240,6 @@ def _specimen(options):
 def _damping_map(options, fit, height, width, geometry, azimuth):
     """The contact file's kn, damping, damping_interval and damping_map: the damping that
     gives the fitted restitution in YADE (free-rocking runs, bisection)."""
-    from pipeline.verification import contact_map
     kn = options.map_kn()
     if options.block is not None:
         depth, density = options.block_depth(width), options.block_density()

@@ -61,8 +61,7 @@ def test_default_specs_are_unchanged(name, record, tmp_path):
     explicit = _specs(name, record, tmp_path / "b", column_file=None)
     assert [s.params for s in default] == [s.params for s in explicit]
     assert [s.run_id for s in default] == [s.run_id for s in explicit]
-    assert not any("description" in s.tags or "column_description" in s.tags
-                   for s in default)
+    assert not any(s.column_description is not None for s in default)
     # only the ensemble's own drum columns (tilt, offsets) are descriptions by default
     assert {s.params.column.column_file["name"] for s in default
             if s.params.column.column_file is not None} \
@@ -80,8 +79,8 @@ def test_described_specs_carry_the_description(name, record, tmp_path):
         data = spec.params.column.column_file
         assert isinstance(data, dict) and data["name"].startswith(DORIC)
         assert len(data["blocks"]) == 13
-        assert spec.tags["description"] == DORIC
-        assert spec.tags["column_description"] == ColumnGeometry.load(DORIC).to_dict()
+        assert spec.column_description["name"] == DORIC
+        assert spec.column_description == ColumnGeometry.load(DORIC).to_dict()
         assert spec.params.column.kind == "both"
     if name in ("friction", "records", "synthetic"):
         assert all(s.params.column.column_file == ColumnGeometry.load(DORIC).to_dict()
@@ -205,7 +204,7 @@ def test_perturbed_description_applies_tolerances_tilt_and_offsets():
 def test_ensemble_members_are_the_perturbed_described_column(record, tmp_path):
     specs = _specs("ensemble", record, tmp_path, column_file=DORIC, members=4)
     nominal, members = specs[0], specs[1:]
-    assert nominal.tags["member"] == -1
+    assert nominal.tags.member == -1
     assert nominal.params.column.column_file == ColumnGeometry.load(DORIC).to_dict()
     assert nominal.params.contact.kn == DORIC_KN
     heights = {round(math.fsum(b["height"] for b in s.params.column.column_file["blocks"]), 6)

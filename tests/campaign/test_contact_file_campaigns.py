@@ -30,12 +30,12 @@ def test_column_campaign_runs_carry_the_files_kn_and_damping(tmp_path, contact, 
 
 def test_ensemble_fixes_the_files_damping_and_multiplies_its_kn(tmp_path, contact, pulse_file):
     specs = ensemble.ensemble_specs([pulse_file], tmp_path / "e", members=6, contact_file=contact)
-    members = [s for s in specs if s.tags["member"] >= 0]
+    members = [s for s in specs if s.tags.member >= 0]
     assert {s.params.contact.damping for s in specs} == {FILE["damping"]}
     factors = [s.params.contact.kn / FILE["kn"] for s in members]
     lo, hi, _ = ensemble_members.ENSEMBLE_RANGES["kn_factor"]
     assert all(lo - 1e-6 <= f <= hi + 1e-6 for f in factors) and len(set(factors)) == 6
-    nominal = next(s for s in specs if s.tags["member"] == -1)
+    nominal = next(s for s in specs if s.tags.member == -1)
     assert nominal.params.contact.kn == FILE["kn"]
     assert len({s.params.contact.mu_s for s in members}) == 6       # friction still sampled
 

@@ -53,7 +53,7 @@ def test_specs_sample_each_setting_independently(tmp_path):
     assert len(specs) == 3 * len(VARIANTS) and len({s.run_id for s in specs}) == len(specs)
     by = {}
     for s in specs:
-        by.setdefault(s.tags["variant"], []).append(s.params)
+        by.setdefault(s.tags.variant, []).append(s.params)
     assert [p.numerics.rim_points for p in by["rim 64"]] == [64] * 3
     assert [p.numerics.dt_factor for p in by["dt 0.15"]] == [0.15] * 3
     assert all(p.numerics.rim_points == 16 and p.numerics.dt_factor is None

@@ -7,6 +7,7 @@ import subprocess
 import sys
 import tempfile
 import time
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import pandas as pd
@@ -32,12 +33,18 @@ def pulse_npz(path, azimuth_deg, amplitude=5.0, duration=5.0):
 
 
 # ---------------------------------------------------------------- the task, without YADE
+@dataclass(frozen=True)
+class Failing:
+    """A test campaign's tags: whether the fake run fails."""
+    fail: bool
+
+
 def fake_worker(spec, run_dir):
     """Stands in for run_column_spec: reads the motion, writes what a run writes."""
     motion = Motion.load(spec.motion_file)
     (run_dir / "trajectory.npz").write_bytes(b"trajectory")
     (run_dir / "yade.log").write_text(f"ran in {run_dir}\n")
-    if spec.tags.get("fail"):
+    if spec.tags is not None and spec.tags.fail:
         raise RuntimeError(f"boom; see {run_dir / 'yade.log'}")
     (run_dir / "summary.json").write_text(json.dumps(
         {"record": motion.record_id, "parameters": {"motion_file": spec.motion_file},
@@ -55,9 +62,9 @@ def test_task_carries_its_motion_and_returns_files_with_client_paths(tmp_path):
     assert summary["record"] == "a"
     assert summary["parameters"]["motion_file"] == "/client/only/a.npz"
     assert summary["log"] == client_dir + "/yade.log"
-    lean = run_task(fake_worker, spec.tagged(keep_trajectory=False), data, client_dir, code, "t0")
+    lean = run_task(fake_worker, replace(spec, keep_trajectory=False), data, client_dir, code, "t0")
     assert sorted(lean["files"]) == ["summary.json"]
-    failed = run_task(fake_worker, spec.tagged(fail=True), data, client_dir, code, "t0")
+    failed = run_task(fake_worker, replace(spec, tags=Failing(True)), data, client_dir, code, "t0")
     assert failed["message"] == f"boom; see {client_dir}/yade.log"
     assert sorted(failed["files"]) == ["yade.log"]          # logs, no summary, no npz
     assert not list(Path(tempfile.gettempdir()).glob(f"{TASK_PREFIX}-t0-*"))

@@ -118,7 +118,7 @@ def test_block_never_topples_below_g_tan_alpha_and_always_under_a_huge_pulse(tmp
     motion = Motion.load(specs[0].motion_file)
     for spec in specs:
         pga = horizontal_peak(motion.scale(spec.params.drive.scale).acc)[0]
-        assert pga == pytest.approx(spec.tags["level_m_s2"], rel=1e-5)
+        assert pga == pytest.approx(spec.tags.level_m_s2, rel=1e-5)
     table, cost = fragility_block.block_runs(specs)
     assert cost["block2d_cases"] == 6 * 6
     levels = level_table(table).set_index(["record_id", "level_m_s2"])

@@ -27,13 +27,13 @@ WIDER = 2.0         # the model's base is this much wider than the guide's: a st
 def stabler_block_worker(spec, run_dir):
     """Worker: the 2D block of the run's height and WIDER x its width under the run's
     pulse, written as the run's summary (the specimen's one column)."""
-    height, width = pulse_block.block_of(spec.params, spec.tags["azimuth_deg"])
-    pulse = one_cosine_pulse(spec.tags["pga_g"] * pulse_grid.G, spec.tags["pgv_pga_s"], 0.0,
+    height, width = pulse_block.block_of(spec.params, spec.tags.azimuth_deg)
+    pulse = one_cosine_pulse(spec.tags.pga_g * pulse_grid.G, spec.tags.pgv_pga_s, 0.0,
                              pulse_grid.PULSE_DT_S, 0.0)
     fell = bool(rocking_response_sampled(height, WIDER * width, pulse.acc[:, 1], pulse.dt,
                                          t_after=30.0, max_step=1e-3)["overturned"][0])
     column = ColumnOutcome(column="box", toppled=fell,
-                           downfall_azimuth_deg=spec.tags["azimuth_deg"] if fell else None)
+                           downfall_azimuth_deg=spec.tags.azimuth_deg if fell else None)
     RunSummary(record=spec.record_id, columns=[column]).save(run_dir / "summary.json")
 
 

@@ -26,8 +26,9 @@ def test_finished_runs_of_the_same_worker_are_copied_once(tmp_path):
     target = tmp_path / "ensemble"
     (target / "runs" / "b").mkdir(parents=True)
     (target / "runs" / "b" / "error.txt").write_text("an earlier attempt")
-    def spec(run_id, **tags):
-        return RunSpec("r", "r", "/m.npz", RunParams(), run_id, tags)
+    def spec(run_id, keep_trajectory=True):
+        return RunSpec("r", "r", "/m.npz", RunParams(), run_id,
+                       keep_trajectory=keep_trajectory)
     specs = [spec("a", keep_trajectory=False), spec("b"), spec("c", keep_trajectory=False),
              spec("d"), spec("e", keep_trajectory=False)]
     assert reuse_finished(specs, target, run_column_spec) == 1

@@ -95,7 +95,7 @@ def test_scores_of_a_synthetic_threshold_model(tmp_path):
         "observed": frame[OUTCOME].to_numpy().astype(bool), "runs": 8, "overturned": k,
         "P": k / 8, "ci95_low": 0.0, "ci95_high": 1.0,
         "single_set_predicted": k >= 4})
-    full = [SimpleNamespace(tags={"member": m, "point": {"m": m}}) for m in (-1, 0, 1)]
+    full = [SimpleNamespace(tags=SimpleNamespace(member=m, point={"m": m})) for m in (-1, 0, 1)]
     options = {"specimen": SPECIMEN, "experiments": EXPERIMENTS, "outcome": OUTCOME,
                "validate_from": "2021-08-01", "members": 8, "axis_deg": 90.0}
     write_scores(per_test, tmp_path, options, full, True)
@@ -179,7 +179,7 @@ def test_the_planned_runs_are_those_the_specs_hold(tmp_path):
         specs = [s for c in candidates for s in stm.run_specs(
             [], tmp_path, {**options, "ranges": c, "tests": calibration})]
         specs += stm.run_specs([], tmp_path, {**options, "ranges": chosen})
-        distinct = {s.run_id: s.tags["core_s"] for s in specs}
+        distinct = {s.run_id: s.core_s for s in specs}
         built.append((len(distinct), sum(distinct.values())))
     assert runs == max(n for n, _ in built) == 2 * 2 * 2 + 2 * 1 + 3
     assert core == pytest.approx(max(c for _, c in built), rel=1e-3)

@@ -1,13 +1,14 @@
 """RunSpec: a run's id comes from what defines the run, never from a campaign's tags; a
 spec cannot be changed after it is made."""
-import json
 import pickle
+from dataclasses import replace
 
 import numpy as np
 import pytest
 
 from pipeline.campaign.spec import RunSpec
-from pipeline.files import InputError
+from pipeline.campaign.tags import ConvergenceTags, EnsembleTags
+from pipeline.files import InputError, content_hash
 from pipeline.scenario import Column, Contact, RunParams
 
 
@@ -15,7 +16,7 @@ def test_the_run_id_follows_motion_content_and_parameters_not_tags(tmp_path):
     a, b = tmp_path / "a.npz", tmp_path / "b.npz"
     np.savez(a, x=np.arange(3))
     b.write_bytes(a.read_bytes())                      # same content, other name
-    one = RunSpec.create("A", "A", a, {"hd": 6.0}, "code1", member=3)
+    one = RunSpec.create("A", "A", a, {"hd": 6.0}, "code1", EnsembleTags(3, 1))
     assert RunSpec.create("B", "B", b, {"hd": 6.0}, "code1").run_id == one.run_id
     assert RunSpec.create("A", "A", a, {"hd": 6.1}, "code1").run_id != one.run_id
     assert RunSpec.create("A", "A", a, {"hd": 6.0}, "code2").run_id != one.run_id
@@ -23,14 +24,16 @@ def test_the_run_id_follows_motion_content_and_parameters_not_tags(tmp_path):
     assert RunSpec.create("A", "A", a, {"hd": 6.0, "kn": Contact().kn}, "code1").run_id \
         == one.run_id
     assert RunSpec.create("A", "A", a, RunParams(Column(hd=6.0)), "code1").run_id == one.run_id
-    tagged = one.tagged(member=4, seed=9)
-    assert tagged.run_id == one.run_id and tagged.tags["member"] == 4
-    assert one.tags["member"] == 3
+    # the id is the hash of (code, motion content, parameters) alone: tags, the trajectory
+    # kept, a cost estimate or a description's name change nothing
+    expected = content_hash("code1", a, RunParams(Column(hd=6.0)).to_dict())
+    assert one.run_id == expected
+    assert RunSpec.create("A", "A", a, {"hd": 6.0}, "code1", ConvergenceTags("x", 2, 9),
+                          keep_trajectory=False, core_s=5.0).run_id == expected
+    tagged = replace(one, tags=replace(one.tags, member=4))
+    assert tagged.run_id == one.run_id and tagged.tags.member == 4
+    assert one.tags.member == 3 and tagged.tags.seed == 1
     assert tagged.params.column.hd == 6.0 and tagged.params.contact == Contact()
-    assert tagged.to_dict() == {"record": "A", "record_id": "A", "motion_file": str(a),
-                                "params": RunParams(Column(hd=6.0)).to_dict(),
-                                "run_id": one.run_id, "member": 4, "seed": 9}
-    assert RunSpec.from_dict(json.loads(json.dumps(tagged.to_dict()))) == tagged
     assert pickle.loads(pickle.dumps(tagged)) == tagged        # to a Dask worker and back
 
 
@@ -40,15 +43,15 @@ def test_a_spec_is_read_only_and_checked():
         spec["member"]                                  # not a mapping: attributes
     with pytest.raises(AttributeError):
         spec.run_id = "other"
-    assert spec.keep_trajectory and not spec.tagged(keep_trajectory=False).keep_trajectory
-    with pytest.raises(InputError, match="hide a field"):
-        RunSpec("A", "A", "/m.npz", RunParams(), "id1", {"run_id": "x"})
+    with pytest.raises(TypeError):
+        EnsembleTags(member=1, seed=2, stage="x")       # no tag a campaign does not declare
+    assert spec.keep_trajectory and not replace(spec, keep_trajectory=False).keep_trajectory
+    with pytest.raises(InputError, match="tags dataclass"):
+        RunSpec("A", "A", "/m.npz", RunParams(), "id1", {"member": 1})
     with pytest.raises(InputError, match="run_id"):
         RunSpec("A", "A", "/m.npz", RunParams(), "")
     with pytest.raises(InputError, match="RunParams"):
         RunSpec("A", "A", "/m.npz", {"hd": 6.0}, "id1")
-    with pytest.raises(InputError, match="lacks params"):
-        RunSpec.from_dict({"record": "A", "record_id": "A", "motion_file": "m", "run_id": "i"})
     with pytest.raises(InputError, match="unknown run parameter.*height_m"):
         RunSpec.create("A", "A", "/m.npz", {"height_m": 6.0}, "code1")
     with pytest.raises(InputError, match="--scale 25 outside"):

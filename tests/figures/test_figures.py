@@ -51,7 +51,7 @@ def lying_east_trajectory():
 
 def test_body_rotated_about_north_lies_along_east():
     traj = lying_east_trajectory()
-    bottom, top = animation.body_surface(traj.bodies[0], traj.pos[1, 0], traj.quat[1, 0])
+    bottom, top = animation.body_surfaces(traj.bodies[0], traj.pos[1, 0], traj.quat[1, 0])[0]
     axis = top.mean(axis=0) - bottom.mean(axis=0)
     assert axis == pytest.approx([3.5, 0, 0], abs=1e-9)
     assert bottom[:, 2].min() == pytest.approx(0.0, abs=1e-9)   # lies on the pedestal

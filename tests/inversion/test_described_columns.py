@@ -10,7 +10,7 @@ from pipeline.outcome.summary import RunSummary
 from pipeline import cli
 from pipeline.campaign.column_file import column_kn, description
 from pipeline.files import InputError, write_json
-from pipeline.inversion.forward import member_parameters, table_path
+from pipeline.inversion.forward import ForwardTags, member_parameters, table_path
 from pipeline.inversion.grid import GRIDS, TableGrid, node_positions
 from pipeline.inversion.table import ForwardTable
 from pipeline.scenario import RunParams
@@ -49,7 +49,7 @@ def test_from_runs_of_a_described_grid(tmp_path):
                  "downfall_azimuth_deg": 33.0 if node else None}]).save(
                 tmp_path / "runs" / run_id / "summary.json")
             specs.append(RunSpec(run_id, run_id, "/m.npz", RunParams(), run_id,
-                                 {"slice": 0, "node": node, "member": member}))
+                                 ForwardTags(0, node, member, 0.0, 0.0, grid)))
     table = ForwardTable.from_runs(specs, tmp_path, grid)
     assert table.columns == ("drums",) and table.toppled.shape == (1, 1, 2, 1, 1)
     assert table.toppled[0, 0, 1, 0, 0] and table.azimuth_deg[0, 0, 1, 0, 0] == 33.0

@@ -7,7 +7,7 @@ import pytest
 from pipeline.campaign.spec import RunSpec
 from pipeline.outcome.summary import RunSummary
 from pipeline.files import InputError
-from pipeline.inversion.forward import member_parameters
+from pipeline.inversion.forward import ForwardTags, member_parameters
 from pipeline.inversion.grid import GRIDS, TableGrid, node_positions, subevent_layout
 from pipeline.inversion.table import ForwardTable
 from pipeline.motion.synthetics import SOURCES, subevents
@@ -64,7 +64,7 @@ def test_from_runs_places_each_outcome(tmp_path):
                      "downfall_azimuth_deg": 7.0 if member == -1 else None}]).save(
                 tmp_path / "runs" / run_id / "summary.json")
             specs.append(RunSpec(run_id, run_id, "/m.npz", RunParams(), run_id,
-                                 {"slice": 0, "node": node, "member": member}))
+                                 ForwardTags(0, node, member, 0.0, 0.0, grid)))
     table = ForwardTable.from_runs(specs, tmp_path, grid)
     assert table.toppled.shape == (1, 2, 2, 2, 2)
     assert table.toppled[0, 0, 1, 0].all() and table.toppled.sum() == 2

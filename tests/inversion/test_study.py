@@ -5,7 +5,6 @@ import dataclasses
 import numpy as np
 
 from pipeline.inversion.candidates import CandidateGrid
-from pipeline.inversion.credible import magnitude_set
 from pipeline.inversion.study import member_study, split_for_study
 from pipeline.inversion.study_summary import placement_summary, study_answer, study_summary, warning_rates
 
@@ -77,10 +76,6 @@ def test_the_rows_do_not_depend_on_the_processes(make_away_table):
     assert done == [("independent", 3), ("independent", 6), ("predictive", 3),
                     ("predictive", 6)]
 
-
-def test_the_magnitude_set_holds_95_percent():
-    assert magnitude_set({"6": 0.5, "6.5": 0.46, "7": 0.04}) == ["6", "6.5"]
-    assert magnitude_set({"6": 0.96, "7": 0.04}) == ["6"]
 
 
 def test_member_study_command_on_a_table_file(make_away_table, tmp_path, capsys):

@@ -5,21 +5,28 @@ import pytest
 
 from pipeline import paper
 from pipeline.files import InputError
-from pipeline.verification.contact_map import damping_for_restitution, rocking_restitution
+from pipeline.verification.contact_map import bisect_damping, block_measure, rocking_restitution
 
 H, B, D = (paper.MARBLE_BLOCK_M[k] for k in ("height", "width", "depth"))
+
+
+def damping_for(restitution, cache):
+    """(damping, measured restitution, YADE runs made), as ``contact --damping-map`` finds
+    them for the paper's marble block."""
+    measured, runs = block_measure(H, B, D, paper.MARBLE_BLOCK_KN_N_M,
+                                   paper.MARBLE_DENSITY_KG_M3, cache)
+    damping, found = bisect_damping(restitution, measured, "this block", lambda _: None)
+    return damping, found, runs()
 
 
 @pytest.mark.yade
 def test_stated_restitution_is_honoured_at_another_release(tmp_path):
     stated = 0.96                      # between Housner's 0.942 and the elastic ~0.98
     cache = tmp_path / "map.json"
-    damping, measured, runs = damping_for_restitution(stated, H, B, D, log=lambda _: None,
-                                                      cache=cache)
+    damping, measured, runs = damping_for(stated, cache)
     assert 0.0 < damping < 1.0 and abs(measured - stated) <= 5e-4 and 3 <= runs <= 12
     # mapped once: the same answer from the cache, no run
-    assert damping_for_restitution(stated, H, B, D, log=lambda _: None, cache=cache) == \
-        (damping, measured, 0)
+    assert damping_for(stated, cache) == (damping, measured, 0)
     # released from a quarter of alpha instead of a half: the impacts keep the restitution
     assert rocking_restitution(H, B, D, damping, release_ratio=0.25) == \
         pytest.approx(stated, abs=3e-3)
@@ -29,7 +36,7 @@ def test_stated_restitution_is_honoured_at_another_release(tmp_path):
 def test_restitution_below_housner_refused():
     # Housner's perfectly inelastic impact, 1 - 1.5 / 26 = 0.942, is the lossiest
     with pytest.raises(InputError, match="reaches"):
-        damping_for_restitution(0.90, H, B, D, log=lambda _: None, cache=None)
+        damping_for(0.90, None)
 
 
 @pytest.mark.yade

@@ -55,7 +55,7 @@ def gmm_check(source_names=tuple(SOURCES), rings_km=RINGS_KM, azimuth_step_deg=A
     top depth and the site's rupture distances, at Vs30 = GMM_VS30_M_S.
     Units: PGA in g, PGV in cm/s.
     """
-    import pygmm  # noqa: PLC0415  (slow import, only needed here)
+    import pygmm  # lazy: pygmm, slow to import, only needed here
 
     models = {"cy14": pygmm.ChiouYoungs2014, "bssa14": pygmm.BooreStewartSeyhanAtkinson2014}
     rows = []

@@ -23,7 +23,7 @@ def read(path, key=None):
 def read_asdf(source, name="ASDF file"):
     """ASDF (HDF5): raw waveforms of one station with StationXML (sensitivity, orientation)
     and QuakeML (epicentre, magnitude).  Uses the ``*_unprocessed``/``raw_recording`` tag."""
-    import h5py
+    import h5py  # lazy: h5py, only for ASDF files
     try:
         h5 = h5py.File(source, "r")
     except OSError as exc:
