@@ -82,8 +82,8 @@ def hazard_job(job_options, constrain_options):
                    OQ_DATABASE="127.0.0.1")
         sites = job_options.oq_site
         calc = {}
-        for name, text in (("classical", classical_text(job, sites)),
-                           ("disaggregation", disaggregation_text(job, sites))):
+        for name, text in (("classical", classical_text(job, tmp, sites)),
+                           ("disaggregation", disaggregation_text(job, tmp, sites))):
             (tmp / f"{name}.ini").write_text(text, encoding="utf-8")
             calc[name], times[name] = _engine(job_options.oq_python, tmp, name, env)
         for f in (tmp / "out_classical").glob("*.csv"):

@@ -6,8 +6,10 @@ magnitude and distance (a disaggregation job).  Text only: the engine runs elsew
 
 The job's source and ground-motion logic trees, its site parameters (``site_model_file``
 or the ``reference_*`` values) and its other settings are kept; file names become
-absolute, so the rewritten job may be written anywhere."""
+relative to the directory the rewritten job is written to (the engine refuses absolute
+ones)."""
 import configparser
+import os
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -65,20 +67,23 @@ def load_job(path):
     return OqJob(path.resolve(), sections)
 
 
-def _absolute(job, key, value):
+def _relative(job, key, value, directory):
     if not (key.endswith("_file") or key.endswith("_csv")):
         return value
-    return " ".join(str((job.path.parent / token).resolve()) for token in value.split())
+    return " ".join(os.path.relpath((job.path.parent / token).resolve(), directory)
+                    for token in value.split())
 
 
-def _text(job, sites, extra):
-    """The job's text: its settings (file names absolute) without the replaced ones, the
-    sites (``(lon, lat)`` degrees) when given, then ``extra`` (key, value) pairs."""
+def _text(job, directory, sites, extra):
+    """The job's text to be written in ``directory``: its settings (file names relative to
+    ``directory``) without the replaced ones, the sites (``(lon, lat)`` degrees) when given,
+    then ``extra`` (key, value) pairs."""
+    directory = Path(directory).resolve()
     drop = set(_OUTPUT_KEYS) | (set(_SITE_KEYS) if sites else set())
     lines = []
     for section, items in job.sections:
         lines.append(f"[{section}]")
-        lines += [f"{k} = {_absolute(job, k, v)}" for k, v in items if k not in drop]
+        lines += [f"{k} = {_relative(job, k, v, directory)}" for k, v in items if k not in drop]
         lines.append("")
     lines.append("[constrained_hazard]")
     if sites:
@@ -87,10 +92,10 @@ def _text(job, sites, extra):
     return "\n".join(lines) + "\n"
 
 
-def classical_text(job, sites=()):
+def classical_text(job, directory, sites=()):
     """The classical job: PGA and PGV curves of every realisation and the ruptures'
     contexts kept (``postproc_func = dummy.main``) for the joint rate density."""
-    return _text(job, sites, (
+    return _text(job, directory, sites, (
         ("description", "'constrained hazard: PGA and PGV of every realisation'"),
         ("calculation_mode", "classical"),
         ("intensity_measure_types_and_levels",
@@ -98,10 +103,10 @@ def classical_text(job, sites=()):
         ("postproc_func", "dummy.main"), ("individual_rlzs", "true")))
 
 
-def disaggregation_text(job, sites=()):
+def disaggregation_text(job, directory, sites=()):
     """The disaggregation job: PGA by magnitude and distance (``Mag_Dist``), every
     realisation, at :data:`POES_DISAGG`."""
-    return _text(job, sites, (
+    return _text(job, directory, sites, (
         ("description", "'constrained hazard: PGA by magnitude and distance'"),
         ("calculation_mode", "disaggregation"),
         ("intensity_measure_types_and_levels", f'{{"PGA": {PGA_LEVELS}}}'),
