@@ -7,7 +7,7 @@ JOBS ?= $(shell nproc)
 
 .PHONY: setup test run-all records campaigns bench clean invert-demo shake-table rock-fragility rock-survival docs \
 	convergence paper-question invert-study invert-study-table contact-convergence \
-	shake-table-scores shake-table-scores-quick field-rock oq-case-mrd
+	shake-table-scores shake-table-scores-quick field-rock oq-case-mrd oq-hazard-job
 
 setup: .venv/.installed
 	@command -v yade >/dev/null || { echo "installing YADE (apt-get install yade)"; \
@@ -242,13 +242,24 @@ invert-study-table: setup
 # stating the engine's wall time of each step.  The engine is an optional extra with pins
 # of its own: it goes into an environment of its own, $(OQ_VENV), made when missing
 # (records/tools/oq_engine_requirements.txt: its requirements but GDAL, which has no wheel).
+# oq-hazard-job: the same case from its job.ini to the constrained hazard in one command
+# (pipeline hazard-job; a test input, not the hazard at that place, and an illustrative
+# rock), stating the engine's wall time of each step.
 OQ_VENV ?= .venv-oq
-oq-case-mrd:
-	@test -x $(OQ_VENV)/bin/python || { echo "installing the OpenQuake engine into $(OQ_VENV)"; \
-	  python3 -m venv $(OQ_VENV) && \
-	  $(OQ_VENV)/bin/pip install -q -r records/tools/oq_engine_requirements.txt && \
-	  $(OQ_VENV)/bin/pip install -q --no-deps openquake-engine==3.26.2; }
+$(OQ_VENV)/.installed:
+	@echo "installing the OpenQuake engine into $(OQ_VENV)"
+	test -x $(OQ_VENV)/bin/python || python3 -m venv $(OQ_VENV)
+	$(OQ_VENV)/bin/pip install -q -r records/tools/oq_engine_requirements.txt
+	$(OQ_VENV)/bin/pip install -q --no-deps openquake-engine==3.26.2
+	touch $@
+
+oq-case-mrd: $(OQ_VENV)/.installed
 	records/tools/run_oq_case_mrd.sh $(OQ_VENV)/bin/python results/oq_case_mrd
+
+oq-hazard-job: setup $(OQ_VENV)/.installed
+	$(PY) -m pipeline hazard-job --oq-job records/hazard/openquake_postproc_case_mrd/input/job.ini \
+	  --oq-python $(OQ_VENV)/bin/python --oq-site 11.202 42.424 \
+	  --median-g 0.01 --beta 0.5 --age-ka 10 --age-sd-ka 1 --out results/oq_hazard_job
 
 clean:
 	rm -rf results/*/ results/REPORT.md

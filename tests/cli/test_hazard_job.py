@@ -5,6 +5,7 @@ shipped per-realisation curves and constrain's result on them."""
 import csv
 import json
 import os
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -36,6 +37,14 @@ def test_without_the_engine_one_line_how_to_install(tmp_path, capsys):
     assert code != 0 and len(err) == 1
     assert "no OpenQuake engine" in err[0] and "make oq-case-mrd" in err[0]
     assert not out.exists()
+
+
+def test_a_python_without_the_engine_one_line(tmp_path, capsys):
+    code, err = _run(capsys, "--oq-python", sys.executable, *SPECIMEN,
+                     "--out", str(tmp_path / "out"))
+    assert code != 0 and len(err) == 1, err
+    assert "no OpenQuake engine in" in err[0] and "pip install" in err[0]
+    assert not (tmp_path / "out").exists()
 
 
 @pytest.mark.parametrize("argv, message", [
