@@ -71,6 +71,7 @@ def hazard_job(job_options, constrain_options):
     """Run the job's engine steps and ``constrain``; returns (constrain's summary,
     {step: engine wall time s})."""
     job = load_job(job_options.oq_job)
+    _check_sites(job_options, constrain_options)
     check_engine(job_options.oq_python)
     out = constrain_options.out
     times = {}
@@ -103,6 +104,19 @@ def hazard_job(job_options, constrain_options):
             shutil.rmtree(target)
         shutil.move(str(export), str(target))
     return summary, times
+
+
+def _check_sites(job_options, constrain_options):
+    """--site and --specimen-site within the --oq-site given (before the engine runs)."""
+    count = len(job_options.oq_site)
+    if count == 0:
+        return
+    named = [("--site", constrain_options.site)] + [
+        ("--specimen-site", s) for s in constrain_options.specimen_site]
+    for flag, site in named:
+        if site is not None and site >= count:
+            raise InputError(f"{flag} {site}: beyond the {count} --oq-site given "
+                             "(counted from 0)")
 
 
 def _run(cmd, cwd, env, what):

@@ -50,7 +50,9 @@ def test_a_python_without_the_engine_one_line(tmp_path, capsys):
 @pytest.mark.parametrize("argv, message", [
     (["--oq-site", "200", "0", *SPECIMEN], "longitude"),
     (["--median-g", "0.3", "--beta", "-1", "--age-ka", "2"], "--beta"),
-    (["--median-g", "0.3", "--beta", "0.4", "--age-range-ka", "3", "1"], "age")])
+    (["--median-g", "0.3", "--beta", "0.4", "--age-range-ka", "3", "1"], "age"),
+    (["--oq-site", "11.2", "42.4", "--specimen-site", "1", *SPECIMEN], "--specimen-site 1"),
+    (["--oq-site", "11.2", "42.4", "--site", "2", *SPECIMEN], "--site 2")])
 def test_options_checked_before_the_engine(tmp_path, capsys, argv, message):
     out = tmp_path / "out"
     code, err = _run(capsys, "--oq-python", str(tmp_path / "python"), *argv,
