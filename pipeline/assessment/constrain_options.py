@@ -56,7 +56,14 @@ class ConstrainOptions(SpecimenOptions):
     floor: float = param(FLOOR, "", "survival probability below which elimination drops a "
                          "branch", 0, 1, low_open=True, high_open=True, flag="--floor",
                          metavar="P")
+    joint_hazard: Path = param(
+        None, "", "or PGV/PGA at each PGA level from the mean rate density mrd of PGA and "
+        "PGV (an OpenQuake datastore or its extract) at --site: one distribution for every "
+        "branch (the engine writes the mean's only, no branch's)", flag="--joint-hazard",
+        metavar="FILE")
     out: Path = param(CONSTRAIN_OUT, "", "output directory", flag="--out", metavar="DIR")
+
+    RATIO_FLAGS = (*SpecimenOptions.RATIO_FLAGS, "joint_hazard")
 
     def __post_init__(self):
         if self.logic_tree is None:
@@ -78,7 +85,20 @@ class ConstrainOptions(SpecimenOptions):
         if self.age_ka:
             _per_specimen(self.age_sd_ka, n, "--age-sd-ka")
         self.specimen_sites()
+        if self.joint_hazard is not None and (self.pgv_pga_median is not None or
+                                              self.magnitude is not None):
+            raise InputError("PGV/PGA: give --joint-hazard, --pgv-pga-median/"
+                             "--pgv-pga-sigma or --magnitude/--distance-km, one of them")
         _check_out(self.out)
+
+    def ratio_model(self, specimens):
+        """PGV/PGA from --joint-hazard's mean rate density at --site, or as
+        :meth:`SpecimenOptions.ratio_model`."""
+        if self.joint_hazard is None:
+            return super().ratio_model(specimens)
+        from pipeline.hazard.joint_hazard import load_joint_hazard  # noqa: PLC0415  (h5py: lazy)
+        from pipeline.hazard.mrd_ratio import ratio_from_mrd  # noqa: PLC0415
+        return ratio_from_mrd(load_joint_hazard(self.joint_hazard), self.site or 0)
 
     def specimen_sites(self):
         """The site of each specimen (--specimen-site), or None (all at --site)."""

@@ -1,0 +1,57 @@
+"""PGV/PGA given PGA from a site's mean rate density of PGA and PGV (OpenQuake's ``mrd``,
+:class:`~pipeline.hazard.joint_hazard.JointHazard`), for ``constrain``: at each PGA cell
+the events' ln(PGV/PGA) (cells at their geometric centres), taken as a lognormal of their
+rate-weighted mean and standard deviation; between cells interpolated in ln PGA, held
+beyond the first and last cell with events.  The engine writes the mean's rate density
+only, so every branch gets this one distribution (its PGA curve its own)."""
+from dataclasses import dataclass
+
+import numpy as np
+
+from pipeline.files import InputError
+
+
+@dataclass(frozen=True)
+class RatioFromMrd:
+    """ln(PGV/PGA) (PGV m/s, PGA m/s^2: ln s) given PGA at ``pga_m_s2`` (the PGA cells
+    with events): ``ln_mean`` and ``ln_sd``; ``source``: the file and site."""
+    pga_m_s2: np.ndarray
+    ln_mean: np.ndarray
+    ln_sd: np.ndarray
+    source: dict
+
+    def __post_init__(self):
+        if self.pga_m_s2.size < 1 or not (self.pga_m_s2.shape == self.ln_mean.shape ==
+                                         self.ln_sd.shape):
+            raise InputError(f"{self.source.get('file', 'mrd')}: no PGA cell with events")
+        if np.any(np.diff(self.pga_m_s2) <= 0) or np.any(self.ln_sd < 0):
+            raise InputError(f"{self.source.get('file', 'mrd')}: cells out of order")
+
+    def ln_mean_sd(self, pga_m_s2):
+        """(mean, sd) of ln(PGV/PGA) at PGA levels (m/s^2)."""
+        ln_a = np.log(np.asarray(pga_m_s2, float))
+        x = np.log(self.pga_m_s2)
+        return np.interp(ln_a, x, self.ln_mean), np.interp(ln_a, x, self.ln_sd)
+
+    def describe(self):
+        return {"source": "mean rate density of PGA and PGV (mrd), the same for every "
+                          "branch (the engine writes the mean's only)",
+                **{k: v for k, v in self.source.items() if k in ("file", "site_index")},
+                "pga_cells_with_events": int(self.pga_m_s2.size),
+                "distribution": "lognormal given PGA: the rate-weighted mean and sd of the "
+                                "events' ln(PGV/PGA) in each PGA cell (geometric centres)"}
+
+
+def ratio_from_mrd(joint, site):
+    """The :class:`RatioFromMrd` of ``joint`` (a JointHazard) at ``site`` (0-based)."""
+    one = joint.site(site)
+    rates = one.cell_rates_per_yr[0]
+    pga = np.sqrt(one.pga_levels_m_s2[:-1] * one.pga_levels_m_s2[1:])
+    pgv = np.sqrt(one.pgv_levels_m_s[:-1] * one.pgv_levels_m_s[1:])
+    total = rates.sum(axis=1)
+    keep = total > 0
+    ln_ratio = np.log(pgv)[None, :] - np.log(pga)[keep][:, None]
+    w = rates[keep] / total[keep][:, None]
+    mean = (w * ln_ratio).sum(axis=1)
+    sd = np.sqrt(np.maximum((w * (ln_ratio - mean[:, None]) ** 2).sum(axis=1), 0.0))
+    return RatioFromMrd(pga[keep], mean, sd, dict(one.source))
