@@ -1,11 +1,12 @@
 """``hazard-job``: an OpenQuake job run at the specimens' sites by the engine's own command
 line (in its own environment, one process, no server), its exports kept, then the
-``constrain`` workflow on the per-realisation PGA curves.
+``constrain`` workflow on the per-realisation PGA curves (PGV/PGA from the run's rate
+density unless the options give another source).
 
 The engine writes into a temporary directory; only when every step succeeded does its
 export move to ``<out>/openquake`` (the logic tree ``constrain`` reads; the PGA-PGV rate
 density ``mrd_pga_pgv.hdf5`` and ``disaggregation/Mag_Dist-*.csv`` for ``survival
---joint-hazard`` and ``--disaggregation``)."""
+--joint-hazard`` and ``--disaggregation``), removed again if ``constrain`` then fails."""
 import os
 import re
 import shutil
@@ -98,12 +99,26 @@ def hazard_job(job_options, constrain_options):
               str(tmp / "oqdata" / f"calc_{calc['classical']}.hdf5"),
               str(export / "mrd_pga_pgv.hdf5")], tmp, env, "the PGA-PGV rate density")
         times["mrd"] = time.monotonic() - start
-        summary = constrain_files(replace(constrain_options, logic_tree=export))
-        target = out / EXPORT
+        target, created = out / EXPORT, not out.exists()
         if target.exists():
             shutil.rmtree(target)
+        out.mkdir(parents=True, exist_ok=True)
         shutil.move(str(export), str(target))
+    try:            # constrain.json names the export where it stays
+        summary = constrain_files(_with_export(constrain_options, target))
+    except BaseException:
+        shutil.rmtree(out if created else target, ignore_errors=True)
+        raise
     return summary, times
+
+
+def _with_export(o, export):
+    """``constrain``'s options on the export: its logic tree, and PGV/PGA from its rate
+    density when no other source of PGV/PGA is given."""
+    own = o.joint_hazard is not None or o.pgv_pga_median is not None or \
+        o.magnitude is not None
+    return replace(o, logic_tree=export, **({} if own else {
+        "joint_hazard": export / "mrd_pga_pgv.hdf5"}))
 
 
 def _check_sites(job_options, constrain_options):

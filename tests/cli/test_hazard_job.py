@@ -84,3 +84,4 @@ def test_the_qa_case_run_gives_the_shipped_curves(tmp_path, capsys):
     assert list((export / "disaggregation").glob("Mag_Dist-*.csv"))
     summary = json.loads((out / "constrain.json").read_text())
     assert summary["branch_count"] == 2
+    assert summary["pgv_pga"]["file"].endswith("mrd_pga_pgv.hdf5")
