@@ -20,7 +20,7 @@ def constrain_files(o):
     """constrain.json's content for the options ``o``
     (:class:`~pipeline.assessment.constrain_options.ConstrainOptions`), its files written to
     ``o.out``."""
-    from pipeline.figures.constrain import plot_constrain  # noqa: PLC0415  (matplotlib: lazy)
+    from pipeline.figures.constrain import plot_constrain  # lazy: matplotlib, only when a figure is drawn
     ages = o.age_models()
     sites = o.specimen_sites()
     tree = load_logic_tree(o.logic_tree, o.site if o.site is not None or sites is None

@@ -61,7 +61,7 @@ def joint_survival_files(out, joint, specimens, age, draws, seed, hazard_compone
 
 def _write(out, summary, data, hazard_component, site_motion):
     """survival.json (and site_motion.json) checked, then written with survival.png."""
-    from pipeline.figures.survival import plot_survival  # noqa: PLC0415  (matplotlib: lazy)
+    from pipeline.figures.survival import plot_survival  # lazy: matplotlib, only when a figure is drawn
     summary["hazard_component"] = hazard_component
     summary["figure"] = "survival.png"
     if site_motion is not None:
@@ -99,7 +99,7 @@ def survival_outputs(o):
 
 def _joint_site(o):
     """The joint hazard of --joint-hazard at --site (unset: the file's only site)."""
-    from pipeline.hazard.joint_hazard import load_joint_hazard  # noqa: PLC0415  (h5py: lazy)
+    from pipeline.hazard.joint_hazard import load_joint_hazard  # lazy: h5py, only for --joint-hazard
     joint = load_joint_hazard(o.joint_hazard)
     if o.site is None and len(joint.sites) != 1:
         raise InputError(f"{o.joint_hazard}: {len(joint.sites)} sites: name one with --site")
