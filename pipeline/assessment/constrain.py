@@ -5,9 +5,10 @@ options; this loads the inputs, runs :func:`~pipeline.hazard.constrain_assess.co
 and writes the files as one set."""
 import csv
 import io
+from dataclasses import replace
 
 from pipeline.constants import STANDARD_GRAVITY
-from pipeline.files import file_set, result_json_text, write_text
+from pipeline.files import file_set, write_text
 from pipeline.hazard.constrain_assess import constrain_tree
 from pipeline.hazard.constrain_sites import SiteGroup
 from pipeline.hazard.logictree import load_logic_tree
@@ -17,10 +18,10 @@ FILES = ("branch_weights.csv", "branch_test.csv", "prior_curves.csv",
 
 
 def constrain_files(o):
-    """constrain.json's content for the options ``o``
+    """constrain.json (a :class:`~pipeline.hazard.results.ConstrainResult`) for the options ``o``
     (:class:`~pipeline.assessment.constrain_options.ConstrainOptions`), its files written to
     ``o.out``."""
-    from pipeline.figures.constrain import plot_constrain  # noqa: PLC0415  (matplotlib: lazy)
+    from pipeline.figures.constrain import plot_constrain  # lazy: matplotlib, only when a figure is drawn
     ages = o.age_models()
     sites = o.specimen_sites()
     tree = load_logic_tree(o.logic_tree, o.site if o.site is not None or sites is None
@@ -34,15 +35,15 @@ def constrain_files(o):
     ratio = o.ratio_model(specimens)
     summary, rows, figure = constrain_tree(tree, specimens, ratio, ages, o.rule, o.floor,
                                            o.draws, o.seed, groups)
-    summary["hazard_component"] = o.hazard_component
     files = {"branch_weights.csv": _branch_table(rows),
-             "branch_test.csv": figure["branch_test"].csv(),
-             "prior_curves.csv": _curve_table(summary, summary["prior"], "prior")}
-    if summary["posterior"] is not None:
-        files["constrained_curves.csv"] = _curve_table(summary, summary["posterior"],
+             "branch_test.csv": summary.branch_test.csv(),
+             "prior_curves.csv": _curve_table(summary, summary.prior, "prior")}
+    if summary.posterior is not None:
+        files["constrained_curves.csv"] = _curve_table(summary, summary.posterior,
                                                        f"constrained ({o.rule})")
-    summary["files"] = [*files, "constrain.json", "constrain.png"]
-    files["constrain.json"] = result_json_text(summary, "constrain.json")   # before any file
+    summary = replace(summary, hazard_component=o.hazard_component,
+                      files=[*files, "constrain.json", "constrain.png"])
+    files["constrain.json"] = summary.text()   # before any file
     with file_set(o.out, FILES, ("constrain.json",)) as stage:
         plot_constrain(figure, stage / "constrain.png")
         for name, text in files.items():
@@ -72,13 +73,13 @@ def _curve_table(summary, stats, what):
     """A curve file: comment lines, then pga_g, pga_m_s2, the mean and each fractile's
     annual rate of exceedance (1/yr) per level."""
     fractiles = list(stats["fractiles"])
-    lines = [f"# {what} hazard curves of the logic tree {summary['hazard'].get('file')}: "
+    lines = [f"# {what} hazard curves of the logic tree {summary.hazard.get('file')}: "
              "annual rates of exceeding PGA (1/yr)",
              "# mean: the weighted mean of the branches' rates; fractile_q: OpenQuake's "
              "weighted quantile over the branches",
              ",".join(["pga_g", "pga_m_s2", "mean_annual_rate_per_yr"]
                       + [f"fractile_{q}_annual_rate_per_yr" for q in fractiles])]
-    for k, level in enumerate(summary["levels_m_s2"]):
+    for k, level in enumerate(summary.levels_m_s2):
         values = [level / STANDARD_GRAVITY, level, stats["mean_rates_per_yr"][k]] + \
             [stats["fractiles"][q][k] for q in fractiles]
         lines.append(",".join(f"{v:.9g}" for v in values))

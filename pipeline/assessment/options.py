@@ -14,7 +14,7 @@ from pipeline.constants import STANDARD_GRAVITY
 from pipeline.files import InputError
 from pipeline.assessment.age_options import age_kinds, check_age_kinds
 from pipeline.hazard.ages import LowerBound, TruncatedNormal, UniformInterval, load_age_samples
-from pipeline.hazard.components import COMPONENTS
+from pipeline.hazard.fragility.components import COMPONENTS
 from pipeline.hazard.disagg_ratio import ratio_mixture
 from pipeline.hazard.disaggregation import load_mag_dist
 from pipeline.hazard.fragility import (BELOW_GRID, GMM_MECHANISMS, Logistic, Lognormal,
@@ -22,6 +22,7 @@ from pipeline.hazard.fragility import (BELOW_GRID, GMM_MECHANISMS, Logistic, Log
 from pipeline.hazard.fragility.kinds import BETA_RANGE, MEDIAN_G_RANGE
 from pipeline.hazard.fragility.ratio import DEFAULT_VS30_M_S, PGA_PGV_CORRELATION
 from pipeline.hazard.pga_pgv_correlation import BRADLEY_2012
+from pipeline.records import rotd50_fraction
 from pipeline.scenario.parameters import check_fields, param
 
 COLUMNS = ("monolithic", "drums", "block2d", "block2d_worst")
@@ -134,7 +135,6 @@ class SpecimenOptions:
     def campaign_fragility(self, path, column):
         """The fragility of ``column`` in the campaign's file ``path``, as the options
         ask for it (form, below the grid, the hazard's component)."""
-        from pipeline.records import rotd50_fraction
         return load_campaign_fragility(path, column, self.fragility_form, self.below_grid,
                                        self.hazard_component, self.magnitude,
                                        self.distance_km, rotd50_fraction)

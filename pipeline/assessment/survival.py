@@ -3,6 +3,8 @@ hazard curves written as ``survival.json`` and ``survival.png``, and the PGA ran
 site's standing and fallen columns allow as ``site_motion.json`` (docs/survival.md).
 The command reads its options; this reads the input files and writes the results
 (:func:`survival_outputs`)."""
+from dataclasses import replace
+
 from pipeline.assessment.options import parse_logistic
 from pipeline.constants import STANDARD_GRAVITY
 from pipeline.files import InputError, file_set, result_json_text, write_text
@@ -60,13 +62,12 @@ def joint_survival_files(out, joint, specimens, age, draws, seed, hazard_compone
 
 
 def _write(out, summary, data, hazard_component, site_motion):
-    """survival.json (and site_motion.json) checked, then written with survival.png."""
-    from pipeline.figures.survival import plot_survival  # noqa: PLC0415  (matplotlib: lazy)
-    summary["hazard_component"] = hazard_component
-    summary["figure"] = "survival.png"
-    if site_motion is not None:
-        summary["site_motion"] = site_motion
-    texts = {"survival.json": result_json_text(summary, "survival.json")}   # before any file
+    """survival.json (a :class:`~pipeline.hazard.results.SurvivalResult`; and
+    site_motion.json) checked, then written with survival.png; returns survival.json."""
+    from pipeline.figures.survival import plot_survival  # lazy: matplotlib, only when a figure is drawn
+    summary = replace(summary, hazard_component=hazard_component, figure="survival.png",
+                      **({} if site_motion is None else {"site_motion": site_motion}))
+    texts = {"survival.json": summary.text()}   # before any file
     if site_motion is not None:
         texts["site_motion.json"] = result_json_text(site_motion, "site_motion.json")
     with file_set(out, FILES, SUMMARIES) as stage:
@@ -78,8 +79,8 @@ def _write(out, summary, data, hazard_component, site_motion):
 
 def survival_outputs(o):
     """What ``survival`` writes for the options ``o``
-    (:class:`~pipeline.assessment.options.SurvivalOptions`): (survival.json's content or
-    None, site_motion.json's or None, the age model or None), the files written to
+    (:class:`~pipeline.assessment.options.SurvivalOptions`): (survival.json as a
+    :class:`~pipeline.hazard.results.SurvivalResult` or None, site_motion.json's or None, the age model or None), the files written to
     ``o.out``."""
     site_motion = None if o.observations is None else _site_motion(o)
     if not o.hazard and o.joint_hazard is None:
@@ -99,7 +100,7 @@ def survival_outputs(o):
 
 def _joint_site(o):
     """The joint hazard of --joint-hazard at --site (unset: the file's only site)."""
-    from pipeline.hazard.joint_hazard import load_joint_hazard  # noqa: PLC0415  (h5py: lazy)
+    from pipeline.hazard.joint_hazard import load_joint_hazard  # lazy: h5py, only for --joint-hazard
     joint = load_joint_hazard(o.joint_hazard)
     if o.site is None and len(joint.sites) != 1:
         raise InputError(f"{o.joint_hazard}: {len(joint.sites)} sites: name one with --site")

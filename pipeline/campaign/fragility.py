@@ -199,6 +199,13 @@ def fragility_specs(records, campaign_dir, levels=None, members=DEFAULT_MEMBERS,
                                                 description=data,
                                                 kn=base_kn or column_kn(data, stiffness))
     member_params = ensemble_members.with_fixed_contact(member_params, contact)
+    runs, extra = _level_runs(records, levels, member_params, seed, azimuths, campaign_dir)
+    return mark(column_specs(runs, campaign_dir, extra), data)
+
+
+def _level_runs(records, levels, member_params, seed, azimuths, campaign_dir):
+    """(record, parameters with ``scale``) per record x level (m/s^2) x member, and their
+    :class:`LevelTags`: each record scaled to the level's horizontal PGA."""
     cache = motion_cache(campaign_dir)
     runs, extra = [], []
     for record in records:
@@ -211,7 +218,7 @@ def fragility_specs(records, campaign_dir, levels=None, members=DEFAULT_MEMBERS,
             for mi, params in enumerate(member_params):
                 runs.append((record, {**params, "scale": scale}))
                 extra.append(LevelTags(level, li, mi, scale, seed, azimuths, list(levels)))
-    return mark(column_specs(runs, campaign_dir, extra), data)
+    return runs, extra
 
 
 def _pulse_specs(records, campaign_dir, data, column, pulses, members, headings, azimuth,

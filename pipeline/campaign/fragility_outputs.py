@@ -13,7 +13,7 @@ from pipeline.campaign.fragility_tables import level_table, scaled_runs, summari
 from pipeline.campaign.pulse_outputs import pulse_outputs
 from pipeline.campaign.run_dirs import finished_summary
 from pipeline.files import write_csv
-from pipeline.hazard.fragility.file import FragilityFile, write_fragility_file
+from pipeline.hazard.fragility.file import write_fragility_file
 from pipeline.simulate import run_code_version
 from pipeline.campaign.tags import PulseTags
 
@@ -43,7 +43,7 @@ def fragility_outputs(specs, campaign_dir, failures, animations, figures=True):
     table = table.sort_values(["record_id", "level_index", "member", "model", "column"],
                               kind="stable")
     write_csv(campaign_dir / "fragility_runs.csv", table)
-    summary = FragilityFile.of(summarise(table, specs, cost))
+    summary = summarise(table, specs, cost)
     write_fragility_file(campaign_dir, summary)
     write_csv(campaign_dir / "fragility_levels.csv", level_table(table))
     written = []

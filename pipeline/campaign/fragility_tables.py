@@ -13,6 +13,9 @@ from pipeline.campaign.pulse_block import block_size
 from pipeline.campaign.tables import collect
 from pipeline.constants import MODEL_GRAVITY
 from pipeline.files import json_safe
+from pipeline.hazard.fragility.checker import leaf
+from pipeline.hazard.fragility.file import Block2d, ColumnFits, FragilityFile
+from pipeline.hazard.fragility.fits import LogisticSurface, LognormalFit
 from pipeline.rocking.housner import block_constants
 from pipeline.stats.ensemble import wilson_interval
 from pipeline.stats.fragility import binned_fractions, fragility_fit, logistic_surface
@@ -22,6 +25,12 @@ INTENSITY_MEASURES = {"PGA": ("pga_m_s2", "m/s^2", "PGA (m/s$^2$)"),
                       "PGV": ("pgv_m_s", "m/s", "PGV (m/s)"),
                       "PGV/PGA": ("pgv_pga_s", "s", "PGV/PGA (s)")}
 MODELS_3D = ("monolithic", "drums")
+FILE = "fragility.json"
+BRACKETS = ("all_stood_up_to_m_s2", "all_toppled_from_m_s2")   # a column's bracketing levels
+FILE_FIELDS = ("records", "members", "columns", "block2d")      # FragilityFile's own keys
+FILE_ORDER = ("records", "levels_m_s2", "members", "seed", "column", "column_file",
+              "azimuths", "intensity_measures", "columns", "comparison", "levels", "block2d",
+              "cost")                                           # fragility.json's key order
 MODELS_2D = ("block2d", "block2d_worst")
 # amplitude-dependent record parameters, rescaled to the scaled motion in the runs table
 SCALED_LINEAR = ("pga", "pgv", "pgd")
@@ -78,7 +87,8 @@ def level_table(table):
 
 
 def summarise(table, specs, cost):
-    """``fragility.json``: {"records", "levels_m_s2", "members", "seed", "column",
+    """``fragility.json`` as a :class:`~pipeline.hazard.fragility.file.FragilityFile`, its
+    parts built as their types: {"records", "levels_m_s2", "members", "seed", "column",
     "azimuths", "intensity_measures", "columns": {name: {"model": "3D"|"2D",
     "description", "runs", "toppled", "all_stood_up_to_m_s2" (highest PGA level below
     which no run toppled), "all_toppled_from_m_s2" (lowest level from which every run
@@ -100,27 +110,32 @@ def summarise(table, specs, cost):
         else f"3D YADE column as described in {column_file}",
         "block2d": "2D rigid block (Housner), shaken along the strongest azimuth",
         "block2d_worst": f"2D rigid block, worst of {first.azimuths} azimuths over 180 deg"}
-    columns = _column_fits(table, descriptions, alpha, p)
-    comparison = _comparison(columns)
+    columns, brackets = _column_fits(table, descriptions, alpha, p)
+    comparison = _comparison(columns, brackets)
     levels = level_table(table)
-    return json_safe({
-        "records": list(dict.fromkeys(s.record_id for s in specs)),
-        "levels_m_s2": first.levels, "members": 1 + max(s.tags.member for s in specs),
-        "seed": first.seed, "column": specs[0].params.column.kind,
+    block = {"alpha_rad": alpha, "p_per_s": p,
+             "uplift_acc_m_s2": MODEL_GRAVITY * math.tan(alpha),
+             "restitution": "Housner, 1 - 1.5 sin^2 alpha",
+             "excitation": "horizontal acceleration projected on an azimuth; no "
+                           "vertical motion, no sliding",
+             "integrator": "pipeline.rocking.sampled.rocking_response_sampled"}
+    extra = json_safe({
+        "levels_m_s2": first.levels, "seed": first.seed,
+        "column": specs[0].params.column.kind,
         **({"column_file": column_file} if column_file else {}),
         "azimuths": first.azimuths,
         "intensity_measures": {im: {"column": key, "unit": unit,
                                     "definition": _IM_DEFINITIONS[im]}
                                for im, (key, unit, _) in INTENSITY_MEASURES.items()},
-        "columns": columns, "comparison": comparison,
-        "levels": levels.to_dict(orient="records"),
-        "block2d": {"alpha_rad": alpha, "p_per_s": p,
-                    "uplift_acc_m_s2": MODEL_GRAVITY * math.tan(alpha),
-                    "restitution": "Housner, 1 - 1.5 sin^2 alpha",
-                    "excitation": "horizontal acceleration projected on an azimuth; no "
-                                  "vertical motion, no sliding",
-                    "integrator": "pipeline.rocking.sampled.rocking_response_sampled"},
+        "comparison": comparison, "levels": levels.to_dict(orient="records"),
         "cost": cost})
+    return FragilityFile(
+        columns=columns, records=tuple(dict.fromkeys(s.record_id for s in specs)),
+        members=1 + max(s.tags.member for s in specs),
+        block2d=Block2d(alpha_rad=alpha, p_per_s=p,
+                        extra=json_safe({k: block[k] for k in list(block)[2:]}),
+                        order=tuple(block)),
+        extra=extra, order=tuple(k for k in FILE_ORDER if k in extra or k in FILE_FIELDS))
 
 
 def _block_alpha_p(table, specs):
@@ -139,45 +154,51 @@ def _block_alpha_p(table, specs):
 def _column_fits(table, descriptions, alpha, p):
     """Per column type present: counts, the bracketing levels, a lognormal fit and binned
     fractions per intensity measure, and the logistic surface in (PGA, PGV/PGA)."""
-    columns = {}
+    columns, brackets = {}, {}
     for name in [c for c in (*MODELS_3D, *MODELS_2D) if c in set(table["column"])]:
         sub = table[table["column"] == name]
         y = sub["toppled"].astype(bool).to_numpy()
-        stood_to, toppled_from = _brackets(sub.groupby("level_m_s2")["toppled"].mean())
-        entry = {"model": "3D" if name in MODELS_3D else "2D", "description": descriptions[name],
-                 "runs": len(sub), "toppled": int(y.sum()),
-                 "all_stood_up_to_m_s2": stood_to, "all_toppled_from_m_s2": toppled_from}
+        brackets[name] = _brackets(sub.groupby("level_m_s2")["toppled"].mean())
+        where = f"columns.{name}"
+        fits = {}
         for im, (key, unit, _) in INTENSITY_MEASURES.items():
             values = sub[key].astype(float).to_numpy()
-            entry[im] = {**fragility_fit(values, y), "unit": unit,
-                         "bins": binned_fractions(values, y)}
-        entry["logistic"] = logistic_surface(sub["pga_m_s2"].astype(float),
-                                             sub["pgv_pga_s"].astype(float), y, alpha=alpha, p=p)
-        columns[name] = entry
-    return columns
+            fits[im] = leaf(LognormalFit, json_safe({**fragility_fit(values, y), "unit": unit,
+                                                     "bins": binned_fractions(values, y)}),
+                            FILE, f"{where}.{im}")
+        surface = logistic_surface(sub["pga_m_s2"].astype(float),
+                                   sub["pgv_pga_s"].astype(float), y, alpha=alpha, p=p)
+        columns[name] = ColumnFits(
+            description=descriptions[name], model="3D" if name in MODELS_3D else "2D",
+            runs=len(sub), toppled=int(y.sum()), fits=fits,
+            logistic=leaf(LogisticSurface, json_safe(surface), FILE, f"{where}.logistic"),
+            extra=dict(zip(BRACKETS, brackets[name])),
+            order=("model", "description", "runs", "toppled", *BRACKETS, *fits, "logistic"))
+    return columns, brackets
 
 
-def _comparison(columns):
-    """3D column against 2D block per intensity measure: medians, their ratio, betas,
-    P(toppled) and (PGA) the bracketing levels."""
+def _comparison(columns, brackets):
+    """3D column against 2D block per intensity measure (``columns``: name ->
+    :class:`ColumnFits`; ``brackets``: name -> its two bracketing levels): medians, their
+    ratio, betas, P(toppled) and (PGA) the bracketing levels."""
     comparison = []
     for column in MODELS_3D:
         for block in MODELS_2D:
             if column not in columns or block not in columns:
                 continue
             for im in INTENSITY_MEASURES:
-                m3, m2 = columns[column][im]["median"], columns[block][im]["median"]
+                three, two = columns[column], columns[block]
+                m3, m2 = three.fits[im].median, two.fits[im].median
                 comparison.append({
                     "column": column, "block": block, "im": im, "median_3d": m3,
                     "median_2d": m2, "ratio_3d_to_2d": None if m3 is None or m2 is None
-                    else m3 / m2, "beta_3d": columns[column][im]["beta"],
-                    "beta_2d": columns[block][im]["beta"],
-                    "p_toppled_3d": columns[column]["toppled"] / columns[column]["runs"],
-                    "p_toppled_2d": columns[block]["toppled"] / columns[block]["runs"],
-                    **({"all_stood_up_to_3d": columns[column]["all_stood_up_to_m_s2"],
-                        "all_stood_up_to_2d": columns[block]["all_stood_up_to_m_s2"],
-                        "all_toppled_from_3d": columns[column]["all_toppled_from_m_s2"],
-                        "all_toppled_from_2d": columns[block]["all_toppled_from_m_s2"]}
+                    else m3 / m2, "beta_3d": three.fits[im].beta, "beta_2d": two.fits[im].beta,
+                    "p_toppled_3d": three.toppled / three.runs,
+                    "p_toppled_2d": two.toppled / two.runs,
+                    **({"all_stood_up_to_3d": brackets[column][0],
+                        "all_stood_up_to_2d": brackets[block][0],
+                        "all_toppled_from_3d": brackets[column][1],
+                        "all_toppled_from_2d": brackets[block][1]}
                        if im == "PGA" else {})})
     return comparison
 

@@ -54,21 +54,21 @@ def run(args):
 
 
 def _print(summary, out):
-    for line in summary["warnings"]:
+    for line in summary.warnings:
         print(f"warning: {line}")
-    print(f"{summary['branch_count']} branches, {summary['specimen_count']} specimen(s); "
-          f"rule {summary['rule']}")
-    for row in summary["ground_motion_at_rates"]:
+    print(f"{summary.branch_count} branches, {summary.specimen_count} specimen(s); "
+          f"rule {summary.rule}")
+    for row in summary.ground_motion_at_rates:
         if row["curve"] not in ("mean", "range 0.05-0.95"):
             continue
         change = row["change_percent"]
         print(f"  {row['curve']} PGA at {row['annual_rate_per_yr']:g} /yr: "
               f"{_g(row['prior_g'])} g -> {_g(row['posterior_g'])} g"
               + ("" if change is None else f" ({change:+.0f} %)"))
-    test = summary["branch_test"]
-    print(f"branch test: P(every specimen survived) below {test['level']:g} under "
-          f"{len(test['branches_below_level'])} of {summary['branch_count']} branches "
-          f"(prior weight {test['prior_weight_below_level']:.3g})")
+    test = summary.branch_test
+    print(f"branch test: P(every specimen survived) below {test.level:g} under "
+          f"{len(test.branches_below_level)} of {summary.branch_count} branches "
+          f"(prior weight {test.prior_weight_below_level:.3g})")
     print(f"wrote {display_path(out / 'constrain.json')}, branch_weights.csv, "
           "branch_test.csv, the curves and constrain.png")
 

@@ -50,16 +50,15 @@ def run(args):
         _print_site_motion(site_motion)
         print(f"wrote {display_path(o.out / 'site_motion.json')}")
         return 0
-    for line in summary["warnings"]:
+    for line in summary.warnings:
         print(f"warning: {line}")
-    interval = summary["survival_interval"]
-    bound = summary["intensity_scale_bound_5pct"]
-    print(f"overturning rate {summary['annual_overturning_rate_per_yr']:.3g} /yr; survived "
-          f"{_age_words(age)} with P = {summary['survival_probability']:.3g}"
+    interval = summary.survival_interval
+    print(f"overturning rate {summary.annual_overturning_rate_per_yr:.3g} /yr; survived "
+          f"{_age_words(age)} with P = {summary.survival_probability:.3g}"
           + ("" if interval is None else f" [{interval[0]:.3g}, {interval[1]:.3g}]")
-          + f"; hazard rates x {_g(summary['rate_scale_bound_5pct'])} or intensities x "
-          f"{_g(bound)} leave 5 %")
-    for row in summary.get("hazard_curves", [])[1:]:
+          + f"; hazard rates x {_g(summary.rate_scale_bound_5pct)} or intensities x "
+          f"{_g(summary.intensity_scale_bound_5pct)} leave 5 %")
+    for row in (summary.given("hazard_curves") or [])[1:]:
         print(f"under {row['kind'] or row['file']}: rate {row['annual_overturning_rate_per_yr']:.3g}"
               f" /yr, survival P = {row['survival_probability']:.3g}")
     if site_motion is not None:

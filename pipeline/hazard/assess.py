@@ -1,5 +1,8 @@
-"""What survival says for one specimen or a set at one site: ``survival.json``'s content
-and the arrays its figure draws (:func:`assess`)."""
+"""What survival says for one specimen or a set at one site: ``survival.json`` as a
+:class:`~pipeline.hazard.results.SurvivalResult` and the arrays its figure draws
+(:func:`assess`)."""
+from dataclasses import replace
+
 import numpy as np
 
 from pipeline.constants import STANDARD_GRAVITY
@@ -9,6 +12,7 @@ from pipeline.hazard.survival import (contribution_by_intensity, intensity_scale
                                       overturning_rate, rate_density, rate_outside,
                                       rate_exceeding, rate_scale_bound,
                                       survival_probability)
+from pipeline.hazard.results import SurvivalResult
 from pipeline.provenance import software_versions
 
 BOUND_SURVIVAL = 0.05         # survival probability the bounds keep (the keys' 5pct)
@@ -55,7 +59,7 @@ ASSUMPTIONS = [
 
 
 def assess(curve, specimens, ratio_model, age, draws, seed, more_curves=()):
-    """(summary dict for survival.json, figure data dict) for ``specimens``
+    """(survival.json as a :class:`SurvivalResult`, figure data dict) for ``specimens``
     (:class:`~pipeline.hazard.fragility.kinds.Fragility` objects) at the site of ``curve``
     (:class:`~pipeline.hazard.curves.HazardCurve`); ``ratio_model``: the PGV/PGA model or
     None; ``age``: the specimens' age (:class:`~pipeline.hazard.ages.AgeModel`, years).
@@ -88,10 +92,11 @@ def assess(curve, specimens, ratio_model, age, draws, seed, more_curves=()):
                        (age, draws, seed))
     if more_curves:
         survivals = [row["survival_probability"] for row in curves]
-        summary["hazard_curves"] = curves
-        summary["survival_range_over_curves"] = [min(survivals), max(survivals)]
+        summary = replace(summary, hazard_curves=curves,
+                          survival_range_over_curves=[min(survivals), max(survivals)])
     if len(specimens) > 1:
-        summary["site_set"] = _site_set(curve, specimens, ratio_model, entries, age)
+        summary = replace(summary, site_set=_site_set(curve, specimens, ratio_model, entries,
+                                                      age))
     figure = _figure_data(curve, probability, headline, drawn, age, specimens,
                           ratio_model)
     return summary, figure
@@ -144,38 +149,38 @@ def _headline(curve, specimens, drawn, entries, ratio_model, age, warnings):
 
 
 def _summary(curve, specimens, entries, headline, ratio_model, warnings, run):
-    """survival.json's content but for hazard_curves and site_set; ``run``: (age model,
+    """survival.json but for hazard_curves and site_set; ``run``: (age model,
     draws, seed)."""
     age, draws, seed = run
     one = len(specimens) == 1
-    return {
-        "hazard_route": {"route": "curve", "what": "the PGA hazard curve, PGV/PGA at each PGA "
-                         "level lognormal (stated, or one scenario's ground-motion model)"},
-        "annual_overturning_rate_per_yr": headline["annual_overturning_rate_per_yr"],
-        "survival_probability": headline["survival_probability"],
-        "survival_interval": headline["survival_interval"],
+    return SurvivalResult(
+        hazard_route={"route": "curve", "what": "the PGA hazard curve, PGV/PGA at each PGA "
+                      "level lognormal (stated, or one scenario's ground-motion model)"},
+        annual_overturning_rate_per_yr=headline["annual_overturning_rate_per_yr"],
+        survival_probability=headline["survival_probability"],
+        survival_interval=headline["survival_interval"],
         **({} if headline["survival_interval"] is not None else {
             "survival_interval_note": "no uncertainty stated for the fragility" if draws
             else "--draws 0"}),
         **({k: entries[0][k] for k in ("survival_per_parameter_set",
                                        "survival_parameter_set_range", "outside_grid")
             if k in entries[0]} if one else {}),
-        "rate_scale_bound_5pct": headline["rate_scale_bound_5pct"],
-        "intensity_scale_bound_5pct": headline["intensity_scale_bound_5pct"],
-        "contribution_by_intensity": headline["contribution_by_intensity"],
-        "curve_ends": headline["curve_ends"],
-        "headline": "the specimen" if one else "the set under common shaking (all survive)",
+        rate_scale_bound_5pct=headline["rate_scale_bound_5pct"],
+        intensity_scale_bound_5pct=headline["intensity_scale_bound_5pct"],
+        contribution_by_intensity=headline["contribution_by_intensity"],
+        curve_ends=headline["curve_ends"],
+        headline="the specimen" if one else "the set under common shaking (all survive)",
         **age_keys(age),
-        "definitions": _definitions(draws),
-        "specimens": entries,
-        "hazard": {**curve.source, "levels_m_s2": curve.levels_m_s2.tolist(),
-                   "levels_g": (curve.levels_m_s2 / STANDARD_GRAVITY).tolist(),
-                   "rates_per_yr": curve.rates_per_yr.tolist(), "notes": list(curve.notes),
-                   "interpolation": "linear in (ln PGA, ln rate)"},
-        "pgv_pga": None if ratio_model is None else ratio_model.describe(),
-        "pgv_pga_used": any(f.uses_ratio for f in specimens),
-        "assumptions": ASSUMPTIONS, "warnings": warnings,
-        "draws": draws, "seed": seed, "software": software_versions()}
+        definitions=_definitions(draws),
+        specimens=entries,
+        hazard={**curve.source, "levels_m_s2": curve.levels_m_s2.tolist(),
+                "levels_g": (curve.levels_m_s2 / STANDARD_GRAVITY).tolist(),
+                "rates_per_yr": curve.rates_per_yr.tolist(), "notes": list(curve.notes),
+                "interpolation": "linear in (ln PGA, ln rate)"},
+        pgv_pga=None if ratio_model is None else ratio_model.describe(),
+        pgv_pga_used=any(f.uses_ratio for f in specimens),
+        assumptions=ASSUMPTIONS, warnings=warnings,
+        draws=draws, seed=seed, software=software_versions())
 
 
 def _definitions(draws):

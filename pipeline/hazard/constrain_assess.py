@@ -16,6 +16,7 @@ from pipeline.hazard.constrain_sites import (SITE_ASSUMPTION, SiteGroup, branch_
                                              check_same_branches, combined)
 from pipeline.hazard.fragility import overturn_probability
 from pipeline.hazard.logictree import LogicTree
+from pipeline.hazard.results import ConstrainResult
 from pipeline.provenance import software_versions
 
 AGE_SAMPLES = 2000           # Monte Carlo samples of differing, uncertain ages
@@ -57,7 +58,8 @@ ASSUMPTIONS = [
 
 def constrain_tree(tree, specimens, ratio_model, ages, rule, floor, draws, seed,
                    groups=None):
-    """(summary dict, branch rows, figure data) for the
+    """(constrain.json as a :class:`~pipeline.hazard.results.ConstrainResult`, branch
+    rows, figure data) for the
     :class:`~pipeline.hazard.logictree.LogicTree` ``tree`` and ``specimens`` (fragility
     objects, one per specimen) of ages ``ages`` (:class:`~pipeline.hazard.ages.AgeModel`,
     years, one per specimen).  ``groups``: the specimens by site
@@ -91,38 +93,38 @@ def constrain_tree(tree, specimens, ratio_model, ages, rule, floor, draws, seed,
     prior_stats = _statistics(tree, tree.weights)
     post_stats = None if posterior[rule] is None else _statistics(tree, posterior[rule])
     other = "eliminate" if rule == "bayes" else "bayes"
-    summary = {
-        "rule": rule, "headline": WHY_BAYES, "floor": floor,
-        "branch_count": tree.size, "specimen_count": len(specimens),
-        "specimens": [{"fragility": f.describe(), **_age_keys(a)}
-                      for f, a in zip(specimens, ages)],
-        "age_model": mode.value,
-        "age_integration_se_max": None if age_se is None else float(np.nanmax(age_se)),
-        "branches": _branch_rows(tree, p, posterior, carlo, age_se),
-        "levels_m_s2": tree.levels_m_s2.tolist(),
-        "levels_g": (tree.levels_m_s2 / STANDARD_GRAVITY).tolist(),
-        "prior": prior_stats,
-        "posterior": post_stats,
-        f"posterior_{other}": None if posterior[other] is None
-        else _statistics(tree, posterior[other]),
-        "ground_motion_at_rates": _motions(tree, prior_stats, post_stats),
-        "members": members, "monte_carlo": carlo,
-        "sites": [{"site": g.site, "specimens": list(g.members)} for g in groups],
-        "branch_test": test.as_json(),
-        "hazard": {**tree.source, "notes": list(tree.notes),
-                   "interpolation": "linear in (ln PGA, ln rate)",
-                   "cells_per_interval": cells[2]},
-        "pgv_pga": None if ratio_model is None else ratio_model.describe(),
-        "warnings": warnings,
-        "assumptions": ASSUMPTIONS + ([SITE_ASSUMPTION] if len(groups) > 1 else []),
-        "draws": draws, "seed": seed, "software": software_versions()}
+    summary = ConstrainResult(
+        rule=rule, headline=WHY_BAYES, floor=floor,
+        branch_count=tree.size, specimen_count=len(specimens),
+        specimens=[{"fragility": f.describe(), **_age_keys(a)}
+                   for f, a in zip(specimens, ages)],
+        age_model=mode.value,
+        age_integration_se_max=None if age_se is None else float(np.nanmax(age_se)),
+        branches=_branch_rows(tree, p, posterior, carlo, age_se),
+        levels_m_s2=tree.levels_m_s2.tolist(),
+        levels_g=(tree.levels_m_s2 / STANDARD_GRAVITY).tolist(),
+        prior=prior_stats,
+        posterior=post_stats,
+        **{f"posterior_{other}": None if posterior[other] is None
+           else _statistics(tree, posterior[other])},
+        ground_motion_at_rates=_motions(tree, prior_stats, post_stats),
+        members=members, monte_carlo=carlo,
+        sites=[{"site": g.site, "specimens": list(g.members)} for g in groups],
+        branch_test=test,
+        hazard={**tree.source, "notes": list(tree.notes),
+                "interpolation": "linear in (ln PGA, ln rate)",
+                "cells_per_interval": cells[2]},
+        pgv_pga=None if ratio_model is None else ratio_model.describe(),
+        warnings=warnings,
+        assumptions=ASSUMPTIONS + ([SITE_ASSUMPTION] if len(groups) > 1 else []),
+        draws=draws, seed=seed, software=software_versions())
     figure = {"levels_m_s2": tree.levels_m_s2, "rates_per_yr": tree.rates_per_yr,
               "prior_weights": tree.weights, "posterior_weights": posterior[rule],
               "prior": prior_stats, "posterior": post_stats, "rule": rule,
               "ages": list(ages),
               "target_rates": TARGET_RATES, "branch_ids": tree.branch_ids}
     figure["branch_test"] = test
-    return summary, summary["branches"], figure
+    return summary, summary.branches, figure
 
 
 class AgeIntegration(Enum):

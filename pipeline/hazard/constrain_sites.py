@@ -98,6 +98,13 @@ class BranchTest:
                               "specimens_below_level": list(r.specimens_below_level)}
                              for r in self.rows]}
 
+    @classmethod
+    def from_json(cls, data):
+        """The branch test constrain.json's ``branch_test`` holds (:meth:`as_json`)."""
+        return cls(data["level"], tuple(
+            BranchTestRow(**{**r, "specimens_below_level": tuple(r["specimens_below_level"])})
+            for r in data["branches"]))
+
     def csv(self):
         """branch_test.csv: one row per branch."""
         return "\n".join([",".join(BranchTestRow.__dataclass_fields__)]

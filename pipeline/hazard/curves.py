@@ -90,23 +90,13 @@ def load_hazard(path, site=None):
     return _plain(path, lines)
 
 
-def _openquake(path, lines, site):
-    header, columns = lines[0], [c.strip() for c in lines[1].split(",")]
-    if not header.startswith("#"):
-        raise InputError(f"{path}: an OpenQuake hazard curve starts with a '#' line stating "
-                         "investigation_time and imt")
-    found = re.search(r"investigation_time\s*=\s*([^,\"'\s]+)", header)
-    if not found:
-        raise InputError(f"{path}: no investigation_time in the first line")
-    time_yr = parse_number(found.group(1), f"{path}: investigation_time")
-    if not (math.isfinite(time_yr) and 0 < time_yr <= MAX_INVESTIGATION_YR):
-        raise InputError(f"{path}: investigation_time must be a positive number of years "
-                         f"(at most {MAX_INVESTIGATION_YR:g}), got {show(found.group(1))}")
+def _oq_levels(path, header, names):
+    """(the levels of the columns ``names``, poe-<level> or <IMT>-<level>; the IMT the
+    first line ``header`` or the columns state, checked)."""
     found = OQ_HEADER_IMT.search(header)
     imt = found.group(1) if found else None
-    first = 3 if len(columns) > 2 and columns[2].lower() == "depth" else 2
     levels = []
-    for name in columns[first:]:
+    for name in names:
         match = _OQ_LEVEL.match(name)
         if not match:
             raise InputError(f"{path}: column {show(name)} is not poe-<level> or <IMT>-<level>")
@@ -120,6 +110,23 @@ def _openquake(path, lines, site):
         raise InputError(f"{path}: missing IMT (no imt=... in the first line, poe-<level> "
                          "columns)")
     _check_imt(imt, path)
+    return levels, imt
+
+
+def _openquake(path, lines, site):
+    header, columns = lines[0], [c.strip() for c in lines[1].split(",")]
+    if not header.startswith("#"):
+        raise InputError(f"{path}: an OpenQuake hazard curve starts with a '#' line stating "
+                         "investigation_time and imt")
+    found = re.search(r"investigation_time\s*=\s*([^,\"'\s]+)", header)
+    if not found:
+        raise InputError(f"{path}: no investigation_time in the first line")
+    time_yr = parse_number(found.group(1), f"{path}: investigation_time")
+    if not (math.isfinite(time_yr) and 0 < time_yr <= MAX_INVESTIGATION_YR):
+        raise InputError(f"{path}: investigation_time must be a positive number of years "
+                         f"(at most {MAX_INVESTIGATION_YR:g}), got {show(found.group(1))}")
+    first = 3 if len(columns) > 2 and columns[2].lower() == "depth" else 2
+    levels, imt = _oq_levels(path, header, columns[first:])
     if not levels:
         raise InputError(f"{path}: no poe-<level> columns")
     if len(levels) > MAX_LEVELS:

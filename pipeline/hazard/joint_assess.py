@@ -8,6 +8,7 @@ import numpy as np
 
 from pipeline.hazard.assess import BOUND_SURVIVAL, END_SHARE_WARNING, INTERVAL, age_keys
 from pipeline.hazard.joint_survival import cell_mean_probability, joint_overturning_rate
+from pipeline.hazard.results import SurvivalResult
 from pipeline.hazard.survival import rate_scale_bound, survival_probability
 from pipeline.provenance import software_versions
 
@@ -57,7 +58,7 @@ def _warnings(rate, what):
 
 
 def assess_joint(joint, specimens, age, draws, seed):
-    """(summary dict for survival.json, figure data dict) for ``specimens`` under the
+    """(survival.json as a :class:`SurvivalResult`, figure data dict) for ``specimens`` under the
     joint hazard ``joint`` of one site (``JointHazard.site(n)``) over the age ``age``
     (:class:`~pipeline.hazard.ages.AgeModel`)."""
     rng = np.random.default_rng(seed)
@@ -78,31 +79,31 @@ def assess_joint(joint, specimens, age, draws, seed):
     if all(d is not None for d in drawn):
         rates = [_rate(joint, list(group)).rate_per_yr for group in zip(*drawn)]
         interval = np.percentile(age.survival(np.array(rates)), INTERVAL).tolist()
-    summary = {
-        "hazard_route": {"route": ROUTE, "what": "the joint hazard of PGA and PGV "
-                         "(OpenQuake mean rate density, mrd), PGV/PGA from each event"},
-        "annual_overturning_rate_per_yr": rate,
-        "survival_probability": float(age.survival(rate)),
-        "survival_interval": interval,
+    summary = SurvivalResult(
+        hazard_route={"route": ROUTE, "what": "the joint hazard of PGA and PGV "
+                      "(OpenQuake mean rate density, mrd), PGV/PGA from each event"},
+        annual_overturning_rate_per_yr=rate,
+        survival_probability=float(age.survival(rate)),
+        survival_interval=interval,
         **({} if interval is not None else {
             "survival_interval_note": "no uncertainty stated for the fragility" if draws
             else "--draws 0"}),
-        "rate_scale_bound_5pct": rate_scale_bound(rate, age, BOUND_SURVIVAL),
-        "intensity_scale_bound_5pct": None,
-        "intensity_scale_bound_note": "not computed under a joint hazard",
-        "share_top_pga": headline.share_top_pga, "share_top_pgv": headline.share_top_pgv,
-        "headline": "the specimen" if len(specimens) == 1
+        rate_scale_bound_5pct=rate_scale_bound(rate, age, BOUND_SURVIVAL),
+        intensity_scale_bound_5pct=None,
+        intensity_scale_bound_note="not computed under a joint hazard",
+        share_top_pga=headline.share_top_pga, share_top_pgv=headline.share_top_pgv,
+        headline="the specimen" if len(specimens) == 1
         else "the set under common shaking (all survive)",
         **age_keys(age),
-        "specimens": entries,
-        "hazard": {**joint.source, "site": list(joint.sites[0]),
-                   "pga_levels_m_s2": joint.pga_levels_m_s2.tolist(),
-                   "pgv_levels_m_s": joint.pgv_levels_m_s.tolist(),
-                   "investigation_time_yr": joint.investigation_time_yr,
-                   "events_per_yr": headline.events_per_yr},
-        "pgv_pga": None, "pgv_pga_used": any(f.uses_ratio for f in specimens),
-        "assumptions": ASSUMPTIONS, "warnings": warnings,
-        "draws": draws, "seed": seed, "software": software_versions()}
+        specimens=entries,
+        hazard={**joint.source, "site": list(joint.sites[0]),
+                "pga_levels_m_s2": joint.pga_levels_m_s2.tolist(),
+                "pgv_levels_m_s": joint.pgv_levels_m_s.tolist(),
+                "investigation_time_yr": joint.investigation_time_yr,
+                "events_per_yr": headline.events_per_yr},
+        pgv_pga=None, pgv_pga_used=any(f.uses_ratio for f in specimens),
+        assumptions=ASSUMPTIONS, warnings=warnings,
+        draws=draws, seed=seed, software=software_versions())
     return summary, _figure_data(joint, specimens, summary, age)
 
 
@@ -122,12 +123,12 @@ def _figure_data(joint, specimens, summary, age):
     band = age.band_yr
     ages = np.linspace(0.0, 2.0 * (age.typical_yr if band is None
                                    else age.typical_yr + 2.0 * (band[1] - age.typical_yr)), 200)
-    rate = summary["annual_overturning_rate_per_yr"]
+    rate = summary.annual_overturning_rate_per_yr
     return {"levels_m_s2": levels[:-1], "rates_per_yr": exceed, "probability_x": mid,
             "probability": marginal, "density_x": mid, "density": part / np.diff(np.log(levels)),
-            "contribution": [{"share": summary["share_top_pga"]}],
+            "contribution": [{"share": summary.share_top_pga}],
             "ages_yr": ages, "survival": np.array([survival_probability(rate, a) for a in ages]),
             "age_yr": age.typical_yr, "age_band": band,
-            "survival_probability": summary["survival_probability"],
-            "survival_interval": summary["survival_interval"],
+            "survival_probability": summary.survival_probability,
+            "survival_interval": summary.survival_interval,
             "set": len(specimens) > 1, "pgv_pga_used": True}

@@ -1,12 +1,11 @@
 """REPORT section of the field rock Double Rock: its fragility over a pulse grid, its
 survival and the logic tree its survival constrains (``make field-rock`` writes
 results/field-rock-*; ``make run-all`` the same at a reduced size, results/field-rock-quick-*)."""
-import json
-
 import pandas as pd
 
 from pipeline.hazard.constrain_assess import BAND_CURVE, MEAN_CURVE, fractile_curve
 from pipeline.hazard.fragility.file import read_fragility_file
+from pipeline.hazard.results import read_constrain_result
 from pipeline.report.fragility import rock_fragility_section
 from pipeline.report.common import _figure, _fmt, _table
 from pipeline.report.hazard import survival_section
@@ -88,20 +87,20 @@ def constrain_part(results, name, command):
     path = results / name / "constrain.json"
     if not path.is_file():
         return f"Constrained hazard: not run yet ({command}).\n"
-    c = json.loads(path.read_text())
-    ages = ", ".join(f"{s['age_ka']:g} +- {s['age_sd_ka']:g} ka" for s in c["specimens"])
+    c = read_constrain_result(path)
+    ages = ", ".join(f"{s['age_ka']:g} +- {s['age_sd_ka']:g} ka" for s in c.specimens)
     lines = ["### Constrained hazard\n",
-             f"{c['branch_count']} branches; age {ages} (assumed for the demonstration); "
-             f"headline rule `{c['rule']}`. " + c.get("headline", "") + "\n"]
+             f"{c.branch_count} branches; age {ages} (assumed for the demonstration); "
+             f"headline rule `{c.rule}`. " + c.headline + "\n"]
     rows = [{"branch": b["branch"], "path": b.get("path", ""),
              "prior weight": _fmt(b["prior_weight"], 3),
              "P_s": f"{b['survival_probability']:.3g}",
              "Bayes": _fmt(b.get("posterior_bayes"), 3),
              "elimination": _fmt(b.get("posterior_eliminate"), 3)}
-            for b in c["branches"]]
+            for b in c.branches]
     lines.append(_table(pd.DataFrame(rows)) + "\n")
-    best = max(b["survival_probability"] for b in c["branches"])
-    floor = c.get("floor", 0.05)
+    best = max(b["survival_probability"] for b in c.branches)
+    floor = c.floor
     if best < floor:
         lines.append(f"Under every branch the rock's survival of its age is below "
                      f"{floor:g} (at most {best:.2g}): this hazard is too high for a rock of "
@@ -111,12 +110,12 @@ def constrain_part(results, name, command):
                "prior (g)": _fmt(r["prior_g"], 3), "constrained (g)": _fmt(r["posterior_g"], 3),
                "change": "-" if r["change_percent"] is None
                else f"{r['change_percent']:+.1f} %"}
-              for r in c["ground_motion_at_rates"] if r["curve"] in MOTION_ROWS]
+              for r in c.ground_motion_at_rates if r["curve"] in MOTION_ROWS]
     if motion:
         lines.append("PGA at stated annual rates, before and after (the fractiles in "
                      f"`{name}/constrain.json` and `constrained_curves.csv`):\n")
         lines.append(_table(pd.DataFrame(motion)) + "\n")
-    lines += [f"Warning: {w}\n" for w in c.get("warnings", [])]
+    lines += [f"Warning: {w}\n" for w in c.warnings]
     lines.append(_figure(results, results / name / "constrain.png",
                          "branch fan, prior and constrained mean and fractiles, the rock's age"))
     return "\n".join(lines)

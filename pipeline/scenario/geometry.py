@@ -136,7 +136,7 @@ class ColumnGeometry(Specimen):
         yaml_file = path.suffix.lower() in (".yaml", ".yml")
         if yaml_file:
             try:
-                import yaml  # noqa: F401  lazy: PyYAML, optional (YAML column files only)
+                import yaml  # noqa: F401  # lazy: PyYAML, optional (YAML column files only)
             except ImportError:
                 raise InputError(f"{path}: reading YAML needs PyYAML (pip install pyyaml); "
                                  "or give the description as JSON") from None

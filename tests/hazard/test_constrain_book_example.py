@@ -59,7 +59,7 @@ def tree():
 def _prior(tree):
     summary, _, _ = constrain_tree(tree, [Lognormal(0.4 * G, 0.4)], None,
                                    [TruncatedNormal(1e3)], "bayes", FLOOR, 0, 0)
-    return summary["prior"]
+    return summary.prior
 
 
 def test_the_table_is_the_books_file(tree):

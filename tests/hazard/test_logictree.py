@@ -230,7 +230,7 @@ def test_draws_in_one_matrix_product_equal_the_per_draw_loop(monkeypatch):
     pairs = list(zip(first.draws(25, rng), second.draws(25, rng)))
     survival = np.exp([log_survival_fixed(_set_rates(tree, cells, list(pair)),
                                           [3000.0, 9000.0]) for pair in pairs])
-    np.testing.assert_allclose(summary["monte_carlo"]["survival_interval"],
+    np.testing.assert_allclose(summary.monte_carlo["survival_interval"],
                                np.percentile(survival, (2.5, 97.5), axis=0).T, rtol=1e-12)
 
 
@@ -384,7 +384,7 @@ def test_monte_carlo_interval_holds_the_headline():
     for row in rows:
         lo, hi = row["survival_interval"]
         assert lo < row["survival_probability"] < hi
-    assert summary["monte_carlo"]["draws"] == 200
+    assert summary.monte_carlo["draws"] == 200
 
 
 @pytest.mark.parametrize("extra, words", [

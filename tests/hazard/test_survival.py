@@ -11,10 +11,10 @@ from scipy import integrate, stats
 
 from pipeline import RECORDS_DIR
 from pipeline.campaign.fragility_tables import _column_fits
-from pipeline.files import json_safe
 from pipeline.cli import main
 from pipeline.files import InputError
 from pipeline.hazard import load_hazard
+from pipeline.hazard.fragility.file import FragilityFile, write_fragility_file
 from pipeline.hazard.ages import LowerBound, TruncatedNormal, UniformInterval
 from pipeline.hazard.fragility import (Logistic, Lognormal, RatioFromGmm, RatioLognormal,
                                        load_campaign_fragility, overturn_probability)
@@ -302,15 +302,14 @@ def test_reads_what_campaign_fragility_writes(tmp_path):
     table = pd.DataFrame({"column": "monolithic", "toppled": toppled, "pga_m_s2": pga,
                           "pgv_m_s": pga * ratio, "pgv_pga_s": ratio,
                           "level_m_s2": pga})
-    columns = _column_fits(table, {"monolithic": "3D YADE monolithic column"}, 0.165, 2.0)
-    path = tmp_path / "fragility.json"
-    path.write_text(json.dumps(json_safe({"columns": columns})))
+    columns, _ = _column_fits(table, {"monolithic": "3D YADE monolithic column"}, 0.165, 2.0)
+    path = write_fragility_file(tmp_path, FragilityFile(columns=columns))
     surface = load_campaign_fragility(tmp_path)
-    written = columns["monolithic"]["logistic"]
+    written = json.loads(path.read_text())["columns"]["monolithic"]["logistic"]
     assert surface.coefficients == tuple(written["coefficients"][k] for k in ("b0", "b1", "b2"))
     np.testing.assert_allclose(surface.cov, written["cov"])
     lognormal = load_campaign_fragility(path, "monolithic", "pga")
-    written = columns["monolithic"]["PGA"]
+    written = json.loads(path.read_text())["columns"]["monolithic"]["PGA"]
     assert lognormal.median_m_s2 == written["median"] and lognormal.beta == written["beta"]
     assert lognormal.median_ci95 == tuple(written["median_ci95"])
 

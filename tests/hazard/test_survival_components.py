@@ -14,7 +14,7 @@ from pipeline import RECORDS_DIR, paper
 from pipeline.cli import main
 from pipeline.constants import STANDARD_GRAVITY
 from pipeline.hazard import load_hazard
-from pipeline.hazard.components import records_fraction
+from pipeline.hazard.fragility.components import records_fraction
 from pipeline.hazard.fragility import Lognormal, RatioLognormal, load_campaign_fragility, \
     overturn_probability
 from pipeline.hazard.survival import overturning_rate, rate_outside

@@ -1,7 +1,7 @@
 """The REPORT section of the field rock: it names the full-size command in both its sizes,
 says that no published fragility exists, says what has not run, and quotes constrain.json."""
-import json
-
+from pipeline.hazard.constrain_sites import BranchTest, BranchTestRow
+from pipeline.hazard.results import ConstrainResult
 from pipeline.report import field_rock_section
 from pipeline.report.field_rock import FIELD_ROCK_QUICK
 
@@ -32,10 +32,17 @@ def test_the_constrained_hazard_is_quoted_and_a_hopeless_tree_is_said(tmp_path):
                "posterior_g": 0.4, "change_percent": -20.0},
               {"annual_rate_per_yr": 1e-4, "curve": "fractile 0.16", "prior_g": 0.3,
                "posterior_g": 0.3, "change_percent": 0.0}]
-    (out / "constrain.json").write_text(json.dumps({
-        "branch_count": 2, "rule": "bayes", "headline": "", "floor": 0.05,
-        "specimens": [{"age_ka": 15, "age_sd_ka": 3}], "branches": branches,
-        "ground_motion_at_rates": motion, "warnings": ["something said"]}))
+    test = BranchTest(0.05, tuple(
+        BranchTestRow(b["branch"], 0.5, b["survival_probability"], True, (0,), 0, None,
+                      b["survival_probability"]) for b in branches))
+    (out / "constrain.json").write_text(ConstrainResult(
+        branch_count=2, rule="bayes", headline="", floor=0.05, specimen_count=1,
+        specimens=[{"age_ka": 15, "age_sd_ka": 3}], age_model="known ages",
+        age_integration_se_max=None, branches=branches, levels_m_s2=[1.0], levels_g=[0.1],
+        prior={}, posterior={}, posterior_eliminate=None, ground_motion_at_rates=motion,
+        members=None, monte_carlo=None, sites=[], branch_test=test, hazard={},
+        pgv_pga=None, warnings=["something said"], assumptions=[], draws=0, seed=0,
+        software={}).text())
     text = field_rock_section(tmp_path)
     assert "### Constrained hazard" in text and "15 +- 3 ka" in text
     assert "below 0.05 (at most 0.01)" in text

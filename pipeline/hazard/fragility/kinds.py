@@ -10,7 +10,7 @@ covariance (each only its standard error when the file holds no covariance: ``no
 says so).  A column campaign's fragility is one of these two with its members' own fits
 (``member_fits``); the other kinds are
 :class:`~pipeline.hazard.fragility.grid.PulseGrid` (a pulse grid's cells) and
-:class:`~pipeline.hazard.components.OnHazardMeasure` (any kind read on the hazard
+:class:`~pipeline.hazard.fragility.components.OnHazardMeasure` (any kind read on the hazard
 curve's PGA).
 """
 import math

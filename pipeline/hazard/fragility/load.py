@@ -10,7 +10,7 @@ import pandas as pd
 
 from pipeline.constants import STANDARD_GRAVITY
 from pipeline.files import InputError
-from pipeline.hazard.components import on_hazard_measure
+from pipeline.hazard.fragility.components import on_hazard_measure
 from pipeline.hazard.fragility.checker import key_text
 from pipeline.hazard.fragility.file import MAX_MEMBERS, FragilityFile, read_fragility_file
 from pipeline.hazard.fragility.grid import BELOW_GRID, PulseGrid
@@ -33,7 +33,7 @@ def load_campaign_fragility(path, column=None, form=None, below="ramp", componen
     form (from ``fragility_runs.csv`` beside the file, when there) in ``member_fits``,
     refitted only when ``members`` asks for them (survival's members' spread).
     ``component`` (rotd50 or rotd100, the hazard curve's PGA): the fragility put on it
-    (:func:`pipeline.hazard.components.on_hazard_measure`, ``record_fraction(record)``
+    (:func:`pipeline.hazard.fragility.components.on_hazard_measure`, ``record_fraction(record)``
     the RotD50 / vector peak of a record's motion); None: as in the file."""
     fragility, kind, records = _load_campaign_fragility(path, column, form, below, members)
     if component is None:

@@ -51,7 +51,7 @@ class RatioFromGmm:
     medians: dict = field(default=None, compare=False)
 
     def __post_init__(self):
-        import pygmm  # noqa: PLC0415  (slow import, only needed here)
+        import pygmm  # lazy: pygmm, slow to import and only for a ground-motion model's PGV/PGA
         scenario = pygmm.Scenario(mag=self.magnitude, dist_jb=self.distance_km,
                                   v_s30=self.vs30_m_s, mechanism=self.mechanism)
         model = pygmm.BooreStewartSeyhanAtkinson2014(scenario)
