@@ -38,6 +38,12 @@ def setup(p):
     field = o.__dataclass_fields__["logic_tree"]
     p.add_argument("--logic-tree", dest="logic_tree", type=Path, required=True,
                    metavar=field.metadata["metavar"], help=field.metadata["help"])
+    add_specimen_arguments(p)
+
+
+def add_specimen_arguments(p):
+    """Every flag of ``ConstrainOptions`` but ``--logic-tree`` (``hazard-job`` shares them)."""
+    o = ConstrainOptions
     add_arguments(p, o, ("site", "specimen_site"))
     add_arguments(p, o, o.FRAGILITY_FLAGS)
     add_arguments(p.add_argument_group(o.AGE_GROUP), o, AGE_FLAGS)

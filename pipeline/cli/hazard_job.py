@@ -10,7 +10,7 @@ engine's export in ``<out>/openquake``.
 """
 from pipeline.assessment.constrain_options import ConstrainOptions
 from pipeline.assessment.hazard_job import EXPORT, HazardJobOptions, hazard_job
-from pipeline.assessment.options import AGE_FLAGS, CONSTRAIN_OUT
+from pipeline.assessment.options import CONSTRAIN_OUT
 from pipeline.cli import constrain
 from pipeline.cli._fields import add_arguments, from_args
 
@@ -30,13 +30,7 @@ DESCRIPTION = (
 def setup(p):
     """``HazardJobOptions``' flags, then ``constrain``'s but --logic-tree."""
     add_arguments(p, HazardJobOptions)
-    o = ConstrainOptions
-    add_arguments(p, o, ("site", "specimen_site"))
-    add_arguments(p, o, o.FRAGILITY_FLAGS)
-    add_arguments(p.add_argument_group(o.AGE_GROUP), o, AGE_FLAGS)
-    add_arguments(p, o, ("rule", "floor"))
-    add_arguments(p.add_argument_group(o.RATIO_GROUP), o, o.RATIO_FLAGS)
-    add_arguments(p, o, (*o.DRAW_FLAGS, "out"))
+    constrain.add_specimen_arguments(p)
 
 
 def run(args):
