@@ -64,6 +64,39 @@ def detect(path, head):
                for line in leading)
 
 
+def _samples(text, name, axes, axes_text, scale):
+    """The table's numbers (time, accelerations in the file's units) and its time step (s),
+    checked: columns, samples, finite values, the acceleration bound (``scale``: the units
+    in m/s^2), a uniform time column and the duration."""
+    try:
+        data = np.loadtxt(io.StringIO(text.replace(",", " ")), comments="#", ndmin=2)
+    except ValueError as exc:
+        raise InputError(f"{name}: not a table of numbers ({str(exc).splitlines()[0][:100]})") \
+            from None
+    if data.shape[1] != 1 + len(axes):
+        raise InputError(f"{name}: {data.shape[1]} columns, expected time and "
+                         f"{len(axes)} acceleration column(s) for axes {axes_text}")
+    if len(data) < MIN_SAMPLES:
+        raise InputError(f"{name}: {len(data)} samples, at least {MIN_SAMPLES} needed")
+    if not np.all(np.isfinite(data)):
+        raise InputError(f"{name}: NaN or infinite values in the table")
+    peak = float(np.abs(data[:, 1:]).max()) * scale / STANDARD_GRAVITY
+    if peak > MAX_ACCELERATION_G:
+        raise InputError(f"{name}: table acceleration up to {peak:.4g} g, beyond the "
+                         f"{MAX_ACCELERATION_G:g} g a lab table may reach (no shake table or "
+                         "recorded earthquake comes near): check '# units:'")
+    steps = np.diff(data[:, 0])
+    dt = float(np.median(steps))
+    if dt <= 0 or np.abs(steps - dt).max() > SAMPLING_TOLERANCE * dt:
+        raise InputError(f"{name}: time column is not uniformly increasing (steps "
+                         f"{steps.min():.6g}-{steps.max():.6g} s)")
+    if data[-1, 0] - data[0, 0] > MAX_DURATION_S:
+        raise InputError(f"{name}: the table spans {data[-1, 0] - data[0, 0]:.6g} s (a time "
+                         f"step of {dt:.6g} s), more than the {MAX_DURATION_S:g} s a lab table "
+                         "may last: is the time column in seconds?")
+    return data, dt
+
+
 def read(path, key=None):
     name = path.name
     text = read_bytes(path).removeprefix(BOM).decode("utf-8", errors="replace")
@@ -94,32 +127,7 @@ def read(path, key=None):
     orientations = [_orientation(a, name) for a in axes]
     if rows < MIN_SAMPLES:
         raise InputError(f"{name}: {rows} samples, at least {MIN_SAMPLES} needed")
-    try:
-        data = np.loadtxt(io.StringIO(text.replace(",", " ")), comments="#", ndmin=2)
-    except ValueError as exc:
-        raise InputError(f"{name}: not a table of numbers ({str(exc).splitlines()[0][:100]})") \
-            from None
-    if data.shape[1] != 1 + len(axes):
-        raise InputError(f"{name}: {data.shape[1]} columns, expected time and "
-                         f"{len(axes)} acceleration column(s) for axes {header['axes']}")
-    if len(data) < MIN_SAMPLES:
-        raise InputError(f"{name}: {len(data)} samples, at least {MIN_SAMPLES} needed")
-    if not np.all(np.isfinite(data)):
-        raise InputError(f"{name}: NaN or infinite values in the table")
-    peak = float(np.abs(data[:, 1:]).max()) * UNITS[units] / STANDARD_GRAVITY
-    if peak > MAX_ACCELERATION_G:
-        raise InputError(f"{name}: table acceleration up to {peak:.4g} g, beyond the "
-                         f"{MAX_ACCELERATION_G:g} g a lab table may reach (no shake table or "
-                         "recorded earthquake comes near): check '# units:'")
-    steps = np.diff(data[:, 0])
-    dt = float(np.median(steps))
-    if dt <= 0 or np.abs(steps - dt).max() > SAMPLING_TOLERANCE * dt:
-        raise InputError(f"{name}: time column is not uniformly increasing (steps "
-                         f"{steps.min():.6g}-{steps.max():.6g} s)")
-    if data[-1, 0] - data[0, 0] > MAX_DURATION_S:
-        raise InputError(f"{name}: the table spans {data[-1, 0] - data[0, 0]:.6g} s (a time "
-                         f"step of {dt:.6g} s), more than the {MAX_DURATION_S:g} s a lab table "
-                         "may last: is the time column in seconds?")
+    data, dt = _samples(text, name, axes, header["axes"], UNITS[units])
     horizontal = [o for o in orientations if o[1] == 0.0]
     vertical = [o for o in orientations if o[1] != 0.0]
     if len(horizontal) > 2 or len(vertical) > 1 or not horizontal:
