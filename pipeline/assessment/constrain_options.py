@@ -21,34 +21,38 @@ class ConstrainOptions(SpecimenOptions):
         None, "", "OpenQuake's export (the directory, or its realizations.csv, with one "
         "hazard_curve CSV per realisation) or a plain table branch,weight,"
         "pga_<g|m_s2|cm_s2>,annual_rate_per_yr (one row per branch and level)",
-        metavar="PATH")
+        flag="--logic-tree", metavar="PATH", required=True)
     site: int = param(None, "", "the site of the curves (0-based: the row of OpenQuake "
                       "curves with several sites, or the site column of a plain table)", 0,
-                      None, flag="--site", metavar="N")
+                      None, flag="--site", metavar="N",
+                      optional="the curves' only site (--joint-hazard: its first)")
     specimen_site: tuple[int, ...] = param(
         (), "", "the site of each specimen (0-based: the row of OpenQuake curves with "
-        "several sites, or the site column of a plain table), in the order of the fragilities, or one for all; sites taken as far "
-        "apart (the set's survival the product over sites); unset: every specimen at "
-        "--site", 0, None, flag="--specimen-site", metavar="N")
+        "several sites, or the site column of a plain table), in the order of the "
+        "fragilities, or one for all; sites taken as far apart (the set's survival the "
+        "product over sites)", 0, None, flag="--specimen-site", metavar="N",
+        optional="every specimen at --site")
     age_ka: tuple[float, ...] = param(
         (), "ka", "a specimen's age (a mean with --age-sd-ka): one per specimen, in the "
         "order of the fragilities, or one for all", 0, MAX_AGE_KA, low_open=True,
-        flag="--age-ka", metavar="KA")
+        flag="--age-ka", metavar="KA", optional=True)
     age_sd_ka: tuple[float, ...] = param(
         (0.0,), "ka", "its standard deviation (normal truncated at 0): one per specimen or "
         "one for all", 0, MAX_AGE_KA, flag="--age-sd-ka", metavar="KA")
     age_min_ka: tuple[float, ...] = param(
         (), "ka", "or a lower bound only on a specimen's age: one per specimen or one for "
-        "all", 0, MAX_AGE_KA, low_open=True, flag="--age-min-ka", metavar="KA")
+        "all", 0, MAX_AGE_KA, low_open=True, flag="--age-min-ka", metavar="KA",
+        optional=True)
     age_range_ka: tuple[tuple[float, float], ...] = param(
         (), "ka", "or an interval a specimen's age lies in, uniform over it: one per "
         "specimen or one for all", 0, MAX_AGE_KA, flag="--age-range-ka",
-        metavar=("LO", "HI"))
+        metavar=("LO", "HI"), optional=True)
     age_samples: tuple[Path, ...] = param(
         (), "", "or samples of a specimen's age (ka) in the column --age-column of a CSV "
-        "file: one file per specimen or one for all", flag="--age-samples", metavar="FILE")
+        "file: one file per specimen or one for all", flag="--age-samples", metavar="FILE",
+        optional=True)
     age_column: str = param(None, "", "the column of --age-samples", flag="--age-column",
-                            metavar="NAME")
+                            metavar="NAME", optional=True)
     rule: str = param("bayes", "", "the headline's rule: bayes (weights x survival "
                       "probability) or eliminate (branches of survival below --floor "
                       "dropped); both are written", flag="--rule",
@@ -60,14 +64,12 @@ class ConstrainOptions(SpecimenOptions):
         None, "", "or PGV/PGA at each PGA level from the mean rate density mrd of PGA and "
         "PGV (an OpenQuake datastore or its extract) at --site: one distribution for every "
         "branch (the engine writes the mean's only, no branch's)", flag="--joint-hazard",
-        metavar="FILE")
+        metavar="FILE", optional=True)
     out: Path = param(CONSTRAIN_OUT, "", "output directory", flag="--out", metavar="DIR")
 
     RATIO_FLAGS = (*SpecimenOptions.RATIO_FLAGS, "joint_hazard")
 
     def __post_init__(self):
-        if self.logic_tree is None:
-            raise InputError("give --logic-tree")
         check_fields(self)
         self.check_specimens()
         n = self.specimen_count

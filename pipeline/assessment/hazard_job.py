@@ -36,17 +36,15 @@ ENGINE_HANG_S = 24 * 3600.0        # a generous bound on one engine step
 class HazardJobOptions:
     """The engine side of ``hazard-job`` (the rest: ``constrain``'s options)."""
     oq_job: Path = param(None, "", "an OpenQuake job.ini with source and ground-motion "
-                         "logic trees", flag="--oq-job", metavar="JOB_INI")
+                         "logic trees", flag="--oq-job", metavar="JOB_INI", required=True)
     oq_python: Path = param(OQ_PYTHON, "", "the Python of the environment holding the "
                             "OpenQuake engine", flag="--oq-python", metavar="PATH")
     oq_site: tuple[tuple[float, float], ...] = param(
         (), "degrees", "a site (longitude, latitude) the engine computes, in the order "
-        "--site and --specimen-site count them; unset: the job's own sites",
-        flag="--oq-site", metavar=("LON", "LAT"))
+        "--site and --specimen-site count them", flag="--oq-site", metavar=("LON", "LAT"),
+        optional="the job's own sites")
 
     def __post_init__(self):
-        if self.oq_job is None:
-            raise InputError("give --oq-job")
         check_fields(self)
         if len(self.oq_site) > MAX_SITES:
             raise InputError(f"{len(self.oq_site)} --oq-site (at most {MAX_SITES})")

@@ -20,6 +20,7 @@ from pipeline.hazard.disaggregation import load_mag_dist
 from pipeline.hazard.fragility import (BELOW_GRID, GMM_MECHANISMS, Logistic, Lognormal,
                                       RatioFromGmm, RatioLognormal, load_campaign_fragility)
 from pipeline.hazard.fragility.kinds import BETA_RANGE, MEDIAN_G_RANGE
+from pipeline.hazard.fragility.load import FRAGILITY_FORMS
 from pipeline.hazard.fragility.ratio import DEFAULT_VS30_M_S, PGA_PGV_CORRELATION
 from pipeline.hazard.pga_pgv_correlation import BRADLEY_2012
 from pipeline.records import rotd50_fraction
@@ -46,14 +47,15 @@ class SpecimenOptions:
         flag="--hazard-component", choices=COMPONENTS)
     fragility: tuple[Path, ...] = param(
         (), "", "fragility.json of campaign fragility (or its directory); repeat for a set "
-        "of specimens at the site", flag="--fragility", metavar="FILE")
-    column: str = param(None, "", "which column entry of fragility.json (unset: the first "
-                        "3D one)", flag="--column", choices=COLUMNS)
+        "of specimens at the site", flag="--fragility", metavar="FILE",
+        optional="stated fragilities only")
+    column: str = param(None, "", "which column entry of fragility.json", flag="--column",
+                        choices=COLUMNS, optional="the first 3D one")
     fragility_form: str = param(
-        None, "", "from fragility.json: pga (its lognormal PGA fit), pga-pgv (its logistic "
-        "surface in PGA and PGV/PGA; unset: for columns) or grid (a pulse grid's cells, "
-        "bilinear in ln PGA and ln PGV/PGA, the logistic surface outside; unset: for a "
-        "pulse grid)", flag="--fragility-form", choices=("pga", "pga-pgv", "grid"))
+        "auto", "", "from fragility.json: pga (its lognormal PGA fit), pga-pgv (its logistic "
+        "surface in PGA and PGV/PGA) or grid (a pulse grid's cells, bilinear in ln PGA and "
+        "ln PGV/PGA, the logistic surface outside); auto: pga-pgv for columns, grid for a "
+        "pulse grid", flag="--fragility-form", choices=FRAGILITY_FORMS)
     below_grid: str = param(
         "ramp", "", "a pulse grid's P below its first PGA: ramp (0 at the uplift acceleration "
         "g tan(alpha), rising linearly in ln PGA to the edge's P), zero, edge (the "
@@ -61,22 +63,23 @@ class SpecimenOptions:
         flag="--below-grid", choices=BELOW_GRID)
     median_g: tuple[float, ...] = param(
         (), "g", "a stated lognormal fragility over PGA: median PGA (as a file's PGA fit); "
-        "repeat with --beta for a set", *MEDIAN_G_RANGE, flag="--median-g", metavar="G")
+        "repeat with --beta for a set", *MEDIAN_G_RANGE, flag="--median-g", metavar="G",
+        optional=True)
     beta: tuple[float, ...] = param((), "", "its dispersion (natural log)", *BETA_RANGE,
-                                    flag="--beta", metavar="B")
+                                    flag="--beta", metavar="B", optional=True)
     logistic: tuple[str, ...] = param(
         (), "", "a stated logistic surface logit P = b0 + b1 ln(PGA / 1 m/s^2) + b2 "
         "ln(PGV/PGA / 1 s) (b1 > 0); repeat for a set", flag="--logistic",
-        metavar="B0,B1,B2")
+        metavar="B0,B1,B2", optional=True)
     pgv_pga_median: float = param(None, "s", "stated lognormal PGV/PGA: median", 0.001, 10,
-                                  flag="--pgv-pga-median", metavar="S")
+                                  flag="--pgv-pga-median", metavar="S", optional=True)
     pgv_pga_sigma: float = param(None, "", "its sigma (natural log)", 0, 3,
-                                 flag="--pgv-pga-sigma", metavar="LN")
+                                 flag="--pgv-pga-sigma", metavar="LN", optional=True)
     magnitude: float = param(None, "", "or from Boore et al. (2014) at this moment "
                              "magnitude, e.g. the mode of the hazard's disaggregation", 3, 8.5,
-                             flag="--magnitude", metavar="M")
+                             flag="--magnitude", metavar="M", optional=True)
     distance_km: float = param(None, "km", "and this Joyner-Boore distance", 0, 300,
-                               flag="--distance-km", metavar="KM")
+                               flag="--distance-km", metavar="KM", optional=True)
     vs30: float = param(DEFAULT_VS30_M_S, "m/s", "Vs30 for the model", 150, 1500,
                         flag="--vs30", metavar="M_S")
     mechanism: str = param("SS", "", "fault mechanism for the model (SS strike-slip, NS "
@@ -177,45 +180,51 @@ class SurvivalOptions(SpecimenOptions):
         "(static curves) or a plain table pga_<g|m_s2|cm_s2>,annual_rate_per_yr; repeat for "
         "several curves of the site (e.g. an engine's mean and quantile curves): the first "
         "gives the headline, survival.json's hazard_curves the result under each",
-        flag="--hazard", metavar="FILE")
+        flag="--hazard", metavar="FILE", optional=True)
     joint_hazard: Path = param(
         None, "", "or the joint hazard of PGA and PGV: an OpenQuake datastore (or its "
         "extract) holding the mean rate density mrd of PGA and PGV; PGV/PGA then comes "
         "from each event (no --pgv-pga-median, --magnitude)", flag="--joint-hazard",
-        metavar="FILE")
+        metavar="FILE", optional=True)
     site: int = param(None, "", "row (0-based) of an OpenQuake file with several sites", 0,
-                      None, flag="--site", metavar="N")
+                      None, flag="--site", metavar="N", optional="the file's only site")
     age_ka: float = param(None, "ka", "the specimen's age (a mean with --age-sd-ka)", 0,
-                          MAX_AGE_KA, low_open=True, flag="--age-ka", metavar="KA")
+                          MAX_AGE_KA, low_open=True, flag="--age-ka", metavar="KA",
+                          optional=True)
     age_sd_ka: float = param(0.0, "ka", "its standard deviation (normal truncated at 0)", 0,
                              MAX_AGE_KA, flag="--age-sd-ka", metavar="KA")
     age_min_ka: float = param(None, "ka", "or the age known as a lower bound only (survival "
                               "exp(-rate min) is then an upper bound)", 0, MAX_AGE_KA,
-                              low_open=True, flag="--age-min-ka", metavar="KA")
+                              low_open=True, flag="--age-min-ka", metavar="KA",
+                              optional=True)
     age_range_ka: tuple[float, float] = param(
         None, "ka", "or an interval the age lies in, uniform over it (e.g. from "
-        "deglaciation)", 0, MAX_AGE_KA, flag="--age-range-ka", metavar=("LO", "HI"))
+        "deglaciation)", 0, MAX_AGE_KA, flag="--age-range-ka", metavar=("LO", "HI"),
+        optional=True)
     age_samples: Path = param(None, "", "or samples of the age's distribution: a CSV file "
                               "(a header line; # comments) with the ages in ka in the column "
-                              "--age-column", flag="--age-samples", metavar="FILE")
+                              "--age-column", flag="--age-samples", metavar="FILE",
+                              optional=True)
     age_column: str = param(None, "", "the column of --age-samples", flag="--age-column",
-                            metavar="NAME")
+                            metavar="NAME", optional=True)
     observations: Path = param(
         None, "", "an observations file of invert (sites with fallen and standing columns): "
         "writes site_motion.json, the PGA range consistent with the site's outcome; "
         "fragility per column type from --fragility (a column fragility.json) or one stated "
-        "--median-g/--beta or --logistic for all", flag="--observations", metavar="FILE")
-    observation_site: str = param(None, "", "the site's name in --observations (unset: its "
-                                  "only site)", flag="--observation-site", metavar="NAME")
+        "--median-g/--beta or --logistic for all", flag="--observations", metavar="FILE",
+        optional=True)
+    observation_site: str = param(None, "", "the site's name in --observations",
+                                  flag="--observation-site", metavar="NAME",
+                                  optional="its only site")
     at_pgv_pga: float = param(None, "s", "the PGV/PGA at which the PGA range is stated (for "
                               "a fragility over PGA and PGV/PGA)", 0.001, 10,
-                              flag="--at-pgv-pga", metavar="S")
+                              flag="--at-pgv-pga", metavar="S", optional=True)
     disaggregation: Path = param(
         None, "", "or PGV/PGA at each PGA level a mixture over OpenQuake's magnitude-distance "
         "disaggregation of the first --hazard curve (its Mag_Dist CSV export): the "
         "ground-motion model at each bin, weighted by the bin's share of the events near "
         "that level (with --vs30, --mechanism, --pga-pgv-correlation)",
-        flag="--disaggregation", metavar="FILE")
+        flag="--disaggregation", metavar="FILE", optional=True)
     disaggregation_column: str = param(
         "mean", "", "the column of --disaggregation: mean, or rlzK for realisation K (that "
         "of the first --hazard curve)", flag="--disaggregation-column", metavar="NAME")
@@ -325,7 +334,7 @@ def _default_of(cls, name):
 def _check_column_site(options):
     if options.column is not None and not options.fragility:
         raise InputError("--column applies to --fragility files")
-    if options.fragility_form is not None and not options.fragility:
+    if options.fragility_form != _default("fragility_form") and not options.fragility:
         raise InputError("--fragility-form applies to --fragility files (a stated fragility "
                          "has its own form)")
     if options.below_grid != "ramp" and not options.fragility:

@@ -262,7 +262,7 @@ def columns_outputs(specs, campaign_dir, failures, animations, figures=True):
 
 @dataclass(frozen=True)
 class ColumnsOptions(CampaignOptions):
-    column_files: str = column_file_param("default: all shipped", many=True)
+    column_files: str = column_file_param(many=True, unset="all shipped")
     column: str = param("both", "", "both: each description and a monolith of its outline; "
                         "drums: the description only; monolithic: the monolith only",
                         flag="--column", choices=COLUMN_KINDS)

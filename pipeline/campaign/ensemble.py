@@ -147,7 +147,8 @@ def yade_cost(campaign_dir, run_ids):
 @dataclass(frozen=True)
 class EnsembleOptions(CampaignOptions):
     record: str = param(None, "", "catalogue id, record file or processed .npz",
-                        flag="--record", metavar="ID_OR_FILE")
+                        flag="--record", metavar="ID_OR_FILE",
+                        optional="the records of --records/--set")
     column: str = param("both", "", "column model (both: the twin model)", flag="--column",
                         choices=COLUMN_KINDS)
     members: int = param(DEFAULT_MEMBERS, "", "members of the first Latin-hypercube batch, "
@@ -163,7 +164,8 @@ class EnsembleOptions(CampaignOptions):
     seed: int = param(DEFAULT_SEED, "", "seed of the Latin hypercube", flag="--seed")
     vary: tuple = param((), "", "override a range: " + ", ".join(
         f"{k} {v[0]:g}-{v[1]:g}" for k, v in ENSEMBLE_RANGES.items())
-        + "; scale=LO,HI samples an amplitude scaling", flag="--vary", metavar="NAME=LO,HI")
+        + "; scale=LO,HI samples an amplitude scaling", flag="--vary", metavar="NAME=LO,HI",
+        optional="the ranges above")
     column_file: str = column_file_param(
         "every member is the described column with the sampled height and diameter "
         "tolerances on every block, the tilt added to its own and the drum offsets on the "

@@ -258,10 +258,10 @@ def _pulse_specs(records, campaign_dir, data, column, pulses, members, headings,
 
 @dataclass(frozen=True)
 class FragilityOptions(CampaignOptions):
-    levels: str = param(None, "m/s^2", "horizontal PGA targets of the scaled records "
-                        "(default 8 levels 0.5-8, geometric: "
-                        + ",".join(f"{v:g}" for v in DEFAULT_LEVELS) + ")", flag="--levels",
-                        metavar="A,A,...")
+    levels: str = param(None, "m/s^2", "horizontal PGA targets of the scaled records",
+                        flag="--levels", metavar="A,A,...",
+                        optional="8 levels 0.5-8, geometric: "
+                        + ",".join(f"{v:g}" for v in DEFAULT_LEVELS))
     members: int = param(DEFAULT_MEMBERS, "", "ensemble members per record and level "
                          "(sampled like campaign ensemble, the same at every level)", 1, 10000,
                          flag="--members")
@@ -277,17 +277,18 @@ class FragilityOptions(CampaignOptions):
     stiffness: str = stiffness_param("with --column-file, what kn_factor multiplies")
     pulses: str = param(None, "", "shake with a grid of one-cosine pulses instead of scaled "
                         "records: pga_g=LO:HI:N;pgv_pga_s=LO:HI:N, or the preset vsr (PGA "
-                        "0.2-1.1 g x PGV/PGA 0.1-1.0 s, 10 x 10; the default for a mesh "
-                        "specimen)", flag="--pulses", metavar="GRID")
+                        "0.2-1.1 g x PGV/PGA 0.1-1.0 s, 10 x 10)", flag="--pulses",
+                        metavar="GRID", optional="scaled records; a mesh specimen: vsr")
     azimuth: float = param(None, "deg", "pulse grid: shake along this fixed azimuth (a "
-                           "table); default: sampled per member over 360 deg (a field rock)",
-                           flag="--azimuth", metavar="DEG")
+                           "table)", flag="--azimuth", metavar="DEG",
+                           optional="sampled per member over 360 deg (a field rock)")
     headings: int = param(None, "", "pulse grid: sampled shaking directions per parameter "
-                          f"set (default {DEFAULT_HEADINGS}; 1 with --azimuth, which fixes "
-                          "the direction)", 1, 360, flag="--headings")
+                          "set", 1, 360, flag="--headings",
+                          optional=f"{DEFAULT_HEADINGS}; 1 with --azimuth, which fixes the "
+                          "direction")
     ranges: str = param(None, "", "pulse grid: ranges the members' unknowns are drawn from "
-                        f"(default {pulse_grid.DEFAULT_RANGES}; LO = HI fixes one)",
-                        flag="--ranges", metavar="NAME=LO:HI;...")
+                        "(LO = HI fixes one)", flag="--ranges", metavar="NAME=LO:HI;...",
+                        optional=pulse_grid.DEFAULT_RANGES)
     adaptive: bool = param(False, "", "pulse grid: run each cell only until it is decided "
                            "on which side of P = 0.5 it lies (the 2D block as a guide: a few "
                            "runs near its threshold, one probe run elsewhere; more where a "

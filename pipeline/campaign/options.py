@@ -18,18 +18,20 @@ STIFFNESS_HELP = ("contact stiffness per point: matched raises the paper's kn fo
                   f"paper's column ({paper_rocking_hz():.1f} Hz); paper: {paper.COLUMN_KN_N_M:g} N/m for all")
 
 
-def column_file_param(note="", many=False):
-    """The ``--column-file NAME_OR_FILE`` field; ``note``: what the campaign does with it."""
-    return param(None, "", column_file_help(many) + (f"; {note}" if note else ""),
-                 flag="--column-file", metavar="NAME_OR_FILE,..." if many else "NAME_OR_FILE")
+def column_file_param(note="", many=False, default=None, unset="the paper's column"):
+    """The ``--column-file NAME_OR_FILE`` field; ``note``: what the campaign does with it,
+    ``default`` its specimen when not given, else ``unset`` what it runs then."""
+    return param(default, "", column_file_help(many) + (f"; {note}" if note else ""),
+                 flag="--column-file", metavar="NAME_OR_FILE,..." if many else "NAME_OR_FILE",
+                 optional=unset if default is None else None)
 
 
 def stiffness_param(note="with --column-file"):
     """The ``--stiffness`` field: None when not given (matched, where a description is
     run), so that a combination that would ignore it is refused
     (:func:`refuse_ignored_stiffness`)."""
-    return param(None, "", (f"{note}: " if note else "") + STIFFNESS_HELP
-                 + "; default matched", flag="--stiffness", choices=STIFFNESS_CHOICES)
+    return param(None, "", (f"{note}: " if note else "") + STIFFNESS_HELP,
+                 flag="--stiffness", choices=STIFFNESS_CHOICES, optional="matched")
 
 
 def contact_file_param(note=""):
@@ -37,7 +39,7 @@ def contact_file_param(note=""):
     campaign uses it beside its own parameters."""
     return param(None, "", "contact parameters (kn, damping; mu_s, mu_k) from a file "
                  "`contact` writes, for every run" + (f"; {note}" if note else ""),
-                 flag="--contact-file", metavar="JSON")
+                 flag="--contact-file", metavar="JSON", optional=True)
 
 
 def contact_of(options):

@@ -222,14 +222,14 @@ def _f(value):
 
 @dataclass(frozen=True)
 class ShakeTableOptions(CampaignOptions):
-    experiments: Path = param(EXPERIMENTS, "", "experiment table (default: the SP1 granite "
-                              "tests shipped in records/shake_table/tests.csv)",
+    experiments: Path = param(EXPERIMENTS, "", "experiment table (the default: the SP1 "
+                              "granite tests shipped)",
                               flag="--experiments", metavar="CSV")
     outcome: str = param(OUTCOME, "", "column of the observed outcome, 1 = overturned",
                          flag="--outcome", metavar="COLUMN")
     column_file: str = column_file_param(
-        "the specimen: a mesh specimen or column description (default "
-        "records/shake_table/sp1.json, the scanned rock SP1)")
+        "the specimen: a mesh specimen or column description (the default: the scanned "
+        "rock SP1)", default=SPECIMEN)
     validate_from: str = param(VALIDATE_FROM, "", "tests from this date on are held out for "
                                "validation; the earlier ones calibrate",
                                flag="--validate-from", metavar="YYYY-MM-DD")
@@ -240,8 +240,8 @@ class ShakeTableOptions(CampaignOptions):
     axis_deg: float = param(AXIS_DEG, "deg", "azimuth of the table's shaking line, for the "
                             "PGA-threshold baseline's critical angle (90: East-West)",
                             0.0, 360.0, flag="--axis-deg", metavar="DEG")
-    tests: str = param(None, "", "only these tests (a quick look; default all)",
-                       flag="--tests", metavar="TEST,TEST")
+    tests: str = param(None, "", "only these tests (a quick look)",
+                       flag="--tests", metavar="TEST,TEST", optional="all")
     contact_file: str = contact_file_param(
         "its values are the base every --grid point starts from: a point's own values "
         "override them")
@@ -249,22 +249,23 @@ class ShakeTableOptions(CampaignOptions):
                          "drawn as campaign fragility --column-file draws them (--ranges, "
                          "--seed), each test's P with its Monte Carlo error, scored as "
                          "probabilities; a test's members stop early once its first ones "
-                         "agree", 1, 1000, flag="--members")
-    seed: int = param(None, "", "members mode: Latin-hypercube seed of the members "
-                      "(default the fragility's)", flag="--seed")
-    ranges: str = param(None, "", "members mode: ranges the members are drawn from (default "
-                        "the fragility's; LO = HI fixes one)", flag="--ranges",
-                        metavar="NAME=LO:HI;...")
+                         "agree", 1, 1000, flag="--members",
+                         optional="the calibration grid (no members mode)")
+    seed: int = param(None, "", "members mode: Latin-hypercube seed of the members",
+                      flag="--seed", optional="the fragility's")
+    ranges: str = param(None, "", "members mode: ranges the members are drawn from (LO = "
+                        "HI fixes one)", flag="--ranges", metavar="NAME=LO:HI;...",
+                        optional="the fragility's")
     candidates: str = param(None, "", "members mode: candidate ranges separated by '|' "
                             "('default': the fragility's), each run on the calibration tests "
                             "and scored by log-likelihood; the best is frozen, then run and "
                             "scored on every test", flag="--candidates",
-                            metavar="RANGES|RANGES")
+                            metavar="RANGES|RANGES", optional="no choice of ranges")
     providers: Path = param(None, "", "members mode: other models' 0/1 predictions scored "
-                            "beside the members (CSV: test and one column per model; "
-                            "default for the shipped tests: the providers' models of SP1, "
-                            "records/shake_table/sp1_numerical.csv)", flag="--providers",
-                            metavar="CSV")
+                            "beside the members (CSV: test and one column per model)",
+                            flag="--providers", metavar="CSV",
+                            optional="for the shipped tests, the providers' models of SP1 "
+                            "(records/shake_table/sp1_numerical.csv)")
     TAKES_JOBS = True
     DRIVER_ONLY = ("candidates", "providers", "jobs")
 
@@ -312,7 +313,7 @@ class ShakeTableOptions(CampaignOptions):
 
     def kwargs(self):
         return {"experiments": self.experiments, "outcome": self.outcome,
-                "specimen": self.column_file or SPECIMEN,
+                "specimen": self.column_file,
                 "validate_from": self.validate_from, "grid": self.grid,
                 "tests": self.test_names() or None, "axis_deg": self.axis_deg,
                 "contact_file": self.contact_file, "members": self.members,

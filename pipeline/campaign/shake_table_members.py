@@ -60,7 +60,7 @@ KN_OF_RUN_CPU_S = 1.2e8
 def check(options):
     """One-line refusals of the members mode's options, before any work."""
     ensemble_members.check_seed(options.seed)
-    specimen = ColumnGeometry.load(options.column_file or shake_table_experiments.SPECIMEN).to_dict()
+    specimen = ColumnGeometry.load(options.column_file).to_dict()
     contact = None if options.contact_file is None else contact_values(options.contact_file)
     member_sets(specimen, options.members, options.seed, options.ranges, contact)
     if options.candidates is not None:

@@ -12,11 +12,14 @@ from pipeline.files import display_path
 def _help(f):
     meta = f.metadata
     unit = f" ({meta['unit']})" if meta.get("unit") else ""
-    return f"{meta['help']}{unit}{_default(f.default)}{_bounds(meta)}".replace("%", "%%")
+    unset = meta.get("optional")
+    unset = f"; unset: {unset}" if isinstance(unset, str) else ""
+    return f"{meta['help']}{unit}{_default(f.default)}{unset}{_bounds(meta)}".replace("%", "%%")
 
 
 def _default(value):
-    """'; default ...' of a declared default, or '' (None, (), a switch)."""
+    """'; default ...' of a declared default, or '' (None, (), a switch: what unset means
+    is the field's ``optional``)."""
     if value is None or value == () or isinstance(value, bool):
         return ""
     if isinstance(value, tuple):

@@ -39,10 +39,10 @@ from pipeline.inversion.sites import OBS_UNCERTAINTY_DEG, draw_site_columns, map
     site_frame, site_position
 from pipeline.stats.circular import azimuth_deg
 from pipeline.inversion import write_outputs
+from pipeline.inversion.options import DEMO_TRIALS as DEFAULT_TRIALS   # declared with --trials
 
 FALLEN_PER_SITE = (1, 3, 10, 30)
 SITE_COUNTS = (1, 3)
-DEFAULT_TRIALS = 20
 DEMO_SEED = 2009
 # the paper's question: a 95 % back-azimuth arc no wider than BOUND_DEG (deg), and its
 # words and result keys

@@ -12,6 +12,8 @@ from pipeline.inversion.likelihood import DEFAULT_FLOOR, DEFAULT_KERNEL_DEG, DEF
 from pipeline.scenario.parameters import check_fields, param
 
 DEFAULT_FORWARD_DIR = RESULTS_DIR / "inversion-forward"   # the forward runs' campaign
+DEMO_TRIALS = 20           # --trials of --demo
+STUDY_TRIALS = 200         # --trials of --member-study: Wilson intervals of about +-0.03 at 0.95
 
 
 @dataclass(frozen=True)
@@ -19,18 +21,20 @@ class InversionOptions:
     """What the workflows take from the command line (see ``toppling invert --help``),
     declared as :func:`~pipeline.scenario.parameters.param` fields (the command builds
     their flags); checked on creation, before any work."""
-    out: Path = param(None, "", "output directory (default results/inversion/<file stem>; "
-                      "--demo: results/inversion)", flag="--out", metavar="DIR")
+    out: Path = param(None, "", "output directory", flag="--out", metavar="DIR",
+                      optional="results/inversion/<file stem>; --demo: results/inversion")
     scheduler: str = param(None, "", "run the forward campaign on an existing Dask cluster",
-                           flag="--scheduler", metavar="ADDRESS")
-    jobs: int = param(None, "", "parallel YADE runs / pyprop8 processes (default: all cores)",
-                      flag="--jobs")
+                           flag="--scheduler", metavar="ADDRESS",
+                           optional="on this machine")
+    jobs: int = param(None, "", "parallel YADE runs / pyprop8 processes", flag="--jobs",
+                      optional="all cores")
     allow_long: bool = param(False, "", f"start a forward table estimated to take over "
                              f"{LONG_RUN_S / 3600:g} h on this machine (refused otherwise; "
                              "the estimate is printed before any run)", flag="--allow-long")
     table: Path = param(None, "", "use this forward table file (tables/forward_table_<key>.npz) "
                         "as it is: no pyprop8, no YADE (its code version is reported, not "
-                        "checked)", flag="--table", metavar="FILE")
+                        "checked)", flag="--table", metavar="FILE",
+                        optional="the table of the forward runs, run or reused")
     forward_dir: Path = param(DEFAULT_FORWARD_DIR, "", "campaign directory of the forward runs",
                               flag="--forward-dir", metavar="DIR")
     kernel_deg: float = param(DEFAULT_KERNEL_DEG, "deg", "width of the von Mises kernel on "
@@ -42,8 +46,9 @@ class InversionOptions:
                             "falls inform its next column; calibrated in the member study); "
                             "independent: the product over columns (too sure when a site has "
                             "several columns)", flag="--likelihood", choices=LIKELIHOODS)
-    trials: int = param(None, "", "trials per configuration (--demo: default 20; "
-                        "--member-study: default 200)", 1, 1000, "--trials")
+    trials: int = param(None, "", "trials per configuration", 1, 1000, "--trials",
+                        optional=f"{DEMO_TRIALS} with --demo, {STUDY_TRIALS} with "
+                        "--member-study")
 
     def __post_init__(self):
         check_fields(self)

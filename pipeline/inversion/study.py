@@ -59,10 +59,10 @@ from pipeline.inversion.candidates import OutOfReach
 from pipeline.inversion.posterior import invert
 from pipeline.stats.circular import azimuth_deg
 from pipeline.files import InputError, die_with_parent
+from pipeline.inversion.options import STUDY_TRIALS   # declared with --trials
 
 LIKELIHOOD_MEMBERS = (3, 6, 12, 24, 48)
 OBSERVATION_MEMBERS = 16
-STUDY_TRIALS = 200         # per configuration: Wilson intervals of about +-0.03 at 0.95
 STUDY_SEED = 2027
 PLACEMENTS = ("node", "between", "between_spokes", "between_magnitudes", "beyond")
 

@@ -32,30 +32,47 @@ def kinetic_friction(mu_s):
 
 
 def param(default, unit, help, low=None, high=None, flag=None, low_open=False, choices=None,
-          metavar=None, high_open=False):
+          metavar=None, high_open=False, optional=None, required=False):
     """A dataclass field with unit, help text, bounds [low, high] (low excluded when
     ``low_open``, high when ``high_open``; either may be None: unbounded), its command-line
     flag and the flag's metavar (the command line builds the flags:
-    :mod:`pipeline.cli._fields`).  A tuple field's bounds hold for each of its values."""
+    :mod:`pipeline.cli._fields`).  A tuple field's bounds hold for each of its values.
+
+    A default of None or () says "not given" and must be declared so: ``optional``, what
+    leaving the field unset means (a phrase the help text shows as "unset: ...", or True
+    when the help already says it: an alternative not taken, no file), or ``required``
+    (None refused on creation: "give --flag").  Any other default is the value a run takes
+    when the field is not given."""
+    unset = default is None or default == ()
+    if unset and not optional and not required:
+        raise TypeError(f"param {flag or help!r}: a default of {default!r} must be declared "
+                        "optional (what unset means) or required")
+    if not unset and (optional or required):
+        raise TypeError(f"param {flag or help!r}: only a default of None or () is optional "
+                        f"or required, got {default!r}")
     return field(default=default, metadata={"unit": unit, "help": help, "low": low, "high": high,
                                             "low_open": low_open, "high_open": high_open,
                                             "flag": flag, "choices": choices,
-                                            "metavar": metavar})
+                                            "metavar": metavar, "optional": optional,
+                                            "required": required})
 
 
 def check_fields(obj):
-    """Validate every field of a parameter dataclass against its metadata."""
+    """Validate every field of a parameter dataclass against its metadata: a required
+    field given, each value in its choices or range (an optional field may be unset)."""
     for f in dataclasses.fields(obj):
         value, meta = getattr(obj, f.name), f.metadata
         name = meta.get("flag") or f.name
+        if value is None and meta.get("required"):
+            raise InputError(f"give {name}")
+        if value is None and f.default is None:      # unset: its meaning declared (param)
+            continue
         if meta.get("choices"):
-            if value not in meta["choices"] and not (value is None and f.default is None):
+            if value not in meta["choices"]:
                 raise InputError(f"{name} must be one of {', '.join(meta['choices'])}, "
                                  f"got {value!r}")
             continue
         if meta.get("low") is None and meta.get("high") is None:
-            continue
-        if value is None and f.default is None:      # unset: decided where it is used
             continue
         for v in _leaves(value):
             if isinstance(v, bool) or not isinstance(v, (int, float)) or \
@@ -85,9 +102,9 @@ class Contact:
                            "the explicit contact law is unstable above ~1.2)",
                            0.0, 1.0, "--damping")
     mu_s: float = param(paper.MU_STATIC, "", "static friction coefficient", 0.01, 2.0, "--mu-s")
-    mu_k: float = param(None, "", "kinetic friction coefficient (default: "
-                        f"{paper.MU_KINETIC:g} / {paper.MU_STATIC:g} x mu_s, the paper's pair)",
-                        None, None, "--mu-k")
+    mu_k: float = param(None, "", "kinetic friction coefficient", None, None, "--mu-k",
+                        optional=f"{paper.MU_KINETIC:g} / {paper.MU_STATIC:g} x mu_s, the "
+                        "paper's pair")
 
     def __post_init__(self):
         check_fields(self)
@@ -110,9 +127,10 @@ class Numerics:
                                  -360.0, 360.0)
     verlet_distance: float = param(0.02, "m", "collider bound enlargement", 0.0, 1.0)
     dt_factor: float = param(None, "", "time step as a fraction of sqrt(m_min / (kn x rim "
-                             "points)); default: the largest stable at the contact damping "
-                             f"(0.235 at the paper's 0.36), at most {CONVERGED_DT_FACTOR:g} "
-                             "(converged, make bench)", 0.0, 0.5, "--dt-factor", low_open=True)
+                             "points))", 0.0, 0.5, "--dt-factor", low_open=True,
+                             optional="the largest stable at the contact damping (0.235 at "
+                             f"the paper's 0.36), at most {CONVERGED_DT_FACTOR:g} (converged, "
+                             "make bench)")
     drive: str = param("inertial", "", "pedestal drive: gravity table (inertial) or per-step "
                        "velocity (kinematic, slow)", choices=("inertial", "kinematic"))
     drive_interval_s: float = param(0.002, "s", "gravity update interval", 0.0, 0.1,

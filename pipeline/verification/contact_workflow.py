@@ -33,37 +33,38 @@ TILT_COLUMNS = {"tilt_rad": 1.0, "tilt_deg": math.pi / 180.0}
 class ContactOptions:
     """What ``contact`` is asked (see ``python -m pipeline contact --help``)."""
     free_rocking: Path = param(None, "", "recorded decay: columns time_s and tilt_rad or "
-                               "tilt_deg", flag="--free-rocking", metavar="CSV")
+                               "tilt_deg", flag="--free-rocking", metavar="CSV",
+                               optional="--frequency-hz instead")
     frequency_hz: float = param(None, "Hz", "instead of a record: the rocking frequency (full "
                                 "cycles per s) at the amplitudes whose ratios "
                                 "--amplitude-ratio gives", 0.01, 100.0, "--frequency-hz",
-                                metavar="HZ")
+                                metavar="HZ", optional="--free-rocking instead")
     amplitude_ratio: str = param(None, "", "ratios of successive amplitudes (the next over "
                                  "the previous), in (0, 1)", flag="--amplitude-ratio",
-                                 metavar="R,R")
+                                 metavar="R,R", optional=True)
     block: str = param(None, "", "the block's height and width in its rocking plane (m)",
-                       flag="--block", metavar="HEIGHT,WIDTH")
+                       flag="--block", metavar="HEIGHT,WIDTH", optional="--column-file instead")
     column_file: str = param(None, "", "instead of --block: the specimen tested, a column "
                              "description (as the monolith of its outline) or a mesh "
                              "specimen (a scanned rock)", flag="--column-file",
-                             metavar="NAME_OR_FILE")
+                             metavar="NAME_OR_FILE", optional="--block instead")
     azimuth: float = param(None, "", "with --column-file: the direction it was tilted toward "
-                           "(deg clockwise from North; default its weak side, where its "
-                           "critical angle is smallest)", flag="--azimuth", metavar="DEG")
+                           "(deg clockwise from North)", flag="--azimuth", metavar="DEG",
+                           optional="its weak side, where its critical angle is smallest")
     damping_map: bool = param(False, "", "also find the contact damping ratio that gives "
                               "this restitution in the YADE model of the block or specimen "
                               "(free-rocking runs, bisection: minutes; measured restitutions "
                               "are cached), and the damping interval of the restitution +- "
                               "its standard error, so that `run --contact-file` and the "
                               "campaigns take the file", flag="--damping-map")
-    depth: float = param(None, "", "the block's depth across the rocking plane (m; default "
-                         "its width)", flag="--depth", metavar="M")
-    density: float = param(None, "", f"the block's density (default "
-                           f"{paper.MARBLE_DENSITY_KG_M3:g} kg/m^3)", flag="--density",
-                           metavar="KG_M3")
-    kn: float = param(None, "", f"contact stiffness per point of the map (default the "
-                      f"paper's block {paper.MARBLE_BLOCK_KN_N_M:g} N/m; with --column-file "
-                      f"the model's {paper.COLUMN_KN_N_M:g} N/m)", flag="--kn", metavar="N_M")
+    depth: float = param(None, "", "the block's depth across the rocking plane (m)",
+                         flag="--depth", metavar="M", optional="its width")
+    density: float = param(None, "", "the block's density (kg/m^3)", flag="--density",
+                           metavar="KG_M3", optional=f"{paper.MARBLE_DENSITY_KG_M3:g}, the "
+                           "paper's marble")
+    kn: float = param(None, "", "contact stiffness per point of the map (N/m)", flag="--kn",
+                      metavar="N_M", optional=f"the paper's block {paper.MARBLE_BLOCK_KN_N_M:g}; "
+                      f"with --column-file the model's {paper.COLUMN_KN_N_M:g}")
     out: Path = param(Path("contact.json"), "", "contact file written (JSON)", flag="--out")
 
     def __post_init__(self):

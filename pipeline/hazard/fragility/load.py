@@ -19,16 +19,20 @@ from pipeline.hazard.pulse_cells import lay_cells
 from pipeline.stats.fragility import fragility_fit, logistic_surface
 from pipeline.userfiles import DATA_FILE_BYTES, Unreadable, number, read_text, show
 
+# what a fragility is read as: its PGA fit, its logistic surface, a pulse grid's cells, or
+# auto (the surface of columns, the cells of a pulse grid)
+FRAGILITY_FORMS = ("auto", "pga", "pga-pgv", "grid")
 BLOCK_MODEL = "block2d"          # a pulse grid's 2D rigid block, beside the specimen
 
 
-def load_campaign_fragility(path, column=None, form=None, below="ramp", component=None,
+def load_campaign_fragility(path, column=None, form="auto", below="ramp", component=None,
                             magnitude=None, distance_km=None, record_fraction=None,
                             members=True):
     """The fragility of one column entry of ``campaign fragility``'s ``fragility.json``:
-    ``form`` "pga" (its lognormal PGA fit) or "pga-pgv" (its logistic surface; default);
+    ``form`` "pga" (its lognormal PGA fit), "pga-pgv" (its logistic surface) or "auto"
+    (pga-pgv);
     ``column``: monolithic, drums, block2d or block2d_worst (default: the first 3D one).
-    A pulse-grid file (``--pulses``): :func:`load_pulse_grid` (``form`` default "grid";
+    A pulse-grid file (``--pulses``): :func:`load_pulse_grid` (``form`` "auto": "grid";
     ``below``: P below the grid, :class:`PulseGrid`).  Each member's own fit of the same
     form (from ``fragility_runs.csv`` beside the file, when there) in ``member_fits``,
     refitted only when ``members`` asks for them (survival's members' spread).
@@ -47,8 +51,9 @@ def _load_campaign_fragility(path, column, form, below, members):
     file = read_fragility_file(path)          # every value below checked
     path = file.path
     if file.pulse_grid is not None:
-        return load_pulse_grid(file, column, form or "grid", below), "line", ()
-    form = form or "pga-pgv"
+        return load_pulse_grid(file, column, "grid" if form == "auto" else form, below), \
+            "line", ()
+    form = "pga-pgv" if form == "auto" else form
     columns = file.columns
     if column is None:
         column = next((c for c in ("monolithic", "drums") if c in columns), next(iter(columns)))
