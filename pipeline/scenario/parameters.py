@@ -175,10 +175,11 @@ class Column:
     n_drums: int = param(paper.N_DRUMS, "", "number of drums", 1, 60, "--drums")
     density: float = param(paper.MARBLE_DENSITY_KG_M3, "kg/m^3", "density",
                            *DENSITY_RANGE, "--density")
-    centred: bool = field(default=None, metadata={"help": "single column at the centre"})
-    column_file: object = field(default=None, metadata={
-        "help": "column description: a shipped example's name, a .json/.yaml file or the "
-        "description as a dict"})
+    centred: bool = param(None, "", "single column at the centre",
+                          optional="centred unless the twin model (both)")
+    column_file: object = param(None, "", "column description: a shipped example's name, a "
+                                ".json/.yaml file or the description as a dict",
+                                optional="the paper's column")
     geometry: object = field(default=None, init=False, repr=False, compare=False)
     colonnade: object = field(default=None, init=False, repr=False, compare=False)
 
@@ -265,8 +266,8 @@ class Drive:
     """How the record drives the pedestal: the part of it run (``window``: start and end,
     s on the record's clock; None: all of it), turned clockwise by ``rotate_deg`` and
     scaled by ``scale``."""
-    window: tuple = field(default=None, metadata={
-        "help": "[start, end] (s, record's clock) of the motion run; None: all of it"})
+    window: tuple = param(None, "s", "[start, end] (record's clock) of the motion run",
+                          optional="all of it")
     rotate_deg: float = param(0.0, "deg", "the motion turned clockwise by this angle",
                               flag="--rotate")
     scale: float = param(1.0, "", "motion scale factor", 0.0, MAX_SCALE, "--scale")

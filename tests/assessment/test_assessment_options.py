@@ -137,3 +137,28 @@ def test_each_default_and_range_is_declared_once_and_the_help_says_it():
         from_args(ConstrainOptions, _parsed(constrain_command, [
             "--logic-tree", TREE, "--median-g", "0.3", "--beta", "0.4", "--median-g", "20",
             "--beta", "0.4", "--age-ka", "2"]))
+
+
+def test_the_fragility_form_auto_is_declared_and_reads_a_columns_surface(tmp_path):
+    """--fragility-form's default is declared (auto: the logistic surface of a column
+    file; tests/hazard/test_pulse_grid_survival: a pulse grid's cells) and taken."""
+    from dataclasses import replace
+    from tests.hazard.test_survival import _fragility_json
+    parser = argparse.ArgumentParser()
+    survival_command.setup(parser)
+    text = " ".join(parser.format_help().split())
+    assert "auto: pga-pgv for columns, grid for a pulse grid; default auto" in text
+    options = from_args(SurvivalOptions, _parsed(survival_command, [
+        "--hazard", HAZARD, "--age-ka", "15", "--fragility",
+        str(_fragility_json(tmp_path / "fragility.json")), "--magnitude", "6.5",
+        "--distance-km", "10", "--draws", "0", "--out", str(tmp_path / "out")]))
+    assert options.fragility_form == "auto"
+    auto, = options.specimens()
+    stated, = replace(options, fragility_form="pga-pgv").specimens()
+    assert auto.inner.coefficients == stated.inner.coefficients == (1.0, 3.0, 2.0)  # the file's
+    assert replace(options, fragility_form="pga").specimens()[0].inner.median_m_s2 == 3.0
+
+
+def test_a_required_logic_tree_left_out_is_refused_before_any_work():
+    with pytest.raises(InputError, match="^give --logic-tree$"):
+        ConstrainOptions(median_g=(0.3,), beta=(0.4,), age_ka=(2.0,))
