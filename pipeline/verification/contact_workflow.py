@@ -57,12 +57,12 @@ class ContactOptions:
                               "are cached), and the damping interval of the restitution +- "
                               "its standard error, so that `run --contact-file` and the "
                               "campaigns take the file", flag="--damping-map")
-    depth: float = param(None, "", "the block's depth across the rocking plane (m)",
+    depth: float = param(None, "m", "the block's depth across the rocking plane",
                          flag="--depth", metavar="M", optional="its width")
-    density: float = param(None, "", "the block's density (kg/m^3)", flag="--density",
+    density: float = param(None, "kg/m^3", "the block's density", flag="--density",
                            metavar="KG_M3", optional=f"{paper.MARBLE_DENSITY_KG_M3:g}, the "
                            "paper's marble")
-    kn: float = param(None, "", "contact stiffness per point of the map (N/m)", flag="--kn",
+    kn: float = param(None, "N/m", "contact stiffness per point of the map", flag="--kn",
                       metavar="N_M", optional=f"the paper's block {paper.MARBLE_BLOCK_KN_N_M:g}; "
                       f"with --column-file the model's {paper.COLUMN_KN_N_M:g}")
     out: Path = param(Path("contact.json"), "", "contact file written (JSON)", flag="--out")
