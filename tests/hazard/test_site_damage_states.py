@@ -83,6 +83,13 @@ def test_crossing_fragilities_give_no_negative_probability():
     assert np.all(fragility.at_least(0, pga) == 1.0)
 
 
+def test_a_fragility_per_state_holds_four_states_and_collapse():
+    with pytest.raises(InputError, match="needs 4 entries"):
+        StateFragility((Lognormal(1.0, 0.4),) * 3)
+    with pytest.raises(InputError, match="needs the collapse one"):
+        StateFragility((Lognormal(1.0, 0.4),) * 3 + (None,))
+
+
 def test_a_state_without_its_fragility_is_refused():
     with pytest.raises(InputError, match="state 'severe'") as caught:
         motion_bound([lognormals((1.0, 2.0, None, 9.0), 0.4)], [(2, 2)])
