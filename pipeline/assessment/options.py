@@ -13,6 +13,7 @@ from pipeline import RESULTS_DIR
 from pipeline.constants import STANDARD_GRAVITY
 from pipeline.files import InputError
 from pipeline.assessment.age_options import age_kinds, check_age_kinds
+from pipeline.assessment.state_options import parse_state_lognormal
 from pipeline.hazard.ages import LowerBound, TruncatedNormal, UniformInterval, load_age_samples
 from pipeline.hazard.fragility.components import COMPONENTS
 from pipeline.hazard.disagg_ratio import ratio_mixture
@@ -216,6 +217,11 @@ class SurvivalOptions(SpecimenOptions):
     observation_site: str = param(None, "", "the site's name in --observations",
                                   flag="--observation-site", metavar="NAME",
                                   optional="its only site")
+    state_lognormal: tuple[str, ...] = param(
+        (), "", "a stated lognormal fragility of a damage state below collapse, "
+        "P(DS >= STATE) over PGA, for columns of --observations seen in a damage state "
+        "(slight, moderate or severe; collapse is the toppling fragility); repeat per state",
+        flag="--state-lognormal", metavar="STATE,MEDIAN_G,BETA", optional=True)
     at_pgv_pga: float = param(None, "s", "the PGV/PGA at which the PGA range is stated (for "
                               "a fragility over PGA and PGV/PGA)", 0.001, 10,
                               flag="--at-pgv-pga", metavar="S", optional=True)
@@ -305,6 +311,9 @@ class SurvivalOptions(SpecimenOptions):
         if self.observations is None and (self.observation_site is not None
                                           or self.at_pgv_pga is not None):
             raise InputError("--observation-site and --at-pgv-pga apply with --observations")
+        if self.state_lognormal and self.observations is None:
+            raise InputError("--state-lognormal applies with --observations")
+        parse_state_lognormal(self.state_lognormal)
         if self.observations is not None and self.specimen_count != 1:
             raise InputError("--observations: give one fragility (--fragility, one "
                              "--median-g/--beta or one --logistic), used by column type")

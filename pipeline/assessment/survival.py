@@ -6,6 +6,7 @@ The command reads its options; this reads the input files and writes the results
 from dataclasses import replace
 
 from pipeline.assessment.options import parse_logistic
+from pipeline.assessment.state_options import parse_state_lognormal, state_fragility
 from pipeline.constants import STANDARD_GRAVITY
 from pipeline.files import InputError, file_set, result_json_text, write_text
 from pipeline.hazard.assess import assess
@@ -109,21 +110,27 @@ def _joint_site(o):
 
 def _site_motion(o):
     """site_motion.json's content: the PGA range consistent with one site's columns, each
-    column type's fragility from the options ``o``."""
+    column type's fragility from the options ``o``: of toppling, with the lower damage
+    states' of --state-lognormal (a campaign's fits per damage state would plug in
+    here, read per column type like its toppling fit)."""
+    lower = parse_state_lognormal(o.state_lognormal)
     if o.fragility:
-        def fragility_for(column):
+        def toppling(column):
             return o.campaign_fragility(o.fragility[0], column)
     elif o.median_g:
         stated = Lognormal(o.median_g[0] * STANDARD_GRAVITY, o.beta[0],
                            label=f"stated lognormal: median {o.median_g[0]:g} g, "
                            f"beta {o.beta[0]:g} (every column)")
-        def fragility_for(column):
+        def toppling(column):
             return stated
     else:
         stated = Logistic(parse_logistic(o.logistic[0]),
                           label=f"stated logistic surface {o.logistic[0]} (every column)")
-        def fragility_for(column):
+        def toppling(column):
             return stated
+
+    def fragility_for(column):
+        return state_fragility(toppling(column), lower)
     return site_motion_result(
         o.observations, o.observation_site, fragility_for, o.at_pgv_pga,
         f"{o.hazard_component}: a campaign's fragility put on it "

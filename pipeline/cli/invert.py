@@ -107,7 +107,7 @@ def _what_to_run(p, grids):
                    "columns bound the back azimuth, the epicentre and the magnitude (default "
                    "--grid study: 2,304 runs; make invert-study)")
     add_arguments(p, InversionOptions,
-                  names=("scheduler", "jobs", "allow_long", "table", "forward_dir"))
+                  names=("scheduler", "jobs", "allow_long", "table", "extend_table", "forward_dir"))
 
 
 def _forward_grid(g, full, mechanisms):

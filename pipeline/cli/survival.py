@@ -39,7 +39,7 @@ def setup(p):
     add_arguments(p.add_argument_group(o.AGE_GROUP), o, AGE_FLAGS)
     add_arguments(p.add_argument_group(o.RATIO_GROUP), o, o.RATIO_FLAGS)
     add_arguments(p.add_argument_group(o.OBSERVATION_GROUP), o,
-                  ("observations", "observation_site", "at_pgv_pga"))
+                  ("observations", "observation_site", "state_lognormal", "at_pgv_pga"))
     add_arguments(p, o, (*o.DRAW_FLAGS, "out"))
 
 

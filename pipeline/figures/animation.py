@@ -1,6 +1,7 @@
 """Animations of runs (GIF, or MP4 when ffmpeg is present) and VTK export for ParaView.
 
-Bodies are drawn part by part (a drum, or a capital's echinus and abacus) from the
+Every body of the run is drawn, a colonnade's columns, epistyles and frieze blocks too;
+bodies are drawn part by part (a drum, or a capital's echinus and abacus) from the
 trajectory (centre of mass + quaternion, body z = long axis) in the absolute frame:
 pedestal-frame position + pedestal displacement, so the pedestal is seen to move with
 the ground.
@@ -97,6 +98,28 @@ def body_top_m(body):
     return max(z + p["bottom_centre"][2] + p["height"] for p in body_parts(body))
 
 
+def view_box(bodies):
+    """The animation's view: (East range, North range, height) m.  Square about the
+    middle of the bodies as placed, reaching the pedestal's half width and 1 m beyond
+    the outermost body (a column at the centre: the pedestal and 1 m around it; a
+    colonnade: every column and beam), as high as the highest face (at least 1 m)."""
+    xy = np.array([b["initial_pos"][:2] if "initial_pos" in b else (0.0, 0.0)
+                   for b in bodies], float)
+    low, high = xy.min(axis=0), xy.max(axis=0)
+    middle = (low + high) / 2
+    reach = float((high - low).max()) / 2 + PEDESTAL_HALF + 1.0
+    return ((middle[0] - reach, middle[0] + reach), (middle[1] - reach, middle[1] + reach),
+            max(max(body_top_m(b) for b in bodies), 1.0))
+
+
+def body_colour(body):
+    """A body's line colour: its column's (drums, monolithic, block), a colonnade's beams
+    (epistyle and frieze blocks, which rest on others) brown, other columns black."""
+    if body["column"] in COLUMN_COLOURS:
+        return COLUMN_COLOURS[body["column"]]
+    return "tab:brown" if body.get("rests_on") else "k"
+
+
 def _frame_indices(t, fps, max_seconds):
     end = t[-1] if max_seconds is None else min(t[-1], max_seconds)
     times = np.arange(0.0, end + 1e-9, 1.0 / fps)
@@ -120,17 +143,15 @@ def animate_run(run, path, fps=20, max_seconds=None, max_frames=600):
     bodies = traj.bodies
     fig = figure(figsize=(7, 6))
     ax = fig.add_subplot(projection="3d")
-    height = max(body_top_m(b) for b in bodies)
-    reach = PEDESTAL_HALF + 1.0
-
-    ax.set(xlim=(-reach, reach), ylim=(-reach, reach), zlim=(0, max(height, 1.0)),
+    (x0, x1), (y0, y1), top = view_box(bodies)
+    ax.set(xlim=(x0, x1), ylim=(y0, y1), zlim=(0, top),
            xlabel="East (m)", ylabel="North (m)", zlabel="Up (m)")
-    ax.set_box_aspect((2 * reach, 2 * reach, max(height, 1.0)))
+    ax.set_box_aspect((x1 - x0, y1 - y0, top))
     square = np.array([[-1, -1], [1, -1], [1, 1], [-1, 1], [-1, -1]]) * PEDESTAL_HALF
     pedestal_line, = ax.plot([], [], [], color="grey")
     # one line per body part: bottom and top outline and every third side edge, apart
     # by NaN (one artist instead of ~10: a frame draws about 3x faster)
-    body_lines = [[ax.plot([], [], [], color=COLUMN_COLOURS.get(body["column"], "k"), lw=0.8)[0]
+    body_lines = [[ax.plot([], [], [], color=body_colour(body), lw=0.8)[0]
                    for _ in body_parts(body)] for body in bodies]
     title = ax.set_title("")
     gap = np.full((1, 3), np.nan)

@@ -14,16 +14,23 @@ first site (azimuthal equidistant: distance and azimuth from obspy.geodetics).
 ``column`` is ``drums``, ``monolithic`` or a column file: a shipped example's name or a
 JSON/YAML file (relative to the observations file's folder); ``invert`` computes a forward
 table for each described column.  ``uncertainty_deg`` (optional, default
-10) is the 1-sigma uncertainty of the measured downfall azimuth.  Every problem is one
+10) is the 1-sigma uncertainty of the measured downfall azimuth.  A standing column may
+say more (docs/damage.md): ``damage_state`` (none, slight, moderate or severe: the state
+it was seen in) or ``residual_slide_m`` with ``base_width_m`` (the largest shift measured
+between neighbouring drums, or of the bottom drum on its base, and the bottom drum's
+diameter, m: at least the state of the residual slide's limits; the peak measures leave
+no trace).  Every problem is one
 line naming the site and column; so is every problem with the file itself (too large,
 not UTF-8, not JSON, nested too deeply, an integer of absurd length).
 """
+import dataclasses
 import json
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from pipeline.files import InputError
+from pipeline.outcome.damage import LEVELS, DamageState
 from pipeline.userfiles import MAX_NESTING, read_text
 from pipeline.userfiles import Unreadable as _Unreadable
 from pipeline.userfiles import json_int as _json_int
@@ -39,21 +46,59 @@ DEFAULT_UNCERTAINTY_DEG = 10.0
 MAX_UNCERTAINTY_DEG = 120.0
 STATES = ("fallen", "standing")
 SITE_KEYS = {"name", "east_km", "north_km", "latitude", "longitude", "columns"}
-COLUMN_KEYS = {"column", "state", "downfall_azimuth_deg", "uncertainty_deg", "note"}
+COLUMN_KEYS = {"column", "state", "downfall_azimuth_deg", "uncertainty_deg", "note",
+               "damage_state", "residual_slide_m", "base_width_m"}
+STANDING_STATES = tuple(s.label for s in DamageState if s is not DamageState.COLLAPSE)
+MAX_SLIDE_M = 10.0           # a residual slide beyond this is no joint's
+BASE_WIDTH_RANGE_M = (0.01, 20.0)
 MAX_SITES = 1000
 MAX_COLUMNS_PER_SITE = 1000
 
 
 @dataclass(frozen=True)
 class ColumnObservation:
+    """One column as found: ``state`` fallen or standing; a fallen one's
+    ``downfall_azimuth_deg`` and its ``uncertainty_deg``; a standing one's
+    ``damage_state`` (:class:`DamageState`, below collapse) or ``residual_slide_m`` and
+    ``base_width_m`` (m), or neither."""
     column: str
     state: str
     downfall_azimuth_deg: float = None
     uncertainty_deg: float = DEFAULT_UNCERTAINTY_DEG
+    damage_state: DamageState = None
+    residual_slide_m: float = None
+    base_width_m: float = None
 
     @property
     def fallen(self):
         return self.state == "fallen"
+
+    @property
+    def state_range(self):
+        """(lowest, highest) :class:`DamageState` the column is in: collapse when it fell;
+        standing, none to severe, its ``damage_state``, or from the state of its residual
+        slide over the base width (docs/damage.md) to severe."""
+        if self.fallen:
+            return DamageState.COLLAPSE, DamageState.COLLAPSE
+        if self.damage_state is not None:
+            return self.damage_state, self.damage_state
+        if self.residual_slide_m is not None:
+            return DamageState.of(self.residual_slide_m / self.base_width_m,
+                                  LEVELS.residual), DamageState.SEVERE
+        return DamageState.NONE, DamageState.SEVERE
+
+    def as_dict(self):
+        """The column in the file's schema."""
+        if self.fallen:
+            return {"column": self.column, "state": self.state,
+                    "downfall_azimuth_deg": self.downfall_azimuth_deg,
+                    "uncertainty_deg": self.uncertainty_deg}
+        out = {"column": self.column, "state": self.state}
+        if self.damage_state is not None:
+            out["damage_state"] = self.damage_state.label
+        if self.residual_slide_m is not None:
+            out.update(residual_slide_m=self.residual_slide_m, base_width_m=self.base_width_m)
+        return out
 
 
 @dataclass(frozen=True)
@@ -90,10 +135,7 @@ class Observations:
             site = {"name": s.name, "east_km": s.east_km, "north_km": s.north_km}
             if s.latitude is not None:
                 site.update(latitude=s.latitude, longitude=s.longitude)
-            site["columns"] = [{"column": c.column, "state": c.state,
-                                **({"downfall_azimuth_deg": c.downfall_azimuth_deg,
-                                    "uncertainty_deg": c.uncertainty_deg} if c.fallen else {})}
-                               for c in s.columns]
+            site["columns"] = [c.as_dict() for c in s.columns]
             sites.append(site)
         return {"sites": sites}
 
@@ -105,10 +147,9 @@ class Observations:
         for s in self.sites:
             east = s.east_km * math.cos(a) + s.north_km * math.sin(a)
             north = -s.east_km * math.sin(a) + s.north_km * math.cos(a)
-            cols = tuple(ColumnObservation(c.column, c.state,
-                                           None if not c.fallen else
-                                           (c.downfall_azimuth_deg + degrees) % 360.0,
-                                           c.uncertainty_deg) for c in s.columns)
+            cols = tuple(c if not c.fallen else dataclasses.replace(
+                c, downfall_azimuth_deg=(c.downfall_azimuth_deg + degrees) % 360.0)
+                for c in s.columns)
             sites.append(Site(s.name, east, north, cols))
         return Observations(tuple(sites), self.source, dict(self.meta))
 
@@ -137,13 +178,42 @@ def parse_column(item, where):
     if state == "standing":
         if item.get("downfall_azimuth_deg") is not None:
             raise InputError(f"{where}: a standing column has no downfall_azimuth_deg")
-        return ColumnObservation(column.strip(), state)
+        return ColumnObservation(column.strip(), state, **_standing_damage(item, where))
+    damage = sorted({"damage_state", "residual_slide_m", "base_width_m"} & set(item))
+    if damage:
+        raise InputError(f"{where}: a fallen column is in collapse; {damage[0]} describes a "
+                         "standing one")
     if item.get("downfall_azimuth_deg") is None:
         raise InputError(f"{where}: a fallen column needs downfall_azimuth_deg")
     azimuth = _number(item["downfall_azimuth_deg"], f"{where}: downfall_azimuth_deg", 0.0, 360.0)
     sigma = item.get("uncertainty_deg", DEFAULT_UNCERTAINTY_DEG)
     sigma = _number(sigma, f"{where}: uncertainty_deg", 0.0, MAX_UNCERTAINTY_DEG)
     return ColumnObservation(column.strip(), state, azimuth % 360.0, sigma)
+
+
+def _standing_damage(item, where):
+    """A standing column's ``damage_state`` or ``residual_slide_m`` and ``base_width_m``
+    (keyword arguments of :class:`ColumnObservation`)."""
+    if "damage_state" in item:
+        if "residual_slide_m" in item or "base_width_m" in item:
+            raise InputError(f"{where}: give damage_state or residual_slide_m with "
+                             "base_width_m, not both")
+        name = item["damage_state"]
+        if name == DamageState.COLLAPSE.label:
+            raise InputError(f"{where}: a column in collapse fell: state 'fallen'")
+        if name not in STANDING_STATES:
+            raise InputError(f"{where}: 'damage_state' must be one of "
+                             f"{', '.join(STANDING_STATES)}, got {_show(name)}")
+        return {"damage_state": DamageState[name.upper()]}
+    if ("residual_slide_m" in item) != ("base_width_m" in item):
+        raise InputError(f"{where}: residual_slide_m and base_width_m go together (the "
+                         "shift over the bottom drum's diameter gives the damage state)")
+    if "residual_slide_m" not in item:
+        return {}
+    return {"residual_slide_m": _number(item["residual_slide_m"],
+                                        f"{where}: residual_slide_m", 0.0, MAX_SLIDE_M),
+            "base_width_m": _number(item["base_width_m"], f"{where}: base_width_m",
+                                    *BASE_WIDTH_RANGE_M)}
 
 
 def parse_observations(data, source="observations"):

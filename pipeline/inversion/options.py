@@ -6,7 +6,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from pipeline import RESULTS_DIR
-from pipeline.files import LONG_RUN_S, check_jobs
+from pipeline.files import LONG_RUN_S, InputError, check_jobs
 from pipeline.inversion.likelihood import DEFAULT_FLOOR, DEFAULT_KERNEL_DEG, DEFAULT_LIKELIHOOD, \
     LIKELIHOODS, check_model_options
 from pipeline.scenario.parameters import check_fields, param
@@ -35,6 +35,11 @@ class InversionOptions:
                         "as it is: no pyprop8, no YADE (its code version is reported, not "
                         "checked)", flag="--table", metavar="FILE",
                         optional="the table of the forward runs, run or reused")
+    extend_table: Path = param(None, "", "a computed forward table of the same grid but for "
+                               "fewer rings: only the missing rings are run, then joined to it "
+                               "(the joined table is written to the forward directory's "
+                               "tables/)", flag="--extend-table", metavar="FILE",
+                               optional="no table extended")
     forward_dir: Path = param(DEFAULT_FORWARD_DIR, "", "campaign directory of the forward runs",
                               flag="--forward-dir", metavar="DIR")
     kernel_deg: float = param(DEFAULT_KERNEL_DEG, "deg", "width of the von Mises kernel on "
@@ -54,6 +59,9 @@ class InversionOptions:
         check_fields(self)
         check_model_options(self.kernel_deg, self.floor, self.likelihood)
         check_jobs(self.jobs)
+        if self.table is not None and self.extend_table is not None:
+            raise InputError("give --table (a table used as it is) or --extend-table (a "
+                             "table to extend by rings), not both")
 
 
 CANDIDATE_PRESETS = {"quick": {"radius_km": 12.0, "step_km": 1.0, "strike_step_deg": 90.0},

@@ -154,6 +154,47 @@ class ForwardTable:
                 name: {k: other.info.get(k) for k in ("grid_key", "yade_wall_s", "runs",
                                                       "code_version")}}})
 
+    def with_rings(self, other, grid):
+        """This table and ``other``'s rings in one table of ``grid`` (a
+        :class:`~pipeline.inversion.grid.TableGrid` whose rings are both tables' rings): the
+        same slices, node azimuths, columns, members and nominal runs, other rings.  The info
+        keeps each part's grid key, code version and YADE time (``parts``)."""
+        same = (self.slices == other.slices
+                and np.array_equal(self.azimuths_deg, other.azimuths_deg)
+                and tuple(self.columns) == tuple(other.columns)
+                and np.array_equal(self.members, other.members)
+                and (self.nominal_toppled is None) == (other.nominal_toppled is None))
+        if not same:
+            raise InputError("forward tables to join: they differ in more than their rings "
+                             "(slices, node azimuths, columns, members or nominal run)")
+        distances = np.r_[self.distances_km, other.distances_km]
+        if len(np.unique(distances)) < len(distances):
+            raise InputError("forward tables to join share a ring: "
+                             f"{sorted(set(self.distances_km) & set(other.distances_km))} km")
+        if sorted(distances.tolist()) != [float(d) for d in grid.distances_km]:
+            raise InputError(f"forward tables to join: rings {sorted(distances.tolist())} km "
+                             f"are not the grid's {list(grid.distances_km)} km")
+        order = np.argsort(distances)
+
+        def join(a, b):
+            return None if a is None else np.concatenate([a, b], axis=1)[:, order]
+
+        parts = [part for table in (self, other)
+                 for part in table.info.get("parts", [_part_info(table)])]
+        return dataclasses.replace(
+            self, distances_km=distances[order],
+            toppled=join(self.toppled, other.toppled),
+            azimuth_deg=join(self.azimuth_deg, other.azimuth_deg),
+            valid=join(self.valid, other.valid),
+            nominal_toppled=join(self.nominal_toppled, other.nominal_toppled),
+            nominal_azimuth_deg=join(self.nominal_azimuth_deg, other.nominal_azimuth_deg),
+            nominal_valid=join(self.nominal_valid, other.nominal_valid),
+            info={"grid": grid.as_dict(), "grid_key": grid.key(),
+                  "yade_wall_s": round(sum(p["yade_wall_s"] for p in parts), 1),
+                  "runs": sum(p["runs"] for p in parts),
+                  "simulated_runs": sum(p["simulated_runs"] for p in parts),
+                  "code_version": parts[-1]["code_version"], "parts": parts})
+
     def select_members(self, mask):
         """A table with the members where ``mask`` (bool over ``members``) holds."""
         mask = np.asarray(mask, bool)
@@ -275,3 +316,10 @@ class ForwardTable:
 
 def _code_version():
     return run_code_version()
+
+
+def _part_info(table):
+    """What :meth:`ForwardTable.with_rings` keeps of a table it joins."""
+    return {"distances_km": [float(d) for d in table.distances_km],
+            **{k: table.info.get(k) for k in ("grid_key", "code_version", "yade_wall_s",
+                                              "runs", "simulated_runs")}}

@@ -2,6 +2,7 @@
 reused or read from a file, after a cost estimate and the long-run gate), then an
 inversion of an observations file, the demo, the member study or a hidden truth.  Each
 writes its files under ``options.out`` and returns the command's exit status."""
+import json
 import logging
 import time
 from pathlib import Path
@@ -92,12 +93,52 @@ def forward_table(options, grid, sibling_of=None, more_runs=0):
                 "yade_wall_s": table.info.get("yade_wall_s"), "runs": table.info.get("runs"),
                 "reused_file": True}
         return table, info
+    if options.extend_table is not None:
+        return _extended_table(options, grid, more_runs)
     if not options.scheduler:
         preflight(grid, options.forward_dir, check_jobs(options.jobs), options.allow_long, more_runs)
     table, cost = forward.run_forward(grid, options.forward_dir, check_jobs(options.jobs),
                                       options.scheduler)
     return table, {**cost, "grid": grid.as_dict(), "grid_key": grid.key(),
                    "code_version": table.info.get("code_version"), "reused_file": False}
+
+
+def _extended_table(options, grid, more_runs):
+    """(ForwardTable, info dict) of ``grid``: the --extend-table file's rings and the rings
+    it lacks, run as a table of their own and joined to it."""
+    base = ForwardTable.load(options.extend_table)
+    stated = dict(base.info.get("grid") or {})
+    wanted = json.loads(json.dumps(grid.as_dict()))
+    if {k: v for k, v in stated.items() if k != "distances_km"} != \
+            {k: v for k, v in wanted.items() if k != "distances_km"}:
+        raise InputError(f"--extend-table {options.extend_table}: its grid differs from the "
+                         "chosen one in more than its rings (--grid, --mechanisms, --depths, "
+                         "--magnitudes, --azimuth-step, --members, --seed, --fmax, "
+                         "--duration)")
+    extra = sorted(set(base.distances_km.tolist()) - set(grid.distances_km))
+    if extra:
+        raise InputError(f"--extend-table {options.extend_table}: its rings {extra} km are "
+                         "not among the chosen --distances")
+    missing = tuple(d for d in grid.distances_km if d not in base.distances_km)
+    info = {"table": str(options.extend_table), "grid": wanted, "reused_file": True,
+            **{k: base.info.get(k) for k in ("grid_key", "code_version", "yade_wall_s",
+                                              "runs")}}
+    if not missing:
+        return base, info
+    rings = grid.replace(distances_km=missing)
+    log.info(f"--extend-table: running the rings {', '.join(f'{d:g}' for d in missing)} km "
+             f"and joining them to {options.extend_table}")
+    if not options.scheduler:
+        preflight(rings, options.forward_dir, check_jobs(options.jobs), options.allow_long,
+                  more_runs)
+    ring_table, cost = forward.run_forward(rings, options.forward_dir,
+                                           check_jobs(options.jobs), options.scheduler)
+    table = base.with_rings(ring_table, grid)
+    path = table.save(forward.table_path(options.forward_dir, grid))
+    log.info(f"wrote {path} (the joined table)")
+    return table, {**cost, "table": str(path), "grid": wanted, "grid_key": grid.key(),
+                   "code_version": table.info["code_version"], "reused_file": False,
+                   "extended": str(options.extend_table)}
 
 
 def _say_reach(summary):

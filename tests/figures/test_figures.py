@@ -94,3 +94,42 @@ def test_animation_gif(tmp_path):
         assert gif.info["duration"] == 500
     with pytest.raises(InputError):
         animation.animate_run(lying_east_trajectory(), tmp_path / "a.avi")
+
+
+def colonnade_trajectory():
+    """The shipped colonnade's bodies as placed (no YADE): standing, then every body
+    moved 0.5 m East."""
+    from scipy.spatial.transform import Rotation
+
+    from pipeline.scenario import scene_params
+    from pipeline.scenario.colonnade_file import load
+    scene = scene_params(colonnade=load("parthenon-north-flank"), t_max=1.0)
+    bodies = [dict(b, initial_pos=b["centre"], initial_rotation=b["rotation"])
+              for column in scene.columns for b in column["bodies"]]
+    pos = np.array([b["centre"] for b in bodies], float)
+    quat = Rotation.from_matrix([b["rotation"] for b in bodies]).as_quat()[:, [3, 0, 1, 2]]
+    return Trajectory(t=np.array([0.0, 1.0]), pos=np.stack([pos, pos + [0.5, 0.0, 0.0]]),
+                      quat=np.stack([quat, quat]), bodies=bodies)
+
+
+def test_a_colonnade_animates_with_every_body_in_view(tmp_path):
+    from PIL import Image
+    traj = colonnade_trajectory()
+    kinds = {b["column"][0] for b in traj.bodies}
+    assert kinds == {"N", "E", "F"}                # columns, epistyles, frieze blocks
+    (x0, x1), (y0, y1), top = animation.view_box(traj.bodies)
+    for body in traj.bodies:                        # every body as placed, 1 m inside
+        x, y, _ = body["initial_pos"]
+        assert x0 + 1.0 < x < x1 - 1.0 and y0 + 1.0 < y < y1 - 1.0
+    assert top == pytest.approx(max(b["centre"][2] + b["parts"][0]["height"] / 2
+                                    for b in traj.bodies if b["column"].startswith("F")))
+    assert {animation.body_colour(b) for b in traj.bodies if b.get("rests_on")} == \
+        {"tab:brown"}
+    # every body part in the frame: a box 2 + 4 polygons, a frustum 2 + CIRCLE_SEGMENTS
+    points, polys = animation.frame_polydata(traj, 1)
+    parts = [p for b in traj.bodies for p in animation.body_parts(b)]
+    n = animation.CIRCLE_SEGMENTS
+    assert len(polys) == 1 + sum(6 if p["shape"] == "box" else 2 + n for p in parts)
+    out = animation.animate_run(traj, tmp_path / "colonnade.gif", fps=1)
+    with Image.open(out) as gif:
+        assert gif.n_frames == 2

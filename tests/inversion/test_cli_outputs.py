@@ -168,3 +168,21 @@ def test_invert_site_motion_refuses_in_one_line(tmp_path, capsys, extra, message
     err = capsys.readouterr().err.strip()
     assert message in err and len(err.splitlines()) == 1
     assert not out.exists()
+
+
+def test_invert_refuses_a_damage_state_its_site_fragility_cannot_weigh(tmp_path, capsys,
+                                                                      make_away_table):
+    # --site-fragility holds P(topple) only: a column seen in a damage state needs the
+    # fragilities of its states, refused in one line before any work
+    table = make_away_table().save(tmp_path / "toy.npz")
+    data = json.loads((EXAMPLES_DIR / "two_sites.json").read_text())
+    data["sites"][0]["columns"].append({"column": "monolithic", "state": "standing",
+                                        "damage_state": "slight"})
+    obs = tmp_path / "obs.json"
+    obs.write_text(json.dumps(data))
+    out = tmp_path / "out"
+    assert cli.main(["invert", str(obs), "--table", str(table), "--out", str(out),
+                     "--site-fragility", str(_column_fragility(tmp_path / "f"))]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "observed slight, which needs the fragility of damage state 'slight'" in err
+    assert len(err.splitlines()) == 1 and not out.exists()

@@ -46,6 +46,25 @@ def test_column_file_names_pass_through():
     assert obs.column_types() == ["columns/ionic.json"]
 
 
+def test_a_standing_column_says_its_damage_states():
+    # residual slide over D against the limits 0.005, 0.025, 0.1 (docs/damage.md): at
+    # least that state, and up to severe (the peak measures leave no trace)
+    cases = [({}, ("none", "severe")),
+             ({"damage_state": "slight"}, ("slight", "slight")),
+             ({"residual_slide_m": 0.004, "base_width_m": 1.0}, ("none", "severe")),
+             ({"residual_slide_m": 0.01, "base_width_m": 1.0}, ("slight", "severe")),
+             ({"residual_slide_m": 0.06, "base_width_m": 2.0}, ("moderate", "severe")),
+             ({"residual_slide_m": 0.25, "base_width_m": 2.0}, ("severe", "severe"))]
+    columns = [{"column": "drums", "state": "standing", **extra} for extra, _ in cases]
+    obs = parse_observations({"sites": [dict(GOOD_SITE, columns=GOOD_SITE["columns"]
+                                             + columns)]})
+    ranges = [tuple(s.label for s in c.state_range) for c in obs.sites[0].columns]
+    assert ranges == [("collapse", "collapse"), ("none", "severe")] + [r for _, r in cases]
+    again = parse_observations(obs.as_dict())           # the file's schema, read back
+    assert again.sites[0].columns == obs.sites[0].columns
+    assert obs.turned(90.0).sites[0].columns[2:] == obs.sites[0].columns[2:]
+
+
 BAD = [
     ("[1, 2", "not valid JSON"),
     ({"site": []}, "expected an object with a 'sites' list"),
@@ -75,6 +94,29 @@ BAD = [
     ({"sites": [GOOD_SITE, dict(GOOD_SITE, name="B")]}, "at the same place"),
     ({"sites": [dict(GOOD_SITE, columns=[{"column": "ionic.json", "state": "standing"}])]},
      "column 'ionic.json': no such file or shipped example"),
+    ({"sites": [dict(GOOD_SITE, columns=[{"column": "drums", "state": "standing",
+                                          "damage_state": "collapse"}])]},
+     "a column in collapse fell: state 'fallen'"),
+    ({"sites": [dict(GOOD_SITE, columns=[{"column": "drums", "state": "standing",
+                                          "damage_state": "cracked"}])]},
+     "'damage_state' must be one of none, slight, moderate, severe"),
+    ({"sites": [dict(GOOD_SITE, columns=[{"column": "drums", "state": "fallen",
+                                          "downfall_azimuth_deg": 10,
+                                          "damage_state": "severe"}])]},
+     "a fallen column is in collapse; damage_state describes a standing one"),
+    ({"sites": [dict(GOOD_SITE, columns=[{"column": "drums", "state": "standing",
+                                          "residual_slide_m": 0.02}])]},
+     "residual_slide_m and base_width_m go together"),
+    ({"sites": [dict(GOOD_SITE, columns=[{"column": "drums", "state": "standing",
+                                          "residual_slide_m": -0.02, "base_width_m": 1}])]},
+     "residual_slide_m -0.02 outside the allowed range"),
+    ({"sites": [dict(GOOD_SITE, columns=[{"column": "drums", "state": "standing",
+                                          "residual_slide_m": 0.02, "base_width_m": 0}])]},
+     "base_width_m 0 outside the allowed range"),
+    ({"sites": [dict(GOOD_SITE, columns=[{"column": "drums", "state": "standing",
+                                          "residual_slide_m": 0.02, "base_width_m": 1,
+                                          "damage_state": "slight"}])]},
+     "give damage_state or residual_slide_m with base_width_m, not both"),
     ({"sites": [dict(GOOD_SITE, columns=[{"column": "corinthian", "state": "standing"}])]},
      "column 'corinthian': no such file or shipped example"),
 ]
