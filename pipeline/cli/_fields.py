@@ -2,11 +2,12 @@
 :func:`pipeline.scenario.parameters.param` and a flag becomes one option, with its
 default, unit, bounds and help; parsed values go back through the dataclass, which
 checks them."""
+import argparse
 import dataclasses
 import typing
 from pathlib import Path
 
-from pipeline.files import display_path
+from pipeline.files import InputError, display_path
 
 
 def _help(f):
@@ -70,7 +71,22 @@ def add_arguments(parser, cls, names=None):
             kwargs.update(_tuple_kwargs(typing.get_args(kind)))
         else:
             kwargs["type"] = kind
+        if "action" not in kwargs and "nargs" not in kwargs:
+            kwargs["action"] = _Once
         parser.add_argument(meta["flag"], **kwargs)
+
+
+class _Once(argparse.Action):
+    """Store a flag's one value; the flag given again is noted (``_repeated``), and
+    :func:`from_args` refuses it: a later value would silently replace the first."""
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        if getattr(namespace, self.dest, None) is not None:
+            repeated = getattr(namespace, "_repeated", [])
+            setattr(namespace, "_repeated", repeated + [
+                f"{option_string} given more than once ({getattr(namespace, self.dest)} "
+                f"and {values}); give it once"])
+        setattr(namespace, self.dest, values)
 
 
 def _tuple_kwargs(args):
@@ -94,7 +110,11 @@ def _tuples(value):
 
 
 def from_args(cls, args, **fixed):
-    """An instance of ``cls`` from parsed arguments (fields left None keep defaults)."""
+    """An instance of ``cls`` from parsed arguments (fields left None keep defaults);
+    InputError when a one-value flag was given twice."""
+    repeated = getattr(args, "_repeated", None)
+    if repeated:
+        raise InputError(repeated[0])
     values = {f.name: getattr(args, f.name) for f in dataclasses.fields(cls)
               if getattr(args, f.name, None) is not None}
     values = {k: _tuples(v) for k, v in values.items()}

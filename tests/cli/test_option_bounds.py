@@ -255,3 +255,19 @@ def test_a_constant_amplitude_is_refused(tmp_path, capsys, noise_rad):
     err = refused(capsys, ["contact", "--free-rocking", str(record), "--block", f"{H},{B}",
                            "--out", str(out)])
     assert "do not decay" in err and not out.exists()
+
+
+@pytest.mark.parametrize("argv, flag", [
+    (["survival", "--median-g", "0.3", "--beta", "0.4", "--age-ka", "1", "--age-ka", "2"],
+     "--age-ka"),
+    (["campaign", "ensemble", "--record", "GM20", "--precision", "0.1", "--precision", "0.2"],
+     "--precision"),
+    (["survival", "--median-g", "0.3", "--beta", "0.4", "--draws", "10", "--draws", "10"],
+     "--draws"),
+])
+def test_a_one_value_flag_given_twice_is_refused(tmp_path, capsys, argv, flag):
+    """A later value would replace the first unseen: refused, naming the flag."""
+    out = tmp_path / "out"
+    err = refused(capsys, argv + ["--out", str(out)])
+    assert flag in err and "given more than once" in err
+    assert not out.exists()
