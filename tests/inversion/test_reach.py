@@ -33,14 +33,14 @@ def table(make_away_table):
                            distances=RINGS)
 
 
-def hidden_source(truth, sites, columns=12):
+def hidden_source(truth, sites, columns=12, share=share_toppled):
     """Observations of ``columns`` columns per site {name: (e, n)} of a source at
-    ``truth``: round(columns x share) fall away from it, the others stand."""
+    ``truth``: round(columns x share(distance km)) fall away from it, the others stand."""
     out = []
     for name, (e, n) in sites.items():
         r = math.hypot(e - truth[0], n - truth[1])
         away = math.degrees(math.atan2(e - truth[0], n - truth[1])) % 360.0
-        fallen = round(columns * share_toppled(r))
+        fallen = round(columns * share(r))
         out.append({"name": name, "east_km": e, "north_km": n, "columns": [
             {"column": "drums" if k % 2 else "monolithic", "state": "fallen",
              "downfall_azimuth_deg": away, "uncertainty_deg": 10} if k < fallen else
