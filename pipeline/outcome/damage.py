@@ -191,15 +191,17 @@ class DamageMeasures:
 
 
 # ---------------------------------------------------------------- geometry of the rims
-def rim_face_points(rim):
-    """Points (n, 3; m, body frame) of a rim's outline in its face (circles sampled)."""
+def rim_face_points(rim, circle_points=CIRCLE_POINTS, polygon="vertices"):
+    """Points (n, 3; m, body frame) of a rim's outline in its face: a points rim's points,
+    ``circle_points`` on a circle, a polygon's "vertices" or its perimeter "points"
+    (``polygon``)."""
     if rim["kind"] == "points":
         return np.asarray(rim["points"], float)
     if rim["kind"] == "circle":
-        angle = 2 * np.pi * np.arange(CIRCLE_POINTS) / CIRCLE_POINTS
+        angle = 2 * np.pi * np.arange(circle_points) / circle_points
         xy = rim["radius"] * np.column_stack([np.cos(angle), np.sin(angle)]) + rim["centre"]
     else:
-        xy = np.asarray(rim["vertices"], float)
+        xy = np.asarray(rim[polygon], float)
     n = np.asarray(rim.get("normal", (0.0, 0.0, 1.0)), float)
     return np.column_stack([xy, rim["z"] - (n[0] * xy[:, 0] + n[1] * xy[:, 1]) / n[2]])
 
