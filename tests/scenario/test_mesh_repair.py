@@ -396,16 +396,21 @@ def test_a_mesh_just_outside_the_sizes_says_its_size_in_enough_digits(tmp_path, 
     refused(path, f"is {shown} m across with units m: expected 0.02-30 m")
 
 
+def sp1_unshared(path, seed, jitter_m):
+    """SP1 written to ``path`` (OBJ) with every face's own corners, each coordinate moved
+    by up to ``jitter_m`` (m, uniform; generator seeded with ``seed``)."""
+    corners, triangles = split(*sp1_as_written())
+    corners = corners + np.random.default_rng(seed).uniform(-jitter_m, jitter_m, corners.shape)
+    path.write_text("".join(f"v {x:.17g} {y:.17g} {z:.17g}\n" for x, y, z in corners)
+                    + "".join(f"f {a + 1} {b + 1} {c + 1}\n" for a, b, c in triangles))
+    return path
+
+
 def test_sp1_with_unshared_jittered_corners_is_merged_and_said(tmp_path, capsys):
     """Every face with its own corners, each coordinate moved by up to 2 um (an
     exporter's rounding): the corners within 1e-5 of the size (7.9 um) are merged, and
     said; the specimen is SP1's to the jitter."""
-    vertices, faces = sp1_as_written()
-    corners, triangles = split(vertices, faces)
-    corners = corners + np.random.default_rng(2).uniform(-2e-6, 2e-6, corners.shape)
-    path = tmp_path / "sp1_jittered.obj"
-    path.write_text("".join(f"v {x:.17g} {y:.17g} {z:.17g}\n" for x, y, z in corners)
-                    + "".join(f"f {a + 1} {b + 1} {c + 1}\n" for a, b, c in triangles))
+    path = sp1_unshared(tmp_path / "sp1_jittered.obj", 2, 2e-6)
     with hang_bound(120):
         rock, shipped = load(path, mass_kg=SP1_MASS), load(SP1, mass_kg=SP1_MASS)
     assert rock.volume_m3 == pytest.approx(shipped.volume_m3, rel=1e-5)
@@ -416,10 +421,5 @@ def test_sp1_with_unshared_jittered_corners_is_merged_and_said(tmp_path, capsys)
 
 
 def test_sp1_with_corners_farther_apart_says_they_are_unshared(tmp_path):
-    vertices, faces = sp1_as_written()
-    corners, triangles = split(vertices, faces)
-    corners = corners + np.random.default_rng(3).uniform(-1e-4, 1e-4, corners.shape)
-    path = tmp_path / "sp1_apart.obj"
-    path.write_text("".join(f"v {x:.17g} {y:.17g} {z:.17g}\n" for x, y, z in corners)
-                    + "".join(f"f {a + 1} {b + 1} {c + 1}\n" for a, b, c in triangles))
+    path = sp1_unshared(tmp_path / "sp1_apart.obj", 3, 1e-4)
     refused(path, "its faces share few vertices, none closer than 7.9e-06 m")
