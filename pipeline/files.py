@@ -353,6 +353,15 @@ def csv_true(value):
     return isinstance(value, str) and value.strip().lower() == "true"
 
 
+def csv_number(value):
+    """A number read back from a CSV cell or a JSON value as a float; NaN for a missing or
+    unreadable one (None, "", text)."""
+    try:
+        return float(value)
+    except (TypeError, ValueError):
+        return math.nan
+
+
 def csv_true_column(series):
     """:func:`csv_true` of every cell of a pandas Series (a bool Series)."""
     return series.map(csv_true).astype(bool)
