@@ -6,39 +6,31 @@ a validator, then property-based fuzzing (Hypothesis) of arbitrary JSON-like val
 arbitrary bytes and text, and shipped files with one field changed to anything."""
 import copy
 import json
-import os
-import tempfile
-from pathlib import Path
 
 import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
-# Hypothesis keeps its example database and caches out of the source tree.
-os.environ.setdefault("HYPOTHESIS_STORAGE_DIRECTORY",
-                      str(Path(tempfile.gettempdir()) / "toppling-columns-hypothesis"))
-
-from hypothesis import HealthCheck, given, settings  # noqa: E402
-from hypothesis import strategies as st  # noqa: E402
-
-from pipeline import cli  # noqa: E402
-from pipeline.files import InputError  # noqa: E402
-from pipeline.inversion import EXAMPLES_DIR as OBSERVATION_EXAMPLES  # noqa: E402
-from pipeline.inversion.observations import COLUMN_KEYS as COLUMN_KEYS_OBS  # noqa: E402
-from pipeline.inversion.observations import (  # noqa: E402
+from pipeline import cli
+from pipeline.files import InputError
+from pipeline.inversion import EXAMPLES_DIR as OBSERVATION_EXAMPLES
+from pipeline.inversion.observations import COLUMN_KEYS as COLUMN_KEYS_OBS
+from pipeline.inversion.observations import (
     MAX_SITES,
     SITE_KEYS,
     Observations,
     load_observations,
     parse_observations,
 )
-from pipeline.userfiles import MAX_FILE_BYTES  # noqa: E402
-from pipeline.scenario.column_format import (  # noqa: E402
+from pipeline.userfiles import MAX_FILE_BYTES
+from pipeline.scenario.column_format import (
     BLOCK_KEYS,
     EXAMPLES_DIR,
     OPTIONAL_BLOCK_KEYS,
     TOP_KEYS,
     example_names,
 )
-from pipeline.scenario.geometry import ColumnGeometry  # noqa: E402
+from pipeline.scenario.geometry import ColumnGeometry
 
 yaml = pytest.importorskip("yaml")
 
