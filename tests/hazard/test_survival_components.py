@@ -12,6 +12,7 @@ from scipy import stats
 
 from pipeline import RECORDS_DIR, paper
 from pipeline.cli import main
+from tests.refusal import refused
 from pipeline.constants import STANDARD_GRAVITY
 from pipeline.hazard import load_hazard
 from pipeline.hazard.fragility.components import records_fraction
@@ -295,12 +296,9 @@ def test_quantile_curves_of_one_calculation_order_the_survival(tmp_path):
 
 def test_below_grid_without_a_grid_is_refused_in_one_line(tmp_path, capsys):
     out = tmp_path / "out"
-    assert main(["survival", "--hazard", str(CASE_37["mean"]), "--site", "0", "--median-g",
-                 "0.2", "--beta", "0.4", "--age-ka", "1", "--below-grid", "zero",
-                 "--out", str(out)]) == 2
-    err = capsys.readouterr().err.strip()
-    assert "--below-grid applies to a pulse-grid" in err and len(err.splitlines()) == 1
-    assert not out.exists()
+    refused(capsys, ["survival", "--hazard", CASE_37["mean"], "--site", "0", "--median-g",
+                     "0.2", "--beta", "0.4", "--age-ka", "1", "--below-grid", "zero",
+                     "--out", out], "--below-grid applies to a pulse-grid", out)
 
 
 def test_beside_and_above_the_grid_p_carries_the_surface_from_the_edge(tmp_path):

@@ -19,6 +19,7 @@ from pipeline.inversion.likelihood import ForwardModel
 from pipeline.inversion.observations import parse_observations
 from pipeline.inversion.candidates import CandidateGrid
 from pipeline.inversion.posterior import EDGE_BAYES_FACTOR, invert
+from tests.refusal import refused
 
 RINGS = (2.5, 5.0, 10.0)
 MEMBERS = 8
@@ -169,11 +170,8 @@ def refuses_hidden_truth(table, tmp_path, capsys, sites, words):
         "sites": [{"name": name, "east_km": e, "north_km": n, "twins": twins}
                   for name, e, n, twins in sites]}))
     out = tmp_path / "out"
-    assert cli.main(["invert", "--hidden-truth", str(truth), "--table", str(path),
-                     "--out", str(out)]) == 2
-    err = capsys.readouterr().err
-    assert words in err and len(err.strip().splitlines()) == 1
-    assert not out.exists()
+    refused(capsys, ["invert", "--hidden-truth", truth, "--table", path, "--out", out], words,
+            out)
 
 
 def test_a_hidden_truth_out_of_reach_is_refused_before_any_run(table, tmp_path, capsys):
