@@ -362,6 +362,21 @@ def csv_number(value):
         return math.nan
 
 
+def finite_number(value, name, minimum=-math.inf):
+    """``value`` as a finite float >= ``minimum`` (None stays None: not known); else an
+    InputError naming ``name``."""
+    if value is None:
+        return None
+    try:
+        value = float(value)
+    except (TypeError, ValueError):
+        raise InputError(f"{name} must be a number, got {value!r}") from None
+    if not (math.isfinite(value) and value >= minimum):
+        bound = "" if minimum == -math.inf else f" >= {minimum:g}"
+        raise InputError(f"{name} must be a finite number{bound}, got {value!r}")
+    return value
+
+
 def csv_true_column(series):
     """:func:`csv_true` of every cell of a pandas Series (a bool Series)."""
     return series.map(csv_true).astype(bool)

@@ -28,7 +28,7 @@ import numpy as np
 from scipy.spatial import ConvexHull
 from scipy.spatial.transform import Rotation
 
-from pipeline.files import InputError
+from pipeline.files import InputError, finite_number
 
 CIRCLE_POINTS = 360          # points on a circular face's outline
 
@@ -66,16 +66,9 @@ LEVELS = DamageLevels()
 
 
 def _number(value, name, minimum=0.0, allow_none=False):
-    if value is None and allow_none:
-        return None
-    try:
-        value = float(value)
-    except (TypeError, ValueError):
-        raise InputError(f"damage: {name} must be a number, got {value!r}") from None
-    if not (math.isfinite(value) and value >= minimum):
-        raise InputError(f"damage: {name} must be a finite number >= {minimum:g}, "
-                         f"got {value!r}")
-    return value
+    if value is None and not allow_none:
+        raise InputError(f"damage: {name} must be a number, got None")
+    return finite_number(value, f"damage: {name}", minimum)
 
 
 @dataclass(frozen=True, kw_only=True)
