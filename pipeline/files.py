@@ -353,6 +353,30 @@ def csv_true(value):
     return isinstance(value, str) and value.strip().lower() == "true"
 
 
+def csv_number(value):
+    """A number read back from a CSV cell or a JSON value as a float; NaN for a missing or
+    unreadable one (None, "", text)."""
+    try:
+        return float(value)
+    except (TypeError, ValueError):
+        return math.nan
+
+
+def finite_number(value, name, minimum=-math.inf):
+    """``value`` as a finite float >= ``minimum`` (None stays None: not known); else an
+    InputError naming ``name``."""
+    if value is None:
+        return None
+    try:
+        value = float(value)
+    except (TypeError, ValueError):
+        raise InputError(f"{name} must be a number, got {value!r}") from None
+    if not (math.isfinite(value) and value >= minimum):
+        bound = "" if minimum == -math.inf else f" >= {minimum:g}"
+        raise InputError(f"{name} must be a finite number{bound}, got {value!r}")
+    return value
+
+
 def csv_true_column(series):
     """:func:`csv_true` of every cell of a pandas Series (a bool Series)."""
     return series.map(csv_true).astype(bool)

@@ -2,6 +2,8 @@
 import math
 import os
 import signal
+import tempfile
+from pathlib import Path
 
 import matplotlib
 import numpy as np
@@ -11,6 +13,9 @@ from scipy.spatial.transform import Rotation
 
 matplotlib.use("Agg")
 os.environ.setdefault("MPLBACKEND", "Agg")
+# Hypothesis keeps its example database and caches out of the source tree.
+os.environ.setdefault("HYPOTHESIS_STORAGE_DIRECTORY",
+                      str(Path(tempfile.gettempdir()) / "toppling-columns-hypothesis"))
 
 from pipeline.motion import Motion  # noqa: E402
 from pipeline.motion.pulses import one_sine_pulse  # noqa: E402

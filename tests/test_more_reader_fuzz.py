@@ -4,21 +4,14 @@ a file holds, the reader returns a valid result or one InputError (the CLI: exit
 line), never another exception, and the CLI writes nothing when it refuses."""
 import json
 import math
-import os
-import tempfile
-from pathlib import Path
 
-# Hypothesis keeps its example database and caches out of the source tree.
-os.environ.setdefault("HYPOTHESIS_STORAGE_DIRECTORY",
-                      str(Path(tempfile.gettempdir()) / "toppling-columns-hypothesis"))
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
-from hypothesis import HealthCheck, given, settings  # noqa: E402
-from hypothesis import strategies as st  # noqa: E402
-
-from pipeline import cli  # noqa: E402
-from pipeline.files import InputError  # noqa: E402
-from pipeline.records.readers import lab_table  # noqa: E402
-from pipeline.scenario.contact_file import CONTACT_KEYS, contact_values  # noqa: E402
+from pipeline import cli
+from pipeline.files import InputError
+from pipeline.records.readers import lab_table
+from pipeline.scenario.contact_file import CONTACT_KEYS, contact_values
 
 FUZZ = settings(max_examples=120, deadline=None, database=None,
                 suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large,

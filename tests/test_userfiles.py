@@ -4,10 +4,8 @@ took paths of their own go through it.  Each test has a generous hang bound, so 
 regression fails instead of hanging."""
 import os
 import shutil
-import signal
 import subprocess
 import sys
-from contextlib import contextmanager
 from pathlib import Path
 
 import pytest
@@ -16,23 +14,15 @@ from pipeline import PROJECT_ROOT
 from pipeline.files import InputError
 from pipeline.userfiles import (check_regular, read_bytes, read_json, read_text,
                                 read_user_bytes, read_user_text, Unreadable)
+from tests.hang import hang_bound as bound
 
 HANG_S = 60       # far beyond what refusing a file takes; reached only by a blocked open
 
 
-@contextmanager
 def hang_bound(seconds=HANG_S):
-    """Raise AssertionError in the main thread once ``seconds`` pass (a blocked open of a
-    named pipe is interrupted by the signal)."""
-    def alarm(*_):
-        raise AssertionError(f"no answer within {seconds} s: a blocked read")
-    previous = signal.signal(signal.SIGALRM, alarm)
-    signal.alarm(seconds)
-    try:
-        yield
-    finally:
-        signal.alarm(0)
-        signal.signal(signal.SIGALRM, previous)
+    """Raise AssertionError once ``seconds`` pass (a blocked open of a named pipe is
+    interrupted by the signal)."""
+    return bound(seconds, AssertionError, ": a blocked read")
 
 
 def command(*args, timeout=3 * HANG_S):

@@ -56,15 +56,8 @@ def parse_pulses(text):
     text = str(text).strip()
     text = PULSE_PRESETS.get(text.lower(), text)
     axes = {}
-    for item in text.split(";"):
-        if not item.strip():
-            continue
-        name, _, value = (s.strip() for s in item.partition("="))
-        if name not in PULSE_AXES:
-            raise InputError(f"--pulses: unknown axis {name!r} (give pga_g=LO:HI:N;"
-                             "pgv_pga_s=LO:HI:N, or the preset vsr)")
-        if name in axes:
-            raise InputError(f"--pulses names {name} twice")
+    for name, value in _items(text, "--pulses", PULSE_AXES, "axis",
+                              "give pga_g=LO:HI:N;pgv_pga_s=LO:HI:N, or the preset vsr"):
         parts = value.split(":")
         try:
             lo, hi, n = float(parts[0]), float(parts[1]), parts[2]
@@ -74,10 +67,7 @@ def parse_pulses(text):
         except (ValueError, IndexError):
             raise InputError(f"--pulses {name}={value!r}: expected LO:HI:N (N a whole "
                              "number)") from None
-        low, high = PULSE_AXES[name]
-        if not (math.isfinite(lo) and math.isfinite(hi) and low <= lo <= hi <= high):
-            raise InputError(f"--pulses {name}: need {low:g} <= LO <= HI <= {high:g}, got "
-                             f"{value}")
+        _check_span("--pulses", name, value, lo, hi, PULSE_AXES[name])
         if not 1 <= n <= MAX_AXIS_SIZE or (n == 1) != (lo == hi):
             raise InputError(f"--pulses {name}: N must be 1-{MAX_AXIS_SIZE}, and 1 exactly "
                              f"when LO = HI, got {value}")
@@ -97,29 +87,42 @@ def parse_ranges(text, mesh=True):
     ranges = {}
     for source in ((DEFAULT_RANGES,) if mesh else ()) + (text or "",):
         given = {}
-        for item in source.split(";"):
-            if not item.strip():
-                continue
-            name, _, value = (s.strip() for s in item.partition("="))
-            if name not in RANGE_BOUNDS:
-                raise InputError(f"--ranges: unknown parameter {name!r} (known: "
-                                 f"{', '.join(RANGE_BOUNDS)})")
-            if name in given:
-                raise InputError(f"--ranges names {name} twice")
+        for name, value in _items(source, "--ranges", RANGE_BOUNDS, "parameter",
+                                  f"known: {', '.join(RANGE_BOUNDS)}"):
             try:
                 lo, hi = (float(v) for v in value.split(":"))
             except ValueError:
                 raise InputError(f"--ranges {name}={value!r}: expected LO:HI") from None
-            low, high = RANGE_BOUNDS[name]
-            if not (math.isfinite(lo) and math.isfinite(hi) and low <= lo <= hi <= high):
-                raise InputError(f"--ranges {name}: need {low:g} <= LO <= HI <= {high:g}, "
-                                 f"got {value}")
+            _check_span("--ranges", name, value, lo, hi, RANGE_BOUNDS[name])
             given[name] = (lo, hi)
         if "footprint_tolerance_m" in given and not mesh:
             raise InputError("--ranges footprint_tolerance_m: only a mesh specimen has a "
                              "footprint tolerance")
         ranges.update(given)
     return ranges
+
+
+def _items(text, flag, known, what, hint):
+    """(name, value) of each ``name=value`` of ``text`` (``;`` between them), each name one
+    of ``known`` and given once; else InputError naming ``flag``, ``what`` and ``hint``."""
+    seen = set()
+    for item in text.split(";"):
+        if not item.strip():
+            continue
+        name, _, value = (s.strip() for s in item.partition("="))
+        if name not in known:
+            raise InputError(f"{flag}: unknown {what} {name!r} ({hint})")
+        if name in seen:
+            raise InputError(f"{flag} names {name} twice")
+        seen.add(name)
+        yield name, value
+
+
+def _check_span(flag, name, value, lo, hi, bounds):
+    """InputError unless LO and HI are finite and ``bounds[0] <= lo <= hi <= bounds[1]``."""
+    low, high = bounds
+    if not (math.isfinite(lo) and math.isfinite(hi) and low <= lo <= hi <= high):
+        raise InputError(f"{flag} {name}: need {low:g} <= LO <= HI <= {high:g}, got {value}")
 
 
 def sample_sets(members, seed, ranges):

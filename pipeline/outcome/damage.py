@@ -28,7 +28,7 @@ import numpy as np
 from scipy.spatial import ConvexHull
 from scipy.spatial.transform import Rotation
 
-from pipeline.files import InputError
+from pipeline.files import InputError, finite_number
 
 CIRCLE_POINTS = 360          # points on a circular face's outline
 
@@ -66,16 +66,9 @@ LEVELS = DamageLevels()
 
 
 def _number(value, name, minimum=0.0, allow_none=False):
-    if value is None and allow_none:
-        return None
-    try:
-        value = float(value)
-    except (TypeError, ValueError):
-        raise InputError(f"damage: {name} must be a number, got {value!r}") from None
-    if not (math.isfinite(value) and value >= minimum):
-        raise InputError(f"damage: {name} must be a finite number >= {minimum:g}, "
-                         f"got {value!r}")
-    return value
+    if value is None and not allow_none:
+        raise InputError(f"damage: {name} must be a number, got None")
+    return finite_number(value, f"damage: {name}", minimum)
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -191,15 +184,17 @@ class DamageMeasures:
 
 
 # ---------------------------------------------------------------- geometry of the rims
-def rim_face_points(rim):
-    """Points (n, 3; m, body frame) of a rim's outline in its face (circles sampled)."""
+def rim_face_points(rim, circle_points=CIRCLE_POINTS, polygon="vertices"):
+    """Points (n, 3; m, body frame) of a rim's outline in its face: a points rim's points,
+    ``circle_points`` on a circle, a polygon's "vertices" or its perimeter "points"
+    (``polygon``)."""
     if rim["kind"] == "points":
         return np.asarray(rim["points"], float)
     if rim["kind"] == "circle":
-        angle = 2 * np.pi * np.arange(CIRCLE_POINTS) / CIRCLE_POINTS
+        angle = 2 * np.pi * np.arange(circle_points) / circle_points
         xy = rim["radius"] * np.column_stack([np.cos(angle), np.sin(angle)]) + rim["centre"]
     else:
-        xy = np.asarray(rim["vertices"], float)
+        xy = np.asarray(rim[polygon], float)
     n = np.asarray(rim.get("normal", (0.0, 0.0, 1.0)), float)
     return np.column_stack([xy, rim["z"] - (n[0] * xy[:, 0] + n[1] * xy[:, 1]) / n[2]])
 

@@ -7,7 +7,7 @@ import math
 from dataclasses import dataclass, field, fields
 from pathlib import Path
 
-from pipeline.files import InputError, read_run_json, write_json
+from pipeline.files import InputError, finite_number, read_run_json, write_json
 from pipeline.outcome.colonnade import ColonnadeOutcome
 from pipeline.outcome.damage import DamageMeasures, damage_at_rest
 
@@ -21,23 +21,9 @@ def _azimuth_or_none(value, name):
     return value
 
 
-def _finite(value, name, minimum=-math.inf):
-    """``value`` as a finite float >= ``minimum`` (None stays None: not known)."""
-    if value is None:
-        return None
-    try:
-        value = float(value)
-    except (TypeError, ValueError):
-        raise InputError(f"{name} must be a number, got {value!r}") from None
-    if not (math.isfinite(value) and value >= minimum):
-        bound = "" if minimum == -math.inf else f" >= {minimum:g}"
-        raise InputError(f"{name} must be a finite number{bound}, got {value!r}")
-    return value
-
-
 def _non_negative(value, name):
     """``value`` as a float >= 0 (None stays None: not known)."""
-    return _finite(value, name, minimum=0.0)
+    return finite_number(value, name, minimum=0.0)
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -159,7 +145,7 @@ class RunSummary:
             object.__setattr__(self, name, _non_negative(getattr(self, name),
                                                          f"run summary: {name}"))
         for name in ("motion_end_s", "start_in_file_s"):       # times: may be negative
-            object.__setattr__(self, name, _finite(getattr(self, name),
+            object.__setattr__(self, name, finite_number(getattr(self, name),
                                                    f"run summary: {name}"))
         if isinstance(self.colonnade, dict):
             try:

@@ -25,7 +25,7 @@ from pathlib import Path
 import pandas as pd
 
 from pipeline import paper
-from pipeline.files import InputError, csv_true, write_json
+from pipeline.files import InputError, csv_number, csv_true, write_json
 from pipeline.records.catalog import catalog
 from pipeline.motion.measures import record_parameters
 from pipeline.records import CACHE_DIR, processed_motion, resolve
@@ -80,7 +80,7 @@ def selection(cache_dir=None, pga=None):
     rows, recordings = [], {}
     for _, row in table.iterrows():
         value, reason = math.nan, ""
-        distance, baz = _number(row.get("epicentral_distance_km")), _number(
+        distance, baz = csv_number(row.get("epicentral_distance_km")), csv_number(
             row.get("back_azimuth_deg"))
         if not _true(row.get("usable", True)):
             reason = "unusable (see notes)"
@@ -135,13 +135,6 @@ def horizontal_pga(record_id, cache_dir=None):
     write_json(path, {"record_id": source.id, "input_hash": key, "pga_h": value,
                       "units": "m/s^2", "measure": "peak of the horizontal acceleration vector"})
     return value
-
-
-def _number(value):
-    try:
-        return float(value)
-    except (TypeError, ValueError):
-        return math.nan
 
 
 def _true(value):

@@ -4,6 +4,7 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
+
 from pipeline.stats.circular import circular_summary
 
 
@@ -31,13 +32,6 @@ def _spread(azimuths):
 
 def _table(frame):
     return frame.to_markdown(index=False) if frame is not None and not frame.empty else "(none)"
-
-
-def _float(value):
-    try:
-        return float(value)
-    except (TypeError, ValueError):
-        return math.nan
 
 
 def _percent(value):

@@ -6,8 +6,8 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from pipeline.files import csv_true, csv_true_column
-from pipeline.report.common import _figure, _float, _fmt, _p, _percent, _read_csv, _table
+from pipeline.files import csv_number, csv_true, csv_true_column
+from pipeline.report.common import _figure, _fmt, _p, _percent, _read_csv, _table
 from pipeline.stats.ensemble import wilson_interval
 from pipeline import paper
 from pipeline.records.catalog import catalog_row
@@ -117,11 +117,12 @@ def per_record_table(runs):
     for index, run in runs.iterrows():
         record = str(run["record_id"])
         row = rows.setdefault(record, {
-            "record": record, "distance (km)": _fmt(_float(run.get("epicentral_distance_km")), 1),
-            "back azimuth (deg)": _fmt(_float(run.get("back_azimuth_deg"))),
-            "PGA (m/s^2)": _fmt(_float(run.get("pga_h")), 2)})
+            "record": record,
+            "distance (km)": _fmt(csv_number(run.get("epicentral_distance_km")), 1),
+            "back azimuth (deg)": _fmt(csv_number(run.get("back_azimuth_deg"))),
+            "PGA (m/s^2)": _fmt(csv_number(run.get("pga_h")), 2)})
         column = run["column"]
-        azimuth = _float(run.get("downfall_azimuth_deg"))
+        azimuth = csv_number(run.get("downfall_azimuth_deg"))
         row[f"{column} (deg)"] = (_fmt(azimuth) if run["toppled"] and math.isfinite(azimuth)
                                   else "toppled" if run["toppled"] else "stands")
         if not run["toppled"]:
@@ -156,7 +157,7 @@ def _column_statement(column, fractions, directions, correlations):
             f"{_percent(f['ci_low'])}-{_percent(f['ci_high'])}; each run is a sample: a "
             f"record near its threshold can flip with a CPU's last bits, so the count is "
             f"known to its interval, not exactly)")
-    if "paper_toppled" in f and math.isfinite(_float(f.get("paper_fraction"))):
+    if "paper_toppled" in f and math.isfinite(csv_number(f.get("paper_fraction"))):
         inside = f["ci_low"] <= f["paper_fraction"] <= f["ci_high"]
         text += (f"; the paper: {int(f['paper_toppled'])} of {int(f['paper_records'])} "
                  f"({_percent(f['paper_fraction'])}, {_percent(f['paper_ci_low'])}-"
@@ -174,7 +175,7 @@ def _column_statement(column, fractions, directions, correlations):
              f"the epicentre (within 45 deg of the back azimuth), {int(d['away'])} away and "
              f"{int(d['transverse'])} transverse; directions independent of the source "
              f"would give about {n / 4:.1f}, {n / 4:.1f} and {n / 2:.1f}.")
-    p_dir, p_ax = _float(d.get("rayleigh_p")), _float(d.get("axial_rayleigh_p"))
+    p_dir, p_ax = csv_number(d.get("rayleigh_p")), csv_number(d.get("axial_rayleigh_p"))
     if n < MIN_FALLS:
         return text + (f" Too few falls (fewer than {MIN_FALLS}) to test whether they are "
                        "concentrated relative to the back azimuth."), None
@@ -209,7 +210,7 @@ def _correlation_text(column, correlations, n):
     if c is not None and not c.empty:
         parts = []
         for _, r in c.iterrows():
-            value = _float(r["circcorr"])
+            value = csv_number(r["circcorr"])
             if math.isfinite(value):
                 parts.append(f"{REFERENCE_NAMES.get(r['reference'], r['reference'])} "
                              f"{value:+.2f}")
@@ -303,11 +304,11 @@ def records_section(results):
             "fraction (95 % Wilson)": [f"{_percent(f)} ({_percent(lo)}-{_percent(hi)})"
                                        for f, lo, hi in zip(shown["fraction"], shown["ci_low"],
                                                             shown["ci_high"])],
-            "paper": [f"{int(k)}/{int(n)}" if math.isfinite(_float(k)) else "-"
+            "paper": [f"{int(k)}/{int(n)}" if math.isfinite(csv_number(k)) else "-"
                       for k, n in zip(shown.get("paper_toppled", [math.nan] * len(shown)),
                                       shown.get("paper_records", [math.nan] * len(shown)))],
             "paper fraction (95 % Wilson)": [
-                f"{_percent(f)} ({_percent(lo)}-{_percent(hi)})" if math.isfinite(_float(f))
+                f"{_percent(f)} ({_percent(lo)}-{_percent(hi)})" if math.isfinite(csv_number(f))
                 else "-" for f, lo, hi in zip(*(shown.get(c, [math.nan] * len(shown)) for c in (
                     "paper_fraction", "paper_ci_low", "paper_ci_high")))]})
     lines.append("Toppled records:\n\n" + _table(shown) + "\n")

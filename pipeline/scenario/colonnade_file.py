@@ -17,7 +17,7 @@ from pipeline.files import InputError
 from pipeline.scenario.colonnade import Beam, Colonnade, Course, PlacedColumn, Stylobate
 from pipeline.scenario.column_format import (DENSITY_RANGE, EXAMPLES_DIR, _check_keys,
                                              _one_line, _parse_json, _parse_yaml,
-                                             example_names)
+                                             example_names, shipped_or_file)
 from pipeline.scenario.geometry import ColumnGeometry
 from pipeline.userfiles import MAX_NESTING, read_text
 from pipeline.userfiles import Unreadable as _Unreadable
@@ -77,17 +77,8 @@ def load_if_colonnade(value):
 
 def _found(name_or_path):
     """The Path of a shipped colonnade's name or of a file; InputError when neither."""
-    text = str(name_or_path)
-    path = Path(text)
-    shipped = COLONNADES_DIR / f"{text}.json"
-    try:
-        if path.suffix == "" and "/" not in text and shipped.is_file():
-            path = shipped
-        found = path.is_file()
-    except (OSError, ValueError):
-        found = False
+    path, found, shown = shipped_or_file(name_or_path, COLONNADES_DIR)
     if not found:
-        shown = text if text.isprintable() and len(text) <= 300 else _show(text)
         raise InputError(f"colonnade {shown}: no such file or shipped colonnade (shipped: "
                          f"{', '.join(shipped_names())})")
     return path

@@ -161,3 +161,20 @@ def _parse_block(raw, where, index):
 def example_names():
     """Names of the shipped column descriptions."""
     return sorted(p.stem for p in EXAMPLES_DIR.glob("*.json"))
+
+
+def shipped_or_file(name_or_path, directory):
+    """(path, found, shown) of a description named by the user: the shipped
+    ``directory/<name>.json`` for a bare name it holds, else the path as given; ``found``:
+    it is a file (False for a name no file system takes: too long, a NUL byte);
+    ``shown``: the name as a message may print it."""
+    text = str(name_or_path)
+    path = Path(text)
+    shipped = directory / f"{text}.json"
+    try:
+        if path.suffix == "" and "/" not in text and shipped.is_file():
+            path = shipped
+        found = path.is_file()
+    except (OSError, ValueError):
+        found = False
+    return path, found, text if text.isprintable() and len(text) <= 300 else _show(text)

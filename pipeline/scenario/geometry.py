@@ -42,7 +42,6 @@ The file format: :mod:`pipeline.scenario.column_format`; solids:
 """
 import math
 from dataclasses import dataclass, field, replace
-from pathlib import Path
 
 import numpy as np
 
@@ -52,7 +51,7 @@ from pipeline.scenario.bodies import _build, _statics, column_scene
 from pipeline.scenario.column_format import (DENSITY_RANGE, EXAMPLES_DIR, MAX_BLOCKS,
                                              MAX_COLUMN_HEIGHT_M, TOP_KEYS, _check_keys, _number,
                                              _one_line, _parse_block, _parse_json, _parse_yaml,
-                                             example_names)
+                                             example_names, shipped_or_file)
 from pipeline.scenario.mesh import MESH_SUFFIXES, MeshSpecimen
 from pipeline.scenario.outline import perimeter_points
 from pipeline.scenario.solids import Box, ColumnBlock, Frustum
@@ -61,7 +60,6 @@ from pipeline.userfiles import MAX_NESTING, read_text
 from pipeline.userfiles import Unreadable as _Unreadable
 from pipeline.userfiles import keys_text as _keys
 from pipeline.userfiles import nesting as _nesting
-from pipeline.userfiles import show as _show
 
 
 @dataclass(frozen=True)
@@ -117,20 +115,11 @@ class ColumnGeometry(Specimen):
         files over MAX_FILE_BYTES are refused unread, and nesting beyond MAX_NESTING,
         integers over MAX_INT_DIGITS digits and YAML tags other than the standard ones
         are refused while parsing."""
-        text = str(name_or_path)
-        path = Path(text)
-        shipped = EXAMPLES_DIR / f"{text}.json"
-        try:
-            if path.suffix == "" and "/" not in text and shipped.is_file():
-                path = shipped
-            found = path.is_file()
-        except (OSError, ValueError):              # a name too long, a NUL byte
-            found = False
+        path, found, shown = shipped_or_file(name_or_path, EXAMPLES_DIR)
         if found and path.suffix.lower() in MESH_SUFFIXES:
             return MeshSpecimen.load(path)
         if not found:
             known = ", ".join(example_names())
-            shown = text if text.isprintable() and len(text) <= 300 else _show(text)
             raise InputError(f"--column-file {shown}: no such file or shipped example "
                              f"(shipped: {known})")
         yaml_file = path.suffix.lower() in (".yaml", ".yml")

@@ -20,6 +20,7 @@ from pipeline.constants import (
     STANDS_AXIS_Z,
 )
 from pipeline.files import write_json
+from pipeline.outcome.damage import rim_face_points
 import numpy as np
 from scipy.spatial.transform import Rotation
 
@@ -184,15 +185,7 @@ def base_points(body, circle_points=720):
     """Points (n, 3; m, body frame about the centre of mass) of the outline a scene body
     (a :class:`SceneBody` as a dict) stands on: its base rim, in the rim's face."""
     rim = next(r for r in body["rims"] if r["role"] == "base")
-    if rim["kind"] == "points":
-        return np.asarray(rim["points"], float)
-    if rim["kind"] == "circle":
-        angle = 2 * np.pi * np.arange(circle_points) / circle_points
-        xy = rim["radius"] * np.column_stack([np.cos(angle), np.sin(angle)]) + rim["centre"]
-    else:
-        xy = np.asarray(rim["points"], float)
-    n = np.asarray(rim["normal"], float)
-    return np.column_stack([xy, rim["z"] - (n[0] * xy[:, 0] + n[1] * xy[:, 1]) / n[2]])
+    return rim_face_points(rim, circle_points, polygon="points")
 
 
 def support_line(column, azimuth_deg):

@@ -167,6 +167,13 @@ def worker_yade_processes(cluster):
     return list(scene_processes(cluster))
 
 
+def wait_for(condition, seconds):
+    """Poll ``condition`` every 0.05 s until it holds or ``seconds`` (s) pass (a bound)."""
+    deadline = time.monotonic() + seconds
+    while not condition() and time.monotonic() < deadline:
+        time.sleep(0.05)
+
+
 def campaign_args(records, out, *extra):
     return ["campaign", "records", "--records", ",".join(map(str, records)), "--out", str(out),
             "--animations", "0", *extra]
@@ -214,9 +221,7 @@ def test_a_worker_runs_its_tasks_in_one_yade_process_and_keeps_none_after(tmp_pa
               if line.startswith("run_scene.py --serve: process ")]
     assert len(served) == 6
     assert len(set(served)) <= 2                     # two workers: one YADE process each
-    deadline = time.monotonic() + 5
-    while worker_yade_processes(cluster) and time.monotonic() < deadline:
-        time.sleep(0.05)
+    wait_for(lambda: not worker_yade_processes(cluster), 5)
     assert not worker_yade_processes(cluster), "idle YADE processes outlived the campaign"
 
 
@@ -227,9 +232,7 @@ def test_ctrl_c_on_a_cluster_stops_and_kills_its_runs(tmp_path, cluster):
     records = [pulse_npz(tmp_path / f"p{k}.npz", 45.0 * k, duration=20.0) for k in range(2)]
     out = tmp_path / "camp"
     proc = cli_process(*campaign_args(records, out, "--scheduler", cluster.address))
-    deadline = time.monotonic() + 60
-    while not task_yade_processes(cluster) and time.monotonic() < deadline:
-        time.sleep(0.05)
+    wait_for(lambda: task_yade_processes(cluster), 60)
     assert task_yade_processes(cluster), "no YADE run started on the workers"
     sent = time.monotonic()
     proc.send_signal(signal.SIGINT)
@@ -237,9 +240,7 @@ def test_ctrl_c_on_a_cluster_stops_and_kills_its_runs(tmp_path, cluster):
     assert time.monotonic() - sent < 30.0
     assert proc.returncode == 130
     assert json.loads((out / "campaign.json").read_text())["interrupted"] is True
-    deadline = time.monotonic() + 5
-    while task_yade_processes(cluster) and time.monotonic() < deadline:
-        time.sleep(0.05)
+    wait_for(lambda: not task_yade_processes(cluster), 5)
     assert not task_yade_processes(cluster), "the workers kept running the interrupted campaign"
 
 
@@ -255,9 +256,7 @@ def test_a_killed_worker_loses_no_finished_result(tmp_path, cluster):
         return (any(out.glob("runs/*/summary.json"))
                 and victim.pid in task_yade_processes(cluster).values())
 
-    deadline = time.monotonic() + 90
-    while not ready() and time.monotonic() < deadline:
-        time.sleep(0.05)
+    wait_for(ready, 90)
     assert ready(), "no result, or the third worker runs nothing"
     finished = {p.parent.name: p.read_bytes() for p in out.glob("runs/*/summary.json")}
     victim.send_signal(signal.SIGKILL)

@@ -2,22 +2,13 @@
 holds, the reader returns a valid disaggregation or raises one InputError whose message
 is one line naming the file; never another exception.  What loads has non-negative,
 finite bin rates."""
-import os
-import tempfile
-from pathlib import Path
-
 import numpy as np
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
-# Hypothesis keeps its example database and caches out of the source tree.
-os.environ.setdefault("HYPOTHESIS_STORAGE_DIRECTORY",
-                      str(Path(tempfile.gettempdir()) / "toppling-columns-hypothesis"))
-
-from hypothesis import HealthCheck, given, settings  # noqa: E402
-from hypothesis import strategies as st  # noqa: E402
-
-from pipeline import RECORDS_DIR  # noqa: E402
-from pipeline.files import InputError  # noqa: E402
-from pipeline.hazard.disaggregation import load_mag_dist  # noqa: E402
+from pipeline import RECORDS_DIR
+from pipeline.files import InputError
+from pipeline.hazard.disaggregation import load_mag_dist
 
 SOURCE = (RECORDS_DIR / "hazard" / "openquake_postproc_case_mrd" / "disaggregation"
           / "Mag_Dist-0_7.csv").read_text().splitlines()

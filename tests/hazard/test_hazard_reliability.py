@@ -9,6 +9,7 @@ import pytest
 
 from pipeline import RECORDS_DIR
 from pipeline.cli import main
+from tests.refusal import refused
 
 CASE_11 = RECORDS_DIR / "hazard" / "openquake_logictree_case_11"
 CASE_14 = RECORDS_DIR / "hazard" / "oq_classical_case_14_hazard_curve-rlz-000_PGA.csv"
@@ -78,12 +79,9 @@ def test_constrain_refuses_one_fragility_given_twice(tmp_path, capsys, as_direct
 
 def test_survival_refuses_one_hazard_curve_given_twice(tmp_path, capsys):
     out = tmp_path / "out"
-    assert main(["survival", "--hazard", str(CASE_14), "--hazard", str(CASE_14), "--site",
-                 "0", "--median-g", "0.3", "--beta", "0.4", "--age-ka", "2",
-                 "--out", str(out)]) == 2
-    err = capsys.readouterr().err.strip()
-    assert "the same curve twice" in err and len(err.splitlines()) == 1
-    assert not out.exists()
+    refused(capsys, ["survival", "--hazard", CASE_14, "--hazard", CASE_14, "--site", "0",
+                     "--median-g", "0.3", "--beta", "0.4", "--age-ka", "2", "--out", out],
+            "the same curve twice", out)
 
 
 def test_campaign_columns_refuses_one_description_given_twice(tmp_path):

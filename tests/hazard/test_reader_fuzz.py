@@ -8,27 +8,20 @@ rise."""
 import copy
 import json
 import math
-import os
-import tempfile
 from pathlib import Path
 
 import numpy as np
 import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
-# Hypothesis keeps its example database and caches out of the source tree.
-os.environ.setdefault("HYPOTHESIS_STORAGE_DIRECTORY",
-                      str(Path(tempfile.gettempdir()) / "toppling-columns-hypothesis"))
+from pipeline.constants import STANDARD_GRAVITY
+from pipeline.files import InputError
+from pipeline.hazard import load_hazard
+from pipeline.hazard.curves import HazardCurve
+from pipeline.hazard.fragility import load_campaign_fragility
 
-from hypothesis import HealthCheck, given, settings  # noqa: E402
-from hypothesis import strategies as st  # noqa: E402
-
-from pipeline.constants import STANDARD_GRAVITY  # noqa: E402
-from pipeline.files import InputError  # noqa: E402
-from pipeline.hazard import load_hazard  # noqa: E402
-from pipeline.hazard.curves import HazardCurve  # noqa: E402
-from pipeline.hazard.fragility import load_campaign_fragility  # noqa: E402
-
-from tests.hazard.test_reader_robustness import COLUMN, USGS_DOC, grid_document  # noqa: E402
+from tests.hazard.test_reader_robustness import COLUMN, USGS_DOC, grid_document
 
 FUZZ = settings(max_examples=150, deadline=None, database=None,
                 suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large,

@@ -12,6 +12,7 @@ from scipy import stats
 
 from pipeline import RECORDS_DIR, paper
 from pipeline.cli import main
+from tests.refusal import refused
 from pipeline.constants import STANDARD_GRAVITY
 from pipeline.hazard import load_hazard
 from pipeline.hazard.fragility.components import records_fraction
@@ -126,11 +127,9 @@ def test_survival_json_reports_the_rate_outside_the_grid(tmp_path):
                       lambda a: min(1.0, 0.3 + 0.5 * math.log(a / (0.2 * G)))
                       , uplift_g=0.1)
     curve = _power_law_curve(tmp_path / "curve.csv", 0.02, 40.0)
-    out = tmp_path / "out"
-    assert main(["survival", "--hazard", str(curve), "--fragility", str(path),
-                 "--pgv-pga-median", "0.1", "--pgv-pga-sigma", "0.3", "--age-ka", "1",
-                 "--draws", "0", "--hazard-component", "rotd100", "--out", str(out)]) == 0
-    summary = json.loads((out / "survival.json").read_text())
+    summary = _survival(tmp_path / "out", "--hazard", curve, "--fragility", path,
+                        "--pgv-pga-median", "0.1", "--pgv-pga-sigma", "0.3", "--age-ka", "1",
+                        "--draws", "0", "--hazard-component", "rotd100")
     outside = summary["outside_grid"]
     rate = summary["annual_overturning_rate_per_yr"]
     assert outside["share_below_grid"] == pytest.approx(outside["rate_below_grid_per_yr"] / rate)
@@ -193,6 +192,12 @@ MEMBERS = (2.0, 4.0)          # medians (m/s^2) of the two members' lognormal fr
 BETA = 0.3
 
 
+def _survival(out, *args):
+    """survival.json of ``survival args --out out``, which succeeds."""
+    assert main(["survival", *map(str, args), "--out", str(out)]) == 0
+    return json.loads((out / "survival.json").read_text())
+
+
 def _column_campaign(directory, records=("not-a-record",), runs_table=True):
     """fragility.json and fragility_runs.csv of a column campaign whose two members topple
     with lognormal fragilities of medians MEMBERS: at each of 40 PGA levels 60 runs per
@@ -223,11 +228,9 @@ def test_column_members_spread_meets_each_members_closed_form(tmp_path):
     fits = fragility.members()
     assert [f.median_m_s2 for f in fits] == pytest.approx(MEMBERS, rel=0.03)
     curve = _power_law_curve(tmp_path / "curve.csv", 0.05, 300.0)
-    out = tmp_path / "out"
-    assert main(["survival", "--hazard", str(curve), "--fragility", str(campaign),
-                 "--column", "monolithic", "--fragility-form", "pga", "--age-ka", "2",
-                 "--draws", "50", "--hazard-component", "rotd100", "--out", str(out)]) == 0
-    summary = json.loads((out / "survival.json").read_text())
+    summary = _survival(tmp_path / "out", "--hazard", curve, "--fragility", campaign,
+                        "--column", "monolithic", "--fragility-form", "pga", "--age-ka", "2",
+                        "--draws", "50", "--hazard-component", "rotd100")
     expected = [math.exp(-2000.0 * 1e-4 * m ** -2.5 * math.exp(0.5 * (2.5 * BETA) ** 2))
                 for m in MEMBERS]
     assert summary["survival_per_parameter_set"] == pytest.approx(expected, rel=0.03)
@@ -273,12 +276,10 @@ def test_quantile_curves_of_one_calculation_order_the_survival(tmp_path):
     # the files state quantile curves ordered at every level
     assert np.all(curves["0.16"].rates_per_yr <= curves["0.5"].rates_per_yr)
     assert np.all(curves["0.5"].rates_per_yr <= curves["0.84"].rates_per_yr)
-    out = tmp_path / "out"
-    argv = ["survival", "--site", "0", "--median-g", "0.15", "--beta", "0.4",
-            "--age-ka", "10", "--draws", "0"]
-    assert main(argv + [a for k in ("mean", "0.16", "0.5", "0.84")
-                        for a in ("--hazard", str(CASE_37[k]))] + ["--out", str(out)]) == 0
-    summary = json.loads((out / "survival.json").read_text())
+    argv = ["--site", "0", "--median-g", "0.15", "--beta", "0.4", "--age-ka", "10",
+            "--draws", "0"]
+    summary = _survival(tmp_path / "out", *argv, *[a for k in ("mean", "0.16", "0.5", "0.84")
+                                                   for a in ("--hazard", CASE_37[k])])
     rows = summary["hazard_curves"]
     assert [r["kind"] for r in rows] == ["mean", "quantile-0.16", "quantile-0.5",
                                           "quantile-0.84"]
@@ -288,21 +289,16 @@ def test_quantile_curves_of_one_calculation_order_the_survival(tmp_path):
     assert s["quantile-0.16"] >= s["quantile-0.5"] >= s["quantile-0.84"]
     assert summary["survival_range_over_curves"] == [min(s.values()), max(s.values())]
     # the same curve given alone: the same result
-    alone = tmp_path / "alone"
-    assert main(argv + ["--hazard", str(CASE_37["0.84"]), "--out", str(alone)]) == 0
-    single = json.loads((alone / "survival.json").read_text())
+    single = _survival(tmp_path / "alone", *argv, "--hazard", CASE_37["0.84"])
     assert single["survival_probability"] == pytest.approx(s["quantile-0.84"], rel=1e-12)
     assert "hazard_curves" not in single
 
 
 def test_below_grid_without_a_grid_is_refused_in_one_line(tmp_path, capsys):
     out = tmp_path / "out"
-    assert main(["survival", "--hazard", str(CASE_37["mean"]), "--site", "0", "--median-g",
-                 "0.2", "--beta", "0.4", "--age-ka", "1", "--below-grid", "zero",
-                 "--out", str(out)]) == 2
-    err = capsys.readouterr().err.strip()
-    assert "--below-grid applies to a pulse-grid" in err and len(err.splitlines()) == 1
-    assert not out.exists()
+    refused(capsys, ["survival", "--hazard", CASE_37["mean"], "--site", "0", "--median-g",
+                     "0.2", "--beta", "0.4", "--age-ka", "1", "--below-grid", "zero",
+                     "--out", out], "--below-grid applies to a pulse-grid", out)
 
 
 def test_beside_and_above_the_grid_p_carries_the_surface_from_the_edge(tmp_path):

@@ -134,18 +134,7 @@ def magnitudes_table(members=16):
 
 def magnitude_source(truth, sites, mw, columns=12):
     """Observations of ``columns`` columns a site of a source of ``mw`` at ``truth``."""
-    from pipeline.inversion.observations import parse_observations
-    out = []
-    for name, (e, n) in sites.items():
-        r = math.hypot(e - truth[0], n - truth[1])
-        away = math.degrees(math.atan2(e - truth[0], n - truth[1])) % 360.0
-        fallen = round(columns * min(1.0, REACH_KM[mw] / r))
-        out.append({"name": name, "east_km": e, "north_km": n, "columns": [
-            {"column": "drums" if k % 2 else "monolithic", "state": "fallen",
-             "downfall_azimuth_deg": away, "uncertainty_deg": 10} if k < fallen else
-            {"column": "drums" if k % 2 else "monolithic", "state": "standing"}
-            for k in range(columns)]})
-    return parse_observations({"sites": out})
+    return hidden_source(truth, sites, columns, lambda r: min(1.0, REACH_KM[mw] / r))
 
 
 def posterior_of(table, truth, sites, mw):

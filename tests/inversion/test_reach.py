@@ -6,6 +6,7 @@ The toy physics: every fallen column falls away from the source, and the share o
 that fall is 2.5 km / r (1 at 2.5 km, 1/2 at 5, 1/4 at 10, 1/6.4 at 16 km); the table holds
 it at the rings 2.5, 5 and 10 km, the hidden sources' columns follow it at their own
 distances."""
+import json
 import math
 
 import numpy as np
@@ -13,11 +14,12 @@ import pytest
 
 from pipeline import cli
 from pipeline.files import InputError
-from pipeline.inversion import truth_check
+from pipeline.inversion import truth_check, workflows
 from pipeline.inversion.likelihood import ForwardModel
 from pipeline.inversion.observations import parse_observations
 from pipeline.inversion.candidates import CandidateGrid
 from pipeline.inversion.posterior import EDGE_BAYES_FACTOR, invert
+from tests.refusal import refused
 
 RINGS = (2.5, 5.0, 10.0)
 MEMBERS = 8
@@ -33,14 +35,14 @@ def table(make_away_table):
                            distances=RINGS)
 
 
-def hidden_source(truth, sites, columns=12):
+def hidden_source(truth, sites, columns=12, share=share_toppled):
     """Observations of ``columns`` columns per site {name: (e, n)} of a source at
-    ``truth``: round(columns x share) fall away from it, the others stand."""
+    ``truth``: round(columns x share(distance km)) fall away from it, the others stand."""
     out = []
     for name, (e, n) in sites.items():
         r = math.hypot(e - truth[0], n - truth[1])
         away = math.degrees(math.atan2(e - truth[0], n - truth[1])) % 360.0
-        fallen = round(columns * share_toppled(r))
+        fallen = round(columns * share(r))
         out.append({"name": name, "east_km": e, "north_km": n, "columns": [
             {"column": "drums" if k % 2 else "monolithic", "state": "fallen",
              "downfall_azimuth_deg": away, "uncertainty_deg": 10} if k < fallen else
@@ -128,7 +130,6 @@ def test_invert_warns_when_the_source_may_lie_beyond(table, tmp_path, capsys):
     """The command's outputs: the reach's keys in inversion_summary.json, a warning line
     (the independent likelihood: one site's 12 columns read as 12 draws, sharp enough to
     put the posterior on the edge; the predictive reads them as a few)."""
-    import json
     path = table.save(tmp_path / "toy.npz")
     observations = tmp_path / "far.json"
     observations.write_text(json.dumps(hidden_source((0.0, 0.0), {"A": (0.0, 16.0)}).as_dict()))
@@ -158,55 +159,42 @@ def test_a_region_thinner_than_a_cell_is_one_line(table):
     assert finer.east_km.size > 0
 
 
-def test_a_hidden_truth_out_of_reach_is_refused_before_any_run(table, tmp_path, capsys):
-    """invert --hidden-truth with sites 26 km apart and a table whose rings end at 10 km:
-    one line, exit 2, before pyprop8 or YADE, nothing written."""
-    import json
+def refuses_hidden_truth(table, tmp_path, capsys, sites, words):
+    """invert --hidden-truth with ``sites`` ((name, east km, north km, twins)) and a
+    toy table: one line holding ``words``, exit 2, nothing written."""
     path = table.save(tmp_path / "toy.npz")
     truth = tmp_path / "truth.json"
     truth.write_text(json.dumps({
         "source": {"mechanism": "strike-slip", "strike_deg": 30, "depth_km": 10, "mw": 6.5,
                    "east_km": 0, "north_km": 0},
-        "sites": [{"name": "A", "east_km": -13, "north_km": 0, "twins": 1},
-                  {"name": "B", "east_km": 13, "north_km": 0, "twins": 1}]}))
+        "sites": [{"name": name, "east_km": e, "north_km": n, "twins": twins}
+                  for name, e, n, twins in sites]}))
     out = tmp_path / "out"
-    assert cli.main(["invert", "--hidden-truth", str(truth), "--table", str(path),
-                     "--out", str(out)]) == 2
-    err = capsys.readouterr().err
-    assert "sites A and B lie 26.0 km apart" in err and len(err.strip().splitlines()) == 1
-    assert not out.exists()
+    refused(capsys, ["invert", "--hidden-truth", truth, "--table", path, "--out", out], words,
+            out)
+
+
+def test_a_hidden_truth_out_of_reach_is_refused_before_any_run(table, tmp_path, capsys):
+    """invert --hidden-truth with sites 26 km apart and a table whose rings end at 10 km:
+    one line, exit 2, before pyprop8 or YADE, nothing written."""
+    refuses_hidden_truth(table, tmp_path, capsys, [("A", -13, 0, 1), ("B", 13, 0, 1)],
+                         "sites A and B lie 26.0 km apart")
 
 
 def test_a_hidden_truth_with_two_sites_at_one_place_is_refused_before_any_run(
         table, tmp_path, capsys, monkeypatch):
     """Two sites of a truth file at one place: one line, exit 2, no campaign run (pyprop8
     or YADE) and nothing written."""
-    import json
-
-    import pipeline.inversion.workflows as workflows
-
     def no_run(*args, **kwargs):
         raise AssertionError("a campaign ran")
     monkeypatch.setattr(workflows, "run_campaign", no_run)
-    path = table.save(tmp_path / "toy.npz")
-    truth = tmp_path / "truth.json"
-    truth.write_text(json.dumps({
-        "source": {"mechanism": "strike-slip", "strike_deg": 30, "depth_km": 10, "mw": 6.5,
-                   "east_km": 0, "north_km": 0},
-        "sites": [{"name": "A", "east_km": 3, "north_km": 1, "twins": 1},
-                  {"name": "B", "east_km": 3, "north_km": 1, "twins": 2}]}))
-    out = tmp_path / "out"
-    assert cli.main(["invert", "--hidden-truth", str(truth), "--table", str(path),
-                     "--out", str(out)]) == 2
-    err = capsys.readouterr().err
-    assert "sites A and B are at the same place" in err and len(err.strip().splitlines()) == 1
-    assert not out.exists()
+    refuses_hidden_truth(table, tmp_path, capsys, [("A", 3, 1, 1), ("B", 3, 1, 2)],
+                         "sites A and B are at the same place")
 
 
 def test_edge_bayes_factor_is_a_finite_number_at_the_ends():
     """All the posterior in the outermost cells: a large finite factor (JSON holds it);
     every candidate an outermost cell: the data cannot favour them, factor 1."""
-    import math
 
     from pipeline.inversion.posterior import edge_bayes_factor
     assert math.isfinite(edge_bayes_factor(1.0, 0.3))

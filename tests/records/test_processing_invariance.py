@@ -7,6 +7,7 @@ import pytest
 from pipeline.motion import Motion
 from pipeline.motion.measures import record_parameters
 from pipeline.records import build_motion, processing, read_east_north_up, resolve
+from tests.records.test_records import wavelet
 
 MEASURES = ("pga_h", "pgv_h", "pgd_h", "arias_h")
 AZIMUTHS = ("az_max_acc_deg", "az_max_vel_deg", "az_max_disp_deg")
@@ -52,15 +53,8 @@ def test_pulse_five_seconds_into_a_long_file_keeps_its_amplitude():
     """d(t) = D exp(-((t-t0)/w)^2) sin(2 pi f t) at t0 = 5 s in a 900 s file: the
     processed PGV and PGD equal the analytic ones (a 5 % taper of 900 s, 45 s, would
     have erased it)."""
-    dt, D, t0, w, f = 0.01, 0.2, 5.0, 1.0, 1.0
-    t = np.arange(0, 900.0, dt)
-    g = np.exp(-((t - t0) / w) ** 2)
-    gp = -2 * (t - t0) / w ** 2 * g
-    gpp = (4 * (t - t0) ** 2 / w ** 4 - 2 / w ** 2) * g
-    s, sp, spp = np.sin(2 * np.pi * f * t), 2 * np.pi * f * np.cos(2 * np.pi * f * t), \
-        -(2 * np.pi * f) ** 2 * np.sin(2 * np.pi * f * t)
-    acc = D * (gpp * s + 2 * gp * sp + g * spp)
-    vel, disp = D * (gp * s + g * sp), D * g * s
+    dt, t0, w = 0.01, 5.0, 1.0
+    acc, vel, disp = wavelet(np.arange(0, 900.0, dt), 0.2, t0, w, 1.0)
     enz = np.column_stack([acc, np.zeros_like(acc), 0.3 * acc])
     params, steps = measures(enz, dt)
     assert params["pga_h"] == pytest.approx(np.abs(acc).max(), rel=0.01)

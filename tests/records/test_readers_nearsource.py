@@ -10,12 +10,9 @@ its own regular expressions / ElementTree, never through the reader.
 """
 import csv
 import gzip
-import importlib
-import importlib.util
 import json
 import re
 import shutil
-import sys
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
@@ -25,32 +22,14 @@ import pytest
 from obspy import UTCDateTime
 
 from pipeline.files import InputError
+from pipeline.records import readers
+from pipeline.records.readers import at2_triplet as at2
+from pipeline.records.readers import dmg_v2, geonet
+from pipeline.records.readers import mseed_stationxml as mseed
 
 REPO = Path(__file__).resolve().parents[2]
 RECORDS = REPO / "records"
 G = 9.80665
-
-
-def _reader(name):
-    """Import a reader module, also while ``pipeline.records`` is not yet a package."""
-    try:
-        return importlib.import_module(f"pipeline.records.readers.{name}")
-    except ImportError:
-        directory = REPO / "pipeline" / "records" / "readers"
-        if "pipeline.records.readers" not in sys.modules:
-            spec = importlib.util.spec_from_file_location(
-                "pipeline.records.readers", directory / "__init__.py",
-                submodule_search_locations=[str(directory)])
-            module = importlib.util.module_from_spec(spec)
-            sys.modules[spec.name] = module
-            spec.loader.exec_module(module)
-        return importlib.import_module(f"pipeline.records.readers.{name}")
-
-
-geonet = _reader("geonet")
-dmg_v2 = _reader("dmg_v2")
-mseed = _reader("mseed_stationxml")
-at2 = _reader("at2_triplet")
 
 KAIKOURA = sorted((RECORDS / "kaikoura2016").glob("*.V?A.gz"))
 COALINGA = RECORDS / "coalinga1983" / "ce36456p_CE36456.V2.gz"
@@ -487,13 +466,10 @@ def test_each_reader_detects_its_own_files_only(fmt):
 
 
 def test_registry_routes_the_shipped_files_to_these_readers():
-    package = sys.modules.get("pipeline.records.readers")
-    if not hasattr(package, "formats"):
-        pytest.skip("reader registry not available")
     for fmt, paths in SAMPLES.items():
         for path in paths:
             head = _head(path)
-            chosen = next(m for m in package.formats() if m.detect(path, head))
+            chosen = next(m for m in readers.formats() if m.detect(path, head))
             assert chosen.FORMAT == fmt, path.name
 
 

@@ -40,19 +40,22 @@ def test_significant_duration_of_linear_energy_build_up():
     assert measures.significant_duration(acc, dt) == pytest.approx(0.9 * 10.0, abs=2 * dt)
 
 
-def test_peaks_of_analytically_integrated_pulse_survive_processing():
-    """d(t) = D exp(-((t-t0)/w)^2) sin(2 pi f t): its analytic second derivative is
-    processed; PGV and PGD must match the analytic velocity and displacement."""
-    dt, D, t0, w, f = 0.005, 0.2, 20.0, 2.0, 0.8
-    t = np.arange(0, 40.0, dt)
+def wavelet(t, D, t0, w, f):
+    """(acc m/s^2, vel m/s, disp m) at times ``t`` (s) of d(t) = D exp(-((t-t0)/w)^2)
+    sin(2 pi f t), differentiated analytically (D m, t0 and w s, f Hz)."""
     g = np.exp(-((t - t0) / w) ** 2)
     gp = -2 * (t - t0) / w ** 2 * g
     gpp = (4 * (t - t0) ** 2 / w ** 4 - 2 / w ** 2) * g
     s, sp, spp = np.sin(2 * np.pi * f * t), 2 * np.pi * f * np.cos(2 * np.pi * f * t), \
         -(2 * np.pi * f) ** 2 * np.sin(2 * np.pi * f * t)
-    disp = D * g * s
-    vel = D * (gp * s + g * sp)
-    acc = D * (gpp * s + 2 * gp * sp + g * spp)
+    return D * (gpp * s + 2 * gp * sp + g * spp), D * (gp * s + g * sp), D * g * s
+
+
+def test_peaks_of_analytically_integrated_pulse_survive_processing():
+    """d(t) = D exp(-((t-t0)/w)^2) sin(2 pi f t): its analytic second derivative is
+    processed; PGV and PGD must match the analytic velocity and displacement."""
+    dt = 0.005
+    acc, vel, disp = wavelet(np.arange(0, 40.0, dt), 0.2, 20.0, 2.0, 0.8)
     enz = np.column_stack([acc, 0.5 * acc, np.zeros_like(acc)])
     a, v, d, _ = processing.process(enz, dt)
     assert np.max(np.abs(v[:, 0])) == pytest.approx(np.max(np.abs(vel)), rel=0.02)

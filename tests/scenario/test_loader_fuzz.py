@@ -6,39 +6,31 @@ a validator, then property-based fuzzing (Hypothesis) of arbitrary JSON-like val
 arbitrary bytes and text, and shipped files with one field changed to anything."""
 import copy
 import json
-import os
-import tempfile
-from pathlib import Path
 
 import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
-# Hypothesis keeps its example database and caches out of the source tree.
-os.environ.setdefault("HYPOTHESIS_STORAGE_DIRECTORY",
-                      str(Path(tempfile.gettempdir()) / "toppling-columns-hypothesis"))
-
-from hypothesis import HealthCheck, given, settings  # noqa: E402
-from hypothesis import strategies as st  # noqa: E402
-
-from pipeline import cli  # noqa: E402
-from pipeline.files import InputError  # noqa: E402
-from pipeline.inversion import EXAMPLES_DIR as OBSERVATION_EXAMPLES  # noqa: E402
-from pipeline.inversion.observations import COLUMN_KEYS as COLUMN_KEYS_OBS  # noqa: E402
-from pipeline.inversion.observations import (  # noqa: E402
+from pipeline import cli
+from pipeline.files import InputError
+from pipeline.inversion import EXAMPLES_DIR as OBSERVATION_EXAMPLES
+from pipeline.inversion.observations import COLUMN_KEYS as COLUMN_KEYS_OBS
+from pipeline.inversion.observations import (
     MAX_SITES,
     SITE_KEYS,
     Observations,
     load_observations,
     parse_observations,
 )
-from pipeline.userfiles import MAX_FILE_BYTES  # noqa: E402
-from pipeline.scenario.column_format import (  # noqa: E402
+from pipeline.userfiles import MAX_FILE_BYTES
+from pipeline.scenario.column_format import (
     BLOCK_KEYS,
     EXAMPLES_DIR,
     OPTIONAL_BLOCK_KEYS,
     TOP_KEYS,
     example_names,
 )
-from pipeline.scenario.geometry import ColumnGeometry  # noqa: E402
+from pipeline.scenario.geometry import ColumnGeometry
 
 yaml = pytest.importorskip("yaml")
 
@@ -193,13 +185,6 @@ COLUMN_FILES = [
 ]
 
 
-@pytest.mark.parametrize("name, content, words", COLUMN_FILES,
-                         ids=[c[0] for c in COLUMN_FILES])
-def test_malformed_column_files_are_one_line_errors(tmp_path, name, content, words):
-    message = load_column(write(tmp_path / name, content))
-    assert message != "ok" and words in message, message
-
-
 @pytest.mark.parametrize("field, words", [
     ("blocks: *i", "blocks[0]: expected an object"),
     ("blocks: [{shape: frustum, height: *i, bottom_diameter: 1, top_diameter: 1}]",
@@ -308,16 +293,21 @@ WRONG_BLOCK_TYPES = [
 ]
 
 
-@pytest.mark.parametrize("change, words", WRONG_TYPES)
-def test_wrong_types_in_a_description_are_one_line_errors(change, words):
-    doc = good()
-    doc.update(change)
+def assert_one_line_error(doc, words):
+    """``doc`` read as col.json raises one printable line naming the file and ``words``."""
     with pytest.raises(InputError) as info:
         ColumnGeometry.from_dict(doc, where="col.json")
     message = str(info.value)
     assert message.startswith("col.json: ") and len(message.splitlines()) == 1, message
     assert message.isprintable() and len(message) < 1000, message
     assert words in message, message
+
+
+@pytest.mark.parametrize("change, words", WRONG_TYPES)
+def test_wrong_types_in_a_description_are_one_line_errors(change, words):
+    doc = good()
+    doc.update(change)
+    assert_one_line_error(doc, words)
 
 
 @pytest.mark.parametrize("change, words", WRONG_BLOCK_TYPES)
@@ -326,12 +316,7 @@ def test_wrong_types_in_a_block_are_one_line_errors(change, words):
     doc["blocks"][2].update(change)
     if change.get("shape", "frustum") is None:
         del doc["blocks"][2]["shape"]
-    with pytest.raises(InputError) as info:
-        ColumnGeometry.from_dict(doc, where="col.json")
-    message = str(info.value)
-    assert message.startswith("col.json: ") and len(message.splitlines()) == 1, message
-    assert message.isprintable() and len(message) < 1000, message
-    assert words in message, message
+    assert_one_line_error(doc, words)
 
 
 def test_a_malformed_described_column_stops_invert_with_one_line(tmp_path, capsys):
@@ -426,10 +411,14 @@ OBSERVATION_FILES = [
 ]
 
 
-@pytest.mark.parametrize("name, content, words", OBSERVATION_FILES,
-                         ids=[c[0] for c in OBSERVATION_FILES])
-def test_malformed_observation_files_are_one_line_errors(tmp_path, name, content, words):
-    message = load_obs(write(tmp_path / name, content))
+MALFORMED_FILES = ([(load_column, *case) for case in COLUMN_FILES]
+                   + [(load_obs, *case) for case in OBSERVATION_FILES])
+
+
+@pytest.mark.parametrize("load, name, content, words", MALFORMED_FILES,
+                         ids=[f"{c[0].__name__}-{c[1]}" for c in MALFORMED_FILES])
+def test_malformed_files_are_one_line_errors(tmp_path, load, name, content, words):
+    message = load(write(tmp_path / name, content))
     assert message != "ok" and words in message, message
 
 
@@ -501,6 +490,13 @@ def structured(documents, values, keys=()):
     return build()
 
 
+def spliced(data, text, pieces):
+    """``text`` (bytes) with up to 8 bytes from a drawn place replaced by one of ``pieces``."""
+    start = data.draw(st.integers(0, len(text)))
+    stop = data.draw(st.integers(start, min(len(text), start + 8)))
+    return text[:start] + data.draw(pieces) + text[stop:]
+
+
 @pytest.fixture(scope="module")
 def fuzz_dir(tmp_path_factory):
     return tmp_path_factory.mktemp("fuzz")
@@ -557,11 +553,8 @@ def test_fuzz_shipped_column_text_with_a_splice(fuzz_dir, data, name, suffix):
     """The text of a shipped file (as JSON or YAML) with a few bytes replaced."""
     doc = SHIPPED[name]
     text = (json.dumps(doc, indent=1) if suffix == ".json" else yaml.safe_dump(doc)).encode()
-    start = data.draw(st.integers(0, len(text)))
-    stop = data.draw(st.integers(start, min(len(text), start + 8)))
-    splice = data.draw(st.binary(max_size=8) | YAML_TOKENS.map(str.encode))
     load_column(write(fuzz_dir / ("spliced" + suffix),
-                      text[:start] + splice + text[stop:]))
+                      spliced(data, text, st.binary(max_size=8) | YAML_TOKENS.map(str.encode))))
 
 
 @FUZZ
@@ -588,7 +581,4 @@ def test_fuzz_observations_with_one_field_changed(fuzz_dir, doc):
 @given(data=st.data(), doc=st.sampled_from(OBSERVATIONS))
 def test_fuzz_observation_text_with_a_splice(fuzz_dir, data, doc):
     text = json.dumps(doc, indent=1).encode()
-    start = data.draw(st.integers(0, len(text)))
-    stop = data.draw(st.integers(start, min(len(text), start + 8)))
-    splice = data.draw(st.binary(max_size=8))
-    load_obs(write(fuzz_dir / "spliced.json", text[:start] + splice + text[stop:]))
+    load_obs(write(fuzz_dir / "spliced.json", spliced(data, text, st.binary(max_size=8))))

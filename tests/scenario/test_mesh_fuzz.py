@@ -6,26 +6,18 @@ or raises one InputError whose message is one line naming the description; never
 another exception, never a hang (a generous bound per mesh)."""
 import json
 import math
-import os
-import signal
-import tempfile
-from pathlib import Path
 
 import numpy as np
 import pytest
 import trimesh
+from hypothesis import HealthCheck, example, given, settings
+from hypothesis import strategies as st
 
-# Hypothesis keeps its example database and caches out of the source tree.
-os.environ.setdefault("HYPOTHESIS_STORAGE_DIRECTORY",
-                      str(Path(tempfile.gettempdir()) / "toppling-columns-hypothesis"))
-
-from hypothesis import HealthCheck, example, given, settings  # noqa: E402
-from hypothesis import strategies as st  # noqa: E402
-
-from pipeline.files import InputError  # noqa: E402
-from pipeline.scenario import mesh as mesh_module  # noqa: E402
-from pipeline.scenario.geometry import ColumnGeometry  # noqa: E402
-from pipeline.scenario.mesh import MeshSpecimen  # noqa: E402
+from pipeline.files import InputError
+from pipeline.scenario import mesh as mesh_module
+from pipeline.scenario.geometry import ColumnGeometry
+from pipeline.scenario.mesh import MeshSpecimen
+from tests.hang import hang_bound
 
 FUZZ = settings(max_examples=80, deadline=None, database=None,
                 suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large,
@@ -91,20 +83,14 @@ OPTIONS = st.fixed_dictionaries({}, optional={
 
 def check(path, description):
     """The loader's answer: a valid specimen, or a one-line InputError naming the file."""
-    def stop(*_):
-        raise TimeoutError(f"no answer within {SECONDS_PER_MESH} s")
-    previous = signal.signal(signal.SIGALRM, stop)
-    signal.alarm(SECONDS_PER_MESH)
-    try:
-        rock = ColumnGeometry.load(description)
-    except InputError as exc:
-        message = str(exc)
-        assert message and message.isprintable() and len(message.splitlines()) == 1, message
-        assert description.name in message, message
-        return message
-    finally:
-        signal.alarm(0)
-        signal.signal(signal.SIGALRM, previous)
+    with hang_bound(SECONDS_PER_MESH):
+        try:
+            rock = ColumnGeometry.load(description)
+        except InputError as exc:
+            message = str(exc)
+            assert message and message.isprintable() and len(message.splitlines()) == 1, message
+            assert description.name in message, message
+            return message
     assert isinstance(rock, MeshSpecimen)
     assert rock.mass > 0 and rock.volume_m3 > 0 and math.isfinite(rock.mass)
     assert np.isfinite(rock.com).all() and np.isfinite(rock.inertia).all()

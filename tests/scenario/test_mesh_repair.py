@@ -2,9 +2,6 @@
 vertices, per-face normals, UV charts, binary STL, faces wound at random) gives the
 specimen of the shipped file; open, flat, huge, split and absurd meshes answer in one
 line; an open base is closed on request; SP2's model loads as a closed mesh."""
-import signal
-from contextlib import contextmanager
-
 import numpy as np
 import pytest
 import trimesh
@@ -15,6 +12,7 @@ from pipeline.scenario import ColumnSpec
 from pipeline.scenario import mesh as mesh_module
 from pipeline.scenario import mesh_pose
 from pipeline.scenario.mesh import MeshSpecimen
+from tests.hang import hang_bound
 
 SP1 = RECORDS_DIR / "shake_table" / "SP1.obj"
 SP1_MASS = 353.802                       # kg, records/shake_table/sp1.json
@@ -28,20 +26,6 @@ def fresh_loader():
     """Every test reads its meshes anew and sees its notes (both are once per process)."""
     mesh_module._posed.cache_clear()
     mesh_module._SAID.clear()
-
-
-@contextmanager
-def within(seconds):
-    """Fail instead of hanging (a generous bound, not a timing)."""
-    def stop(*_):
-        raise TimeoutError(f"no answer within {seconds} s")
-    previous = signal.signal(signal.SIGALRM, stop)
-    signal.alarm(seconds)
-    try:
-        yield
-    finally:
-        signal.alarm(0)
-        signal.signal(signal.SIGALRM, previous)
 
 
 def sp1_as_written():
@@ -153,7 +137,7 @@ def test_faces_wound_at_random_give_the_mass_of_the_closed_surface(tmp_path):
 def test_sp2_model_loads_as_a_closed_mesh():
     """The providers' model of the second rock: a Blender OBJ whose vertices are split
     where face normals change; merged by position it is closed, 0.124 m^3."""
-    with within(120):
+    with hang_bound(120):
         rock = MeshSpecimen.load(SP2)
     assert rock.volume_m3 == pytest.approx(0.124, abs=0.001)
     assert "vertices merged by position" in rock.repairs[0]
@@ -173,7 +157,7 @@ def export(mesh, path):
 
 
 def refused(path, words, **options):
-    with within(120), pytest.raises(InputError, match=words) as info:
+    with hang_bound(120), pytest.raises(InputError, match=words) as info:
         MeshSpecimen.from_dict({"name": "x", "mesh": str(path), **options})
     assert "\n" not in str(info.value)
     return str(info.value)
@@ -238,7 +222,7 @@ def test_a_huge_hull_rolls_onto_its_rest_pose(tmp_path, monkeypatch):
     monkeypatch.setattr(mesh_pose, "MAX_POSE_HULL_FACES", 600)
     path = export(ellipsoid, tmp_path / "ellipsoid.obj")
     volume = trimesh.load(path, process=False).volume            # of the file's vertices
-    with within(120):
+    with hang_bound(120):
         rock = MeshSpecimen.load(path)
     assert rock.repairs == ("rest pose found by rolling on its convex hull of 5,120 faces "
                             "(the stable poses are sought on at most 600)",)
@@ -262,7 +246,7 @@ def test_any_quaternion_length_is_a_rotation_and_overflow_is_one_line(tmp_path):
 def test_upside_down_sp1_settles_onto_a_stable_pose(tmp_path):
     vertices, faces = sp1_as_written()
     turned = trimesh.Trimesh(vertices * [1, -1, -1], faces, process=False)   # 180 deg about x
-    with within(120):
+    with hang_bound(120):
         rock = load(export(turned, tmp_path / "upside_down.obj"))
     assert rock.settled_by_deg > 10
     assert rock.volume_m3 == pytest.approx(load(SP1).volume_m3, rel=1e-9)
@@ -412,17 +396,22 @@ def test_a_mesh_just_outside_the_sizes_says_its_size_in_enough_digits(tmp_path, 
     refused(path, f"is {shown} m across with units m: expected 0.02-30 m")
 
 
+def sp1_unshared(path, seed, jitter_m):
+    """SP1 written to ``path`` (OBJ) with every face's own corners, each coordinate moved
+    by up to ``jitter_m`` (m, uniform; generator seeded with ``seed``)."""
+    corners, triangles = split(*sp1_as_written())
+    corners = corners + np.random.default_rng(seed).uniform(-jitter_m, jitter_m, corners.shape)
+    path.write_text("".join(f"v {x:.17g} {y:.17g} {z:.17g}\n" for x, y, z in corners)
+                    + "".join(f"f {a + 1} {b + 1} {c + 1}\n" for a, b, c in triangles))
+    return path
+
+
 def test_sp1_with_unshared_jittered_corners_is_merged_and_said(tmp_path, capsys):
     """Every face with its own corners, each coordinate moved by up to 2 um (an
     exporter's rounding): the corners within 1e-5 of the size (7.9 um) are merged, and
     said; the specimen is SP1's to the jitter."""
-    vertices, faces = sp1_as_written()
-    corners, triangles = split(vertices, faces)
-    corners = corners + np.random.default_rng(2).uniform(-2e-6, 2e-6, corners.shape)
-    path = tmp_path / "sp1_jittered.obj"
-    path.write_text("".join(f"v {x:.17g} {y:.17g} {z:.17g}\n" for x, y, z in corners)
-                    + "".join(f"f {a + 1} {b + 1} {c + 1}\n" for a, b, c in triangles))
-    with within(120):
+    path = sp1_unshared(tmp_path / "sp1_jittered.obj", 2, 2e-6)
+    with hang_bound(120):
         rock, shipped = load(path, mass_kg=SP1_MASS), load(SP1, mass_kg=SP1_MASS)
     assert rock.volume_m3 == pytest.approx(shipped.volume_m3, rel=1e-5)
     assert rock.inertia == pytest.approx(shipped.inertia, rel=1e-4)
@@ -432,10 +421,5 @@ def test_sp1_with_unshared_jittered_corners_is_merged_and_said(tmp_path, capsys)
 
 
 def test_sp1_with_corners_farther_apart_says_they_are_unshared(tmp_path):
-    vertices, faces = sp1_as_written()
-    corners, triangles = split(vertices, faces)
-    corners = corners + np.random.default_rng(3).uniform(-1e-4, 1e-4, corners.shape)
-    path = tmp_path / "sp1_apart.obj"
-    path.write_text("".join(f"v {x:.17g} {y:.17g} {z:.17g}\n" for x, y, z in corners)
-                    + "".join(f"f {a + 1} {b + 1} {c + 1}\n" for a, b, c in triangles))
+    path = sp1_unshared(tmp_path / "sp1_apart.obj", 3, 1e-4)
     refused(path, "its faces share few vertices, none closer than 7.9e-06 m")

@@ -6,11 +6,11 @@ not name are kept, in their order, in ``extra``."""
 from dataclasses import dataclass, field
 
 from pipeline.hazard.fragility.checker import MAX_TEXT, MAX_TOTAL, Checker, key_text, leaf
-from pipeline.hazard.fragility.keyed import build, join
+from pipeline.hazard.fragility.keyed import Keyed, build, join
 
 
 @dataclass(frozen=True)
-class Scores:
+class Scores(Keyed):
     """Scores of 0/1 outcomes of ``n`` tests under a prediction: the log-likelihood per
     test (P clipped to [0.01, 0.99]: 0 down to ln 0.01), the Brier score (0-1); for
     the grid ``outside_grid`` (tests beyond it) and ``empty_cells_filled`` (cells
@@ -20,8 +20,6 @@ class Scores:
     n: int
     outside_grid: int | None = None
     empty_cells_filled: int | None = None
-    extra: dict = field(default_factory=dict)
-    order: tuple = field(default=(), compare=False)
 
     def __post_init__(self):
         c = Checker("")
@@ -40,15 +38,13 @@ class Scores:
 
 
 @dataclass(frozen=True)
-class ModelCheck:
+class ModelCheck(Keyed):
     """One model against the tests: its ``grid`` (the cells) and ``logistic`` (its
     surface, or None) :class:`Scores`, and ``bins``: observed rate and mean predicted P
     per PGA x PGV/PGA bin of the shake-table figure."""
     grid: Scores
     logistic: Scores | None = None
     bins: tuple = ()
-    extra: dict = field(default_factory=dict)
-    order: tuple = field(default=(), compare=False)
 
     def __post_init__(self):
         Checker("").lst(list(self.bins), "bins", MAX_TOTAL)
@@ -67,7 +63,7 @@ class ModelCheck:
 
 
 @dataclass(frozen=True)
-class Experiments:
+class Experiments(Keyed):
     """The check of a pulse grid against ``tests`` shake-table tests of which
     ``overturned`` overturned (``outcome``: whose; ``direction`` and ``note`` text):
     ``baselines`` (label -> :class:`Scores`) and ``models`` (name -> :class:`ModelCheck`)."""
@@ -78,8 +74,6 @@ class Experiments:
     note: str | None = None
     baselines: dict = field(default_factory=dict)
     models: dict = field(default_factory=dict)
-    extra: dict = field(default_factory=dict)
-    order: tuple = field(default=(), compare=False)
 
     def __post_init__(self):
         c = Checker("")

@@ -27,6 +27,7 @@ from pipeline.hazard.fragility.checker import leaf
 from pipeline.hazard.fragility.experiments import Experiments
 from pipeline.hazard.fragility.fits import LognormalFit, LogisticSurface
 from pipeline.hazard.fragility.rows import ContourRow, GridCell
+from pipeline.hazard.fragility.keyed import Keyed
 from pipeline.hazard.fragility.keyed import build as _build
 from pipeline.hazard.fragility.keyed import join as _join
 from pipeline.userfiles import DATA_FILE_BYTES, read_json
@@ -38,7 +39,7 @@ __all__ = ["MAX_MEMBERS", "Block2d", "ColumnFits", "ContourRow", "FragilityFile"
 
 
 @dataclass(frozen=True)
-class Block2d:
+class Block2d(Keyed):
     """The 2D rigid block beside the specimen: ``alpha_rad`` (critical angle, rad),
     ``p_per_s`` (frequency parameter, 1/s), ``R_m`` (pivot distance, m), ``uplift_g``
     (g tan alpha of the runs' median alpha, g), ``uplift_g_smallest`` (of the smallest
@@ -49,12 +50,10 @@ class Block2d:
     uplift_g: float | None = None
     uplift_g_smallest: float | None = None
     model: str | None = None
-    extra: dict = field(default_factory=dict)
-    order: tuple = field(default=(), compare=False)
 
 
 @dataclass(frozen=True)
-class GridModel:
+class GridModel(Keyed):
     """One model of a pulse grid: ``cells`` (:class:`GridCell`), ``contours`` (level,
     e.g. "0.5", -> :class:`ContourRow` per PGV/PGA), ``logistic``
     (:class:`LogisticSurface`), ``runs`` and ``overturned`` (counts)."""
@@ -63,8 +62,6 @@ class GridModel:
     logistic: LogisticSurface | None = None
     runs: int | None = None
     overturned: int | None = None
-    extra: dict = field(default_factory=dict)
-    order: tuple = field(default=(), compare=False)
 
     def contour(self, level):
         """The :class:`ContourRow` per PGV/PGA of the contour at P = ``level`` (a number,
@@ -73,7 +70,7 @@ class GridModel:
 
 
 @dataclass(frozen=True)
-class PulseGridSection:
+class PulseGridSection(Keyed):
     """``pulse_grid``: the axes ``pga_g`` (g) and ``pgv_pga_s`` (s), ``members``
     (parameter sets), ``headings`` (directions per set), ``models`` (name ->
     :class:`GridModel`), ``block2d``, ``direction`` and ``ranges`` (text), the runs
@@ -96,12 +93,10 @@ class PulseGridSection:
     full_grid_runs: int | None = None
     sampling: str | None = None
     experiments: Experiments | None = None
-    extra: dict = field(default_factory=dict)
-    order: tuple = field(default=(), compare=False)
 
 
 @dataclass(frozen=True)
-class ColumnFits:
+class ColumnFits(Keyed):
     """One column type of a column campaign: ``description``, ``model`` ("3D" or "2D"),
     ``runs`` and ``toppled`` (counts), ``fits`` (intensity measure, e.g. "PGA", -> its
     :class:`LognormalFit`) and ``logistic`` (:class:`LogisticSurface`, in PGA and
@@ -112,12 +107,10 @@ class ColumnFits:
     toppled: int | None = None
     fits: dict = field(default_factory=dict)
     logistic: LogisticSurface | None = None
-    extra: dict = field(default_factory=dict)
-    order: tuple = field(default=(), compare=False)
 
 
 @dataclass(frozen=True)
-class FragilityFile:
+class FragilityFile(Keyed):
     """``fragility.json``: ``specimen`` (its name), ``mode`` ("pulses" for a pulse grid),
     a column campaign's ``columns`` (name -> :class:`ColumnFits`), ``records`` (ids),
     ``members`` and ``block2d``, or a pulse grid's ``pulse_grid``; ``path`` where it was
@@ -129,8 +122,6 @@ class FragilityFile:
     members: int | None = None
     block2d: Block2d | None = None
     pulse_grid: PulseGridSection | None = None
-    extra: dict = field(default_factory=dict)
-    order: tuple = field(default=(), compare=False)
     path: Path | None = field(default=None, compare=False)
 
     @classmethod

@@ -5,11 +5,12 @@ value (``median must be ...``); read from a file,
 :func:`~pipeline.hazard.fragility.checker.leaf` names the file and the key path before
 it (``fragility.json: columns.monolithic.logistic.cov must be a 3x3 list of numbers``).
 Keys a fit does not name are kept, in their order, in ``extra``."""
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
 from pipeline.hazard.fragility.checker import TOLERANCE, Checker, counts
+from pipeline.hazard.fragility.keyed import Keyed
 from pipeline.hazard.fragility.keyed import build as _build
 from pipeline.hazard.fragility.keyed import join as _join
 from pipeline.userfiles import show
@@ -19,7 +20,7 @@ B = ("b0", "b1", "b2")           # a logistic surface's coefficients: logit P = 
 
 
 @dataclass(frozen=True)
-class LognormalFit:
+class LognormalFit(Keyed):
     """A lognormal fragility of one intensity measure: ``median`` (in ``unit``) and
     ``beta`` (log standard deviation) with their 95 % intervals (each holding its
     estimate), ``n`` runs of which ``toppled`` toppled, a ``note``, ``bins`` (the observed
@@ -34,8 +35,6 @@ class LognormalFit:
     n: int | None = None
     toppled: int | None = None
     bins: tuple | None = None
-    extra: dict = field(default_factory=dict)
-    order: tuple = field(default=(), compare=False)
 
     def __post_init__(self):
         """Any fit the campaign writes (a degenerate one too: a beta of 1e6, an interval
@@ -60,7 +59,7 @@ class LognormalFit:
 
 
 @dataclass(frozen=True)
-class LogisticSurface:
+class LogisticSurface(Keyed):
     """logit P = b0 + b1 ln PGA + b2 ln PGV/PGA (PGA m/s^2, PGV/PGA s), as
     :func:`pipeline.stats.fragility.logistic_surface` fits it: ``coefficients``, ``se``
     and ``ci95`` per coefficient (:data:`B`; an interval holding its coefficient), ``cov``
@@ -76,8 +75,6 @@ class LogisticSurface:
     note: str | None = None
     separated: bool | None = None
     dimensionless: dict | None = None
-    extra: dict = field(default_factory=dict)
-    order: tuple = field(default=(), compare=False)
 
     def __post_init__(self):
         c = Checker("")

@@ -1,9 +1,17 @@
 """The types of ``fragility.json`` to and from the dicts its JSON holds: the keys a type
 names become its fields, the others stay in its ``extra``, and the keys' order is kept
 (``order``), so that a file read and written again is the same file."""
-from dataclasses import MISSING, fields
+from dataclasses import MISSING, dataclass, field, fields
 
 KEPT = ("extra", "order", "path")     # fields that are not keys of the file
+
+
+@dataclass(frozen=True)
+class Keyed:
+    """What every type of the file keeps besides its named keys: the others (``extra``)
+    and the keys' order as read (``order``); keyword-only, after the type's own fields."""
+    extra: dict = field(default_factory=dict, kw_only=True)
+    order: tuple = field(default=(), compare=False, kw_only=True)
 
 
 def build(cls, data, convert=None, **more):

@@ -64,7 +64,19 @@ class Fragility(ABC):
 
 
 @dataclass(frozen=True)
-class Lognormal(Fragility):
+class _Fitted(Fragility):
+    """A fitted form's ``note`` and the campaign's fits of its members (``member_fits``),
+    keyword-only."""
+    note: str | None = field(default=None, kw_only=True)
+    member_fits: tuple | None = field(default=None, compare=False, kw_only=True)
+
+    def members(self):
+        """One fragility per member (parameter set) of the campaign, or None."""
+        return None if not self.member_fits else list(self.member_fits)
+
+
+@dataclass(frozen=True)
+class Lognormal(_Fitted):
     """P(overturn | PGA) = Phi(ln(PGA / median) / beta): ``median_m_s2`` (m/s^2), ``beta``
     (natural log); optional 95 % intervals of each (same units) for :meth:`draws`."""
     median_m_s2: float
@@ -72,8 +84,6 @@ class Lognormal(Fragility):
     median_ci95: tuple | None = None
     beta_ci95: tuple | None = None
     label: str = "lognormal"
-    note: str | None = None
-    member_fits: tuple | None = field(default=None, compare=False)
     uses_ratio = False
 
     def probability(self, pga_m_s2, pgv_pga_s=None):
@@ -92,10 +102,6 @@ class Lognormal(Fragility):
         return [replace(self, median_m_s2=float(np.exp(m)), beta=float(np.exp(b)),
                         member_fits=None) for m, b in zip(ln_m, ln_b)]
 
-    def members(self):
-        """One fragility per member (parameter set) of the campaign, or None."""
-        return None if not self.member_fits else list(self.member_fits)
-
     def describe(self):
         return {"form": "P = Phi(ln(PGA / median) / beta)", "label": self.label,
                 "median_m_s2": self.median_m_s2, "median_g": self.median_m_s2 / STANDARD_GRAVITY,
@@ -104,15 +110,13 @@ class Lognormal(Fragility):
 
 
 @dataclass(frozen=True)
-class Logistic(Fragility):
+class Logistic(_Fitted):
     """logit P = b0 + b1 ln(PGA / 1 m/s^2) + b2 ln(PGV/PGA / 1 s): ``coefficients``
     (b0, b1, b2); ``cov`` (3 x 3) or ``se`` (3, None where fixed) for :meth:`draws`."""
     coefficients: tuple
     cov: tuple | None = None
     se: tuple | None = None
     label: str = "logistic surface"
-    note: str | None = None
-    member_fits: tuple | None = field(default=None, compare=False)
     uses_ratio = True
 
     def probability(self, pga_m_s2, pgv_pga_s):
@@ -134,10 +138,6 @@ class Logistic(Fragility):
             return None
         return [replace(self, coefficients=tuple(float(v) for v in row), member_fits=None)
                 for row in sample]
-
-    def members(self):
-        """One fragility per member (parameter set) of the campaign, or None."""
-        return None if not self.member_fits else list(self.member_fits)
 
     def describe(self):
         return {"form": "logit P = b0 + b1 ln(PGA / 1 m/s^2) + b2 ln(PGV/PGA / 1 s)",

@@ -4,16 +4,16 @@ What a row cannot know alone (a cell on the grid once, its sets below the grid's
 ``members``, its runs within the sets' headings) the file's checks say
 (:mod:`pipeline.hazard.fragility.check`).  Keys a row does not name are kept, in their
 order, in ``extra``."""
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 from pipeline.hazard.fragility.checker import MAX_MEMBERS, MAX_RUNS, TOLERANCE, Checker
-from pipeline.hazard.fragility.keyed import build, join
+from pipeline.hazard.fragility.keyed import Keyed, build, join
 
 OUTSIDE = ("below", "above")      # where a contour's crossing lies beyond the grid
 
 
 @dataclass(frozen=True)
-class GridCell:
+class GridCell(Keyed):
     """One cell of a pulse grid's model: at ``pga_g`` (g) and ``pgv_pga_s`` (s), ``n``
     runs of which ``overturned`` overturned, ``P`` their fraction with its Wilson 95 %
     interval ``ci95`` (holding it); ``sets`` (indices of the parameter sets run there,
@@ -30,8 +30,6 @@ class GridCell:
     P_per_set: tuple | None = None
     set_sd: float | None = None
     set_spread_sd: float | None = None
-    extra: dict = field(default_factory=dict)
-    order: tuple = field(default=(), compare=False)
 
     def __post_init__(self):
         c = Checker("")
@@ -81,7 +79,7 @@ class GridCell:
 
 
 @dataclass(frozen=True)
-class ContourRow:
+class ContourRow(Keyed):
     """Where one PGV/PGA row (``pgv_pga_s``, s) of a model's cells crosses a contour's
     level: ``pga_g`` (g; None where the row does not cross), ``pga_g_band`` (where the
     cells' Wilson bounds cross it, g; an open side None), ``outside_grid``
@@ -92,8 +90,6 @@ class ContourRow:
     pga_g_band: tuple | None = None
     outside_grid: str | None = None
     pga_g_per_set: dict | None = None
-    extra: dict = field(default_factory=dict)
-    order: tuple = field(default=(), compare=False)
 
     def __post_init__(self):
         c = Checker("")

@@ -20,6 +20,15 @@ CRUST_LAYERS = (
 # function (a boxcar of ``subevent_rise_s`` convolved with one of
 # ``subevent_duration_s``).  Rise 0.5 s / duration 1.5 s keeps PGA and PGV
 # within a factor ~1.5 of the NGA-West2 medians at 5-20 km (gmm_check.csv).
+# Both sources rupture alike from a hypocentre at the origin.
+RUPTURE = {
+    "hypocentre_x_km": 0.0,
+    "hypocentre_y_km": 0.0,
+    "subevents_along_strike_km": (-4.0, 0.0, 4.0, 8.0, 12.0),
+    "rupture_velocity_km_s": 2.8,
+    "subevent_rise_s": 0.5,
+    "subevent_duration_s": 1.5,
+}
 SOURCES = {
     "strike_slip": {
         "mechanism": "strike-slip",
@@ -29,12 +38,7 @@ SOURCES = {
         "rake_deg": 180.0,  # ... right-lateral
         "mw": 6.5,
         "depth_km": 8.0,
-        "hypocentre_x_km": 0.0,
-        "hypocentre_y_km": 0.0,
-        "subevents_along_strike_km": (-4.0, 0.0, 4.0, 8.0, 12.0),
-        "rupture_velocity_km_s": 2.8,
-        "subevent_rise_s": 0.5,
-        "subevent_duration_s": 1.5,
+        **RUPTURE,
     },
     "thrust": {
         "mechanism": "reverse",
@@ -44,12 +48,7 @@ SOURCES = {
         "rake_deg": 90.0,
         "mw": 6.5,
         "depth_km": 10.0,
-        "hypocentre_x_km": 0.0,
-        "hypocentre_y_km": 0.0,
-        "subevents_along_strike_km": (-4.0, 0.0, 4.0, 8.0, 12.0),
-        "rupture_velocity_km_s": 2.8,
-        "subevent_rise_s": 0.5,
-        "subevent_duration_s": 1.5,
+        **RUPTURE,
     },
 }
 

@@ -73,6 +73,19 @@ def fixed_width_values(lines, width, per_line, count, name, what):
     return values, n_lines
 
 
+def counted_samples(fields, count, name, non_numeric, holder):
+    """The texts ``fields`` as floats, exactly ``count`` of them (the header's); else one
+    InputError: "{name}: {non_numeric}" or "{name}: {holder} has n samples, header says
+    count"."""
+    try:
+        values = np.array(fields, dtype=float)
+    except ValueError:
+        raise InputError(f"{name}: {non_numeric}") from None
+    if values.size != count:
+        raise InputError(f"{name}: {holder} has {values.size} samples, header says {count}")
+    return values
+
+
 def _is_float(text):
     try:
         float(text)

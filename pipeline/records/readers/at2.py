@@ -13,6 +13,7 @@ from obspy import Stream, Trace
 from pipeline.constants import STANDARD_GRAVITY
 from pipeline.files import InputError
 from pipeline.records.readers import HEAD_BYTES, VERTICAL_DOWN, VERTICAL_UP, read_bytes
+from pipeline.records.readers._text import counted_samples
 
 FORMAT = "at2"
 PRIORITY = 50
@@ -95,12 +96,8 @@ def read_at2(path):
         raise InputError(f"{path.name}: AT2 DT {match.group(2)!r} is not a number") from None
     if not (np.isfinite(dt) and dt > 0):
         raise InputError(f"{path.name}: AT2 DT must be a positive time step, got {dt:g}")
-    try:
-        values = np.array(" ".join(lines[4:]).split(), dtype=float)
-    except ValueError:
-        raise InputError(f"{path.name}: non-numeric AT2 samples") from None
-    if values.size != npts:
-        raise InputError(f"{path.name}: AT2 has {values.size} samples, header says {npts}")
+    values = counted_samples(" ".join(lines[4:]).split(), npts, path.name,
+                             "non-numeric AT2 samples", "AT2")
     trace = Trace(values * STANDARD_GRAVITY)
     trace.stats.delta = dt
     trace.stats.channel = lines[1].rsplit(",", 1)[-1].strip()[:8]

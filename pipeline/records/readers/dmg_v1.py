@@ -1,12 +1,12 @@
 """CSMIP/DMG Volume 1 text (uncorrected acceleration; gzip allowed)."""
 import re
 
-import numpy as np
 from obspy import Stream, Trace, UTCDateTime
 
 from pipeline.constants import STANDARD_GRAVITY
 from pipeline.files import InputError
 from pipeline.records.readers import VERTICAL_DOWN, VERTICAL_UP, read_bytes
+from pipeline.records.readers._text import counted_samples
 
 FORMAT = "dmg-v1"
 PRIORITY = 30
@@ -52,13 +52,11 @@ def _dmg_channel(lines, start, name, info):
         raise InputError(f"{name}: DMG V1 unit {unit!r} not supported")
     n_lines = -(-npts // per_line)
     body = lines[data_line + 1:data_line + 1 + n_lines]
-    try:
-        values = np.array([float(line[k:k + width]) for line in body
-                           for k in range(0, per_line * width, width) if line[k:k + width].strip()])
-    except ValueError:
-        raise InputError(f"{name}: non-numeric DMG V1 samples after line {data_line + 1}") from None
-    if values.size != npts:
-        raise InputError(f"{name}: DMG V1 channel has {values.size} samples, header says {npts}")
+    values = counted_samples([line[k:k + width] for line in body
+                              for k in range(0, per_line * width, width)
+                              if line[k:k + width].strip()], npts, name,
+                             f"non-numeric DMG V1 samples after line {data_line + 1}",
+                             "DMG V1 channel")
 
     trace = Trace(values * scale)
     trace.stats.sampling_rate = rate
