@@ -100,3 +100,21 @@ def test_curves_that_contradict_themselves_are_refused():
                "damage_states": {"drums": {**good.to_json(), "runs": 299}}}
     with pytest.raises(InputError, match="damage_states.drums"):
         FragilityFile.of(written)
+
+
+def test_the_report_shows_each_state_as_the_file_states_it(tmp_path):
+    from pipeline.report import fragility_section
+    fits = damage_state_fits(_table(300), {"drums": "the drum column"}, 0.2, 1.5)
+    column = ColumnFits(description="d", model="3D", runs=300, toppled=1,
+                        order=("description", "model", "runs", "toppled"))
+    write_fragility_file(tmp_path / "fragility", FragilityFile(
+        columns={"drums": column}, records=("R1",), members=1, damage_states=fits,
+        order=("records", "members", "columns")))
+    text = fragility_section(tmp_path)
+    for state in fits["drums"].states:
+        row = next(line for line in text.splitlines()
+                   if line.startswith("| the drum column") and f"| {state.state} " in line)
+        cells = [c.strip() for c in row.strip("|").split("|")]
+        fit = state.fits["PGA"]
+        assert cells[2] == f"{state.reached} of {state.runs}"
+        assert cells[3].startswith(f"{fit.median:.3g} [{fit.median_ci95[0]:.2f}, ")
