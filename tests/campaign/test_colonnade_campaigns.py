@@ -92,7 +92,7 @@ def test_a_still_colonnade_campaign_writes_its_colonnade_outcomes(name, table, t
     path = tmp_path / "weak.npz"
     m = one_sine_pulse(30.0, 0.5, duration=2.0)
     Motion(m.dt, m.acc, m.vel, m.disp, meta={"record_id": "weak"}).save(path)
-    out = tmp_path / name
+    out = tmp_path / ("colonnade" if name == "records" else name)   # the report's folder
     extra = ["--members", "1", "--max-members", "1"] if name == "ensemble" else []
     assert cli.main(["campaign", name, "--records", str(path), "--column-file", SHIPPED,
                      "--out", str(out), "--jobs", "1", "--animations", "0", *extra]) == 0
@@ -106,3 +106,11 @@ def test_a_still_colonnade_campaign_writes_its_colonnade_outcomes(name, table, t
     assert (whole["colonnade"] == SHIPPED).all()
     assert (whole[["columns", "columns_fallen", "beams", "beams_fallen"]].to_numpy()
             == [4, 0, 6, 0]).all()
+    if name == "records":                     # the report's section from these files
+        from pipeline.report import colonnade_section
+        text = colonnade_section(tmp_path)
+        row = next(line for line in text.splitlines() if line.startswith("| weak"))
+        cells = [c.strip() for c in row.strip("|").split("|")]
+        assert cells[1:4] == ["0 of 4", "0 of 6", "-"]
+        assert cells[6] == "N1 none, N2 none, N3 none, N4 none" and float(cells[7]) == 0.0
+        assert "Not run yet" in colonnade_section(tmp_path / "nothing")
