@@ -179,6 +179,8 @@ def columns_specs(records, campaign_dir, column_files=None, column="both",
     contact stiffness of :func:`matched_kn`, "paper" the paper's kn for all; a contact
     file's values (its kn too) go over them."""
     names = list(column_files) if column_files else example_names()
+    for name in names:
+        description(name, meshes=True)          # a colonnade refused in its own words
     geometries = [ColumnGeometry.load(name) for name in names]
     described = [g.to_dict() for g in geometries]
     for k, data in enumerate(described):

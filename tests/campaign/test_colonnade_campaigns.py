@@ -50,12 +50,13 @@ def test_campaigns_run_the_colonnade_whole(name, record, tmp_path):
     assert all(s.params.contact.kn <= 2.0 * paper.COLUMN_KN_N_M for s in paper_kn)
 
 
-@pytest.mark.parametrize("name", ("slenderness", "fragility"))
+@pytest.mark.parametrize("name", ("slenderness", "fragility", "columns"))
 def test_campaigns_that_scale_one_column_refuse_a_colonnade_in_one_line(name, record,
                                                                         tmp_path):
     out = tmp_path / "out"
+    option = {"column_files": [SHIPPED]} if name == "columns" else {"column_file": SHIPPED}
     with pytest.raises(InputError) as exc:
-        _specs(name, record, out, column_file=SHIPPED)
+        _specs(name, record, out, **option)
     message = str(exc.value)
     assert "\n" not in message and SHIPPED in message and "campaign records" in message
     assert not out.exists()
