@@ -41,7 +41,9 @@ records: setup
 PAPER_BATCH ?= 1
 FRAGILITY_LEVELS := 1,2,4,8
 # the colonnade (reduced): the shipped stretch of the Parthenon's north flank
-# (docs/colonnades.md), one run per record at its columns' matched contact stiffness
+# (docs/colonnades.md), one run per record at its columns' matched contact stiffness:
+# 58 bodies stepping 7.5e-5 s, about 6.5 s of one core per simulated second (NF04: 26 s
+# simulated, 2.8 min of one core), about 5-10 min on 2 idle cores for the three
 COLONNADE := parthenon-north-flank
 COLONNADE_RECORDS ?= NF04,RSN181-IMPVALL,RSN126-GAZLI
 STEP_TIMES := results/run-all-steps.tsv

@@ -22,6 +22,7 @@ def colonnade_section(results, name=COLONNADE_DIR):
     rows = []
     for _, row in whole.iterrows():
         states = columns[columns["run_id"] == row["run_id"]].sort_values("column")
+        standing = states[~states["toppled"].astype(str).str.lower().eq("true")]
         rows.append({
             "record": row["record_id"],
             "columns fallen": f"{row['columns_fallen']} of {row['columns']}",
@@ -34,8 +35,9 @@ def colonnade_section(results, name=COLONNADE_DIR):
             f"{row['fall_order']} ({_yes_no(row['in_sequence'])})",
             "damage state per column": ", ".join(
                 f"{c['column']} {c['damage_state']}" for _, c in states.iterrows()),
-            "largest residual slide (mm)": _fmt(
-                1000 * states["max_residual_slide_m"].astype(float).max(), 1)})
+            "largest residual slide of a standing column (mm)": _fmt(
+                1000 * standing["max_residual_slide_m"].astype(float).max(), 1)
+            if len(standing) else "-"})
     walls = [s.wall_s for s in (finished_summary(folder, r) for r in whole["run_id"])
              if s is not None]
     simulated = runs.drop_duplicates("run_id")["simulated_s"].astype(float).sum()
