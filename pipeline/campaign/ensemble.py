@@ -172,7 +172,8 @@ class EnsembleOptions(CampaignOptions):
         "every member is the described column with the sampled height and diameter "
         "tolerances on every block, the tilt added to its own and the drum offsets on the "
         "blocks above the first (joined blocks keep theirs); with --column both a monolith "
-        "of its outline stands beside it")
+        "of its outline stands beside it; a colonnade's description: the colonnade, every "
+        "column with the same tolerances, no sampled tilt or offsets (docs/colonnades.md)")
     stiffness: str = stiffness_param("with --column-file, what kn_factor multiplies")
     contact_file: str = contact_file_param(
         "its damping and friction for every member (not sampled), its kn what kn_factor "
