@@ -50,6 +50,10 @@ def fragility_outputs(specs, campaign_dir, failures, animations, figures=True):
     if figures:
         from pipeline.figures.fragility import plot_fragility  # lazy: matplotlib, not imported by a run or after Ctrl-C
         written = plot_fragility(table, summary, campaign_dir)
+        if summary.damage_states:
+            from pipeline.figures.damage_states import plot_damage_states  # lazy: matplotlib, as above
+            written.append(plot_damage_states(summary, campaign_dir /
+                                              "fragility_damage_states.png"))
     for name, entry in summary.columns.items():
         fit = entry.fits["PGA"]
         log.info(f"{name:>14}: {entry.toppled}/{entry.runs} toppled; PGA median "

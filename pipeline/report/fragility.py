@@ -36,7 +36,8 @@ def fragility_section(results):
              "maximum-likelihood fits P(toppled | IM) = Phi(ln(IM / median) / beta).\n",
              _table(pd.DataFrame(rows)) + "\n"]
     lines += damage_state_lines(summary)
-    for fig in ("fragility_curves.png", "fragility_2d_vs_3d.png", "fragility_surface.png"):
+    for fig in ("fragility_curves.png", "fragility_2d_vs_3d.png", "fragility_surface.png",
+                "fragility_damage_states.png"):
         lines.append(_figure(results, results / "fragility" / fig, fig[:-4].replace("_", " ")))
     return "\n".join(lines)
 

@@ -118,3 +118,10 @@ def test_the_report_shows_each_state_as_the_file_states_it(tmp_path):
         fit = state.fits["PGA"]
         assert cells[2] == f"{state.reached} of {state.runs}"
         assert cells[3].startswith(f"{fit.median:.3g} [{fit.median_ci95[0]:.2f}, ")
+
+
+def test_the_figure_draws_every_state(tmp_path):
+    from pipeline.figures.damage_states import plot_damage_states
+    fits = damage_state_fits(_table(300), {"drums": "d", "monolithic": "m"}, 0.2, 1.5)
+    path = plot_damage_states(FragilityFile(damage_states=fits), tmp_path / "ds.png")
+    assert path.stat().st_size > 10_000

@@ -197,5 +197,6 @@ def test_tiny_yade_fragility_campaign_writes_the_documented_keys(tmp_path):
     assert all(s["runs"] == 4 and s["reached"] >= 2 for s in states.values())
     assert states["collapse"]["reached"] == 2
     for name in ("fragility_runs.csv", "fragility_levels.csv", "fragility_curves.png",
-                 "fragility_2d_vs_3d.png", "fragility_surface.png"):
+                 "fragility_2d_vs_3d.png", "fragility_surface.png",
+                 "fragility_damage_states.png"):
         assert (out / name).exists(), name
