@@ -45,8 +45,9 @@ def colonnade_section(results, name=COLONNADE_DIR):
     lines = [title,
              f"The colonnade `{names}` (docs/colonnades.md: its proportions, sources and "
              f"what was assumed) shaken by {len(whole)} record(s), one run each, every "
-             "column and beam a YADE body as described, the contact stiffness of its "
-             "heaviest column (the campaigns' matched rule). A single run is a sample: "
+             "column and beam a YADE body as described, at the contact stiffness "
+             f"{_kn(runs)} N/m per point (the campaigns' matched rule for its heaviest "
+             "column, unless --stiffness paper). A single run is a sample: "
              "counts, not probabilities (an ensemble gives those: `campaign ensemble "
              "--column-file`). Fall azimuths in deg clockwise from North; parallel: their "
              "circular spread under 15 deg; in sequence: the fallen columns struck one "
@@ -62,3 +63,9 @@ def _yes_no(value):
     if pd.isna(value):
         return "-"
     return "yes" if str(value).lower() == "true" else "no"
+
+
+def _kn(runs):
+    """The runs' contact stiffness (N/m per point), or its range."""
+    lo, hi = runs["kn"].astype(float).min(), runs["kn"].astype(float).max()
+    return f"{lo:.2g}" if lo == hi else f"{lo:.2g} to {hi:.2g}"
