@@ -40,6 +40,12 @@ records: setup
 # in full).  The ensembles' nominal runs are the records campaign's (copied, not rerun).
 PAPER_BATCH ?= 1
 FRAGILITY_LEVELS := 1,2,4,8
+# the colonnade (reduced): the shipped stretch of the Parthenon's north flank
+# (docs/colonnades.md), one run per record at its columns' matched contact stiffness:
+# 58 bodies stepping 7.5e-5 s, about 6.5 s of one core per simulated second (NF04: 26 s
+# simulated, 2.8 min of one core), about 5-10 min on 2 idle cores for the three
+COLONNADE := parthenon-north-flank
+COLONNADE_RECORDS ?= NF04,RSN181-IMPVALL,RSN126-GAZLI
 STEP_TIMES := results/run-all-steps.tsv
 # $(call timed,NAME,COMMAND): run COMMAND, append NAME and its wall seconds to STEP_TIMES
 define timed
@@ -62,6 +68,9 @@ campaigns: setup
 	$(call timed,real columns,$(PY) -m pipeline campaign columns --jobs $(JOBS))
 	$(call timed,fragility (reduced),$(PY) -m pipeline campaign fragility \
 	  --levels $(FRAGILITY_LEVELS) --members 1 --jobs $(JOBS))
+	$(call timed,colonnade (reduced),$(PY) -m pipeline campaign records \
+	  --column-file $(COLONNADE) --records $(COLONNADE_RECORDS) --out results/colonnade \
+	  --animations 0 --jobs $(JOBS))
 	$(call timed,inversion demo (quick),$(PY) -m pipeline invert --demo --quick --jobs $(JOBS))
 	$(call timed,field rock fragility (reduced),$(PY) -m pipeline campaign fragility \
 	  --column-file $(FIELD_ROCK) --pulses "$(FIELD_ROCK_QUICK_PULSES)" --adaptive --animations 0 \

@@ -170,7 +170,8 @@ def simulate(motion, out_dir, run=None, back_azimuth=None, record=None, motion_f
                  "sliding thresholds at every sample, so no body can move",
             motion_end_s=drive.duration + drive.start_in_file_s,
             wall_s=time.perf_counter() - started, provenance=provenance,
-            start_in_file_s=drive.start_in_file_s)
+            start_in_file_s=drive.start_in_file_s,
+            colonnade=None if column.colonnade is None else column.colonnade.name)
     else:
         summary = summarise(trajectory, record=record, back_azimuth_deg=drive.back_azimuth,
                             parameters=parameters, provenance=provenance,

@@ -25,6 +25,7 @@ from dataclasses import replace
 from pipeline import paper
 from pipeline.files import InputError
 from pipeline.scenario.colonnade_file import load_if_colonnade
+from pipeline.scenario.colonnade_file import to_dict as colonnade_to_dict
 from pipeline.scenario.column_format import example_names
 from pipeline.scenario.geometry import ColumnGeometry
 
@@ -40,17 +41,25 @@ def column_file_help(many=False):
             + ", ".join(example_names()) + ")")
 
 
-def description(column_file, meshes=False):
+COLONNADE_CAMPAIGNS = "run, campaign records, friction, synthetic and ensemble"
+
+
+def description(column_file, meshes=False, colonnades=False):
     """The validated description dict of a shipped example's name, a file or a dict;
-    None for None.  InputError (one line) for an unknown name, a missing file or a
-    description that does not validate, and for a mesh specimen unless ``meshes`` (a
-    campaign that scales or perturbs blocks cannot take one)."""
+    None for None; a colonnade's dict (:func:`pipeline.scenario.colonnade_file.to_dict`,
+    every column written out) when ``colonnades``.  InputError (one line) for an unknown
+    name, a missing file or a description that does not validate, for a mesh specimen
+    unless ``meshes`` (a campaign that scales or perturbs blocks cannot take one) and for
+    a colonnade unless ``colonnades``."""
     if column_file is None:
         return None
-    if (isinstance(column_file, (dict, str))) and load_if_colonnade(column_file) is not None:
-        shown = column_file["name"] if isinstance(column_file, dict) else column_file
-        raise InputError(f"--column-file {shown}: a colonnade; the campaigns take one column "
-                         "(colonnades run with run)")
+    colonnade = (load_if_colonnade(column_file) if isinstance(column_file, (dict, str))
+                 else None)
+    if colonnade is not None:
+        if colonnades:
+            return colonnade_to_dict(colonnade)
+        raise InputError(f"--column-file {colonnade.name}: a colonnade; this command takes "
+                         f"one column (colonnades run with {COLONNADE_CAMPAIGNS})")
     if isinstance(column_file, dict):
         data = ColumnGeometry.from_dict(column_file).to_dict()
     elif not isinstance(column_file, str) or not column_file.strip():
@@ -74,10 +83,14 @@ def check_stiffness(stiffness):
 
 def column_kn(data, stiffness="matched"):
     """Contact stiffness per point (N/m) for a description: the campaign ``columns`` rule
-    (:func:`matched_kn`; also for ``stiffness`` None) or the paper's kn."""
+    (:func:`matched_kn`, for a colonnade the largest over its columns; also for
+    ``stiffness`` None) or the paper's kn."""
     check_stiffness(stiffness)
     if stiffness == "paper":
         return paper.COLUMN_KN_N_M
+    colonnade = load_if_colonnade(data)
+    if colonnade is not None:
+        return max(matched_kn(c.column) for c in colonnade.columns)
     return matched_kn(ColumnGeometry.from_dict(data))
 
 
@@ -151,6 +164,12 @@ def summary_entry(specs):
         if spec.column_description is not None:
             return {"column_file": spec.column_description}
     return {}
+
+
+def runs_colonnade(specs):
+    """Whether the specs run a colonnade (its description in ``column_description``)."""
+    return any(s.column_description is not None and "stylobate" in s.column_description
+               for s in specs)
 
 
 def paper_rocking_hz():

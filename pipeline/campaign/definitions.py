@@ -14,7 +14,7 @@ from pipeline.campaign.options import (CAMPAIGN_NOTE, CampaignOptions, ColumnFil
 from pipeline.scenario.contact_file import contact_values, refuse_set_twice, with_contact
 from pipeline.campaign.run_dirs import finished_runs
 from pipeline.campaign.column_file import (at_slenderness, check_stiffness, column_kn,
-                                           description, mark, matched_kn)
+                                           description, mark, matched_kn, runs_colonnade)
 from pipeline.campaign.runs import (column_outputs, column_specs, described_twins,
                                     pulse_record, run_column_spec, twin)
 from pipeline.campaign.tables import collect, write_tables
@@ -75,7 +75,7 @@ def slenderness_specs(records, campaign_dir, column_file=None, stiffness="matche
 
 def friction_specs(records, campaign_dir, column_file=None, stiffness="matched",
                    contact_file=None):
-    data = description(column_file, meshes=True)
+    data = description(column_file, meshes=True, colonnades=True)
     check_stiffness(stiffness)
     contact = _contact(contact_file)
     refuse_set_twice(contact, ("mu_s", "mu_k"), "the friction campaign's sweep")
@@ -105,7 +105,7 @@ def _nearsource_records():
 
 def records_specs(records, campaign_dir, column_file=None, stiffness="matched",
                   contact_file=None):
-    data = description(column_file, meshes=True)
+    data = description(column_file, meshes=True, colonnades=True)
     check_stiffness(stiffness)
     runs = [(r, twin()) for r in (list(records) if records else _nearsource_records())]
     return mark(column_specs(with_contact(described_twins(runs, data, stiffness),
@@ -134,7 +134,7 @@ def signal_window(record):
 
 def synthetic_specs(records, campaign_dir, column_file=None, stiffness="matched",
                     contact_file=None):
-    data = description(column_file, meshes=True)
+    data = description(column_file, meshes=True, colonnades=True)
     check_stiffness(stiffness)
     contact = _contact(contact_file)
     paths = list(records) if records else [
@@ -152,7 +152,7 @@ def synthetic_outputs(specs, campaign_dir, failures, animations, figures=True):
     from pipeline.figures.synthetic_map import plot_downfall_map  # lazy: matplotlib, not imported by a run or after Ctrl-C
     result = column_outputs("synthetic")(specs, campaign_dir, failures, animations, figures)
     runs, _ = collect(specs, "synthetic", campaign_dir)
-    if runs.empty or "source" not in runs.columns:
+    if runs.empty or "source" not in runs.columns or runs_colonnade(specs):
         return result
     for source in sorted(runs["source"].dropna().unique()) if figures else []:
         path = Path(campaign_dir) / f"map_{source}.png"
@@ -179,6 +179,8 @@ def columns_specs(records, campaign_dir, column_files=None, column="both",
     contact stiffness of :func:`matched_kn`, "paper" the paper's kn for all; a contact
     file's values (its kn too) go over them."""
     names = list(column_files) if column_files else example_names()
+    for name in names:
+        description(name, meshes=True)          # a colonnade refused in its own words
     geometries = [ColumnGeometry.load(name) for name in names]
     described = [g.to_dict() for g in geometries]
     for k, data in enumerate(described):

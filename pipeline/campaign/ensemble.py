@@ -29,7 +29,7 @@ from pipeline.scenario.parameters import param
 from pipeline.campaign.column_file import description as column_file_description
 from pipeline.campaign.runs import column_specs, run_column_spec
 from pipeline.campaign.run_dirs import finished_summary
-from pipeline.campaign.tables import collect, write_parquet
+from pipeline.campaign.tables import collect, colonnade_table, write_parquet
 from pipeline.files import InputError, write_csv, write_json
 from pipeline.simulate import run_code_version
 from pipeline.campaign.sizing import (DEFAULT_ARC_DEG, DEFAULT_MAX_MEMBERS, DEFAULT_PRECISION,
@@ -49,7 +49,7 @@ def ensemble_specs(records, campaign_dir, record=None, column="both", members=DE
     """Specs of the nominal run and ``members`` members per record (``record_members``:
     {record: members} overrides it per record), sampled in batches of ``batch``; a
     contact file fixes what it sets (:func:`contact_ranges`)."""
-    data = column_file_description(column_file)
+    data = column_file_description(column_file, colonnades=True)
     records = list(records or []) + ([record] if record else [])
     if not records:
         raise InputError("campaign ensemble needs --record ID_OR_FILE (or --records/--set)")
@@ -115,6 +115,10 @@ def ensemble_outputs(specs, campaign_dir, failures, animations, figures=True):
                      + ("" if az is None else f", mean downfall {az:.0f} deg "
                      f"(R {col['resultant_length']:.2f})"))
     write_summaries(campaign_dir, summaries)
+    colonnades = colonnade_table(specs, campaign_dir)
+    if not colonnades.empty:
+        write_csv(campaign_dir / "colonnades.csv", colonnades.assign(
+            member=colonnades["run_id"].map(member_of)))
     if len(records) > 1:
         pooled = pooled_summary(runs)
         if pooled is not None:
@@ -170,7 +174,8 @@ class EnsembleOptions(CampaignOptions):
         "every member is the described column with the sampled height and diameter "
         "tolerances on every block, the tilt added to its own and the drum offsets on the "
         "blocks above the first (joined blocks keep theirs); with --column both a monolith "
-        "of its outline stands beside it")
+        "of its outline stands beside it; a colonnade's description: the colonnade, every "
+        "column with the same tolerances, no sampled tilt or offsets (docs/colonnades.md)")
     stiffness: str = stiffness_param("with --column-file, what kn_factor multiplies")
     contact_file: str = contact_file_param(
         "its damping and friction for every member (not sampled), its kn what kn_factor "

@@ -41,6 +41,7 @@ from pipeline.campaign.column_file import perturbed
 from pipeline.constants import RIM_POINTS
 from pipeline.files import InputError
 from pipeline.scenario import Contact, Numerics
+from pipeline.scenario.colonnade_file import load_if_colonnade
 from pipeline.scenario.column_format import MAX_OFFSET_M
 from pipeline.scenario.contact_file import ranges_left
 from pipeline.scenario.geometry import ColumnGeometry
@@ -164,7 +165,10 @@ def _first(seed):
 def described_member(data, v, seed, index):
     """Member ``index`` of a described column from its sampled values ``v``.  Validated
     before anything runs without the sampled offsets (sizes, tilts, statics: milliseconds;
-    a member with offset joints takes about a second), whose size is checked alone."""
+    a member with offset joints takes about a second), whose size is checked alone.  Of a
+    colonnade (a dict with ``stylobate``): :func:`colonnade_member`."""
+    if "stylobate" in data:
+        return colonnade_member(data, v, seed, index)
     args = (data, 1 + v.get("height_tolerance", 0.0), 1 + v.get("diameter_tolerance", 0.0),
             v.get("tilt_deg", 0.0), v.get("tilt_azimuth_deg", 0.0))
     member = perturbed(*args, v.get("drum_offset_mm", 0.0) / 1000.0,
@@ -174,6 +178,24 @@ def described_member(data, v, seed, index):
         for k, block in enumerate(member["blocks"]):
             if max(map(abs, block.get("offset_m", [0.0, 0.0]))) > MAX_OFFSET_M:
                 raise InputError(f"blocks[{k}]: offset_m above {MAX_OFFSET_M:g} m")
+    except InputError as exc:
+        raise InputError(f"ensemble member {index} of {data['name']}: {exc}") from None
+    return member
+
+
+def colonnade_member(data, v, seed, index):
+    """Member ``index`` of a colonnade (its dict, every column written out): every
+    column takes the same sampled height and diameter tolerances; no tilt and no drum
+    offsets (they would move the capitals apart or together, and beams laid joint to
+    joint over the column axes would part or overlap): tilts and offsets as described.
+    Validated as a colonnade (InputError naming the member)."""
+    columns = [{**placed, "column": perturbed(placed["column"],
+                                              1 + v.get("height_tolerance", 0.0),
+                                              1 + v.get("diameter_tolerance", 0.0))}
+               for placed in data["columns"]]
+    member = {**data, "columns": columns}
+    try:
+        load_if_colonnade(member)
     except InputError as exc:
         raise InputError(f"ensemble member {index} of {data['name']}: {exc}") from None
     return member

@@ -50,12 +50,21 @@ def fragility_outputs(specs, campaign_dir, failures, animations, figures=True):
     if figures:
         from pipeline.figures.fragility import plot_fragility  # lazy: matplotlib, not imported by a run or after Ctrl-C
         written = plot_fragility(table, summary, campaign_dir)
+        if summary.damage_states:
+            from pipeline.figures.damage_states import plot_damage_states  # lazy: matplotlib, as above
+            written.append(plot_damage_states(summary, campaign_dir /
+                                              "fragility_damage_states.png"))
     for name, entry in summary.columns.items():
         fit = entry.fits["PGA"]
         log.info(f"{name:>14}: {entry.toppled}/{entry.runs} toppled; PGA median "
                  + ("-" if fit.median is None else
                     f"{fit.median:.2f} m/s^2 [{fit.median_ci95[0]:.2f}, "
                     f"{fit.median_ci95[1]:.2f}], beta {fit.beta:.2f}"))
+    for name, entry in (summary.damage_states or {}).items():
+        log.info(f"{name:>14}: damage states reached (of {entry.runs} runs): " + ", ".join(
+            f"{s.state} {s.reached}" + ("" if s.fits["PGA"].median is None else
+                                        f" (PGA median {s.fits['PGA'].median:.2f} m/s^2)")
+            for s in entry.states))
     log.info(f"2D block: {cost['block2d_cases']} cases in {cost['block2d_wall_s']:.1f} s; "
              f"YADE: {cost['yade_runs']} runs, {cost['yade_wall_s_total']:.0f} s")
     return {"code_version": run_code_version(), **summary_entry(specs),

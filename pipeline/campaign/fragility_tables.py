@@ -14,6 +14,7 @@ from pipeline.campaign.tables import collect
 from pipeline.constants import MODEL_GRAVITY
 from pipeline.files import json_safe
 from pipeline.hazard.fragility.checker import leaf
+from pipeline.hazard.fragility.damage_states import STATES, ColumnStates, StateFits
 from pipeline.hazard.fragility.file import Block2d, ColumnFits, FragilityFile
 from pipeline.hazard.fragility.fits import LogisticSurface, LognormalFit
 from pipeline.rocking.housner import block_constants
@@ -32,6 +33,7 @@ FILE_ORDER = ("records", "levels_m_s2", "members", "seed", "column", "column_fil
               "azimuths", "intensity_measures", "columns", "comparison", "levels", "block2d",
               "cost")                                           # fragility.json's key order
 MODELS_2D = ("block2d", "block2d_worst")
+STATE_RANK = {state: k for k, state in enumerate(("none", *STATES))}   # runs-table labels
 # amplitude-dependent record parameters, rescaled to the scaled motion in the runs table
 SCALED_LINEAR = ("pga", "pgv", "pgd")
 SCALED_SQUARE = ("arias",)
@@ -98,7 +100,8 @@ def summarise(table, specs, cost):
     coefficients {b0, b1, b2}, se, ci95, n, toppled, method, separated, note,
     dimensionless}}}, "comparison": [{column, block, im, median_3d, median_2d,
     ratio_3d_to_2d, ...}], "levels": [per record and level fractions],
-    "block2d": {...}, "cost": {...}}"""
+    "block2d": {...}, "cost": {...}, "damage_states": {3D column type: P(damage state or
+    worse) fitted alike per state, :func:`damage_state_fits`}}"""
     first = specs[0].tags
     alpha, p = _block_alpha_p(table, specs)
     described = summary_entry(specs)
@@ -111,6 +114,7 @@ def summarise(table, specs, cost):
         "block2d": "2D rigid block (Housner), shaken along the strongest azimuth",
         "block2d_worst": f"2D rigid block, worst of {first.azimuths} azimuths over 180 deg"}
     columns, brackets = _column_fits(table, descriptions, alpha, p)
+    damage = damage_state_fits(table, descriptions, alpha, p)
     comparison = _comparison(columns, brackets)
     levels = level_table(table)
     block = {"alpha_rad": alpha, "p_per_s": p,
@@ -135,6 +139,7 @@ def summarise(table, specs, cost):
         block2d=Block2d(alpha_rad=alpha, p_per_s=p,
                         extra=json_safe({k: block[k] for k in list(block)[2:]}),
                         order=tuple(block)),
+        damage_states=damage,
         extra=extra, order=tuple(k for k in FILE_ORDER if k in extra or k in FILE_FIELDS))
 
 
@@ -159,22 +164,50 @@ def _column_fits(table, descriptions, alpha, p):
         sub = table[table["column"] == name]
         y = sub["toppled"].astype(bool).to_numpy()
         brackets[name] = _brackets(sub.groupby("level_m_s2")["toppled"].mean())
-        where = f"columns.{name}"
-        fits = {}
-        for im, (key, unit, _) in INTENSITY_MEASURES.items():
-            values = sub[key].astype(float).to_numpy()
-            fits[im] = leaf(LognormalFit, json_safe({**fragility_fit(values, y), "unit": unit,
-                                                     "bins": binned_fractions(values, y)}),
-                            FILE, f"{where}.{im}")
-        surface = logistic_surface(sub["pga_m_s2"].astype(float),
-                                   sub["pgv_pga_s"].astype(float), y, alpha=alpha, p=p)
+        fits, logistic = _fits(sub, y, f"columns.{name}", alpha, p)
         columns[name] = ColumnFits(
             description=descriptions[name], model="3D" if name in MODELS_3D else "2D",
-            runs=len(sub), toppled=int(y.sum()), fits=fits,
-            logistic=leaf(LogisticSurface, json_safe(surface), FILE, f"{where}.logistic"),
+            runs=len(sub), toppled=int(y.sum()), fits=fits, logistic=logistic,
             extra=dict(zip(BRACKETS, brackets[name])),
             order=("model", "description", "runs", "toppled", *BRACKETS, *fits, "logistic"))
     return columns, brackets
+
+
+def _fits(sub, y, where, alpha, p):
+    """A lognormal fit with binned fractions per intensity measure and the logistic
+    surface in (PGA, PGV/PGA) of the outcomes ``y`` (bool per row of ``sub``)."""
+    fits = {}
+    for im, (key, unit, _) in INTENSITY_MEASURES.items():
+        values = sub[key].astype(float).to_numpy()
+        fits[im] = leaf(LognormalFit, json_safe({**fragility_fit(values, y), "unit": unit,
+                                                 "bins": binned_fractions(values, y)}),
+                        FILE, f"{where}.{im}")
+    surface = logistic_surface(sub["pga_m_s2"].astype(float), sub["pgv_pga_s"].astype(float),
+                               y, alpha=alpha, p=p)
+    return fits, leaf(LogisticSurface, json_safe(surface), FILE, f"{where}.logistic")
+
+
+def damage_state_fits(table, descriptions, alpha, p):
+    """Per 3D column type, P(damage state or worse | IM) for every state above none
+    (:data:`~pipeline.hazard.fragility.damage_states.STATES`), fitted as P(toppled):
+    column type -> :class:`ColumnStates`, over the runs with damage measures (None when
+    no run has them)."""
+    out = {}
+    for name in [c for c in MODELS_3D if c in set(table["column"])]:
+        sub = table[table["column"] == name]
+        rank = sub["damage_state"].map(STATE_RANK) if "damage_state" in sub else None
+        if rank is None or rank.isna().all():
+            continue
+        sub, rank = sub[rank.notna()], rank[rank.notna()].to_numpy(int)
+        states = []
+        for k, state in enumerate(STATES, start=1):
+            y = rank >= k
+            fits, logistic = _fits(sub, y, f"damage_states.{name}.states.{state}", alpha, p)
+            states.append(StateFits(state=state, runs=len(sub), reached=int(y.sum()),
+                                    fits=fits, logistic=logistic))
+        out[name] = ColumnStates(description=descriptions[name], runs=len(sub),
+                                 states=tuple(states))
+    return out or None
 
 
 def _comparison(columns, brackets):

@@ -12,7 +12,8 @@ from pipeline.scenario.parameters import check_fields, param
 from pipeline.scenario.contact_file import contact_values
 
 CAMPAIGN_NOTE = ("the described column stands in the drums' place and a monolith of its "
-                 "outline in the monolith's")
+                 "outline in the monolith's; a colonnade's description puts the colonnade "
+                 "there instead (docs/colonnades.md)")
 STIFFNESS_HELP = ("contact stiffness per point: matched raises the paper's kn for heavy "
                   "columns so that each rocks on its contact springs no slower than the "
                   f"paper's column ({paper_rocking_hz():.1f} Hz); paper: {paper.COLUMN_KN_N_M:g} N/m for all")

@@ -6,9 +6,9 @@ import logging
 from pathlib import Path
 
 from pipeline import RESULTS_DIR
-from pipeline.campaign.column_file import column_kn, summary_entry
+from pipeline.campaign.column_file import column_kn, runs_colonnade, summary_entry
 from pipeline.campaign.spec import RunSpec
-from pipeline.campaign.tables import collect, write_tables
+from pipeline.campaign.tables import collect, colonnade_table, write_tables
 from pipeline.files import InputError, csv_true_column, write_csv
 from pipeline.motion import Motion
 from pipeline.records import CACHE_DIR, catalog, catalog_row, processed_motion, resolve
@@ -92,7 +92,9 @@ def pulse_record():
 
 
 def column_outputs(name, size_by=None):
-    """Outputs of a column campaign: runs.csv, impacts.csv, direction statistics, figures."""
+    """Outputs of a column campaign: runs.csv, impacts.csv, direction statistics, figures;
+    for a colonnade runs.csv, impacts.csv and colonnades.csv
+    (:func:`pipeline.campaign.tables.colonnade_table`), no figures."""
 
     def outputs(specs, campaign_dir, failures, animations, figures=True):
         campaign_dir = Path(campaign_dir)
@@ -103,7 +105,10 @@ def column_outputs(name, size_by=None):
             runs.insert(1, "description", runs["run_id"].map(names))
         write_tables(campaign_dir, runs, impacts)
         written = []
-        if not runs.empty:
+        if runs_colonnade(specs):
+            # the colonnade's own outcomes instead of the twin columns' statistics
+            write_csv(campaign_dir / "colonnades.csv", colonnade_table(specs, campaign_dir))
+        elif not runs.empty:
             write_csv(campaign_dir / "direction_statistics.csv", direction_statistics(runs))
             if figures:
                 from pipeline import figures as figure_module  # lazy: matplotlib, not imported by a run or after Ctrl-C

@@ -46,6 +46,32 @@ def write_parquet(path, frame):
         frame.to_parquet(tmp, index=False, engine="pyarrow")
 
 
+COLONNADE_COLUMNS = ("run_id", "record_id", "colonnade", "columns", "columns_fallen", "beams",
+                     "beams_fallen", "fall_azimuth_mean_deg", "fall_azimuth_spread_deg",
+                     "parallel", "fall_order", "in_sequence")
+
+
+def colonnade_table(specs, campaign_dir):
+    """One row per finished run of a colonnade: what its ``summary.json`` says of the
+    colonnade as a whole (:class:`~pipeline.outcome.colonnade.ColonnadeOutcome`: columns
+    and beams fallen, the fallen columns' azimuth mean and spread, parallel, the fall
+    order as names joined by spaces, in sequence); empty without colonnades."""
+    rows = []
+    for spec, summary in finished_runs(campaign_dir, specs):
+        whole = summary.colonnade
+        if whole is None:
+            continue
+        rows.append({"run_id": spec.run_id, "record_id": spec.record_id,
+                     "colonnade": whole.name, "columns": whole.columns,
+                     "columns_fallen": whole.columns_fallen, "beams": whole.beams,
+                     "beams_fallen": whole.beams_fallen,
+                     "fall_azimuth_mean_deg": _nan(whole.fall_azimuth_mean_deg),
+                     "fall_azimuth_spread_deg": _nan(whole.fall_azimuth_spread_deg),
+                     "parallel": whole.parallel, "fall_order": " ".join(whole.fall_order),
+                     "in_sequence": whole.in_sequence})
+    return pd.DataFrame(rows, columns=COLONNADE_COLUMNS)
+
+
 def _missing(value):
     return value is None or (isinstance(value, float) and math.isnan(value))
 

@@ -156,14 +156,19 @@ class RunSummary:
             raise InputError("run summary: simulated and stopped_early must be true or false")
 
     @classmethod
-    def still(cls, record, columns, **values):
+    def still(cls, record, columns, colonnade=None, **values):
         """A run YADE never ran: every column standing (``columns``: scene column dicts
         with name, x, y, and bodies for the damage measures, all zero; none for a
-        colonnade's beams, which rest on others)."""
-        return cls(record=record, simulated=False,
-                   columns=[ColumnOutcome.standing(c["name"], c["x"], c["y"],
-                                                   None if c.get("rests_on") else c.get("bodies"))
-                            for c in columns], **values)
+        colonnade's beams, which rest on others); ``colonnade``: the name of the
+        colonnade the scene holds (its outcome: nothing fell), or None."""
+        outcomes = [ColumnOutcome.standing(c["name"], c["x"], c["y"],
+                                           None if c.get("rests_on") else c.get("bodies"))
+                    for c in columns]
+        whole = None if colonnade is None else ColonnadeOutcome.of(
+            colonnade, [o for o, c in zip(outcomes, columns) if not c.get("rests_on")],
+            [o for o, c in zip(outcomes, columns) if c.get("rests_on")])
+        return cls(record=record, simulated=False, columns=outcomes, colonnade=whole,
+                   **values)
 
     def column(self, name):
         """The :class:`ColumnOutcome` of column ``name``."""

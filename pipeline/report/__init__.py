@@ -4,7 +4,8 @@
 
 Sections for campaigns that have not run say so instead of inventing numbers.  One module
 per kind of section: ``records`` (records, processing, synthetics), ``campaigns``
-(verification, sweeps, real columns, shake table, speed, run-all's cost), ``ensembles``
+(verification, sweeps, real columns, shake table, speed, run-all's cost), ``colonnades``
+(a colonnade under records), ``ensembles``
 (ensembles, the paper's question, convergence), ``contact_stiffness``, ``fragility``,
 ``inversion``; shared helpers in ``common``."""
 import datetime
@@ -15,6 +16,7 @@ from pipeline import RESULTS_DIR, __version__
 from pipeline.files import write_text
 from pipeline.report.campaigns import (columns_section, run_all_section, shake_table_section,
                                        speed_section, sweep_section, verification_section)
+from pipeline.report.colonnades import colonnade_section
 from pipeline.report.contact_stiffness import contact_stiffness_section
 from pipeline.report.ensembles import (convergence_section, ensemble_section,
                                        paper_question_section)
@@ -31,7 +33,7 @@ from pipeline.report.records import (back_azimuth_table, correlation_table, per_
                                      with_back_azimuth)
 from pipeline.stats.ensemble import wilson_interval
 
-__all__ = ["build_report", "back_azimuth_table", "columns_section",
+__all__ = ["build_report", "back_azimuth_table", "colonnade_section", "columns_section",
            "contact_stiffness_section", "convergence_section", "field_rock_section",
            "correlation_table", "paper_question_section",
            "ensemble_section", "fragility_section", "inversion_section",
@@ -74,6 +76,7 @@ def build_report(results=RESULTS_DIR):
         field_rock_section(results), field_rock_section(results, FIELD_ROCK_QUICK),
         paper_question_section(results), ensemble_section(results),
         convergence_section(results), fragility_section(results), columns_section(results),
+        colonnade_section(results),
         inversion_section(results), member_study_section(results),
         records_section(results), processing_section(results), synthetic_section(results),
         speed_section(results), run_all_section(results)]

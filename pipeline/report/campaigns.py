@@ -145,7 +145,9 @@ def run_all_section(results):
             f"`{path.relative_to(results)}`): {total / 60:.1f} min in all, the venv and the "
             "report not counted.  Reduced in size: the paper's question (one member per "
             "record beside the nominal run; `make paper-question` sizes every record by its "
-            "error), fragility (4 levels, one member; `campaign fragility`: 8 x 4) and the "
+            "error), fragility (4 levels, one member; `campaign fragility`: 8 x 4), the "
+            "colonnade (three records, one run each; `campaign ensemble --column-file` "
+            "gives probabilities) and the "
             "inversion (the quick grid; `make invert-demo`, `make invert-study`).  Runs "
             "finished earlier are reused, so a second run-all costs far less.\n\n"
             + _table(frame[["step", "wall (min)", "exit"]]) + "\n")

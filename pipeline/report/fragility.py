@@ -35,9 +35,36 @@ def fragility_section(results):
              f"{summary.members} members per record and level; lognormal "
              "maximum-likelihood fits P(toppled | IM) = Phi(ln(IM / median) / beta).\n",
              _table(pd.DataFrame(rows)) + "\n"]
-    for fig in ("fragility_curves.png", "fragility_2d_vs_3d.png", "fragility_surface.png"):
+    lines += damage_state_lines(summary)
+    for fig in ("fragility_curves.png", "fragility_2d_vs_3d.png", "fragility_surface.png",
+                "fragility_damage_states.png"):
         lines.append(_figure(results, results / "fragility" / fig, fig[:-4].replace("_", " ")))
     return "\n".join(lines)
+
+
+def damage_state_lines(summary):
+    """The damage-state fragilities of a campaign's ``fragility.json`` (a
+    :class:`~pipeline.hazard.fragility.file.FragilityFile`): per 3D column type and
+    state, the runs that reached it and the lognormal fit in PGA; [] without them."""
+    if not summary.damage_states:
+        return []
+    rows = []
+    for name, entry in summary.damage_states.items():
+        for state in entry.states:
+            fit = state.fits["PGA"]
+            lo, hi = fit.median_ci95 or (None, None)
+            rows.append({"column": name if entry.description is None else entry.description,
+                         "damage state or worse": state.state,
+                         "runs reached": f"{state.reached} of {state.runs}",
+                         "PGA median [95 %] m/s^2": "-" if fit.median is None else
+                         f"{fit.median:.3g} [{_fmt(lo, 2)}, {_fmt(hi, 2)}]",
+                         "beta": _fmt(fit.beta, 2), "note": fit.note or ""})
+    return ["Damage states (docs/damage.md): P(the state or a worse one | IM), fitted per "
+            "state as P(toppled) is (lognormal in PGA here; PGV, PGV/PGA and the logistic "
+            "surface in fragility.json, `damage_states`); the Monte Carlo error is the "
+            "fits' 95 % intervals and the binned fractions' Wilson intervals there. A fit "
+            "is missing where every run, or none, reached the state.\n",
+            _table(pd.DataFrame(rows)) + "\n"]
 
 
 ROCK_FRAGILITY = {

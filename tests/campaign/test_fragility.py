@@ -189,6 +189,14 @@ def test_tiny_yade_fragility_campaign_writes_the_documented_keys(tmp_path):
         assert {"form", "coefficients", "se", "ci95", "n", "method", "separated"} <= set(
             entry["logistic"])
     assert summary["cost"]["yade_runs"] == 2 and summary["cost"]["runs_not_simulated"] == 2
+    # the damage states of the 3D column (none for the 2D block): collapse is toppling,
+    # and a run that toppled reached every milder state
+    assert set(summary["damage_states"]) == {"monolithic"}
+    states = summary["damage_states"]["monolithic"]["states"]
+    assert list(states) == ["slight", "moderate", "severe", "collapse"]
+    assert all(s["runs"] == 4 and s["reached"] >= 2 for s in states.values())
+    assert states["collapse"]["reached"] == 2
     for name in ("fragility_runs.csv", "fragility_levels.csv", "fragility_curves.png",
-                 "fragility_2d_vs_3d.png", "fragility_surface.png"):
+                 "fragility_2d_vs_3d.png", "fragility_surface.png",
+                 "fragility_damage_states.png"):
         assert (out / name).exists(), name

@@ -111,6 +111,7 @@ def test_a_colonnade_run_writes_its_description_and_outcome(tmp_path):
 def test_a_campaign_refuses_a_colonnade_in_one_line():
     from pipeline.campaign.column_file import description
     from pipeline.files import InputError
-    with pytest.raises(InputError, match="a colonnade; the campaigns take one column"):
+    with pytest.raises(InputError, match="a colonnade; this command takes one column"):
         description(NAME)
     assert description("doric-peristyle")["name"] == "doric-peristyle"
+    assert description(NAME, colonnades=True)["name"] == NAME       # records, ensemble, ...

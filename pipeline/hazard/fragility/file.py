@@ -24,6 +24,7 @@ from pathlib import Path
 from pipeline.files import write_json
 from pipeline.hazard.fragility.check import MAX_MEMBERS, check_fragility, key_text
 from pipeline.hazard.fragility.checker import leaf
+from pipeline.hazard.fragility.damage_states import damage_states_json, damage_states_of
 from pipeline.hazard.fragility.experiments import Experiments
 from pipeline.hazard.fragility.fits import LognormalFit, LogisticSurface
 from pipeline.hazard.fragility.rows import ContourRow, GridCell
@@ -113,7 +114,9 @@ class ColumnFits(Keyed):
 class FragilityFile(Keyed):
     """``fragility.json``: ``specimen`` (its name), ``mode`` ("pulses" for a pulse grid),
     a column campaign's ``columns`` (name -> :class:`ColumnFits`), ``records`` (ids),
-    ``members`` and ``block2d``, or a pulse grid's ``pulse_grid``; ``path`` where it was
+    ``members``, ``block2d`` and ``damage_states`` (3D column type -> the fragility of each
+    damage state, :class:`~pipeline.hazard.fragility.damage_states.ColumnStates`; None in
+    files written before them), or a pulse grid's ``pulse_grid``; ``path`` where it was
     read from (None when built in memory)."""
     specimen: str | None = None
     mode: str | None = None
@@ -122,6 +125,7 @@ class FragilityFile(Keyed):
     members: int | None = None
     block2d: Block2d | None = None
     pulse_grid: PulseGridSection | None = None
+    damage_states: dict | None = None
     path: Path | None = field(default=None, compare=False)
 
     @classmethod
@@ -135,7 +139,8 @@ class FragilityFile(Keyed):
                 k: _column(e, name, f"columns.{key_text(k)}") for k, e in v.items()},
             "records": lambda v: tuple(v or ()),
             "block2d": lambda v: None if v is None else _build(Block2d, v),
-            "pulse_grid": lambda v: None if v is None else _section(v, name)}, path=path)
+            "pulse_grid": lambda v: None if v is None else _section(v, name),
+            "damage_states": lambda v: damage_states_of(v, name)}, path=path)
 
     def to_json(self):
         """The dict written to ``fragility.json``."""
@@ -144,7 +149,8 @@ class FragilityFile(Keyed):
                 k: _column_json(e) for k, e in v.items()},
             "records": list,
             "block2d": lambda v: None if v is None else _join(v),
-            "pulse_grid": lambda v: None if v is None else _section_json(v)})
+            "pulse_grid": lambda v: None if v is None else _section_json(v),
+            "damage_states": damage_states_json})
 
 
 def read_fragility_file(path):

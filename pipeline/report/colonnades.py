@@ -1,0 +1,71 @@
+"""Report section of a colonnade campaign (``campaign records --column-file`` a colonnade;
+``make run-all`` writes results/colonnade): per record what the colonnade did as a whole
+(colonnades.csv) and each column's damage state (runs.csv), from the files the campaign
+wrote."""
+import pandas as pd
+
+from pipeline.campaign.run_dirs import finished_summary
+from pipeline.report.common import _fmt, _read_csv, _table
+
+COLONNADE_DIR = "colonnade"
+
+
+def colonnade_section(results, name=COLONNADE_DIR):
+    """The colonnade campaign in ``results/name``, when it has run."""
+    folder = results / name
+    whole, runs = _read_csv(folder / "colonnades.csv"), _read_csv(folder / "runs.csv")
+    title = "## A colonnade under records (campaign records with a colonnade)\n"
+    if whole is None or runs is None:
+        return (title + "\nNot run yet (`make run-all`, or `python -m pipeline campaign "
+                "records --column-file parthenon-north-flank`: see docs/colonnades.md).\n")
+    columns = runs[runs["damage_state"].notna() & (runs["damage_state"].astype(str) != "")]
+    rows = []
+    for _, row in whole.iterrows():
+        states = columns[columns["run_id"] == row["run_id"]].sort_values("column")
+        standing = states[~states["toppled"].astype(str).str.lower().eq("true")]
+        rows.append({
+            "record": row["record_id"],
+            "columns fallen": f"{row['columns_fallen']} of {row['columns']}",
+            "beams fallen": f"{row['beams_fallen']} of {row['beams']}",
+            "azimuth mean, spread (deg)": "-" if pd.isna(row["fall_azimuth_spread_deg"])
+            else f"{_fmt(row['fall_azimuth_mean_deg'])}, "
+                 f"{_fmt(row['fall_azimuth_spread_deg'])}",
+            "parallel": _yes_no(row["parallel"]),
+            "fall order (in sequence)": "-" if pd.isna(row["fall_order"]) else
+            f"{row['fall_order']} ({_yes_no(row['in_sequence'])})",
+            "damage state per column": ", ".join(
+                f"{c['column']} {c['damage_state']}" for _, c in states.iterrows()),
+            "largest residual slide of a standing column (mm)": _fmt(
+                1000 * standing["max_residual_slide_m"].astype(float).max(), 1)
+            if len(standing) else "-"})
+    walls = [s.wall_s for s in (finished_summary(folder, r) for r in whole["run_id"])
+             if s is not None]
+    simulated = runs.drop_duplicates("run_id")["simulated_s"].astype(float).sum()
+    names = ", ".join(sorted(set(whole["colonnade"])))
+    lines = [title,
+             f"The colonnade `{names}` (docs/colonnades.md: its proportions, sources and "
+             f"what was assumed) shaken by {len(whole)} record(s), one run each, every "
+             "column and beam a YADE body as described, at the contact stiffness "
+             f"{_kn(runs)} N/m per point (the campaigns' matched rule for its heaviest "
+             "column, unless --stiffness paper). A single run is a sample: "
+             "counts, not probabilities (an ensemble gives those: `campaign ensemble "
+             "--column-file`). Fall azimuths in deg clockwise from North; parallel: their "
+             "circular spread under 15 deg; in sequence: the fallen columns struck one "
+             "after the other along the row. Damage states as defined in docs/damage.md.\n",
+             _table(pd.DataFrame(rows)) + "\n",
+             f"Cost: {simulated:.0f} s simulated in {sum(walls) / 60:.1f} min of YADE wall "
+             f"time over {len(walls)} run(s) (files: `{name}/colonnades.csv`, "
+             f"`{name}/runs.csv`).\n"]
+    return "\n".join(lines)
+
+
+def _yes_no(value):
+    if pd.isna(value):
+        return "-"
+    return "yes" if str(value).lower() == "true" else "no"
+
+
+def _kn(runs):
+    """The runs' contact stiffness (N/m per point), or its range."""
+    lo, hi = runs["kn"].astype(float).min(), runs["kn"].astype(float).max()
+    return f"{lo:.2g}" if lo == hi else f"{lo:.2g} to {hi:.2g}"
