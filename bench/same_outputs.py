@@ -16,13 +16,15 @@ processed motions in the campaign directory).  ``--pga-pgv-correlation`` is pass
 both (default 0.733, the default of the revisions before 0.654 became it).
 
 Printed per file: keys added and removed, and each value that differs (before, after,
-relative difference); values that hold code versions, run ids, paths or wall times
-(``VOLATILE``) are counted apart.  Exit status 1 when a value differs by more than
+relative difference); values that hold code versions, run ids or wall times
+(``VOLATILE``) are counted and named apart, and the checkout's and the output's own
+directories are read as ``<checkout>`` and ``<out>`` in every value.  Exit status 1 when a value differs by more than
 ``--rtol``.
 """
 import argparse
 import csv
 import difflib
+import io
 import json
 import math
 import os
@@ -36,11 +38,12 @@ USGS = "records/hazard/usgs_nshm2014r1_curves_-118_34_vs760.json"
 GRID = "pga_g=0.1:0.5:3;pgv_pga_s=0.2:0.8:2"
 SITE = ["--magnitude", "6.5", "--distance-km", "55", "--vs30", "800", "--age-ka", "15",
         "--age-sd-ka", "3"]
-# keys whose values say which code ran, where, when or how fast: compared, counted apart
-VOLATILE = {"run_id", "provenance", "code_hash", "software", "versions", "created",
+# keys whose values say which code ran, where, when or how fast (run ids and the motion
+# cache's file names hash the code): compared, counted apart
+VOLATILE = {"run_id", "provenance", "code_hash", "code_version", "software", "versions", "created",
             "created_utc", "yade_wall_s", "yade_wall_s_total", "wall_s", "campaign_wall_s",
             "python", "git", "command", "path", "out", "directory", "fragility_file",
-            "elapsed_s", "core_s"}
+            "elapsed_s", "core_s", "block2d_wall_s", "run_dir", "motion_file"}
 REPORT_SNIPPET = """
 import sys
 from pathlib import Path
@@ -83,6 +86,7 @@ def run_checkout(checkout, out, python, rho):
     """Every step at ``checkout`` into ``out``/results; the REPORT text to report.md."""
     results = (out / "results").resolve()
     results.mkdir(parents=True, exist_ok=True)
+    (out / "checkout.txt").write_text(f"{checkout}\n")
     env = dict(os.environ, PYTHONPATH=str(checkout))
     for name, argv in commands(results, rho):
         argv = [python, "-m", "pipeline", *argv, "--out", str(results / name)]
@@ -126,20 +130,28 @@ def _nan(x):
     return isinstance(x, float) and math.isnan(x)
 
 
-def read_csv(path):
-    """Rows of a CSV file as dicts of cells (by header)."""
-    with open(path, newline="") as f:
-        return list(csv.DictReader(f))
+def read_csv(text):
+    """Rows of a CSV text as dicts of cells (by header)."""
+    return list(csv.DictReader(io.StringIO(text, newline="")))
 
 
-def compare_file(before, after):
-    """Differences between two output files (JSON or CSV), as compare_values gives."""
+def read_text(path, roots):
+    """A file's text with each (directory, placeholder) of ``roots`` replaced."""
+    text = path.read_text()
+    for directory, placeholder in roots:
+        text = text.replace(str(directory), placeholder)
+    return text
+
+
+def compare_file(before, after, roots_before=(), roots_after=()):
+    """Differences between two output files (JSON or CSV), as compare_values gives;
+    ``roots_*``: (directory, placeholder) pairs read as their placeholder."""
     found = []
+    text_a, text_b = read_text(before, roots_before), read_text(after, roots_after)
     if before.suffix == ".json":
-        compare_values(json.loads(before.read_text()), json.loads(after.read_text()), "",
-                       found)
+        compare_values(json.loads(text_a), json.loads(text_b), "", found)
         return found
-    rows_a, rows_b = read_csv(before), read_csv(after)
+    rows_a, rows_b = read_csv(text_a), read_csv(text_b)
     if len(rows_a) != len(rows_b):
         return [("value", "rows", len(rows_a), len(rows_b))]
     for i, (ra, rb) in enumerate(zip(rows_a, rows_b)):
@@ -186,6 +198,9 @@ def report_file(rel, found, rtol):
                                   or relative(f[2], f[3]) > rtol)]
     print(f"{rel}: {len(real)} value(s) differ ({len(beyond)} beyond rtol {rtol:g}), "
           f"{len(keys)} key(s) added or removed, {len(moving)} volatile value(s) differ")
+    if moving:
+        names = sorted({path.split("/")[-1] for _, path, _, _ in moving})
+        print(f"    volatile: {', '.join(names)[:200]}")
     for kind, path, a, b in keys:
         print(f"    {kind:7s} {path}: {short(a if kind == 'removed' else b)}")
     for _, path, a, b in real:
@@ -195,6 +210,12 @@ def report_file(rel, found, rtol):
     return len(beyond)
 
 
+def roots(out):
+    """The checkout and output directories of one side, with their placeholders."""
+    checkout = (out / "checkout.txt").read_text().strip()
+    return ((checkout, "<checkout>"), (str(out.resolve()), "<out>"))
+
+
 def compare(out, rtol):
     """Compare every output and the REPORT text of out/before and out/after."""
     before, after = out / "before", out / "after"
@@ -202,11 +223,13 @@ def compare(out, rtol):
     for rel in sorted(rel_a ^ rel_b):
         print(f"{rel}: only {'before' if rel in rel_a else 'after'}")
     beyond = 0
+    roots_a, roots_b = roots(before), roots(after)
     for rel in sorted(rel_a & rel_b):
-        found = compare_file(before / "results" / rel, after / "results" / rel)
+        found = compare_file(before / "results" / rel, after / "results" / rel, roots_a,
+                             roots_b)
         beyond += report_file(rel, found, rtol)
-    text_a = (before / "report.md").read_text().splitlines()
-    text_b = (after / "report.md").read_text().splitlines()
+    text_a = read_text(before / "report.md", roots_a).splitlines()
+    text_b = read_text(after / "report.md", roots_b).splitlines()
     diff = list(difflib.unified_diff(text_a, text_b, "before/report.md", "after/report.md",
                                      lineterm="", n=0))
     print(f"REPORT sections: {'the same text' if not diff else 'differ'}")
