@@ -2,9 +2,9 @@
 
 Runs, at each checkout, small fragility campaigns (a few YADE runs: the field rock Double
 Rock over a 3 x 2 pulse grid, the same grid adaptive, the twin model under one record at
-two levels), then ``survival`` and ``constrain`` as ``make run-all`` runs them on the
-field rock's fragility (and ``survival`` under the shipped USGS curve, as ``make
-rock-survival``), then the REPORT sections those results feed; and compares every JSON
+``make run-all``'s four levels), then ``survival`` and ``constrain`` as ``make run-all``
+runs them on the field rock's fragility (and ``survival`` under the shipped USGS curve, as
+``make rock-survival``, on it and on the twin model's fits), then the REPORT sections those results feed; and compares every JSON
 and CSV file and the REPORT text, value by value (JSON by key, not key order)::
 
     python bench/same_outputs.py BEFORE AFTER [--out /tmp/same-outputs] [--rtol 0]
@@ -55,6 +55,8 @@ print(field_rock_section(r, "field-rock-quick"))
 print(rock_fragility_section(r, "field-rock-adaptive-fragility"))
 print(survival_section(r, "rock-survival"))
 print(fragility_section(r))
+for form in ("pga-pgv", "pga"):
+    print(survival_section(r, f"fragility-survival-{form}"))
 """
 
 
@@ -63,6 +65,8 @@ def commands(results, rho):
     quick = results / "field-rock-quick-fragility" / "fragility.json"
     tiny = ["--members", "1", "--headings", "1", "--animations", "0", "--jobs", "1"]
     corr = ["--pga-pgv-correlation", rho]
+    usgs_site = ["--magnitude", "6.5", "--distance-km", "10", "--age-ka", "15",
+                 "--age-sd-ka", "3"]
     hazards = [a for q in ("hazard_curve-mean", "quantile_curve-0.1", "quantile_curve-0.9")
                for a in ("--hazard", f"{TREE}/{q}-PGA_13.csv")]
     return [
@@ -70,15 +74,18 @@ def commands(results, rho):
                                         "--pulses", GRID, *tiny]),
         ("field-rock-adaptive-fragility", ["campaign", "fragility", "--column-file", ROCK,
                                            "--pulses", GRID, "--adaptive", *tiny]),
-        ("fragility", ["campaign", "fragility", "--records", "GM20", "--levels", "2,8",
+        ("fragility", ["campaign", "fragility", "--records", "GM20", "--levels", "1,2,4,8",
                        "--members", "1", "--animations", "0", "--jobs", "1"]),
         ("field-rock-quick-survival", ["survival", *hazards, "--fragility", str(quick),
                                        *SITE, *corr]),
         ("field-rock-quick-constrain", ["constrain", "--logic-tree", TREE, "--fragility",
                                         str(quick), *SITE, *corr]),
         ("rock-survival", ["survival", "--hazard", USGS, "--fragility", str(quick),
-                           "--magnitude", "6.5", "--distance-km", "10", "--age-ka", "15",
-                           "--age-sd-ka", "3", *corr]),
+                           *usgs_site, *corr]),
+        *[(f"fragility-survival-{form}", ["survival", "--hazard", USGS, "--fragility",
+                                          str(results / "fragility" / "fragility.json"),
+                                          "--fragility-form", form, *usgs_site, *corr])
+          for form in ("pga-pgv", "pga")],
     ]
 
 
