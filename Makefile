@@ -81,10 +81,37 @@ campaigns: setup
 	$(call timed,field rock constrained hazard (reduced),$(PY) -m pipeline constrain \
 	  --logic-tree $(FIELD_ROCK_TREE) --fragility results/field-rock-quick-fragility/fragility.json \
 	  $(FIELD_ROCK_SITE) --out results/field-rock-quick-constrain)
+	$(call timed,field rock survival at correlation 0.733 (reduced),$(PY) -m pipeline survival \
+	  $(FIELD_ROCK_SURVIVAL_HAZARD) --fragility results/field-rock-quick-fragility/fragility.json \
+	  $(FIELD_ROCK_SITE) --pga-pgv-correlation 0.733 --out results/field-rock-quick-survival-bradley2012)
+	$(call timed,hazard routes (Double Rock at an OpenQuake QA site),$(HAZARD_ROUTES))
 	$(call timed,shake-table scores (reduced),$(PY) -m pipeline campaign shake-table --members 4 \
 	  --tests $(SCORES_QUICK_TESTS) --candidates "$(SCORES_QUICK_CANDIDATES)" \
 	  --out results/shake-table-scores-quick --animations 0 \
 	  --jobs $(JOBS))
+
+# the routes to the joint hazard of PGA and PGV on one site (the OpenQuake QA case
+# postproc/case_mrd shipped in records/hazard/), with Double Rock's reduced fragility:
+# survival under (a) the mean rate density, (b) the PGA curve with its Mag_Dist
+# disaggregation, (c) the PGA curve with one scenario (M 5.75, 110 km: the modal bin of
+# that disaggregation at 0.0062 g; the site's Vs30 1000 m/s), and constrain under (a) and
+# (c); 100 fragility draws (route b evaluates the grid once per bin). About 1 min on 2 cores
+ROUTES_CASE := records/hazard/openquake_postproc_case_mrd
+ROUTES_ROCK := --fragility results/field-rock-quick-fragility/fragility.json --age-ka 15 \
+  --age-sd-ka 3 --draws 100
+ROUTES_SCENARIO := --magnitude 5.75 --distance-km 110 --vs30 1000
+ROUTES_OUT := results/hazard-routes
+HAZARD_ROUTES := $(PY) -m pipeline survival --joint-hazard $(ROUTES_CASE)/mrd_pga_pgv.hdf5 \
+  $(ROUTES_ROCK) --out $(ROUTES_OUT)/joint-survival && \
+  $(PY) -m pipeline survival --hazard $(ROUTES_CASE)/hazard_curve-mean-PGA_6.csv \
+  --disaggregation $(ROUTES_CASE)/disaggregation/Mag_Dist-mean-0_7.csv --vs30 1000 \
+  $(ROUTES_ROCK) --out $(ROUTES_OUT)/disaggregation-survival && \
+  $(PY) -m pipeline survival --hazard $(ROUTES_CASE)/hazard_curve-mean-PGA_6.csv \
+  $(ROUTES_SCENARIO) $(ROUTES_ROCK) --out $(ROUTES_OUT)/scenario-survival && \
+  $(PY) -m pipeline constrain --logic-tree $(ROUTES_CASE) --joint-hazard \
+  $(ROUTES_CASE)/mrd_pga_pgv.hdf5 $(ROUTES_ROCK) --out $(ROUTES_OUT)/joint-constrain && \
+  $(PY) -m pipeline constrain --logic-tree $(ROUTES_CASE) $(ROUTES_SCENARIO) $(ROUTES_ROCK) \
+  --out $(ROUTES_OUT)/scenario-constrain
 
 run-all: campaigns
 	$(PY) -m pipeline report

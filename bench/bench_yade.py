@@ -32,11 +32,16 @@ One run prints, and writes to results/bench/bench.json (+ convergence.png):
 12. run_wing: the ``run`` command of this checkout beside that of the revision before the
    fragility wing was typed (RUN_WING_REFERENCE, from ``git archive``), alternating, on a
    pulse record and a long record: command and YADE wall seconds, outcomes, ratios.
+13. colonnade: a colonnade beside its columns run apart (``colonnade_bench.py``);
+14. hazard: ``constrain`` at a study's size (500 branches, 20 specimens at 10 sites, 400
+   draws) and a 50 x 50 rate density of PGA and PGV integrated per branch
+   (``hazard_bench.py``; no YADE).
 
 Units: seconds (s), metres, m/s^2; azimuths in degrees clockwise from North.
 ``--quick`` shortens every run and skips the convergence table (for development);
 ``--only-rock-fragility`` (section 11), ``--only-run-wing`` (section 12) and
-``--only-colonnade`` (section 13) run one section and add it to an existing bench.json.
+``--only-colonnade`` (section 13) and ``--only-hazard`` (section 14) run one section and
+add it to an existing bench.json.
 """
 import argparse
 import contextlib
@@ -69,6 +74,7 @@ from pipeline.scenario.runner import reuse_processes  # noqa: E402
 from pipeline.scenario.scene_file import Measurement, SceneFile  # noqa: E402
 from pipeline.simulate import can_move  # noqa: E402
 from colonnade_bench import colonnade_cost, print_colonnade_cost  # noqa: E402
+from hazard_bench import hazard_cost, print_hazard_cost  # noqa: E402
 
 STARTUP_T_MAX_S = 1e-3          # a run this short measures YADE's start-up (s)
 PULSE = {"azimuth_deg": 30.0, "amplitude": 5.0, "period": 1.0, "duration": 8.0}   # deg, m/s^2, s, s
@@ -923,11 +929,16 @@ def main(argv=None):
     parser.add_argument("--only-run-wing", action="store_true",
                         help="run only section 12 (the run command against revision "
                         f"{RUN_WING_REFERENCE}) and add it to the bench.json in --out")
+    parser.add_argument("--only-hazard", action="store_true",
+                        help="run only section 14 (constrain at a study's size, a rate "
+                        "density per branch) and add it to the bench.json in --out")
     args = parser.parse_args(argv)
     colonnade_s = args.duration or (1.0 if args.quick else 5.0)
 
     def colonnade(work):
         return colonnade_cost(work, shaking_motion(colonnade_s), colonnade_s)
+    if args.only_hazard:
+        return only_section(args.out, "hazard", hazard_cost, print_hazard_cost)
     if args.only_colonnade:
         return only_section(args.out, "colonnade", colonnade, print_colonnade_cost)
     if args.only_run_wing:
@@ -980,6 +991,8 @@ def main(argv=None):
         print_run_wing(result["run_wing"])
         result["colonnade"] = colonnade(work)
         print_colonnade_cost(result["colonnade"])
+        result["hazard"] = hazard_cost(work)
+        print_hazard_cost(result["hazard"])
     result["bench_wall_s"] = time.perf_counter() - started
     write_json(args.out / "bench.json", result)
     print(f"\nbench: {result['bench_wall_s']:.0f} s wall; wrote {args.out / 'bench.json'}")

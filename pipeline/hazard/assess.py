@@ -7,7 +7,7 @@ import numpy as np
 
 from pipeline.constants import STANDARD_GRAVITY
 from pipeline.hazard.ages import AgeKind
-from pipeline.hazard.disagg_ratio import overturn_probability_over
+from pipeline.hazard.disagg_ratio import RatioMixture, overturn_probability_over
 from pipeline.hazard.survival import (contribution_by_intensity, intensity_scale_bound,
                                       overturning_rate, rate_density, rate_outside,
                                       rate_exceeding, rate_scale_bound,
@@ -155,7 +155,10 @@ def _summary(curve, specimens, entries, headline, ratio_model, warnings, run):
     one = len(specimens) == 1
     return SurvivalResult(
         hazard_route={"route": "curve", "what": "the PGA hazard curve, PGV/PGA at each PGA "
-                      "level lognormal (stated, or one scenario's ground-motion model)"},
+                      + ("level a mixture over the magnitude-distance disaggregation's bins "
+                         "(the ground-motion model at each)"
+                         if isinstance(ratio_model, RatioMixture) else
+                         "level lognormal (stated, or one scenario's ground-motion model)")},
         annual_overturning_rate_per_yr=headline["annual_overturning_rate_per_yr"],
         survival_probability=headline["survival_probability"],
         survival_interval=headline["survival_interval"],

@@ -23,6 +23,7 @@ from pipeline.report.ensembles import (convergence_section, ensemble_section,
 from pipeline.report.fragility import fragility_section, rock_fragility_section
 from pipeline.report.field_rock import FIELD_ROCK_QUICK, field_rock_section
 from pipeline.report.hazard import survival_section
+from pipeline.report.hazard_routes import hazard_routes_section
 from pipeline.report.inversion import inversion_section
 from pipeline.report.member_study import member_study_section
 from pipeline.report.shake_table_scores import QUICK as SCORES_QUICK
@@ -35,7 +36,7 @@ from pipeline.stats.ensemble import wilson_interval
 
 __all__ = ["build_report", "back_azimuth_table", "colonnade_section", "columns_section",
            "contact_stiffness_section", "convergence_section", "field_rock_section",
-           "correlation_table", "paper_question_section",
+           "correlation_table", "hazard_routes_section", "paper_question_section",
            "ensemble_section", "fragility_section", "inversion_section",
            "member_study_section", "per_record_table",
            "processing_section", "record_orientation", "records_section", "records_statements",
@@ -74,6 +75,7 @@ def build_report(results=RESULTS_DIR):
         rock_fragility_section(results),
         rock_fragility_section(results, "rock-fragility-table"), survival_section(results),
         field_rock_section(results), field_rock_section(results, FIELD_ROCK_QUICK),
+        hazard_routes_section(results),
         paper_question_section(results), ensemble_section(results),
         convergence_section(results), fragility_section(results), columns_section(results),
         colonnade_section(results),

@@ -32,6 +32,8 @@ SOURCES = {
     "inversion/demo_summary.json": "make run-all",
     "inversion/member-study/member_study.json": "make invert-study",
     "rock-survival/survival.json": "make rock-survival",
+    "field-rock-quick-survival/survival.json": "make run-all",
+    "field-rock-quick-survival-bradley2012/survival.json": "make run-all",
 }
 FIGURE = re.compile(r"!\[([^\]]*)\]\(([^)\s]+)\)")     # ![alt](path)
 

@@ -104,6 +104,8 @@ def test_one_disaggregation_bin_is_todays_one_scenario(tmp_path, capsys):
     assert mixed["annual_overturning_rate_per_yr"] == pytest.approx(
         today["annual_overturning_rate_per_yr"], rel=1e-9)
     assert mixed["pgv_pga"]["source"] == "magnitude-distance disaggregation"
+    assert "disaggregation" in mixed["hazard_route"]["what"]
+    assert "one scenario" in today["hazard_route"]["what"]
 
 
 def test_a_disaggregation_that_does_not_add_up_is_one_line(tmp_path, capsys):

@@ -221,3 +221,11 @@ def test_a_null_in_a_quoted_file_is_said_as_none(tmp_path):
     bench.write_text(json.dumps({"section": {"diff_g": None, "runs": 3}}))
     assert docs_numbers.bench_value("section.diff_g", "{:.2f}", path=bench) == "none"
     assert docs_numbers.bench_value("section.runs", "{:d}", path=bench) == "3"
+
+
+def test_every_file_the_docs_quote_is_one_of_the_quoted_files():
+    """value("FILE", ...) in a page names a file of SOURCES (with the command writing it)."""
+    quoted = {m for page in (ROOT / "docs").glob("*.md")
+              for m in re.findall(r"\{\{\s*value\(\s*\"([^\"]+)\"", page.read_text())}
+    assert "field-rock-quick-survival-bradley2012/survival.json" in quoted
+    assert quoted <= set(docs_numbers.SOURCES)

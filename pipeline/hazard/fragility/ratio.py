@@ -7,6 +7,7 @@ the hazard's disaggregation; ln PGV given ln PGA by their correlation).
 :func:`overturn_probability` averages fragilities
 (:class:`~pipeline.hazard.fragility.kinds.Fragility`) over it.
 """
+import functools
 import importlib.metadata
 import math
 from dataclasses import dataclass, field
@@ -81,6 +82,17 @@ class RatioFromGmm:
                 "distribution": "lognormal given PGA: ln PGV | ln PGA by their correlation"}
 
 
+@functools.cache
+def _ratio_nodes():
+    """Gauss-Hermite nodes and weights (summing to 1) over a standard normal, computed once
+    (read only)."""
+    nodes, weights = np.polynomial.hermite_e.hermegauss(RATIO_NODES)
+    nodes.flags.writeable = False
+    weights = weights / weights.sum()
+    weights.flags.writeable = False
+    return nodes, weights
+
+
 def overturn_probability(fragilities, ratio_model, pga_m_s2, combine="each"):
     """P(overturn) at PGA levels (m/s^2) averaged over PGV/PGA (Gauss-Hermite in ln PGV/PGA).
 
@@ -94,8 +106,7 @@ def overturn_probability(fragilities, ratio_model, pga_m_s2, combine="each"):
             raise InputError("the fragility depends on PGV/PGA: give its distribution "
                              "(--pgv-pga-median and --pgv-pga-sigma, or --magnitude and "
                              "--distance-km)")
-        nodes, weights = np.polynomial.hermite_e.hermegauss(RATIO_NODES)
-        weights = weights / weights.sum()
+        nodes, weights = _ratio_nodes()
         mean, sd = ratio_model.ln_mean_sd(pga)
         ratio = np.exp(mean[:, None] + sd[:, None] * nodes[None, :])
         each = np.array([f.probability(pga[:, None], ratio) for f in fragilities])

@@ -1,0 +1,46 @@
+"""The REPORT section of the three routes to the joint hazard: it says when nothing has run,
+quotes each route's survival.json and constrain.json as written, and says that constrain
+has no disaggregation route."""
+import json
+
+from pipeline.cli import main
+from pipeline.report import hazard_routes_section
+from pipeline.report.hazard_routes import HAZARD_ROUTES
+
+CASE = "records/hazard/openquake_postproc_case_mrd"
+CURVE = f"{CASE}/hazard_curve-mean-PGA_6.csv"
+ROCK = ["--logistic=-1,3,1.5", "--age-ka", "15", "--age-sd-ka", "3"]
+SCENARIO = ["--magnitude", "5.75", "--distance-km", "110", "--vs30", "1000"]
+
+
+def test_nothing_run_says_so(tmp_path):
+    text = hazard_routes_section(tmp_path)
+    assert text.startswith("## Three routes to the joint hazard of PGA and PGV at one site\n")
+    assert "Not run yet (`make run-all`)" in text
+
+
+def test_each_route_is_quoted_from_its_files(tmp_path):
+    root = tmp_path / HAZARD_ROUTES
+    runs = {"joint-survival": ["survival", "--joint-hazard", f"{CASE}/mrd_pga_pgv.hdf5"],
+            "disaggregation-survival": [
+                "survival", "--hazard", CURVE, "--vs30", "1000", "--disaggregation",
+                f"{CASE}/disaggregation/Mag_Dist-mean-0_7.csv"],
+            "scenario-survival": ["survival", "--hazard", CURVE, *SCENARIO],
+            "joint-constrain": ["constrain", "--logic-tree", CASE, "--joint-hazard",
+                                f"{CASE}/mrd_pga_pgv.hdf5"],
+            "scenario-constrain": ["constrain", "--logic-tree", CASE, *SCENARIO]}
+    for name, argv in runs.items():
+        assert main([*argv, *ROCK, "--out", str(root / name)]) == 0
+    text = hazard_routes_section(tmp_path)
+    rates = {name: json.loads((root / f"{name}-survival" / "survival.json").read_text())
+             ["annual_overturning_rate_per_yr"]
+             for name in ("joint", "disaggregation", "scenario")}
+    assert len({f"{r:.3g}" for r in rates.values()}) == 3      # three routes, three rates
+    for rate in rates.values():
+        assert f" {rate:.3g} " in text
+    assert "14 magnitude-distance bins" in text        # the case's bins with events
+    assert "M 5.75, 110 km, correlation 0.654" in text
+    joint = json.loads((root / "joint-constrain" / "constrain.json").read_text())
+    for branch in joint["branches"]:
+        assert f" {1 - branch['survival_probability']:.3g} " in text
+    assert "not run: `constrain` takes PGV/PGA from one scenario or the rate density" in text
