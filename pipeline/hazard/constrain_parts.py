@@ -5,6 +5,7 @@ ground motion at a rate, the members' and the draws' spread, and the sites.  Rat
 1/yr, PGA in m/s^2 or g as named, ages in ka or years as named."""
 from dataclasses import dataclass
 
+from pipeline.hazard.ages import AgeDescription
 from pipeline.hazard.record import (ABSENT, Record, check_probability, check_rate, each,
                                     optional)
 
@@ -17,8 +18,9 @@ class ConstrainSpecimen(Record):
     fragility: dict
     age_ka: float | None
     age_sd_ka: float | None
-    age: dict
+    age: AgeDescription
     NAME = "specimens"
+    PARTS = {"age": AgeDescription.from_json}
 
 
 @dataclass(frozen=True, kw_only=True)

@@ -12,6 +12,7 @@ from pathlib import Path
 from pipeline.files import InputError, result_json_text
 from pipeline.hazard.constrain_parts import (CONSTRAIN_PARTS, CurveStatistics, Members,
                                              MonteCarlo)
+from pipeline.hazard.ages import AgeDescription
 from pipeline.hazard.constrain_sites import BranchTest
 from pipeline.hazard.record import ABSENT, Record, check_probability, check_rate
 from pipeline.hazard.survival_parts import (SURVIVAL_PARTS, CurveEnds, HazardRoute,
@@ -68,7 +69,7 @@ class SurvivalResult(_ResultFile):
     age_ka: float | None
     age_sd_ka: float | None
     age_distribution: str
-    age: dict
+    age: AgeDescription
     definitions: dict = ABSENT
     specimens: list
     hazard: dict
@@ -87,7 +88,7 @@ class SurvivalResult(_ResultFile):
     site_motion: dict = ABSENT
 
     NAME = "survival.json"
-    PARTS = SURVIVAL_PARTS
+    PARTS = {**SURVIVAL_PARTS, "age": AgeDescription.from_json}
 
     def __post_init__(self):
         check_probability(self, "survival_probability")

@@ -75,7 +75,7 @@ def test_every_kind_describes_itself():
     kinds = {age.kind for age in (LowerBound(1.0), UniformInterval(1.0, 2.0),
                                   AgeSamples((1.0,)), TruncatedNormal(1.0, 0.5))}
     assert kinds == set(AgeKind)
-    assert UniformInterval(1.0, 2.0).describe()["kind"] == "interval"
+    assert UniformInterval(1.0, 2.0).describe().kind is AgeKind.INTERVAL
 
 
 @pytest.mark.parametrize("make, message", [
