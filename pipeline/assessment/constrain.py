@@ -76,7 +76,7 @@ def _curve_table(summary, stats, what):
     """A curve file: comment lines, then pga_g, pga_m_s2, the mean and each fractile's
     annual rate of exceedance (1/yr) per level."""
     fractiles = list(stats.fractiles)
-    lines = [f"# {what} hazard curves of the logic tree {summary.hazard.get('file')}: "
+    lines = [f"# {what} hazard curves of the logic tree {summary.hazard.file}: "
              "annual rates of exceeding PGA (1/yr)",
              "# mean: the weighted mean of the branches' rates; fractile_q: OpenQuake's "
              "weighted quantile over the branches",

@@ -12,6 +12,7 @@ from pipeline.hazard.survival import (contribution_by_intensity, intensity_scale
                                       overturning_rate, rate_density, rate_outside,
                                       rate_exceeding, rate_scale_bound,
                                       survival_probability)
+from pipeline.hazard.hazard_described import CurveHazard
 from pipeline.hazard.record import ABSENT
 from pipeline.hazard.results import SurvivalResult
 from pipeline.hazard.survival_parts import (ContributionRow, CurveEnds, CurveRow, HazardRoute,
@@ -188,10 +189,10 @@ def _summary(curve, specimens, entries, headline, ratio_model, warnings, run):
         **age_keys(age),
         definitions=_definitions(draws),
         specimens=entries,
-        hazard={**curve.source, "levels_m_s2": curve.levels_m_s2.tolist(),
-                "levels_g": (curve.levels_m_s2 / STANDARD_GRAVITY).tolist(),
-                "rates_per_yr": curve.rates_per_yr.tolist(), "notes": list(curve.notes),
-                "interpolation": "linear in (ln PGA, ln rate)"},
+        hazard=CurveHazard(source=dict(curve.source), levels_m_s2=curve.levels_m_s2.tolist(),
+                           levels_g=(curve.levels_m_s2 / STANDARD_GRAVITY).tolist(),
+                           rates_per_yr=curve.rates_per_yr.tolist(), notes=list(curve.notes),
+                           interpolation="linear in (ln PGA, ln rate)"),
         pgv_pga=None if ratio_model is None else ratio_model.describe(),
         pgv_pga_used=any(f.uses_ratio for f in specimens),
         assumptions=ASSUMPTIONS, warnings=warnings,

@@ -17,6 +17,7 @@ from pipeline.hazard.constrain_parts import (BranchRow, ConstrainSpecimen, Curve
                                              MotionAtRate, SiteRow)
 from pipeline.hazard.constrain_sites import (SITE_ASSUMPTION, SiteGroup, branch_test,
                                              check_same_branches, combined)
+from pipeline.hazard.hazard_described import TreeHazard
 from pipeline.hazard.fragility import overturn_probability
 from pipeline.hazard.logictree import LogicTree
 from pipeline.hazard.record import ABSENT
@@ -115,9 +116,9 @@ def constrain_tree(tree, specimens, ratio_model, ages, rule, floor, draws, seed,
         members=members, monte_carlo=carlo,
         sites=[SiteRow(site=g.site, specimens=list(g.members)) for g in groups],
         branch_test=test,
-        hazard={**tree.source, "notes": list(tree.notes),
-                "interpolation": "linear in (ln PGA, ln rate)",
-                "cells_per_interval": cells[2]},
+        hazard=TreeHazard(source=dict(tree.source), notes=list(tree.notes),
+                          interpolation="linear in (ln PGA, ln rate)",
+                          cells_per_interval=cells[2]),
         pgv_pga=None if ratio_model is None else ratio_model.describe(),
         warnings=warnings,
         assumptions=ASSUMPTIONS + ([SITE_ASSUMPTION] if len(groups) > 1 else []),

@@ -7,6 +7,7 @@ route."""
 import numpy as np
 
 from pipeline.hazard.assess import BOUND_SURVIVAL, END_SHARE_WARNING, INTERVAL, age_keys
+from pipeline.hazard.hazard_described import JointHazardDescribed
 from pipeline.hazard.joint_survival import cell_mean_probability, joint_overturning_rate
 from pipeline.hazard.results import SurvivalResult
 from pipeline.hazard.survival_parts import HazardRoute, Route, SpecimenResult
@@ -96,11 +97,11 @@ def assess_joint(joint, specimens, age, draws, seed):
         else "the set under common shaking (all survive)",
         **age_keys(age),
         specimens=entries,
-        hazard={**joint.source, "site": list(joint.sites[0]),
-                "pga_levels_m_s2": joint.pga_levels_m_s2.tolist(),
-                "pgv_levels_m_s": joint.pgv_levels_m_s.tolist(),
-                "investigation_time_yr": joint.investigation_time_yr,
-                "events_per_yr": headline.events_per_yr},
+        hazard=JointHazardDescribed(source=dict(joint.source), site=list(joint.sites[0]),
+                                    pga_levels_m_s2=joint.pga_levels_m_s2.tolist(),
+                                    pgv_levels_m_s=joint.pgv_levels_m_s.tolist(),
+                                    investigation_time_yr=joint.investigation_time_yr,
+                                    events_per_yr=headline.events_per_yr),
         pgv_pga=None, pgv_pga_used=any(f.uses_ratio for f in specimens),
         assumptions=ASSUMPTIONS, warnings=warnings,
         draws=draws, seed=seed, software=software_versions())

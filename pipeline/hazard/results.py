@@ -14,9 +14,11 @@ from pipeline.hazard.constrain_parts import (CONSTRAIN_PARTS, CurveStatistics, M
                                              MonteCarlo)
 from pipeline.hazard.ages import AgeDescription
 from pipeline.hazard.constrain_sites import BranchTest
+from pipeline.hazard.hazard_described import (CurveHazard, JointHazardDescribed, TreeHazard,
+                                              read_survival_hazard)
 from pipeline.hazard.record import ABSENT, Record, check_probability, check_rate
 from pipeline.hazard.survival_parts import (SURVIVAL_PARTS, CurveEnds, HazardRoute,
-                                            OutsideGrid, SiteSet)
+                                            OutsideGrid, Route, SiteSet)
 from pipeline.userfiles import DATA_FILE_BYTES, read_json
 
 RULES = ("bayes", "eliminate")              # constrain's rules (constrain.json's rule)
@@ -72,7 +74,7 @@ class SurvivalResult(_ResultFile):
     age: AgeDescription
     definitions: dict = ABSENT
     specimens: list
-    hazard: dict
+    hazard: CurveHazard | JointHazardDescribed
     pgv_pga: dict | None
     pgv_pga_used: bool
     assumptions: list
@@ -88,9 +90,14 @@ class SurvivalResult(_ResultFile):
     site_motion: dict = ABSENT
 
     NAME = "survival.json"
-    PARTS = {**SURVIVAL_PARTS, "age": AgeDescription.from_json}
+    PARTS = {**SURVIVAL_PARTS, "age": AgeDescription.from_json,
+             "hazard": read_survival_hazard}
 
     def __post_init__(self):
+        joint = isinstance(self.hazard, JointHazardDescribed)
+        if joint != (self.hazard_route.route is Route.JOINT):
+            raise InputError(f"{self.NAME}: the hazard is not of the route "
+                             f"{self.hazard_route.route.value}")
         check_probability(self, "survival_probability")
         check_rate(self, "annual_overturning_rate_per_yr")
         if not self.specimens:
@@ -126,7 +133,7 @@ class ConstrainResult(_ResultFile):
     monte_carlo: MonteCarlo | None
     sites: list
     branch_test: BranchTest
-    hazard: dict
+    hazard: TreeHazard
     pgv_pga: dict | None
     warnings: list
     assumptions: list
@@ -137,7 +144,8 @@ class ConstrainResult(_ResultFile):
     files: list = ABSENT
 
     NAME = "constrain.json"
-    PARTS = {**CONSTRAIN_PARTS, "branch_test": BranchTest.from_json}
+    PARTS = {**CONSTRAIN_PARTS, "branch_test": BranchTest.from_json,
+             "hazard": TreeHazard.from_json}
 
     def __post_init__(self):
         if self.rule not in RULES:

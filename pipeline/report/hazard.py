@@ -23,10 +23,7 @@ def survival_section(results, name=ROCK_SURVIVAL):
     lines = [f"## {heading}\n",
              f"Fragility: {fragility['label']} ({fragility.get('inside', fragility['form'])}"
              f"; outside the grid: {fragility.get('outside', '-')}). Hazard: "
-             f"{hazard.get('format', '')} `{hazard.get('file', '')}`"
-             + ("" if hazard.get("lat") is None else
-                f" at {abs(hazard['lat']):g} {'N' if hazard['lat'] >= 0 else 'S'}, "
-                f"{abs(hazard['lon']):g} {'E' if hazard['lon'] >= 0 else 'W'}")
+             f"{hazard.format} `{hazard.file}`" + _where(hazard.source)
              + (f"; PGV/PGA from {ratio.get('model', ratio.get('source'))} at M "
                 f"{ratio['magnitude']:g}, {ratio['distance_jb_km']:g} km"
                 if "magnitude" in ratio else "")
@@ -68,6 +65,15 @@ def survival_section(results, name=ROCK_SURVIVAL):
                          "hazard curve and fragility, fragility-weighted rate density, "
                          "survival against age"))
     return "\n".join(lines)
+
+
+def _where(source):
+    """ at lat N/S, lon E/W of a hazard's ``source`` (the loader's; none for a plain table)."""
+    lat, lon = source.get("lat"), source.get("lon")
+    if lat is None:
+        return ""
+    return (f" at {abs(lat):g} {'N' if lat >= 0 else 'S'}, "
+            f"{abs(lon):g} {'E' if lon >= 0 else 'W'}")
 
 
 def _age(summary):

@@ -1,8 +1,10 @@
 """The REPORT section of the field rock: it names the full-size command in both its sizes,
 says that no published fragility exists, says what has not run, and quotes constrain.json."""
+from pipeline.hazard.ages import TruncatedNormal
 from pipeline.hazard.constrain_parts import (BranchRow, ConstrainSpecimen, CurveStatistics,
                                              MotionAtRate)
 from pipeline.hazard.constrain_sites import BranchTest, BranchTestRow
+from pipeline.hazard.hazard_described import TreeHazard
 from pipeline.hazard.results import ConstrainResult
 from pipeline.report import field_rock_section
 from pipeline.report.field_rock import FIELD_ROCK_QUICK
@@ -43,10 +45,12 @@ def test_the_constrained_hazard_is_quoted_and_a_hopeless_tree_is_said(tmp_path):
     (out / "constrain.json").write_text(ConstrainResult(
         branch_count=2, rule="bayes", headline="", floor=0.05, specimen_count=1,
         specimens=[ConstrainSpecimen(fragility={}, age_ka=15, age_sd_ka=3,
-                                     age={"kind": "normal"})], age_model="known ages",
+                                     age=TruncatedNormal(15e3, 3e3).describe())], age_model="known ages",
         age_integration_se_max=None, branches=branches, levels_m_s2=[1.0], levels_g=[0.1],
         prior=curves, posterior=curves, posterior_eliminate=None, ground_motion_at_rates=motion,
-        members=None, monte_carlo=None, sites=[], branch_test=test, hazard={},
+        members=None, monte_carlo=None, sites=[], branch_test=test,
+        hazard=TreeHazard(source={"format": "plain logic-tree table", "file": "tree.csv"},
+                          notes=[], interpolation="", cells_per_interval=1),
         pgv_pga=None, warnings=["something said"], assumptions=[], draws=0, seed=0,
         software={}).text())
     text = field_rock_section(tmp_path)
