@@ -6,7 +6,6 @@ from dataclasses import replace
 import numpy as np
 
 from pipeline.constants import STANDARD_GRAVITY
-from pipeline.hazard.ages import AgeKind
 from pipeline.hazard.disagg_ratio import overturn_probability_over
 from pipeline.hazard.survival import (contribution_by_intensity, intensity_scale_bound,
                                       overturning_rate, rate_density, rate_outside,
@@ -17,7 +16,7 @@ from pipeline.hazard.record import ABSENT
 from pipeline.hazard.results import SurvivalResult
 from pipeline.hazard.survival_parts import (ContributionRow, CurveEnds, CurveRow, HazardRoute,
                                             OutsideGrid, Route, SetSurvival, SiteSet,
-                                            SpecimenResult)
+                                            SpecimenResult, age_keys)
 from pipeline.provenance import software_versions
 
 BOUND_SURVIVAL = 0.05         # survival probability the bounds keep (the keys' 5pct)
@@ -388,15 +387,3 @@ def _figure_data(curve, probability, headline, drawn, age, specimens, ratio_mode
             "survival_probability": headline["survival_probability"],
             "survival_interval": headline["survival_interval"],
             "set": len(specimens) > 1, "pgv_pga_used": any(f.uses_ratio for f in specimens)}
-
-
-def age_keys(age):
-    """survival.json's age: age_ka and age_sd_ka (a normal's; null for other kinds),
-    age_distribution in words and age (:meth:`AgeModel.describe`)."""
-    normal = age.kind is AgeKind.NORMAL
-    words = {AgeKind.NORMAL: "fixed" if normal and age.sd_yr == 0 else "normal truncated at 0",
-             AgeKind.LOWER_BOUND: "a lower bound (survival an upper bound)",
-             AgeKind.INTERVAL: "uniform on an interval", AgeKind.SAMPLES: "samples"}
-    return {"age_ka": age.mean_yr / 1000.0 if normal else None,
-            "age_sd_ka": age.sd_yr / 1000.0 if normal else None,
-            "age_distribution": words[age.kind], "age": age.describe()}

@@ -6,7 +6,6 @@ from enum import Enum
 import numpy as np
 
 from pipeline.constants import STANDARD_GRAVITY
-from pipeline.hazard.ages import AgeKind
 from pipeline.hazard.constrain import (FRACTILES, TARGET_RATES, bayes, branch_rates,
                                        cell_matrix, change_percent, draw_chunk, eliminate,
                                        log_survival_fixed, log_survival_sampled,
@@ -21,6 +20,7 @@ from pipeline.hazard.hazard_described import TreeHazard
 from pipeline.hazard.fragility import overturn_probability
 from pipeline.hazard.logictree import LogicTree
 from pipeline.hazard.record import ABSENT
+from pipeline.hazard.survival_parts import age_keys
 from pipeline.hazard.results import ConstrainResult
 from pipeline.provenance import software_versions
 
@@ -171,11 +171,9 @@ def _age_mode(ages, rng):
 
 
 def _age_keys(age):
-    """A specimen's age in constrain.json: age_ka and age_sd_ka (a normal's; null for
-    other kinds) and age (:meth:`~pipeline.hazard.ages.AgeModel.describe`)."""
-    normal = age.kind is AgeKind.NORMAL
-    return {"age_ka": age.mean_yr / 1000.0 if normal else None,
-            "age_sd_ka": age.sd_yr / 1000.0 if normal else None, "age": age.describe()}
+    """A specimen's age in constrain.json: survival.json's (:func:`~pipeline.hazard.
+    survival_parts.age_keys`) but its age_distribution."""
+    return {k: v for k, v in age_keys(age).items() if k != "age_distribution"}
 
 
 def _log_survival(tree, cells, batch, ratio_model, ages, mode, samples):

@@ -6,11 +6,11 @@ the site overturns (any of it) with 1 - prod(1 - P_i) in each event, as on the s
 route."""
 import numpy as np
 
-from pipeline.hazard.assess import BOUND_SURVIVAL, END_SHARE_WARNING, INTERVAL, age_keys
+from pipeline.hazard.assess import BOUND_SURVIVAL, END_SHARE_WARNING, INTERVAL
 from pipeline.hazard.hazard_described import JointHazardDescribed
 from pipeline.hazard.joint_survival import cell_mean_probability, joint_overturning_rate
 from pipeline.hazard.results import SurvivalResult
-from pipeline.hazard.survival_parts import HazardRoute, Route, SpecimenResult
+from pipeline.hazard.survival_parts import HazardRoute, Route, SpecimenResult, age_keys
 from pipeline.hazard.survival import rate_scale_bound, survival_probability
 from pipeline.provenance import software_versions
 

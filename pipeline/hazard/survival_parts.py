@@ -7,6 +7,7 @@ from dataclasses import dataclass
 from enum import Enum
 
 from pipeline.constants import STANDARD_GRAVITY
+from pipeline.hazard.ages import AgeKind
 from pipeline.hazard.record import ABSENT, Record, check_probability, check_rate, each
 
 
@@ -189,3 +190,15 @@ SURVIVAL_PARTS = {"hazard_route": HazardRoute.from_json,
                   "hazard_curves": each(CurveRow.from_json),
                   "site_set": SiteSet.from_json}
 """Readers of survival.json's fields that are records (field name to reader)."""
+
+
+def age_keys(age):
+    """survival.json's age: age_ka and age_sd_ka (a normal's; null for other kinds),
+    age_distribution in words and age (:meth:`~pipeline.hazard.ages.AgeModel.describe`)."""
+    normal = age.kind is AgeKind.NORMAL
+    words = {AgeKind.NORMAL: "fixed" if normal and age.sd_yr == 0 else "normal truncated at 0",
+             AgeKind.LOWER_BOUND: "a lower bound (survival an upper bound)",
+             AgeKind.INTERVAL: "uniform on an interval", AgeKind.SAMPLES: "samples"}
+    return {"age_ka": age.mean_yr / 1000.0 if normal else None,
+            "age_sd_ka": age.sd_yr / 1000.0 if normal else None,
+            "age_distribution": words[age.kind], "age": age.describe()}
