@@ -12,8 +12,8 @@ from pipeline.hazard.record import Record, as_json
 @dataclass(frozen=True, kw_only=True)
 class _Described(Record):
     """A hazard described: ``source`` (the loader's description, its keys those of the
-    file's format, at least ``format`` and ``file``) and the fields of the use, written
-    after it (a key of both is refused)."""
+    file's format, ``format`` and ``file`` among them; empty for a hazard made in code)
+    and the fields of the use, written after it (a key of both is refused)."""
     source: dict
     NAME = "hazard"
 
@@ -21,8 +21,8 @@ class _Described(Record):
         if not isinstance(self.source, dict):
             raise ValueError("the source is not an object")
         for key in ("format", "file"):
-            if not isinstance(self.source.get(key), str):
-                raise ValueError(f"no {key} in the source")
+            if not isinstance(self.source.get(key, ""), str):
+                raise ValueError(f"the source's {key} is not a string")
         both = sorted(set(self.source) & set(self._own()))
         if both:
             raise ValueError(f"the source and the description both hold {', '.join(both)}")
@@ -32,14 +32,14 @@ class _Described(Record):
         return [f.name for f in fields(cls) if f.name != "source"]
 
     @property
-    def file(self) -> str:
-        """The file the hazard was read from."""
-        return self.source["file"]
+    def file(self) -> str | None:
+        """The file the hazard was read from (None: made in code)."""
+        return self.source.get("file")
 
     @property
-    def format(self) -> str:
-        """The file's format, in words."""
-        return self.source["format"]
+    def format(self) -> str | None:
+        """The file's format, in words (None: made in code)."""
+        return self.source.get("format")
 
     def as_json(self) -> dict:
         """The source's keys, then the fields of the use in their order."""

@@ -23,7 +23,7 @@ def survival_section(results, name=ROCK_SURVIVAL):
     lines = [f"## {heading}\n",
              f"Fragility: {fragility['label']} ({fragility.get('inside', fragility['form'])}"
              f"; outside the grid: {fragility.get('outside', '-')}). Hazard: "
-             f"{hazard.format} `{hazard.file}`" + _where(hazard.source)
+             f"{hazard.format or ''} `{hazard.file or ''}`" + _where(hazard.source)
              + (f"; PGV/PGA from {ratio.get('model', ratio.get('source'))} at M "
                 f"{ratio['magnitude']:g}, {ratio['distance_jb_km']:g} km"
                 if "magnitude" in ratio else "")

@@ -97,7 +97,8 @@ def test_an_inner_record_the_type_does_not_describe_is_one_line_naming_it(tmp_pa
             (("curve_ends", "share_at_last_level"), None, "curve_ends: no share_at_last_level"),
             (("age", "kind"), "interval", "an age of kind interval holds lo_yr, hi_yr"),
             (("hazard_route", "route"), "joint", "the hazard is not of the route joint"),
-            (("hazard", "file"), None, "no file in the source")]:
+            (("hazard", "file"), 1, "the source's file is not a string"),
+            (("hazard", "levels_g"), None, "hazard: no levels_g")]:
         bad = tmp_path / "bad.json"
         bad.write_text(json.dumps(_changed(data, path, value)))
         with pytest.raises(InputError) as refused:
