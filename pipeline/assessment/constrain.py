@@ -55,15 +55,18 @@ def _branch_table(rows):
     """branch_weights.csv: one row per branch."""
     names = ["branch", "path", "prior_weight", "survival_probability", "posterior_bayes",
              "posterior_eliminate"]
-    if rows and "survival_interval" in rows[0]:
+    drawn = bool(rows) and rows[0].given("survival_interval") is not None
+    if drawn:
         names += ["survival_lo_2.5pct", "survival_hi_97.5pct"]
     buf = io.StringIO()
     writer = csv.writer(buf, lineterminator="\n")
     writer.writerow(names)
     for row in rows:
-        values = [row[k] for k in names[:6]]
-        if "survival_interval" in row:
-            values += row["survival_interval"]
+        values = [getattr(row, k) for k in ("branch", "path", "prior_weight",
+                                            "survival_probability", "posterior_bayes",
+                                            "posterior_eliminate")]
+        if drawn:
+            values += row.survival_interval
         writer.writerow(["" if v is None else (f"{v:.9g}" if isinstance(v, float) else v)
                          for v in values])
     return buf.getvalue()
@@ -72,15 +75,15 @@ def _branch_table(rows):
 def _curve_table(summary, stats, what):
     """A curve file: comment lines, then pga_g, pga_m_s2, the mean and each fractile's
     annual rate of exceedance (1/yr) per level."""
-    fractiles = list(stats["fractiles"])
-    lines = [f"# {what} hazard curves of the logic tree {summary.hazard.get('file')}: "
+    fractiles = list(stats.fractiles)
+    lines = [f"# {what} hazard curves of the logic tree {summary.hazard.file}: "
              "annual rates of exceeding PGA (1/yr)",
              "# mean: the weighted mean of the branches' rates; fractile_q: OpenQuake's "
              "weighted quantile over the branches",
              ",".join(["pga_g", "pga_m_s2", "mean_annual_rate_per_yr"]
                       + [f"fractile_{q}_annual_rate_per_yr" for q in fractiles])]
     for k, level in enumerate(summary.levels_m_s2):
-        values = [level / STANDARD_GRAVITY, level, stats["mean_rates_per_yr"][k]] + \
-            [stats["fractiles"][q][k] for q in fractiles]
+        values = [level / STANDARD_GRAVITY, level, stats.mean_rates_per_yr[k]] + \
+            [stats.fractiles[q][k] for q in fractiles]
         lines.append(",".join(f"{v:.9g}" for v in values))
     return "\n".join(lines) + "\n"

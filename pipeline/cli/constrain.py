@@ -65,11 +65,11 @@ def _print(summary, out):
     print(f"{summary.branch_count} branches, {summary.specimen_count} specimen(s); "
           f"rule {summary.rule}")
     for row in summary.ground_motion_at_rates:
-        if row["curve"] not in ("mean", "range 0.05-0.95"):
+        if row.curve not in ("mean", "range 0.05-0.95"):
             continue
-        change = row["change_percent"]
-        print(f"  {row['curve']} PGA at {row['annual_rate_per_yr']:g} /yr: "
-              f"{_g(row['prior_g'])} g -> {_g(row['posterior_g'])} g"
+        change = row.change_percent
+        print(f"  {row.curve} PGA at {row.annual_rate_per_yr:g} /yr: "
+              f"{_g(row.prior_g)} g -> {_g(row.posterior_g)} g"
               + ("" if change is None else f" ({change:+.0f} %)"))
     test = summary.branch_test
     print(f"branch test: P(every specimen survived) below {test.level:g} under "

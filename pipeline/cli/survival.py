@@ -59,8 +59,8 @@ def run(args):
           + f"; hazard rates x {_g(summary.rate_scale_bound_5pct)} or intensities x "
           f"{_g(summary.intensity_scale_bound_5pct)} leave 5 %")
     for row in (summary.given("hazard_curves") or [])[1:]:
-        print(f"under {row['kind'] or row['file']}: rate {row['annual_overturning_rate_per_yr']:.3g}"
-              f" /yr, survival P = {row['survival_probability']:.3g}")
+        print(f"under {row.kind or row.file}: rate {row.annual_overturning_rate_per_yr:.3g}"
+              f" /yr, survival P = {row.survival_probability:.3g}")
     if site_motion is not None:
         _print_site_motion(site_motion)
     print(f"wrote {display_path(o.out / 'survival.json')} and survival.png")

@@ -48,12 +48,12 @@ def plot_constrain(data, path):
 
 
 def _stats(ax, x, stats, colour, style, label):
-    ax.loglog(x, stats["mean_rates_per_yr"], color=colour, ls=style, lw=2.2,
+    ax.loglog(x, stats.mean_rates_per_yr, color=colour, ls=style, lw=2.2,
               label=f"{label} mean", zorder=3)
-    lo, hi = (stats["fractiles"][fractile_key(q)] for q in BAND)
+    lo, hi = (stats.fractiles[fractile_key(q)] for q in BAND)
     ax.fill_between(x, lo, hi, color=colour, alpha=0.12, zorder=2,
                     label=f"{label} 5-95 % fractiles")
-    ax.loglog(x, stats["fractiles"][fractile_key(0.5)], color=colour, ls=style, lw=1.0, zorder=3,
+    ax.loglog(x, stats.fractiles[fractile_key(0.5)], color=colour, ls=style, lw=1.0, zorder=3,
               label=f"{label} median")
 
 

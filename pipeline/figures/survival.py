@@ -29,8 +29,8 @@ def plot_survival(data, path):
     ax_d.fill_between(data["density_x"], data["density"], color="tab:blue", alpha=0.2)
     ax_d.set_xlabel("PGA (m/s$^2$)")
     ax_d.set_ylabel("P(overturn) |d$\\lambda$/d ln PGA| (1/yr)")
-    top = data["contribution"][-1]
-    ax_d.set_title(f"rate density; at/above the last level: {100 * (top['share'] or 0):.0f} %",
+    top = data["top_share"]
+    ax_d.set_title(f"rate density; at/above the last level: {100 * (top or 0):.0f} %",
                    fontsize=10)
     ax_d.grid(True, which="both", alpha=0.3)
 

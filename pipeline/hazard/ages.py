@@ -18,13 +18,14 @@ import csv
 import io
 import math
 from abc import ABC, abstractmethod
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 from enum import Enum
 
 import numpy as np
 from scipy import stats
 
 from pipeline.files import InputError
+from pipeline.hazard.record import ABSENT, Record
 from pipeline.hazard.survival import survival_probability
 from pipeline.userfiles import DATA_FILE_BYTES, read_user_text, show
 
@@ -47,6 +48,37 @@ def _check_age(value, what):
         raise InputError(f"{what} must be 0 to {MAX_AGE_YR:g} years, got {show(value)}")
 
 
+@dataclass(frozen=True, kw_only=True)
+class AgeDescription(Record):
+    """An age as results describe it (survival.json's and constrain.json's ``age``): its
+    kind, the values of that kind (years; samples: their count, where they come from and
+    their mean, least and greatest) and what survival over it means."""
+    kind: AgeKind
+    samples: int = ABSENT
+    source: str | None = ABSENT
+    mean_yr: float = ABSENT
+    sd_yr: float = ABSENT
+    min_yr: float = ABSENT
+    max_yr: float = ABSENT
+    lo_yr: float = ABSENT
+    hi_yr: float = ABSENT
+    survival: str
+    NAME = "age"
+    PARTS = {"kind": AgeKind}
+    VALUES = {AgeKind.LOWER_BOUND: ("min_yr",), AgeKind.INTERVAL: ("lo_yr", "hi_yr"),
+              AgeKind.SAMPLES: ("samples", "source", "mean_yr", "min_yr", "max_yr"),
+              AgeKind.NORMAL: ("mean_yr", "sd_yr")}
+
+    def __post_init__(self):
+        if not isinstance(self.kind, AgeKind):
+            raise ValueError(f"kind {self.kind!r} is not one of "
+                             f"{', '.join(k.value for k in AgeKind)}")
+        given = tuple(f.name for f in fields(self)[1:-1] if getattr(self, f.name) is not ABSENT)
+        if given != self.VALUES[self.kind]:
+            raise ValueError(f"an age of kind {self.kind.value} holds "
+                             f"{', '.join(self.VALUES[self.kind])}, not {', '.join(given)}")
+
+
 class AgeModel(ABC):
     """A specimen's age (years) as dated; ``kind`` says which."""
     kind: AgeKind
@@ -57,7 +89,7 @@ class AgeModel(ABC):
 
     @abstractmethod
     def describe(self):
-        """A JSON-ready dict: the kind, its values (years) and what survival means."""
+        """The age as results describe it (:class:`AgeDescription`)."""
 
     @property
     def fixed_yr(self):
@@ -105,8 +137,8 @@ class LowerBound(AgeModel):
         return np.full(n, float(self.min_yr))
 
     def describe(self):
-        return {"kind": self.kind.value, "min_yr": self.min_yr,
-                "survival": "exp(-rate min): an upper bound (the age is at least min)"}
+        return AgeDescription(kind=self.kind, min_yr=self.min_yr, survival="exp(-rate min): "
+                              "an upper bound (the age is at least min)")
 
 
 @dataclass(frozen=True)
@@ -146,9 +178,9 @@ class UniformInterval(AgeModel):
         return rng.uniform(self.lo_yr, self.hi_yr, n)
 
     def describe(self):
-        return {"kind": self.kind.value, "lo_yr": self.lo_yr, "hi_yr": self.hi_yr,
-                "survival": "(exp(-rate lo) - exp(-rate hi)) / (rate (hi - lo)): the age "
-                            "uniform on [lo, hi]"}
+        return AgeDescription(kind=self.kind, lo_yr=self.lo_yr, hi_yr=self.hi_yr,
+                              survival="(exp(-rate lo) - exp(-rate hi)) / (rate (hi - lo)): "
+                              "the age uniform on [lo, hi]")
 
 
 @dataclass(frozen=True)
@@ -185,10 +217,10 @@ class AgeSamples(AgeModel):
 
     def describe(self):
         ages = np.asarray(self.ages_yr, float)
-        return {"kind": self.kind.value, "samples": len(ages), "source": self.source,
-                "mean_yr": float(ages.mean()), "min_yr": float(ages.min()),
-                "max_yr": float(ages.max()),
-                "survival": "the mean of exp(-rate t) over the samples"}
+        return AgeDescription(kind=self.kind, samples=len(ages), source=self.source,
+                              mean_yr=float(ages.mean()), min_yr=float(ages.min()),
+                              max_yr=float(ages.max()),
+                              survival="the mean of exp(-rate t) over the samples")
 
 
 @dataclass(frozen=True)
@@ -230,8 +262,9 @@ class TruncatedNormal(AgeModel):
                                    scale=self.sd_yr, size=n, random_state=rng)
 
     def describe(self):
-        return {"kind": self.kind.value, "mean_yr": self.mean_yr, "sd_yr": self.sd_yr,
-                "survival": "E[exp(-rate T)], T normal truncated at 0 (closed form)"}
+        return AgeDescription(kind=self.kind, mean_yr=self.mean_yr, sd_yr=self.sd_yr,
+                              survival="E[exp(-rate T)], T normal truncated at 0 (closed "
+                              "form)")
 
 
 def load_age_samples(path, column, scale_to_yr=1.0):

@@ -6,13 +6,17 @@ from dataclasses import replace
 import numpy as np
 
 from pipeline.constants import STANDARD_GRAVITY
-from pipeline.hazard.ages import AgeKind
 from pipeline.hazard.disagg_ratio import RatioMixture, overturn_probability_over
 from pipeline.hazard.survival import (contribution_by_intensity, intensity_scale_bound,
                                       overturning_rate, rate_density, rate_outside,
                                       rate_exceeding, rate_scale_bound,
                                       survival_probability)
+from pipeline.hazard.hazard_described import CurveHazard
+from pipeline.hazard.record import ABSENT
 from pipeline.hazard.results import SurvivalResult
+from pipeline.hazard.survival_parts import (ContributionRow, CurveEnds, CurveRow, HazardRoute,
+                                            OutsideGrid, Route, SetSurvival, SiteSet,
+                                            SpecimenResult, age_keys)
 from pipeline.provenance import software_versions
 
 BOUND_SURVIVAL = 0.05         # survival probability the bounds keep (the keys' 5pct)
@@ -70,16 +74,16 @@ def assess(curve, specimens, ratio_model, age, draws, seed, more_curves=()):
     warnings = list(curve.notes)
     entries = []
     for k, fragility in enumerate(specimens):
-        entry = _specimen_entry(curve, fragility, drawn[k], ratio_model, age, draws)
+        entry, said = _specimen_entry(curve, fragility, drawn[k], ratio_model, age, draws)
         entries.append(entry)
-        warnings += [f"specimen {k}: {w}" for w in entry.pop("warnings")]
+        warnings += [f"specimen {k}: {w}" for w in said]
     headline, probability, members = _headline(curve, specimens, drawn, entries, ratio_model,
                                                age, warnings)
     curves = [_curve_row(curve, headline, specimens, ratio_model, age)] \
         if more_curves else []
     for k, other in enumerate(more_curves, start=1):
-        result = _result(other, probability, members, age)
-        warnings += [f"hazard curve {k}: {w}" for w in list(other.notes) + result["warnings"]]
+        result, said = _result(other, probability, members, age)
+        warnings += [f"hazard curve {k}: {w}" for w in list(other.notes) + said]
         curves.append(_curve_row(other, result, specimens, ratio_model, age))
     times = sorted({c.source.get("investigation_time_yr") for c in (curve, *more_curves)}
                    - {None})
@@ -91,7 +95,7 @@ def assess(curve, specimens, ratio_model, age, draws, seed, more_curves=()):
     summary = _summary(curve, specimens, entries, headline, ratio_model, warnings,
                        (age, draws, seed))
     if more_curves:
-        survivals = [row["survival_probability"] for row in curves]
+        survivals = [row.survival_probability for row in curves]
         summary = replace(summary, hazard_curves=curves,
                           survival_range_over_curves=[min(survivals), max(survivals)])
     if len(specimens) > 1:
@@ -103,33 +107,35 @@ def assess(curve, specimens, ratio_model, age, draws, seed, more_curves=()):
 
 
 def _specimen_entry(curve, fragility, drawn, ratio_model, age, draws):
-    """One specimen's entry of ``specimens``: its result, parameter sets and what comes
-    from outside its grid, with its ``warnings`` (a list the caller takes out)."""
+    """(one specimen's entry of ``specimens``, a :class:`SpecimenResult`: its result,
+    parameter sets and what comes from outside its grid; its warnings)."""
     def probability(x):
         return overturn_probability_over([fragility], ratio_model, x)[0]
     members = None if drawn is None else [
         (lambda x, f=d: overturn_probability_over([f], ratio_model, x)[0]) for d in drawn]
-    entry = _result(curve, probability, members, age)
-    entry = {"fragility": fragility.describe(), **entry,
-             **_per_parameter_set(curve, fragility, ratio_model, age),
-             **_outside_grid(curve, fragility, ratio_model, probability,
-                             entry["annual_overturning_rate_per_yr"])}
-    if drawn is None:
-        entry["survival_interval_note"] = "no uncertainty stated for this fragility" \
-            if draws else "--draws 0"
-    outside = entry.get("outside_grid") or {}
-    entry["warnings"] += _above_grid_warning(outside, entry["fragility"],
-                                             entry["annual_overturning_rate_per_yr"])
-    for side in ("below", "above"):
-        share = outside.get(f"share_{side}_grid")
+    result, warnings = _result(curve, probability, members, age)
+    rate = result["annual_overturning_rate_per_yr"]
+    described = fragility.describe()
+    outside = _outside_grid(curve, fragility, ratio_model, probability, rate)
+    entry = SpecimenResult(
+        fragility=described, **result,
+        **_per_parameter_set(curve, fragility, ratio_model, age),
+        outside_grid=ABSENT if outside is None else outside,
+        survival_interval_note=ABSENT if drawn is not None else
+        "no uncertainty stated for this fragility" if draws else "--draws 0")
+    if outside is None:
+        return entry, warnings
+    warnings += _above_grid_warning(outside, described, rate)
+    for side, share in (("below", outside.share_below_grid),
+                        ("above", outside.share_above_grid)):
         if share is not None and share > END_SHARE_WARNING:
-            entry["warnings"].append(
+            warnings.append(
                 f"{100 * share:.0f} % of the overturning rate comes from PGA {side} the "
-                "fragility's grid" + (f" (rate {outside['rate_per_yr_zero_below_grid']:.3g}"
-                                      f" to {outside['rate_per_yr_edge_held_below_grid']:.3g}"
+                "fragility's grid" + (f" (rate {outside.rate_per_yr_zero_below_grid:.3g}"
+                                      f" to {outside.rate_per_yr_edge_held_below_grid:.3g}"
                                       " /yr with P = 0 or the edge's P below it)"
                                       if side == "below" else ""))
-    return entry
+    return entry, warnings
 
 
 def _headline(curve, specimens, drawn, entries, ratio_model, age, warnings):
@@ -138,14 +144,22 @@ def _headline(curve, specimens, drawn, entries, ratio_model, age, warnings):
     if len(specimens) == 1:
         members = None if drawn[0] is None else [_combined([d], ratio_model, "each")
                                                  for d in drawn[0]]
-        return entries[0], _combined(specimens, ratio_model, "each"), members
+        return _result_of(entries[0]), _combined(specimens, ratio_model, "each"), members
     probability = _combined(specimens, ratio_model, "any_common")
     members = None
     if all(d is not None for d in drawn):
         members = [_combined(list(group), ratio_model, "any_common") for group in zip(*drawn)]
-    headline = _result(curve, probability, members, age)
-    warnings += [f"set: {w}" for w in headline.pop("warnings")]
+    headline, said = _result(curve, probability, members, age)
+    warnings += [f"set: {w}" for w in said]
     return headline, probability, members
+
+
+def _result_of(entry):
+    """The fields of :func:`_result` of a specimen's entry (its headline)."""
+    return {k: getattr(entry, k) for k in (
+        "annual_overturning_rate_per_yr", "survival_probability", "survival_interval",
+        "rate_scale_bound_5pct", "intensity_scale_bound_5pct", "contribution_by_intensity",
+        "curve_ends")}
 
 
 def _summary(curve, specimens, entries, headline, ratio_model, warnings, run):
@@ -154,20 +168,22 @@ def _summary(curve, specimens, entries, headline, ratio_model, warnings, run):
     age, draws, seed = run
     one = len(specimens) == 1
     return SurvivalResult(
-        hazard_route={"route": "curve", "what": "the PGA hazard curve, PGV/PGA at each PGA "
-                      + ("level a mixture over the magnitude-distance disaggregation's bins "
-                         "(the ground-motion model at each)"
-                         if isinstance(ratio_model, RatioMixture) else
-                         "level lognormal (stated, or one scenario's ground-motion model)")},
+        hazard_route=HazardRoute(route=Route.CURVE, what="the PGA hazard curve, PGV/PGA at "
+                                 "each PGA level " + (
+                                     "a mixture over the magnitude-distance disaggregation's "
+                                     "bins (the ground-motion model at each)"
+                                     if isinstance(ratio_model, RatioMixture) else
+                                     "lognormal (stated, or one scenario's ground-motion "
+                                     "model)")),
         annual_overturning_rate_per_yr=headline["annual_overturning_rate_per_yr"],
         survival_probability=headline["survival_probability"],
         survival_interval=headline["survival_interval"],
         **({} if headline["survival_interval"] is not None else {
             "survival_interval_note": "no uncertainty stated for the fragility" if draws
             else "--draws 0"}),
-        **({k: entries[0][k] for k in ("survival_per_parameter_set",
-                                       "survival_parameter_set_range", "outside_grid")
-            if k in entries[0]} if one else {}),
+        **({k: getattr(entries[0], k) for k in ("survival_per_parameter_set",
+                                                "survival_parameter_set_range",
+                                                "outside_grid")} if one else {}),
         rate_scale_bound_5pct=headline["rate_scale_bound_5pct"],
         intensity_scale_bound_5pct=headline["intensity_scale_bound_5pct"],
         contribution_by_intensity=headline["contribution_by_intensity"],
@@ -176,10 +192,10 @@ def _summary(curve, specimens, entries, headline, ratio_model, warnings, run):
         **age_keys(age),
         definitions=_definitions(draws),
         specimens=entries,
-        hazard={**curve.source, "levels_m_s2": curve.levels_m_s2.tolist(),
-                "levels_g": (curve.levels_m_s2 / STANDARD_GRAVITY).tolist(),
-                "rates_per_yr": curve.rates_per_yr.tolist(), "notes": list(curve.notes),
-                "interpolation": "linear in (ln PGA, ln rate)"},
+        hazard=CurveHazard(source=dict(curve.source), levels_m_s2=curve.levels_m_s2.tolist(),
+                           levels_g=(curve.levels_m_s2 / STANDARD_GRAVITY).tolist(),
+                           rates_per_yr=curve.rates_per_yr.tolist(), notes=list(curve.notes),
+                           interpolation="linear in (ln PGA, ln rate)"),
         pgv_pga=None if ratio_model is None else ratio_model.describe(),
         pgv_pga_used=any(f.uses_ratio for f in specimens),
         assumptions=ASSUMPTIONS, warnings=warnings,
@@ -230,7 +246,8 @@ def _combined(specimens, ratio_model, combine):
 
 
 def _result(curve, probability, members, age):
-    """Rate, survival, interval, bounds and contributions of one probability function."""
+    """(Rate, survival, interval, bounds, contributions and curve ends of one probability
+    function: the fields of a :class:`SpecimenResult` but its fragility; its warnings)."""
     zero = curve.zero_rate_from_m_s2
     rate = overturning_rate(curve.levels_m_s2, curve.rates_per_yr, probability, zero)
     total = rate["rate_per_yr"]
@@ -244,9 +261,6 @@ def _result(curve, probability, members, age):
                                                 probability, age, BOUND_SURVIVAL, zero)
     contribution = contribution_by_intensity(curve.levels_m_s2, curve.rates_per_yr,
                                              probability)
-    for row in contribution:
-        row["lo_g"] = row["lo_m_s2"] / STANDARD_GRAVITY
-        row["hi_g"] = None if row["hi_m_s2"] is None else row["hi_m_s2"] / STANDARD_GRAVITY
     warnings = []
     for key, where in (("share_first_interval", "first interval"),
                        ("share_at_last_level", "last level")):
@@ -262,25 +276,23 @@ def _result(curve, probability, members, age):
             "rate_scale_bound_5pct": rate_scale_bound(total, age, BOUND_SURVIVAL),
             "intensity_scale_bound_5pct": bound_c,
             **({"intensity_scale_bound_note": bound_note} if bound_note else {}),
-            "contribution_by_intensity": contribution,
-            "curve_ends": {k: v for k, v in rate.items() if k != "rate_per_yr"},
-            "warnings": warnings}
+            "contribution_by_intensity": [ContributionRow.of(row) for row in contribution],
+            "curve_ends": CurveEnds(**{k: v for k, v in rate.items() if k != "rate_per_yr"})
+            }, warnings
 
 
 def _curve_row(curve, result, specimens, ratio_model, age):
     """One hazard curve's row of ``hazard_curves``: the curve and the headline under it."""
     source = curve.source
-    row = {"file": source.get("file"), "format": source.get("format"),
-           "kind": source.get("kind"), "site_index": source.get("site_index"),
-           "investigation_time_yr": source.get("investigation_time_yr"),
-           **{k: result[k] for k in ("annual_overturning_rate_per_yr", "survival_probability",
-                                     "survival_interval", "rate_scale_bound_5pct",
-                                     "intensity_scale_bound_5pct")}}
-    if len(specimens) == 1:
-        sets = _per_parameter_set(curve, specimens[0], ratio_model, age)
-        if sets:
-            row["survival_parameter_set_range"] = sets["survival_parameter_set_range"]
-    return row
+    sets = _per_parameter_set(curve, specimens[0], ratio_model, age) \
+        if len(specimens) == 1 else {}
+    return CurveRow(
+        **{k: source.get(k) for k in ("file", "format", "kind", "site_index",
+                                      "investigation_time_yr")},
+        **{k: result[k] for k in ("annual_overturning_rate_per_yr", "survival_probability",
+                                  "survival_interval", "rate_scale_bound_5pct",
+                                  "intensity_scale_bound_5pct")},
+        survival_parameter_set_range=sets.get("survival_parameter_set_range", ABSENT))
 
 
 def _per_parameter_set(curve, fragility, ratio_model, age):
@@ -303,7 +315,7 @@ def _outside_grid(curve, fragility, ratio_model, probability, rate):
     with P = 0 below it and with the edge's P held below it; nothing for other forms."""
     grid = fragility.grid_range()
     if grid is None:
-        return {}
+        return None
     lo, hi = grid
     below, above = rate_outside(curve.levels_m_s2, curve.rates_per_yr, probability, lo, hi)
     zero = curve.zero_rate_from_m_s2
@@ -313,18 +325,18 @@ def _outside_grid(curve, fragility, ratio_model, probability, rate):
         for name, variant in fragility.variants().items()}
     last = float(curve.levels_m_s2[-1])
     beyond = rate_exceeding(curve.levels_m_s2, curve.rates_per_yr, hi)
-    return {"outside_grid": {
-        "pga_range_m_s2": [lo, hi], "pga_range_g": [lo / STANDARD_GRAVITY, hi / STANDARD_GRAVITY],
-        "rate_below_grid_per_yr": below, "rate_above_grid_per_yr": above,
-        "share_below_grid": below / rate if rate > 0 else None,
-        "share_above_grid": above / rate if rate > 0 else None,
-        "rate_per_yr_zero_below_grid": bounds["zero"],
-        "rate_per_yr_edge_held_below_grid": bounds["edge"],
-        "hazard_last_level_g": last / STANDARD_GRAVITY,
-        "hazard_reach_over_grid_top": last / hi,
-        "hazard_rate_above_grid_per_yr": beyond,
-        "rate_per_yr_one_above_grid": rate - above + max(beyond, above),
-        "p_above_grid": fragility.describe().get("above_grid")}}
+    return OutsideGrid(
+        pga_range_m_s2=[lo, hi], pga_range_g=[lo / STANDARD_GRAVITY, hi / STANDARD_GRAVITY],
+        rate_below_grid_per_yr=below, rate_above_grid_per_yr=above,
+        share_below_grid=below / rate if rate > 0 else None,
+        share_above_grid=above / rate if rate > 0 else None,
+        rate_per_yr_zero_below_grid=bounds["zero"],
+        rate_per_yr_edge_held_below_grid=bounds["edge"],
+        hazard_last_level_g=last / STANDARD_GRAVITY,
+        hazard_reach_over_grid_top=last / hi,
+        hazard_rate_above_grid_per_yr=beyond,
+        rate_per_yr_one_above_grid=rate - above + max(beyond, above),
+        p_above_grid=fragility.describe().get("above_grid"))
 
 
 def _above_grid_warning(outside, described, rate):
@@ -332,38 +344,35 @@ def _above_grid_warning(outside, described, rate):
     grid: P = 1 above it would add more than END_SHARE_WARNING of the rate, or more than
     REACH_SHARE with the hazard curve reaching beyond REACH_WARNING x the grid's top PGA
     (P held at 1 above the grid adds nothing: no warning)."""
-    if not outside:
-        return []
-    could_add = outside["rate_per_yr_one_above_grid"] - rate
-    reach = outside["hazard_reach_over_grid_top"]
+    could_add = outside.rate_per_yr_one_above_grid - rate
+    reach = outside.hazard_reach_over_grid_top
     if not (could_add > END_SHARE_WARNING * rate
             or (reach > REACH_WARNING and could_add > REACH_SHARE * rate)):
         return []
-    top = outside["pga_range_g"][1]
+    top = outside.pga_range_g[1]
     how = (described.get("above_grid") or {}).get("summary", "P extended above it")
-    return [f"the hazard curve reaches {outside['hazard_last_level_g']:.3g} g, {reach:.3g} x "
+    return [f"the hazard curve reaches {outside.hazard_last_level_g:.3g} g, {reach:.3g} x "
             f"the grid's top PGA {top:.3g} g (on the hazard's PGA); above it {how}; PGA above "
             f"{top:.3g} g has the "
-            f"rate {outside['hazard_rate_above_grid_per_yr']:.3g} /yr against the overturning "
+            f"rate {outside.hazard_rate_above_grid_per_yr:.3g} /yr against the overturning "
             f"rate {rate:.3g} /yr (P = 1 above the grid: "
-            f"{outside['rate_per_yr_one_above_grid']:.3g} /yr)"]
+            f"{outside.rate_per_yr_one_above_grid:.3g} /yr)"]
 
 
 def _site_set(curve, specimens, ratio_model, entries, age):
     """Survival of all specimens of a set under the three assumptions of ASSUMPTIONS."""
     zero = curve.zero_rate_from_m_s2
-    out = {}
-    rates = {"independent": sum(e["annual_overturning_rate_per_yr"] for e in entries)}
+    rates = {"independent": sum(e.annual_overturning_rate_per_yr for e in entries)}
     for name, combine in (("common_shaking", "any_common"),
                           ("fully_correlated", "any_correlated")):
         rates[name] = overturning_rate(curve.levels_m_s2, curve.rates_per_yr,
                                        _combined(specimens, ratio_model, combine),
                                        zero)["rate_per_yr"]
-    for name, rate in rates.items():
-        out[name] = {"annual_rate_any_overturns_per_yr": rate,
-                     "survival_probability_all": float(age.survival(rate)),
-                     "rate_scale_bound_5pct": rate_scale_bound(rate, age, BOUND_SURVIVAL)}
-    return out
+    return SiteSet(**{name: SetSurvival(
+        annual_rate_any_overturns_per_yr=rate,
+        survival_probability_all=float(age.survival(rate)),
+        rate_scale_bound_5pct=rate_scale_bound(rate, age, BOUND_SURVIVAL))
+        for name, rate in rates.items()})
 
 
 def _figure_data(curve, probability, headline, drawn, age, specimens, ratio_model):
@@ -376,20 +385,9 @@ def _figure_data(curve, probability, headline, drawn, age, specimens, ratio_mode
     survival = np.array([survival_probability(rate, a) for a in ages])
     return {"levels_m_s2": curve.levels_m_s2, "rates_per_yr": curve.rates_per_yr,
             "probability_x": x, "probability": probability(x), "density_x": x,
-            "density": density, "contribution": headline["contribution_by_intensity"],
+            "density": density,
+            "top_share": headline["contribution_by_intensity"][-1].share,
             "ages_yr": ages, "survival": survival, "age_yr": age.typical_yr, "age_band": band,
             "survival_probability": headline["survival_probability"],
             "survival_interval": headline["survival_interval"],
             "set": len(specimens) > 1, "pgv_pga_used": any(f.uses_ratio for f in specimens)}
-
-
-def age_keys(age):
-    """survival.json's age: age_ka and age_sd_ka (a normal's; null for other kinds),
-    age_distribution in words and age (:meth:`AgeModel.describe`)."""
-    normal = age.kind is AgeKind.NORMAL
-    words = {AgeKind.NORMAL: "fixed" if normal and age.sd_yr == 0 else "normal truncated at 0",
-             AgeKind.LOWER_BOUND: "a lower bound (survival an upper bound)",
-             AgeKind.INTERVAL: "uniform on an interval", AgeKind.SAMPLES: "samples"}
-    return {"age_ka": age.mean_yr / 1000.0 if normal else None,
-            "age_sd_ka": age.sd_yr / 1000.0 if normal else None,
-            "age_distribution": words[age.kind], "age": age.describe()}

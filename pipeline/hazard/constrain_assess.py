@@ -6,16 +6,21 @@ from enum import Enum
 import numpy as np
 
 from pipeline.constants import STANDARD_GRAVITY
-from pipeline.hazard.ages import AgeKind
 from pipeline.hazard.constrain import (FRACTILES, TARGET_RATES, bayes, branch_rates,
                                        cell_matrix, change_percent, draw_chunk, eliminate,
                                        log_survival_fixed, log_survival_sampled,
                                        motion_at_rate, weighted_mean,
                                        weighted_quantile)
+from pipeline.hazard.constrain_parts import (BranchRow, ConstrainSpecimen, CurveStatistics,
+                                             MemberMotion, Members, Mixture, MonteCarlo,
+                                             MotionAtRate, SiteRow)
 from pipeline.hazard.constrain_sites import (SITE_ASSUMPTION, SiteGroup, branch_test,
                                              check_same_branches, combined)
+from pipeline.hazard.hazard_described import TreeHazard
 from pipeline.hazard.fragility import overturn_probability
 from pipeline.hazard.logictree import LogicTree
+from pipeline.hazard.record import ABSENT
+from pipeline.hazard.survival_parts import age_keys
 from pipeline.hazard.results import ConstrainResult
 from pipeline.provenance import software_versions
 
@@ -96,7 +101,7 @@ def constrain_tree(tree, specimens, ratio_model, ages, rule, floor, draws, seed,
     summary = ConstrainResult(
         rule=rule, headline=WHY_BAYES, floor=floor,
         branch_count=tree.size, specimen_count=len(specimens),
-        specimens=[{"fragility": f.describe(), **_age_keys(a)}
+        specimens=[ConstrainSpecimen(fragility=f.describe(), **_age_keys(a))
                    for f, a in zip(specimens, ages)],
         age_model=mode.value,
         age_integration_se_max=None if age_se is None else float(np.nanmax(age_se)),
@@ -109,11 +114,11 @@ def constrain_tree(tree, specimens, ratio_model, ages, rule, floor, draws, seed,
            else _statistics(tree, posterior[other])},
         ground_motion_at_rates=_motions(tree, prior_stats, post_stats),
         members=members, monte_carlo=carlo,
-        sites=[{"site": g.site, "specimens": list(g.members)} for g in groups],
+        sites=[SiteRow(site=g.site, specimens=list(g.members)) for g in groups],
         branch_test=test,
-        hazard={**tree.source, "notes": list(tree.notes),
-                "interpolation": "linear in (ln PGA, ln rate)",
-                "cells_per_interval": cells[2]},
+        hazard=TreeHazard(source=dict(tree.source), notes=list(tree.notes),
+                          interpolation="linear in (ln PGA, ln rate)",
+                          cells_per_interval=cells[2]),
         pgv_pga=None if ratio_model is None else ratio_model.describe(),
         warnings=warnings,
         assumptions=ASSUMPTIONS + ([SITE_ASSUMPTION] if len(groups) > 1 else []),
@@ -166,11 +171,9 @@ def _age_mode(ages, rng):
 
 
 def _age_keys(age):
-    """A specimen's age in constrain.json: age_ka and age_sd_ka (a normal's; null for
-    other kinds) and age (:meth:`~pipeline.hazard.ages.AgeModel.describe`)."""
-    normal = age.kind is AgeKind.NORMAL
-    return {"age_ka": age.mean_yr / 1000.0 if normal else None,
-            "age_sd_ka": age.sd_yr / 1000.0 if normal else None, "age": age.describe()}
+    """A specimen's age in constrain.json: survival.json's (:func:`~pipeline.hazard.
+    survival_parts.age_keys`) but its age_distribution."""
+    return {k: v for k, v in age_keys(age).items() if k != "age_distribution"}
 
 
 def _log_survival(tree, cells, batch, ratio_model, ages, mode, samples):
@@ -235,39 +238,41 @@ BAND_CURVE = f"range {fractile_key(BAND[0])}-{fractile_key(BAND[1])}"
 def _statistics(tree, weights):
     """Mean and fractile curves (annual rates) under ``weights``."""
     rates = tree.rates_per_yr
-    return {"mean_rates_per_yr": weighted_mean(rates, weights).tolist(),
-            "fractiles": {fractile_key(q): weighted_quantile(rates, weights, q).tolist()
-                          for q in FRACTILES}}
+    return CurveStatistics(
+        mean_rates_per_yr=weighted_mean(rates, weights).tolist(),
+        fractiles={fractile_key(q): weighted_quantile(rates, weights, q).tolist()
+                   for q in FRACTILES})
 
 
 def _motions(tree, prior, posterior):
     """PGA at TARGET_RATES on the mean and each fractile curve, before and after."""
     rows = []
-    curves = [(MEAN_CURVE, "mean_rates_per_yr", None)] + \
-        [(fractile_curve(q), "fractiles", fractile_key(q)) for q in FRACTILES]
+    curves = [(MEAN_CURVE, None)] + [(fractile_curve(q), fractile_key(q)) for q in FRACTILES]
     for rate in TARGET_RATES:
-        for name, key, q in curves:
-            before = _pga(tree, prior, key, q, rate)
-            after = None if posterior is None else _pga(tree, posterior, key, q, rate)
-            rows.append({"annual_rate_per_yr": rate, "curve": name,
-                         "prior_m_s2": before, "posterior_m_s2": after,
-                         "prior_g": _g(before), "posterior_g": _g(after),
-                         "change_percent": change_percent(before, after)})
+        for name, q in curves:
+            before = _pga(tree, prior, q, rate)
+            after = None if posterior is None else _pga(tree, posterior, q, rate)
+            rows.append(_motion_row(rate, name, before, after))
         band = [fractile_key(q) for q in BAND]
-        lo_b, hi_b = (_pga(tree, prior, "fractiles", q, rate) for q in band)
+        lo_b, hi_b = (_pga(tree, prior, q, rate) for q in band)
         lo_a, hi_a = (None, None) if posterior is None else \
-            (_pga(tree, posterior, "fractiles", q, rate) for q in band)
+            (_pga(tree, posterior, q, rate) for q in band)
         width_b = None if None in (lo_b, hi_b) else hi_b - lo_b
         width_a = None if None in (lo_a, hi_a) else hi_a - lo_a
-        rows.append({"annual_rate_per_yr": rate, "curve": BAND_CURVE,
-                     "prior_m_s2": width_b, "posterior_m_s2": width_a,
-                     "prior_g": _g(width_b), "posterior_g": _g(width_a),
-                     "change_percent": change_percent(width_b, width_a)})
+        rows.append(_motion_row(rate, BAND_CURVE, width_b, width_a))
     return rows
 
 
-def _pga(tree, stats, key, q, rate):
-    curve = stats[key] if q is None else stats[key][q]
+def _motion_row(rate, curve, before, after):
+    """PGA (m/s^2 or None) on ``curve`` at ``rate`` before and after, as a row."""
+    return MotionAtRate(annual_rate_per_yr=rate, curve=curve, prior_m_s2=before,
+                        posterior_m_s2=after, prior_g=_g(before), posterior_g=_g(after),
+                        change_percent=change_percent(before, after))
+
+
+def _pga(tree, stats, q, rate):
+    """PGA (m/s^2) at ``rate`` on the mean (``q`` None) or the fractile ``q`` of ``stats``."""
+    curve = stats.mean_rates_per_yr if q is None else stats.fractiles[q]
     return motion_at_rate(tree.levels_m_s2, np.asarray(curve), rate)
 
 
@@ -301,17 +306,16 @@ def _members(tree, specimens, survival_of, floor, warnings):
         mix = None if mixed is None else motion_at_rate(
             tree.levels_m_s2, weighted_mean(tree.rates_per_yr, mixed), rate)
         known = [v for v in per if v is not None]
-        at[f"{rate:g}"] = {"mixture_g": _g(mix), "per_member_g": [_g(v) for v in per],
-                           "member_range_g": [_g(min(known)), _g(max(known))] if known
-                           else None}
-    return {"count": count,
-            "survival_per_member": ps.tolist(),
-            "posterior_bayes_per_member": [None if w is None else w.tolist()
-                                           for w in posteriors],
-            "mixture": {"survival_probability": mixture.tolist(),
-                        "posterior_bayes": None if mixed is None else mixed.tolist(),
-                        "posterior_eliminate": _list(eliminate(tree.weights, mixture, floor))},
-            "mean_ground_motion_at_rates": at}
+        at[f"{rate:g}"] = MemberMotion(
+            mixture_g=_g(mix), per_member_g=[_g(v) for v in per],
+            member_range_g=[_g(min(known)), _g(max(known))] if known else None)
+    return Members(
+        count=count, survival_per_member=ps.tolist(),
+        posterior_bayes_per_member=[None if w is None else w.tolist() for w in posteriors],
+        mixture=Mixture(survival_probability=mixture.tolist(),
+                        posterior_bayes=None if mixed is None else mixed.tolist(),
+                        posterior_eliminate=_list(eliminate(tree.weights, mixture, floor))),
+        mean_ground_motion_at_rates=at)
 
 
 def _draws(tree, cells, specimens, survival_of, draws, rng, floor):
@@ -337,13 +341,13 @@ def _draws(tree, cells, specimens, survival_of, draws, rng, floor):
         values = [v for v in values if v is not None]
         motion[f"{rate:g}"] = None if not values else \
             (np.percentile(values, INTERVAL) / STANDARD_GRAVITY).tolist()
-    return {"draws": draws,
-            "survival_interval": np.percentile(ps, INTERVAL, axis=0).T.tolist(),
-            "posterior_bayes_interval": None if not len(usable) else
-            np.percentile(usable, INTERVAL, axis=0).T.tolist(),
-            "posterior_mean_pga_g_interval_at_rates": motion,
-            "definition": f"{INTERVAL[0]:g}-{INTERVAL[1]:g} percentiles over {draws} draws of "
-                          "the fragility's estimate (its Monte Carlo or fitting error)"}
+    return MonteCarlo(
+        draws=draws, survival_interval=np.percentile(ps, INTERVAL, axis=0).T.tolist(),
+        posterior_bayes_interval=None if not len(usable) else
+        np.percentile(usable, INTERVAL, axis=0).T.tolist(),
+        posterior_mean_pga_g_interval_at_rates=motion,
+        definition=f"{INTERVAL[0]:g}-{INTERVAL[1]:g} percentiles over {draws} draws of the "
+                   "fragility's estimate (its Monte Carlo or fitting error)")
 
 
 def _end_warnings(tree, cells, specimens, ratio_model, weights):
@@ -367,17 +371,13 @@ def _list(array):
 
 
 def _branch_rows(tree, p, posterior, carlo, age_se):
-    rows = []
-    for k in range(tree.size):
-        row = {"branch": tree.branch_ids[k], "path": tree.branch_paths[k],
-               "prior_weight": float(tree.weights[k]), "survival_probability": float(p[k]),
-               "posterior_bayes": None if posterior["bayes"] is None
-               else float(posterior["bayes"][k]),
-               "posterior_eliminate": None if posterior["eliminate"] is None
-               else float(posterior["eliminate"][k])}
-        if age_se is not None:
-            row["survival_age_se_relative"] = float(age_se[k])
-        if carlo is not None:
-            row["survival_interval"] = carlo["survival_interval"][k]
-        rows.append(row)
-    return rows
+    """Each branch's :class:`BranchRow`."""
+    def weight(rule, k):
+        return None if posterior[rule] is None else float(posterior[rule][k])
+    return [BranchRow(
+        branch=tree.branch_ids[k], path=tree.branch_paths[k],
+        prior_weight=float(tree.weights[k]), survival_probability=float(p[k]),
+        posterior_bayes=weight("bayes", k), posterior_eliminate=weight("eliminate", k),
+        survival_age_se_relative=ABSENT if age_se is None else float(age_se[k]),
+        survival_interval=ABSENT if carlo is None else carlo.survival_interval[k])
+        for k in range(tree.size)]

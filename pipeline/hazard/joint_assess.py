@@ -6,13 +6,14 @@ the site overturns (any of it) with 1 - prod(1 - P_i) in each event, as on the s
 route."""
 import numpy as np
 
-from pipeline.hazard.assess import BOUND_SURVIVAL, END_SHARE_WARNING, INTERVAL, age_keys
+from pipeline.hazard.assess import BOUND_SURVIVAL, END_SHARE_WARNING, INTERVAL
+from pipeline.hazard.hazard_described import JointHazardDescribed
 from pipeline.hazard.joint_survival import cell_mean_probability, joint_overturning_rate
 from pipeline.hazard.results import SurvivalResult
+from pipeline.hazard.survival_parts import HazardRoute, Route, SpecimenResult, age_keys
 from pipeline.hazard.survival import rate_scale_bound, survival_probability
 from pipeline.provenance import software_versions
 
-ROUTE = "joint"
 ASSUMPTIONS = [
     "Overturnings are a Poisson process in time: survival of age t is exp(-rate t); over "
     "an uncertain age, the mean of exp(-rate T) over its distribution.",
@@ -70,18 +71,18 @@ def assess_joint(joint, specimens, age, draws, seed):
     for k, f in enumerate(specimens):
         one = _rate(joint, [f])
         warnings += _warnings(one, f"specimen {k}: ") if len(specimens) > 1 else []
-        entries.append({"fragility": f.describe(),
-                        "annual_overturning_rate_per_yr": one.rate_per_yr,
-                        "survival_probability": float(age.survival(one.rate_per_yr)),
-                        "share_top_pga": one.share_top_pga,
-                        "share_top_pgv": one.share_top_pgv})
+        entries.append(SpecimenResult(
+            fragility=f.describe(), annual_overturning_rate_per_yr=one.rate_per_yr,
+            survival_probability=float(age.survival(one.rate_per_yr)),
+            share_top_pga=one.share_top_pga, share_top_pgv=one.share_top_pgv))
     interval = None
     if all(d is not None for d in drawn):
         rates = [_rate(joint, list(group)).rate_per_yr for group in zip(*drawn)]
         interval = np.percentile(age.survival(np.array(rates)), INTERVAL).tolist()
     summary = SurvivalResult(
-        hazard_route={"route": ROUTE, "what": "the joint hazard of PGA and PGV "
-                      "(OpenQuake mean rate density, mrd), PGV/PGA from each event"},
+        hazard_route=HazardRoute(route=Route.JOINT, what="the joint hazard of PGA and PGV "
+                                 "(OpenQuake mean rate density, mrd), PGV/PGA from each "
+                                 "event"),
         annual_overturning_rate_per_yr=rate,
         survival_probability=float(age.survival(rate)),
         survival_interval=interval,
@@ -96,11 +97,11 @@ def assess_joint(joint, specimens, age, draws, seed):
         else "the set under common shaking (all survive)",
         **age_keys(age),
         specimens=entries,
-        hazard={**joint.source, "site": list(joint.sites[0]),
-                "pga_levels_m_s2": joint.pga_levels_m_s2.tolist(),
-                "pgv_levels_m_s": joint.pgv_levels_m_s.tolist(),
-                "investigation_time_yr": joint.investigation_time_yr,
-                "events_per_yr": headline.events_per_yr},
+        hazard=JointHazardDescribed(source=dict(joint.source), site=list(joint.sites[0]),
+                                    pga_levels_m_s2=joint.pga_levels_m_s2.tolist(),
+                                    pgv_levels_m_s=joint.pgv_levels_m_s.tolist(),
+                                    investigation_time_yr=joint.investigation_time_yr,
+                                    events_per_yr=headline.events_per_yr),
         pgv_pga=None, pgv_pga_used=any(f.uses_ratio for f in specimens),
         assumptions=ASSUMPTIONS, warnings=warnings,
         draws=draws, seed=seed, software=software_versions())
@@ -126,7 +127,7 @@ def _figure_data(joint, specimens, summary, age):
     rate = summary.annual_overturning_rate_per_yr
     return {"levels_m_s2": levels[:-1], "rates_per_yr": exceed, "probability_x": mid,
             "probability": marginal, "density_x": mid, "density": part / np.diff(np.log(levels)),
-            "contribution": [{"share": summary.share_top_pga}],
+            "top_share": summary.share_top_pga,
             "ages_yr": ages, "survival": np.array([survival_probability(rate, a) for a in ages]),
             "age_yr": age.typical_yr, "age_band": band,
             "survival_probability": summary.survival_probability,

@@ -6,131 +6,105 @@ fields (survival's curve route, :func:`pipeline.hazard.assess.assess`, and joint
 :func:`pipeline.hazard.joint_assess.assess_joint`; constrain's other rule): a field left
 :data:`ABSENT` is not written.  Their inner parts are as docs/survival.md and
 docs/constrained-hazard.md describe them."""
-from dataclasses import dataclass, fields
+from dataclasses import dataclass
 from pathlib import Path
 
 from pipeline.files import InputError, result_json_text
+from pipeline.hazard.constrain_parts import (CONSTRAIN_PARTS, CurveStatistics, Members,
+                                             MonteCarlo)
+from pipeline.hazard.ages import AgeDescription
 from pipeline.hazard.constrain_sites import BranchTest
+from pipeline.hazard.hazard_described import (CurveHazard, JointHazardDescribed, TreeHazard,
+                                              read_survival_hazard)
+from pipeline.hazard.record import ABSENT, Record, check_probability, check_rate
+from pipeline.hazard.survival_parts import (SURVIVAL_PARTS, CurveEnds, HazardRoute,
+                                            OutsideGrid, Route, SiteSet)
 from pipeline.userfiles import DATA_FILE_BYTES, read_json
 
 RULES = ("bayes", "eliminate")              # constrain's rules (constrain.json's rule)
+__all__ = ["ABSENT", "ConstrainResult", "SurvivalResult", "read_constrain_result",
+           "read_survival_result"]
 
 
-class _Absent:
-    """A field the route does not fill (not written to the file)."""
-
-    def __repr__(self):
-        return "ABSENT"
-
-
-ABSENT = _Absent()
-
-
-class _ResultFile:
-    """What both results share: the file's ``NAME``, its ``REQUIRED`` fields, the writer
-    and the reader."""
-    NAME = ""
-    REQUIRED = ()
-
-    def _check_required(self):
-        missing = [k for k in self.REQUIRED if getattr(self, k) is ABSENT]
-        if missing:
-            raise InputError(f"{self.NAME}: no {', '.join(missing)}")
-
-    def given(self, name):
-        """The field ``name``, or None where the route leaves it absent."""
-        value = getattr(self, name)
-        return None if value is ABSENT else value
-
-    def as_json(self) -> dict:
-        """The file's content: the fields given, in their order."""
-        out = {}
-        for f in fields(self):
-            value = getattr(self, f.name)
-            if value is not ABSENT:
-                out[f.name] = value.as_json() if hasattr(value, "as_json") else value
-        return out
+class _ResultFile(Record):
+    """What both results share: the file's ``NAME``, its writer and its reader."""
 
     def text(self) -> str:
         """The file's text (a NaN or an infinity a one-line error, before any file)."""
         return result_json_text(self.as_json(), self.NAME)
 
     @classmethod
-    def _read(cls, path, **convert):
+    def _read(cls, path):
         data = read_json(path, cls.NAME, DATA_FILE_BYTES)
         if not isinstance(data, dict):
             raise InputError(f"{path}: not a {cls.NAME} (no JSON object)")
-        unknown = sorted(set(data) - {f.name for f in fields(cls)})
-        if unknown:
-            raise InputError(f"{path}: unknown keys {', '.join(unknown)}")
         try:
-            return cls(**{k: convert[k](v) if k in convert else v for k, v in data.items()})
-        except (InputError, ValueError, TypeError) as e:
-            raise InputError(f"{path}: {e}") from None
+            return cls.from_json(data)
+        except InputError as e:
+            raise InputError(f"{path}: {str(e).removeprefix(cls.NAME + ': ')}") from None
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, kw_only=True)
 class SurvivalResult(_ResultFile):
     """survival.json: the headline (annual overturning rate, 1/yr; survival probability
     over the age; its interval or null; the bounds on the hazard's rates and PGA levels
-    that leave survival at 5 %), the age, each specimen's entry, the hazard and the
-    PGV/PGA model as described, assumptions, warnings, draws and seed, software."""
-    hazard_route: dict = ABSENT
-    annual_overturning_rate_per_yr: float = ABSENT
-    survival_probability: float = ABSENT
-    survival_interval: list | None = ABSENT
+    that leave survival at 5 %), the age, each specimen's entry
+    (:class:`~pipeline.hazard.survival_parts.SpecimenResult`), the hazard and the PGV/PGA
+    model as described, assumptions, warnings, draws and seed, software.  A field without
+    a default is required on every route."""
+    hazard_route: HazardRoute
+    annual_overturning_rate_per_yr: float
+    survival_probability: float
+    survival_interval: list | None
     survival_interval_note: str = ABSENT
     survival_per_parameter_set: list = ABSENT
     survival_parameter_set_range: list = ABSENT
-    outside_grid: dict = ABSENT
-    rate_scale_bound_5pct: float | None = ABSENT
-    intensity_scale_bound_5pct: float | None = ABSENT
+    outside_grid: OutsideGrid = ABSENT
+    rate_scale_bound_5pct: float | None
+    intensity_scale_bound_5pct: float | None
     intensity_scale_bound_note: str = ABSENT
     contribution_by_intensity: list = ABSENT
-    curve_ends: dict = ABSENT
-    share_top_pga: float = ABSENT
-    share_top_pgv: float = ABSENT
-    headline: str = ABSENT
-    age_ka: float | None = ABSENT
-    age_sd_ka: float | None = ABSENT
-    age_distribution: str = ABSENT
-    age: dict = ABSENT
+    curve_ends: CurveEnds = ABSENT
+    share_top_pga: float | None = ABSENT
+    share_top_pgv: float | None = ABSENT
+    headline: str
+    age_ka: float | None
+    age_sd_ka: float | None
+    age_distribution: str
+    age: AgeDescription
     definitions: dict = ABSENT
-    specimens: list = ABSENT
-    hazard: dict = ABSENT
-    pgv_pga: dict | None = ABSENT
-    pgv_pga_used: bool = ABSENT
-    assumptions: list = ABSENT
-    warnings: list = ABSENT
-    draws: int = ABSENT
-    seed: int = ABSENT
-    software: dict = ABSENT
+    specimens: list
+    hazard: CurveHazard | JointHazardDescribed
+    pgv_pga: dict | None
+    pgv_pga_used: bool
+    assumptions: list
+    warnings: list
+    draws: int
+    seed: int
+    software: dict
     hazard_curves: list = ABSENT
     survival_range_over_curves: list = ABSENT
-    site_set: dict = ABSENT
+    site_set: SiteSet = ABSENT
     hazard_component: str = ABSENT
     figure: str = ABSENT
     site_motion: dict = ABSENT
 
     NAME = "survival.json"
-    REQUIRED = ("hazard_route", "annual_overturning_rate_per_yr", "survival_probability",
-                "survival_interval", "rate_scale_bound_5pct", "intensity_scale_bound_5pct",
-                "headline", "age_ka", "age_sd_ka", "age_distribution", "age", "specimens",
-                "hazard", "pgv_pga", "pgv_pga_used", "assumptions", "warnings", "draws",
-                "seed", "software")
+    PARTS = {**SURVIVAL_PARTS, "age": AgeDescription.from_json,
+             "hazard": read_survival_hazard}
 
     def __post_init__(self):
-        self._check_required()
-        p, rate = self.survival_probability, self.annual_overturning_rate_per_yr
-        if p < 0.0 or p > 1.0:      # a NaN is the writer's one-line error
-            raise InputError(f"{self.NAME}: survival_probability {p!r} is not in [0, 1]")
-        if rate < 0.0:
-            raise InputError(f"{self.NAME}: annual_overturning_rate_per_yr {rate!r} < 0")
+        joint = isinstance(self.hazard, JointHazardDescribed)
+        if joint != (self.hazard_route.route is Route.JOINT):
+            raise InputError(f"{self.NAME}: the hazard is not of the route "
+                             f"{self.hazard_route.route.value}")
+        check_probability(self, "survival_probability")
+        check_rate(self, "annual_overturning_rate_per_yr")
         if not self.specimens:
             raise InputError(f"{self.NAME}: no specimens")
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, kw_only=True)
 class ConstrainResult(_ResultFile):
     """constrain.json: the rule and its floor, the branches' survival and weights before
     and after, the prior and constrained curves' statistics (``posterior`` under the
@@ -138,46 +112,42 @@ class ConstrainResult(_ResultFile):
     motion at the stated rates, the members' and draws' spread, the branch test
     (:class:`~pipeline.hazard.constrain_sites.BranchTest`), the hazard and the PGV/PGA
     model as described, warnings, assumptions, draws and seed, software, and the files
-    of the set."""
-    rule: str = ABSENT
-    headline: str = ABSENT
-    floor: float = ABSENT
-    branch_count: int = ABSENT
-    specimen_count: int = ABSENT
-    specimens: list = ABSENT
-    age_model: str = ABSENT
-    age_integration_se_max: float | None = ABSENT
-    branches: list = ABSENT
-    levels_m_s2: list = ABSENT
-    levels_g: list = ABSENT
-    prior: dict = ABSENT
-    posterior: dict | None = ABSENT
-    posterior_bayes: dict | None = ABSENT
-    posterior_eliminate: dict | None = ABSENT
-    ground_motion_at_rates: list = ABSENT
-    members: dict | None = ABSENT
-    monte_carlo: dict | None = ABSENT
-    sites: list = ABSENT
-    branch_test: BranchTest = ABSENT
-    hazard: dict = ABSENT
-    pgv_pga: dict | None = ABSENT
-    warnings: list = ABSENT
-    assumptions: list = ABSENT
-    draws: int = ABSENT
-    seed: int = ABSENT
-    software: dict = ABSENT
+    of the set (the parts' types in :mod:`pipeline.hazard.constrain_parts`)."""
+    rule: str
+    headline: str
+    floor: float
+    branch_count: int
+    specimen_count: int
+    specimens: list
+    age_model: str
+    age_integration_se_max: float | None
+    branches: list
+    levels_m_s2: list
+    levels_g: list
+    prior: CurveStatistics
+    posterior: CurveStatistics | None
+    posterior_bayes: CurveStatistics | None = ABSENT
+    posterior_eliminate: CurveStatistics | None = ABSENT
+    ground_motion_at_rates: list
+    members: Members | None
+    monte_carlo: MonteCarlo | None
+    sites: list
+    branch_test: BranchTest
+    hazard: TreeHazard
+    pgv_pga: dict | None
+    warnings: list
+    assumptions: list
+    draws: int
+    seed: int
+    software: dict
     hazard_component: str = ABSENT
     files: list = ABSENT
 
     NAME = "constrain.json"
-    REQUIRED = ("rule", "headline", "floor", "branch_count", "specimen_count", "specimens",
-                "age_model", "age_integration_se_max", "branches", "levels_m_s2",
-                "levels_g", "prior", "posterior", "ground_motion_at_rates", "members",
-                "monte_carlo", "sites", "branch_test", "hazard", "pgv_pga", "warnings",
-                "assumptions", "draws", "seed", "software")
+    PARTS = {**CONSTRAIN_PARTS, "branch_test": BranchTest.from_json,
+             "hazard": TreeHazard.from_json}
 
     def __post_init__(self):
-        self._check_required()
         if self.rule not in RULES:
             raise InputError(f"{self.NAME}: rule {self.rule!r} is not one of "
                              f"{', '.join(RULES)}")
@@ -201,4 +171,4 @@ def read_survival_result(path: Path) -> SurvivalResult:
 
 def read_constrain_result(path: Path) -> ConstrainResult:
     """constrain.json at ``path`` (as :func:`read_survival_result`)."""
-    return ConstrainResult._read(path, branch_test=BranchTest.from_json)
+    return ConstrainResult._read(path)

@@ -88,29 +88,26 @@ def constrain_part(results, name, command):
     if not path.is_file():
         return f"Constrained hazard: not run yet ({command}).\n"
     c = read_constrain_result(path)
-    ages = ", ".join(f"{s['age_ka']:g} +- {s['age_sd_ka']:g} ka" for s in c.specimens)
+    ages = ", ".join(f"{s.age_ka:g} +- {s.age_sd_ka:g} ka" for s in c.specimens)
     lines = ["### Constrained hazard\n",
              f"{c.branch_count} branches; age {ages} (assumed for the demonstration); "
              f"headline rule `{c.rule}`. " + c.headline + "\n"]
-    rows = [{"branch": b["branch"], "path": b.get("path", ""),
-             "prior weight": _fmt(b["prior_weight"], 3),
-             "P_s": f"{b['survival_probability']:.3g}",
-             "Bayes": _fmt(b.get("posterior_bayes"), 3),
-             "elimination": _fmt(b.get("posterior_eliminate"), 3)}
+    rows = [{"branch": b.branch, "path": b.path, "prior weight": _fmt(b.prior_weight, 3),
+             "P_s": f"{b.survival_probability:.3g}", "Bayes": _fmt(b.posterior_bayes, 3),
+             "elimination": _fmt(b.posterior_eliminate, 3)}
             for b in c.branches]
     lines.append(_table(pd.DataFrame(rows)) + "\n")
-    best = max(b["survival_probability"] for b in c.branches)
+    best = max(b.survival_probability for b in c.branches)
     floor = c.floor
     if best < floor:
         lines.append(f"Under every branch the rock's survival of its age is below "
                      f"{floor:g} (at most {best:.2g}): this hazard is too high for a rock of "
                      "this fragility and age, and the reweighting ranks branches that are all "
                      "unlikely.\n")
-    motion = [{"annual rate (1/yr)": f"{r['annual_rate_per_yr']:g}", "curve": r["curve"],
-               "prior (g)": _fmt(r["prior_g"], 3), "constrained (g)": _fmt(r["posterior_g"], 3),
-               "change": "-" if r["change_percent"] is None
-               else f"{r['change_percent']:+.1f} %"}
-              for r in c.ground_motion_at_rates if r["curve"] in MOTION_ROWS]
+    motion = [{"annual rate (1/yr)": f"{r.annual_rate_per_yr:g}", "curve": r.curve,
+               "prior (g)": _fmt(r.prior_g, 3), "constrained (g)": _fmt(r.posterior_g, 3),
+               "change": "-" if r.change_percent is None else f"{r.change_percent:+.1f} %"}
+              for r in c.ground_motion_at_rates if r.curve in MOTION_ROWS]
     if motion:
         lines.append("PGA at stated annual rates, before and after (the fractiles in "
                      f"`{name}/constrain.json` and `constrained_curves.csv`):\n")

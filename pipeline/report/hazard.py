@@ -17,16 +17,13 @@ def survival_section(results, name=ROCK_SURVIVAL):
                 "fragility under the USGS 2014 hazard curve at 34 N, 118 W).\n")
     s = read_survival_result(path)
     specimen = s.specimens[0]
-    fragility, hazard, ratio = specimen["fragility"], s.hazard, s.pgv_pga or {}
+    fragility, hazard, ratio = specimen.fragility, s.hazard, s.pgv_pga or {}
     interval = s.survival_interval
     sets = s.given("survival_parameter_set_range")
     lines = [f"## {heading}\n",
              f"Fragility: {fragility['label']} ({fragility.get('inside', fragility['form'])}"
              f"; outside the grid: {fragility.get('outside', '-')}). Hazard: "
-             f"{hazard.get('format', '')} `{hazard.get('file', '')}`"
-             + ("" if hazard.get("lat") is None else
-                f" at {abs(hazard['lat']):g} {'N' if hazard['lat'] >= 0 else 'S'}, "
-                f"{abs(hazard['lon']):g} {'E' if hazard['lon'] >= 0 else 'W'}")
+             f"{hazard.format or ''} `{hazard.file or ''}`" + _where(hazard.source)
              + (f"; PGV/PGA from {ratio.get('model', ratio.get('source'))} at M "
                 f"{ratio['magnitude']:g}, {ratio['distance_jb_km']:g} km"
                 if "magnitude" in ratio else "")
@@ -46,19 +43,19 @@ def survival_section(results, name=ROCK_SURVIVAL):
                      f"({measure['fragility']}) times {measure['fraction']:.3f} "
                      f"({measure['source']}).\n")
     if below is not None and outside is not None:
-        share = outside["share_below_grid"]
+        share = outside.share_below_grid
         lines.append(f"Below the grid's first PGA ({below['first_pga_g']:.3g} g): "
                      f"{below['definition']}; "
                      + ("" if share is None else f"{100 * share:.1f} % of the rate comes "
                         "from there, ")
-                     + f"the rate {outside['rate_per_yr_zero_below_grid']:.3g} to "
-                     f"{outside['rate_per_yr_edge_held_below_grid']:.3g} /yr with P = 0 or "
+                     + f"the rate {outside.rate_per_yr_zero_below_grid:.3g} to "
+                     f"{outside.rate_per_yr_edge_held_below_grid:.3g} /yr with P = 0 or "
                      "the edge's P held there.\n")
-    rows = [{"PGA (g)": f"{r['lo_g']:.3g}-" + ("" if r["hi_g"] is None else f"{r['hi_g']:.3g}"),
-             "rate (1/yr)": f"{r['rate_per_yr']:.3g}",
-             "share": "-" if r["share"] is None else f"{100 * r['share']:.1f} %"}
+    rows = [{"PGA (g)": f"{r.lo_g:.3g}-" + ("" if r.hi_g is None else f"{r.hi_g:.3g}"),
+             "rate (1/yr)": f"{r.rate_per_yr:.3g}",
+             "share": "-" if r.share is None else f"{100 * r.share:.1f} %"}
             for r in s.given("contribution_by_intensity") or ()   # none on the joint route
-            if (r["share"] or 0) >= 0.01]
+            if (r.share or 0) >= 0.01]
     if rows:
         lines.append("Contribution by PGA (intervals holding 1 % or more of the rate):\n")
         lines.append(_table(pd.DataFrame(rows)) + "\n")
@@ -68,6 +65,15 @@ def survival_section(results, name=ROCK_SURVIVAL):
                          "hazard curve and fragility, fragility-weighted rate density, "
                          "survival against age"))
     return "\n".join(lines)
+
+
+def _where(source):
+    """ at lat N/S, lon E/W of a hazard's ``source`` (the loader's; none for a plain table)."""
+    lat, lon = source.get("lat"), source.get("lon")
+    if lat is None:
+        return ""
+    return (f" at {abs(lat):g} {'N' if lat >= 0 else 'S'}, "
+            f"{abs(lon):g} {'E' if lon >= 0 else 'W'}")
 
 
 def _age(summary):

@@ -1,5 +1,6 @@
 """Ages as they are dated: each survival E[exp(-r T)] against numerical integration over
 the age's distribution (scipy quad), and the bad ages refused in one line."""
+import json
 import math
 
 import numpy as np
@@ -75,7 +76,7 @@ def test_every_kind_describes_itself():
     kinds = {age.kind for age in (LowerBound(1.0), UniformInterval(1.0, 2.0),
                                   AgeSamples((1.0,)), TruncatedNormal(1.0, 0.5))}
     assert kinds == set(AgeKind)
-    assert UniformInterval(1.0, 2.0).describe()["kind"] == "interval"
+    assert UniformInterval(1.0, 2.0).describe().kind is AgeKind.INTERVAL
 
 
 @pytest.mark.parametrize("make, message", [
@@ -119,3 +120,15 @@ def test_drawn_ages_average_to_the_closed_form(age):
     survival = np.exp(-rate * age.draw(40_000, np.random.default_rng(7)))
     error = survival.std(ddof=1) / math.sqrt(survival.size)
     assert survival.mean() == pytest.approx(float(age.survival(rate)), abs=4 * error + 1e-15)
+
+
+@pytest.mark.parametrize("age", [LowerBound(1e4), UniformInterval(1.3e4, 2.2e4),
+                                 AgeSamples((1e4, 2e4, 4e4), "a file"),
+                                 TruncatedNormal(1.5e4, 3e3)])
+def test_an_age_described_reads_back_as_written(age):
+    """Each kind's description is written with the keys of its kind only, and read back
+    from its JSON to the same description."""
+    described = age.describe()
+    data = json.loads(json.dumps(described.as_json()))
+    assert data["kind"] == age.kind.value and list(data)[-1] == "survival"
+    assert type(described).from_json(data) == described

@@ -124,7 +124,7 @@ def test_constrains_prior_mean_is_the_books_mean(tree):
     """The prior mean is the book's recorded mean curve (risk_target.m's 15-16 digits)."""
     levels_g, mean = _columns(BOOK / "book_mean_hazard_sa1.csv")
     np.testing.assert_allclose(levels_g, LEVELS_G, rtol=1e-15)
-    np.testing.assert_allclose(_prior(tree)["mean_rates_per_yr"], mean, rtol=1e-13)
+    np.testing.assert_allclose(_prior(tree).mean_rates_per_yr, mean, rtol=1e-13)
 
 
 def _book_fractile(values, weights, q):
@@ -142,7 +142,7 @@ def _book_fractile(values, weights, q):
 def test_prior_fractiles_against_the_books_stepped_fractiles(tree, q):
     """constrain's q fractile lies between the book's (stepped) fractile and the ranked
     branch below it at every level: the rules differ only in interpolating the step."""
-    got = np.array(_prior(tree)["fractiles"][f"{q:g}"])
+    got = np.array(_prior(tree).fractiles[f"{q:g}"])
     book, below = _book_fractile(tree.rates_per_yr, tree.weights, q)
     assert np.all(below * (1 - 1e-12) <= got) and np.all(got <= book * (1 + 1e-12))
     assert np.any(got < book * (1 - 1e-3))             # the step is interpolated
@@ -200,7 +200,7 @@ def test_bayes_weights_with_the_books_fragility(tree):
     expected = tree.weights * np.exp(-lam * 1000.0)
     summary, rows, _ = constrain_tree(tree, [Lognormal(0.4 * G, 0.4)], None,
                                    [TruncatedNormal(1e3)], "bayes", FLOOR, 0, 0)
-    got = np.array([r["posterior_bayes"] for r in rows])
+    got = np.array([r.posterior_bayes for r in rows])
     np.testing.assert_allclose(got, expected / expected.sum(), rtol=2e-3)
-    np.testing.assert_allclose([r["survival_probability"] for r in rows],
+    np.testing.assert_allclose([r.survival_probability for r in rows],
                                np.exp(-lam * 1000.0), rtol=2e-3)

@@ -199,7 +199,7 @@ def test_lognormal_under_power_law_branches(exponent, median, beta):
                                       FLOOR, 0, 0)
     p = np.exp(-closed * age)
     expected = tree.weights * p / (tree.weights @ p)
-    np.testing.assert_allclose([r["posterior_bayes"] for r in rows], expected, rtol=1e-3)
+    np.testing.assert_allclose([r.posterior_bayes for r in rows], expected, rtol=1e-3)
     for k in range(tree.size):     # the same cells as survival's per-curve integration
         one = overturning_rate(tree.levels_m_s2, tree.rates_per_yr[k], fragility.probability)
         assert rates[k] == pytest.approx(one["rate_per_yr"], rel=1e-12)
@@ -230,7 +230,7 @@ def test_draws_in_one_matrix_product_equal_the_per_draw_loop(monkeypatch):
     pairs = list(zip(first.draws(25, rng), second.draws(25, rng)))
     survival = np.exp([log_survival_fixed(_set_rates(tree, cells, list(pair)),
                                           [3000.0, 9000.0]) for pair in pairs])
-    np.testing.assert_allclose(summary.monte_carlo["survival_interval"],
+    np.testing.assert_allclose(summary.monte_carlo.survival_interval,
                                np.percentile(survival, (2.5, 97.5), axis=0).T, rtol=1e-12)
 
 
@@ -382,9 +382,9 @@ def test_monte_carlo_interval_holds_the_headline():
     summary, rows, _ = constrain_tree(tree, [fragility], None, [TruncatedNormal(2e3)],
                                       "bayes", FLOOR, 200, 0)
     for row in rows:
-        lo, hi = row["survival_interval"]
-        assert lo < row["survival_probability"] < hi
-    assert summary.monte_carlo["draws"] == 200
+        lo, hi = row.survival_interval
+        assert lo < row.survival_probability < hi
+    assert summary.monte_carlo.draws == 200
 
 
 @pytest.mark.parametrize("extra, words", [

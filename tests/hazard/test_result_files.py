@@ -65,3 +65,43 @@ def test_a_missing_key_is_named(tmp_path):
     bad.write_text(json.dumps(data))
     with pytest.raises(InputError, match="no hazard"):
         read_survival_result(bad)
+
+
+def _changed(data, path, value):
+    """A copy of ``data`` with the key ``path`` (keys and list indices) set to ``value``
+    (None: the key removed)."""
+    data = json.loads(json.dumps(data))
+    inner = data
+    for key in path[:-1]:
+        inner = inner[key]
+    if value is None:
+        del inner[path[-1]]
+    else:
+        inner[path[-1]] = value
+    return data
+
+
+def test_an_inner_record_the_type_does_not_describe_is_one_line_naming_it(tmp_path):
+    """Each specimen, the route, the age and the hazard are types of their own: a value
+    out of range, an unknown key or a key missing inside one is refused by name."""
+    out = tmp_path / "s"
+    assert cli.main(["survival", "--hazard", HAZARD, "--age-ka", "15", "--median-g", "0.3",
+                     "--beta", "0.4", "--draws", "0", "--out", str(out)]) == 0
+    data = json.loads((out / "survival.json").read_text())
+    for path, value, said in [
+            (("specimens", 0, "survival_probability"), 1.5,
+             "specimens: survival_probability 1.5 is not in [0, 1]"),
+            (("specimens", 0, "unheard_of"), 1, "specimens: unknown keys unheard_of"),
+            (("specimens", 0, "contribution_by_intensity", 0, "rate_per_yr"), -1.0,
+             "contribution_by_intensity: rate_per_yr -1.0 < 0"),
+            (("curve_ends", "share_at_last_level"), None, "curve_ends: no share_at_last_level"),
+            (("age", "kind"), "interval", "an age of kind interval holds lo_yr, hi_yr"),
+            (("hazard_route", "route"), "joint", "the hazard is not of the route joint"),
+            (("hazard", "file"), 1, "the source's file is not a string"),
+            (("hazard", "levels_g"), None, "hazard: no levels_g")]:
+        bad = tmp_path / "bad.json"
+        bad.write_text(json.dumps(_changed(data, path, value)))
+        with pytest.raises(InputError) as refused:
+            read_survival_result(bad)
+        assert said in str(refused.value) and "\n" not in str(refused.value), path
+        assert str(bad) in str(refused.value)
