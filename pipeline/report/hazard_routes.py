@@ -65,13 +65,13 @@ def _constrain_rows(path, words):
                  "not run: `constrain` takes PGV/PGA from one scenario or the rate density"}]
     c = read_constrain_result(path)
     mean = next((r for r in c.ground_motion_at_rates
-                 if r["curve"] == "mean" and r["annual_rate_per_yr"] == RATE), None)
-    motion = "-" if mean is None or mean["prior_g"] is None else \
-        f"{mean['prior_g']:.4g} -> {mean['posterior_g']:.4g}"
-    return [{"route": words if k == 0 else "", "branch": f"{b['branch']} {b.get('path', '')}",
-             "prior weight": f"{b['prior_weight']:.3g}",
-             "1 - P_s": f"{1 - b['survival_probability']:.3g}",
-             "Bayes weight": f"{b['posterior_bayes']:.6g}",
+                 if r.curve == "mean" and r.annual_rate_per_yr == RATE), None)
+    motion = "-" if mean is None or mean.prior_g is None else \
+        f"{mean.prior_g:.4g} -> {mean.posterior_g:.4g}"
+    return [{"route": words if k == 0 else "", "branch": f"{b.branch} {b.path}",
+             "prior weight": f"{b.prior_weight:.3g}",
+             "1 - P_s": f"{1 - b.survival_probability:.3g}",
+             "Bayes weight": f"{b.posterior_bayes:.6g}",
              f"mean PGA at {RATE:g} /yr (g)": motion if k == 0 else ""}
             for k, b in enumerate(c.branches)]
 
