@@ -6,7 +6,8 @@ The members are those of ``campaign fragility --column-file``: the same Latin hy
 (:func:`pipeline.campaign.pulse_grid.parse_ranges`: its defaults for a mesh specimen,
 ``--ranges`` over them; kn log-uniform; mu_k in the fragility's ratio to mu_s) and seed
 (the fragility's default); a contact file fixes what it sets, as there.  The table's
-motion is the test's own, along its axis as shipped (``rotate_deg`` 0).
+motion is the test's own, along its axis as shipped (``rotate_deg`` 0), turned by a
+member's yaw (the rock's orientation on the table, a drawn unknown).
 
 Each test's members stop early by the pulse grid's adaptive rule
 (:func:`pipeline.campaign.pulse_adaptive.adaptive_sampling`, every test a row of one cell
@@ -102,7 +103,12 @@ def member_sets(specimen, members, seed, ranges, contact=None):
 
 
 def run_params(specimen, point, base):
-    """Run parameters of one member (or the single set) on the table."""
+    """Run parameters of one member (or the single set) on the table; a member's
+    ``yaw_deg`` (the rock turned clockwise) turns the table motion by -yaw_deg."""
+    point = dict(point)
+    yaw = point.pop("yaw_deg", 0.0)
+    if yaw != 0.0:
+        point["rotate_deg"] = round((point.get("rotate_deg", 0.0) - yaw) % 360.0, 6) % 360.0
     params = shake_table_experiments.grid_run_params(specimen, point, base)
     if "kn" not in point and "kn" not in (base or {}) and "mesh" not in specimen:
         params["kn"] = column_kn(specimen)          # a description's matched kn, as there
