@@ -254,7 +254,7 @@ def test_a_column_draws_nothing_unless_told_and_a_mesh_draws_the_calibrated_rang
     assert pulse_grid.parse_ranges(None, mesh=False) == {}
     assert pulse_grid.parse_ranges("damping=0.1:0.2", mesh=False) == {"damping": (0.1, 0.2)}
     rock = pulse_grid.parse_ranges(None, mesh=True)
-    assert set(rock) == {"kn", "damping", "mu_s", "footprint_tolerance_m"}
+    assert set(rock) == {"kn", "damping", "mu_s", "footprint_tolerance_m", "yaw_deg"}
     assert pulse_grid.parse_ranges("damping=0.2:0.2", mesh=True)["damping"] == (0.2, 0.2)
     with pytest.raises(InputError, match="would repeat one run"):
         pulse_grid.pulse_runs(None, "monolithic", "pga_g=0.2:0.2:1;pgv_pga_s=0.5:0.5:1", 2, 1,
@@ -345,17 +345,21 @@ def test_a_contour_that_leaves_the_grid_is_said_on_its_side_with_its_rows():
 
 
 def test_members_span_the_calibration_grid():
-    """The fragility's default member ranges and the shake-table calibration's default grid
-    read one neighbourhood: footprint and damping span the grid's two values, mu_s lies
-    about the calibration's choice of 0.7, and every grid value lies in its bounds."""
-    from pipeline.campaign import shake_table_experiments
+    """The fragility's default member ranges are the one declaration's, and they sit in the
+    shake-table calibration's neighbourhood: damping spans the grid's two values, the
+    footprint starts at the calibration's 1 mm and stays within the grid's span, mu_s
+    lies about the calibration's choice of 0.7, the yaw about the stated orientation."""
+    from pipeline.campaign import member_ranges, shake_table_experiments
     points = shake_table_experiments.parse_grid(shake_table_experiments.DEFAULT_GRID)
     ranges = pulse_grid.parse_ranges("")
+    assert ranges == member_ranges.by_name()
     assert len(points) == 2 ** 4
-    for name in ("footprint_tolerance_m", "damping"):
-        tried = sorted({p[name] for p in points})
-        assert (tried[0], tried[-1]) == ranges[name]
+    tried = sorted({p["damping"] for p in points})
+    assert (tried[0], tried[-1]) == ranges["damping"]
+    footprints = sorted({p["footprint_tolerance_m"] for p in points})
+    assert ranges["footprint_tolerance_m"][0] == footprints[0]
+    assert ranges["footprint_tolerance_m"][1] <= footprints[-1]
     assert sorted({p["mu_s"] for p in points}) == [0.3, 0.7]
     assert ranges["mu_s"][0] < 0.7 < ranges["mu_s"][1]
     assert sorted({p["rotate_deg"] for p in points}) == [0.0, 180.0]
-    assert ranges["kn"] == (4e7, 1.2e8)
+    assert ranges["yaw_deg"][0] == -ranges["yaw_deg"][1] < 0
