@@ -35,23 +35,25 @@ CHOSEN_BY = ("make shake-table-scores: among the four candidates of the Makefile
 
 MEMBER_RANGES = (
     MemberRange("kn", 4e7, 1.2e9, "N/m",
-                "chosen by the shake-table scoring (CHOSEN_BY): the contact stiffness of "
-                "the asperities is not measured; the stiffness check (make "
-                "contact-convergence) changes a few predictions up to 1.2e9"),
+                "the contact stiffness of the asperities is not measured: chosen by the "
+                "shake-table scoring (make shake-table-scores) over 4e7-1.2e8; the "
+                "stiffness check (make contact-convergence) changes a few predictions up "
+                "to 1.2e9"),
     MemberRange("damping", 0.05, 0.1, "",
                 "the shake-table calibration grid's two values, which scored alike"),
     MemberRange("mu_s", 0.6, 0.8, "",
                 "dry rock on rock 0.6-0.85 (Byerlee 1978, PAGEOPH 116); the calibration "
                 "chose 0.7 over the providers' PyBullet 0.3 at every footprint"),
     MemberRange("footprint_tolerance_m", 0.001, 0.0015, "m",
-                "the seating: which asperities of the scanned base touch; chosen by the "
-                "shake-table scoring (CHOSEN_BY) over 1-3 mm"),
+                "the seating, which asperities of the scanned base touch: chosen by the "
+                "shake-table scoring (make shake-table-scores) over 1-3 mm"),
     MemberRange("yaw_deg", -10.0, 10.0, "deg",
                 "the rock's turn about the vertical from its stated orientation: the "
                 "providers give SP1's orientation on the table only through their "
-                "simulation (scan x = table axis; records/shake_table/README.md) with no "
-                "tolerance, and re-placed the rock by hand after each overturn; +-10 deg "
-                "is an assumption for a hand placement, not a measurement"),
+                "simulation (scan x = table axis; records/shake_table/README.md), with no "
+                "tolerance, and the rock was put back on the table after each overturn "
+                "(145 of the 259 June-July tests with a motion); +-10 deg is an "
+                "assumption for that placement, not a measurement"),
 )
 ORDER = tuple(r.name for r in MEMBER_RANGES)
 
