@@ -244,6 +244,10 @@ def drive(run, records, campaign_dir, options, gate=None):
         choice = choose_ranges(tried, fold_of)
         log.info(f"shake-table (members): chosen on the calibration tests: ranges "
                  f"{choice['chosen'] or 'default'}")
+        if choice["chosen"]:
+            log.warning(f"shake-table (members): the chosen ranges {choice['chosen']} are "
+                        "not the declared defaults; campaign fragility draws them once "
+                        "pipeline/campaign/member_ranges.py declares them")
         options = {**options, "ranges": choice["chosen"]}
         fulls[-1] = run_specs(records, campaign_dir, options)
     per_test, settled = _members(run, campaign_dir, options, fulls[-1], frame)

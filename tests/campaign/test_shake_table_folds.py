@@ -157,3 +157,32 @@ def test_folds_the_calibration_days_cannot_fill_are_refused_before_any_run(tmp_p
     lines = [x for x in capsys.readouterr().err.splitlines() if not x.startswith("note:")]
     assert code == 2 and len(lines) == 1 and "--folds 2" in lines[0], lines
     assert not out.exists()
+
+
+def test_the_driver_chooses_over_the_calibration_days_folds(tmp_path, monkeypatch):
+    """The members mode's driver, its runs replaced by a P per test that is right for the
+    'default' candidate and wrong for the other: the folds are the calibration tests' days
+    (two blocks), the August test stays out of them, and the choice reaches the scores."""
+    from pipeline.campaign import shake_table_members as stm
+    from pipeline.campaign.shake_table import ShakeTableOptions
+    tests = ["Test011", "Test012", "Test044", "Test075", "Test131", "Test178", "Test693"]
+    options = {**ShakeTableOptions().kwargs(), "members": 2, "specimen": SPECIMEN,
+               "tests": tests, "candidates": "default|yaw_deg=0:0", "folds": 2, "jobs": 1}
+
+    def members(run, campaign_dir, opts, full, frame):
+        right = not opts.get("ranges")
+        rows = frame.assign(runs=2, overturned=0, ci95_low=0.0, ci95_high=1.0,
+                            single_set_predicted=False)
+        rows["P"] = np.where(rows["observed"] == right, 1.0, 0.0)
+        return rows[["test", "date", "split", "pga_g", "pgv_pga_s", "observed", "runs",
+                     "overturned", "P", "ci95_low", "ci95_high", "single_set_predicted"]], True
+    written = {}
+    monkeypatch.setattr(stm, "_members", members)
+    monkeypatch.setattr(stm, "write_scores", lambda *args: written.update(choice=args[-1]))
+    stm.drive(lambda o: None, [], tmp_path, options)
+    choice = written["choice"]
+    assert choice["chosen"] == ""
+    days = [f["days"] for f in choice["folds"]]
+    assert days == [["2021-06-21", "2021-06-23"], ["2021-06-25", "2021-07-06"]]
+    assert sum(f["held_out"]["tests"] for f in choice["folds"]) == 6
+    assert all(f["chosen_without"] is None for f in choice["folds"])
