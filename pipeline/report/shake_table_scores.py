@@ -34,6 +34,9 @@ def shake_table_scores_section(results, name=FULL):
     lines.append(_intro(summary, quick))
     if summary.get("ranges_choice"):
         lines.append(_choice(summary["ranges_choice"]))
+        lines.append(_figure(results, results / name / "shake_table_folds_reliability.png",
+                             "Reliability per fold of test days: the ranges chosen without "
+                             "the fold, scored on it (P = 0 and P = 1 bins apart)"))
     for split, label in SPLITS:
         part = summary.get("splits", {}).get(split)
         if part:
