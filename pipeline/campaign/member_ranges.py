@@ -50,8 +50,10 @@ MEMBER_RANGES = (
     MemberRange("yaw_deg", -10.0, 10.0, "deg",
                 "the rock's turn about the vertical from its stated orientation: the "
                 "providers give SP1's orientation on the table only through their "
-                "simulation (scan x = table axis; records/shake_table/README.md), with no "
-                "tolerance, and the rock was put back on the table after each overturn "
+                "simulation (scan x = table axis: records/shake_table/README.md, 'Table "
+                "axis'; 'only known through this simulation setup': "
+                "records/tools/derive_shake_table.py), with no tolerance, and the rock "
+                "was put back on the table after each overturn "
                 "(145 of the 259 June-July tests with a motion); +-10 deg is an "
                 "assumption for that placement, not a measurement"),
 )
