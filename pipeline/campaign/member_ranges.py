@@ -28,10 +28,10 @@ class MemberRange:
             raise ValueError(f"member range {self.name}: its source must be stated")
 
 
-CHOSEN_BY = ("make shake-table-scores: among the four candidates of the Makefile's "
-             "SCORES_CANDIDATES (the earlier defaults footprint 1-3 mm and kn 4e7-1.2e8, kn "
-             "4e7-1.2e9, footprint 1-1.5 mm, both) by log-likelihood per test on SP1's "
-             "June-July tests; on the August tests: accuracy 0.900, Brier 0.088")
+CHOSEN_BY = ("make shake-table-scores, before the yaw was drawn: among four candidates "
+             "(the earlier defaults footprint 1-3 mm and kn 4e7-1.2e8, kn 4e7-1.2e9, "
+             "footprint 1-1.5 mm, both) by log-likelihood per test on SP1's June-July "
+             "tests; on the August tests: accuracy 0.900, Brier 0.088")
 
 MEMBER_RANGES = (
     MemberRange("kn", 4e7, 1.2e9, "N/m",
