@@ -21,8 +21,8 @@ import numpy as np
 from scipy.stats import qmc
 
 from pipeline.campaign.column_file import column_kn
-from pipeline.campaign.shake_table_experiments import GRID_CONTACT, GRID_SPECIMEN, \
-    neighbourhood_ranges
+from pipeline.campaign import member_ranges
+from pipeline.campaign.shake_table_experiments import GRID_CONTACT, GRID_SPECIMEN
 from pipeline.constants import STANDARD_GRAVITY
 from pipeline.files import InputError
 from pipeline.motion.pulses import one_cosine_pulse
@@ -36,11 +36,12 @@ PULSE_AXES = {"pga_g": (0.01, 5.0), "pgv_pga_s": (0.01, 3.0)}
 MAX_AXIS_SIZE = 50
 PULSE_DT_S = 0.005                # sample interval of the pulses, at most
 PULSE_TAIL_S = 4.0                # at rest after the pulse: the body settles or falls
-# member ranges: defaults from the shake-table calibration's neighbourhood
-# (shake_table_experiments.CALIBRATION_NEIGHBOURHOOD); bounds as the calibration's --grid
+# member ranges: defaults from their one declaration (member_ranges.MEMBER_RANGES);
+# bounds as the calibration's --grid; yaw_deg turns the specimen about the vertical
+# from its stated heading (a run turns the shaking by -yaw_deg instead)
 RANGE_BOUNDS = {"kn": GRID_CONTACT["kn"], "damping": GRID_CONTACT["damping"],
-                "mu_s": GRID_CONTACT["mu_s"], **GRID_SPECIMEN}
-DEFAULT_RANGES = neighbourhood_ranges()
+                "mu_s": GRID_CONTACT["mu_s"], **GRID_SPECIMEN, "yaw_deg": (-180.0, 180.0)}
+DEFAULT_RANGES = member_ranges.ranges_text()
 LOG_UNIFORM = ("kn",)
 # the long-run gate's cost of a run, at most (it stops early once the specimen has fallen
 # or settled): SP1 over the vsr grid took 1,600 runs in 166 s on 2 cores (2026-11-27),
@@ -157,6 +158,15 @@ def member_azimuths(members, headings, seed, heading_deg=0.0):
     return np.round((heading_deg + 360.0 * u) % 360.0, 6)
 
 
+def yawed(azimuths, sets):
+    """(members, headings) shaking azimuths (deg) relative to each member's yawed
+    specimen: a specimen turned clockwise by its ``yaw_deg`` is shaken from azimuth
+    minus that turn."""
+    yaw = np.array([[point.get("yaw_deg", 0.0)] for point in sets], float)
+    turned = np.round((azimuths - yaw) % 360.0, 6) % 360.0
+    return np.where(yaw == 0.0, azimuths, turned)
+
+
 def pulse_file(cache_dir, pga_m_s2, pgv_pga_s):
     """The pulse of one cell along North (a run turns it by its azimuth), saved once."""
     name = f"cosine_pulse_{pga_m_s2:.6g}ms2_{pgv_pga_s:.6g}s.npz"
@@ -193,6 +203,7 @@ def pulse_runs(data, column, pulses, members, headings, azimuth, seed, ranges,
         azimuths = member_azimuths(members, headings, seed, heading)
     else:
         azimuths = np.full((members, 1), float(azimuth))
+    azimuths = yawed(azimuths, sets)
     runs = []
     for i, ratio in enumerate(grid["pgv_pga_s"]):
         for j, pga_g in enumerate(grid["pga_g"]):

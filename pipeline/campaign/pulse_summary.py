@@ -143,7 +143,9 @@ def summarise_grid(table, specs, grid, sets, azimuths, azimuth, ranges_text):
         "tail_s": PULSE_TAIL_S, "g_m_s2": G,
         "direction": ("fixed azimuth {:g} deg (a table)".format(azimuth) if azimuth is not None
                       else "sampled per member over 360 deg relative to the specimen's heading "
-                           "(a field rock: the direction is unknown)"),
+                           "(a field rock: the direction is unknown)")
+                     + (", less each member's yaw_deg" if any(p.get("yaw_deg") for p in sets)
+                        else ""),
         "azimuths_deg": azimuths.tolist(),
         "members": len(sets), "headings": int(azimuths.shape[1]),
         "ranges": ranges_text, "parameter_sets": sets,

@@ -42,6 +42,7 @@ from pipeline.campaign.shake_table_experiments import (AXIS_DEG, DEFAULT_GRID, E
                                                        PGV_PGA_EDGES_S, SPECIMEN,
                                                        VALIDATE_FROM, grid_run_params,
                                                        load_experiments, parse_grid)
+from pipeline.campaign.shake_table_folds import DEFAULT_FOLDS, date_folds
 from pipeline.campaign.tags import ShakeTableTags
 
 log = logging.getLogger(__name__)
@@ -258,16 +259,22 @@ class ShakeTableOptions(CampaignOptions):
                         optional="the fragility's")
     candidates: str = param(None, "", "members mode: candidate ranges separated by '|' "
                             "('default': the fragility's), each run on the calibration tests "
-                            "and scored by log-likelihood; the best is frozen, then run and "
-                            "scored on every test", flag="--candidates",
+                            "and scored by log-likelihood over --folds blocks of test days; "
+                            "the best is frozen, then run and scored on every test",
+                            flag="--candidates",
                             metavar="RANGES|RANGES", optional="no choice of ranges")
+    folds: int = param(DEFAULT_FOLDS, "", "members mode with --candidates: the calibration "
+                       "tests' days cut into this many blocks of consecutive days; chosen: "
+                       "the candidate whose worst block scores best, checked on each block "
+                       "by the choice made without it (1: the score over all calibration "
+                       "tests, no check)", 1, 10, flag="--folds")
     providers: Path = param(None, "", "members mode: other models' 0/1 predictions scored "
                             "beside the members (CSV: test and one column per model)",
                             flag="--providers", metavar="CSV",
                             optional="for the shipped tests, the providers' models of SP1 "
                             "(records/shake_table/sp1_numerical.csv)")
     TAKES_JOBS = True
-    DRIVER_ONLY = ("candidates", "providers", "jobs")
+    DRIVER_ONLY = ("candidates", "folds", "providers", "jobs")
 
     def check(self):
         contact_of(self)
@@ -306,6 +313,7 @@ class ShakeTableOptions(CampaignOptions):
             if not (run["split"] == "calibration").any():
                 raise InputError(f"--candidates: no test before --validate-from "
                                  f"{self.validate_from} to choose the ranges on")
+            date_folds(run.loc[run["split"] == "calibration", "day"], self.folds)
 
     def test_names(self):
         """The tests of ``--tests`` (an empty list: all)."""
@@ -318,7 +326,7 @@ class ShakeTableOptions(CampaignOptions):
                 "tests": self.test_names() or None, "axis_deg": self.axis_deg,
                 "contact_file": self.contact_file, "members": self.members,
                 "seed": self.seed, "ranges": self.ranges, "candidates": self.candidates,
-                "providers": self.providers}
+                "folds": self.folds, "providers": self.providers}
 
 
 def _worker(spec, run_dir):

@@ -7,7 +7,7 @@ and ``motion_file`` (a lab table, :mod:`pipeline.records.readers.lab_table`, rel
 the CSV; empty when the motion is missing).  A grid (``--grid``, :func:`parse_grid`) names
 contact parameters (m, N/m, dimensionless), the specimen's footprint tolerance (m) and the
 table motion's turn (deg); :data:`CALIBRATION_NEIGHBOURHOOD` is the one home of the values
-the calibration tries and the ranges a fragility's members draw.
+the calibration tries (the members' ranges: :mod:`pipeline.campaign.member_ranges`).
 """
 import dataclasses
 import io
@@ -19,6 +19,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from pipeline.campaign.member_ranges import number_text
 from pipeline.files import InputError
 from pipeline.records import RECORDS_DIR
 from pipeline.scenario.geometry import ColumnGeometry
@@ -40,38 +41,23 @@ GRID_SPECIMEN = {"footprint_tolerance_m": (0.0, 0.05)}
 # and the motion: rotate_deg turns the table motion clockwise (180: the other sign of an
 # axis whose sign the laboratory does not state)
 GRID_MOTION = {"rotate_deg": (0.0, 360.0)}
-# The shake-table calibration's neighbourhood of a rock's seating and contact, one home
-# for the values the calibration grid tries and the ranges a fragility's members draw
-# from (campaign fragility --ranges; docs/rock-fragility.md says why): per parameter,
-# (grid values, member range).  The footprint and damping ranges span the grid's two
-# values; mu_s: the grid tries 0.3 (the providers' PyBullet value) and 0.7, the members
-# draw about the calibration's choice of 0.7; kn: the grid keeps the contact's own (the
-# paper's or a contact file's), the members draw the stiffnesses that scored alike;
-# rotate_deg: the grid tries both signs of the table's axis, the members draw directions.
+# The shake-table calibration's neighbourhood of a rock's seating and contact: per
+# parameter the values the calibration grid tries (footprint and damping: two values each;
+# mu_s: 0.3, the providers' PyBullet value, and 0.7; rotate_deg: both signs of the
+# table's axis; kn: the contact's own, the paper's or a contact file's).  The ranges a
+# fragility's members draw are declared apart, in pipeline.campaign.member_ranges.
 CALIBRATION_NEIGHBOURHOOD = {
-    "footprint_tolerance_m": ((0.001, 0.003), (0.001, 0.003)),
-    "damping": ((0.05, 0.1), (0.05, 0.1)),
-    "mu_s": ((0.3, 0.7), (0.6, 0.8)),
-    "rotate_deg": ((0, 180), None),
-    "kn": ((), (4e7, 1.2e8)),
+    "footprint_tolerance_m": (0.001, 0.003),
+    "damping": (0.05, 0.1),
+    "mu_s": (0.3, 0.7),
+    "rotate_deg": (0, 180),
 }
-
-
-def _number(value):
-    """A value as the grid's and the ranges' text spell it: 0.001, 4e7, 1.2e8."""
-    return f"{value:g}".replace("e+0", "e").replace("e+", "e")
 
 
 def neighbourhood_grid():
     """The calibration grid's text (``name=V,V;...``) of the neighbourhood."""
-    return ";".join(f"{name}={','.join(_number(v) for v in grid)}"
-                    for name, (grid, _) in CALIBRATION_NEIGHBOURHOOD.items() if grid)
-
-
-def neighbourhood_ranges(order=("kn", "damping", "mu_s", "footprint_tolerance_m")):
-    """The members' ranges' text (``name=LO:HI;...``) of the neighbourhood."""
-    return ";".join(f"{name}={_number(CALIBRATION_NEIGHBOURHOOD[name][1][0])}:"
-                    f"{_number(CALIBRATION_NEIGHBOURHOOD[name][1][1])}" for name in order)
+    return ";".join(f"{name}={','.join(number_text(v) for v in grid)}"
+                    for name, grid in CALIBRATION_NEIGHBOURHOOD.items())
 
 
 DEFAULT_GRID = neighbourhood_grid()

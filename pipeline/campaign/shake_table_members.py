@@ -6,7 +6,8 @@ The members are those of ``campaign fragility --column-file``: the same Latin hy
 (:func:`pipeline.campaign.pulse_grid.parse_ranges`: its defaults for a mesh specimen,
 ``--ranges`` over them; kn log-uniform; mu_k in the fragility's ratio to mu_s) and seed
 (the fragility's default); a contact file fixes what it sets, as there.  The table's
-motion is the test's own, along its axis as shipped (``rotate_deg`` 0).
+motion is the test's own, along its axis as shipped (``rotate_deg`` 0), turned by a
+member's yaw (the rock's orientation on the table, a drawn unknown).
 
 Each test's members stop early by the pulse grid's adaptive rule
 (:func:`pipeline.campaign.pulse_adaptive.adaptive_sampling`, every test a row of one cell
@@ -36,12 +37,12 @@ from pipeline.campaign import ensemble_members, pulse_adaptive, pulse_grid, shak
 from pipeline.campaign.column_file import column_kn
 from pipeline.campaign.run_dirs import finished_runs, finished_summary
 from pipeline.campaign.runs import column_specs
+from pipeline.campaign.shake_table_folds import choose_ranges, date_folds
 from pipeline.campaign.shake_table_scores import load_providers, write_scores
 from pipeline.files import InputError, duration_text, write_csv
 from pipeline.scenario.contact_file import contact_values
 from pipeline.scenario.geometry import ColumnGeometry
 from pipeline.stats.ensemble import wilson_interval
-from pipeline.stats.forecast import forecast_scores
 from pipeline.campaign.tags import ShakeMemberTags
 
 log = logging.getLogger(__name__)
@@ -50,9 +51,6 @@ log = logging.getLogger(__name__)
 # June-July tests (make shake-table; the parameters make contact-convergence varies kn at)
 SINGLE_SET = "footprint_tolerance_m=0.001;damping=0.1;mu_s=0.7;rotate_deg=0"
 MAX_CANDIDATES = 8
-CHOICE_RULE = ("each candidate's members on the calibration tests only; chosen: the highest "
-               "log-likelihood per test (ties: the lower Brier score, then the first given); "
-               "frozen, then run and scored on every test")
 # a run at a stiffer contact takes longer: the time step goes as sqrt(m / kn)
 KN_OF_RUN_CPU_S = 1.2e8
 
@@ -102,7 +100,12 @@ def member_sets(specimen, members, seed, ranges, contact=None):
 
 
 def run_params(specimen, point, base):
-    """Run parameters of one member (or the single set) on the table."""
+    """Run parameters of one member (or the single set) on the table; a member's
+    ``yaw_deg`` (the rock turned clockwise) turns the table motion by -yaw_deg."""
+    point = dict(point)
+    yaw = point.pop("yaw_deg", 0.0)
+    if yaw != 0.0:
+        point["rotate_deg"] = round((point.get("rotate_deg", 0.0) - yaw) % 360.0, 6) % 360.0
     params = shake_table_experiments.grid_run_params(specimen, point, base)
     if "kn" not in point and "kn" not in (base or {}) and "mesh" not in specimen:
         params["kn"] = column_kn(specimen)          # a description's matched kn, as there
@@ -203,12 +206,17 @@ def drive(run, records, campaign_dir, options, gate=None):
     """Say the cost and ask the gate, run the members test by test in the pulse grid's
     adaptive stages, then write members.csv, the scores and the reliability diagram.
     With ``candidates``: each candidate's members on the calibration tests first, the
-    best by log-likelihood chosen (:func:`choose_ranges`), then the chosen on every test."""
+    best chosen over ``folds`` blocks of test days
+    (:func:`pipeline.campaign.shake_table_folds.choose_ranges`), then the chosen on every
+    test."""
     specimen = ColumnGeometry.load(options["specimen"]).to_dict()
     candidates = candidate_ranges(options.get("candidates"), "mesh" in specimen)
     frame = tests_of(options["experiments"], options["outcome"], options.get("tests"),
                      options["validate_from"])
     calibration = list(frame.loc[frame["split"] == "calibration", "test"])
+    days = frame.loc[frame["split"] == "calibration", ["test", "day"]]
+    fold_of = (dict(zip(days["test"], date_folds(days["day"], options["folds"])))
+               if candidates else None)
     passes = ([{**options, "ranges": c, "tests": calibration} for c in candidates]
               + [options] if candidates else [options])
     n, jobs = options["members"], max(options.get("jobs") or 1, 1)
@@ -233,9 +241,13 @@ def drive(run, records, campaign_dir, options, gate=None):
             per_test, _ = _members(run, campaign_dir, opts, full,
                                    frame[frame["test"].isin(calibration)])
             tried.append((text, per_test))
-        choice = choose_ranges(tried)
+        choice = choose_ranges(tried, fold_of)
         log.info(f"shake-table (members): chosen on the calibration tests: ranges "
                  f"{choice['chosen'] or 'default'}")
+        if choice["chosen"]:
+            log.warning(f"shake-table (members): the chosen ranges {choice['chosen']} are "
+                        "not the declared defaults; campaign fragility draws them once "
+                        "pipeline/campaign/member_ranges.py declares them")
         options = {**options, "ranges": choice["chosen"]}
         fulls[-1] = run_specs(records, campaign_dir, options)
     per_test, settled = _members(run, campaign_dir, options, fulls[-1], frame)
@@ -286,24 +298,6 @@ def candidate_ranges(text, mesh=True):
         raise InputError(f"--candidates: {repeated[0]!r} draws the same ranges as an earlier "
                          "candidate")
     return out
-
-
-def choose_ranges(tried):
-    """The candidate with the highest log-likelihood per test on the calibration tests
-    (a proper score; ties: the lower Brier score, then the first): {"rule", "chosen",
-    "candidates": [{"ranges", scores}]}.  ``tried``: (ranges text, members.csv rows)."""
-    scored = []
-    for text, rows in tried:
-        rows = rows[rows["P"].notna()]
-        s = forecast_scores(rows["observed"].to_numpy(bool), rows["P"].to_numpy(float),
-                            rows["runs"].to_numpy())
-        scored.append({"ranges": text or None, "tests": s["n"],
-                       "member_runs": int(rows["runs"].sum()),
-                       **{k: s[k] for k in ("log_likelihood_per_test", "brier", "accuracy",
-                                            "balanced_accuracy")}})
-    best = max(range(len(scored)), key=lambda k: (scored[k]["log_likelihood_per_test"],
-                                                  -scored[k]["brier"], -k))
-    return {"rule": CHOICE_RULE, "chosen": tried[best][0], "candidates": scored}
 
 
 def run_specs(records, campaign_dir, options):

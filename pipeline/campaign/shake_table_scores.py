@@ -3,7 +3,9 @@ each test's P from its members, per split (calibration: before ``--validate-from
 validation: the held-out tests from it on; all), beside the single parameter set and the
 baselines, every one scored as a probability forecast the same way
 (:func:`pipeline.stats.forecast.forecast_scores`: a 0/1 forecast is P = 0 or 1).
-Files: ``members.csv``, ``shake_table_members.json``, ``shake_table_reliability.png``."""
+Files: ``members.csv``, ``shake_table_members.json``, ``shake_table_reliability.png``;
+with the ranges chosen over folds, ``folds.csv`` and ``shake_table_folds_reliability.png``
+(per fold, the reliability of the ranges chosen without it)."""
 import io
 import logging
 import math
@@ -13,6 +15,7 @@ import numpy as np
 import pandas as pd
 
 from pipeline.campaign import shake_table_experiments
+from pipeline.campaign.shake_table_folds import fold_table
 from pipeline.files import InputError, write_csv, write_json
 from pipeline.records import RECORDS_DIR
 from pipeline.scenario.geometry import ColumnGeometry
@@ -87,7 +90,8 @@ def split_scores(rows, threshold_g, providers):
 def write_scores(per_test, campaign_dir, options, full, settled, choice=None):
     """Write members.csv, shake_table_members.json and the reliability diagram; return
     the JSON's dict.  ``choice``: how the ranges were chosen on the calibration tests
-    (:func:`pipeline.campaign.shake_table_members.choose_ranges`), if they were."""
+    (:func:`pipeline.campaign.shake_table_folds.choose_ranges`), if they were; with
+    folds, also folds.csv and shake_table_folds_reliability.png."""
     campaign_dir = Path(campaign_dir)
     specimen = ColumnGeometry.load(options["specimen"])
     axis = options.get("axis_deg", shake_table_experiments.AXIS_DEG)
@@ -120,6 +124,13 @@ def write_scores(per_test, campaign_dir, options, full, settled, choice=None):
     plot_reliability({s: v["members"]["reliability_diagram"] for s, v in splits.items()},
                      campaign_dir / "shake_table_reliability.png",
                      f"{specimen.name}: {options['members']} members per test at most")
+    if choice and choice.get("folds"):
+        write_csv(campaign_dir / "folds.csv", fold_table(choice))
+        plot_reliability({f"fold {f['fold']}: {' to '.join(f['days'] or [])}, "
+                          f"{f['chosen_without'] or 'default'}": f["reliability"]
+                          for f in choice["folds"]},
+                         campaign_dir / "shake_table_folds_reliability.png",
+                         f"{specimen.name}: each fold scores the ranges chosen without it")
     for line in result["lines"]:
         log.info(line)
     return result
@@ -136,16 +147,30 @@ def _line(name, s):
 
 
 def choice_lines(choice):
-    """What the log says of the candidate ranges on the calibration tests."""
+    """What the log says of the candidate ranges on the calibration tests and of the
+    folds' out-of-sample check."""
     if not choice:
         return []
-    out = ["candidate ranges on the calibration tests (chosen by log-likelihood):"]
+    out = ["candidate ranges on the calibration tests (chosen by the worst fold's "
+           "log-likelihood):"]
     for c in choice["candidates"]:
         mark = "*" if c["ranges"] == (choice["chosen"] or None) else " "
+        folds = ", ".join(f"{v:.3f}" for v in c.get("per_fold_log_likelihood", []))
         out.append(f" {mark}{c['ranges'] or 'default'}: log-likelihood "
-                   f"{c['log_likelihood_per_test']:.3f}/test, Brier {c['brier']:.3f}, "
-                   f"accuracy {c['accuracy']:.3f} ({c['tests']} tests, "
+                   f"{c['log_likelihood_per_test']:.3f}/test (per fold {folds}), Brier "
+                   f"{c['brier']:.3f}, accuracy {c['accuracy']:.3f} ({c['tests']} tests, "
                    f"{c['member_runs']} member runs)")
+    for f in choice.get("folds", []):
+        held = f["held_out"]
+        missed = [r["label"] for r in f["reliability"] if not r["covers"]]
+        out.append(f"  fold {f['fold']} ({' to '.join(f['days'] or [])}, {held['tests']} "
+                   f"tests), chosen without it {f['chosen_without'] or 'default'}: "
+                   f"log-likelihood {held['log_likelihood_per_test']:.3f}/test, Brier "
+                   f"{held['brier']:.3f}, accuracy {held['accuracy']:.3f}; bins outside "
+                   f"their interval: {', '.join(missed) or 'none'}")
+    cv = choice.get("cross_validated_log_likelihood_per_test")
+    if cv is not None:
+        out.append(f"  cross-validated log-likelihood of the choice: {cv:.3f}/test")
     return out
 
 

@@ -135,6 +135,16 @@ def setting(name, fmt="{:g}", times=1):
     return fmt.format(getattr(importlib.import_module(module), attribute) * times)
 
 
+def member_ranges_table():
+    """Markdown table of the members' ranges from their one declaration
+    (:data:`pipeline.campaign.member_ranges.MEMBER_RANGES`): name, range, unit, source."""
+    from pipeline.campaign.member_ranges import MEMBER_RANGES, number_text
+    rows = ["| drawn | range | unit | where the range comes from |", "|---|---|---|---|"]
+    rows += [f"| `{r.name}` | {number_text(r.low)} to {number_text(r.high)} | {r.unit or '-'} "
+             f"| {r.source} |" for r in MEMBER_RANGES]
+    return "\n".join(rows)
+
+
 def bench_convergence_table(path=BENCH_JSON):
     """Markdown table of bench section 5: the twin model's downfall azimuth (deg) per
     column under the one-sine pulse toward N30E at each time-step factor and number of rim

@@ -34,6 +34,9 @@ def shake_table_scores_section(results, name=FULL):
     lines.append(_intro(summary, quick))
     if summary.get("ranges_choice"):
         lines.append(_choice(summary["ranges_choice"]))
+        lines.append(_figure(results, results / name / "shake_table_folds_reliability.png",
+                             "Reliability per fold of test days: the ranges chosen without "
+                             "the fold, scored on it (P = 0 and P = 1 bins apart)"))
     for split, label in SPLITS:
         part = summary.get("splits", {}).get(split)
         if part:
@@ -64,18 +67,43 @@ def _intro(summary, quick):
 
 
 def _choice(choice):
-    """The candidate ranges as scored on the calibration tests, the chosen one marked."""
+    """The candidate ranges as scored on the calibration tests, the chosen one marked;
+    with folds, each fold's score of the choice made without it."""
     chosen = choice.get("chosen") or None
     rows = [{"members' ranges (over the defaults)": c.get("ranges") or "default",
              "chosen": "yes" if c.get("ranges") == chosen else "",
              "log-likelihood / test": f"{c['log_likelihood_per_test']:.3f}",
              "Brier": f"{c['brier']:.3f}", "accuracy": f"{c['accuracy']:.3f}",
-             "tests": c.get("tests", "?"), "member runs": c.get("member_runs", "?")}
+             "tests": c.get("tests", "?"), "member runs": c.get("member_runs", "?"),
+             **({"worst fold": f"{c['worst_fold_log_likelihood']:.3f}"}
+                if "worst_fold_log_likelihood" in c else {})}
             for c in choice.get("candidates", [])]
-    return ("The members' ranges were chosen before any held-out test was run: each "
-            "candidate's members on the calibration tests alone, the highest log-likelihood "
-            "per test chosen and frozen, then run on the held-out tests:\n\n"
-            + _table(pd.DataFrame(rows)) + "\n")
+    folds = choice.get("folds") or []
+    if not folds:
+        return ("The members' ranges were chosen before any held-out test was run: each "
+                "candidate's members on the calibration tests alone, the highest "
+                "log-likelihood per test chosen and frozen, then run on the held-out "
+                "tests:\n\n" + _table(pd.DataFrame(rows)) + "\n")
+    per_fold = [{"fold": f["fold"], "days": " to ".join(f.get("days") or []),
+                 "chosen without it": f.get("chosen_without") or "default",
+                 "tests": f["held_out"]["tests"],
+                 "log-likelihood / test": f"{f['held_out']['log_likelihood_per_test']:.3f}",
+                 "Brier": f"{f['held_out']['brier']:.3f}",
+                 "accuracy": f"{f['held_out']['accuracy']:.3f}",
+                 "bins whose interval misses P": ", ".join(
+                     r["label"] for r in f["reliability"] if not r["covers"]) or "none"}
+                for f in folds]
+    cv = choice.get("cross_validated_log_likelihood_per_test")
+    return (f"The members' ranges were chosen before any held-out test was run, out of "
+            f"sample over the calibration tests' days ({len(folds)} blocks of consecutive "
+            "test days): each candidate's members on the calibration tests alone, the "
+            "candidate whose worst block scores best by log-likelihood chosen and frozen, "
+            "then run on the held-out tests:\n\n" + _table(pd.DataFrame(rows))
+            + "\n\nEach block scores the choice the same rule makes on the other blocks "
+            "(cross-validated log-likelihood "
+            + ("n/a" if cv is None else f"{cv:.3f}") + " per test; `folds.csv` and "
+            "`shake_table_folds_reliability.png` give each block's reliability bins, P = 0 "
+            "and P = 1 apart):\n\n" + _table(pd.DataFrame(per_fold)) + "\n")
 
 
 def _rule(summary):

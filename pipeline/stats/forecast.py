@@ -144,3 +144,48 @@ def forecast_scores(observed, p, runs=None, edges=BIN_EDGES):
             **brier_decomposition(y, q, edges), **classification(y, q),
             "clip": clip, "reliability_diagram": reliability_table(y, q, edges)}
 
+
+
+def end_bins(p, edges=BIN_EDGES):
+    """Bin of each forecast with the certain forecasts apart: 0 for P = 0, k + 1 for
+    (0, e_1) and [e_k, e_k+1) (k >= 1), len(edges) for P = 1."""
+    q = np.asarray(p, float)
+    inner = np.clip(np.searchsorted(edges, q, side="right") - 1, 0, len(edges) - 2) + 1
+    return np.where(q == 0.0, 0, np.where(q == 1.0, len(edges), inner))
+
+
+def end_bin_label(b, edges=BIN_EDGES):
+    """The text of bin ``b`` of :func:`end_bins`: "P = 0", "(0, 0.1)", "[0.1, 0.2)", ...,
+    "[0.9, 1)", "P = 1"."""
+    if b == 0:
+        return "P = 0"
+    if b == len(edges):
+        return "P = 1"
+    lo, hi = edges[b - 1], edges[b]
+    return f"{'(' if b == 1 else '['}{lo:g}, {hi:g})"
+
+
+def reliability_with_ends(observed, p, runs=None, edges=BIN_EDGES, confidence=0.95):
+    """The reliability diagram's rows (as :func:`reliability_table`'s, with ``label``)
+    over :func:`end_bins`: the forecasts P = 0 and P = 1 each a bin of their own, so that
+    a model's certainties are checked apart from its near-certainties.  ``covers``: the
+    bin's mean forecast, P held as for the log-likelihood (:func:`clipped`: 1/(2(n + 1))
+    from 0 and 1 for a P of n runs, ``runs`` None: :data:`FLOOR`), lies within the
+    observed rate's Wilson interval."""
+    y, q = _arrays(observed, p)
+    k = end_bins(q, edges)
+    held = clipped(q, None if runs is None else np.asarray(runs, float).ravel())
+    rows = []
+    for b in range(len(edges) + 1):
+        inside = k == b
+        n = int(inside.sum())
+        if not n:
+            continue
+        hits = int(y[inside].sum())
+        lo, hi = wilson_interval(hits, n, confidence)
+        mean_held = float(held[inside].mean())
+        rows.append({"label": end_bin_label(b, edges), "n": n,
+                     "mean_forecast": float(q[inside].mean()), "mean_forecast_held": mean_held,
+                     "overturned": hits, "observed_rate": hits / n,
+                     "observed_ci95": [lo, hi], "covers": bool(lo <= mean_held <= hi)})
+    return rows

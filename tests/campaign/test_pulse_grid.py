@@ -69,6 +69,7 @@ def test_bad_pulse_grids_are_refused_in_one_line(text, words):
     ("damping=0.1:2", True, "LO <= HI"), ("friction=0.5:0.6", True, "unknown parameter"),
     ("kn=1e8", True, "LO:HI"), ("footprint_tolerance_m=0.001:0.002", False, "only a mesh"),
     ("damping=0.1:0.2;damping=0.1:0.2", False, "twice"),
+    ("yaw_deg=-200:0", True, "LO <= HI"),
 ])
 def test_bad_member_ranges_are_refused_in_one_line(text, mesh, words):
     with pytest.raises(InputError, match=words) as error:
@@ -119,6 +120,27 @@ def test_sampled_directions_turn_with_the_specimen(tmp_path):
     for (_, _, p0, t0), (_, _, p37, t37) in zip(runs[0.0][1], runs[37.0][1]):
         assert {k: v for k, v in p0.items() if k not in ("rotate_deg", "column_file")} == \
             {k: v for k, v in p37.items() if k not in ("rotate_deg", "column_file")}
+
+
+def test_a_members_yaw_turns_the_directions_it_is_shaken_from(tmp_path):
+    """A member turned clockwise by its yaw is shaken from the azimuth minus the yaw: a
+    fixed --azimuth spreads over the members' yaws; sampled directions stay one per
+    quarter relative to each member's turned specimen."""
+    data = box_description(tmp_path)
+    pulses = "pga_g=0.3:0.3:1;pgv_pga_s=0.2:0.2:1"
+    sets, fixed, _ = pulse_grid.pulse_runs(data, "monolithic", pulses, 6, 1, 90.0, 7,
+                                           "yaw_deg=-30:30")[1:]
+    yaw = np.array([p["yaw_deg"] for p in sets])
+    assert np.ptp(yaw) > 30.0                           # drawn over the range
+    assert np.allclose(fixed[:, 0], (90.0 - yaw) % 360.0, atol=1e-6)
+    sets, sampled, runs = pulse_grid.pulse_runs(data, "monolithic", pulses, 6, 4, None, 7,
+                                                "yaw_deg=-30:30")[1:]
+    unturned = pulse_grid.member_azimuths(6, 4, 7)
+    assert np.allclose((sampled - (unturned - yaw[:, None]) + 180.0) % 360.0 - 180.0, 0.0,
+                       atol=1e-6)
+    quarter = np.floor(((sampled + yaw[:, None]) % 360.0) / 90.0)
+    assert all(sorted(q) == [0, 1, 2, 3] for q in quarter)
+    assert {run[2]["rotate_deg"] for run in runs} == set(sampled.ravel())
 
 
 def test_scores_of_certain_and_even_predictions():
@@ -254,7 +276,7 @@ def test_a_column_draws_nothing_unless_told_and_a_mesh_draws_the_calibrated_rang
     assert pulse_grid.parse_ranges(None, mesh=False) == {}
     assert pulse_grid.parse_ranges("damping=0.1:0.2", mesh=False) == {"damping": (0.1, 0.2)}
     rock = pulse_grid.parse_ranges(None, mesh=True)
-    assert set(rock) == {"kn", "damping", "mu_s", "footprint_tolerance_m"}
+    assert set(rock) == {"kn", "damping", "mu_s", "footprint_tolerance_m", "yaw_deg"}
     assert pulse_grid.parse_ranges("damping=0.2:0.2", mesh=True)["damping"] == (0.2, 0.2)
     with pytest.raises(InputError, match="would repeat one run"):
         pulse_grid.pulse_runs(None, "monolithic", "pga_g=0.2:0.2:1;pgv_pga_s=0.5:0.5:1", 2, 1,
@@ -345,17 +367,21 @@ def test_a_contour_that_leaves_the_grid_is_said_on_its_side_with_its_rows():
 
 
 def test_members_span_the_calibration_grid():
-    """The fragility's default member ranges and the shake-table calibration's default grid
-    read one neighbourhood: footprint and damping span the grid's two values, mu_s lies
-    about the calibration's choice of 0.7, and every grid value lies in its bounds."""
-    from pipeline.campaign import shake_table_experiments
+    """The fragility's default member ranges are the one declaration's, and they sit in the
+    shake-table calibration's neighbourhood: damping spans the grid's two values, the
+    footprint starts at the calibration's 1 mm and stays within the grid's span, mu_s
+    lies about the calibration's choice of 0.7, the yaw about the stated orientation."""
+    from pipeline.campaign import member_ranges, shake_table_experiments
     points = shake_table_experiments.parse_grid(shake_table_experiments.DEFAULT_GRID)
     ranges = pulse_grid.parse_ranges("")
+    assert ranges == member_ranges.by_name()
     assert len(points) == 2 ** 4
-    for name in ("footprint_tolerance_m", "damping"):
-        tried = sorted({p[name] for p in points})
-        assert (tried[0], tried[-1]) == ranges[name]
+    tried = sorted({p["damping"] for p in points})
+    assert (tried[0], tried[-1]) == ranges["damping"]
+    footprints = sorted({p["footprint_tolerance_m"] for p in points})
+    assert ranges["footprint_tolerance_m"][0] == footprints[0]
+    assert ranges["footprint_tolerance_m"][1] <= footprints[-1]
     assert sorted({p["mu_s"] for p in points}) == [0.3, 0.7]
     assert ranges["mu_s"][0] < 0.7 < ranges["mu_s"][1]
     assert sorted({p["rotate_deg"] for p in points}) == [0.0, 180.0]
-    assert ranges["kn"] == (4e7, 1.2e8)
+    assert ranges["yaw_deg"][0] == -ranges["yaw_deg"][1] < 0

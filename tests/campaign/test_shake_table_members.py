@@ -10,9 +10,9 @@ import pandas as pd
 import pytest
 
 from pipeline import cli
-from pipeline.campaign import ensemble_members, pulse_grid
+from pipeline.campaign import ensemble_members, member_ranges, pulse_grid
 from pipeline.campaign.shake_table_experiments import EXPERIMENTS, OUTCOME, SPECIMEN
-from pipeline.campaign.shake_table_members import choose_ranges, member_sets
+from pipeline.campaign.shake_table_members import choose_ranges, member_sets, run_params
 from pipeline.campaign.shake_table_scores import write_scores
 from pipeline.scenario.geometry import ColumnGeometry
 
@@ -27,7 +27,7 @@ from pipeline.scenario.geometry import ColumnGeometry
     (["--members", "4", "--grid", "damping=0.05,0.1"], "names 2 parameter sets"),
     (["--members", "4", "--seed", "-1"], "seed"),
     (["--members", "4", "--ranges", "kn=1e8:1e8;damping=0.1:0.1;mu_s=0.7:0.7;"
-      "footprint_tolerance_m=0.001:0.001"], "nothing drawn"),
+      "footprint_tolerance_m=0.001:0.001;yaw_deg=0:0"], "nothing drawn"),
     (["--members", "4", "--tests", "Test011,Test011"], "names Test011 twice"),
     (["--candidates", "default|kn=4e7:1e9"], "--candidates belongs to the members mode"),
     (["--members", "4", "--candidates", "kn=4e7:1e9"], "give 2 to 8 ranges"),
@@ -35,7 +35,7 @@ from pipeline.scenario.geometry import ColumnGeometry
                                                                range(2, 10)])],
      "give 2 to 8 ranges"),
     (["--members", "4", "--candidates", "default|"], "same ranges as an earlier"),
-    (["--members", "4", "--candidates", "default|kn=4e7:1.2e8"], "same ranges as an earlier"),
+    (["--members", "4", "--candidates", "default|kn=4e7:1.2e9"], "same ranges as an earlier"),
     (["--members", "4", "--candidates", "default|kn=4e7"], "--candidates kn='4e7': expected"),
     (["--members", "4", "--candidates", "default|kn=4e7:1e9", "--ranges", "kn=4e7:1e8"],
      "give one"),
@@ -62,20 +62,29 @@ def test_bad_providers_table_is_refused(tmp_path, capsys):
 
 def test_members_are_the_fragilitys_draws():
     """The members of SP1 are the parameter sets campaign fragility --column-file draws
-    for it (same seed), within its documented ranges, mu_k at 0.6/0.7 of mu_s."""
+    for it (same seed), over the one declaration of the members' ranges, mu_k at 0.6/0.7
+    of mu_s; kn log-uniform; a member's yaw turns the table motion the other way."""
     rock = ColumnGeometry.load(SPECIMEN).to_dict()
     sets, drawn = member_sets(rock, 8, None, None)
-    _, fragility_sets, _, _ = pulse_grid.pulse_runs(
+    _, fragility_sets, azimuths, _ = pulse_grid.pulse_runs(
         rock, "monolithic", "pga_g=0.5:0.5:1;pgv_pga_s=0.1:0.1:1", 8, 1, 90.0,
         ensemble_members.DEFAULT_SEED, None)
     assert sets == fragility_sets
-    assert drawn == {"kn": (4e7, 1.2e8), "damping": (0.05, 0.1), "mu_s": (0.6, 0.8),
-                     "footprint_tolerance_m": (0.001, 0.003)}
+    declared = {r.name: (r.low, r.high) for r in member_ranges.MEMBER_RANGES}
+    assert drawn == declared == pulse_grid.parse_ranges(None)
+    kn_lo, kn_hi = declared["kn"]
     for point in sets:
-        assert 4e7 <= point["kn"] <= 1.2e8 and 0.001 <= point["footprint_tolerance_m"] <= 0.003
+        for name, (lo, hi) in declared.items():
+            assert lo <= point[name] <= hi
         assert point["mu_k"] == pytest.approx(point["mu_s"] * 0.6 / 0.7, abs=1e-4)
     # kn is log-uniform: as many members below the geometric mean as above it
-    assert sum(p["kn"] < math.sqrt(4e7 * 1.2e8) for p in sets) == 4
+    assert sum(p["kn"] < math.sqrt(kn_lo * kn_hi) for p in sets) == 4
+    # the fixed azimuth 90 turned by each member's yaw; on the table the motion the same way
+    for point, row in zip(sets, azimuths):
+        assert row[0] == pytest.approx((90.0 - point["yaw_deg"]) % 360.0, abs=1e-6)
+        params = run_params(rock, point, None)
+        assert params["rotate_deg"] == pytest.approx((-point["yaw_deg"]) % 360.0, abs=1e-6)
+    assert "rotate_deg" not in run_params(rock, {"kn": 1e8}, None)
 
 
 def test_scores_of_a_synthetic_threshold_model(tmp_path):
@@ -125,7 +134,8 @@ def test_a_split_without_tests_has_no_scores():
 
 
 def _rows(observed, p, runs=8):
-    return pd.DataFrame({"observed": observed, "P": p, "runs": [runs] * len(p)})
+    return pd.DataFrame({"test": [f"T{k}" for k in range(len(p))], "observed": observed,
+                         "P": p, "runs": [runs] * len(p)})
 
 
 def test_the_candidate_with_the_best_log_likelihood_is_chosen_not_the_best_accuracy():

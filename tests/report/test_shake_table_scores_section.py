@@ -60,3 +60,25 @@ def test_the_candidate_ranges_are_quoted_with_the_chosen_marked(tmp_path):
     assert len(rows) == 2
     assert "default" in rows[0] and "yes" not in rows[0]
     assert "kn=4e7:1.2e9" in rows[1] and "yes" in rows[1] and "0.83 " in rows[1]
+
+
+def test_the_folds_are_quoted_with_the_bins_their_interval_misses(tmp_path):
+    _write(tmp_path, FULL, members_accuracy=0.95, provider_ll=-0.2, provider_brier=0.06)
+    path = tmp_path / FULL / "shake_table_members.json"
+    summary = json.loads(path.read_text())
+    held = {"tests": 58, "log_likelihood_per_test": -0.4321, "brier": 0.15, "accuracy": 0.81}
+    summary["ranges_choice"] = {
+        "chosen": None, "cross_validated_log_likelihood_per_test": -0.4567,
+        "candidates": [{"ranges": None, "tests": 259, "member_runs": 1268,
+                        "log_likelihood_per_test": -0.5641, "brier": 0.2043,
+                        "accuracy": 0.7992, "worst_fold_log_likelihood": -0.7777}],
+        "folds": [{"fold": 0, "days": ["2021-06-21", "2021-06-25"], "chosen_without": None,
+                   "held_out": held,
+                   "reliability": [{"label": "P = 0", "covers": False},
+                                   {"label": "P = 1", "covers": True}]}]}
+    path.write_text(json.dumps(summary))
+    text = shake_table_scores_section(tmp_path, FULL)
+    assert "-0.778" in text and "-0.457 per test" in text
+    row = [line for line in text.splitlines() if "-0.432" in line]
+    assert len(row) == 1 and "2021-06-21 to 2021-06-25" in row[0]
+    assert row[0].rstrip(" |").endswith("P = 0")
