@@ -11,7 +11,7 @@ ROOT = Path(__file__).resolve().parents[2]
 MACROS = ("bench_convergence_table", "bench_value", "column_examples", "column_sources",
           "bench_speed_table", "engine_shares", "run_all_steps", "run_all_minutes",
           "setting", "time_step_table", "twin_time_step", "value", "report", "report_section",
-          "record_value", "record_rocking_hd")
+          "record_value", "record_rocking_hd", "member_ranges_table")
 
 
 def _bench(tmp_path):
