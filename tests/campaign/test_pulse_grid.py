@@ -171,7 +171,8 @@ def test_a_box_mesh_fragility_matches_the_2d_block_away_from_its_threshold(tmp_p
     run_campaign("fragility", jobs=2, campaign_dir=tmp_path / "frag", options={
         "column_file": str(tmp_path / "box.json"), "pulses": "pga_g=0.15:1.0:2;pgv_pga_s=0.5:0.5:1",
         "members": 1, "azimuth": 90.0, "headings": 1,
-        "ranges": "kn=1.2e8:1.2e8;damping=0.1:0.1;mu_s=0.8:0.8;footprint_tolerance_m=0.001:0.001"})
+        "ranges": "kn=1.2e8:1.2e8;damping=0.1:0.1;mu_s=0.8:0.8;footprint_tolerance_m=0.001:0.001;"
+                  "yaw_deg=0:0"})
     summary = json.loads((tmp_path / "frag" / "fragility.json").read_text())
     section = summary["pulse_grid"]
     assert section["block2d"]["alpha_rad"] == pytest.approx(block["alpha"], rel=1e-3)
