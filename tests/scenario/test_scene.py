@@ -100,6 +100,7 @@ def test_free_rocking_energy_never_grows_and_early_stop(tmp_path):
     assert rise <= 0.01 * released
     assert energy[-1] < energy[0] - 0.9 * released      # rocking dies out
     assert traj.stopped_early and traj.t[-1] < 10.0
+    assert np.all(np.diff(traj.t) > 0)      # the stop records its state once, not twice
 
 
 def test_twin_model_falls_in_the_pulse_plane_and_stops_early(tmp_path):
@@ -111,6 +112,7 @@ def test_twin_model_falls_in_the_pulse_plane_and_stops_early(tmp_path):
     # the twin columns stand 3 m apart and start at their own positions
     assert cols["drums"]["position_m"] == [-1.5, 0.0]
     assert traj.stopped_early
+    assert np.all(np.diff(traj.t) > 0)
 
 
 def test_run_ends_when_one_column_lies_and_the_other_cannot_fall(tmp_path):
@@ -128,6 +130,7 @@ def test_run_ends_when_one_column_lies_and_the_other_cannot_fall(tmp_path):
     cols = {c["column"]: c for c in column_outcomes(traj)}
     assert cols["slender"]["toppled"] and not cols["stocky"]["toppled"]
     assert traj.stopped_early and traj.t[-1] < traj.motion_end + 0.5
+    assert np.all(np.diff(traj.t) > 0)
     last = traj.angvel[-1, 1]                  # the stocky column still rocks at the end
     assert np.linalg.norm(last) * 1.0 > Numerics().rest_velocity
     energy = total_energy(dataclasses.replace(traj, pos=traj.pos[:, 1:], quat=traj.quat[:, 1:],
