@@ -76,6 +76,39 @@ ROCK_FRAGILITY = {
                              "tests, along the table's axis, against the tests")}
 
 
+def _contour_rows(section):
+    """Rows of the P-level contours of a pulse grid's models: PGA (g) per PGV/PGA with the
+    Monte Carlo band in brackets."""
+    rows = []
+    for model, entry in section.models.items():
+        for level, contour in entry.contours.items():
+            row = {"model": model, "P": level}
+            for r in contour:
+                lo, hi = r.pga_g_band
+                row[f"PGV/PGA {r.pgv_pga_s:g} s"] = (
+                    f"{_fmt(r.pga_g, 2)} [{_fmt(lo, 2)}, {_fmt(hi, 2)}]")
+            rows.append(row)
+    return rows
+
+
+def _experiment_lines(check):
+    """The check against the shake-table experiments: the baselines' and each model's
+    scores as a table."""
+    def score_row(label, score):
+        return {"prediction": label,
+                "log-likelihood per test": _fmt(score.log_likelihood_per_test, 3),
+                "Brier": _fmt(score.brier, 3), "tests": score.n}
+
+    rows = [score_row(label, s) for label, s in check.baselines.items()]
+    for model, result in check.models.items():
+        rows.append(score_row(f"{model}: pulse fragility (grid; {result.grid.outside_grid}"
+                              " tests outside it, nearest edge)", result.grid))
+        if result.logistic is not None:
+            rows.append(score_row(f"{model}: its logistic surface", result.logistic))
+    return [f"Against the {check.tests} shake-table tests ({check.overturned} "
+            f"overturned; {check.note}):\n", _table(pd.DataFrame(rows)) + "\n"]
+
+
 def rock_fragility_section(results, name="rock-fragility"):
     """A specimen's fragility over the pulse grid (campaign fragility --pulses; ``make
     rock-fragility`` writes results/rock-fragility and results/rock-fragility-table):
@@ -102,16 +135,7 @@ def rock_fragility_section(results, name="rock-fragility"):
              "PGA (g) where P(overturn) crosses each level, per PGV/PGA (linear between "
              "cells; in brackets where the Wilson 95 % bounds cross it, the Monte Carlo "
              "band; - beyond the grid):\n"]
-    rows = []
-    for model, entry in section.models.items():
-        for level, contour in entry.contours.items():
-            row = {"model": model, "P": level}
-            for r in contour:
-                lo, hi = r.pga_g_band
-                row[f"PGV/PGA {r.pgv_pga_s:g} s"] = (
-                    f"{_fmt(r.pga_g, 2)} [{_fmt(lo, 2)}, {_fmt(hi, 2)}]")
-            rows.append(row)
-    lines.append(_table(pd.DataFrame(rows)) + "\n")
+    lines.append(_table(pd.DataFrame(_contour_rows(section))) + "\n")
     lines += [f"Warning: {w}.\n" for w in section.warnings]
     for model, entry in section.models.items():
         per_set = [r for r in entry.contour(0.5) if r.pga_g_per_set]
@@ -133,22 +157,8 @@ def rock_fragility_section(results, name="rock-fragility"):
                          f"{d['b1']:.2f} ln(PGA / (g tan alpha)) + {d['b2']:.2f} ln(p PGV/PGA)"
                          + (" (Firth-penalised: separable outcomes)"
                             if entry.logistic.separated else "") + ".\n")
-    check = section.experiments
-    if check:
-        def score_row(label, score):
-            return {"prediction": label,
-                    "log-likelihood per test": _fmt(score.log_likelihood_per_test, 3),
-                    "Brier": _fmt(score.brier, 3), "tests": score.n}
-
-        rows = [score_row(label, s) for label, s in check.baselines.items()]
-        for model, result in check.models.items():
-            rows.append(score_row(f"{model}: pulse fragility (grid; {result.grid.outside_grid}"
-                                  " tests outside it, nearest edge)", result.grid))
-            if result.logistic is not None:
-                rows.append(score_row(f"{model}: its logistic surface", result.logistic))
-        lines.append(f"Against the {check.tests} shake-table tests ({check.overturned} "
-                     f"overturned; {check.note}):\n")
-        lines.append(_table(pd.DataFrame(rows)) + "\n")
+    if section.experiments:
+        lines += _experiment_lines(section.experiments)
     lines.append(_figure(results, results / name / "fragility_pulse_grid.png",
                          "P(overturn) over the pulse grid, contours, 2D block, observed rates"))
     return "\n".join(lines)
