@@ -37,59 +37,9 @@ def binary_regression(X, y, link="logit", firth=False):
     y = np.asarray(y, bool).astype(float)
     if link not in ("logit", "probit"):
         raise ValueError(f"unknown link {link!r}")
-
-    def parts(b):
-        eta = X @ b
-        if link == "logit":
-            log_p, log_q = -np.logaddexp(0.0, -eta), -np.logaddexp(0.0, eta)
-            p = np.exp(log_p)
-            w = p * (1.0 - p)
-            score = X.T @ (y - p)
-        else:
-            log_p, log_q = stats.norm.logcdf(eta), stats.norm.logsf(eta)
-            pdf = stats.norm.pdf(eta)
-            w = pdf ** 2 / np.maximum(np.exp(log_p) * np.exp(log_q), 1e-300)
-            ratio = np.where(y > 0, np.exp(stats.norm.logpdf(eta) - log_p),
-                             -np.exp(stats.norm.logpdf(eta) - log_q))
-            score = X.T @ ratio
-        loglik = float(np.sum(y * log_p + (1.0 - y) * log_q))
-        info = X.T @ (X * w[:, None])
-        return loglik, score, info
-
-    method = None
-    if link == "logit" and not firth:
-        try:
-            import statsmodels.api as sm  # lazy: statsmodels is slow to import
-        except ImportError:
-            sm = None
-        if sm is not None:
-            with warnings.catch_warnings():
-                warnings.simplefilter("ignore")
-                fit = sm.Logit(y, X).fit(disp=0, maxiter=200)
-            b = np.asarray(fit.params, float)
-            method = "maximum likelihood (statsmodels Logit, Newton)"
-            converged = bool(fit.mle_retvals.get("converged", True))
-    if method is None:
-        def objective(b):
-            loglik, score, info = parts(b)
-            if not firth:
-                return -loglik, -score
-            sign, logdet = np.linalg.slogdet(info)
-            return -(loglik + 0.5 * (logdet if sign > 0 else -1e6))
-
-        start = np.zeros(X.shape[1])
-        if firth:
-            fit = optimize.minimize(objective, start, method="Nelder-Mead",
-                                    options={"xatol": 1e-8, "fatol": 1e-10, "maxiter": 20000,
-                                             "maxfev": 40000})
-            fit = optimize.minimize(objective, fit.x, method="BFGS")
-        else:   # concave log-likelihood: Newton steps in a trust region
-            fit = optimize.minimize(objective, start, jac=True, hess=lambda b: parts(b)[2],
-                                    method="trust-exact", options={"gtol": 1e-9})
-        b, converged = fit.x, bool(fit.success)
-        method = ("Firth-penalised likelihood" + f" ({link}, scipy.optimize Nelder-Mead + BFGS)"
-                  if firth else f"maximum likelihood ({link}, scipy.optimize trust-exact Newton)")
-    loglik, _, info = parts(b)
+    fitted = _statsmodels_logit(X, y) if link == "logit" and not firth else None
+    b, converged, method = fitted or _scipy_fit(X, y, link, firth)
+    loglik, _, info = _likelihood_parts(X, y, b, link)
     try:
         cov = np.linalg.inv(info)
     except np.linalg.LinAlgError:
@@ -100,3 +50,62 @@ def binary_regression(X, y, link="logit", firth=False):
             "ci95": [[float(v - z * e), float(v + z * e)] for v, e in zip(b, se)],
             "cov": cov.tolist(), "log_likelihood": loglik, "converged": converged,
             "method": method}
+
+
+def _likelihood_parts(X, y, b, link):
+    """(log-likelihood, score, Fisher information) of coefficients ``b``."""
+    eta = X @ b
+    if link == "logit":
+        log_p, log_q = -np.logaddexp(0.0, -eta), -np.logaddexp(0.0, eta)
+        p = np.exp(log_p)
+        w = p * (1.0 - p)
+        score = X.T @ (y - p)
+    else:
+        log_p, log_q = stats.norm.logcdf(eta), stats.norm.logsf(eta)
+        pdf = stats.norm.pdf(eta)
+        w = pdf ** 2 / np.maximum(np.exp(log_p) * np.exp(log_q), 1e-300)
+        ratio = np.where(y > 0, np.exp(stats.norm.logpdf(eta) - log_p),
+                         -np.exp(stats.norm.logpdf(eta) - log_q))
+        score = X.T @ ratio
+    loglik = float(np.sum(y * log_p + (1.0 - y) * log_q))
+    info = X.T @ (X * w[:, None])
+    return loglik, score, info
+
+
+def _statsmodels_logit(X, y):
+    """(coefficients, converged, method) of statsmodels' Logit, or None without it."""
+    try:
+        import statsmodels.api as sm  # lazy: statsmodels is slow to import
+    except ImportError:
+        return None
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        fit = sm.Logit(y, X).fit(disp=0, maxiter=200)
+    return (np.asarray(fit.params, float), bool(fit.mle_retvals.get("converged", True)),
+            "maximum likelihood (statsmodels Logit, Newton)")
+
+
+def _scipy_fit(X, y, link, firth):
+    """(coefficients, converged, method) by scipy.optimize: Firth's penalised likelihood
+    (Nelder-Mead, then BFGS) or the concave log-likelihood by Newton steps in a trust
+    region."""
+    def objective(b):
+        loglik, score, info = _likelihood_parts(X, y, b, link)
+        if not firth:
+            return -loglik, -score
+        sign, logdet = np.linalg.slogdet(info)
+        return -(loglik + 0.5 * (logdet if sign > 0 else -1e6))
+
+    start = np.zeros(X.shape[1])
+    if firth:
+        fit = optimize.minimize(objective, start, method="Nelder-Mead",
+                                options={"xatol": 1e-8, "fatol": 1e-10, "maxiter": 20000,
+                                         "maxfev": 40000})
+        fit = optimize.minimize(objective, fit.x, method="BFGS")
+    else:
+        fit = optimize.minimize(objective, start, jac=True,
+                                hess=lambda b: _likelihood_parts(X, y, b, link)[2],
+                                method="trust-exact", options={"gtol": 1e-9})
+    method = ("Firth-penalised likelihood" + f" ({link}, scipy.optimize Nelder-Mead + BFGS)"
+              if firth else f"maximum likelihood ({link}, scipy.optimize trust-exact Newton)")
+    return fit.x, bool(fit.success), method
