@@ -205,15 +205,25 @@ def study_trial(models, pool, n_sites, fallen, candidates, rng):
     try:
         post = invert(model, observations, candidates)
     except OutOfReach:
-        lost = out_of_reach_row(truth, observations, model.table, candidates)
-        return {**row, **{k: lost[k] for k in ("back_azimuth_in_95", "width95_deg",
-                                               "epicentre_in_95", "distance_in_95",
-                                               "credible_area_95_km2", "no_candidate")},
-                **{k: lost[k] for k in REACH_KEYS}, "mw_in_95": False, "p_true_mw": np.nan,
-                "mw_ci95_width": np.nan, "reach_edge_bayes_factor": np.nan,
-                "reach_edge_warning": False, "fit_warning": False, "fit_p_value": np.nan,
-                "beyond_bayes_factor": np.nan, "beyond_warning": False,
-                "p_beyond": np.nan, "beyond_in_95": False, "p_true_mechanism": np.nan}
+        return _refused_row(row, truth, observations, model.table, candidates)
+    return _answer_row(row, post, truth, true_baz, true_mw)
+
+
+def _refused_row(row, truth, observations, table, candidates):
+    """A study trial's row when no candidate lies within the table's reach of every site."""
+    lost = out_of_reach_row(truth, observations, table, candidates)
+    return {**row, **{k: lost[k] for k in ("back_azimuth_in_95", "width95_deg",
+                                           "epicentre_in_95", "distance_in_95",
+                                           "credible_area_95_km2", "no_candidate")},
+            **{k: lost[k] for k in REACH_KEYS}, "mw_in_95": False, "p_true_mw": np.nan,
+            "mw_ci95_width": np.nan, "reach_edge_bayes_factor": np.nan,
+            "reach_edge_warning": False, "fit_warning": False, "fit_p_value": np.nan,
+            "beyond_bayes_factor": np.nan, "beyond_warning": False,
+            "p_beyond": np.nan, "beyond_in_95": False, "p_true_mechanism": np.nan}
+
+
+def _answer_row(row, post, truth, true_baz, true_mw):
+    """A study trial's row from its posterior, checked against the truth."""
     summary = post.summary()
     check = truth_check(post, {"epicentre_km": truth, "back_azimuth_deg": true_baz,
                                "distance_km": row["true_distance_km"],
