@@ -38,18 +38,7 @@ def plot_downfall_map(runs, source_name, path, arrow_km=3.0):
     fig, ax = new_figure(figsize=(8, 8))
     for ring in sorted(set(np.round(np.hypot(frame["x_km"], frame["y_km"]), 6))):
         ax.add_patch(Circle((0, 0), ring, fill=False, color="0.85", lw=0.8))
-    ax.plot(subs["x_km"], subs["y_km"], "-", color="darkred", lw=3, solid_capstyle="butt")
-    ax.plot(subs["x_km"], subs["y_km"], "o", color="darkred", ms=4)
-    if src["dip_deg"] < 90:
-        up_dip = math.radians(src["strike_deg"] - 90.0)
-        shift = src["depth_km"] / math.tan(math.radians(src["dip_deg"]))
-        ax.plot(subs["x_km"] + shift * math.sin(up_dip), subs["y_km"] + shift * math.cos(up_dip),
-                "--", color="darkred", lw=1.5)
-    ax.plot(0, 0, "*", color="k", ms=14, zorder=5)
-    ax.add_collection(beach([src["strike_deg"], src["dip_deg"], src["rake_deg"]],
-                            xy=(-reach + 4.5, reach - 4.5), width=7.0, facecolor="darkred",
-                            linewidth=1, zorder=6))
-
+    _draw_source(ax, src, subs, reach)
     columns = sorted(frame["column"].unique(), key=lambda c: (c not in COLUMN_COLOURS, c))
     for k, column in enumerate(columns):
         col = colour(column, k)
@@ -85,3 +74,19 @@ def plot_downfall_map(runs, source_name, path, arrow_km=3.0):
                  f"depth {src['depth_km']:g} km")
     ax.grid(alpha=0.3)
     save_figure(fig, path, dpi=150, bbox_inches="tight")
+
+
+def _draw_source(ax, src, subs, reach):
+    """The rupture's sub-event line, a dipping fault's surface trace (dashed), the
+    epicentre and the mechanism's beach ball in the upper left corner (km)."""
+    ax.plot(subs["x_km"], subs["y_km"], "-", color="darkred", lw=3, solid_capstyle="butt")
+    ax.plot(subs["x_km"], subs["y_km"], "o", color="darkred", ms=4)
+    if src["dip_deg"] < 90:
+        up_dip = math.radians(src["strike_deg"] - 90.0)
+        shift = src["depth_km"] / math.tan(math.radians(src["dip_deg"]))
+        ax.plot(subs["x_km"] + shift * math.sin(up_dip), subs["y_km"] + shift * math.cos(up_dip),
+                "--", color="darkred", lw=1.5)
+    ax.plot(0, 0, "*", color="k", ms=14, zorder=5)
+    ax.add_collection(beach([src["strike_deg"], src["dip_deg"], src["rake_deg"]],
+                            xy=(-reach + 4.5, reach - 4.5), width=7.0, facecolor="darkred",
+                            linewidth=1, zorder=6))
