@@ -186,31 +186,7 @@ def generate_sources(source_names, rings_km=RINGS_KM, azimuth_step_deg=AZIMUTH_S
                                  sub, num, cfg["fmax_hz"])))
     if tasks:
         jobs = jobs or os.cpu_count() or 1
-        if allow_long is not None:
-            computed = list(dict.fromkeys(name for name, _ in tasks))
-            sites = sum(len(plans[name]["sites"]) for name in computed)
-            core_s = sum(len(call[0]) for _, call in tasks) * num["nt"] * num["nk"] \
-                * PYPROP8_CORE_S_PER_SAMPLE          # sites x sub-events x samples
-            files.check_long(f"synthetics of {', '.join(computed)}", sites, core_s / sites,
-                             jobs, allow_long, "a larger --step or fewer --rings",
-                             unit="sites")
-        started = time.monotonic()
-        totals = dict.fromkeys((name for name, _ in tasks), 0.0)
-        progress = tqdm(total=len(tasks), desc="pyprop8 " + ", ".join(totals),
-                        unit="sub-event")
-        calls = [task for _, task in tasks]
-        parallel = jobs > 1 and len(tasks) > 1
-        pool_or_none = Pool(min(jobs, len(tasks)), initializer=die_with_parent,
-                            initargs=(os.getpid(),)) if parallel \
-            else contextlib.nullcontext()
-        with pool_or_none as pool:
-            results = (pool.imap(_point_source_task, calls) if parallel    # in order:
-                       else map(_point_source_task, calls))                # reproducible sums
-            for (name, _), disp in zip(tasks, results):
-                totals[name] = totals[name] + disp
-                progress.update(1)
-        progress.close()
-        elapsed = time.monotonic() - started
+        totals, elapsed = _run_tasks(tasks, plans, num, jobs, allow_long)
         for name, total in totals.items():
             _write_source(name, plans[name], total, cfg, num, elapsed, jobs)
             if ship:
@@ -223,6 +199,37 @@ def generate_sources(source_names, rings_km=RINGS_KM, azimuth_step_deg=AZIMUTH_S
             _write_source(name, plan, plan["shipped"], cfg, num, 0.0, 0, origin=origin)
     write_gmm_summary(cfg["base"])
     return {name: plans[name]["paths"] for name in source_names}
+
+
+def _run_tasks(tasks, plans, num, jobs, allow_long):
+    """The pyprop8 sub-event calls of ``tasks`` [(source name, call)] on ``jobs``
+    processes, summed per source in order (reproducible sums): ({name: displacements},
+    wall s); the long-run gate first (``allow_long``, as :func:`generate_sources`)."""
+    if allow_long is not None:
+        computed = list(dict.fromkeys(name for name, _ in tasks))
+        sites = sum(len(plans[name]["sites"]) for name in computed)
+        core_s = sum(len(call[0]) for _, call in tasks) * num["nt"] * num["nk"] \
+            * PYPROP8_CORE_S_PER_SAMPLE          # sites x sub-events x samples
+        files.check_long(f"synthetics of {', '.join(computed)}", sites, core_s / sites,
+                         jobs, allow_long, "a larger --step or fewer --rings",
+                         unit="sites")
+    started = time.monotonic()
+    totals = dict.fromkeys((name for name, _ in tasks), 0.0)
+    progress = tqdm(total=len(tasks), desc="pyprop8 " + ", ".join(totals),
+                    unit="sub-event")
+    calls = [task for _, task in tasks]
+    parallel = jobs > 1 and len(tasks) > 1
+    pool_or_none = Pool(min(jobs, len(tasks)), initializer=die_with_parent,
+                        initargs=(os.getpid(),)) if parallel \
+        else contextlib.nullcontext()
+    with pool_or_none as pool:
+        results = (pool.imap(_point_source_task, calls) if parallel    # in order:
+                   else map(_point_source_task, calls))                # reproducible sums
+        for (name, _), disp in zip(tasks, results):
+            totals[name] = totals[name] + disp
+            progress.update(1)
+    progress.close()
+    return totals, time.monotonic() - started
 
 
 def shipped_path(source_name):
