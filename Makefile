@@ -50,7 +50,7 @@ STEP_TIMES := results/run-all-steps.tsv
 # $(call timed,NAME,COMMAND): run COMMAND, append NAME and its wall seconds to STEP_TIMES
 define timed
 @s=$$(date +%s.%N); $(2); rc=$$?; e=$$(date +%s.%N); \
-  awk -v n='$(1)' -v s=$$s -v e=$$e -v rc=$$rc 'BEGIN{printf "%s\t%.1f\t%d\n", n, e - s, rc}' \
+  awk -v n='$(subst ','\'',$(1))' -v s=$$s -v e=$$e -v rc=$$rc 'BEGIN{printf "%s\t%.1f\t%d\n", n, e - s, rc}' \
   >> $(STEP_TIMES); exit $$rc
 endef
 

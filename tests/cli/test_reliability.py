@@ -449,7 +449,7 @@ def start_private_campaign(tmp_path, started, executor="threads"):
     proc = private_tmp_cli(tmp_path, "campaign", "records", "--records", records, "--out",
                            str(out), "--jobs", "2", "--animations", "0", "--executor",
                            executor)
-    deadline = time.monotonic() + 60
+    deadline = time.monotonic() + 180    # a hang bound: a loaded machine starts YADE slowly
     while time.monotonic() < deadline:
         children = _descendants(proc.pid)
         yade = [p for p in children if "run_scene.py" in _cmdline(p)]
