@@ -74,7 +74,6 @@ import argparse
 import csv
 import gzip
 import importlib
-import importlib.util
 import io
 import json
 import re
@@ -135,19 +134,8 @@ def warn(message):
 
 
 def reader(name):
-    """A reader module of pipeline/records/readers, also before pipeline.records is a package."""
-    try:
-        return importlib.import_module(f"pipeline.records.readers.{name}")
-    except ImportError:
-        directory = REPO / "pipeline" / "records" / "readers"
-        if "pipeline.records.readers" not in sys.modules:
-            spec = importlib.util.spec_from_file_location(
-                "pipeline.records.readers", directory / "__init__.py",
-                submodule_search_locations=[str(directory)])
-            module = importlib.util.module_from_spec(spec)
-            sys.modules[spec.name] = module
-            spec.loader.exec_module(module)
-        return importlib.import_module(f"pipeline.records.readers.{name}")
+    """A reader module of pipeline/records/readers."""
+    return importlib.import_module(f"pipeline.records.readers.{name}")
 
 
 def gzip_copy(src, dst):
