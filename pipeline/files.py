@@ -136,7 +136,9 @@ def file_set(directory: Path, names: Collection[str],
     directory = Path(directory)
     made = not directory.exists()
     directory.mkdir(parents=True, exist_ok=True)
-    stage = Path(tempfile.mkdtemp(prefix=".staging.", suffix=".tmp", dir=directory))
+    _remove_stale_stages(directory)
+    stage = Path(tempfile.mkdtemp(prefix=f".staging.{os.getpid()}.", suffix=".tmp",
+                                  dir=directory))
     try:
         yield stage
         written = {p.name for p in stage.iterdir()}
@@ -158,6 +160,25 @@ def file_set(directory: Path, names: Collection[str],
                 directory.rmdir()
         raise
     shutil.rmtree(stage, ignore_errors=True)
+
+
+def _remove_stale_stages(directory: Path) -> None:
+    """Remove the staging directories in ``directory`` whose process is gone (a command
+    killed with SIGKILL cannot remove its own)."""
+    for stage in directory.glob(".staging.*.tmp"):
+        pid = stage.name.split(".")[2]
+        if pid.isdigit() and not _process_alive(int(pid)):
+            shutil.rmtree(stage, ignore_errors=True)
+
+
+def _process_alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True
+    return True
 
 
 @contextmanager

@@ -80,3 +80,20 @@ def test_a_result_that_json_cannot_hold_is_one_line_naming_its_key():
         result_json_text({"branches": [{"p": 0.5}, {"p": math.nan}]}, "x.json")
     with pytest.raises(ToolError, match=r"^x.json: rates\[2\] is not"):
         result_json_text({"rates": np.array([1.0, 2.0, np.inf])}, "x.json")
+
+
+def test_a_stage_left_by_a_killed_command_is_removed_and_a_running_ones_kept(tmp_path):
+    """SIGKILL leaves a command's staging directory behind; the next command in the folder
+    removes it, and leaves the stage of a command still running."""
+    import subprocess
+    import sys
+    killed = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(60)"])
+    (tmp_path / f".staging.{killed.pid}.abc.tmp").mkdir()
+    killed.kill()
+    killed.wait()
+    running = tmp_path / f".staging.{os.getppid()}.def.tmp"
+    running.mkdir()
+    with file_set(tmp_path, NAMES, ("summary.json",)) as stage:
+        (stage / "a.csv").write_text("new")
+    left = sorted(p.name for p in tmp_path.iterdir())
+    assert left == sorted(["a.csv", running.name])
