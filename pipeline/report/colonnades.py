@@ -5,7 +5,8 @@ wrote."""
 import pandas as pd
 
 from pipeline.campaign.run_dirs import finished_summary
-from pipeline.report.common import _fmt, _read_csv, _table
+from pipeline.report.common import _figure, _fmt, _read_csv, _table
+from pipeline.stats.colonnade import FILE as STATISTICS_FILE, ColonnadeStatistics
 
 COLONNADE_DIR = "colonnade"
 
@@ -42,6 +43,7 @@ def colonnade_section(results, name=COLONNADE_DIR):
              if s is not None]
     simulated = runs.drop_duplicates("run_id")["simulated_s"].astype(float).sum()
     names = ", ".join(sorted(set(whole["colonnade"])))
+    statistics = _statistics(results, folder)
     lines = [title,
              f"The colonnade `{names}` (docs/colonnades.md: its proportions, sources and "
              f"what was assumed) shaken by {len(whole)} record(s), one run each, every "
@@ -53,10 +55,43 @@ def colonnade_section(results, name=COLONNADE_DIR):
              "circular spread under 15 deg; in sequence: the fallen columns struck one "
              "after the other along the row. Damage states as defined in docs/damage.md.\n",
              _table(pd.DataFrame(rows)) + "\n",
+             *statistics,
              f"Cost: {simulated:.0f} s simulated in {sum(walls) / 60:.1f} min of YADE wall "
              f"time over {len(walls)} run(s) (files: `{name}/colonnades.csv`, "
              f"`{name}/runs.csv`).\n"]
     return "\n".join(lines)
+
+
+def _statistics(results, folder):
+    """The colonnade's runs as probabilities (colonnade_statistics.json and its figure),
+    as lines of the section; none when the campaign wrote no statistics."""
+    if not (folder / STATISTICS_FILE).exists():
+        return []
+    groups = ColonnadeStatistics.load(folder / STATISTICS_FILE).groups
+    rows = [{"record": g.record, "runs": g.runs,
+             **{f"P({k} fell)": _proportion(f) for k, f in enumerate(g.fallen)},
+             "P(parallel given >= 2 fell)": _proportion(g.parallel, True),
+             "P(in sequence given >= 3 fell)": _proportion(g.in_sequence, True),
+             "P(in sequence)": _proportion(g.in_sequence_of_all)} for g in groups]
+    return ["The same runs as probabilities (`colonnade_statistics.json`): the fraction of "
+            "runs in which k columns fell, the fallen columns parallel given two or more "
+            "fell with azimuths, in sequence given three or more fell, and in sequence of "
+            "all runs, each with its Wilson 95 % interval, the Monte Carlo error of that "
+            "many runs (an interval from a few runs is wide: it says how little they "
+            "tell). Over the records the runs are pooled: a probability over these "
+            "records, not over a site's motions.\n",
+            _table(pd.DataFrame(rows)) + "\n",
+            _figure(results, folder / "colonnade_statistics.png",
+                    "P(k columns fall), parallel and in sequence, with Wilson 95 % "
+                    "intervals")]
+
+
+def _proportion(q, counts=False):
+    """A :class:`~pipeline.stats.colonnade.Proportion` as "p [lo, hi]" (and its counts)."""
+    if q.p is None:
+        return "- (no run)"
+    lo, hi = q.ci95
+    return f"{q.p:.2f} [{lo:.2f}, {hi:.2f}]" + (f" ({q.count} of {q.of})" if counts else "")
 
 
 def _yes_no(value):
