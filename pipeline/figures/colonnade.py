@@ -13,8 +13,8 @@ MAX_GROUPS = 8          # the pooled group and the first records; more would not
 
 def _shown(statistics):
     """The groups drawn: the pooled ones first, then records up to MAX_GROUPS."""
-    pooled = [g for g in statistics.groups if g.record == "all records"]
-    rest = [g for g in statistics.groups if g.record != "all records"]
+    pooled = [g for g in statistics.groups if g.group == "all records"]
+    rest = [g for g in statistics.groups if g.group != "all records"]
     return (pooled + rest)[:MAX_GROUPS]
 
 
@@ -36,7 +36,7 @@ def plot_colonnade_statistics(statistics, path):
         k = np.arange(g.columns + 1)
         p, err = _errors(g.fallen)
         x = k + (j - (len(groups) - 1) / 2) * width
-        left.bar(x, p, width, yerr=err, capsize=2, label=f"{g.record} ({g.runs} runs)",
+        left.bar(x, p, width, yerr=err, capsize=2, label=f"{g.group} ({g.runs} runs)",
                  color=f"C{j}", alpha=0.8, error_kw={"lw": 0.8})
         for m, q in enumerate((g.parallel, g.in_sequence)):
             pp, ee = _errors([q])

@@ -68,7 +68,7 @@ def _statistics(results, folder):
     if not (folder / STATISTICS_FILE).exists():
         return []
     groups = ColonnadeStatistics.load(folder / STATISTICS_FILE).groups
-    rows = [{"record": g.record, "runs": g.runs,
+    rows = [{"record": g.group, "runs": g.runs,
              **{f"P({k} fell)": _proportion(f) for k, f in enumerate(g.fallen)},
              "P(parallel given >= 2 fell)": _proportion(g.parallel, True),
              "P(in sequence given >= 3 fell)": _proportion(g.in_sequence, True),
@@ -104,3 +104,52 @@ def _kn(runs):
     """The runs' contact stiffness (N/m per point), or its range."""
     lo, hi = runs["kn"].astype(float).min(), runs["kn"].astype(float).max()
     return f"{lo:.2g}" if lo == hi else f"{lo:.2g} to {hi:.2g}"
+
+
+DIRECTIONS_DIR = "colonnade-directions"
+
+
+def directions_section(results, name=DIRECTIONS_DIR):
+    """The colonnade shaken along its row, across it and at 45 deg
+    (``campaign colonnade-directions``), when it has run: directions.csv and the
+    statistics grouped by direction."""
+    folder = results / name
+    table = _read_csv(folder / "directions.csv")
+    title = "## A colonnade shaken in-plane, out-of-plane and obliquely\n"
+    if table is None:
+        return (title + "\nNot run yet (`make run-all`, or `python -m pipeline campaign "
+                "colonnade-directions`: see docs/colonnades.md).\n")
+    groups = {g.group: g for g in ColonnadeStatistics.load(folder).groups} \
+        if (folder / STATISTICS_FILE).exists() else {}
+    rows = []
+    for _, row in table.iterrows():
+        group = groups.get(row["direction"])
+        rows.append({
+            "direction": row["direction"],
+            "azimuth (deg)": _fmt(row["azimuth_deg"]),
+            "runs (samples)": int(row["runs"]),
+            "runs with a column fallen": f"{int(row['runs_with_a_fall'])} of "
+                                         f"{int(row['runs'])}",
+            "P(a column falls) [Wilson 95 %]": f"{row['p_fall']:.2f} "
+                                               f"[{row['p_fall_lo']:.2f}, {row['p_fall_hi']:.2f}]",
+            "columns fallen (all runs)": f"{int(row['columns_fallen'])} of "
+                                         f"{int(row['columns_shaken'])}",
+            "per pulse (PGA, PGV/PGA: columns fallen)": row["fallen_per_pulse"],
+            "parallel given >= 2 fell": "-" if group is None else
+            _proportion(group.parallel, True)})
+    whole = _read_csv(folder / "colonnades.csv")
+    run_ids = [] if whole is None else whole["run_id"]
+    summaries = [s for s in (finished_summary(folder, r) for r in run_ids) if s is not None]
+    return "\n".join([
+        title,
+        "The shipped colonnade shaken by the same one-cosine pulses (the fragility's pulse "
+        "shape) along its row (in-plane), across it (out-of-plane) and at 45 deg to it, "
+        "one run per pulse and direction. Single runs are samples: the counts and their "
+        "Wilson intervals say how few there are, not a probability over a site's "
+        "motions. The 3D discrete-element study of the Forum colonnade at Pompeii found "
+        "the out-of-plane capacity lower than the in-plane one; the table gives what "
+        "these runs show, whichever way it goes.\n",
+        _table(pd.DataFrame(rows)) + "\n",
+        f"Cost: {sum(s.wall_s for s in summaries) / 60:.1f} min of YADE wall time over "
+        f"{len(summaries)} run(s) (files: `{name}/directions.csv`, `{name}/colonnades.csv`, "
+        f"`{name}/colonnade_statistics.json`).\n"])

@@ -1,5 +1,6 @@
 """The statistics of a colonnade's runs (``colonnade_statistics.json``, beside a campaign's
-``colonnades.csv``): per record (and over all records when there are several) the
+``colonnades.csv``): per record (and over all records when there are several), or per
+group of another column of the table (a direction of shaking), the
 probability that k of its n columns fell, k = 0..n, whether the fallen columns fell
 parallel given that at least two fell, and whether they fell in sequence (given at least
 three, and of all runs), each a proportion with its Wilson 95 % interval, the Monte Carlo
@@ -65,14 +66,14 @@ class Proportion:
 
 
 @dataclass(frozen=True, kw_only=True)
-class RecordStatistics:
-    """A colonnade of ``columns`` columns over ``runs`` runs of one record (or
-    :data:`ALL_RECORDS`): ``fallen`` the runs with k columns fallen, k = 0..columns (a
+class GroupStatistics:
+    """A colonnade of ``columns`` columns over ``runs`` runs of one ``group`` (a record,
+    :data:`ALL_RECORDS`, or a direction of shaking): ``fallen`` the runs with k columns fallen, k = 0..columns (a
     :class:`Proportion` of the runs each), ``parallel`` of the runs in which at least two
     fell with azimuths, ``in_sequence`` of the runs in which at least three fell with
     impact times, ``in_sequence_of_all`` the same count of all runs."""
     colonnade: str
-    record: str
+    group: str
     columns: int
     runs: int
     fallen: tuple
@@ -82,7 +83,7 @@ class RecordStatistics:
 
     def __post_init__(self):
         object.__setattr__(self, "fallen", tuple(self.fallen))
-        where = f"{self.colonnade}, {self.record}"
+        where = f"{self.colonnade}, {self.group}"
         if isinstance(self.columns, bool) or not isinstance(self.columns, int) or \
                 self.columns < 1:
             raise InputError(f"{where}: columns must be a count >= 1, got {self.columns!r}")
@@ -105,7 +106,7 @@ class RecordStatistics:
                              "sequence of all runs")
 
     def to_json(self):
-        return {"colonnade": self.colonnade, "record": self.record, "columns": self.columns,
+        return {"colonnade": self.colonnade, "group": self.group, "columns": self.columns,
                 "runs": self.runs,
                 "fallen": [{"k": k, **f.to_json()} for k, f in enumerate(self.fallen)],
                 "parallel_given_two_fell": self.parallel.to_json(),
@@ -121,7 +122,7 @@ class RecordStatistics:
                 list(range(len(fallen))):
             raise InputError(f"{where}.fallen: k must run 0, 1, ... in order")
         try:
-            return cls(colonnade=str(data.get("colonnade")), record=str(data.get("record")),
+            return cls(colonnade=str(data.get("colonnade")), group=str(data.get("group")),
                        columns=data.get("columns"), runs=data.get("runs"),
                        fallen=[Proportion.from_json(f, f"fallen[{k}]")
                                for k, f in enumerate(fallen)],
@@ -138,34 +139,39 @@ class RecordStatistics:
 
 @dataclass(frozen=True)
 class ColonnadeStatistics:
-    """``groups``: a :class:`RecordStatistics` per colonnade and record, then per
-    colonnade over all its records when it ran under several."""
+    """``groups``: a :class:`GroupStatistics` per colonnade and group (record, or
+    ``grouped_by``'s value), then per colonnade over all its records when it ran under
+    several (``pooled``)."""
     groups: tuple
+    grouped_by: str = "record_id"
 
     def __post_init__(self):
         object.__setattr__(self, "groups", tuple(self.groups))
-        if not all(isinstance(g, RecordStatistics) for g in self.groups):
-            raise InputError("colonnade statistics: groups must be RecordStatistics")
+        if not all(isinstance(g, GroupStatistics) for g in self.groups):
+            raise InputError("colonnade statistics: groups must be GroupStatistics")
+        if not isinstance(self.grouped_by, str) or not self.grouped_by:
+            raise InputError("colonnade statistics: grouped_by must name a column")
 
     @classmethod
-    def of(cls, table):
+    def of(cls, table, by="record_id", pooled=ALL_RECORDS):
         """The statistics of ``table``, rows as colonnades.csv holds them (a DataFrame
-        with colonnade, record_id, columns, columns_fallen, parallel, in_sequence; an
-        ensemble's with member, its nominal run -1 left out)."""
+        with colonnade, ``by``, columns, columns_fallen, parallel, in_sequence; an
+        ensemble's with member, its nominal run -1 left out), grouped by ``by``, and
+        over all groups as ``pooled`` (None: not) when there are several."""
         rows = table if "member" not in table else table[table["member"] >= 0]
         groups = []
         for name in dict.fromkeys(rows["colonnade"]):
             sub = rows[rows["colonnade"] == name]
-            records = list(dict.fromkeys(sub["record_id"]))
-            for record in records:
-                groups.append(_group(name, record, sub[sub["record_id"] == record]))
-            if len(records) > 1:
-                groups.append(_group(name, ALL_RECORDS, sub))
-        return cls(tuple(groups))
+            keys = list(dict.fromkeys(sub[by]))
+            for key in keys:
+                groups.append(_group(name, key, sub[sub[by] == key]))
+            if len(keys) > 1 and pooled is not None:
+                groups.append(_group(name, pooled, sub))
+        return cls(tuple(groups), by)
 
     def to_json(self):
         return {"confidence": CONFIDENCE, "interval": "Wilson score",
-                "groups": [g.to_json() for g in self.groups]}
+                "grouped_by": self.grouped_by, "groups": [g.to_json() for g in self.groups]}
 
     def save(self, directory):
         """Write ``directory``/colonnade_statistics.json (atomically)."""
@@ -179,12 +185,13 @@ class ColonnadeStatistics:
         path, data = read_run_json(path, FILE)
         if not isinstance(data, dict) or not isinstance(data.get("groups"), list):
             raise InputError(f"{path}: not a {FILE} (no 'groups')")
-        return cls(tuple(RecordStatistics.from_json(g, f"{path}: groups[{k}]")
-                         for k, g in enumerate(data["groups"])))
+        return cls(tuple(GroupStatistics.from_json(g, f"{path}: groups[{k}]")
+                         for k, g in enumerate(data["groups"])),
+                   data.get("grouped_by", "record_id"))
 
 
-def _group(name, record, rows):
-    """The :class:`RecordStatistics` of the colonnade ``name``'s ``rows`` (one record's,
+def _group(name, group, rows):
+    """The :class:`GroupStatistics` of the colonnade ``name``'s ``rows`` (one group's,
     or all)."""
     counts = set(int(c) for c in rows["columns"])
     if len(counts) != 1:
@@ -195,8 +202,8 @@ def _group(name, record, rows):
     parallel = [csv_true(v) for v in rows["parallel"] if _known(v)]
     sequence = [csv_true(v) for v in rows["in_sequence"] if _known(v)]
     in_sequence = sum(sequence)
-    return RecordStatistics(
-        colonnade=str(name), record=str(record), columns=n, runs=runs,
+    return GroupStatistics(
+        colonnade=str(name), group=str(group), columns=n, runs=runs,
         fallen=[Proportion(fallen.count(k), runs) for k in range(n + 1)],
         parallel=Proportion(sum(parallel), len(parallel)),
         in_sequence=Proportion(in_sequence, len(sequence)),

@@ -9,7 +9,7 @@ from scipy import stats
 
 from pipeline.files import InputError
 from pipeline.stats.colonnade import (ALL_RECORDS, FILE, ColonnadeStatistics, Proportion,
-                                      RecordStatistics)
+                                      GroupStatistics)
 
 NAN = math.nan
 # colonnade "row" of 4 columns; record A's nominal run (member -1) would change every count
@@ -36,10 +36,10 @@ def wilson(k, n, z=stats.norm.ppf(0.975)):
 
 
 def _check(statistics):
-    assert [(g.colonnade, g.record) for g in statistics.groups] == \
+    assert [(g.colonnade, g.group) for g in statistics.groups] == \
         [("row", "A"), ("row", "B"), ("row", ALL_RECORDS)]
     for g in statistics.groups:
-        fallen, parallel, sequence, sequence_all = HAND[g.record]
+        fallen, parallel, sequence, sequence_all = HAND[g.group]
         runs = sum(fallen)
         assert g.runs == runs and g.columns == 4
         assert [(f.count, f.of) for f in g.fallen] == [(k, runs) for k in fallen]
@@ -63,7 +63,7 @@ def test_the_table_as_colonnades_csv_holds_it(tmp_path):
 def test_a_campaign_without_members_counts_every_run_and_one_record_is_not_pooled():
     one = TOY[TOY["record_id"] == "B"].drop(columns="member")
     (group,) = ColonnadeStatistics.of(one).groups
-    assert group.record == "B" and [f.count for f in group.fallen] == [0, 1, 0, 0, 1]
+    assert group.group == "B" and [f.count for f in group.fallen] == [0, 1, 0, 0, 1]
 
 
 def test_written_and_read_back(tmp_path):
@@ -98,6 +98,16 @@ def test_counts_are_checked_on_construction():
         Proportion(3, 2)
     runs = [Proportion(1, 2), Proportion(0, 2)]
     with pytest.raises(InputError, match="do not add up"):
-        RecordStatistics(colonnade="row", record="A", columns=1, runs=2, fallen=runs,
+        GroupStatistics(colonnade="row", group="A", columns=1, runs=2, fallen=runs,
                          parallel=Proportion(0, 0), in_sequence=Proportion(0, 0),
                          in_sequence_of_all=Proportion(0, 2))
+
+
+def test_grouped_by_another_column_without_pooling():
+    """A direction of shaking as the group: each direction its own counts, none pooled."""
+    table = TOY.assign(direction=["in", "in", "in", "across", "across", "across", "in",
+                                  "across"]).drop(columns="member")
+    statistics = ColonnadeStatistics.of(table, by="direction", pooled=None)
+    assert statistics.grouped_by == "direction"
+    assert [(g.group, [f.count for f in g.fallen]) for g in statistics.groups] == \
+        [("in", [1, 1, 1, 0, 1]), ("across", [0, 0, 1, 1, 2])]
