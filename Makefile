@@ -46,6 +46,9 @@ FRAGILITY_LEVELS := 1,2,4,8
 # simulated, 2.8 min of one core), about 5-10 min on 2 idle cores for the three
 COLONNADE := parthenon-north-flank
 COLONNADE_RECORDS ?= NF04,RSN181-IMPVALL,RSN126-GAZLI
+# the same colonnade shaken along its row, across it and at 45 deg by the same one-cosine
+# pulses (campaign colonnade-directions' default --pulses: 2 pulses x 3 directions, one
+# run each; docs/colonnades.md)
 STEP_TIMES := results/run-all-steps.tsv
 # $(call timed,NAME,COMMAND): run COMMAND, append NAME and its wall seconds to STEP_TIMES
 define timed
@@ -71,6 +74,8 @@ campaigns: setup
 	$(call timed,colonnade (reduced),$(PY) -m pipeline campaign records \
 	  --column-file $(COLONNADE) --records $(COLONNADE_RECORDS) --out results/colonnade \
 	  --animations 0 --jobs $(JOBS))
+	$(call timed,colonnade directions (reduced),$(PY) -m pipeline campaign colonnade-directions \
+	  --out results/colonnade-directions --animations 0 --jobs $(JOBS))
 	$(call timed,inversion demo (quick),$(PY) -m pipeline invert --demo --quick --jobs $(JOBS))
 	$(call timed,field rock fragility (reduced),$(PY) -m pipeline campaign fragility \
 	  --column-file $(FIELD_ROCK) --pulses "$(FIELD_ROCK_QUICK_PULSES)" --adaptive --animations 0 \
