@@ -1,7 +1,8 @@
-"""Report section of a colonnade campaign (``campaign records --column-file`` a colonnade;
-``make run-all`` writes results/colonnade): per record what the colonnade did as a whole
-(colonnades.csv) and each column's damage state (runs.csv), from the files the campaign
-wrote."""
+"""Report sections of the colonnade campaigns: ``campaign records --column-file`` a
+colonnade (``make run-all`` writes results/colonnade): per record what the colonnade did
+as a whole (colonnades.csv), its runs as probabilities (colonnade_statistics.json) and
+each column's damage state (runs.csv); ``campaign colonnade-directions``
+(results/colonnade-directions): the falls per direction of shaking (directions.csv)."""
 import pandas as pd
 
 from pipeline.campaign.run_dirs import finished_summary
