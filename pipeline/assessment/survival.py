@@ -151,7 +151,7 @@ def _file_states(o, collapse, column):
     the states below it from the same file's damage-state fits, put on that PGA as
     ``collapse`` is."""
     lower, source = load_state_fragilities(o.fragility[0], column)
-    if isinstance(collapse, OnHazardMeasure):
+    if isinstance(collapse, OnHazardMeasure) and any(f is not None for f in lower):
         lower = tuple(None if f is None else replace(collapse, inner=f) for f in lower)
         source += f", put on its PGA as the toppling fit ({o.hazard_component})"
     return StateFragility(lower + (collapse,), source)

@@ -110,9 +110,9 @@ def load_state_fragilities(path, column):
     if entry is None:
         held = ", ".join(map(key_text, file.damage_states or {}))
         return (None,) * 3, (f"{path} holds no damage-state fits" + (
-            f" for column {key_text(column)} (has {held})" if held else
-            " (damage_states: a fragility.json of campaign fragility with scaled records "
-            "holds them)"))
+            f" for column {key_text(column)}, only for {held}" if held else
+            ": give --state-lognormal, or a fragility.json of campaign fragility with "
+            "damage_states"))
     fitted, states = [], {s.state: s for s in entry.states}
     for state in ("slight", "moderate", "severe"):
         fit = states[state].fits.get("PGA") if state in states else None
