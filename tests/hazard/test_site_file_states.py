@@ -105,7 +105,7 @@ def test_a_file_without_damage_state_fits_is_refused_in_one_line(tmp_path, capsy
     assert main(argv) == 2
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and "holds no damage-state fits" in err
-    assert "observed moderate" in err and str(fragility) in err
+    assert "observed moderate" in err and str(fragility) in err and "put on" not in err
     assert not out.exists()
 
 
