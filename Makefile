@@ -46,9 +46,12 @@ FRAGILITY_LEVELS := 1,2,4,8
 # simulated, 2.8 min of one core), about 5-10 min on 2 idle cores for the three
 COLONNADE := parthenon-north-flank
 COLONNADE_RECORDS ?= NF04,RSN181-IMPVALL,RSN126-GAZLI
-# the same colonnade shaken along its row, across it and at 45 deg by the same one-cosine
-# pulses (campaign colonnade-directions' default --pulses: 2 pulses x 3 directions, one
-# run each; docs/colonnades.md)
+# the same colonnade shaken along its row, across it and at 45 deg by one one-cosine pulse
+# (0.3 g, PGV/PGA 0.3 s: between the rigid single column's overturning amplitude, 0.29 g,
+# and the rigid in-plane frame's, 0.33 g), one run per direction (docs/colonnades.md).
+# A run whose columns all fall took 134 s of one core (15.9 s simulated), one that
+# stands about 50 s: about 5 min of one core for the three
+COLONNADE_DIRECTIONS_PULSES ?= pga_g=0.3:0.3:1;pgv_pga_s=0.3:0.3:1
 STEP_TIMES := results/run-all-steps.tsv
 # $(call timed,NAME,COMMAND): run COMMAND, append NAME and its wall seconds to STEP_TIMES
 define timed
@@ -75,7 +78,8 @@ campaigns: setup
 	  --column-file $(COLONNADE) --records $(COLONNADE_RECORDS) --out results/colonnade \
 	  --animations 0 --jobs $(JOBS))
 	$(call timed,colonnade directions (reduced),$(PY) -m pipeline campaign colonnade-directions \
-	  --out results/colonnade-directions --animations 0 --jobs $(JOBS))
+	  --pulses "$(COLONNADE_DIRECTIONS_PULSES)" --out results/colonnade-directions \
+	  --animations 0 --jobs $(JOBS))
 	$(call timed,inversion demo (quick),$(PY) -m pipeline invert --demo --quick --jobs $(JOBS))
 	$(call timed,field rock fragility (reduced),$(PY) -m pipeline campaign fragility \
 	  --column-file $(FIELD_ROCK) --pulses "$(FIELD_ROCK_QUICK_PULSES)" --adaptive --animations 0 \
