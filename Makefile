@@ -47,10 +47,11 @@ FRAGILITY_LEVELS := 1,2,4,8
 COLONNADE := parthenon-north-flank
 COLONNADE_RECORDS ?= NF04,RSN181-IMPVALL,RSN126-GAZLI
 # the same colonnade shaken along its row, across it and at 45 deg by one one-cosine pulse
-# (0.3 g, PGV/PGA 0.3 s: between the rigid single column's overturning amplitude, 0.29 g,
-# and the rigid in-plane frame's, 0.33 g), one run per direction (docs/colonnades.md).
-# A run whose columns all fall took 134 s of one core (15.9 s simulated), one that
-# stands about 50 s: about 5 min of one core for the three
+# (0.3 g, PGV/PGA 0.3 s: just below the smallest amplitude that overturns a rigid cylinder
+# of the column's height and base diameter, 0.31 g, and the rigid in-plane frame of the
+# colonnade's beam-to-column mass ratio 0.52, 0.35 g), one run per direction
+# (docs/colonnades.md).  A run whose columns all fell took 134 s of one core (15.9 s
+# simulated): about 5-7 min of one core for the three
 COLONNADE_DIRECTIONS_PULSES ?= pga_g=0.3:0.3:1;pgv_pga_s=0.3:0.3:1
 STEP_TIMES := results/run-all-steps.tsv
 # $(call timed,NAME,COMMAND): run COMMAND, append NAME and its wall seconds to STEP_TIMES

@@ -90,7 +90,7 @@ def _statistics(results, folder):
 def _proportion(q, counts=False):
     """A :class:`~pipeline.stats.colonnade.Proportion` as "p [lo, hi]" (and its counts)."""
     if q.p is None:
-        return "- (no run)"
+        return "- (0 of 0)" if counts else "-"
     lo, hi = q.ci95
     return f"{q.p:.2f} [{lo:.2f}, {hi:.2f}]" + (f" ({q.count} of {q.of})" if counts else "")
 
