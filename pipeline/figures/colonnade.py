@@ -37,7 +37,7 @@ def plot_colonnade_statistics(statistics, path):
         p, err = _errors(g.fallen)
         x = k + (j - (len(groups) - 1) / 2) * width
         left.bar(x, p, width, yerr=err, capsize=2, label=f"{g.group} ({g.runs} runs)",
-                 color=f"C{j}", alpha=0.8, error_kw={"lw": 0.8})
+                 color=f"C{j}", alpha=0.8, error_kw={"lw": 0.8, "ecolor": f"C{j}"})
         for m, q in enumerate((g.parallel, g.in_sequence)):
             pp, ee = _errors([q])
             right.errorbar([m + (j - (len(groups) - 1) / 2) * width], pp, yerr=ee,
@@ -49,9 +49,10 @@ def plot_colonnade_statistics(statistics, path):
     left.set_xticks(np.arange(max((g.columns for g in groups), default=0) + 1))
     left.set_xlabel("columns fallen, k")
     left.set_ylabel("P(k columns fall)")
-    left.set_ylim(0, 1.05)
+    left.set_ylim(0, 1.3)
+    left.set_yticks(np.linspace(0, 1, 6))
     left.set_title(f"{name}: columns fallen per run (Wilson 95 %)")
-    left.legend(fontsize=7, loc="upper right")
+    left.legend(fontsize=7, loc="upper center", ncol=min(len(groups), 4), frameon=False)
     right.set_xticks([0, 1], ["parallel\n| >= 2 fell", "in sequence\n| >= 3 fell"])
     right.set_xlim(-0.6, 1.6)
     right.set_ylim(-0.05, 1.05)
