@@ -46,6 +46,13 @@ FRAGILITY_LEVELS := 1,2,4,8
 # simulated, 2.8 min of one core), about 5-10 min on 2 idle cores for the three
 COLONNADE := parthenon-north-flank
 COLONNADE_RECORDS ?= NF04,RSN181-IMPVALL,RSN126-GAZLI
+# the same colonnade shaken along its row, across it and at 45 deg by one one-cosine pulse
+# (0.3 g, PGV/PGA 0.3 s: just below the smallest amplitude that overturns a rigid cylinder
+# of the column's height and base diameter, 0.31 g, and the rigid in-plane frame of the
+# colonnade's beam-to-column mass ratio 0.52, 0.35 g), one run per direction
+# (docs/colonnades.md).  A run whose columns all fell took 134 s of one core (15.9 s
+# simulated): about 5-7 min of one core for the three
+COLONNADE_DIRECTIONS_PULSES ?= pga_g=0.3:0.3:1;pgv_pga_s=0.3:0.3:1
 STEP_TIMES := results/run-all-steps.tsv
 # $(call timed,NAME,COMMAND): run COMMAND, append NAME and its wall seconds to STEP_TIMES
 define timed
@@ -70,6 +77,9 @@ campaigns: setup
 	  --levels $(FRAGILITY_LEVELS) --members 1 --jobs $(JOBS))
 	$(call timed,colonnade (reduced),$(PY) -m pipeline campaign records \
 	  --column-file $(COLONNADE) --records $(COLONNADE_RECORDS) --out results/colonnade \
+	  --animations 0 --jobs $(JOBS))
+	$(call timed,colonnade directions (reduced),$(PY) -m pipeline campaign colonnade-directions \
+	  --pulses "$(COLONNADE_DIRECTIONS_PULSES)" --out results/colonnade-directions \
 	  --animations 0 --jobs $(JOBS))
 	$(call timed,inversion demo (quick),$(PY) -m pipeline invert --demo --quick --jobs $(JOBS))
 	$(call timed,field rock fragility (reduced),$(PY) -m pipeline campaign fragility \

@@ -221,7 +221,8 @@ class SurvivalOptions(SpecimenOptions):
         (), "", "a stated lognormal fragility of a damage state below collapse, "
         "P(DS >= STATE) over PGA, for columns of --observations seen in a damage state "
         "(slight, moderate or severe; collapse is the toppling fragility); repeat per state",
-        flag="--state-lognormal", metavar="STATE,MEDIAN_G,BETA", optional=True)
+        flag="--state-lognormal", metavar="STATE,MEDIAN_G,BETA",
+        optional="with --fragility, the lognormal PGA fits of its damage_states")
     at_pgv_pga: float = param(None, "s", "the PGV/PGA at which the PGA range is stated (for "
                               "a fragility over PGA and PGV/PGA)", 0.001, 10,
                               flag="--at-pgv-pga", metavar="S", optional=True)

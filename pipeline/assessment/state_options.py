@@ -4,9 +4,10 @@
 P(DS >= STATE | PGA) = Phi(ln(PGA / median) / beta); collapse is the column's fragility
 of toppling (``--fragility``, ``--median-g``/``--beta`` or ``--logistic``).
 
-A campaign's ``fragility.json`` with fits per damage state would give the same
-:class:`~pipeline.hazard.damage_states.StateFragility` per column type in
-:func:`state_fragility` (its ``stated`` then read from the file's entry of that type).
+Without ``--state-lognormal``, a campaign's ``fragility.json`` (``--fragility``) gives
+them per column type from its ``damage_states`` fits
+(:func:`pipeline.hazard.fragility.load.load_state_fragilities`), in the same
+:class:`~pipeline.hazard.damage_states.StateFragility` (:func:`state_fragility`).
 """
 import math
 
@@ -54,6 +55,9 @@ def parse_state_lognormal(texts):
     return out
 
 
+STATED_SOURCE = f"stated ({FLAG})"
+
+
 def state_fragility(collapse, stated):
     """The :class:`StateFragility` of a column: ``collapse`` its fragility of toppling,
     ``stated`` the lower states' lognormals ({state index: (median g, beta)})."""
@@ -61,4 +65,4 @@ def state_fragility(collapse, stated):
         stated[s][0] * STANDARD_GRAVITY, stated[s][1],
         label=f"stated lognormal of {STATES[s]}: median {stated[s][0]:g} g, beta "
               f"{stated[s][1]:g}") for s in range(1, COLLAPSE))
-    return StateFragility(lower + (collapse,))
+    return StateFragility(lower + (collapse,), STATED_SOURCE if stated else None)

@@ -10,20 +10,26 @@ from pipeline.assessment.state_options import parse_state_lognormal, state_fragi
 from pipeline.constants import STANDARD_GRAVITY
 from pipeline.files import InputError, file_set, result_json_text, write_text
 from pipeline.hazard.assess import assess
+from pipeline.hazard.damage_states import COLLAPSE, StateFragility
+from pipeline.hazard.fragility.components import OnHazardMeasure
+from pipeline.hazard.fragility.load import load_state_fragilities
 from pipeline.hazard.curves import load_hazard
 from pipeline.hazard.fragility import Logistic, Lognormal
 from pipeline.hazard.joint_assess import assess_joint
 from pipeline.hazard.site_motion import site_motion
 from pipeline.inversion.observations import load_observations
 
+FELL_OR_STOOD = ((COLLAPSE, COLLAPSE), (0, COLLAPSE - 1))   # no damage state seen
 FILES = ("survival.json", "survival.png", "site_motion.json")   # every file survival writes
 SUMMARIES = ("survival.json", "site_motion.json")           # what says what the set holds
 
 
 def site_motion_result(observations_path, site_name, fragility_for, at_pgv_pga, pga_measure):
     """site_motion.json's content: the PGA range consistent with one site's columns
-    (``site_name`` None: the file's only site; ``fragility_for(column type)`` its
-    fragility; ``pga_measure``: what the PGA is, in words)."""
+    (``site_name`` None: the file's only site; ``fragility_for(column type, states)`` its
+    fragility, ``states`` whether a column of that type was seen in a damage state, so
+    that it needs the states below collapse; ``pga_measure``: what the PGA is, in
+    words)."""
     observations = load_observations(observations_path)
     name = site_name
     if name is None:
@@ -31,7 +37,10 @@ def site_motion_result(observations_path, site_name, fragility_for, at_pgv_pga, 
             raise InputError(f"{observations_path.name}: {len(observations.sites)} sites: "
                              "name one with --observation-site")
         name = observations.sites[0].name
-    result = site_motion(observations, name, fragility_for, at_pgv_pga)
+    seen = {c.column for site in observations.sites if site.name == name
+            for c in site.columns if tuple(c.state_range) not in FELL_OR_STOOD}
+    result = site_motion(observations, name,
+                         lambda column: fragility_for(column, column in seen), at_pgv_pga)
     result["pga_measure"] = pga_measure
     return result
 
@@ -111,12 +120,16 @@ def _joint_site(o):
 def _site_motion(o):
     """site_motion.json's content: the PGA range consistent with one site's columns, each
     column type's fragility from the options ``o``: of toppling, with the lower damage
-    states' of --state-lognormal (a campaign's fits per damage state would plug in
-    here, read per column type like its toppling fit)."""
+    states' of --state-lognormal, or else of --fragility's damage-state fits for that
+    column type (:func:`_file_states`)."""
     lower = parse_state_lognormal(o.state_lognormal)
     if o.fragility:
         def toppling(column):
             return o.campaign_fragility(o.fragility[0], column)
+        if not lower:
+            return _site_motion_of(o, lambda column, states: _file_states(
+                o, toppling(column), column) if states else
+                StateFragility.toppling(toppling(column)))
     elif o.median_g:
         stated = Lognormal(o.median_g[0] * STANDARD_GRAVITY, o.beta[0],
                            label=f"stated lognormal: median {o.median_g[0]:g} g, "
@@ -129,8 +142,24 @@ def _site_motion(o):
         def toppling(column):
             return stated
 
-    def fragility_for(column):
-        return state_fragility(toppling(column), lower)
+    return _site_motion_of(o, lambda column, states: state_fragility(toppling(column), lower))
+
+
+def _file_states(o, collapse, column):
+    """The :class:`~pipeline.hazard.damage_states.StateFragility` of ``column``: its
+    toppling fragility ``collapse`` (of --fragility, on the PGA of --hazard-component),
+    the states below it from the same file's damage-state fits, put on that PGA as
+    ``collapse`` is."""
+    lower, source = load_state_fragilities(o.fragility[0], column)
+    if isinstance(collapse, OnHazardMeasure) and any(f is not None for f in lower):
+        lower = tuple(None if f is None else replace(collapse, inner=f) for f in lower)
+        source += f", put on its PGA as the toppling fit ({o.hazard_component})"
+    return StateFragility(lower + (collapse,), source)
+
+
+def _site_motion_of(o, fragility_for):
+    """:func:`site_motion_result` of the options ``o`` with ``fragility_for(column,
+    states)``."""
     return site_motion_result(
         o.observations, o.observation_site, fragility_for, o.at_pgv_pga,
         f"{o.hazard_component}: a campaign's fragility put on it "

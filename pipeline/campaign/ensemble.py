@@ -29,7 +29,8 @@ from pipeline.scenario.parameters import param
 from pipeline.campaign.column_file import description as column_file_description
 from pipeline.campaign.runs import column_specs, run_column_spec
 from pipeline.campaign.run_dirs import finished_summary
-from pipeline.campaign.tables import collect, colonnade_table, write_parquet
+from pipeline.campaign.tables import (collect, colonnade_table, write_colonnade_files,
+                                      write_parquet)
 from pipeline.files import InputError, write_csv, write_json
 from pipeline.simulate import run_code_version
 from pipeline.campaign.sizing import (DEFAULT_ARC_DEG, DEFAULT_MAX_MEMBERS, DEFAULT_PRECISION,
@@ -116,9 +117,8 @@ def ensemble_outputs(specs, campaign_dir, failures, animations, figures=True):
                      f"(R {col['resultant_length']:.2f})"))
     write_summaries(campaign_dir, summaries)
     colonnades = colonnade_table(specs, campaign_dir)
-    if not colonnades.empty:
-        write_csv(campaign_dir / "colonnades.csv", colonnades.assign(
-            member=colonnades["run_id"].map(member_of)))
+    written += write_colonnade_files(campaign_dir, colonnades.assign(
+        member=colonnades["run_id"].map(member_of)), figures)
     if len(records) > 1:
         pooled = pooled_summary(runs)
         if pooled is not None:

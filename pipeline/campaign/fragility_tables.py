@@ -65,7 +65,11 @@ def scaled_runs(specs, campaign_dir):
 
 
 def level_table(table):
-    """Fraction toppled per record and level (and over all records), one column per model."""
+    """Fraction toppled per record and level (and over all records), one column per model
+    (p_COLUMN, its Wilson interval p_COLUMN_lo, p_COLUMN_hi, n_COLUMN runs); for a 3D
+    column with damage states, the fraction of its runs with damage measures
+    (n_COLUMN_states) that reached each state or a worse one, p_COLUMN_STATE with its
+    interval (:func:`state_ranks`, as :func:`damage_state_fits` counts them)."""
     rows = []
     pooled = table.assign(record_id="all records")
     for (record, level), group in pd.concat([table, pooled]).groupby(
@@ -73,10 +77,14 @@ def level_table(table):
         row = {"record_id": record, "level_m_s2": level,
                "pgv_m_s": float(np.exp(np.log(group["pgv_m_s"].astype(float)).mean()))}
         for column, sub in group.groupby("column"):
-            k, n = int(sub["toppled"].sum()), len(sub)
-            lo, hi = wilson_interval(k, n)
-            row.update({f"p_{column}": k / n, f"p_{column}_lo": lo, f"p_{column}_hi": hi,
-                        f"n_{column}": n})
+            row.update(_fraction(f"p_{column}", int(sub["toppled"].sum()), len(sub)))
+            row[f"n_{column}"] = len(sub)
+            ranked = state_ranks(sub) if column in MODELS_3D else None
+            if ranked is not None:
+                row[f"n_{column}_states"] = len(ranked)
+                for k, state in enumerate(STATES, start=1):
+                    row.update(_fraction(f"p_{column}_{state}", int((ranked >= k).sum()),
+                                         len(ranked)))
         rows.append(row)
     out = pd.DataFrame(rows)
     for column in MODELS_3D:
@@ -187,6 +195,24 @@ def _fits(sub, y, where, alpha, p):
     return fits, leaf(LogisticSurface, json_safe(surface), FILE, f"{where}.logistic")
 
 
+def _fraction(key, k, n):
+    """{key: k / n, key_lo, key_hi: its Wilson 95 % interval} (NaN without runs)."""
+    lo, hi = wilson_interval(k, n)
+    return {key: k / n if n else math.nan, f"{key}_lo": lo, f"{key}_hi": hi}
+
+
+def state_ranks(runs):
+    """The damage-state rank (0 none ... 4 collapse) of each of ``runs`` (rows of one
+    column type) that has damage measures, as an int Series on their index; None when no
+    run has them (a runs table written before them)."""
+    if "damage_state" not in runs:
+        return None
+    rank = runs["damage_state"].map(STATE_RANK)
+    if rank.isna().all():
+        return None
+    return rank[rank.notna()].astype(int)
+
+
 def damage_state_fits(table, descriptions, alpha, p):
     """Per 3D column type, P(damage state or worse | IM) for every state above none
     (:data:`~pipeline.hazard.fragility.damage_states.STATES`), fitted as P(toppled):
@@ -195,10 +221,10 @@ def damage_state_fits(table, descriptions, alpha, p):
     out = {}
     for name in [c for c in MODELS_3D if c in set(table["column"])]:
         sub = table[table["column"] == name]
-        rank = sub["damage_state"].map(STATE_RANK) if "damage_state" in sub else None
-        if rank is None or rank.isna().all():
+        ranked = state_ranks(sub)
+        if ranked is None:
             continue
-        sub, rank = sub[rank.notna()], rank[rank.notna()].to_numpy(int)
+        sub, rank = sub.loc[ranked.index], ranked.to_numpy()
         states = []
         for k, state in enumerate(STATES, start=1):
             y = rank >= k

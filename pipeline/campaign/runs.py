@@ -8,7 +8,8 @@ from pathlib import Path
 from pipeline import RESULTS_DIR
 from pipeline.campaign.column_file import column_kn, runs_colonnade, summary_entry
 from pipeline.campaign.spec import RunSpec
-from pipeline.campaign.tables import collect, colonnade_table, write_tables
+from pipeline.campaign.tables import (collect, colonnade_table, write_colonnade_files,
+                                      write_tables)
 from pipeline.files import InputError, csv_true_column, write_csv
 from pipeline.motion import Motion
 from pipeline.records import CACHE_DIR, catalog, catalog_row, processed_motion, resolve
@@ -93,8 +94,8 @@ def pulse_record():
 
 def column_outputs(name, size_by=None):
     """Outputs of a column campaign: runs.csv, impacts.csv, direction statistics, figures;
-    for a colonnade runs.csv, impacts.csv and colonnades.csv
-    (:func:`pipeline.campaign.tables.colonnade_table`), no figures."""
+    for a colonnade runs.csv, impacts.csv, colonnades.csv and its statistics
+    (:func:`pipeline.campaign.tables.write_colonnade_files`)."""
 
     def outputs(specs, campaign_dir, failures, animations, figures=True):
         campaign_dir = Path(campaign_dir)
@@ -107,7 +108,8 @@ def column_outputs(name, size_by=None):
         written = []
         if runs_colonnade(specs):
             # the colonnade's own outcomes instead of the twin columns' statistics
-            write_csv(campaign_dir / "colonnades.csv", colonnade_table(specs, campaign_dir))
+            written = write_colonnade_files(campaign_dir, colonnade_table(specs, campaign_dir),
+                                            figures)
         elif not runs.empty:
             write_csv(campaign_dir / "direction_statistics.csv", direction_statistics(runs))
             if figures:

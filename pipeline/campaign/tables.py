@@ -13,6 +13,7 @@ from pipeline.files import atomic_path, write_csv
 from pipeline.campaign.run_dirs import finished_runs
 from pipeline.motion import Motion
 from pipeline.motion.measures import record_parameters
+from pipeline.stats.colonnade import ALL_RECORDS, ColonnadeStatistics
 
 SYNTHETIC_SITE_KEYS = ("source", "station", "x_km", "y_km", "ring_km")  # from synthetic meta
 IMPACT_COLUMNS = ["run_id", "column", "body_index", "impact_time_s", "x_m", "y_m", "hd",
@@ -70,6 +71,25 @@ def colonnade_table(specs, campaign_dir):
                      "parallel": whole.parallel, "fall_order": " ".join(whole.fall_order),
                      "in_sequence": whole.in_sequence})
     return pd.DataFrame(rows, columns=COLONNADE_COLUMNS)
+
+
+def write_colonnade_files(campaign_dir, table, figures=True, by="record_id",
+                          pooled=ALL_RECORDS):
+    """colonnades.csv (``table``: :func:`colonnade_table`'s rows, an ensemble's with its
+    members), colonnade_statistics.json beside it
+    (:class:`~pipeline.stats.colonnade.ColonnadeStatistics` grouped ``by`` a column,
+    ``pooled`` over the groups) and, with ``figures``, colonnade_statistics.png; nothing
+    without colonnade runs.  Returns the figures."""
+    if table.empty:
+        return []
+    statistics = ColonnadeStatistics.of(table, by, pooled)   # checked before any file
+    write_csv(Path(campaign_dir) / "colonnades.csv", table)
+    statistics.save(Path(campaign_dir))
+    if not figures:
+        return []
+    from pipeline.figures.colonnade import plot_colonnade_statistics  # lazy: matplotlib, not imported by a run or after Ctrl-C
+    return [plot_colonnade_statistics(statistics,
+                                      Path(campaign_dir) / "colonnade_statistics.png")]
 
 
 def _missing(value):

@@ -31,8 +31,10 @@ class StateFragility:
     """``exceedance``: per state slight, moderate, severe, collapse (in that order) a
     fragility of P(DS >= s) (an object with ``probability(pga[, pgv_pga])``,
     ``uses_ratio`` and ``describe()``: :mod:`pipeline.hazard.fragility`), or None where
-    it is not known; collapse (P(topple)) is always given."""
+    it is not known; collapse (P(topple)) is always given.  ``source``: where the states
+    below collapse come from, in words (None: not said)."""
     exceedance: tuple
+    source: str | None = None
 
     def __post_init__(self):
         object.__setattr__(self, "exceedance", tuple(self.exceedance))

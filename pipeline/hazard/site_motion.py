@@ -138,17 +138,21 @@ def site_motion(observations, site_name, fragility_for, pgv_pga_s=None):
         fragilities.append(cache[column.column])
     outcomes = [c.state_range for c in site.columns]
     for k, (column, (lowest, highest)) in enumerate(zip(site.columns, outcomes)):
-        missing = _per_state(cache[column.column]).missing(lowest, highest)
+        fragility = _per_state(cache[column.column])
+        missing = fragility.missing(lowest, highest)
         if missing:
             seen = STATES[lowest] if lowest == highest else f"at least {STATES[lowest]}"
             raise InputError(f"{observations.source}: site {site_name!r}, column {k + 1} "
                              f"({column.column}): observed {seen}, which needs the "
                              f"fragility of damage state {STATES[missing[0]]!r}; it is not "
-                             "given")
+                             "given" + ("" if fragility.source is None else
+                                        f" ({fragility.source})"))
     result = motion_bound(fragilities, outcomes, pgv_pga_s)
     per_state = {name: _per_state(f) for name, f in cache.items()}
     states = {name: f.describe_states() for name, f in per_state.items()
               if f.describe_states()}
+    sources = {name: f.source for name, f in per_state.items() if f.source is not None}
     return {"site": site_name, "observations": observations.source, **result,
             "fragilities": {name: f.collapse.describe() for name, f in per_state.items()},
-            **({"state_fragilities": states} if states else {})}
+            **({"state_fragilities": states} if states else {}),
+            **({"state_fragilities_from": sources} if sources else {})}

@@ -16,7 +16,7 @@ from pipeline import RESULTS_DIR, __version__
 from pipeline.files import write_text
 from pipeline.report.campaigns import (columns_section, run_all_section, shake_table_section,
                                        speed_section, sweep_section, verification_section)
-from pipeline.report.colonnades import colonnade_section
+from pipeline.report.colonnades import colonnade_section, directions_section
 from pipeline.report.contact_stiffness import contact_stiffness_section
 from pipeline.report.ensembles import (convergence_section, ensemble_section,
                                        paper_question_section)
@@ -78,7 +78,7 @@ def build_report(results=RESULTS_DIR):
         hazard_routes_section(results),
         paper_question_section(results), ensemble_section(results),
         convergence_section(results), fragility_section(results), columns_section(results),
-        colonnade_section(results),
+        colonnade_section(results), directions_section(results),
         inversion_section(results), member_study_section(results),
         records_section(results), processing_section(results), synthetic_section(results),
         speed_section(results), run_all_section(results)]

@@ -1,11 +1,13 @@
-"""Report section of a colonnade campaign (``campaign records --column-file`` a colonnade;
-``make run-all`` writes results/colonnade): per record what the colonnade did as a whole
-(colonnades.csv) and each column's damage state (runs.csv), from the files the campaign
-wrote."""
+"""Report sections of the colonnade campaigns: ``campaign records --column-file`` a
+colonnade (``make run-all`` writes results/colonnade): per record what the colonnade did
+as a whole (colonnades.csv), its runs as probabilities (colonnade_statistics.json) and
+each column's damage state (runs.csv); ``campaign colonnade-directions``
+(results/colonnade-directions): the falls per direction of shaking (directions.csv)."""
 import pandas as pd
 
 from pipeline.campaign.run_dirs import finished_summary
-from pipeline.report.common import _fmt, _read_csv, _table
+from pipeline.report.common import _figure, _fmt, _read_csv, _table
+from pipeline.stats.colonnade import FILE as STATISTICS_FILE, ColonnadeStatistics
 
 COLONNADE_DIR = "colonnade"
 
@@ -42,6 +44,7 @@ def colonnade_section(results, name=COLONNADE_DIR):
              if s is not None]
     simulated = runs.drop_duplicates("run_id")["simulated_s"].astype(float).sum()
     names = ", ".join(sorted(set(whole["colonnade"])))
+    statistics = _statistics(results, folder)
     lines = [title,
              f"The colonnade `{names}` (docs/colonnades.md: its proportions, sources and "
              f"what was assumed) shaken by {len(whole)} record(s), one run each, every "
@@ -53,10 +56,43 @@ def colonnade_section(results, name=COLONNADE_DIR):
              "circular spread under 15 deg; in sequence: the fallen columns struck one "
              "after the other along the row. Damage states as defined in docs/damage.md.\n",
              _table(pd.DataFrame(rows)) + "\n",
+             *statistics,
              f"Cost: {simulated:.0f} s simulated in {sum(walls) / 60:.1f} min of YADE wall "
              f"time over {len(walls)} run(s) (files: `{name}/colonnades.csv`, "
              f"`{name}/runs.csv`).\n"]
     return "\n".join(lines)
+
+
+def _statistics(results, folder):
+    """The colonnade's runs as probabilities (colonnade_statistics.json and its figure),
+    as lines of the section; none when the campaign wrote no statistics."""
+    if not (folder / STATISTICS_FILE).exists():
+        return []
+    groups = ColonnadeStatistics.load(folder / STATISTICS_FILE).groups
+    rows = [{"record": g.group, "runs": g.runs,
+             **{f"P({k} fell)": _proportion(f) for k, f in enumerate(g.fallen)},
+             "P(parallel given >= 2 fell)": _proportion(g.parallel, True),
+             "P(in sequence given >= 3 fell)": _proportion(g.in_sequence, True),
+             "P(in sequence)": _proportion(g.in_sequence_of_all)} for g in groups]
+    return ["The same runs as probabilities (`colonnade_statistics.json`): the fraction of "
+            "runs in which k columns fell, the fallen columns parallel given two or more "
+            "fell with azimuths, in sequence given three or more fell, and in sequence of "
+            "all runs, each with its Wilson 95 % interval, the Monte Carlo error of that "
+            "many runs (an interval from a few runs is wide: it says how little they "
+            "tell). Over the records the runs are pooled: a probability over these "
+            "records, not over a site's motions.\n",
+            _table(pd.DataFrame(rows)) + "\n",
+            _figure(results, folder / "colonnade_statistics.png",
+                    "P(k columns fall), parallel and in sequence, with Wilson 95 % "
+                    "intervals")]
+
+
+def _proportion(q, counts=False):
+    """A :class:`~pipeline.stats.colonnade.Proportion` as "p [lo, hi]" (and its counts)."""
+    if q.p is None:
+        return "- (0 of 0)" if counts else "-"
+    lo, hi = q.ci95
+    return f"{q.p:.2f} [{lo:.2f}, {hi:.2f}]" + (f" ({q.count} of {q.of})" if counts else "")
 
 
 def _yes_no(value):
@@ -69,3 +105,52 @@ def _kn(runs):
     """The runs' contact stiffness (N/m per point), or its range."""
     lo, hi = runs["kn"].astype(float).min(), runs["kn"].astype(float).max()
     return f"{lo:.2g}" if lo == hi else f"{lo:.2g} to {hi:.2g}"
+
+
+DIRECTIONS_DIR = "colonnade-directions"
+
+
+def directions_section(results, name=DIRECTIONS_DIR):
+    """The colonnade shaken along its row, across it and at 45 deg
+    (``campaign colonnade-directions``), when it has run: directions.csv and the
+    statistics grouped by direction."""
+    folder = results / name
+    table = _read_csv(folder / "directions.csv")
+    title = "## A colonnade shaken in-plane, out-of-plane and obliquely\n"
+    if table is None:
+        return (title + "\nNot run yet (`make run-all`, or `python -m pipeline campaign "
+                "colonnade-directions`: see docs/colonnades.md).\n")
+    groups = {g.group: g for g in ColonnadeStatistics.load(folder).groups} \
+        if (folder / STATISTICS_FILE).exists() else {}
+    rows = []
+    for _, row in table.iterrows():
+        group = groups.get(row["direction"])
+        rows.append({
+            "direction": row["direction"],
+            "azimuth (deg)": _fmt(row["azimuth_deg"]),
+            "runs (samples)": int(row["runs"]),
+            "runs with a column fallen": f"{int(row['runs_with_a_fall'])} of "
+                                         f"{int(row['runs'])}",
+            "P(a column falls) [Wilson 95 %]": f"{row['p_fall']:.2f} "
+                                               f"[{row['p_fall_lo']:.2f}, {row['p_fall_hi']:.2f}]",
+            "columns fallen (all runs)": f"{int(row['columns_fallen'])} of "
+                                         f"{int(row['columns_shaken'])}",
+            "per pulse (PGA, PGV/PGA: columns fallen)": row["fallen_per_pulse"],
+            "parallel given >= 2 fell": "-" if group is None else
+            _proportion(group.parallel, True)})
+    whole = _read_csv(folder / "colonnades.csv")
+    run_ids = [] if whole is None else whole["run_id"]
+    summaries = [s for s in (finished_summary(folder, r) for r in run_ids) if s is not None]
+    return "\n".join([
+        title,
+        "The shipped colonnade shaken by the same one-cosine pulses (the fragility's pulse "
+        "shape) along its row (in-plane), across it (out-of-plane) and at 45 deg to it, "
+        "one run per pulse and direction. Single runs are samples: the counts and their "
+        "Wilson intervals say how few there are, not a probability over a site's "
+        "motions. The 3D discrete-element study of the Forum colonnade at Pompeii found "
+        "the out-of-plane capacity lower than the in-plane one; the table gives what "
+        "these runs show, whichever way it goes.\n",
+        _table(pd.DataFrame(rows)) + "\n",
+        f"Cost: {sum(s.wall_s for s in summaries) / 60:.1f} min of YADE wall time over "
+        f"{len(summaries)} run(s) (files: `{name}/directions.csv`, `{name}/colonnades.csv`, "
+        f"`{name}/colonnade_statistics.json`).\n"])

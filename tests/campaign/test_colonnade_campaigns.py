@@ -107,6 +107,12 @@ def test_a_still_colonnade_campaign_writes_its_colonnade_outcomes(name, table, t
     assert (whole["colonnade"] == SHIPPED).all()
     assert (whole[["columns", "columns_fallen", "beams", "beams_fallen"]].to_numpy()
             == [4, 0, 6, 0]).all()
+    from pipeline.stats.colonnade import ColonnadeStatistics
+    (group,) = ColonnadeStatistics.load(out).groups        # one record, members only
+    members = len(whole) - (name == "ensemble")             # the nominal run is no sample
+    assert group.runs == members and group.fallen[0].count == members
+    assert (group.parallel.of, group.in_sequence.of) == (0, 0)
+    assert (out / "colonnade_statistics.png").exists()
     if name == "records":                     # the report's section from these files
         from pipeline.report import colonnade_section
         text = colonnade_section(tmp_path)
@@ -114,4 +120,6 @@ def test_a_still_colonnade_campaign_writes_its_colonnade_outcomes(name, table, t
         cells = [c.strip() for c in row.strip("|").split("|")]
         assert cells[1:4] == ["0 of 4", "0 of 6", "-"]
         assert cells[6] == "N1 none, N2 none, N3 none, N4 none" and float(cells[7]) == 0.0
+        assert "| weak     |      1 | 1.00 [0.21, 1.00]" in text     # P(0 fell), Wilson
+        assert "colonnade_statistics.png" in text
         assert "Not run yet" in colonnade_section(tmp_path / "nothing")

@@ -125,3 +125,39 @@ def test_the_figure_draws_every_state(tmp_path):
     fits = damage_state_fits(_table(300), {"drums": "d", "monolithic": "m"}, 0.2, 1.5)
     path = plot_damage_states(FragilityFile(damage_states=fits), tmp_path / "ds.png")
     assert path.stat().st_size > 10_000
+
+
+def test_fragility_levels_give_each_state_or_worse_per_level():
+    """fragility_levels.csv's per-state columns against a hand count: at level 1, states
+    none, slight, severe, collapse (a run without damage measures left out); at level 2,
+    moderate and collapse twice; the Wilson intervals from their closed form."""
+    from scipy import stats
+
+    from pipeline.campaign.fragility_tables import level_table
+    rows = [(1.0, "none"), (1.0, "slight"), (1.0, "severe"), (1.0, "collapse"), (1.0, ""),
+            (2.0, "moderate"), (2.0, "collapse"), (2.0, "collapse")]
+    table = pd.DataFrame({"record_id": "R", "level_m_s2": [r[0] for r in rows],
+                          "damage_state": [r[1] for r in rows], "column": "drums",
+                          "pgv_m_s": 0.1, "toppled": [r[1] == "collapse" for r in rows]})
+    levels = level_table(table)
+    one = levels[(levels["record_id"] == "R") & (levels["level_m_s2"] == 1.0)].iloc[0]
+    two = levels[(levels["record_id"] == "R") & (levels["level_m_s2"] == 2.0)].iloc[0]
+    z = stats.norm.ppf(0.975)
+
+    def wilson(k, n):
+        p, d = k / n, 1 + z * z / n
+        half = z / d * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n))
+        return (p + z * z / (2 * n)) / d - half, (p + z * z / (2 * n)) / d + half
+    hand = {(1.0, "slight"): 3, (1.0, "moderate"): 2, (1.0, "severe"): 2,
+            (1.0, "collapse"): 1, (2.0, "slight"): 3, (2.0, "moderate"): 3,
+            (2.0, "severe"): 2, (2.0, "collapse"): 2}
+    for row, level, n in ((one, 1.0, 4), (two, 2.0, 3)):
+        assert row["n_drums_states"] == n
+        for state in STATES:
+            k = hand[(level, state)]
+            assert row[f"p_drums_{state}"] == pytest.approx(k / n)
+            assert (row[f"p_drums_{state}_lo"], row[f"p_drums_{state}_hi"]) == \
+                pytest.approx(wilson(k, n), abs=1e-9)
+    assert one["p_drums"] == pytest.approx(1 / 5) and one["n_drums"] == 5   # toppled: all runs
+    pooled = levels[levels["record_id"] == "all records"]
+    assert list(pooled["p_drums_collapse"]) == pytest.approx([1 / 4, 2 / 3])

@@ -68,18 +68,10 @@ def _load_campaign_fragility(path, column, form, below, members):
         if fit is None:
             raise InputError(f"{path}: column {named}: no PGA fit in the file (give "
                              "--fragility-form pga-pgv for its logistic surface)")
-        if fit.unit != "m/s^2":
-            raise InputError(f"{path}: column {named}: PGA fit in unknown unit "
-                             f"{fit.unit!r} (expected m/s^2)")
         if fit.median is None:
             raise InputError(f"{path}: column {named}: PGA fragility not fitted "
                              f"({fit.note or 'no median'})")
-        where = f"{path}: column {named}: PGA"
-        low, high = (g * STANDARD_GRAVITY for g in MEDIAN_G_RANGE)
-        pooled = Lognormal(number(fit.median, f"{where} median", low, high, "m/s^2"),
-                           number(fit.beta, f"{where} beta", *BETA_RANGE),
-                           _floats(fit.median_ci95), _floats(fit.beta_ci95), label=label,
-                           note=fit.note)
+        pooled = _pga_lognormal(fit, f"{path}: column {named}: PGA", label)
     elif form == "pga-pgv":
         pooled = _logistic(entry.logistic, f"{path}: column {named}", label)
     else:
@@ -90,6 +82,46 @@ def _load_campaign_fragility(path, column, form, below, members):
     pooled = replace(pooled, member_fits=fits,
                      note="; ".join(filter(None, [pooled.note, note])) or None)
     return pooled, "records", file.records
+
+
+def _pga_lognormal(fit, where, label):
+    """The :class:`Lognormal` of a file's lognormal PGA fit (a
+    :class:`~pipeline.hazard.fragility.fits.LognormalFit` with a median), its median and
+    beta in the ranges a stated one takes."""
+    if fit.unit != "m/s^2":
+        raise InputError(f"{where}: fit in unknown unit {fit.unit!r} (expected m/s^2)")
+    low, high = (g * STANDARD_GRAVITY for g in MEDIAN_G_RANGE)
+    return Lognormal(number(fit.median, f"{where} median", low, high, "m/s^2"),
+                     number(fit.beta, f"{where} beta", *BETA_RANGE),
+                     _floats(fit.median_ci95), _floats(fit.beta_ci95), label=label,
+                     note=fit.note)
+
+
+def load_state_fragilities(path, column):
+    """(fragilities, source): the fragility of each damage state below collapse (slight,
+    moderate, severe), P(DS >= s | PGA) on the file's PGA, of ``column`` in a
+    ``fragility.json``'s ``damage_states``: its lognormal PGA fit (None for a state no
+    run, or every run, reached); ``source`` says where they came from.  A file without
+    damage-state fits, or without the column's, gives (None, None, None) and a source
+    saying so."""
+    file = read_fragility_file(path)
+    path = file.path
+    entry = (file.damage_states or {}).get(column)
+    if entry is None:
+        held = ", ".join(map(key_text, file.damage_states or {}))
+        return (None,) * 3, (f"{path} holds no damage-state fits" + (
+            f" for column {key_text(column)}, only for {held}" if held else
+            ": give --state-lognormal, or a fragility.json of campaign fragility with "
+            "damage_states"))
+    fitted, states = [], {s.state: s for s in entry.states}
+    for state in ("slight", "moderate", "severe"):
+        fit = states[state].fits.get("PGA") if state in states else None
+        fitted.append(None if fit is None or fit.median is None else _pga_lognormal(
+            fit, f"{path}: damage_states.{key_text(column)}.{state}: PGA",
+            f"damage state {state} or worse of {column} from {path.name} (lognormal PGA "
+            "fit)"))
+    return tuple(fitted), (f"{path}: damage_states.{key_text(column)}, the lognormal PGA "
+                           "fit of each state")
 
 
 def member_fits(runs_path, column, form, block=None):
