@@ -32,7 +32,7 @@ def constrain_files(o):
         groups = [SiteGroup(trees[s], tuple(j for j, t in enumerate(sites) if t == s), s)
                   for s in trees]
     specimens = o.specimens()
-    ratio = o.ratio_model(specimens)
+    ratio = o.ratio_model(specimens, tree)
     summary, rows, figure = constrain_tree(tree, specimens, ratio, ages, o.rule, o.floor,
                                            o.draws, o.seed, groups)
     files = {"branch_weights.csv": _branch_table(rows),
