@@ -34,10 +34,13 @@ class BranchRatios:
             raise InputError("PGV/PGA per branch: one model per group of branches")
 
     def describe(self):
+        """constrain.json's pgv_pga: the one model's description and how the branches take
+        it, or each group's."""
+        said = {"per_branch": self.per_branch, "branches": self.why}
+        if len(self.models) == 1:
+            return {**self.models[0].describe(), **said}
         first = self.models[0].describe()
-        return {"source": self.route,
-                "per_branch": self.per_branch,
-                "branches": self.why,
+        return {"source": self.route, **said,
                 **{k: v for k, v in first.items() if k in ("file", "site_index")},
                 "groups": [{"branch_indices": [int(b) for b in rows], **m.describe()}
                            for m, rows in zip(self.models, self.rows)]}

@@ -38,7 +38,8 @@ class RatioFromMrd:
         return np.interp(ln_a, x, self.ln_mean), np.interp(ln_a, x, self.ln_sd)
 
     def describe(self):
-        return {"source": f"rate density of PGA and PGV (mrd) of the {self.kind}",
+        return {"source": "mean rate density of PGA and PGV (mrd)" if self.kind == "mean"
+                else f"rate density of PGA and PGV (mrd) of realisation {self.kind}",
                 **{k: v for k, v in self.source.items() if k in ("file", "site_index")},
                 "pga_cells_with_events": int(self.pga_m_s2.size),
                 "distribution": "lognormal given PGA: the rate-weighted mean and sd of the "
