@@ -7,8 +7,8 @@ import numpy as np
 
 from pipeline.constants import STANDARD_GRAVITY
 from pipeline.hazard.branch_ratio import rates_by_ratio
-from pipeline.hazard.constrain import (FRACTILES, TARGET_RATES, bayes, branch_rates,
-                                       cell_matrix, change_percent, draw_chunk, eliminate,
+from pipeline.hazard.constrain import (FRACTILES, TARGET_RATES, bayes, cell_matrix,
+                                       change_percent, draw_chunk, eliminate,
                                        log_survival_fixed, log_survival_sampled,
                                        motion_at_rate, weighted_mean,
                                        weighted_quantile)
