@@ -288,8 +288,8 @@ def _members(tree, specimens, survival_of, floor, warnings):
                         f"({sorted(counts)}): the members' spread not reported")
         return None
     count = counts.pop()
-    log_ps = np.array([survival_of([[m[k] if m else f for m, f in zip(lists, specimens)]])[0][0]
-                       for k in range(count)])
+    log_ps = survival_of([[m[k] if m else f for m, f in zip(lists, specimens)]
+                          for k in range(count)])[0]        # all members at once
     ps = np.exp(log_ps)
     mixture = ps.mean(axis=0)
     posteriors = [bayes(tree.weights, lp) for lp in log_ps]

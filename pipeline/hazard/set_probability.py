@@ -7,14 +7,14 @@ the shaking they share, computed for D sets in one pass: the expectation over PG
 weighted sum over points (:func:`ratio_quadrature`: Gauss-Hermite nodes of a lognormal,
 and for a mixture over disaggregation bins every bin's nodes times its share, so every
 bin's grid is evaluated in the same call), and a specimen whose D fragilities are pulse
-grids differing only in their counts (draws, members) is evaluated by one interpolation of
-the D grids (:meth:`~pipeline.hazard.fragility.grid.PulseGrid.probability_stack`).
+grids differing only in their counts (draws, members; as they are or on the hazard's
+PGA measure) is evaluated by one interpolation of the D grids
+(:meth:`~pipeline.hazard.fragility.grid.PulseGrid.probability_stack`).
 Units: PGA in m/s^2, PGV/PGA in s."""
 import numpy as np
 
 from pipeline.files import InputError
 from pipeline.hazard.disagg_ratio import RatioMixture, bin_shares
-from pipeline.hazard.fragility.grid import PulseGrid
 from pipeline.hazard.fragility.ratio import ratio_nodes
 
 MAX_VALUES = 4_000_000        # sets x PGA levels x PGV/PGA points held at once (32 MB)
@@ -73,7 +73,7 @@ def _column(fragilities, pga, ratio):
     if all(f is first for f in fragilities):
         return (first.probability(a, ratio) if ratio is not None
                 else first.probability(a))[None]
-    if isinstance(first, PulseGrid) and all(first.stacks_with(f) for f in fragilities):
+    if all(first.stacks_with(f) for f in fragilities):
         return first.probability_stack(fragilities, a, ratio)
     return np.array([f.probability(a, ratio) if ratio is not None else f.probability(a)
                      for f in fragilities])

@@ -61,7 +61,7 @@ class PulseGrid(Fragility):
     def probability(self, pga_m_s2, pgv_pga_s):
         return self._interpolate(self.p, pga_m_s2, pgv_pga_s)
 
-    def probability_stack(self, grids, pga_m_s2, pgv_pga_s):
+    def probability_stack(self, grids, pga_m_s2, pgv_pga_s=None):
         """P of each of the grids ``grids`` (the same cells' layout, runs, surface and
         below-grid rule as this one, their counts their own: its :meth:`draws` or
         :meth:`members`) at the points, D x the points' shape: one interpolation for all
