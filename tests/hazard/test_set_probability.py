@@ -1,7 +1,8 @@
 """Many fragility sets at once (constrain's draws and members): the stacked evaluation of
 pulse grids and the one quadrature over PGV/PGA give what a loop over the draws gives
 with the one-set function (each grid alone, each bin of a disaggregation alone), to
-round-off, on a toy grid with an empty cell, points below, inside, beside and above it."""
+round-off, on a toy grid with an empty cell, points below, inside, beside and above it;
+the sampled ages' survival as one matrix product against each sample's own sum."""
 import math
 
 import numpy as np
@@ -9,9 +10,11 @@ import pytest
 
 from pipeline import RECORDS_DIR
 from pipeline.constants import STANDARD_GRAVITY as G
+from pipeline.hazard.constrain import age_chain, log_survival_sampled
 from pipeline.hazard.disagg_ratio import overturn_probability_over, ratio_mixture
 from pipeline.hazard.disaggregation import load_mag_dist
 from pipeline.hazard.fragility import Logistic, Lognormal, PulseGrid, RatioFromGmm, RatioLognormal
+from pipeline.hazard.fragility.components import OnHazardMeasure
 from pipeline.hazard.set_probability import ratio_quadrature, set_probabilities
 
 PGA = np.geomspace(0.02, 3.0, 37) * G           # below, inside and above the grid
@@ -84,3 +87,30 @@ def test_quadrature_weights_sum_to_one_at_every_level():
         points, weights = ratio_quadrature(model, PGA)
         assert points.shape == weights.shape and points.shape[0] == PGA.size
         np.testing.assert_allclose(weights.sum(axis=1), 1.0, rtol=1e-12)
+
+
+def test_grids_on_the_hazards_measure_stack_as_their_grids():
+    fraction = 0.8
+    wrapped = OnHazardMeasure(_grid(), fraction, {"fraction": fraction})
+    draws = wrapped.draws(6, np.random.default_rng(4))
+    assert all(draws[0].stacks_with(d) for d in draws)
+    batch = [[d] for d in draws]
+    ratio_model = RatioLognormal(0.3, 0.5)
+    np.testing.assert_allclose(set_probabilities(batch, ratio_model, PGA),
+                               _loop(batch, ratio_model), rtol=1e-12, atol=1e-14)
+
+
+def test_sampled_ages_as_the_sum_over_each_sample():
+    """ln P_s over sampled ages against each sample's own sum of dt x rate."""
+    rng = np.random.default_rng(8)
+    ages = rng.uniform(1e3, 2e4, size=(300, 3))
+    rate_of = {}
+
+    def set_rates(members):
+        return rate_of.setdefault(members, rng.uniform(1e-6, 1e-4, size=(2, 5)))
+    log_p, se = log_survival_sampled(set_rates, ages)
+    logs = np.array([-sum(dt * set_rates(m) for m, dt in age_chain(a)) for a in ages])
+    want = np.log(np.exp(logs).mean(axis=0))
+    np.testing.assert_allclose(log_p, want, rtol=1e-12)
+    p = np.exp(logs) / np.exp(want)
+    np.testing.assert_allclose(se, p.std(axis=0, ddof=1) / np.sqrt(len(ages)), rtol=1e-9)
