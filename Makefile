@@ -104,8 +104,9 @@ campaigns: setup
 # postproc/case_mrd shipped in records/hazard/), with Double Rock's reduced fragility:
 # survival under (a) the mean rate density, (b) the PGA curve with its Mag_Dist
 # disaggregation, (c) the PGA curve with one scenario (M 5.75, 110 km: the modal bin of
-# that disaggregation at 0.0062 g; the site's Vs30 1000 m/s), and constrain under (a) and
-# (c); 100 fragility draws (route b evaluates the grid once per bin). About 1 min on 2 cores
+# that disaggregation at 0.0062 g; the site's Vs30 1000 m/s), and constrain under each
+# (route b per realisation: each branch its own Mag_Dist column); 100 fragility draws.
+# About 1 min on 2 cores
 ROUTES_CASE := records/hazard/openquake_postproc_case_mrd
 ROUTES_ROCK := --fragility results/field-rock-quick-fragility/fragility.json --age-ka 15 \
   --age-sd-ka 3 --draws 100
@@ -120,6 +121,9 @@ HAZARD_ROUTES := $(PY) -m pipeline survival --joint-hazard $(ROUTES_CASE)/mrd_pg
   $(ROUTES_SCENARIO) $(ROUTES_ROCK) --out $(ROUTES_OUT)/scenario-survival && \
   $(PY) -m pipeline constrain --logic-tree $(ROUTES_CASE) --joint-hazard \
   $(ROUTES_CASE)/mrd_pga_pgv.hdf5 $(ROUTES_ROCK) --out $(ROUTES_OUT)/joint-constrain && \
+  $(PY) -m pipeline constrain --logic-tree $(ROUTES_CASE) --disaggregation \
+  $(ROUTES_CASE)/disaggregation/Mag_Dist-0_7.csv --vs30 1000 $(ROUTES_ROCK) \
+  --out $(ROUTES_OUT)/disaggregation-constrain && \
   $(PY) -m pipeline constrain --logic-tree $(ROUTES_CASE) $(ROUTES_SCENARIO) $(ROUTES_ROCK) \
   --out $(ROUTES_OUT)/scenario-constrain
 

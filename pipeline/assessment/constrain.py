@@ -24,15 +24,15 @@ def constrain_files(o):
     from pipeline.figures.constrain import plot_constrain  # lazy: matplotlib, only when a figure is drawn
     ages = o.age_models()
     sites = o.specimen_sites()
-    tree = load_logic_tree(o.logic_tree, o.site if o.site is not None or sites is None
-                           else sites[0])
-    groups = None
+    site = o.site if o.site is not None or sites is None else sites[0]
+    groups, trees = None, {}
     if sites is not None:
         trees = {s: load_logic_tree(o.logic_tree, s) for s in dict.fromkeys(sites)}
         groups = [SiteGroup(trees[s], tuple(j for j, t in enumerate(sites) if t == s), s)
                   for s in trees]
+    tree = trees[site] if site in trees else load_logic_tree(o.logic_tree, site)
     specimens = o.specimens()
-    ratio = o.ratio_model(specimens)
+    ratio = o.ratio_model(specimens, tree)
     summary, rows, figure = constrain_tree(tree, specimens, ratio, ages, o.rule, o.floor,
                                            o.draws, o.seed, groups)
     files = {"branch_weights.csv": _branch_table(rows),

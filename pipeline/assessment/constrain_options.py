@@ -10,7 +10,9 @@ from pipeline.assessment.options import (CONSTRAIN_OUT, KA, MAX_AGE_KA, MAX_SPEC
                                          _per_specimen)
 from pipeline.files import InputError
 from pipeline.hazard.ages import LowerBound, TruncatedNormal, UniformInterval, load_age_samples
+from pipeline.hazard import branch_ratio
 from pipeline.hazard.constrain import FLOOR
+from pipeline.hazard.disaggregation import load_mag_dist
 from pipeline.scenario.parameters import check_fields, param
 
 
@@ -61,13 +63,26 @@ class ConstrainOptions(SpecimenOptions):
                          "branch", 0, 1, low_open=True, high_open=True, flag="--floor",
                          metavar="P")
     joint_hazard: Path = param(
-        None, "", "or PGV/PGA at each PGA level from the mean rate density mrd of PGA and "
-        "PGV (an OpenQuake datastore or its extract) at --site: one distribution for every "
-        "branch (the engine writes the mean's only, no branch's)", flag="--joint-hazard",
+        None, "", "or PGV/PGA at each PGA level from the rate density mrd of PGA and PGV "
+        "(an OpenQuake datastore or its extract) at --site: each branch K its realisation "
+        "K's where the file holds one per realisation (mrd-rlzs), else the mean's for every "
+        "branch (the engine writes the mean's only)", flag="--joint-hazard",
         metavar="FILE", optional=True)
+    disaggregation: Path = param(
+        None, "", "or PGV/PGA at each PGA level a mixture over OpenQuake's "
+        "magnitude-distance disaggregation at --site (its Mag_Dist CSV export): the "
+        "ground-motion model at each bin, weighted by the bin's share of the events near "
+        "that level (with --vs30, --mechanism, --pga-pgv-correlation)",
+        flag="--disaggregation", metavar="FILE", optional=True)
+    disaggregation_column: str = param(
+        None, "", "the column of --disaggregation for every branch: mean, or rlzK for "
+        "realisation K", flag="--disaggregation-column", metavar="NAME",
+        optional="each branch K its column rlzK where the file holds every branch's, "
+        "else mean")
     out: Path = param(CONSTRAIN_OUT, "", "output directory", flag="--out", metavar="DIR")
 
-    RATIO_FLAGS = (*SpecimenOptions.RATIO_FLAGS, "joint_hazard")
+    RATIO_FLAGS = (*SpecimenOptions.RATIO_FLAGS, "joint_hazard", "disaggregation",
+                   "disaggregation_column")
 
     def __post_init__(self):
         check_fields(self)
@@ -86,21 +101,37 @@ class ConstrainOptions(SpecimenOptions):
         _per_specimen(values, n, flag)
         if self.age_ka:
             _per_specimen(self.age_sd_ka, n, "--age-sd-ka")
-        self.specimen_sites()
-        if self.joint_hazard is not None and (self.pgv_pga_median is not None or
-                                              self.magnitude is not None):
-            raise InputError("PGV/PGA: give --joint-hazard, --pgv-pga-median/"
-                             "--pgv-pga-sigma or --magnitude/--distance-km, one of them")
+        self._check_route(self.specimen_sites())
         _check_out(self.out)
 
-    def ratio_model(self, specimens):
-        """PGV/PGA from --joint-hazard's mean rate density at --site, or as
-        :meth:`SpecimenOptions.ratio_model`."""
-        if self.joint_hazard is None:
-            return super().ratio_model(specimens)
-        from pipeline.hazard.joint_hazard import load_joint_hazard  # noqa: PLC0415  (h5py: lazy)
-        from pipeline.hazard.mrd_ratio import ratio_from_mrd  # noqa: PLC0415
-        return ratio_from_mrd(load_joint_hazard(self.joint_hazard), self.site or 0)
+    def _check_route(self, sites):
+        """One source of PGV/PGA; --disaggregation (one site's) for specimens at one."""
+        given = [flag for flag, on in (
+            ("--joint-hazard", self.joint_hazard is not None),
+            ("--disaggregation", self.disaggregation is not None),
+            ("--pgv-pga-median/--pgv-pga-sigma", self.pgv_pga_median is not None),
+            ("--magnitude/--distance-km", self.magnitude is not None)) if on]
+        if len(given) > 1:
+            raise InputError(f"PGV/PGA: give {given[0]} or {given[1]}, one of them")
+        if self.disaggregation_column is not None and self.disaggregation is None:
+            raise InputError("--disaggregation-column applies with --disaggregation")
+        if self.disaggregation is not None and sites is not None and len(set(sites)) > 1:
+            raise InputError("--disaggregation is one site's: the specimens are at several "
+                             "sites (--specimen-site)")
+
+    def ratio_model(self, specimens, tree=None):
+        """PGV/PGA per branch of ``tree`` (a :class:`~pipeline.hazard.branch_ratio.
+        BranchRatios`) from --joint-hazard's rate density or --disaggregation at --site,
+        or as :meth:`SpecimenOptions.ratio_model`."""
+        if self.joint_hazard is not None:
+            from pipeline.hazard.joint_hazard import load_joint_hazard  # noqa: PLC0415  (h5py: lazy)
+            return branch_ratio.mrd_ratios(load_joint_hazard(self.joint_hazard),
+                                           self.site or 0, tree)
+        if self.disaggregation is not None:
+            return branch_ratio.disaggregation_ratios(
+                load_mag_dist(self.disaggregation), tree, self.disaggregation_column,
+                self.vs30, self.mechanism, self.pga_pgv_correlation)
+        return super().ratio_model(specimens)
 
     def specimen_sites(self):
         """The site of each specimen (--specimen-site), or None (all at --site)."""

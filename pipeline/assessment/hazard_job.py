@@ -114,7 +114,7 @@ def _with_export(o, export):
     """``constrain``'s options on the export: its logic tree, and PGV/PGA from its rate
     density when no other source of PGV/PGA is given."""
     own = o.joint_hazard is not None or o.pgv_pga_median is not None or \
-        o.magnitude is not None
+        o.magnitude is not None or o.disaggregation is not None
     return replace(o, logic_tree=export, **({} if own else {
         "joint_hazard": export / "mrd_pga_pgv.hdf5"}))
 

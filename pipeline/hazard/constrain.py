@@ -90,15 +90,18 @@ def log_survival_fixed(set_rates, ages_yr):
 
 def log_survival_sampled(set_rates, age_samples):
     """(ln P_s per branch, its standard error relative to P_s per branch): the mean of
-    exp(-sum dt lambda) over sampled ages (Monte Carlo over uncertain, differing ages)."""
-    cache = {}
-
-    def rates(members):
-        if members not in cache:
-            cache[members] = set_rates(members)
-        return cache[members]
-
-    logs = np.array([-sum(dt * rates(m) for m, dt in age_chain(a)) for a in age_samples])
+    exp(-sum dt lambda) over sampled ages (Monte Carlo over uncertain, differing ages).
+    Each set's lambda is computed once; a sample's sum is its durations (samples x sets)
+    times the sets' rates, one matrix product for all samples."""
+    chains = [age_chain(a) for a in age_samples]
+    sets = list(dict.fromkeys(m for chain in chains for m, _ in chain))
+    index = {m: k for k, m in enumerate(sets)}
+    durations = np.zeros((len(chains), len(sets)))
+    for s, chain in enumerate(chains):
+        for members, dt in chain:
+            durations[s, index[members]] += dt
+    rates = np.stack([np.asarray(set_rates(m), float) for m in sets])
+    logs = -np.tensordot(durations, rates, axes=1)
     log_p = logsumexp(logs, axis=0) - np.log(len(logs))
     with np.errstate(invalid="ignore", over="ignore"):
         ratio = np.exp(logs - log_p)                     # samples of P / mean P

@@ -6,8 +6,9 @@ from enum import Enum
 import numpy as np
 
 from pipeline.constants import STANDARD_GRAVITY
-from pipeline.hazard.constrain import (FRACTILES, TARGET_RATES, bayes, branch_rates,
-                                       cell_matrix, change_percent, draw_chunk, eliminate,
+from pipeline.hazard.branch_ratio import rates_by_ratio
+from pipeline.hazard.constrain import (FRACTILES, TARGET_RATES, bayes, cell_matrix,
+                                       change_percent, draw_chunk, eliminate,
                                        log_survival_fixed, log_survival_sampled,
                                        motion_at_rate, weighted_mean,
                                        weighted_quantile)
@@ -17,11 +18,11 @@ from pipeline.hazard.constrain_parts import (BranchRow, ConstrainSpecimen, Curve
 from pipeline.hazard.constrain_sites import (SITE_ASSUMPTION, SiteGroup, branch_test,
                                              check_same_branches, combined)
 from pipeline.hazard.hazard_described import TreeHazard
-from pipeline.hazard.fragility import overturn_probability
 from pipeline.hazard.logictree import LogicTree
 from pipeline.hazard.record import ABSENT
 from pipeline.hazard.survival_parts import age_keys
 from pipeline.hazard.results import ConstrainResult
+from pipeline.hazard.set_probability import set_probabilities
 from pipeline.provenance import software_versions
 
 AGE_SAMPLES = 2000           # Monte Carlo samples of differing, uncertain ages
@@ -182,13 +183,9 @@ def _log_survival(tree, cells, batch, ratio_model, ages, mode, samples):
     (D x B) or None).  ``samples`` None: each age at its fixed or typical value (the
     fragility draws)."""
     def set_rates(members):
-        def probability(x):
-            out = np.empty((len(batch), np.size(x)))     # filled in place: one copy held
-            for k, chosen in enumerate(batch):
-                out[k] = overturn_probability([chosen[j] for j in members], ratio_model, x,
-                                              "any_common")
-            return out
-        return branch_rates(cells, tree.levels_m_s2, tree.rates_per_yr, probability)
+        sets = [[chosen[j] for j in members] for chosen in batch]
+        return rates_by_ratio(cells, tree.levels_m_s2, tree.rates_per_yr, ratio_model,
+                              lambda model: lambda x: set_probabilities(sets, model, x))
     if mode is AgeIntegration.ONE_FOR_ALL:
         rate = set_rates(tuple(range(len(batch[0]))))
         with np.errstate(divide="ignore"):
@@ -291,8 +288,8 @@ def _members(tree, specimens, survival_of, floor, warnings):
                         f"({sorted(counts)}): the members' spread not reported")
         return None
     count = counts.pop()
-    log_ps = np.array([survival_of([[m[k] if m else f for m, f in zip(lists, specimens)]])[0][0]
-                       for k in range(count)])
+    log_ps = survival_of([[m[k] if m else f for m, f in zip(lists, specimens)]
+                          for k in range(count)])[0]        # all members at once
     ps = np.exp(log_ps)
     mixture = ps.mean(axis=0)
     posteriors = [bayes(tree.weights, lp) for lp in log_ps]
@@ -352,10 +349,13 @@ def _draws(tree, cells, specimens, survival_of, draws, rng, floor):
 
 def _end_warnings(tree, cells, specimens, ratio_model, weights):
     """A warning when, for branches of weight, the last level holds much of the rate."""
-    def probability(x):
-        return overturn_probability(specimens, ratio_model, x, "any_common")
-    total = branch_rates(cells, tree.levels_m_s2, tree.rates_per_yr, probability)
-    top = float(probability(tree.levels_m_s2[-1:])[0]) * tree.rates_per_yr[:, -1]
+    def probability_of(model):
+        return lambda x: set_probabilities([specimens], model, x)[0]
+    total = rates_by_ratio(cells, tree.levels_m_s2, tree.rates_per_yr, ratio_model,
+                           probability_of)
+    last = (tree.levels_m_s2[-1:], np.zeros((tree.size, 1)), 1)   # the last level's term
+    top = rates_by_ratio(last, tree.levels_m_s2, tree.rates_per_yr, ratio_model,
+                         probability_of)
     with np.errstate(invalid="ignore", divide="ignore"):
         share = np.where(total > 0, top / total, 0.0)
     w = tree.weights if weights is None else weights

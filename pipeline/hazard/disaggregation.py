@@ -86,18 +86,22 @@ class MagDistDisaggregation:
         """InputError unless column ``column``'s bins add up to the rate of ``curve`` (a
         :class:`~pipeline.hazard.curves.HazardCurve` of the same realisation) at each
         level, interpolated in (ln PGA, ln rate), within :data:`BIN_SUM_TOLERANCE`."""
+        self.check_rates(column, curve.levels_m_s2, curve.rates_per_yr, "the hazard curve")
+
+    def check_rates(self, column, levels_m_s2, rates_per_yr, against):
+        """:meth:`check_curve` against a curve given as its levels (m/s^2) and annual rates
+        of exceedance (1/yr); ``against``: the curve in words, for the message."""
         if column not in self.columns:
             raise InputError(f"{self.source.get('file')}: no column {show(column)} (has "
                              f"{', '.join(self.columns)})")
-        levels = np.log(curve.levels_m_s2)
-        inside = (self.levels_m_s2 >= curve.levels_m_s2[0]) & \
-            (self.levels_m_s2 <= curve.levels_m_s2[-1])
+        levels = np.asarray(levels_m_s2, float)
+        inside = (self.levels_m_s2 >= levels[0]) & (self.levels_m_s2 <= levels[-1])
         if not inside.all():
             raise InputError(f"{self.source.get('file')}: a level outside the curve's "
-                             f"{curve.levels_m_s2[0]:.4g}-{curve.levels_m_s2[-1]:.4g} m/s^2")
-        target = np.exp(np.interp(np.log(self.levels_m_s2), levels,
-                                  np.log(curve.rates_per_yr)))
-        self._check_sums(self.columns.index(column), target, "the hazard curve")
+                             f"{levels[0]:.4g}-{levels[-1]:.4g} m/s^2")
+        target = np.exp(np.interp(np.log(self.levels_m_s2), np.log(levels),
+                                  np.log(np.asarray(rates_per_yr, float))))
+        self._check_sums(self.columns.index(column), target, against)
 
     def _check_sums(self, c, target, against):
         total = self.bin_rates_per_yr[c].sum(axis=(1, 2))

@@ -10,6 +10,8 @@ names (``records/tools/oq_mrd_extract.py``):
   two intensity measures and per site; axis 0 the second IMT (``imt2``), axis 1 the first,
   as ``openquake.hazardlib.calc.mrd`` fills it.  The engine writes the mean over its
   realisations only;
+- ``mrd-rlzs`` where a file holds it (the engine 3.26 writes none; an extract may): the
+  same per realisation, (L-1) x (L-1) x N x R, realisation r that of ``rlz_id`` r;
 - ``oqparam`` (JSON): ``hazard_imtls`` (the levels, PGA in g and PGV in cm/s),
   ``investigation_time`` (years) and ``postproc_args`` (``imt1``, ``imt2``);
 - ``sitecol/lon`` and ``sitecol/lat`` (degrees).
@@ -44,13 +46,15 @@ class JointHazard:
     ``pga_levels_m_s2[i+1]``) and PGV in [``pgv_levels_m_s[j]``, ``pgv_levels_m_s[j+1]``)
     at site ``s`` (the engine's "mean rate density", a rate per cell).  Nothing below the
     first levels or above the last is held.  ``investigation_time_yr``: the calculation's;
-    ``source``: where it comes from (dict)."""
+    ``source``: where it comes from (dict); ``realisation_rates_per_yr[r, s, i, j]``: the
+    same per realisation r, or None (the file holds the mean's only)."""
     pga_levels_m_s2: np.ndarray
     pgv_levels_m_s: np.ndarray
     cell_rates_per_yr: np.ndarray
     investigation_time_yr: float
     sites: tuple
     source: dict = field(default_factory=dict, compare=False)
+    realisation_rates_per_yr: np.ndarray | None = field(default=None, compare=False)
 
     def __post_init__(self):
         where = self.source.get("file", "joint hazard")
@@ -63,16 +67,12 @@ class JointHazard:
                 raise InputError(f"{where}: {name} levels must be positive numbers ({unit})")
             if np.any(np.diff(levels) <= 0):
                 raise InputError(f"{where}: {name} levels do not increase")
-        rates = self.cell_rates_per_yr
         expected = (len(self.sites), self.pga_levels_m_s2.size - 1,
                     self.pgv_levels_m_s.size - 1)
-        if rates.shape != expected:
-            raise InputError(f"{where}: the rates are {rates.shape} (sites x PGA cells x "
-                             f"PGV cells); the levels and sites make {expected}")
-        if not np.all(np.isfinite(rates)):
-            raise InputError(f"{where}: a rate that is not a finite number")
-        if np.any(rates < 0):
-            raise InputError(f"{where}: a negative rate ({rates.min():.3g} /yr)")
+        _check_rates(where, "the rates", self.cell_rates_per_yr, expected)
+        if self.realisation_rates_per_yr is not None:
+            rlz = self.realisation_rates_per_yr
+            _check_rates(where, "the realisations' rates", rlz, (rlz.shape[0], *expected))
         if not (math.isfinite(self.investigation_time_yr) and self.investigation_time_yr > 0):
             raise InputError(f"{where}: investigation time {self.investigation_time_yr!r} "
                              "is not a positive number of years")
@@ -86,16 +86,35 @@ class JointHazard:
         if not (isinstance(index, int | np.integer) and 0 <= index < n):
             raise InputError(f"{self.source.get('file', 'joint hazard')}: site {index} "
                              f"beyond the file's {n} site(s) (0 to {n - 1})")
+        rlz = self.realisation_rates_per_yr
         return JointHazard(self.pga_levels_m_s2, self.pgv_levels_m_s,
                            self.cell_rates_per_yr[index:index + 1],
                            self.investigation_time_yr, (self.sites[index],),
-                           {**self.source, "site_index": int(index)})
+                           {**self.source, "site_index": int(index)},
+                           None if rlz is None else rlz[:, index:index + 1])
+
+    @property
+    def realisations(self):
+        """How many realisations the file holds a rate density of (0: the mean's only)."""
+        rlz = self.realisation_rates_per_yr
+        return 0 if rlz is None else rlz.shape[0]
 
     def pga_interval_rates(self):
         """Summed over PGV: sites x PGA cells, the annual rate (1/yr) of PGA falling in
         each interval between consecutive levels (what the PGA curve gives as
         lambda(x_i) - lambda(x_i+1), less what falls outside the PGV levels)."""
         return self.cell_rates_per_yr.sum(axis=2)
+
+
+def _check_rates(where, what, rates, expected):
+    """InputError unless ``rates`` has the shape ``expected`` and holds finite rates >= 0."""
+    if rates.shape != expected:
+        raise InputError(f"{where}: {what} are {rates.shape} ([realisations x] sites x PGA "
+                         f"cells x PGV cells); the levels and sites make {expected}")
+    if not np.all(np.isfinite(rates)):
+        raise InputError(f"{where}: a rate that is not a finite number")
+    if np.any(rates < 0):
+        raise InputError(f"{where}: a negative rate ({rates.min():.3g} /yr)")
 
 
 def load_joint_hazard(path):
@@ -152,9 +171,8 @@ def _read(path, f):
     if len(sites) != mrd.shape[2]:
         raise InputError(f"{path}: mrd holds {mrd.shape[2]} site(s), sitecol "
                          f"{len(sites)}")
-    rates = np.moveaxis(mrd, 2, 0)                 # sites x imt2 x imt1
-    if imts[0] == "PGA":
-        rates = np.swapaxes(rates, 1, 2)           # sites x PGA x PGV
+    rates = _pga_first(mrd, imts)
+    rlz = _realisations(path, f, mrd.shape, imts)
     time = params.get("investigation_time")
     source = {"format": "OpenQuake mean rate density (mrd)", "file": str(path),
               "engine_version": _attr(f, "engine_version"),
@@ -162,7 +180,27 @@ def _read(path, f):
               "method": args.get("method"), "kind": "mean over the realisations"}
     return JointHazard(levels["PGA"] * STANDARD_GRAVITY, levels["PGV"] * PGV_CM_S_TO_M_S,
                        rates, float(time) if isinstance(time, int | float) else math.nan,
-                       sites, source)
+                       sites, source, rlz)
+
+
+def _pga_first(mrd, imts):
+    """imt2 x imt1 x sites [x realisations] as [realisations x] sites x PGA x PGV."""
+    rates = np.moveaxis(mrd, 2, 0) if mrd.ndim == 3 else np.moveaxis(mrd, (3, 2), (0, 1))
+    return np.swapaxes(rates, -2, -1) if imts[0] == "PGA" else rates
+
+
+def _realisations(path, f, shape, imts):
+    """The rate density per realisation (``mrd-rlzs``, see the module) or None."""
+    if "mrd-rlzs" not in f:
+        return None
+    try:
+        rlz = np.asarray(f["mrd-rlzs"][()], float)
+    except (TypeError, ValueError, AttributeError):
+        raise InputError(f"{path}: mrd-rlzs does not hold numbers") from None
+    if rlz.ndim != 4 or rlz.shape[:3] != shape or rlz.shape[3] < 1:
+        raise InputError(f"{path}: mrd-rlzs is {rlz.shape}; the mrd {shape} makes "
+                         f"{shape[0]} x {shape[1]} x {shape[2]} x realisations")
+    return _pga_first(rlz, imts)
 
 
 def _oqparam(path, f):

@@ -3,7 +3,9 @@
 the events' ln(PGV/PGA) (cells at their geometric centres), taken as a lognormal of their
 rate-weighted mean and standard deviation; between cells interpolated in ln PGA, held
 beyond the first and last cell with events.  The engine writes the mean's rate density
-only, so every branch gets this one distribution (its PGA curve its own)."""
+only: every branch then gets the mean's distribution (its PGA curve its own); a file with
+the rate density per realisation gives each its own
+(:func:`~pipeline.hazard.branch_ratio.mrd_ratios`)."""
 from dataclasses import dataclass
 
 import numpy as np
@@ -14,11 +16,13 @@ from pipeline.files import InputError
 @dataclass(frozen=True)
 class RatioFromMrd:
     """ln(PGV/PGA) (PGV m/s, PGA m/s^2: ln s) given PGA at ``pga_m_s2`` (the PGA cells
-    with events): ``ln_mean`` and ``ln_sd``; ``source``: the file and site."""
+    with events): ``ln_mean`` and ``ln_sd``; ``source``: the file and site; ``kind``:
+    "mean" or the realisation ("rlz-K") whose rate density it is."""
     pga_m_s2: np.ndarray
     ln_mean: np.ndarray
     ln_sd: np.ndarray
     source: dict
+    kind: str = "mean"
 
     def __post_init__(self):
         if self.pga_m_s2.size < 1 or not (self.pga_m_s2.shape == self.ln_mean.shape ==
@@ -34,18 +38,20 @@ class RatioFromMrd:
         return np.interp(ln_a, x, self.ln_mean), np.interp(ln_a, x, self.ln_sd)
 
     def describe(self):
-        return {"source": "mean rate density of PGA and PGV (mrd), the same for every "
-                          "branch (the engine writes the mean's only)",
+        return {"source": "mean rate density of PGA and PGV (mrd)" if self.kind == "mean"
+                else f"rate density of PGA and PGV (mrd) of realisation {self.kind}",
                 **{k: v for k, v in self.source.items() if k in ("file", "site_index")},
                 "pga_cells_with_events": int(self.pga_m_s2.size),
                 "distribution": "lognormal given PGA: the rate-weighted mean and sd of the "
                                 "events' ln(PGV/PGA) in each PGA cell (geometric centres)"}
 
 
-def ratio_from_mrd(joint, site):
-    """The :class:`RatioFromMrd` of ``joint`` (a JointHazard) at ``site`` (0-based)."""
+def ratio_from_mrd(joint, site, realisation=None):
+    """The :class:`RatioFromMrd` of ``joint`` (a JointHazard) at ``site`` (0-based): of its
+    mean, or of ``realisation`` r (an index of its ``realisation_rates_per_yr``)."""
     one = joint.site(site)
-    rates = one.cell_rates_per_yr[0]
+    rates = one.cell_rates_per_yr[0] if realisation is None else \
+        one.realisation_rates_per_yr[realisation, 0]
     pga = np.sqrt(one.pga_levels_m_s2[:-1] * one.pga_levels_m_s2[1:])
     pgv = np.sqrt(one.pgv_levels_m_s[:-1] * one.pgv_levels_m_s[1:])
     total = rates.sum(axis=1)
@@ -54,4 +60,5 @@ def ratio_from_mrd(joint, site):
     w = rates[keep] / total[keep][:, None]
     mean = (w * ln_ratio).sum(axis=1)
     sd = np.sqrt(np.maximum((w * (ln_ratio - mean[:, None]) ** 2).sum(axis=1), 0.0))
-    return RatioFromMrd(pga[keep], mean, sd, dict(one.source))
+    return RatioFromMrd(pga[keep], mean, sd, dict(one.source),
+                        "mean" if realisation is None else f"rlz-{realisation}")

@@ -2,7 +2,9 @@
 survival and the constrained hazard of one rock under (a) OpenQuake's mean rate density
 of PGA and PGV, (b) the PGA curve with PGV given PGA over its magnitude-distance
 disaggregation and (c) the PGA curve with PGV given PGA from one scenario
-(``make run-all`` writes results/hazard-routes/<route>-survival and -constrain)."""
+(``make run-all`` writes results/hazard-routes/<route>-survival and -constrain).  Under
+(a) and (b) ``constrain`` gives each branch its own realisation's PGV/PGA where the input
+holds it, the mean's otherwise: the table says which."""
 import pandas as pd
 
 from pipeline.hazard.results import read_constrain_result, read_survival_result
@@ -35,9 +37,10 @@ def hazard_routes_section(results):
         [_survival_row(root / f"{name}-survival" / "survival.json", words)
          for name, words in ROUTES])) + "\n"]
     lines += ["### Constrained hazard\n",
-              "Each branch's chance that the rock fell within its age (1 - P_s) and its "
-              f"weight after Bayes' rule; the mean curve's PGA at {RATE:g} /yr before and "
-              "after.\n",
+              "Each branch's PGV/PGA given PGA (its own realisation's, or the mean's for "
+              "every branch), its chance that the rock fell within its age (1 - P_s) and "
+              f"its weight after Bayes' rule; the mean curve's PGA at {RATE:g} /yr before "
+              "and after.\n",
               _table(pd.DataFrame(
                   [row for name, words in ROUTES
                    for row in _constrain_rows(root / f"{name}-constrain" / "constrain.json",
@@ -60,20 +63,30 @@ def _survival_row(path, words):
 
 def _constrain_rows(path, words):
     if not path.is_file():
-        return [{"route": words, "branch": "-", "prior weight": "-", "1 - P_s": "-",
-                 "Bayes weight": "-", f"mean PGA at {RATE:g} /yr (g)":
-                 "not run: `constrain` takes PGV/PGA from one scenario or the rate density"}]
+        return [{"route": words, "branch": "-", "PGV/PGA from": "not run", "prior weight": "-",
+                 "1 - P_s": "-", "Bayes weight": "-", f"mean PGA at {RATE:g} /yr (g)": "-"}]
     c = read_constrain_result(path)
     mean = next((r for r in c.ground_motion_at_rates
                  if r.curve == "mean" and r.annual_rate_per_yr == RATE), None)
     motion = "-" if mean is None or mean.prior_g is None else \
         f"{mean.prior_g:.4g} -> {mean.posterior_g:.4g}"
     return [{"route": words if k == 0 else "", "branch": f"{b.branch} {b.path}",
+             "PGV/PGA from": _branch_words(c.pgv_pga, k),
              "prior weight": f"{b.prior_weight:.3g}",
              "1 - P_s": f"{1 - b.survival_probability:.3g}",
              "Bayes weight": f"{b.posterior_bayes:.6g}",
              f"mean PGA at {RATE:g} /yr (g)": motion if k == 0 else ""}
             for k, b in enumerate(c.branches)]
+
+
+def _branch_words(pgv_pga, k):
+    """What branch ``k``'s PGV/PGA came from (constrain.json's pgv_pga), in a few words."""
+    if pgv_pga is None or "per_branch" not in pgv_pga:
+        return _ratio_words(pgv_pga)
+    if not pgv_pga["per_branch"]:
+        return f"{_ratio_words(pgv_pga)}, the mean's for every branch"
+    group = next(g for g in pgv_pga["groups"] if k in g["branch_indices"])
+    return f"{_ratio_words(group)}, its own realisation's"
 
 
 def _ratio_words(pgv_pga):
@@ -82,6 +95,8 @@ def _ratio_words(pgv_pga):
         return "each event of the rate density"
     if "bins_used" in pgv_pga:
         return f"{pgv_pga['bins_used']} magnitude-distance bins"
+    if "pga_cells_with_events" in pgv_pga:
+        return "rate density"
     if "magnitude" in pgv_pga:
         return (f"M {pgv_pga['magnitude']:g}, {pgv_pga['distance_jb_km']:g} km, correlation "
                 f"{pgv_pga['pga_pgv_correlation']:g}")

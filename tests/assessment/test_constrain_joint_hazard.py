@@ -17,7 +17,8 @@ def test_the_mean_rate_density_gives_pgv_pga_for_every_branch(tmp_path, capsys):
     assert main([*BASE, "--out", str(out)]) == 0, capsys.readouterr().err
     summary = json.loads((out / "constrain.json").read_text())
     assert "mean rate density" in summary["pgv_pga"]["source"]
-    assert "mean's only" in summary["pgv_pga"]["source"]
+    assert summary["pgv_pga"]["per_branch"] is False
+    assert "mean's only" in summary["pgv_pga"]["branches"]
     assert summary["branch_count"] == 2
 
 

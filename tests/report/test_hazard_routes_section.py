@@ -1,6 +1,6 @@
 """The REPORT section of the three routes to the joint hazard: it says when nothing has run,
-quotes each route's survival.json and constrain.json as written, and says that constrain
-has no disaggregation route."""
+quotes each route's survival.json and constrain.json as written, each branch's PGV/PGA
+its own realisation's or the mean's as the file says."""
 import json
 
 from pipeline.cli import main
@@ -28,6 +28,9 @@ def test_each_route_is_quoted_from_its_files(tmp_path):
             "scenario-survival": ["survival", "--hazard", CURVE, *SCENARIO],
             "joint-constrain": ["constrain", "--logic-tree", CASE, "--joint-hazard",
                                 f"{CASE}/mrd_pga_pgv.hdf5"],
+            "disaggregation-constrain": [
+                "constrain", "--logic-tree", CASE, "--vs30", "1000", "--disaggregation",
+                f"{CASE}/disaggregation/Mag_Dist-0_7.csv"],
             "scenario-constrain": ["constrain", "--logic-tree", CASE, *SCENARIO]}
     for name, argv in runs.items():
         assert main([*argv, *ROCK, "--out", str(root / name)]) == 0
@@ -40,7 +43,10 @@ def test_each_route_is_quoted_from_its_files(tmp_path):
         assert f" {rate:.3g} " in text
     assert "14 magnitude-distance bins" in text        # the case's bins with events
     assert "M 5.75, 110 km, correlation 0.654" in text
-    joint = json.loads((root / "joint-constrain" / "constrain.json").read_text())
-    for branch in joint["branches"]:
-        assert f" {1 - branch['survival_probability']:.3g} " in text
-    assert "not run: `constrain` takes PGV/PGA from one scenario or the rate density" in text
+    for name in ("joint", "disaggregation", "scenario"):
+        c = json.loads((root / f"{name}-constrain" / "constrain.json").read_text())
+        for branch in c["branches"]:
+            assert f" {1 - branch['survival_probability']:.3g} " in text
+    assert "rate density, the mean's for every branch" in text
+    assert text.count("magnitude-distance bins, its own realisation's") == 2
+    assert "not run" not in text

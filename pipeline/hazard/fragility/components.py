@@ -106,6 +106,14 @@ class OnHazardMeasure(Fragility):
             return self.inner.probability(pga)
         return self.inner.probability(pga, pgv_pga_s)
 
+    def stacks_with(self, other):
+        return isinstance(other, OnHazardMeasure) and other.fraction == self.fraction and \
+            self.inner.stacks_with(other.inner)
+
+    def probability_stack(self, fragilities, pga_m_s2, pgv_pga_s=None):
+        pga = np.asarray(pga_m_s2, float) / self.fraction
+        return self.inner.probability_stack([f.inner for f in fragilities], pga, pgv_pga_s)
+
     def draws(self, n, rng):
         drawn = self.inner.draws(n, rng)
         return None if drawn is None else [replace(self, inner=d) for d in drawn]

@@ -61,20 +61,37 @@ class PulseGrid(Fragility):
     def probability(self, pga_m_s2, pgv_pga_s):
         return self._interpolate(self.p, pga_m_s2, pgv_pga_s)
 
+    def probability_stack(self, grids, pga_m_s2, pgv_pga_s=None):
+        """P of each of the grids ``grids`` (the same cells' layout, runs, surface and
+        below-grid rule as this one, their counts their own: its :meth:`draws` or
+        :meth:`members`) at the points, D x the points' shape: one interpolation for all
+        D (the same numbers as each grid's :meth:`probability`, to round-off)."""
+        cells = np.stack([g.p for g in grids], axis=-1)          # n_pga x n_ratio x D
+        return np.moveaxis(self._interpolate(cells, pga_m_s2, pgv_pga_s), -1, 0)
+
+    def stacks_with(self, other):
+        """True when ``other`` differs from this grid in its counts only (its P per cell),
+        so that :meth:`probability_stack` takes both."""
+        return isinstance(other, PulseGrid) and other == self and \
+            np.array_equal(other.n, self.n)
+
     def _interpolate(self, cells, pga_m_s2, pgv_pga_s):
+        """P at the points from ``cells`` (n_pga x n_ratio, or n_pga x n_ratio x D: then
+        the points' shape x D)."""
         pga, ratio = np.broadcast_arrays(np.asarray(pga_m_s2, float),
                                          np.asarray(pgv_pga_s, float))
+        extra = cells.shape[2:]
         low = pga < self.pga_m_s2[0]
         if self.below == "logistic" or not low.any():
             return self._surface(cells, pga, ratio)
-        p = np.zeros(pga.shape)
+        p = np.zeros(pga.shape + extra)
         if not low.all():
             p[~low] = self._surface(cells, pga[~low], ratio[~low])
         weight = self.below_weight(pga[low])
         ramp = weight > 0                # only where P is not 0 is the edge's P needed
         if ramp.any():
-            below = np.zeros(weight.shape)
-            below[ramp] = weight[ramp] * self._surface(
+            below = np.zeros(weight.shape + extra)
+            below[ramp] = _trailing(weight[ramp], extra) * self._surface(
                 cells, np.full(int(ramp.sum()), self.pga_m_s2[0]), ratio[low][ramp])
             p[low] = below
         return p
@@ -105,18 +122,20 @@ class PulseGrid(Fragility):
         continuous at the edge and a cell of P 0 or 1 stays so; the raw surface, with its
         steps, for ``below`` "logistic"), or without a surface the edge cell's P."""
         pga, ratio = np.broadcast_arrays(np.asarray(pga, float), np.asarray(ratio, float))
-        held, beyond = interpolate(self.pga_m_s2, self.pgv_pga_s, fill_empty(cells)[0],
+        held, beyond = interpolate(self.pga_m_s2, self.pgv_pga_s, _filled(cells),
                                    pga, ratio)               # the edge cell's P outside
         p = np.array(held, float)
         if self.outside is not None and beyond.any():      # the surface only where needed
             a, r = pga[beyond], ratio[beyond]
+            extra = cells.shape[2:]
             if self.below == "logistic":
-                p[beyond] = self.outside.probability(a, r)
+                p[beyond] = _trailing(self.outside.probability(a, r), extra)
             else:
                 edge_a = np.clip(a, self.pga_m_s2[0], self.pga_m_s2[-1])
                 edge_r = np.clip(r, self.pgv_pga_s[0], self.pgv_pga_s[-1])
-                p[beyond] = _carried(held[beyond], self.outside.probability(a, r),
-                                     self.outside.probability(edge_a, edge_r))
+                p[beyond] = _carried(
+                    held[beyond], _trailing(self.outside.probability(a, r), extra),
+                    _trailing(self.outside.probability(edge_a, edge_r), extra))
         return np.clip(p, 0.0, 1.0)
 
     def draws(self, n, rng):
@@ -211,6 +230,21 @@ class PulseGrid(Fragility):
                 "angle of its runs (block2d uplift_g_smallest) or, in a file without it, "
                 "their median",
                 "note": note}
+
+
+def _trailing(values, extra):
+    """``values`` with an axis of one for each of the ``extra`` axes (broadcast over them)."""
+    return np.reshape(values, np.shape(values) + (1,) * len(extra))
+
+
+def _filled(cells):
+    """:func:`~pipeline.hazard.pulse_cells.fill_empty` of cells (n_pga x n_ratio), or of
+    each of a stack (n_pga x n_ratio x D)."""
+    if cells.ndim == 2:
+        return fill_empty(cells)[0]
+    if not np.isnan(cells).any():
+        return cells
+    return np.stack([fill_empty(cells[..., d])[0] for d in range(cells.shape[2])], axis=-1)
 
 
 def _carried(p_edge, surface, surface_at_edge):

@@ -52,6 +52,16 @@ class Fragility(ABC):
         """One fragility per parameter set (member) of the campaign, or None."""
         return None
 
+    def stacks_with(self, other):
+        """True when :meth:`probability_stack` takes ``other`` with this one (by default
+        never: each is evaluated alone)."""
+        return False
+
+    def probability_stack(self, fragilities, pga_m_s2, pgv_pga_s=None):
+        """P of each of ``fragilities`` (this one's kind, each :meth:`stacks_with` it) at
+        the points: D x the points' shape."""
+        return np.array([f.probability(pga_m_s2, pgv_pga_s) for f in fragilities])
+
     def grid_range(self):
         """(first, last) PGA (m/s^2) of the grid the fragility is read from, or None when
         it has no grid."""

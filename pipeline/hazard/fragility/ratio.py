@@ -83,7 +83,7 @@ class RatioFromGmm:
 
 
 @functools.cache
-def _ratio_nodes():
+def ratio_nodes():
     """Gauss-Hermite nodes and weights (summing to 1) over a standard normal, computed once
     (read only)."""
     nodes, weights = np.polynomial.hermite_e.hermegauss(RATIO_NODES)
@@ -106,7 +106,7 @@ def overturn_probability(fragilities, ratio_model, pga_m_s2, combine="each"):
             raise InputError("the fragility depends on PGV/PGA: give its distribution "
                              "(--pgv-pga-median and --pgv-pga-sigma, or --magnitude and "
                              "--distance-km)")
-        nodes, weights = _ratio_nodes()
+        nodes, weights = ratio_nodes()
         mean, sd = ratio_model.ln_mean_sd(pga)
         ratio = np.exp(mean[:, None] + sd[:, None] * nodes[None, :])
         each = np.array([f.probability(pga[:, None], ratio) for f in fragilities])
