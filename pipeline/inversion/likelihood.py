@@ -69,7 +69,6 @@ import copy
 import math
 
 import numpy as np
-from scipy import special
 
 from pipeline.files import InputError
 from pipeline.inversion.observations import ColumnObservation
