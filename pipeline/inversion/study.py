@@ -240,7 +240,8 @@ def just_beyond_sites(pool, s, reach_km, strike_deg, n_sites, fallen, rng):
     """Sites of a source of slice ``s`` just beyond the reach ``reach_km`` (the likelihood's
     last ring): each at a distance uniform between the reach and ``JUST_BEYOND_FACTOR``
     times it (or the pool's next ring, if nearer), at a node azimuth where the pool falls
-    at the rings about it (different azimuths while there are enough); each column drawn
+    at the rings about it, the first's or a neighbour of it (sites that see the source
+    from one side, near enough to each other for candidates in common); each column drawn
     from the nearer ring's members or the farther's in proportion to the distance's
     log-distance weight (the mixture the likelihood assumes between rings).  None when
     the pool has no ring beyond the reach or no fall at its rings about it."""
@@ -253,11 +254,13 @@ def just_beyond_sites(pool, s, reach_km, strike_deg, n_sites, fallen, rng):
              if pool.toppled[s, i0, j].any() or pool.toppled[s, i1, j].any()]
     if not falls:
         return None
-    order = rng.permutation(len(falls))
+    first = falls[int(rng.integers(len(falls)))]
+    na = len(pool.azimuths_deg)
+    near = [j for j in falls if min((j - first) % na, (first - j) % na) <= 1]
     sites = []
     for k, r in enumerate(np.sort(rng.uniform(reach_km, top, n_sites))):
         r = max(float(r), reach_km * (1 + 1e-6))
-        j = falls[order[k % len(falls)]]
+        j = first if k == 0 else near[int(rng.integers(len(near)))]
         w = math.log(r / rings[i0]) / math.log(rings[i1] / rings[i0])
 
         def pick_ring(w=w):

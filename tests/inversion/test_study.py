@@ -236,8 +236,8 @@ def test_the_shell_beyond_the_reach_is_summed_by_sites_and_sites_beyond():
 
 def test_just_beyond_sites_lie_between_the_reach_and_one_and_a_half_times_it():
     """Sources just beyond a 10 km reach, the pool's rings 10 and 20 km about them: every
-    site between 10 and 15 km (JUST_BEYOND_FACTOR x 10), the first the nearest, on a node
-    azimuth turned by the strike; each column from the 20 km ring's members with the
+    site between 10 and 15 km (JUST_BEYOND_FACTOR x 10), the first the nearest, on the
+    first's node azimuth or a neighbour, turned by the strike; each column from the 20 km ring's members with the
     site's log-distance weight ln(r / 10) / ln 2 (the toy's 10 km members fall toward the
     node azimuth, its 20 km members away from it)."""
     import math
@@ -257,9 +257,13 @@ def test_just_beyond_sites_lie_between_the_reach_and_one_and_a_half_times_it():
         sites = just_beyond_sites(pool, 0, 10.0, strike, 3, 40, rng)
         r = [math.hypot(e, n) for _, e, n, _ in sites]
         assert all(10.0 < d <= 15.0 + 1e-9 for d in r) and r == sorted(r)
+        first = None
         for (_, e, n, cols), d in zip(sites, r):
             node = (math.degrees(math.atan2(e, n)) - strike) % 360.0
             assert min(abs(node - a) % 360.0 for a in AZIMUTHS) < 1e-6
+            first = node if first is None else first
+            # the first site's node azimuth or a neighbour (the toy's spokes 30 deg apart)
+            assert min((node - first) % 360.0, (first - node) % 360.0) < 30.0 + 1e-6
             turned = [(c.downfall_azimuth_deg - strike - node + 90.0) % 360.0 for c in cols]
             assert len(cols) == 40 and all(c.fallen for c in cols)
             far += sum(t > 180.0 for t in turned)  # fell away from the node azimuth
