@@ -49,7 +49,12 @@ BEYOND_BAYES_FACTOR = 3.0   # the falls favour the shell this much over the cand
 #   chosen once on draws the reported member study never uses (its trials with seed 1, the
 #   predictive likelihood, 48 members): 3 sites x 1-30 fallen columns gave false alarms
 #   for 0.024 of the sources well within the reach and hits for 0.94 of those beyond it
-#   (refusals included); 1.4 and 2 gave more false alarms (0.13, 0.06) for few more hits
+#   (refusals included); 1.4 and 2 gave more false alarms (0.13, 0.06) for few more hits.
+#   Kept when the shell's decay became a marginal (shell_decay), which lowers B: on a
+#   quarter of those draws (50 trials per K) false alarms at 3 went from 0.014 to 0 and
+#   at 1.4 from 0.15 to 0, hits from 0.95 to 0.925, but 35 of the 40 sources beyond were
+#   refused: too few answered to choose again; choose again on a table that reaches
+#   farther, where the sources beyond are answered
 EXTRAPOLATED = ("the shell's likelihood extrapolates the forward table past its last ring "
                 "(the last ring's fall directions, its P carried on by a decay the table "
                 "cannot measure, marginalised over slopes from the last two rings' to one "
