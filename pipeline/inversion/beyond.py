@@ -7,10 +7,9 @@ sits inside.  So the posterior carries a second set of epicentres beside the can
 a shell of lattice cells (``SHELL_STEP`` times the candidates' step) whose farthest site
 lies beyond the last ring, out to ``SHELL_FACTOR`` times it, and within the radius of some
 site.  There the likelihood reads the last ring's fall directions and carries its P on
-by a decay with distance the table cannot measure, so the shell's likelihood is
-marginalised over it (:mod:`pipeline.inversion.shell_decay`: slopes from the last two
-rings' to one leaving nothing falling at the shell's outer edge): an extrapolation of
-the table, flagged as such in the summary.
+by the table's own decay with distance
+(:meth:`pipeline.inversion.likelihood.ForwardModel.decay`): an extrapolation of the
+table, flagged as such in the summary.
 
 The prior: uniform over area within each set (and the candidates' prior over magnitude,
 mechanism and strike in both), and "beyond the reach" given ``PRIOR_BEYOND``, one less
@@ -39,8 +38,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.special import expit, logsumexp
 
-from pipeline.inversion.shell_decay import SHELL_FACTOR, decay_nodes
-
+SHELL_FACTOR = 2.0          # the shell reaches this many times the table's last ring
 SHELL_STEP = 2              # the shell's lattice step in candidate steps
 PRIOR_BEYOND = 0.05         # prior probability that the source lies in the shell: one
 #                             less the 95 % level, so that the 95 % region takes the shell
@@ -49,16 +47,10 @@ BEYOND_BAYES_FACTOR = 3.0   # the falls favour the shell this much over the cand
 #   chosen once on draws the reported member study never uses (its trials with seed 1, the
 #   predictive likelihood, 48 members): 3 sites x 1-30 fallen columns gave false alarms
 #   for 0.024 of the sources well within the reach and hits for 0.94 of those beyond it
-#   (refusals included); 1.4 and 2 gave more false alarms (0.13, 0.06) for few more hits.
-#   Kept when the shell's decay became a marginal (shell_decay), which lowers B: on a
-#   quarter of those draws (50 trials per K) false alarms at 3 went from 0.014 to 0 and
-#   at 1.4 from 0.15 to 0, hits from 0.95 to 0.925, but 35 of the 40 sources beyond were
-#   refused: too few answered to choose again; choose again on a table that reaches
-#   farther, where the sources beyond are answered
+#   (refusals included); 1.4 and 2 gave more false alarms (0.13, 0.06) for few more hits
 EXTRAPOLATED = ("the shell's likelihood extrapolates the forward table past its last ring "
-                "(the last ring's fall directions, its P carried on by a decay the table "
-                "cannot measure, marginalised over slopes from the last two rings' to one "
-                "leaving nothing falling at the shell's outer edge)")
+                "(the last ring's fall directions, its P carried on by the decay between "
+                "the last two rings)")
 ONE_SITE_NOTE = ("one site: its falls cannot tell a source beyond the reach from a nearer "
                  "one of smaller magnitude, so P(beyond the reach) says little more than "
                  "its prior, and the distance interval and the epicentre "
@@ -176,20 +168,10 @@ def beyond_shell(model, observations, grid, log_prior_slice, log_likelihood):
               "east_km": east, "north_km": north}
     if east.size == 0:
         return Beyond(**common, probability=np.zeros(log_likelihood.shape[:2] + (0,)))
-    shell = shell_log_likelihood(model, observations, east, north, grid.strikes_deg)
+    shell = model.log_likelihood(observations, east, north, grid.strikes_deg)
     log_post = log_prior_slice[:, None, None] + shell
     log_z = [float(logsumexp(log_prior_slice[:, None, None] + ll)) - math.log(ll[0].size)
              for ll in (shell, log_likelihood)]
     probability = np.exp(log_post - logsumexp(log_post))
     return Beyond(**common, probability=probability / probability.sum(),
                   log_bayes_factor=log_z[0] - log_z[1])
-
-
-def shell_log_likelihood(model, observations, east_km, north_km, strikes_deg):
-    """The shell cells' log-likelihood (n_sources, n_strikes, n_cells), marginalised over
-    the decay beyond the last ring: the mean of the whole likelihood over the slope
-    (:func:`pipeline.inversion.shell_decay.decay_nodes`), one slope for every column."""
-    steepness, weights = decay_nodes()
-    each = np.stack([model.at_steepness(t).log_likelihood(observations, east_km, north_km,
-                                                          strikes_deg) for t in steepness])
-    return logsumexp(each, axis=0, b=weights.reshape((-1,) + (1,) * (each.ndim - 1)))

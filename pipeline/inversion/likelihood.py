@@ -18,12 +18,13 @@ f(psi_obs - alpha) = sum_nodes w P_n d_n(psi_obs - alpha), a standing one
 sum_nodes w (1 - P_n): the sub-density of "fell toward psi" and the probability of
 standing are interpolated as mixtures of the four surrounding nodes, bilinearly in
 log distance (clamped at the first ring) and in node azimuth (periodic).  The inversion's
-candidates never lie beyond the last ring of a site; only the shell of the sources
-beyond (:mod:`pipeline.inversion.beyond`) reads there: the last ring's direction density,
-its P carried on by a decay in log distance at the slope ``decay_steepness``
-(:mod:`pipeline.inversion.shell_decay`; the shell marginalises over it).  Interpolating
-in the site frame moves a fall direction fixed relative to the source-to-site direction
-smoothly between nodes.
+candidates never lie beyond the last ring of a site
+(:func:`pipeline.inversion.posterior.invert`); only its shell of the sources beyond
+(:mod:`pipeline.inversion.beyond`) reads there: the last ring's direction density, its
+P carried on by the decay of log-odds P with log distance between the last two rings
+(never rising: a node whose P rises between them keeps its last P).  Interpolating in
+the site frame moves a fall direction that is fixed relative to the source-to-site
+direction smoothly between nodes.
 
 Between spokes (node azimuths ``h`` deg apart) the table cannot tell whether the falls
 keep their direction relative to the source-to-site direction (the site frame, in which
@@ -58,21 +59,24 @@ after f earlier falls and s earlier standing columns of its type at the site, co
 with 1 / A = 1 / (n + 1) + 1 / m, f(psi) = P d(psi) and q = 1 - P as above, psi_i the
 earlier falls and K a von Mises kernel of width sqrt(kernel^2 + sigma^2 + sigma_i^2),
 floored like d.  The first
-column of a type contributes what the independent product gives; later ones weigh less
-the more the site's own columns already say.  A sums two uncertainties of the site's
-fall distribution about the table's: its n members (1 / (n + 1)) and the site's own
-departure from its node (1 / m, ``site_columns``, chosen on the member study's
-calibration draws: :data:`SITE_COLUMNS`; m -> 0 counts a site's columns as one).  The
-predictive likelihood is the default (:data:`DEFAULT_LIKELIHOOD`).
+column of a type contributes exactly what the independent product gives; later ones
+weigh less the more the site's own columns already say.  A sums two uncertainties of the
+site's fall distribution about the table's: the table's n members (1 / (n + 1)) and the
+site's own departure from its node (1 / m, ``site_columns``: the site's motion is not the
+node's, the candidate's strike and cell are not the source's, the site's columns are a
+few draws, not the population).  m was chosen on the member study's calibration draws
+(:data:`SITE_COLUMNS`); m -> infinity is the urn of the table's sampling alone, m -> 0
+counts a site's columns as one.  With A >> j the urn and the product agree.  The
+predictive likelihood is the default (:data:`DEFAULT_LIKELIHOOD`): in the member study its
+95 % regions are calibrated within the reach, where the product's are too narrow.
 """
-import copy
 import math
 
 import numpy as np
+from scipy import special
 
 from pipeline.files import InputError
 from pipeline.inversion.observations import ColumnObservation
-from pipeline.inversion.shell_decay import decay_factor
 from pipeline.stats.circular import concentration, von_mises_pdf
 
 LIKELIHOODS = ("independent", "predictive")
@@ -85,7 +89,8 @@ PSI_STEP_DEG = 0.5
 OBS_CHUNK = 8                  # observations per vectorised block (memory)
 VIRTUAL_STEP_DEG = 7.5         # the largest spacing of the virtual azimuths between spokes
 MW_STEP = 0.1                  # the candidates' magnitude step between the table's slices
-SITE_COLUMNS = 3.0             # m: a site's columns as m draws' worth of the node's (predictive)
+SITE_COLUMNS = 3.0             # m: a site's columns as m draws' worth of the node's (predictive;
+#                                chosen on the member study's calibration draws, docs/inversion.md)
 
 
 def p_toppled(k, n):
@@ -131,7 +136,6 @@ class ForwardModel:
                   + w[:, None] * self.p_nodes[:, :, (j + 1) % len(table.azimuths_deg), :])
         self.sources, self.mix = magnitude_sources(table.slices, self.mw_step)
         self._fallen_cache = {}
-        self.decay_steepness = 0.0      # beyond the last ring: the last two rings' slope
 
     def _virtual_nodes(self):
         """(node index j, weight w of node j + 1) of each virtual azimuth."""
@@ -197,19 +201,16 @@ class ForwardModel:
         return i0, i1, w1, beyond
 
     def decay(self, c, beyond):
-        """P beyond the last ring over the last ring's P (ns, ne, n_virtual) of column type c
-        at ``beyond`` = ln(r / last ring) (ne,), at the slope ``decay_steepness``."""
-        r, one = self.table.distances_km, len(self.table.distances_km) == 1
-        return decay_factor(self.p[:, -1, :, c], None if one else self.p[:, -2, :, c],
-                            1.0 if one else r[-1] / r[-2],
-                            float(p_toppled(0, self.n[..., c].max())), beyond,
-                            self.decay_steepness)
-
-    def at_steepness(self, steepness):
-        """This model (arrays shared) reading beyond the last ring at slope ``steepness``."""
-        model = copy.copy(self)
-        model.decay_steepness = float(steepness)
-        return model
+        """P beyond the last ring over the last ring's P, per slice, candidate and virtual
+        azimuth (ns, ne, n_virtual), for column type c at ``beyond`` = ln(r / last ring)
+        (ne,): log-odds P carried on along the slope between the last two rings, never
+        rising (one ring: no slope, P held)."""
+        last = special.logit(self.p[:, -1, :, c])                       # (ns, nv)
+        rings = np.log(self.table.distances_km)
+        slope = np.zeros(last.shape) if len(rings) == 1 else np.minimum(
+            (last - special.logit(self.p[:, -2, :, c])) / (rings[-1] - rings[-2]), 0.0)
+        far = special.expit(last[:, None, :] + slope[:, None, :] * beyond[None, :, None])
+        return far / self.p[:, -1, :, c][:, None, :]
 
     def azimuth_weights(self, theta_deg):
         """(i0, i1, w1): virtual azimuths around theta (periodic), weight of i1."""
