@@ -166,9 +166,9 @@ def _beyond_lines(study):
     if not rows:
         return []
     return [f"The posterior carries the sources beyond the reach (a shell of epicentres out "
-            f"to {SHELL_FACTOR:g} times the last ring, its likelihood extrapolated past the "
-            f"table, marginalised over the decay, prior {PRIOR_BEYOND:g}).  Sources beyond "
-            "the reach (all, and just beyond: every site within "
+            f"to {SHELL_FACTOR:g} times the last ring, its likelihood extrapolated by the "
+            f"table's decay, prior {PRIOR_BEYOND:g}).  Sources beyond the reach (all, and "
+            "just beyond: every site within "
             f"{JUST_BEYOND_FACTOR:g} times the reach), "
             "by number of sites and of those beyond the reach (covered: the 95 % region holds the "
             "truth, the distance interval open above and the magnitude's reaching the "
