@@ -25,24 +25,22 @@ def site_frame(sites_world, truth_world=(0.0, 0.0)):
 
 
 def draw_site_columns(pool, s, i, j, strike_deg, fallen, rng, sigma_deg=OBS_UNCERTAINTY_DEG,
-                      pick_slice=None):
+                      pick_slice=None, pick_ring=None):
     """Columns at node (slice s, ring i, azimuth j) drawn from ``pool`` until ``fallen``
     have fallen: a column type and a member at random, falls turned by the strike with a
-    normal measurement error of ``sigma_deg``; ``pick_slice()``, when given, chooses each
-    column's slice instead of ``s``.  None when no slice that may be picked has a fall
-    there (the caller checks that for ``pick_slice``)."""
-    if pick_slice is None:
-        if not pool.toppled[s, i, j].any():
-            return None
-        def pick_slice():
-            return s
+    normal measurement error of ``sigma_deg``; ``pick_slice()`` and ``pick_ring()``, when
+    given, choose each column's slice and ring instead of ``s`` and ``i``.  None when no
+    slice that may be picked has a fall there (the caller checks that for the pickers)."""
+    if pick_slice is None and pick_ring is None and not pool.toppled[s, i, j].any():
+        return None
     cols, count = [], 0
     for _ in range(50 * fallen + 50):
-        k = pick_slice()
-        choices = np.argwhere(pool.valid[k, i, j])
+        k = s if pick_slice is None else pick_slice()
+        ring = i if pick_ring is None else pick_ring()
+        choices = np.argwhere(pool.valid[k, ring, j])
         c, m = choices[rng.integers(len(choices))]
-        if pool.toppled[k, i, j, c, m]:
-            az = (pool.azimuth_deg[k, i, j, c, m] + strike_deg
+        if pool.toppled[k, ring, j, c, m]:
+            az = (pool.azimuth_deg[k, ring, j, c, m] + strike_deg
                   + rng.normal(0.0, sigma_deg)) % 360.0
             cols.append(ColumnObservation(pool.columns[c], "fallen", float(az), sigma_deg))
             count += 1

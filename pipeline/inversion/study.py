@@ -25,7 +25,11 @@ slice's with probability w, else the lower's, the mixture the likelihood assumes
 slices, so this tests the inversion's reading of it, not whether the physics is such a
 mixture) and ``beyond`` (the likelihood's table leaves out the last ring and the first
 site lies on it: the source lies beyond the inversion's reach, and the right answer is a
-warning that it may lie farther, with no direction).
+warning that it may lie farther, with no direction) and ``just_beyond`` (the same
+likelihood's table, every site between its last ring and ``JUST_BEYOND_FACTOR`` times it,
+or the pool's next ring if nearer: :func:`just_beyond_sites`; the sources just beyond the
+reach, where a larger source outside and a smaller one at the reach's edge are hardest to
+tell apart).
 
 Per configuration: coverage of the 95 % back-azimuth arc (with its Wilson interval: a
 coverage is calibrated when the interval holds 0.95), its median width, the share of arcs
@@ -42,6 +46,7 @@ shell lies in the 95 % epicentre region (``beyond_in_95``) and how many of its s
 beyond the likelihood's last ring from the source (``sites_beyond``).
 """
 
+import math
 import os
 from functools import partial
 from multiprocessing import Pool
@@ -64,7 +69,10 @@ from pipeline.inversion.options import STUDY_TRIALS   # declared with --trials
 LIKELIHOOD_MEMBERS = (3, 6, 12, 24, 48)
 OBSERVATION_MEMBERS = 16
 STUDY_SEED = 2027
-PLACEMENTS = ("node", "between", "between_spokes", "between_magnitudes", "beyond")
+PLACEMENTS = ("node", "between", "between_spokes", "between_magnitudes", "beyond",
+              "just_beyond")
+BEYOND_PLACEMENTS = ("beyond", "just_beyond")    # sources beyond the likelihood's reach
+JUST_BEYOND_FACTOR = 1.5    # just beyond: sites between the reach and this many times it
 
 
 def split_for_study(table, observation_members=OBSERVATION_MEMBERS):
@@ -93,6 +101,7 @@ def held_out_nodes(table):
         out["between_magnitudes"] = (np.ones(nr, bool), 1)
     if nr >= 2:
         out["beyond"] = (np.arange(nr) < nr - 1, 1)
+        out["just_beyond"] = (np.arange(nr) < nr - 1, 1)
     return out
 
 
@@ -171,13 +180,51 @@ def study_trial(models, pool, n_sites, fallen, candidates, rng):
         return None
     placement, pair, weight, true_mw = drawn
     strike = float(rng.uniform(0.0, 360.0))
+    placed = _draw_sites(models, pool, placement, pair, weight, strike, n_sites, fallen, rng)
+    if placed is None:
+        return None
+    placement, sites = placed
+    model = models[placement]
+    reach = model.table.distances_km[-1]
+    observations, truth = site_frame(sites)
+    true_baz = azimuth_deg(truth[0], truth[1])
+    distances = [float(np.hypot(e, n)) for _, e, n, _ in sites]
+    row = {"slice": pair[0] if weight < 0.5 else pair[1],
+           "mechanism": table.slices[pair[0]]["mechanism"], "true_mw": true_mw,
+           "sites": len(sites), "fallen_per_site": fallen, "strike_deg": strike,
+           "placement": placement, "true_back_azimuth_deg": true_baz,
+           "true_distance_km": float(np.hypot(*truth)),
+           "site_distances_km": " ".join(f"{r:g}" for r in distances),
+           "standing_observed": sum(not c.fallen for *_, cols in sites for c in cols),
+           "no_candidate": False,
+           # sites farther from the source than the likelihood's last ring
+           "sites_beyond": int(sum(r > reach + 1e-9 for r in distances)),
+           # a site as far as the likelihood's last ring: the source at the reach's edge
+           "at_reach_edge": bool(max(distances) >= reach - candidates.step_km)}
+    try:
+        post = invert(model, observations, candidates)
+    except OutOfReach:
+        return _refused_row(row, truth, observations, model.table, candidates)
+    return _answer_row(row, post, truth, true_baz, true_mw)
+
+
+def _draw_sites(models, pool, placement, pair, weight, strike, n_sites, fallen, rng):
+    """(placement, [(name, east km, north km, columns)] about the source at the origin) of
+    a trial; a placement whose nodes see no fall is tried as ``node``; None when no node
+    sees one."""
+    table = models["node"].table
+    if placement == "just_beyond":
+        sites = just_beyond_sites(pool, pair[0], models[placement].table.distances_km[-1],
+                                  strike, n_sites, fallen, rng)
+        if sites is not None:
+            return placement, sites
+        placement = "node"
     first, others = _site_nodes(pool, pair, placement, *held_out_nodes(table)[placement])
     if not first:
         placement = "node"
         first, others = _site_nodes(pool, pair, "node", *held_out_nodes(table)["node"])
     if not first:
         return None
-    model = models[placement]
     start = first[int(rng.integers(len(first)))]
     rest = [n for n in others if n != start]
     picks = rng.choice(len(rest), size=min(n_sites - 1, len(rest)), replace=False)
@@ -186,27 +233,42 @@ def study_trial(models, pool, n_sites, fallen, candidates, rng):
         e, n = site_position(pool.distances_km[i], (pool.azimuths_deg[j] + strike) % 360.0)
         sites.append((f"S{k + 1}", e, n, draw_columns(pool, pair, weight, i, j, strike,
                                                       fallen, rng)))
-    observations, truth = site_frame(sites)
-    true_baz = azimuth_deg(truth[0], truth[1])
-    row = {"slice": pair[0] if weight < 0.5 else pair[1],
-           "mechanism": table.slices[pair[0]]["mechanism"], "true_mw": true_mw,
-           "sites": len(sites), "fallen_per_site": fallen, "strike_deg": strike,
-           "placement": placement, "true_back_azimuth_deg": true_baz,
-           "true_distance_km": float(np.hypot(*truth)),
-           "site_distances_km": " ".join(f"{np.hypot(e, n):g}" for _, e, n, _ in sites),
-           "standing_observed": sum(not c.fallen for *_, cols in sites for c in cols),
-           "no_candidate": False,
-           # sites farther from the source than the likelihood's last ring
-           "sites_beyond": int(sum(pool.distances_km[i] > model.table.distances_km[-1] + 1e-9
-                                   for i, _ in [start] + [rest[p] for p in picks])),
-           # a site as far as the likelihood's last ring: the source at the reach's edge
-           "at_reach_edge": bool(max(np.hypot(e, n) for _, e, n, _ in sites)
-                                 >= model.table.distances_km[-1] - candidates.step_km)}
-    try:
-        post = invert(model, observations, candidates)
-    except OutOfReach:
-        return _refused_row(row, truth, observations, model.table, candidates)
-    return _answer_row(row, post, truth, true_baz, true_mw)
+    return placement, sites
+
+
+def just_beyond_sites(pool, s, reach_km, strike_deg, n_sites, fallen, rng):
+    """Sites of a source of slice ``s`` just beyond the reach ``reach_km`` (the likelihood's
+    last ring): each at a distance uniform between the reach and ``JUST_BEYOND_FACTOR``
+    times it (or the pool's next ring, if nearer), at a node azimuth where the pool falls
+    at the rings about it, the first's or a neighbour of it (sites that see the source
+    from one side, near enough to each other for candidates in common); each column drawn
+    from the nearer ring's members or the farther's in proportion to the distance's
+    log-distance weight (the mixture the likelihood assumes between rings).  None when
+    the pool has no ring beyond the reach or no fall at its rings about it."""
+    rings = pool.distances_km
+    i1 = int(np.searchsorted(rings, reach_km + 1e-9))
+    if i1 == 0 or i1 >= len(rings):
+        return None
+    i0, top = i1 - 1, min(JUST_BEYOND_FACTOR * reach_km, rings[i1])
+    falls = [j for j in range(len(pool.azimuths_deg))
+             if pool.toppled[s, i0, j].any() or pool.toppled[s, i1, j].any()]
+    if not falls:
+        return None
+    first = falls[int(rng.integers(len(falls)))]
+    na = len(pool.azimuths_deg)
+    near = [j for j in falls if min((j - first) % na, (first - j) % na) <= 1]
+    sites = []
+    for k, r in enumerate(np.sort(rng.uniform(reach_km, top, n_sites))):
+        r = max(float(r), reach_km * (1 + 1e-6))
+        j = first if k == 0 else near[int(rng.integers(len(near)))]
+        w = math.log(r / rings[i0]) / math.log(rings[i1] / rings[i0])
+
+        def pick_ring(w=w):
+            return i1 if rng.uniform() < w else i0
+        e, n = site_position(r, (pool.azimuths_deg[j] + strike_deg) % 360.0)
+        sites.append((f"S{k + 1}", e, n, draw_site_columns(
+            pool, s, i0, j, strike_deg, fallen, rng, pick_ring=pick_ring)))
+    return sites
 
 
 def _refused_row(row, truth, observations, table, candidates):

@@ -5,7 +5,7 @@ import numpy as np
 import pandas as pd
 
 from pipeline.inversion.demo import BOUND_DEG, BOUND_TEXT, BOUNDED_FRACTION_KEY
-from pipeline.inversion.study import PLACEMENTS
+from pipeline.inversion.study import BEYOND_PLACEMENTS, PLACEMENTS
 from pipeline.stats.ensemble import wilson_interval
 
 
@@ -91,7 +91,7 @@ def placement_summary(trials):
         parts = [(placement, None, g[g["placement"] == placement]) for placement in PLACEMENTS]
         parts += [(f"{placement}, {WELL_WITHIN}", None,
                    g[(g["placement"] == placement) & inside & ~edge])
-                  for placement in PLACEMENTS if placement != "beyond"]
+                  for placement in PLACEMENTS if placement not in BEYOND_PLACEMENTS]
         reach = [(WELL_WITHIN, inside & ~edge), ("at the reach's edge", inside & edge),
                  ("beyond the reach", ~inside)]
         parts += [(label, None, g[mask]) for label, mask in reach]
@@ -223,12 +223,14 @@ REGIONS = ("distance_in_95", "epicentre_in_95", "mw_in_95")
 
 def beyond_hypothesis(trials):
     """{likelihood: {likelihood_members, beyond: {sites: {sites beyond the reach: ...}},
-    well_within: {sites: ...}}} at each likelihood's largest member count: for the sources
-    beyond the reach, the coverage of the distance, epicentre and magnitude regions (a
-    region holds the truth or the inversion refuses: ``coverage_*``, Wilson intervals),
+    just_beyond: {...}, well_within: {sites: ...}}} at each likelihood's largest member
+    count: for the sources beyond the reach (``just_beyond``: those of that placement
+    alone: every site within ``JUST_BEYOND_FACTOR`` times the reach), the coverage of the distance,
+    epicentre and magnitude regions (a region holds the truth or the inversion refuses:
+    ``coverage_*``, Wilson intervals) and P(beyond) (``p_beyond_*``, refusals left out),
     per number of sites and per number of those beyond the reach (``all`` pooled); for the
-    sources well within it, the posterior's mass put beyond (``p_beyond_*``, refusals
-    left out), the share whose 95 % region holds the shell and the same coverages."""
+    sources well within it, the same, P(beyond)'s 90th percentile and the share whose 95 %
+    region holds the shell."""
     if "p_beyond" not in trials.columns:
         return {}
     out = {}
@@ -236,27 +238,34 @@ def beyond_hypothesis(trials):
         g = g[g["likelihood_members"] == g["likelihood_members"].max()]
         inside = g["within_reach"].astype(bool)
         well = g[inside & ~g["at_reach_edge"].astype(bool)]
-        beyond = {}
-        for sites, part in g[~inside].groupby("sites"):
-            beyond[str(int(sites))] = {"all": _covered(part), **{
-                str(int(n)): _covered(q) for n, q in part.groupby("sites_beyond")}}
         within = {}
         for sites, part in well.groupby("sites"):
             p = part["p_beyond"].dropna()
             within[str(int(sites))] = {
-                **_covered(part), "p_beyond_mean": float(p.mean()) if len(p) else None,
-                "p_beyond_median": float(p.median()) if len(p) else None,
-                "p_beyond_p90": float(p.quantile(0.9)) if len(p) else None,
+                **_covered(part), "p_beyond_p90": float(p.quantile(0.9)) if len(p) else None,
                 "beyond_in_95": float(part["beyond_in_95"].astype(bool).mean())}
         out[kind] = {"likelihood_members": int(g["likelihood_members"].iloc[0]),
-                     "beyond": beyond, "well_within": within}
+                     "beyond": _by_sites(g[~inside]),
+                     "just_beyond": _by_sites(g[~inside & (g["placement"] == "just_beyond")]),
+                     "well_within": within}
     return out
 
 
+def _by_sites(part):
+    """{sites: {"all" | sites beyond the reach: :func:`_covered`}}."""
+    return {str(int(sites)): {"all": _covered(q), **{
+        str(int(n)): _covered(r) for n, r in q.groupby("sites_beyond")}}
+        for sites, q in part.groupby("sites")}
+
+
 def _covered(part):
-    """Trials, the share refused, and each region's coverage (held or refused)."""
+    """Trials, the share refused, P(beyond)'s mean and median (refusals left out) and each
+    region's coverage (held or refused)."""
     refused = part["no_candidate"].astype(bool)
-    entry = {"trials": len(part), "refused": float(refused.mean())}
+    p = part["p_beyond"].dropna()
+    entry = {"trials": len(part), "refused": float(refused.mean()),
+             "p_beyond_mean": float(p.mean()) if len(p) else None,
+             "p_beyond_median": float(p.median()) if len(p) else None}
     for column in REGIONS:
         hits = int((part[column].astype(bool) | refused).sum())
         name = "coverage_" + column.replace("_in_", "_")

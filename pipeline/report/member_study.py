@@ -7,6 +7,7 @@ from pathlib import Path
 import pandas as pd
 
 from pipeline.inversion.beyond import PRIOR_BEYOND, SHELL_FACTOR
+from pipeline.inversion.study import JUST_BEYOND_FACTOR
 from pipeline.report.common import _figure, _fmt, _table
 from pipeline.report.inversion import _table_provenance, _toppled_by_slice
 
@@ -95,7 +96,8 @@ def _placement_lines(base, study):
              "no_candidate": "no candidate", "width_median_deg": "median arc (deg)"}
     words = {"node": "on the nodes", "between": "between the rings",
              "between_spokes": "between the spokes", "between_magnitudes":
-             "between the magnitudes", "beyond": "beyond the last ring"}
+             "between the magnitudes", "beyond": "beyond the last ring",
+             "just_beyond": "just beyond the last ring"}
     table = largest[["likelihood", "trials"] + [c for c in names if c in largest.columns]]
     table = table.rename(columns=names)
     table["source"] = table["source"].map(
@@ -148,11 +150,13 @@ def _beyond_lines(study):
     coverages; nothing for older studies."""
     rows, within = [], []
     for kind, entry in (study.get("beyond_hypothesis") or {}).items():
-        for sites, parts in entry["beyond"].items():
-            for beyond, r in parts.items():
-                rows.append({"likelihood": kind, "sites": sites,
-                             "sites beyond": "any" if beyond == "all" else beyond,
-                             **_coverages(r)})
+        for which, label in (("beyond", "all"), ("just_beyond", "just beyond")):
+            for sites, parts in entry.get(which, {}).items():
+                for beyond, r in parts.items():
+                    rows.append({"likelihood": kind, "sources": label, "sites": sites,
+                                 "sites beyond": "any" if beyond == "all" else beyond,
+                                 **_coverages(r),
+                                 "mean P(beyond)": r.get("p_beyond_mean")})
         for sites, r in entry["well_within"].items():
             within.append({"likelihood": kind, "sites": sites, **_coverages(r),
                            "mean P(beyond)": r["p_beyond_mean"],
@@ -163,8 +167,10 @@ def _beyond_lines(study):
         return []
     return [f"The posterior carries the sources beyond the reach (a shell of epicentres out "
             f"to {SHELL_FACTOR:g} times the last ring, its likelihood extrapolated by the "
-            f"table's decay, prior {PRIOR_BEYOND:g}).  Sources beyond the reach, by number "
-            "of sites and of those beyond the reach (covered: the 95 % region holds the "
+            f"table's decay, prior {PRIOR_BEYOND:g}).  Sources beyond the reach (all, and "
+            "just beyond: every site within "
+            f"{JUST_BEYOND_FACTOR:g} times the reach), "
+            "by number of sites and of those beyond the reach (covered: the 95 % region holds the "
             "truth, the distance interval open above and the magnitude's reaching the "
             "table's largest where the shell lies in the region, or the inversion refuses):",
             "", _table(pd.DataFrame(rows).round(2)) + "\n",
