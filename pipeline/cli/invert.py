@@ -105,7 +105,7 @@ def _what_to_run(p, grids):
                    help="truth tests at 3, 6, 12, 24 and 48 likelihood members per node "
                    "(observed columns from 16 members no likelihood uses): how many fallen "
                    "columns bound the back azimuth, the epicentre and the magnitude (default "
-                   "--grid study: 2,304 runs; make invert-study)")
+                   "--grid study: 3,072 runs; make invert-study)")
     add_arguments(p, InversionOptions,
                   names=("scheduler", "jobs", "allow_long", "table", "extend_table", "forward_dir"))
 

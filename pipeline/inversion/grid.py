@@ -152,9 +152,9 @@ GRIDS = {
                        nominal=False, fmax_hz=5.0, duration_s=15.0, tail_s=3.0),
     "demo": TableGrid(members=6),
     # the member study (invert --member-study): one mechanism, two magnitudes, 64 members
-    # per node (48 for the likelihoods, 16 observed), 2,304 runs
+    # per node (48 for the likelihoods, 16 observed), rings to 20 km: 3,072 runs
     "study": TableGrid(mechanisms=("strike-slip",), magnitudes=(6.0, 7.0),
-                       distances_km=(2.5, 5.0, 10.0), azimuth_step_deg=60.0, members=64,
+                       distances_km=(2.5, 5.0, 10.0, 20.0), azimuth_step_deg=60.0, members=64,
                        nominal=False),
     "full": TableGrid(mechanisms=("strike-slip", "thrust", "normal"), depths_km=(6.0, 12.0),
                       magnitudes=(6.5, 7.0), distances_km=(2.5, 5.0, 10.0, 20.0, 30.0),

@@ -20,7 +20,7 @@ def member_study_section(results):
     path = base / "member_study.json"
     if not path.exists():
         return title + ("\nNot run yet (`make invert-study`: truth tests at 3-48 likelihood "
-                        "members per node, 2,304 YADE runs).\n")
+                        "members per node, 3,072 YADE runs).\n")
     study = json.loads(path.read_text())
     summary = pd.read_csv(base / "member_study_summary.csv")
     grid = (study.get("forward_table") or {}).get("grid") or {}
