@@ -279,7 +279,7 @@ invert-demo: setup
 
 # how many fallen columns bound the source: truth tests at 3-48 likelihood members per node
 # on the study grid's forward table, the one shipped in records/inversion/ (the study
-# alone, minutes); invert-study-table computes the table itself first (3,072 YADE runs,
+# alone, tens of minutes on 2 cores); invert-study-table computes the table itself first (3,072 YADE runs,
 # hours on 2 cores; finished runs are kept when interrupted)
 STUDY_TABLE := records/inversion/forward_table_study.npz
 invert-study: setup
