@@ -49,6 +49,7 @@ import dataclasses
 import json
 import os
 import subprocess
+import signal
 import sys
 import tempfile
 import time
@@ -933,6 +934,8 @@ def main(argv=None):
                         help="run only section 14 (constrain at a study's size, a rate "
                         "density per branch) and add it to the bench.json in --out")
     args = parser.parse_args(argv)
+    # SIGTERM as an exit, so that the temporary work directory is removed
+    signal.signal(signal.SIGTERM, lambda signum, frame: sys.exit(128 + signum))
     colonnade_s = args.duration or (1.0 if args.quick else 5.0)
 
     def colonnade(work):
