@@ -7,7 +7,6 @@ direction of each run, colonnade_statistics.json grouped by direction
 direction: the runs, those in which a column fell, the columns fallen per pulse).  A
 single run is a sample: counts with their Wilson intervals, not probabilities over a
 site's motions."""
-import math
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -19,8 +18,8 @@ from pipeline.campaign.column_file import check_stiffness, column_kn, descriptio
 from pipeline.campaign.options import CampaignOptions, column_file_param, stiffness_param
 from pipeline.campaign.pulse_grid import G, parse_pulses, pulse_file
 from pipeline.campaign.runs import column_specs, motion_cache, run_column_spec, twin
-from pipeline.campaign.tables import (collect, colonnade_table, write_colonnade_files,
-                                      write_tables)
+from pipeline.campaign.tables import (collect, colonnade_table, row_azimuth_deg,
+                                      write_colonnade_files, write_tables)
 from pipeline.files import InputError, write_csv
 from pipeline.scenario.parameters import param
 from pipeline.simulate import run_code_version
@@ -46,13 +45,6 @@ class DirectionTags:
     azimuth_deg: float
     pga_g: float
     pgv_pga_s: float
-
-
-def row_azimuth_deg(data):
-    """The azimuth (deg clockwise from North, in [0, 180)) of a colonnade description's
-    row: its stylobate's axis from start to end."""
-    (x0, y0), (x1, y1) = data["stylobate"]["start"], data["stylobate"]["end"]
-    return math.degrees(math.atan2(x1 - x0, y1 - y0)) % 180.0
 
 
 def directions_specs(records, campaign_dir, column_file=COLONNADE, pulses=DEFAULT_PULSES,
@@ -116,8 +108,11 @@ def directions_outputs(specs, campaign_dir, failures, animations, figures=True):
     tags = {s.run_id: s.tags for s in specs}
     for key in ("direction", "angle_from_row_deg", "azimuth_deg", "pga_g", "pgv_pga_s"):
         table[key] = [getattr(tags[r], key) for r in table["run_id"]]
+    if not runs.empty:
+        runs["direction"] = runs["run_id"].map({s.run_id: s.tags.direction for s in specs})
     written = write_colonnade_files(campaign_dir, table, figures, by="direction",
-                                    pooled=None)
+                                    pooled=None, runs=runs,
+                                    description=specs[0].column_description)
     if not table.empty:
         write_csv(campaign_dir / "directions.csv", direction_table(table))
     return {"code_version": run_code_version(), **summary_entry(specs),

@@ -118,7 +118,8 @@ def ensemble_outputs(specs, campaign_dir, failures, animations, figures=True):
     write_summaries(campaign_dir, summaries)
     colonnades = colonnade_table(specs, campaign_dir)
     written += write_colonnade_files(campaign_dir, colonnades.assign(
-        member=colonnades["run_id"].map(member_of)), figures)
+        member=colonnades["run_id"].map(member_of)), figures, runs=runs,
+        description=described.get("column_file"))
     if len(records) > 1:
         pooled = pooled_summary(runs)
         if pooled is not None:

@@ -109,7 +109,8 @@ def column_outputs(name, size_by=None):
         if runs_colonnade(specs):
             # the colonnade's own outcomes instead of the twin columns' statistics
             written = write_colonnade_files(campaign_dir, colonnade_table(specs, campaign_dir),
-                                            figures)
+                                            figures, runs=runs,
+                                            description=described["column_file"])
         elif not runs.empty:
             write_csv(campaign_dir / "direction_statistics.csv", direction_statistics(runs))
             if figures:

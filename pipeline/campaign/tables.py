@@ -14,6 +14,7 @@ from pipeline.campaign.run_dirs import finished_runs
 from pipeline.motion import Motion
 from pipeline.motion.measures import record_parameters
 from pipeline.stats.colonnade import ALL_RECORDS, ColonnadeStatistics
+from pipeline.stats.colonnade_falls import fall_directions
 
 SYNTHETIC_SITE_KEYS = ("source", "station", "x_km", "y_km", "ring_km")  # from synthetic meta
 IMPACT_COLUMNS = ["run_id", "column", "body_index", "impact_time_s", "x_m", "y_m", "hd",
@@ -74,12 +75,13 @@ def colonnade_table(specs, campaign_dir):
 
 
 def write_colonnade_files(campaign_dir, table, figures=True, by="record_id",
-                          pooled=ALL_RECORDS):
+                          pooled=ALL_RECORDS, runs=None, description=None):
     """colonnades.csv (``table``: :func:`colonnade_table`'s rows, an ensemble's with its
     members), colonnade_statistics.json beside it
     (:class:`~pipeline.stats.colonnade.ColonnadeStatistics` grouped ``by`` a column,
-    ``pooled`` over the groups) and, with ``figures``, colonnade_statistics.png; nothing
-    without colonnade runs.  Returns the figures."""
+    ``pooled`` over the groups) and, with ``figures``, colonnade_statistics.png and, given
+    ``runs`` (runs.csv's rows) and the colonnade's ``description`` (dict),
+    colonnade_falls.png; nothing without colonnade runs.  Returns the figures."""
     if table.empty:
         return []
     statistics = ColonnadeStatistics.of(table, by, pooled)   # checked before any file
@@ -88,8 +90,37 @@ def write_colonnade_files(campaign_dir, table, figures=True, by="record_id",
     if not figures:
         return []
     from pipeline.figures.colonnade import plot_colonnade_statistics  # lazy: matplotlib, not imported by a run or after Ctrl-C
-    return [plot_colonnade_statistics(statistics,
-                                      Path(campaign_dir) / "colonnade_statistics.png")]
+    written = [plot_colonnade_statistics(statistics,
+                                         Path(campaign_dir) / "colonnade_statistics.png")]
+    if runs is not None and description is not None and not runs.empty:
+        written.append(plot_falls(campaign_dir, table, runs, description, by))
+    return written
+
+
+def row_azimuth_deg(description):
+    """The azimuth (deg clockwise from North, in [0, 180)) of a colonnade description's
+    row: its stylobate's axis from start to end."""
+    (x0, y0), (x1, y1) = description["stylobate"]["start"], description["stylobate"]["end"]
+    return math.degrees(math.atan2(x1 - x0, y1 - y0)) % 180.0
+
+
+def plot_falls(campaign_dir, table, runs, description, by="record_id"):
+    """colonnade_falls.png: the fall azimuths of the colonnade's columns in ``runs``
+    grouped as ``table`` (colonnades.csv's rows) groups them ``by``, the row's axis drawn,
+    and each group's shaking azimuth where ``table`` has ``azimuth_deg``."""
+    from pipeline.figures.colonnade_falls import plot_fall_directions  # lazy: matplotlib
+    groups = dict(zip(table["run_id"], table[by].astype(str)))
+    members = table[["run_id", "member"]] if "member" in table else None
+    if members is not None and "member" not in runs:
+        runs = runs.merge(members, on="run_id")
+    falls = fall_directions(runs, groups, [c["name"] for c in description["columns"]])
+    shaking = None
+    if "azimuth_deg" in table:
+        shaking = dict(zip(table[by].astype(str), table["azimuth_deg"].astype(float)))
+    return plot_fall_directions(falls, row_azimuth_deg(description),
+                                Path(campaign_dir) / "colonnade_falls.png", shaking,
+                                f"{description['name']}: where the columns fell "
+                                "(arrow: circular mean, its length R)")
 
 
 def _missing(value):

@@ -74,7 +74,9 @@ def circular_summary(angles_deg, axial=False):
     std = np.rad2deg(math.sqrt(max(0.0, -2.0 * math.log(length)))) / factor if length > 0 else np.inf
     # astropy's small-sample series can dip below 0 for very concentrated data
     p_value = min(max(float(rayleightest(radians)), 0.0), 1.0)
-    return dict(n=n, mean_deg=float(np.mod(mean, period)), resultant_length=length,
+    mean = float(np.mod(mean, period))
+    mean = 0.0 if mean >= period else mean       # numpy's mod gives the period a hair below 0
+    return dict(n=n, mean_deg=mean, resultant_length=length,
                 circular_std_deg=float(std), rayleigh_p=p_value)
 
 

@@ -113,6 +113,7 @@ def test_a_still_colonnade_campaign_writes_its_colonnade_outcomes(name, table, t
     assert group.runs == members and group.fallen[0].count == members
     assert (group.parallel.of, group.in_sequence.of) == (0, 0)
     assert (out / "colonnade_statistics.png").exists()
+    assert "colonnade_falls.png" in done["figures"] and (out / "colonnade_falls.png").exists()
     if name == "records":                     # the report's section from these files
         from pipeline.report import colonnade_section
         text = colonnade_section(tmp_path)

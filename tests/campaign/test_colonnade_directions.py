@@ -67,6 +67,7 @@ def test_a_still_colonnade_end_to_end(tmp_path):
     assert (whole["columns_fallen"] == 0).all()
     directions = pd.read_csv(out / "directions.csv")
     assert (directions["runs"] == 1).all() and (directions["runs_with_a_fall"] == 0).all()
+    assert (out / "colonnade_falls.png").exists()
     statistics = json.loads((out / "colonnade_statistics.json").read_text())
     assert statistics["grouped_by"] == "direction"
     assert [g["group"] for g in statistics["groups"]] == [d for d, _ in DIRECTIONS]

@@ -13,6 +13,14 @@ def test_circular_mean_wraps_through_north():
     assert s["resultant_length"] == pytest.approx(math.cos(math.radians(10)))
 
 
+def test_a_mean_a_hair_west_of_north_is_0_not_360():
+    # symmetric about North: the mean comes out a rounding error below 0 deg
+    mean = circular.circular_summary([355.0, 5.0, 340.0, 20.0])["mean_deg"]
+    assert 0.0 <= mean < 360.0 and min(mean, 360.0 - mean) < 1e-9
+    axial = circular.circular_summary([175.0, 5.0], axial=True)["mean_deg"]
+    assert 0.0 <= axial < 180.0 and min(axial, 180.0 - axial) < 1e-9
+
+
 def test_axial_mean_ignores_sense():
     s = circular.circular_summary([10.0, 190.0], axial=True)
     assert s["mean_deg"] == pytest.approx(10.0)
