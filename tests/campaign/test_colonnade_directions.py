@@ -1,7 +1,8 @@
 """The colonnade-directions campaign: the same pulses along the row, across it and at
-45 deg to it (the azimuths from the stylobate's axis), a still colonnade end to end
-(a pulse below the columns' uplift: YADE is not started), its tables and REPORT section,
-and refusals in one line."""
+45 deg to it (the azimuths from the stylobate's axis), its members (seeded, each drawn on
+its own: more members keep the runs done), a still colonnade end to end (a pulse below
+the columns' uplift: YADE is not started) with members and resumed, its tables and REPORT
+section, and refusals in one line with nothing written."""
 import json
 
 import pandas as pd
@@ -11,6 +12,7 @@ from pipeline import campaign, cli
 from pipeline.campaign.colonnade_directions import DIRECTIONS, direction_table, row_azimuth_deg
 from pipeline.files import InputError
 from pipeline.scenario.colonnade_file import load, to_dict
+from tests.refusal import refused
 
 WEAK = "pga_g=0.05:0.05:1;pgv_pga_s=0.3:0.3:1"      # below g tan(alpha) of every column
 
@@ -42,6 +44,39 @@ def test_refused_in_one_line(tmp_path, options, message):
     assert not (tmp_path / "out" / "runs").exists()
 
 
+def test_members_are_seeded_and_more_of_them_keep_the_runs_done(tmp_path):
+    get = campaign.get("colonnade-directions").specs
+    pulses = "pga_g=0.3:0.3:1;pgv_pga_s=0.3:0.3:1"
+    nominal = get([], tmp_path, pulses=pulses)
+    assert [s.tags.member for s in nominal] == [-1] * 3
+    three = get([], tmp_path, pulses=pulses, members=3)
+    assert len(three) == 9 and len({s.run_id for s in three}) == 9
+    assert not {s.run_id for s in three} & {s.run_id for s in nominal}
+    for direction, _ in DIRECTIONS:            # the same members in every direction
+        mine = [s for s in three if s.tags.direction == direction]
+        assert [s.tags.member for s in mine] == [0, 1, 2]
+        assert len({s.params.contact.mu_s for s in mine}) == 3
+    first = [s for s in three if s.tags.direction == "in-plane"]
+    assert [s.params.contact.mu_s for s in first] == \
+        [s.params.contact.mu_s for s in three if s.tags.direction == "out-of-plane"]
+    four = get([], tmp_path, pulses=pulses, members=4)
+    assert {s.run_id for s in three} < {s.run_id for s in four}           # resumable
+    assert [s.run_id for s in get([], tmp_path, pulses=pulses, members=3)] == \
+        [s.run_id for s in three]
+    other = get([], tmp_path, pulses=pulses, members=3, seed=1)
+    assert not {s.run_id for s in other} & {s.run_id for s in three}
+
+
+@pytest.mark.parametrize("flags, words", [
+    (["--members", "-1"], "--members"), (["--members", "1001"], "--members"),
+    (["--seed", "-3"], "--seed"),
+    (["--pulses", "pga_g=0.3:0.2:2;pgv_pga_s=0.3:0.3:1"], "--pulses"),
+])
+def test_options_out_of_range_refused_with_nothing_written(flags, words, tmp_path, capsys):
+    out = tmp_path / "out"
+    refused(capsys, ["campaign", "colonnade-directions", *flags, "--out", out], words, out)
+
+
 def test_direction_table_counts_by_hand():
     table = pd.DataFrame({
         "direction": ["in-plane", "in-plane", "out-of-plane", "out-of-plane", "oblique"],
@@ -54,6 +89,27 @@ def test_direction_table_counts_by_hand():
     assert out.loc["out-of-plane", "p_fall"] == 1.0 and out.loc["oblique", "p_fall"] == 0.0
     assert out.loc["out-of-plane", "fallen_per_pulse"] == \
         "0.4 g, 0.3 s: 2 of 4; 0.8 g, 0.3 s: 4 of 4"
+    members = pd.concat([table, table.assign(columns_fallen=[1, 0, 0, 4, 3])])
+    again = direction_table(members).set_index("direction")     # two runs of each pulse
+    assert again.loc["out-of-plane", "fallen_per_pulse"] == \
+        "0.4 g, 0.3 s: 2 of 8; 0.8 g, 0.3 s: 8 of 8"
+    assert again.loc["in-plane", ["runs", "runs_with_a_fall"]].tolist() == [4, 2]
+
+
+def test_a_still_colonnade_with_members_end_to_end_and_resumed(tmp_path, capsys):
+    out = tmp_path / "members"
+    argv = ["campaign", "colonnade-directions", "--pulses", WEAK, "--out", str(out),
+            "--jobs", "1", "--animations", "0", "--members", "2"]
+    assert cli.main(argv) == 0
+    whole = pd.read_csv(out / "colonnades.csv")
+    assert sorted(whole["member"]) == [0, 0, 0, 1, 1, 1]
+    from pipeline.stats.colonnade_directions import DirectionStatistics
+    cases = DirectionStatistics.load(out).cases
+    assert [c.direction for c in cases] == [d for d, _ in DIRECTIONS]
+    assert all(c.runs == 2 and c.fallen[0].count == 2 and c.pga_g == 0.05 for c in cases)
+    capsys.readouterr()
+    assert cli.main(argv) == 0
+    assert "6 already done, 0 to run" in capsys.readouterr().out
 
 
 def test_a_still_colonnade_end_to_end(tmp_path):
