@@ -2,12 +2,14 @@
 colonnade (``make run-all`` writes results/colonnade): per record what the colonnade did
 as a whole (colonnades.csv), its runs as probabilities (colonnade_statistics.json) and
 each column's damage state (runs.csv); ``campaign colonnade-directions``
-(results/colonnade-directions): the falls per direction of shaking (directions.csv)."""
+(results/colonnade-directions): the falls per direction of shaking (directions.csv) and
+P(k columns fall) per direction and pulse (direction_statistics.json)."""
 import pandas as pd
 
 from pipeline.campaign.run_dirs import finished_summary
 from pipeline.report.common import _figure, _fmt, _read_csv, _table
 from pipeline.stats.colonnade import FILE as STATISTICS_FILE, ColonnadeStatistics
+from pipeline.stats.colonnade_directions import FILE as DIRECTIONS_FILE, DirectionStatistics
 
 COLONNADE_DIR = "colonnade"
 
@@ -57,6 +59,7 @@ def colonnade_section(results, name=COLONNADE_DIR):
              "after the other along the row. Damage states as defined in docs/damage.md.\n",
              _table(pd.DataFrame(rows)) + "\n",
              *statistics,
+             _falls_figure(results, folder),
              f"Cost: {simulated:.0f} s simulated in {sum(walls) / 60:.1f} min of YADE wall "
              f"time over {len(walls)} run(s) (files: `{name}/colonnades.csv`, "
              f"`{name}/runs.csv`).\n"]
@@ -85,6 +88,36 @@ def _statistics(results, folder):
             _figure(results, folder / "colonnade_statistics.png",
                     "P(k columns fall), parallel and in sequence, with Wilson 95 % "
                     "intervals")]
+
+
+def _runs_each(whole):
+    """How many runs each pulse and direction had: one, or that many members."""
+    if whole is None or "member" not in whole:
+        return "one run per pulse and direction (the colonnade as described)"
+    return (f"{whole['member'].nunique()} members per pulse and direction (the ensemble's "
+            "sampled contact and tolerances)")
+
+
+def _falls_figure(results, folder):
+    """colonnade_falls.png, where the campaign drew it."""
+    return _figure(results, folder / "colonnade_falls.png",
+                   "Where the columns fell: fall azimuths, North up, clockwise; the row's "
+                   "axis and the circular mean drawn")
+
+
+def _per_pulse(results, folder):
+    """P(k columns fall) per direction and pulse (direction_statistics.json), as lines
+    of the section; none when the campaign wrote none."""
+    if not (folder / DIRECTIONS_FILE).exists():
+        return []
+    cases = DirectionStatistics.load(folder / DIRECTIONS_FILE).cases
+    rows = [{"direction": c.direction, "PGA (g)": _fmt(c.pga_g, 2),
+             "PGV/PGA (s)": _fmt(c.pgv_pga_s, 2), "runs": c.runs,
+             **{f"P({k} fell)": _proportion(f) for k, f in enumerate(c.fallen)}}
+            for c in cases]
+    return ["Per direction and pulse (`direction_statistics.json`): the fraction of its "
+            "runs in which k columns fell, with its Wilson 95 % interval.\n",
+            _table(pd.DataFrame(rows)) + "\n"]
 
 
 def _proportion(q, counts=False):
@@ -145,12 +178,14 @@ def directions_section(results, name=DIRECTIONS_DIR):
         title,
         "The shipped colonnade shaken by the same one-cosine pulses (the fragility's pulse "
         "shape) along its row (in-plane), across it (out-of-plane) and at 45 deg to it, "
-        "one run per pulse and direction. Single runs are samples: the counts and their "
+        f"{_runs_each(whole)}. Runs are samples: the counts and their "
         "Wilson intervals say how few there are, not a probability over a site's "
         "motions. The 3D discrete-element study of the Forum colonnade at Pompeii found "
         "the out-of-plane capacity lower than the in-plane one; the table gives what "
         "these runs show, whichever way it goes.\n",
         _table(pd.DataFrame(rows)) + "\n",
+        *_per_pulse(results, folder),
+        _falls_figure(results, folder),
         f"Cost: {sum(s.wall_s for s in summaries) / 60:.1f} min of YADE wall time over "
         f"{len(summaries)} run(s) (files: `{name}/directions.csv`, `{name}/colonnades.csv`, "
-        f"`{name}/colonnade_statistics.json`).\n"])
+        f"`{name}/colonnade_statistics.json`, `{name}/direction_statistics.json`).\n"])

@@ -110,6 +110,12 @@ def test_a_still_colonnade_with_members_end_to_end_and_resumed(tmp_path, capsys)
     capsys.readouterr()
     assert cli.main(argv) == 0
     assert "6 already done, 0 to run" in capsys.readouterr().out
+    from pipeline.report.colonnades import directions_section
+    text = directions_section(tmp_path, "members")
+    assert "2 members per pulse and direction" in text and "colonnade_falls.png" in text
+    row = [line for line in text.splitlines() if line.startswith("| oblique ")][-1]
+    cells = [c.strip() for c in row.strip("|").split("|")]
+    assert cells[1:5] == ["0.05", "0.3", "2", "1.00 [0.34, 1.00]"]    # 2 of 2 stood, Wilson
 
 
 def test_a_still_colonnade_end_to_end(tmp_path):
