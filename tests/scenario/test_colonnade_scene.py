@@ -2,13 +2,15 @@
 its supports' top plates; a colonnade left alone stands (its beams do not sink through
 the capitals: the collision masks let each beam's base meet its supports); the run's
 summary per body and per colonnade."""
+import math
+
 import numpy as np
 import pytest
 
 from pipeline.outcome.columns import summarise
 from pipeline.outcome.damage import DamageState
 from pipeline.scenario import Column, run_yade, scene_params, write_scenario
-from pipeline.scenario.colonnade_file import load
+from pipeline.scenario.colonnade_file import from_dict, load, to_dict
 
 NAME = "parthenon-north-flank"
 
@@ -45,6 +47,44 @@ def test_beams_are_boxes_of_the_file_on_their_supports_plates(scene):
                 assert np.all(np.abs(local[:2]) <= half + 1e-9)          # within it
     assert units["F1"]["bodies"][0]["plate"] is None
     assert units["E1"]["bodies"][0]["plate"] is not None
+
+
+@pytest.mark.parametrize("row_azimuth_deg", [0.0, 30.0, 90.0])
+def test_beams_lie_along_the_line_between_their_capitals(row_azimuth_deg):
+    """The shipped stretch laid along North, at 30 deg and along East (as shipped): each
+    beam's long side runs from the first capital it spans to the last, its width across."""
+    data = to_dict(load(NAME))
+    along = np.array([math.sin(math.radians(row_azimuth_deg)),
+                      math.cos(math.radians(row_azimuth_deg))])
+    data["stylobate"]["end"] = (data["stylobate"]["end"][0] * along).tolist()
+    for column in data["columns"]:
+        column["x"], column["y"] = (column["x"] * along).tolist()
+    units = {c["name"]: c for c in scene_params(colonnade=from_dict(data), motion_duration=0.0,
+                                                t_max=0.5).columns}
+    for name in ("E1", "E2", "E3", "F1", "F2", "F3"):
+        (beam,) = units[name]["bodies"]
+        (part,) = beam["parts"]
+        length, width = part["width"], part["depth"]
+        assert length == pytest.approx(4.2862) and width == pytest.approx(1.48)
+        corners = np.array([world(beam, (sx * length / 2, sy * width / 2, 0.0))[:2]
+                            for sx in (-1, 1) for sy in (-1, 1)])
+        span = corners @ along                           # along the row
+        across = corners @ np.array([along[1], -along[0]])
+        assert np.ptp(span) == pytest.approx(length, abs=1e-9)
+        assert np.ptp(across) == pytest.approx(width, abs=1e-9)
+        epistyle = name if name.startswith("E") else units[name]["rests_on"][0]
+        on = units[epistyle]["rests_on"]                 # the capitals it spans
+        first, last = (np.asarray(units[c]["bodies"][-1]["centre"][:2]) for c in (on[0], on[-1]))
+        axis = (last - first) / np.linalg.norm(last - first)
+        assert axis == pytest.approx(along, abs=1e-9)
+        assert (np.asarray(beam["rotation"]) @ [1.0, 0.0, 0.0])[:2] == \
+            pytest.approx(axis, abs=1e-12)
+    if row_azimuth_deg == 0.0:                           # along North: long in y, narrow in x
+        (beam,) = units["E2"]["bodies"]
+        corners = np.array([world(beam, (sx * 4.2862 / 2, sy * 1.48 / 2, 0.0))[:2]
+                            for sx in (-1, 1) for sy in (-1, 1)])
+        assert np.ptp(corners[:, 0]) == pytest.approx(1.48, abs=1e-9)
+        assert np.ptp(corners[:, 1]) == pytest.approx(4.2862, abs=1e-9)
 
 
 def test_a_colonnade_file_in_the_column_option():
