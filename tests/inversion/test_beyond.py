@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 from scipy.special import expit, logit
 
-from pipeline.inversion.beyond import BEYOND_BAYES_FACTOR, SHELL_FACTOR, SHELL_STEP, shell_lattice
+from pipeline.inversion.beyond import BEYOND_BAYES_FACTOR, PRIOR_BEYOND, SHELL_FACTOR, SHELL_STEP, shell_lattice
 from pipeline.inversion.candidates import CandidateGrid
 from pipeline.inversion.likelihood import ForwardModel
 from pipeline.inversion.posterior import invert
@@ -163,9 +163,9 @@ def test_a_larger_source_beyond_the_reach_is_held_by_the_shell_and_its_magnitude
     assert found["epicentre_in_95"] and found["distance_in_95"] and found["mw_in_95"]
     assert summary["distance_ci95_km"][1] is None and summary["distance_ci95_unbounded"]
     assert summary["magnitude_ci95"][1] == 7.0 and summary["magnitude_ci95_open_above"]
-    assert summary["beyond_extrapolated"] and summary["beyond_prior"] == 0.05
-    # P(beyond) is the test's Bayes factor B times the prior odds 0.05 : 0.95, as odds
-    odds = summary["beyond_bayes_factor"] * 0.05 / 0.95
+    assert summary["beyond_extrapolated"] and summary["beyond_prior"] == PRIOR_BEYOND
+    # P(beyond) is the test's Bayes factor B times the prior odds, as odds
+    odds = summary["beyond_bayes_factor"] * PRIOR_BEYOND / (1.0 - PRIOR_BEYOND)
     assert summary["p_beyond"] == pytest.approx(odds / (1.0 + odds), rel=1e-12)
 
 
@@ -226,6 +226,8 @@ def test_the_shells_result_checks_itself_on_construction():
     with pytest.raises(ValueError, match="needs shell cells"):
         Beyond(**{**cells, "east_km": np.zeros(0), "north_km": np.zeros(0)},
                probability=np.zeros((1, 1, 0)), log_bayes_factor=0.0)
-    shell = Beyond(**cells, probability=np.ones((1, 1, 1)), log_bayes_factor=math.log(19.0))
-    assert shell.p_beyond == pytest.approx(0.5) and shell.warning
+    even = math.log((1.0 - PRIOR_BEYOND) / PRIOR_BEYOND)   # the Bayes factor of even odds
+    shell = Beyond(**cells, probability=np.ones((1, 1, 1)), log_bayes_factor=even)
+    assert shell.p_beyond == pytest.approx(0.5)
+    assert shell.warning == (math.exp(even) > BEYOND_BAYES_FACTOR)
     assert shell.cell_of(11.5, 0.2) == 0 and shell.cell_of(25.0, 0.0) is None
