@@ -18,16 +18,21 @@ def _help(f):
     return f"{meta['help']}{unit}{_default(f.default)}{unset}{_bounds(meta)}".replace("%", "%%")
 
 
+def _number(value):
+    """An int as it is (a seed of 20091000 stays that), a float by ``:g``."""
+    return str(value) if isinstance(value, int) else f"{value:g}"
+
+
 def _default(value):
     """'; default ...' of a declared default, or '' (None, (), a switch: what unset means
     is the field's ``optional``)."""
     if value is None or value == () or isinstance(value, bool):
         return ""
     if isinstance(value, tuple):
-        return "; default " + " ".join(f"{v:g}" if isinstance(v, float) else str(v)
+        return "; default " + " ".join(_number(v) if isinstance(v, float) else str(v)
                                        for v in value)
     if isinstance(value, (int, float)):
-        return f"; default {value:g}"
+        return f"; default {_number(value)}"
     if isinstance(value, Path):
         return f"; default {display_path(value)}"
     return f"; default {value}"
@@ -39,13 +44,13 @@ def _bounds(meta):
     if low is None and high is None:
         return ""
     if high is None:
-        return f"; {'above' if meta.get('low_open') else 'at least'} {low:g}"
+        return f"; {'above' if meta.get('low_open') else 'at least'} {_number(low)}"
     if low is None:
-        return f"; {'below' if meta.get('high_open') else 'at most'} {high:g}"
-    ends = [f"{w} {v:g}" for w, v, is_open in (("above", low, meta.get("low_open")),
+        return f"; {'below' if meta.get('high_open') else 'at most'} {_number(high)}"
+    ends = [f"{w} {_number(v)}" for w, v, is_open in (("above", low, meta.get("low_open")),
                                                 ("below", high, meta.get("high_open")))
             if is_open]
-    return f"; {low:g}-{high:g}" + (f" ({' and '.join(ends)})" if ends else "")
+    return f"; {_number(low)}-{_number(high)}" + (f" ({' and '.join(ends)})" if ends else "")
 
 
 def add_arguments(parser, cls, names=None):

@@ -98,3 +98,17 @@ def test_the_shake_table_specimen_is_its_declared_default(capsys):
     assert "the scanned rock SP1); default records/shake_table/sp1.json" in text
     options = ShakeTableOptions()
     assert options.column_file == SPECIMEN and options.kwargs()["specimen"] == SPECIMEN
+
+
+def test_an_integer_default_and_bounds_read_as_integers():
+    """A seed of 20091000 reads "default 20091000" in the help, not 2.0091e+07; a float
+    stays in the short form."""
+    @dataclasses.dataclass(frozen=True)
+    class Toy:
+        seed: int = param(20091000, "", "the seed", low=0, high=2 ** 63, flag="--seed")
+        width: float = param(1.5e-3, "m", "the width", low=1e-4, high=0.25, flag="--width")
+    parser = argparse.ArgumentParser()
+    add_arguments(parser, Toy)
+    helps = {a.dest: a.help for a in parser._actions}
+    assert "default 20091000" in helps["seed"] and f"0-{2 ** 63}" in helps["seed"]
+    assert "default 0.0015" in helps["width"] and "0.0001-0.25" in helps["width"]
