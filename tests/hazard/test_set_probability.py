@@ -141,11 +141,11 @@ def test_pga_only_sets_and_a_mixed_column():
                                atol=1e-15)
 
 
-def test_quadrature_weights_sum_to_one_at_every_level():
+def test_quadrature_shares_sum_to_one_at_every_level():
     for model in _ratio_models().values():
-        points, weights = ratio_quadrature(model, PGA)
-        assert points.shape == weights.shape and points.shape[0] == PGA.size
-        np.testing.assert_allclose(weights.sum(axis=1), 1.0, rtol=1e-12)
+        points, shares = ratio_quadrature(model, PGA)
+        assert points.shape[:2] == shares.shape and points.shape[0] == PGA.size
+        np.testing.assert_allclose(shares.sum(axis=1), 1.0, rtol=1e-12)
 
 
 def test_grids_on_the_hazards_measure_stack_as_their_grids():
