@@ -3,11 +3,11 @@ at once: survival's :func:`overturn_probability` (each specimen, or a set) is
 :func:`set_probabilities` (``constrain``'s fragility draws and members) of one set.
 
 The expectation over PGV/PGA is a weighted sum over points (:func:`ratio_quadrature`:
-Gauss-Hermite nodes of a lognormal, and for a mixture over disaggregation bins every bin's
-nodes, weighted by its share, so every bin's grid is evaluated in the same call), and a specimen
-whose D fragilities are pulse grids differing only in their counts (draws, members; as
-they are or on the hazard's PGA measure) is evaluated by one interpolation of the D grids
-(:meth:`~pipeline.hazard.fragility.grid.PulseGrid.probability_stack`).
+Gauss-Hermite nodes of a lognormal; for a mixture over disaggregation bins every bin's
+nodes, the bin's mean weighted by its share, every bin evaluated in the same call), and a
+specimen whose D fragilities are pulse grids differing only in their counts (draws,
+members; as they are or on the hazard's PGA measure) is evaluated by one interpolation of
+the D grids (:meth:`~pipeline.hazard.fragility.grid.PulseGrid.probability_stack`).
 Units: PGA in m/s^2, PGV/PGA in s."""
 from functools import reduce
 
