@@ -7,7 +7,7 @@ from pathlib import Path
 from pipeline.assessment.age_options import AGE_VALUES, age_kinds, check_age_kinds
 from pipeline.assessment.options import (CONSTRAIN_OUT, KA, MAX_AGE_KA, MAX_SPECIMENS,
                                          SpecimenOptions, _check_column_site, _check_out,
-                                         _per_specimen)
+                                         _per_specimen, disaggregation_param)
 from pipeline.files import InputError
 from pipeline.hazard.ages import LowerBound, TruncatedNormal, UniformInterval, load_age_samples
 from pipeline.hazard import branch_ratio
@@ -68,12 +68,7 @@ class ConstrainOptions(SpecimenOptions):
         "K's where the file holds one per realisation (mrd-rlzs), else the mean's for every "
         "branch (the engine writes the mean's only)", flag="--joint-hazard",
         metavar="FILE", optional=True)
-    disaggregation: Path = param(
-        None, "", "or PGV/PGA at each PGA level a mixture over OpenQuake's "
-        "magnitude-distance disaggregation at --site (its Mag_Dist CSV export): the "
-        "ground-motion model at each bin, weighted by the bin's share of the events near "
-        "that level (with --vs30, --mechanism, --pga-pgv-correlation)",
-        flag="--disaggregation", metavar="FILE", optional=True)
+    disaggregation: Path = disaggregation_param("at --site")
     disaggregation_column: str = param(
         None, "", "the column of --disaggregation for every branch: mean, or rlzK for "
         "realisation K", flag="--disaggregation-column", metavar="NAME",

@@ -37,6 +37,15 @@ AGE_FLAGS = ("age_ka", "age_sd_ka", "age_min_ka", "age_range_ka", "age_samples",
              "age_column")
 
 
+def disaggregation_param(of):
+    """The ``--disaggregation`` field: the disaggregation ``of`` what (in words)."""
+    return param(None, "", "or PGV/PGA at each PGA level a mixture over OpenQuake's "
+                 f"magnitude-distance disaggregation {of} (its Mag_Dist CSV export): the "
+                 "ground-motion model at each bin, weighted by the bin's share of the events "
+                 "near that level (with --vs30, --mechanism, --pga-pgv-correlation)",
+                 flag="--disaggregation", metavar="FILE", optional=True)
+
+
 @dataclass(frozen=True)
 class SpecimenOptions:
     """The fragilities of the specimens, the PGV/PGA at each PGA level and the draws of
@@ -226,12 +235,7 @@ class SurvivalOptions(SpecimenOptions):
     at_pgv_pga: float = param(None, "s", "the PGV/PGA at which the PGA range is stated (for "
                               "a fragility over PGA and PGV/PGA)", 0.001, 10,
                               flag="--at-pgv-pga", metavar="S", optional=True)
-    disaggregation: Path = param(
-        None, "", "or PGV/PGA at each PGA level a mixture over OpenQuake's magnitude-distance "
-        "disaggregation of the first --hazard curve (its Mag_Dist CSV export): the "
-        "ground-motion model at each bin, weighted by the bin's share of the events near "
-        "that level (with --vs30, --mechanism, --pga-pgv-correlation)",
-        flag="--disaggregation", metavar="FILE", optional=True)
+    disaggregation: Path = disaggregation_param("of the first --hazard curve")
     disaggregation_column: str = param(
         "mean", "", "the column of --disaggregation: mean, or rlzK for realisation K (that "
         "of the first --hazard curve)", flag="--disaggregation-column", metavar="NAME")

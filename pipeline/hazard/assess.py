@@ -6,13 +6,14 @@ from dataclasses import replace
 import numpy as np
 
 from pipeline.constants import STANDARD_GRAVITY
-from pipeline.hazard.disagg_ratio import RatioMixture, overturn_probability_over
+from pipeline.hazard.disagg_ratio import RatioMixture
 from pipeline.hazard.survival import (contribution_by_intensity, intensity_scale_bound,
                                       overturning_rate, rate_density, rate_outside,
                                       rate_exceeding, rate_scale_bound,
                                       survival_probability)
 from pipeline.hazard.hazard_described import CurveHazard
 from pipeline.hazard.record import ABSENT
+from pipeline.hazard.set_probability import overturn_probability
 from pipeline.hazard.results import SurvivalResult
 from pipeline.hazard.survival_parts import (ContributionRow, CurveEnds, CurveRow, HazardRoute,
                                             OutsideGrid, Route, SetSurvival, SiteSet,
@@ -110,9 +111,9 @@ def _specimen_entry(curve, fragility, drawn, ratio_model, age, draws):
     """(one specimen's entry of ``specimens``, a :class:`SpecimenResult`: its result,
     parameter sets and what comes from outside its grid; its warnings)."""
     def probability(x):
-        return overturn_probability_over([fragility], ratio_model, x)[0]
+        return overturn_probability([fragility], ratio_model, x)[0]
     members = None if drawn is None else [
-        (lambda x, f=d: overturn_probability_over([f], ratio_model, x)[0]) for d in drawn]
+        (lambda x, f=d: overturn_probability([f], ratio_model, x)[0]) for d in drawn]
     result, warnings = _result(curve, probability, members, age)
     rate = result["annual_overturning_rate_per_yr"]
     described = fragility.describe()
@@ -240,7 +241,7 @@ def _definitions(draws):
 
 def _combined(specimens, ratio_model, combine):
     def probability(x):
-        p = overturn_probability_over(specimens, ratio_model, x, combine)
+        p = overturn_probability(specimens, ratio_model, x, combine)
         return p[0] if combine == "each" else p
     return probability
 
@@ -303,7 +304,7 @@ def _per_parameter_set(curve, fragility, ratio_model, age):
         return {}
     zero = curve.zero_rate_from_m_s2
     rates = [overturning_rate(curve.levels_m_s2, curve.rates_per_yr,
-                              lambda x, f=m: overturn_probability_over([f], ratio_model, x)[0],
+                              lambda x, f=m: overturn_probability([f], ratio_model, x)[0],
                               zero)["rate_per_yr"] for m in members]
     survival = age.survival(np.array(rates)).tolist()
     return {"rate_per_parameter_set_per_yr": rates, "survival_per_parameter_set": survival,
@@ -321,7 +322,7 @@ def _outside_grid(curve, fragility, ratio_model, probability, rate):
     zero = curve.zero_rate_from_m_s2
     bounds = {name: overturning_rate(
         curve.levels_m_s2, curve.rates_per_yr,
-        lambda x, f=variant: overturn_probability_over([f], ratio_model, x)[0], zero)["rate_per_yr"]
+        lambda x, f=variant: overturn_probability([f], ratio_model, x)[0], zero)["rate_per_yr"]
         for name, variant in fragility.variants().items()}
     last = float(curve.levels_m_s2[-1])
     beyond = rate_exceeding(curve.levels_m_s2, curve.rates_per_yr, hi)

@@ -7,7 +7,7 @@ The survival of a specimen set under branch i is P_s,i = exp(-sum_k dt_k lambda_
 the ages sorted t_(1) <= ... <= t_(n), S_k the specimens at least t_(k) old (standing
 through the interval dt_k = t_(k) - t_(k-1), t_(0) = 0) and lambda_i(S) the annual rate of
 events in which any of S overturns under branch i's curve (the specimens independent given
-the shaking they share, :func:`pipeline.hazard.fragility.overturn_probability` "any_common").
+the shaking they share, :func:`pipeline.hazard.set_probability.overturn_probability` "any_common").
 Exact for earthquakes as a Poisson process: the intervals do not overlap, so their
 survivals multiply.  lambda_i is the cell integration of :mod:`pipeline.hazard.survival`
 (the same cells, the exceedances of the last level counted at it), done for all branches

@@ -11,17 +11,15 @@ l_k less its rate of exceeding l_k+1 (the events whose PGA falls between them: t
 mean over the interval), normalised; from the top level up, the bins' rates of exceeding
 it; below the first level, the shares between the first two (with one level only, the
 shares of exceeding it everywhere).
-:func:`mixture_probability` is P(overturn | PGA) averaged over the mixture, the
-``probability`` that :func:`pipeline.hazard.survival.overturning_rate` integrates against
-the PGA curve.  Units: PGA in m/s^2, distances in km, magnitudes Mw.
+:func:`pipeline.hazard.set_probability.overturn_probability` averages P(overturn | PGA,
+PGV/PGA) over the mixture.  Units: PGA in m/s^2, distances in km, magnitudes Mw.
 """
 from dataclasses import dataclass
 
 import numpy as np
 
 from pipeline.files import InputError
-from pipeline.hazard.fragility.ratio import (DEFAULT_VS30_M_S, RatioFromGmm,
-                                             overturn_probability)
+from pipeline.hazard.fragility.ratio import DEFAULT_VS30_M_S, RatioFromGmm
 from pipeline.hazard.pga_pgv_correlation import BAKER_BRADLEY_2017
 
 
@@ -86,31 +84,3 @@ def ratio_mixture(disaggregation, column="mean", vs30_m_s=DEFAULT_VS30_M_S, mech
                       if shares[:, b].max() > 0 else None)
     return RatioMixture(anchors, shares, tuple(models))
 
-
-def mixture_probability(fragility, mixture, pga_m_s2):
-    """P(overturn) at PGA levels (m/s^2) averaged over PGV/PGA, a mixture over the bins:
-    sum_b share_b(PGA) E_b[P(PGA, PGV/PGA)]."""
-    pga = np.asarray(pga_m_s2, float)
-    shares = bin_shares(mixture.anchors, mixture.shares, pga)
-    total = np.zeros(pga.shape)
-    for b, model in enumerate(mixture.models):
-        if model is not None and shares[:, b].max() > 0:
-            total += shares[:, b] * overturn_probability([fragility], model, pga)[0]
-    return total
-
-
-def overturn_probability_over(fragilities, ratio_model, pga_m_s2, combine="each"):
-    """:func:`~pipeline.hazard.fragility_ratio.overturn_probability` under any PGV/PGA
-    model: a :class:`RatioMixture` the mixture over its bins (each bin's share at the PGA
-    level times the probability under its model: every ``combine`` is an expectation,
-    linear in the mixture), any other model as it is."""
-    if not isinstance(ratio_model, RatioMixture):
-        return overturn_probability(fragilities, ratio_model, pga_m_s2, combine)
-    pga = np.asarray(pga_m_s2, float)
-    shares = bin_shares(ratio_model.anchors, ratio_model.shares, pga)
-    total = 0.0
-    for b, model in enumerate(ratio_model.models):
-        if model is not None and shares[:, b].max() > 0:
-            total = total + shares[:, b] * overturn_probability(fragilities, model, pga,
-                                                                combine)
-    return total

@@ -2,7 +2,7 @@
 
 Units: PGA levels in m/s^2, rates in 1/yr, ages in years.  ``probability`` is a
 function of PGA (m/s^2, array) returning P(overturn) in one event of that PGA (already
-averaged over PGV/PGA: :func:`pipeline.hazard.fragility.overturn_probability`).
+averaged over PGV/PGA: :func:`pipeline.hazard.set_probability.overturn_probability`).
 
 The hazard curve lambda(x) (annual rate of PGA > x) is interpolated linearly in
 (ln x, ln lambda) between its levels x_1 < ... < x_N.  The annual rate of overturning is

@@ -18,6 +18,12 @@ from pipeline.files import InputError
 from pipeline.stats.circular import circular_summary
 from pipeline.userfiles import read_user_bytes
 
+# the runs' arrays: the members' [slice, distance, azimuth, column, member], the nominal
+# run's [slice, distance, azimuth, column] (None without one)
+OUTCOMES = ("toppled", "azimuth_deg", "valid", "nominal_toppled", "nominal_azimuth_deg",
+            "nominal_valid")
+
+
 @dataclass
 class ForwardTable:
     """Outcomes at the nodes, all azimuths in the strike frame (strike = North).
@@ -135,20 +141,11 @@ class ForwardTable:
         if name in self.columns:
             raise InputError(f"forward table: column {name!r} is there already")
 
-        def join(a, b):
-            return None if a is None else np.concatenate([a, b[..., :1]], axis=3)
-
-        def join_members(a, b):
-            return np.concatenate([a, b[:, :, :, :1, :]], axis=3)
+        def join(a, b):                   # b's first column after a's columns (axis 3)
+            return np.concatenate([a, b[:, :, :, :1]], axis=3)
 
         return dataclasses.replace(
-            self, columns=tuple(self.columns) + (name,),
-            toppled=join_members(self.toppled, other.toppled),
-            azimuth_deg=join_members(self.azimuth_deg, other.azimuth_deg),
-            valid=join_members(self.valid, other.valid),
-            nominal_toppled=join(self.nominal_toppled, other.nominal_toppled),
-            nominal_azimuth_deg=join(self.nominal_azimuth_deg, other.nominal_azimuth_deg),
-            nominal_valid=join(self.nominal_valid, other.nominal_valid),
+            self, columns=tuple(self.columns) + (name,), **self._outcomes(join, other),
             info={**self.info, "described_columns": {
                 **self.info.get("described_columns", {}),
                 name: {k: other.info.get(k) for k in ("grid_key", "yade_wall_s", "runs",
@@ -177,18 +174,12 @@ class ForwardTable:
         order = np.argsort(distances)
 
         def join(a, b):
-            return None if a is None else np.concatenate([a, b], axis=1)[:, order]
+            return np.concatenate([a, b], axis=1)[:, order]
 
         parts = [part for table in (self, other)
                  for part in table.info.get("parts", [_part_info(table)])]
         return dataclasses.replace(
-            self, distances_km=distances[order],
-            toppled=join(self.toppled, other.toppled),
-            azimuth_deg=join(self.azimuth_deg, other.azimuth_deg),
-            valid=join(self.valid, other.valid),
-            nominal_toppled=join(self.nominal_toppled, other.nominal_toppled),
-            nominal_azimuth_deg=join(self.nominal_azimuth_deg, other.nominal_azimuth_deg),
-            nominal_valid=join(self.nominal_valid, other.nominal_valid),
+            self, distances_km=distances[order], **self._outcomes(join, other),
             info={"grid": grid.as_dict(), "grid_key": grid.key(),
                   "yade_wall_s": round(sum(p["yade_wall_s"] for p in parts), 1),
                   "runs": sum(p["runs"] for p in parts),
@@ -210,15 +201,9 @@ class ForwardTable:
             raise InputError("no forward-table slice matches the chosen mechanisms, depths "
                              "and magnitudes")
 
-        def pick(values):
-            return None if values is None else values[keep]
-
         return dataclasses.replace(
             self, slices=[s for s, k in zip(self.slices, keep) if k],
-            toppled=self.toppled[keep], azimuth_deg=self.azimuth_deg[keep],
-            valid=self.valid[keep], nominal_toppled=pick(self.nominal_toppled),
-            nominal_azimuth_deg=pick(self.nominal_azimuth_deg),
-            nominal_valid=pick(self.nominal_valid), info=dict(self.info))
+            **self._outcomes(lambda values: values[keep]), info=dict(self.info))
 
     def select_nodes(self, rings, azimuth_stride=1):
         """A table with the rings where ``rings`` (bool over ``distances_km``) holds and
@@ -226,16 +211,19 @@ class ForwardTable:
         rings = np.asarray(rings, bool)
         stride = int(azimuth_stride)
 
-        def pick(values):
-            return None if values is None else values[:, rings][:, :, ::stride]
-
         return dataclasses.replace(
             self, distances_km=self.distances_km[rings],
-            azimuths_deg=self.azimuths_deg[::stride], toppled=pick(self.toppled),
-            azimuth_deg=pick(self.azimuth_deg), valid=pick(self.valid),
-            nominal_toppled=pick(self.nominal_toppled),
-            nominal_azimuth_deg=pick(self.nominal_azimuth_deg),
-            nominal_valid=pick(self.nominal_valid), info=dict(self.info))
+            azimuths_deg=self.azimuths_deg[::stride],
+            **self._outcomes(lambda values: values[:, rings][:, :, ::stride]),
+            info=dict(self.info))
+
+    def _outcomes(self, change, other=None):
+        """The runs' arrays (:data:`OUTCOMES`) each changed, as keywords of
+        :func:`dataclasses.replace`: ``change(a)``, or with ``other`` ``change(a, b)`` (b
+        ``other``'s); the nominal run's None without one."""
+        return {name: None if getattr(self, name) is None else change(
+            getattr(self, name), *(() if other is None else (getattr(other, name),)))
+            for name in OUTCOMES}
 
     # -------------------------------------------------------------- file
     def save(self, path):

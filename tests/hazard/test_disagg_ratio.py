@@ -11,10 +11,10 @@ from scipy import stats
 
 from pipeline import RECORDS_DIR
 from pipeline.constants import STANDARD_GRAVITY
-from pipeline.hazard.disagg_ratio import (bin_shares, level_shares, mixture_probability,
-                                          ratio_mixture)
+from pipeline.hazard.disagg_ratio import bin_shares, level_shares, ratio_mixture
 from pipeline.hazard.disaggregation import MagDistDisaggregation, load_mag_dist
-from pipeline.hazard.fragility import Logistic, RatioFromGmm, overturn_probability
+from pipeline.hazard.fragility import Logistic, RatioFromGmm
+from pipeline.hazard.set_probability import overturn_probability
 from pipeline.hazard.survival import overturning_rate
 
 MEAN = RECORDS_DIR / "hazard" / "openquake_postproc_case_mrd" / "disaggregation" / \
@@ -79,8 +79,8 @@ def _route_b_rate(scenarios, laws, disaggregated_levels):
     levels = np.geomspace(1e-3, 200.0, 121)
     curve = sum(nu * stats.norm.sf((np.log(levels) - law[0]) / law[1])
                 for (_, _, nu), law in zip(scenarios, laws))
-    return overturning_rate(levels, curve, lambda x: mixture_probability(SURFACE, mixture,
-                                                                           x))["rate_per_yr"]
+    return overturning_rate(levels, curve, lambda x: overturn_probability([SURFACE], mixture,
+                                                                           x)[0])["rate_per_yr"]
 
 
 def test_one_bin_is_todays_one_scenario():
@@ -90,7 +90,7 @@ def test_one_bin_is_todays_one_scenario():
                             correlation=RHO)
     pga = np.geomspace(0.01, 50.0, 200)
     today = overturn_probability([SURFACE], RatioFromGmm(6.0, 10.0, correlation=RHO), pga)[0]
-    np.testing.assert_allclose(mixture_probability(SURFACE, mixture, pga), today, rtol=1e-12)
+    np.testing.assert_allclose(overturn_probability([SURFACE], mixture, pga)[0], today, rtol=1e-12)
     assert _route_b_rate(scenario, laws, np.geomspace(0.05, 20.0, 5)) == pytest.approx(
         _direct_rate(scenario, laws), rel=2e-3)
 

@@ -11,8 +11,9 @@ from scipy import stats
 from pipeline import RECORDS_DIR
 from pipeline.constants import STANDARD_GRAVITY
 from pipeline.hazard.curves import load_hazard
-from pipeline.hazard.fragility import Logistic, Lognormal, RatioFromGmm, overturn_probability
+from pipeline.hazard.fragility import Logistic, Lognormal, RatioFromGmm
 from pipeline.hazard.joint_hazard import load_joint_hazard
+from pipeline.hazard.set_probability import overturn_probability
 from pipeline.hazard.joint_survival import (cell_mean_probability, joint_overturning_rate,
                                             scenario_cell_rates)
 from pipeline.hazard.pga_pgv_correlation import BAKER_BRADLEY_2017

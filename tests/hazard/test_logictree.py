@@ -23,8 +23,9 @@ from pipeline.hazard.constrain import (FLOOR, bayes, branch_rates, cell_matrix, 
                                        motion_at_rate, weighted_mean,
                                        weighted_quantile)
 from pipeline.hazard.constrain_assess import constrain_tree
-from pipeline.hazard.fragility import Fragility, Lognormal, overturn_probability
+from pipeline.hazard.fragility import Fragility, Lognormal
 from pipeline.hazard.logictree import LogicTree, load_logic_tree
+from pipeline.hazard.set_probability import overturn_probability
 from pipeline.hazard.survival import overturning_rate
 
 CASE_11 = RECORDS_DIR / "hazard" / "openquake_logictree_case_11"

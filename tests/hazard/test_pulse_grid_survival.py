@@ -11,7 +11,8 @@ from pipeline.cli import main
 from pipeline.constants import STANDARD_GRAVITY
 from pipeline.files import InputError
 from pipeline.hazard.fragility import Logistic, Lognormal, RatioLognormal, \
-    load_campaign_fragility, overturn_probability
+    load_campaign_fragility
+from pipeline.hazard.set_probability import overturn_probability
 from pipeline.hazard.site_motion import motion_bound
 from pipeline.hazard.survival import overturning_rate
 

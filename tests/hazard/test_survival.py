@@ -17,7 +17,8 @@ from pipeline.hazard import load_hazard
 from pipeline.hazard.fragility.file import FragilityFile, write_fragility_file
 from pipeline.hazard.ages import LowerBound, TruncatedNormal, UniformInterval
 from pipeline.hazard.fragility import (Logistic, Lognormal, RatioFromGmm, RatioLognormal,
-                                       load_campaign_fragility, overturn_probability)
+                                       load_campaign_fragility)
+from pipeline.hazard.set_probability import overturn_probability
 from pipeline.hazard.survival import (contribution_by_intensity, intensity_scale_bound,
                                       overturning_rate, rate_scale_bound, survival_probability)
 from pipeline.stats.fragility import logistic_surface

@@ -16,8 +16,8 @@ from tests.refusal import refused
 from pipeline.constants import STANDARD_GRAVITY
 from pipeline.hazard import load_hazard
 from pipeline.hazard.fragility.components import records_fraction
-from pipeline.hazard.fragility import Lognormal, RatioLognormal, load_campaign_fragility, \
-    overturn_probability
+from pipeline.hazard.fragility import Lognormal, RatioLognormal, load_campaign_fragility
+from pipeline.hazard.set_probability import overturn_probability
 from pipeline.hazard.survival import overturning_rate, rate_outside
 from pipeline.motion.measures import horizontal_peak, rotd_peak
 from pipeline.records import rotd50_fraction

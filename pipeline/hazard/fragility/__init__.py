@@ -6,7 +6,7 @@ with each PGA level.  The package of the fragility wing; each concern in its mod
 - :mod:`pipeline.hazard.fragility.grid`: a pulse grid's cells as a fragility
   (:class:`PulseGrid`, :data:`BELOW_GRID`);
 - :mod:`pipeline.hazard.fragility.ratio`: PGV/PGA at a PGA level (:class:`RatioLognormal`,
-  :class:`RatioFromGmm`) and P averaged over it (:func:`overturn_probability`);
+  :class:`RatioFromGmm`) and the nodes P is averaged over it with;
 - :mod:`pipeline.hazard.fragility.load`: a campaign's ``fragility.json`` loaded as one
   (:func:`load_campaign_fragility`, :func:`load_pulse_grid`, :func:`member_fits`);
 - :mod:`pipeline.hazard.fragility.file`: ``fragility.json`` as one type
@@ -21,10 +21,8 @@ from pipeline.hazard.fragility.grid import BELOW_GRID, PulseGrid
 from pipeline.hazard.fragility.kinds import Fragility, Logistic, Lognormal
 from pipeline.hazard.fragility.load import load_campaign_fragility, load_pulse_grid, member_fits
 from pipeline.hazard.fragility.ratio import (GMM_MECHANISMS, PGA_PGV_CORRELATION, RATIO_NODES,
-                                             RatioFromGmm, RatioLognormal,
-                                             overturn_probability)
+                                             RatioFromGmm, RatioLognormal)
 
 __all__ = ["BELOW_GRID", "GMM_MECHANISMS", "PGA_PGV_CORRELATION", "RATIO_NODES", "Fragility",
            "Logistic", "Lognormal", "PulseGrid", "RatioFromGmm", "RatioLognormal",
-           "load_campaign_fragility", "load_pulse_grid", "member_fits",
-           "overturn_probability"]
+           "load_campaign_fragility", "load_pulse_grid", "member_fits"]

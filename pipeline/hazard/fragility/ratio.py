@@ -1,10 +1,10 @@
-"""PGV/PGA (s) at a PGA level, and P(overturn) averaged over it.
+"""PGV/PGA (s) at a PGA level, and the nodes P(overturn) is averaged over it with.
 
 PGV/PGA at a PGA level is lognormal: :class:`RatioLognormal` (a median and sigma the user
 states, the same at every level) or :class:`RatioFromGmm` (the median and sigma of PGV and
 PGA from Boore et al. 2014 (pygmm) at a magnitude and distance, for example the mode of
 the hazard's disaggregation; ln PGV given ln PGA by their correlation).
-:func:`overturn_probability` averages fragilities
+:func:`pipeline.hazard.set_probability.overturn_probability` averages fragilities
 (:class:`~pipeline.hazard.fragility.kinds.Fragility`) over it.
 """
 import functools
@@ -15,7 +15,6 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from pipeline.constants import STANDARD_GRAVITY
-from pipeline.files import InputError
 from pipeline.hazard.pga_pgv_correlation import BAKER_BRADLEY_2017
 
 RATIO_NODES = 24                  # Gauss-Hermite nodes over ln(PGV/PGA)
@@ -91,33 +90,4 @@ def ratio_nodes():
     weights = weights / weights.sum()
     weights.flags.writeable = False
     return nodes, weights
-
-
-def overturn_probability(fragilities, ratio_model, pga_m_s2, combine="each"):
-    """P(overturn) at PGA levels (m/s^2) averaged over PGV/PGA (Gauss-Hermite in ln PGV/PGA).
-
-    ``combine``: "each" (array n_specimens x n_levels), "any_common" (P that any overturns
-    in one event, the specimens independent given the motion they share: 1 - E[prod(1 -
-    P_i)]) or "any_correlated" (the specimens' capacities fully correlated: E[max P_i]).
-    """
-    pga = np.asarray(pga_m_s2, float)
-    if any(f.uses_ratio for f in fragilities):
-        if ratio_model is None:
-            raise InputError("the fragility depends on PGV/PGA: give its distribution "
-                             "(--pgv-pga-median and --pgv-pga-sigma, or --magnitude and "
-                             "--distance-km)")
-        nodes, weights = ratio_nodes()
-        mean, sd = ratio_model.ln_mean_sd(pga)
-        ratio = np.exp(mean[:, None] + sd[:, None] * nodes[None, :])
-        each = np.array([f.probability(pga[:, None], ratio) for f in fragilities])
-    else:
-        weights = np.ones(1)
-        each = np.array([f.probability(pga)[:, None] for f in fragilities])
-    if combine == "each":
-        return each @ weights
-    if combine == "any_common":
-        return 1.0 - np.prod(1.0 - each, axis=0) @ weights
-    if combine == "any_correlated":
-        return each.max(axis=0) @ weights
-    raise ValueError(f"unknown combine {combine!r}")
 
