@@ -22,7 +22,7 @@ from pipeline.hazard.logictree import LogicTree
 from pipeline.hazard.record import ABSENT
 from pipeline.hazard.survival_parts import age_keys
 from pipeline.hazard.results import ConstrainResult
-from pipeline.hazard.set_probability import set_probabilities
+from pipeline.hazard.set_probability import set_probabilities, subset_probabilities
 from pipeline.provenance import software_versions
 
 AGE_SAMPLES = 2000           # Monte Carlo samples of differing, uncertain ages
@@ -182,18 +182,18 @@ def _log_survival(tree, cells, batch, ratio_model, ages, mode, samples):
     per specimen), all integrated by one matrix product; its relative standard error
     (D x B) or None).  ``samples`` None: each age at its fixed or typical value (the
     fragility draws)."""
-    def set_rates(members):
-        sets = [[chosen[j] for j in members] for chosen in batch]
+    def rates_of(subsets):
         return rates_by_ratio(cells, tree.levels_m_s2, tree.rates_per_yr, ratio_model,
-                              lambda model: lambda x: set_probabilities(sets, model, x))
+                              lambda model: lambda x: subset_probabilities(batch, subsets,
+                                                                           model, x))
     if mode is AgeIntegration.ONE_FOR_ALL:
-        rate = set_rates(tuple(range(len(batch[0]))))
+        rate = rates_of([tuple(range(len(batch[0])))])[0]
         with np.errstate(divide="ignore"):
             return np.log(ages[0].survival(rate)), None
     if samples is None:
-        return log_survival_fixed(set_rates, np.array(
+        return log_survival_fixed(rates_of, np.array(
             [a.typical_yr if a.fixed_yr is None else a.fixed_yr for a in ages])), None
-    return log_survival_sampled(set_rates, samples)
+    return log_survival_sampled(rates_of, samples)
 
 
 def _none_left(rule: str, floor: float, tree: LogicTree, p: np.ndarray) -> str:

@@ -17,7 +17,7 @@ from pipeline.files import InputError
 from pipeline.hazard.disagg_ratio import RatioMixture, bin_shares
 from pipeline.hazard.fragility.ratio import ratio_nodes
 
-MAX_VALUES = 4_000_000        # sets x PGA levels x PGV/PGA points held at once (32 MB)
+MAX_VALUES = 4_000_000        # subsets x sets x PGA levels x PGV/PGA points at once (32 MB)
 
 
 def ratio_quadrature(ratio_model, pga_m_s2):
@@ -45,6 +45,14 @@ def set_probabilities(batch, ratio_model, pga_m_s2):
     """D x L: for each of the D sets in ``batch`` (lists of fragilities, one per specimen,
     the same specimens in each), P(any of the set overturns) at PGA levels (m/s^2, L),
     averaged over PGV/PGA from ``ratio_model`` (see the module)."""
+    return subset_probabilities(batch, [tuple(range(len(batch[0])))], ratio_model,
+                                pga_m_s2)[0]
+
+
+def subset_probabilities(batch, subsets, ratio_model, pga_m_s2):
+    """S x D x L: :func:`set_probabilities` of each of the S ``subsets`` (tuples of indices
+    into each set of ``batch``) of the specimens, each specimen's P computed once for all
+    the subsets holding it (the sets of an age chain, the ages sampled)."""
     pga = np.asarray(pga_m_s2, float)
     if any(f.uses_ratio for chosen in batch for f in chosen):
         if ratio_model is None:
@@ -54,26 +62,31 @@ def set_probabilities(batch, ratio_model, pga_m_s2):
         ratio, weights = ratio_quadrature(ratio_model, pga)
     else:
         ratio, weights = None, np.ones((pga.size, 1))
+    used = sorted(set().union(*subsets))
+    columns = {j: _column([chosen[j] for chosen in batch]) for j in used}
     count = len(batch)
-    chunk = max(1, MAX_VALUES // weights.size)
-    out = np.empty((count, pga.size))
-    for start in range(0, count, chunk):
-        part = batch[start:start + chunk]
-        survive = np.ones((len(part), *weights.shape))
-        for j in range(len(part[0])):
-            survive = survive * (1.0 - _column([chosen[j] for chosen in part], pga, ratio))
-        out[start:start + len(part)] = 1.0 - (survive * weights).sum(axis=-1)
+    step = max(1, MAX_VALUES // ((len(subsets) + 1) * count * weights.shape[1]))
+    out = np.empty((len(subsets), count, pga.size))
+    for start in range(0, pga.size, step):          # PGA levels in chunks, all sets at once
+        rows = slice(start, start + step)
+        survive = np.ones((len(subsets), count, *weights[rows].shape))
+        for j in used:
+            spared = 1.0 - columns[j](pga[rows, None], None if ratio is None else ratio[rows])
+            for s, members in enumerate(subsets):
+                if j in members:
+                    survive[s] *= spared
+        out[:, :, rows] = 1.0 - (survive * weights[rows]).sum(axis=-1)
     return out
 
 
-def _column(fragilities, pga, ratio):
-    """P of one specimen's fragilities (one per set) at the points: (1 or D) x L x K."""
+def _column(fragilities):
+    """P of one specimen's fragilities (one per set) as a function of the points (PGA, L x
+    1; PGV/PGA, L x K or None): (1 or D) x L x K."""
     first = fragilities[0]
-    a = pga[:, None]
     if all(f is first for f in fragilities):
-        return (first.probability(a, ratio) if ratio is not None
-                else first.probability(a))[None]
+        return lambda a, ratio: (first.probability(a, ratio) if ratio is not None
+                                 else first.probability(a))[None]
     if all(first.stacks_with(f) for f in fragilities):
-        return first.probability_stack(fragilities, a, ratio)
-    return np.array([f.probability(a, ratio) if ratio is not None else f.probability(a)
-                     for f in fragilities])
+        return lambda a, ratio: first.probability_stack(fragilities, a, ratio)
+    return lambda a, ratio: np.array([f.probability(a, ratio) if ratio is not None
+                                      else f.probability(a) for f in fragilities])
