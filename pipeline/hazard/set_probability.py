@@ -9,7 +9,9 @@ and for a mixture over disaggregation bins every bin's nodes times its share, so
 bin's grid is evaluated in the same call), and a specimen whose D fragilities are pulse
 grids differing only in their counts (draws, members; as they are or on the hazard's
 PGA measure) is evaluated by one interpolation of the D grids
-(:meth:`~pipeline.hazard.fragility.grid.PulseGrid.probability_stack`).
+(:meth:`~pipeline.hazard.fragility.grid.PulseGrid.probability_stack`).  Several subsets
+of the specimens (the sets of an age chain: all, then the older ones, ...) take each
+specimen's P once (:func:`subset_probabilities`).
 Units: PGA in m/s^2, PGV/PGA in s."""
 import numpy as np
 
@@ -54,7 +56,9 @@ def subset_probabilities(batch, subsets, ratio_model, pga_m_s2):
     into each set of ``batch``) of the specimens, each specimen's P computed once for all
     the subsets holding it (the sets of an age chain, the ages sampled)."""
     pga = np.asarray(pga_m_s2, float)
-    if any(f.uses_ratio for chosen in batch for f in chosen):
+    subsets = [tuple(sorted(members)) for members in subsets]
+    used = sorted(set().union(*subsets))
+    if any(chosen[j].uses_ratio for chosen in batch for j in used):
         if ratio_model is None:
             raise InputError("the fragility depends on PGV/PGA: give its distribution "
                              "(--pgv-pga-median and --pgv-pga-sigma, or --magnitude and "
@@ -62,21 +66,34 @@ def subset_probabilities(batch, subsets, ratio_model, pga_m_s2):
         ratio, weights = ratio_quadrature(ratio_model, pga)
     else:
         ratio, weights = None, np.ones((pga.size, 1))
-    used = sorted(set().union(*subsets))
     columns = {j: _column([chosen[j] for chosen in batch]) for j in used}
     count = len(batch)
     step = max(1, MAX_VALUES // ((len(subsets) + 1) * count * weights.shape[1]))
     out = np.empty((len(subsets), count, pga.size))
     for start in range(0, pga.size, step):          # PGA levels in chunks, all sets at once
         rows = slice(start, start + step)
-        survive = np.ones((len(subsets), count, *weights[rows].shape))
+        survive = np.empty((len(subsets), count, *weights[rows].shape))
         for j in used:
-            spared = 1.0 - columns[j](pga[rows, None], None if ratio is None else ratio[rows])
-            for s, members in enumerate(subsets):
-                if j in members:
-                    survive[s] *= spared
-        out[:, :, rows] = 1.0 - (survive * weights[rows]).sum(axis=-1)
+            _spare(survive, subsets, j, columns[j](pga[rows, None],
+                                                   None if ratio is None else ratio[rows]))
+        survive *= weights[rows]
+        out[:, :, rows] = 1.0 - survive.sum(axis=-1)
     return out
+
+
+def _spare(survive, subsets, j, column):
+    """Multiply P(specimen ``j`` stands), 1 - ``column``, into the survival of each subset
+    holding it (S x D x L x K, the subsets' specimens in index order: a subset's first one
+    sets it)."""
+    first = [s for s, members in enumerate(subsets) if members[0] == j]
+    spared = survive[first[0]] if first else np.empty(np.broadcast_shapes(
+        survive.shape[1:], column.shape))
+    np.subtract(1.0, column, out=spared)
+    for s in first[1:]:
+        survive[s] = spared
+    for s, members in enumerate(subsets):
+        if j in members[1:]:
+            survive[s] *= spared
 
 
 def _column(fragilities):
