@@ -4,6 +4,7 @@
 from enum import Enum
 
 import numpy as np
+from threadpoolctl import threadpool_limits
 
 from pipeline.constants import STANDARD_GRAVITY
 from pipeline.hazard.branch_ratio import rates_by_ratio
@@ -62,6 +63,7 @@ ASSUMPTIONS = [
 ]
 
 
+@threadpool_limits.wrap(limits=1)      # BLAS threads only slow its many small products
 def constrain_tree(tree, specimens, ratio_model, ages, rule, floor, draws, seed,
                    groups=None):
     """(constrain.json as a :class:`~pipeline.hazard.results.ConstrainResult`, branch
