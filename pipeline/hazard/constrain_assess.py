@@ -76,14 +76,14 @@ def constrain_tree(tree, specimens, ratio_model, ages, rule, floor, draws, seed,
     groups = groups or [SiteGroup(tree, tuple(range(len(specimens))))]
     rng = np.random.default_rng(seed)
     cells = cell_matrix(tree.levels_m_s2, tree.rates_per_yr)
-    sites, mode = _sites(tree, cells, groups, ages, rng)
+    sites, mode = _sites(tree, cells, groups, ages, rng, ratio_model)
     warnings = list(tree.notes)
 
     def survival_of(batch, sampled=True):
         return combined([_log_survival(t, c, [[chosen[j] for j in m] for chosen in batch],
-                                       ratio_model, [ages[j] for j in m], how,
+                                       ratio, [ages[j] for j in m], how,
                                        samples if sampled else None)
-                         for m, t, c, how, samples in sites])
+                         for m, t, c, how, samples, ratio in sites])
 
     log_p, age_se = (None if v is None else v[0] for v in survival_of([specimens]))
     p = np.exp(log_p)
@@ -94,10 +94,9 @@ def constrain_tree(tree, specimens, ratio_model, ages, rule, floor, draws, seed,
             warnings.append(_none_left(name, floor, tree, p))
     members = _members(tree, specimens, survival_of, floor, warnings)
     carlo = _draws(tree, cells, specimens, survival_of, draws, rng, floor)
-    for m, t, c, _, _ in sites:
-        warnings += _end_warnings(t, c, [specimens[j] for j in m], ratio_model,
-                                  posterior[rule])
-    test = branch_test(groups, _singles(sites, specimens, ratio_model, ages), p, tree, floor)
+    for m, t, c, _, _, ratio in sites:
+        warnings += _end_warnings(t, c, [specimens[j] for j in m], ratio, posterior[rule])
+    test = branch_test(groups, _singles(sites, specimens, ages), p, tree, floor)
     prior_stats = _statistics(tree, tree.weights)
     post_stats = None if posterior[rule] is None else _statistics(tree, posterior[rule])
     other = "eliminate" if rule == "bayes" else "bayes"
@@ -117,7 +116,9 @@ def constrain_tree(tree, specimens, ratio_model, ages, rule, floor, draws, seed,
            else _statistics(tree, posterior[other])},
         ground_motion_at_rates=_motions(tree, prior_stats, post_stats),
         members=members, monte_carlo=carlo,
-        sites=[SiteRow(site=g.site, specimens=list(g.members)) for g in groups],
+        sites=[SiteRow(site=g.site, specimens=list(g.members),
+                       pgv_pga=ABSENT if g.ratio_model is None else g.ratio_model.describe())
+               for g in groups],
         branch_test=test,
         hazard=TreeHazard(source=dict(tree.source), notes=list(tree.notes),
                           interpolation="linear in (ln PGA, ln rate)",
@@ -142,20 +143,22 @@ class AgeIntegration(Enum):
     MONTE_CARLO = f"differing uncertain ages: Monte Carlo over {AGE_SAMPLES} samples"
 
 
-def _sites(tree, cells, groups, ages, rng):
-    """(per site: members, its tree, its cells, its age integration and samples; the age
-    integration reported: the most demanding of the sites')."""
+def _sites(tree, cells, groups, ages, rng, ratio_model):
+    """(per site: members, its tree, its cells, its age integration and samples, its
+    PGV/PGA model (its own or ``ratio_model``); the age integration reported: the most
+    demanding of the sites')."""
     check_same_branches(groups)
     sites = [(g.members, g.tree, cells if g.tree is tree else
               cell_matrix(g.tree.levels_m_s2, g.tree.rates_per_yr),
-              *_age_mode([ages[j] for j in g.members], rng)) for g in groups]
+              *_age_mode([ages[j] for j in g.members], rng),
+              ratio_model if g.ratio_model is None else g.ratio_model) for g in groups]
     return sites, max((s[3] for s in sites), key=list(AgeIntegration).index)
 
 
-def _singles(sites, specimens, ratio_model, ages):
+def _singles(sites, specimens, ages):
     """ln P_s of each specimen alone at its site (n x B): one age each, no sampling."""
     out = np.empty((len(specimens), sites[0][1].size))
-    for members, t, c, _, _ in sites:
+    for members, t, c, _, _, ratio_model in sites:
         for j in members:
             how, _ = _age_mode([ages[j]], None)
             out[j] = _log_survival(t, c, [[specimens[j]]], ratio_model, [ages[j]], how,
