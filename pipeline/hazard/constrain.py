@@ -95,8 +95,9 @@ def log_survival_fixed(rates_of, ages_yr):
 def log_survival_sampled(rates_of, age_samples):
     """(ln P_s per branch, its standard error relative to P_s per branch): the mean of
     exp(-sum dt lambda) over sampled ages (Monte Carlo over uncertain, differing ages).
-    Each set's lambda is computed once (``rates_of`` as for :func:`log_survival_fixed`); a sample's sum is its durations (samples x sets)
-    times the sets' rates, one matrix product for all samples."""
+    Each set's lambda is computed once, all sets at once (``rates_of`` as for
+    :func:`log_survival_fixed`); a sample's sum is its durations (samples x sets) times
+    the sets' rates, one matrix product for all samples."""
     chains = [age_chain(a) for a in age_samples]
     sets = list(dict.fromkeys(m for chain in chains for m, _ in chain))
     index = {m: k for k, m in enumerate(sets)}
