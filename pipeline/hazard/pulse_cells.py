@@ -85,7 +85,7 @@ def interpolate(pga_axis, ratio_axis, values, pga, ratio):
     outside = (x != ln_pga) | (y != ln_ratio)
     values = np.asarray(values, float)
     shape, stack = values.shape[:2], values.shape[2:]
-    cells = values if not stack else np.eye(values[..., 0].size).reshape(*shape, -1)
+    cells = values if not stack else np.eye(shape[0] * shape[1]).reshape(*shape, -1)
     axes = [ln_a, ln_r]
     for k in (0, 1):           # one value: doubled a unit apart, the points lie on it
         if len(axes[k]) == 1:
