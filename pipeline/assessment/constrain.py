@@ -11,7 +11,7 @@ from pipeline.constants import STANDARD_GRAVITY
 from pipeline.files import file_set, write_text
 from pipeline.hazard.constrain_assess import constrain_tree
 from pipeline.hazard.constrain_sites import SiteGroup
-from pipeline.hazard.logictree import load_logic_tree
+from pipeline.hazard.logictree import load_logic_tree, load_logic_trees
 
 FILES = ("branch_weights.csv", "branch_test.csv", "prior_curves.csv",
          "constrained_curves.csv", "constrain.json", "constrain.png")  # a run replaces them
@@ -25,14 +25,15 @@ def constrain_files(o):
     ages = o.age_models()
     sites = o.specimen_sites()
     site = o.site if o.site is not None or sites is None else sites[0]
-    groups, trees = None, {}
+    groups, trees, ratios = None, {}, {}
     if sites is not None:
-        trees = {s: load_logic_tree(o.logic_tree, s) for s in dict.fromkeys(sites)}
-        groups = [SiteGroup(trees[s], tuple(j for j, t in enumerate(sites) if t == s), s)
-                  for s in trees]
+        trees = load_logic_trees(o.logic_tree, list(dict.fromkeys(sites)))
+        ratios = o.site_ratio_models(trees)              # each site its own rate density
+        groups = [SiteGroup(trees[s], tuple(j for j, t in enumerate(sites) if t == s), s,
+                            ratios.get(s)) for s in trees]
     tree = trees[site] if site in trees else load_logic_tree(o.logic_tree, site)
     specimens = o.specimens()
-    ratio = o.ratio_model(specimens, tree)
+    ratio = ratios[site] if site in ratios else o.ratio_model(specimens, tree)
     summary, rows, figure = constrain_tree(tree, specimens, ratio, ages, o.rule, o.floor,
                                            o.draws, o.seed, groups)
     files = {"branch_weights.csv": _branch_table(rows),

@@ -64,7 +64,8 @@ class ConstrainOptions(SpecimenOptions):
                          metavar="P")
     joint_hazard: Path = param(
         None, "", "or PGV/PGA at each PGA level from the rate density mrd of PGA and PGV "
-        "(an OpenQuake datastore or its extract) at --site: each branch K its realisation "
+        "(an OpenQuake datastore or its extract) at --site, or at each specimen's site "
+        "(--specimen-site, the file's site index): each branch K its realisation "
         "K's where the file holds one per realisation (mrd-rlzs), else the mean's for every "
         "branch (the engine writes the mean's only)", flag="--joint-hazard",
         metavar="FILE", optional=True)
@@ -127,6 +128,16 @@ class ConstrainOptions(SpecimenOptions):
                 load_mag_dist(self.disaggregation), tree, self.disaggregation_column,
                 self.vs30, self.mechanism, self.pga_pgv_correlation)
         return super().ratio_model(specimens)
+
+    def site_ratio_models(self, trees):
+        """{site: PGV/PGA per branch of its tree from --joint-hazard's rate density at that
+        site} for ``trees`` ({site: LogicTree}, the specimens' sites), the file read once;
+        {} without --joint-hazard (then one PGV/PGA for every site)."""
+        if self.joint_hazard is None:
+            return {}
+        from pipeline.hazard.joint_hazard import load_joint_hazard  # noqa: PLC0415  (h5py: lazy)
+        joint = load_joint_hazard(self.joint_hazard)
+        return {site: branch_ratio.mrd_ratios(joint, site, tree) for site, tree in trees.items()}
 
     def specimen_sites(self):
         """The site of each specimen (--specimen-site), or None (all at --site)."""

@@ -53,14 +53,15 @@ def branch_rates(cells, levels_m_s2, rates_per_yr, probability):
     happens, under each branch: sum over cells of P(x_mid) d_rate plus P(x_N) at the last
     level x_N times its rate (:func:`pipeline.hazard.survival.overturning_rate`).
     ``probability`` gives one value per PGA (result B) or a row per fragility draw (D x
-    len(x): result D x B, one matrix product for all draws)."""
+    len(x): result D x B, one matrix product for all draws; S x D x len(x) for S sets of
+    specimens: S x D x B)."""
     x_mid, d_rate, _ = cells
     rates = np.atleast_2d(np.asarray(rates_per_yr, float))
     p_mid = np.asarray(probability(x_mid), float)
     top = np.asarray(probability(np.asarray(levels_m_s2, float)[-1:]), float)[..., 0]
     if p_mid.ndim == 1:
         return d_rate @ p_mid + top * rates[:, -1]
-    return p_mid @ d_rate.T + top[:, None] * rates[None, :, -1]
+    return p_mid @ d_rate.T + top[..., None] * rates[:, -1]
 
 
 def draw_chunk(cells):
@@ -82,17 +83,21 @@ def age_chain(ages_yr):
     return chain
 
 
-def log_survival_fixed(set_rates, ages_yr):
-    """ln P_s per branch for known ages: -sum_k dt_k lambda(S_k); ``set_rates(indices)``
-    gives lambda (1/yr, B, or D x B for D fragility draws) of a set."""
-    return -sum(dt * set_rates(members) for members, dt in age_chain(ages_yr))
+def log_survival_fixed(rates_of, ages_yr):
+    """ln P_s per branch for known ages: -sum_k dt_k lambda(S_k); ``rates_of(sets)`` gives
+    lambda (1/yr, B, or D x B for D fragility draws) of each of a list of sets (tuples of
+    specimen indices), all at once."""
+    chain = age_chain(ages_yr)
+    rates = rates_of([members for members, _ in chain])
+    return -sum(dt * rate for (_, dt), rate in zip(chain, rates))
 
 
-def log_survival_sampled(set_rates, age_samples):
+def log_survival_sampled(rates_of, age_samples):
     """(ln P_s per branch, its standard error relative to P_s per branch): the mean of
     exp(-sum dt lambda) over sampled ages (Monte Carlo over uncertain, differing ages).
-    Each set's lambda is computed once; a sample's sum is its durations (samples x sets)
-    times the sets' rates, one matrix product for all samples."""
+    Each set's lambda is computed once, all sets at once (``rates_of`` as for
+    :func:`log_survival_fixed`); a sample's sum is its durations (samples x sets) times
+    the sets' rates, one matrix product for all samples."""
     chains = [age_chain(a) for a in age_samples]
     sets = list(dict.fromkeys(m for chain in chains for m, _ in chain))
     index = {m: k for k, m in enumerate(sets)}
@@ -100,7 +105,7 @@ def log_survival_sampled(set_rates, age_samples):
     for s, chain in enumerate(chains):
         for members, dt in chain:
             durations[s, index[members]] += dt
-    rates = np.stack([np.asarray(set_rates(m), float) for m in sets])
+    rates = np.stack([np.asarray(rate, float) for rate in rates_of(sets)])
     logs = -np.tensordot(durations, rates, axes=1)
     log_p = logsumexp(logs, axis=0) - np.log(len(logs))
     with np.errstate(invalid="ignore", over="ignore"):

@@ -4,6 +4,7 @@
 from enum import Enum
 
 import numpy as np
+from threadpoolctl import threadpool_limits
 
 from pipeline.constants import STANDARD_GRAVITY
 from pipeline.hazard.branch_ratio import rates_by_ratio
@@ -22,7 +23,7 @@ from pipeline.hazard.logictree import LogicTree
 from pipeline.hazard.record import ABSENT
 from pipeline.hazard.survival_parts import age_keys
 from pipeline.hazard.results import ConstrainResult
-from pipeline.hazard.set_probability import set_probabilities
+from pipeline.hazard.set_probability import set_probabilities, subset_probabilities
 from pipeline.provenance import software_versions
 
 AGE_SAMPLES = 2000           # Monte Carlo samples of differing, uncertain ages
@@ -62,6 +63,7 @@ ASSUMPTIONS = [
 ]
 
 
+@threadpool_limits.wrap(limits=1)      # BLAS threads only slow its many small products
 def constrain_tree(tree, specimens, ratio_model, ages, rule, floor, draws, seed,
                    groups=None):
     """(constrain.json as a :class:`~pipeline.hazard.results.ConstrainResult`, branch
@@ -74,14 +76,14 @@ def constrain_tree(tree, specimens, ratio_model, ages, rule, floor, draws, seed,
     groups = groups or [SiteGroup(tree, tuple(range(len(specimens))))]
     rng = np.random.default_rng(seed)
     cells = cell_matrix(tree.levels_m_s2, tree.rates_per_yr)
-    sites, mode = _sites(tree, cells, groups, ages, rng)
+    sites, mode = _sites(tree, cells, groups, ages, rng, ratio_model)
     warnings = list(tree.notes)
 
     def survival_of(batch, sampled=True):
         return combined([_log_survival(t, c, [[chosen[j] for j in m] for chosen in batch],
-                                       ratio_model, [ages[j] for j in m], how,
+                                       ratio, [ages[j] for j in m], how,
                                        samples if sampled else None)
-                         for m, t, c, how, samples in sites])
+                         for m, t, c, how, samples, ratio in sites])
 
     log_p, age_se = (None if v is None else v[0] for v in survival_of([specimens]))
     p = np.exp(log_p)
@@ -92,10 +94,9 @@ def constrain_tree(tree, specimens, ratio_model, ages, rule, floor, draws, seed,
             warnings.append(_none_left(name, floor, tree, p))
     members = _members(tree, specimens, survival_of, floor, warnings)
     carlo = _draws(tree, cells, specimens, survival_of, draws, rng, floor)
-    for m, t, c, _, _ in sites:
-        warnings += _end_warnings(t, c, [specimens[j] for j in m], ratio_model,
-                                  posterior[rule])
-    test = branch_test(groups, _singles(sites, specimens, ratio_model, ages), p, tree, floor)
+    for m, t, c, _, _, ratio in sites:
+        warnings += _end_warnings(t, c, [specimens[j] for j in m], ratio, posterior[rule])
+    test = branch_test(groups, _singles(sites, specimens, ages), p, tree, floor)
     prior_stats = _statistics(tree, tree.weights)
     post_stats = None if posterior[rule] is None else _statistics(tree, posterior[rule])
     other = "eliminate" if rule == "bayes" else "bayes"
@@ -115,7 +116,9 @@ def constrain_tree(tree, specimens, ratio_model, ages, rule, floor, draws, seed,
            else _statistics(tree, posterior[other])},
         ground_motion_at_rates=_motions(tree, prior_stats, post_stats),
         members=members, monte_carlo=carlo,
-        sites=[SiteRow(site=g.site, specimens=list(g.members)) for g in groups],
+        sites=[SiteRow(site=g.site, specimens=list(g.members),
+                       pgv_pga=ABSENT if g.ratio_model is None else g.ratio_model.describe())
+               for g in groups],
         branch_test=test,
         hazard=TreeHazard(source=dict(tree.source), notes=list(tree.notes),
                           interpolation="linear in (ln PGA, ln rate)",
@@ -140,20 +143,22 @@ class AgeIntegration(Enum):
     MONTE_CARLO = f"differing uncertain ages: Monte Carlo over {AGE_SAMPLES} samples"
 
 
-def _sites(tree, cells, groups, ages, rng):
-    """(per site: members, its tree, its cells, its age integration and samples; the age
-    integration reported: the most demanding of the sites')."""
+def _sites(tree, cells, groups, ages, rng, ratio_model):
+    """(per site: members, its tree, its cells, its age integration and samples, its
+    PGV/PGA model (its own or ``ratio_model``); the age integration reported: the most
+    demanding of the sites')."""
     check_same_branches(groups)
     sites = [(g.members, g.tree, cells if g.tree is tree else
               cell_matrix(g.tree.levels_m_s2, g.tree.rates_per_yr),
-              *_age_mode([ages[j] for j in g.members], rng)) for g in groups]
+              *_age_mode([ages[j] for j in g.members], rng),
+              ratio_model if g.ratio_model is None else g.ratio_model) for g in groups]
     return sites, max((s[3] for s in sites), key=list(AgeIntegration).index)
 
 
-def _singles(sites, specimens, ratio_model, ages):
+def _singles(sites, specimens, ages):
     """ln P_s of each specimen alone at its site (n x B): one age each, no sampling."""
     out = np.empty((len(specimens), sites[0][1].size))
-    for members, t, c, _, _ in sites:
+    for members, t, c, _, _, ratio_model in sites:
         for j in members:
             how, _ = _age_mode([ages[j]], None)
             out[j] = _log_survival(t, c, [[specimens[j]]], ratio_model, [ages[j]], how,
@@ -182,18 +187,18 @@ def _log_survival(tree, cells, batch, ratio_model, ages, mode, samples):
     per specimen), all integrated by one matrix product; its relative standard error
     (D x B) or None).  ``samples`` None: each age at its fixed or typical value (the
     fragility draws)."""
-    def set_rates(members):
-        sets = [[chosen[j] for j in members] for chosen in batch]
+    def rates_of(subsets):
         return rates_by_ratio(cells, tree.levels_m_s2, tree.rates_per_yr, ratio_model,
-                              lambda model: lambda x: set_probabilities(sets, model, x))
+                              lambda model: lambda x: subset_probabilities(batch, subsets,
+                                                                           model, x))
     if mode is AgeIntegration.ONE_FOR_ALL:
-        rate = set_rates(tuple(range(len(batch[0]))))
+        rate = rates_of([tuple(range(len(batch[0])))])[0]
         with np.errstate(divide="ignore"):
             return np.log(ages[0].survival(rate)), None
     if samples is None:
-        return log_survival_fixed(set_rates, np.array(
+        return log_survival_fixed(rates_of, np.array(
             [a.typical_yr if a.fixed_yr is None else a.fixed_yr for a in ages])), None
-    return log_survival_sampled(set_rates, samples)
+    return log_survival_sampled(rates_of, samples)
 
 
 def _none_left(rule: str, floor: float, tree: LogicTree, p: np.ndarray) -> str:

@@ -130,9 +130,11 @@ class MonteCarlo(Record):
 
 @dataclass(frozen=True, kw_only=True)
 class SiteRow(Record):
-    """A site of the tree (None: its only one) and the specimens standing there (indices)."""
+    """A site of the tree (None: its only one), the specimens standing there (indices)
+    and, where the site takes its own, its PGV/PGA (as ``pgv_pga`` says it)."""
     site: int | None
     specimens: list
+    pgv_pga: dict = ABSENT
     NAME = "sites"
 
 

@@ -22,10 +22,12 @@ SITE_ASSUMPTION = (
 class SiteGroup:
     """The specimens ``members`` (indices into the specimens) at one site of the logic
     tree, and the tree's curves there (``tree``, a LogicTree; ``site``: its index or None
-    for a tree of one site)."""
+    for a tree of one site); ``ratio_model``: PGV/PGA at the site (the joint hazard's
+    there), or None: the one given for every site."""
     tree: object
     members: tuple
     site: int | None = None
+    ratio_model: object = None
 
 
 def check_same_branches(groups):

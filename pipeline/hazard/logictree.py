@@ -44,7 +44,7 @@ import numpy as np
 from pipeline.hazard.curves import (MAX_LEVELS, OQ_HEADER_IMT, PLAIN_RATE_COLUMN, PLAIN_UNITS,
                                     check_curve, level_unit, load_hazard, parse_number,
                                     plain_body)
-from pipeline.hazard.logictree_sites import plain_site_rows
+from pipeline.hazard.logictree_sites import plain_site_rows, plain_site_tables
 from pipeline.files import InputError
 from pipeline.userfiles import DATA_FILE_BYTES, read_user_bytes, read_user_text, show
 
@@ -97,6 +97,17 @@ def load_logic_tree(path, site=None, imt="PGA"):
     if _header(lines).replace(" ", "").lower().startswith("rlz_id,"):
         return _openquake(path, site)
     return _plain(path, plain_site_rows(path, lines, site), imt)
+
+
+def load_logic_trees(path, sites, imt="PGA"):
+    """{site: :func:`load_logic_tree` (path, site, imt)} for each of ``sites``, a plain
+    table read and split by site once."""
+    path = Path(path)
+    lines = None if path.is_dir() else _lines(path, "logic tree file")
+    if lines is None or _header(lines).replace(" ", "").lower().startswith("rlz_id,"):
+        return {site: load_logic_tree(path, site, imt) for site in sites}
+    return {site: _plain(path, table, imt)
+            for site, table in zip(sites, plain_site_tables(path, lines, sites))}
 
 
 def _header(lines):

@@ -69,21 +69,30 @@ def fill_empty(values):
 
 
 def interpolate(pga_axis, ratio_axis, values, pga, ratio):
-    """P at (pga, ratio) from the cells ``values`` (n_pga x n_ratio, no NaN) on the
-    increasing axes (PGA and PGV/PGA, any one unit each, the points in the same):
-    bilinear in (ln PGA, ln PGV/PGA), the nearest edge cell's P outside the grid's box
-    (an axis of one value: along the other axis only).  Returns (P, outside) as arrays
-    of the points' broadcast shape; outside True where a point lies beyond the box."""
+    """P at (pga, ratio) from the cells ``values`` (n_pga x n_ratio, no NaN; or a stack of
+    grids' cells, n_pga x n_ratio x ...) on the increasing axes (PGA and PGV/PGA, any one
+    unit each, the points in the same): bilinear in (ln PGA, ln PGV/PGA), the nearest edge
+    cell's P outside the grid's box (an axis of one value: along the other axis only).
+    Returns (P, outside): P of the points' broadcast shape (a stack: its axes first), outside
+    True where a point lies beyond the box.  A stack is one matrix product: the
+    interpolant is linear in the cells' values, so its weights at the points are the
+    interpolation of the unit cells, the same for every grid of the stack."""
     pga, ratio = np.broadcast_arrays(np.asarray(pga, float), np.asarray(ratio, float))
     ln_a, ln_r = np.log(np.asarray(pga_axis, float)), np.log(np.asarray(ratio_axis, float))
     with np.errstate(divide="ignore", invalid="ignore"):     # a zero is below any grid
         ln_pga, ln_ratio = np.log(pga), np.log(ratio)
     x, y = np.clip(ln_pga, ln_a[0], ln_a[-1]), np.clip(ln_ratio, ln_r[0], ln_r[-1])
     outside = (x != ln_pga) | (y != ln_ratio)
-    axes, cells = [ln_a, ln_r], np.asarray(values, float)
+    values = np.asarray(values, float)
+    shape, stack = values.shape[:2], values.shape[2:]
+    cells = values if not stack else np.eye(shape[0] * shape[1]).reshape(*shape, -1)
+    axes = [ln_a, ln_r]
     for k in (0, 1):           # one value: doubled a unit apart, the points lie on it
         if len(axes[k]) == 1:
             axes[k] = np.array([axes[k][0], axes[k][0] + 1.0])
             cells = np.concatenate([cells, cells], axis=k)
     p = RegularGridInterpolator(tuple(axes), cells)(np.stack([x, y], axis=-1))
-    return np.clip(p, 0.0, 1.0), outside
+    if stack:                  # the cells of each grid times the weights (points x cells)
+        p = (values.reshape(p.shape[-1], -1).T @ p.reshape(-1, p.shape[-1]).T).reshape(
+            stack + pga.shape)
+    return np.clip(p, 0.0, 1.0, out=p), outside

@@ -8,6 +8,8 @@ nodes, the bin's mean weighted by its share, every bin evaluated in the same cal
 specimen whose D fragilities are pulse grids differing only in their counts (draws,
 members; as they are or on the hazard's PGA measure) is evaluated by one interpolation of
 the D grids (:meth:`~pipeline.hazard.fragility.grid.PulseGrid.probability_stack`).
+Several subsets of the specimens (the sets of an age chain: all, then the older ones, ...)
+take each specimen's P once (:func:`subset_probabilities`).
 Units: PGA in m/s^2, PGV/PGA in s."""
 from functools import reduce
 
@@ -17,7 +19,7 @@ from pipeline.files import InputError
 from pipeline.hazard.disagg_ratio import RatioMixture, bin_shares
 from pipeline.hazard.fragility.ratio import ratio_nodes
 
-MAX_VALUES = 4_000_000        # sets x PGA levels x PGV/PGA points held at once (32 MB)
+MAX_VALUES = 4_000_000        # subsets x sets x PGA levels x PGV/PGA points at once (32 MB)
 
 
 def ratio_quadrature(ratio_model, pga_m_s2):
@@ -54,10 +56,22 @@ def set_probabilities(batch, ratio_model, pga_m_s2, combine="any_common"):
     the same specimens in each) at PGA levels (m/s^2, L), averaged over PGV/PGA from
     ``ratio_model``: P(any of the set overturns), ``combine`` as in
     :func:`overturn_probability` ("each": sets of one specimen, its P)."""
+    if combine == "each" and any(len(chosen) != 1 for chosen in batch):
+        raise ValueError(f"combine 'each' for sets of {len(batch[0])} specimens")
+    return subset_probabilities(batch, [tuple(range(len(batch[0])))], ratio_model,
+                                pga_m_s2, combine)[0]
+
+
+def subset_probabilities(batch, subsets, ratio_model, pga_m_s2, combine="any_common"):
+    """S x D x L: :func:`set_probabilities` of each of the S ``subsets`` (tuples of indices
+    into each set of ``batch``) of the specimens, each specimen's P computed once for all
+    the subsets holding it (the sets of an age chain, the ages sampled)."""
     pga = np.asarray(pga_m_s2, float)
-    if combine not in _COMBINED or (combine == "each" and any(len(c) != 1 for c in batch)):
-        raise ValueError(f"combine {combine!r} for sets of {len(batch[0])} specimens")
-    if any(f.uses_ratio for chosen in batch for f in chosen):
+    if combine not in _COMBINED:
+        raise ValueError(f"combine {combine!r}")
+    subsets = [tuple(sorted(members)) for members in subsets]
+    used = sorted(set().union(*subsets))
+    if any(chosen[j].uses_ratio for chosen in batch for j in used):
         if ratio_model is None:
             raise InputError("the fragility depends on PGV/PGA: give its distribution "
                              "(--pgv-pga-median and --pgv-pga-sigma, or --magnitude and "
@@ -65,14 +79,17 @@ def set_probabilities(batch, ratio_model, pga_m_s2, combine="any_common"):
         (ratio, shares), weights = ratio_quadrature(ratio_model, pga), ratio_nodes()[1]
     else:
         ratio, shares, weights = None, np.ones((pga.size, 1)), np.ones(1)
+    columns = {j: _column([chosen[j] for chosen in batch]) for j in used}
     count = len(batch)
-    chunk = max(1, MAX_VALUES // (shares.size * weights.size))
-    out = np.empty((count, pga.size))
-    for start in range(0, count, chunk):
-        part = batch[start:start + chunk]
-        columns = [_column([chosen[j] for chosen in part], pga, ratio)
-                   for j in range(len(part[0]))]
-        out[start:start + len(part)] = (shares * _COMBINED[combine](columns, weights)).sum(-1)
+    step = max(1, MAX_VALUES // ((len(used) + 1) * count * shares.shape[1] * weights.size))
+    out = np.empty((len(subsets), count, pga.size))
+    for start in range(0, pga.size, step):          # PGA levels in chunks, all sets at once
+        rows = slice(start, start + step)
+        points = None if ratio is None else ratio[rows]
+        p = {j: columns[j](pga[rows, None, None], points) for j in used}
+        for s, members in enumerate(subsets):
+            combined = _COMBINED[combine]([p[j] for j in members], weights)
+            out[s, :, rows] = (shares[rows] * combined).sum(axis=-1)
     return out
 
 
@@ -83,14 +100,14 @@ _COMBINED = {   # the specimens' P at the points ((1 or D) x L x B x K each) to 
     "any_correlated": lambda columns, w: reduce(np.maximum, columns) @ w}
 
 
-def _column(fragilities, pga, ratio):
-    """P of one specimen's fragilities (one per set) at the points: (1 or D) x L x B x K."""
+def _column(fragilities):
+    """P of one specimen's fragilities (one per set) as a function of the points (PGA, L x
+    1 x 1; PGV/PGA, L x B x K or None): (1 or D) x L x B x K."""
     first = fragilities[0]
-    a = pga[:, None, None]
     if all(f is first for f in fragilities):
-        return (first.probability(a, ratio) if ratio is not None
-                else first.probability(a))[None]
+        return lambda a, ratio: (first.probability(a, ratio) if ratio is not None
+                                 else first.probability(a))[None]
     if all(first.stacks_with(f) for f in fragilities):
-        return first.probability_stack(fragilities, a, ratio)
-    return np.array([f.probability(a, ratio) if ratio is not None else f.probability(a)
-                     for f in fragilities])
+        return lambda a, ratio: first.probability_stack(fragilities, a, ratio)
+    return lambda a, ratio: np.array([f.probability(a, ratio) if ratio is not None
+                                      else f.probability(a) for f in fragilities])

@@ -18,7 +18,7 @@ def _any_rate(indices):
 
 
 def site_set_survival(ages, any_rate):
-    return math.exp(log_survival_fixed(any_rate, ages))
+    return math.exp(log_survival_fixed(lambda sets: [any_rate(m) for m in sets], ages))
 
 
 def test_specimens_of_different_ages_against_simulated_histories():

@@ -60,11 +60,12 @@ def _power_law_tree(ks, exponent, lo, hi, n=40, weights=None):
 
 
 def _set_rates(tree, cells, fragilities):
+    """The rates of each of a list of sets (tuples of indices into ``fragilities``)."""
     def rates(members):
         chosen = [fragilities[j] for j in members]
         return branch_rates(cells, tree.levels_m_s2, tree.rates_per_yr,
                             lambda x: overturn_probability(chosen, None, x, "any_common"))
-    return rates
+    return lambda sets: [rates(m) for m in sets]
 
 
 # ---------------------------------------------------------------- (a) step fragility
@@ -76,7 +77,7 @@ def test_step_fragility_gives_the_posterior_in_closed_form():
     k, age = 11, 8000.0
     step = Step(tree.levels_m_s2[k])
     cells = cell_matrix(tree.levels_m_s2, tree.rates_per_yr)
-    rate = _set_rates(tree, cells, [step])((0,))
+    rate = _set_rates(tree, cells, [step])([(0,)])[0]
     lam = tree.rates_per_yr[:, k]
     np.testing.assert_allclose(rate, lam, rtol=1e-12)
     p = np.exp(-lam * age)
@@ -192,7 +193,7 @@ def test_lognormal_under_power_law_branches(exponent, median, beta):
                            median * math.exp(8 * beta), 60, weights=[0.25, 0.5, 0.25])
     cells = cell_matrix(tree.levels_m_s2, tree.rates_per_yr)
     fragility = Lognormal(median, beta)
-    rates = _set_rates(tree, cells, [fragility])((0,))
+    rates = _set_rates(tree, cells, [fragility])([(0,)])[0]
     closed = ks * median ** -exponent * math.exp(exponent ** 2 * beta ** 2 / 2)
     np.testing.assert_allclose(rates, closed, rtol=2e-4)
     age = 0.5 / closed[1]

@@ -86,3 +86,19 @@ def test_an_empty_cell_is_filled_alike_for_survival_and_the_shake_table_check():
     neighbours = (_log_bilinear(PGA_G[3], RATIO_S[3]) + _log_bilinear(PGA_G[5], RATIO_S[3])) / 2
     assert check[0] == pytest.approx(neighbours, abs=1e-12)
     assert fill_empty(values)[1] == 1
+
+
+@pytest.mark.parametrize("axes", [((0.1, 0.2, 0.4), (0.1, 0.5)), ((0.3,), (0.1, 0.5, 1.0)),
+                                  ((0.1, 0.2), (0.7,))])
+def test_a_stack_of_grids_gives_each_grid_alone(axes):
+    """A stack (the weights at the points times every grid's cells) against each grid
+    interpolated alone, points inside, beside and beyond the box, an axis of one value."""
+    values = np.random.default_rng(0).random((len(axes[0]), len(axes[1]), 5, 3))
+    a, r = np.geomspace(0.05, 0.6, 7)[:, None], np.geomspace(0.05, 2.0, 4)[None, :]
+    stacked, outside = interpolate(*axes, values, a, r)
+    alone = [[interpolate(*axes, values[..., i, j], a, r) for j in range(3)]
+             for i in range(5)]
+    assert stacked.shape == (5, 3, 7, 4)
+    np.testing.assert_allclose(stacked, [[p for p, _ in row] for row in alone],
+                               rtol=1e-14, atol=1e-15)
+    assert np.array_equal(outside, alone[0][0][1])

@@ -166,7 +166,7 @@ def test_sampled_ages_as_the_sum_over_each_sample():
 
     def set_rates(members):
         return rate_of.setdefault(members, rng.uniform(1e-6, 1e-4, size=(2, 5)))
-    log_p, se = log_survival_sampled(set_rates, ages)
+    log_p, se = log_survival_sampled(lambda sets: [set_rates(m) for m in sets], ages)
     logs = np.array([-sum(dt * set_rates(m) for m, dt in age_chain(a)) for a in ages])
     want = np.log(np.exp(logs).mean(axis=0))
     np.testing.assert_allclose(log_p, want, rtol=1e-12)

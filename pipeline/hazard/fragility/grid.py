@@ -4,9 +4,9 @@ the cells of ``campaign fragility --pulses`` by their one interpolation
 fitted to the same runs, and below its first PGA as :data:`BELOW_GRID` says."""
 import math
 from dataclasses import dataclass, field, replace
+from functools import cached_property
 
 import numpy as np
-from scipy.special import expit, logit
 
 from pipeline.constants import STANDARD_GRAVITY
 from pipeline.hazard.fragility.kinds import Fragility, Logistic
@@ -53,10 +53,13 @@ class PulseGrid(Fragility):
     below: str = "ramp"
     uses_ratio = True
 
-    @property
+    @cached_property
     def p(self):
+        """The cells' P (n_pga x n_ratio, NaN without runs; read only, computed once)."""
         with np.errstate(invalid="ignore", divide="ignore"):
-            return np.where(self.n > 0, self.overturned / np.maximum(self.n, 1), np.nan)
+            p = np.where(self.n > 0, self.overturned / np.maximum(self.n, 1), np.nan)
+        p.flags.writeable = False
+        return p
 
     def probability(self, pga_m_s2, pgv_pga_s):
         return self._interpolate(self.p, pga_m_s2, pgv_pga_s)
@@ -67,7 +70,7 @@ class PulseGrid(Fragility):
         :meth:`members`) at the points, D x the points' shape: one interpolation for all
         D (the same numbers as each grid's :meth:`probability`, to round-off)."""
         cells = np.stack([g.p for g in grids], axis=-1)          # n_pga x n_ratio x D
-        return np.moveaxis(self._interpolate(cells, pga_m_s2, pgv_pga_s), -1, 0)
+        return self._interpolate(cells, pga_m_s2, pgv_pga_s)
 
     def stacks_with(self, other):
         """True when ``other`` differs from this grid in its counts only (its P per cell),
@@ -77,23 +80,17 @@ class PulseGrid(Fragility):
 
     def _interpolate(self, cells, pga_m_s2, pgv_pga_s):
         """P at the points from ``cells`` (n_pga x n_ratio, or n_pga x n_ratio x D: then
-        the points' shape x D)."""
+        D x the points' shape).  Below the grid (but for ``below`` "logistic") P is the
+        edge's, read at the first PGA, times w(a)."""
         pga, ratio = np.broadcast_arrays(np.asarray(pga_m_s2, float),
                                          np.asarray(pgv_pga_s, float))
-        extra = cells.shape[2:]
         low = pga < self.pga_m_s2[0]
         if self.below == "logistic" or not low.any():
             return self._surface(cells, pga, ratio)
-        p = np.zeros(pga.shape + extra)
-        if not low.all():
-            p[~low] = self._surface(cells, pga[~low], ratio[~low])
-        weight = self.below_weight(pga[low])
-        ramp = weight > 0                # only where P is not 0 is the edge's P needed
-        if ramp.any():
-            below = np.zeros(weight.shape + extra)
-            below[ramp] = _trailing(weight[ramp], extra) * self._surface(
-                cells, np.full(int(ramp.sum()), self.pga_m_s2[0]), ratio[low][ramp])
-            p[low] = below
+        weight = np.ones(pga.shape)
+        weight[low] = self.below_weight(pga[low])
+        p = self._surface(cells, np.where(low, self.pga_m_s2[0], pga), ratio)
+        p *= weight                      # 1 at and above the grid's first PGA: exact
         return p
 
     def below_weight(self, pga_m_s2):
@@ -124,19 +121,18 @@ class PulseGrid(Fragility):
         pga, ratio = np.broadcast_arrays(np.asarray(pga, float), np.asarray(ratio, float))
         held, beyond = interpolate(self.pga_m_s2, self.pgv_pga_s, _filled(cells),
                                    pga, ratio)               # the edge cell's P outside
-        p = np.array(held, float)
-        if self.outside is not None and beyond.any():      # the surface only where needed
-            a, r = pga[beyond], ratio[beyond]
-            extra = cells.shape[2:]
-            if self.below == "logistic":
-                p[beyond] = _trailing(self.outside.probability(a, r), extra)
-            else:
-                edge_a = np.clip(a, self.pga_m_s2[0], self.pga_m_s2[-1])
-                edge_r = np.clip(r, self.pgv_pga_s[0], self.pgv_pga_s[-1])
-                p[beyond] = _carried(
-                    held[beyond], _trailing(self.outside.probability(a, r), extra),
-                    _trailing(self.outside.probability(edge_a, edge_r), extra))
-        return np.clip(p, 0.0, 1.0)
+        if self.outside is None or not beyond.any():       # the surface only where needed
+            return held
+        a, r = pga[beyond], ratio[beyond]
+        if self.below == "logistic":
+            held[..., beyond] = self.outside.probability(a, r)
+            return held
+        odds = np.ones(pga.shape)        # of the surface over its odds at the edge
+        odds[beyond] = _odds_ratio(
+            self.outside.probability(a, r),
+            self.outside.probability(np.clip(a, self.pga_m_s2[0], self.pga_m_s2[-1]),
+                                     np.clip(r, self.pgv_pga_s[0], self.pgv_pga_s[-1])))
+        return _carried(held, odds)
 
     def draws(self, n, rng):
         """``n`` grids with every cell's count redrawn Binomial(n_cell, P_cell): the Monte
@@ -232,11 +228,6 @@ class PulseGrid(Fragility):
                 "note": note}
 
 
-def _trailing(values, extra):
-    """``values`` with an axis of one for each of the ``extra`` axes (broadcast over them)."""
-    return np.reshape(values, np.shape(values) + (1,) * len(extra))
-
-
 def _filled(cells):
     """:func:`~pipeline.hazard.pulse_cells.fill_empty` of cells (n_pga x n_ratio), or of
     each of a stack (n_pga x n_ratio x D)."""
@@ -247,10 +238,20 @@ def _filled(cells):
     return np.stack([fill_empty(cells[..., d])[0] for d in range(cells.shape[2])], axis=-1)
 
 
-def _carried(p_edge, surface, surface_at_edge):
-    """P outside a grid: logit P = logit p_edge + logit surface - logit surface_at_edge."""
+def _odds_ratio(surface, surface_at_edge):
+    """exp(logit surface - logit surface_at_edge), each clipped to [1e-12, 1 - 1e-12]."""
     tiny = 1e-12
-    shift = (logit(np.clip(surface, tiny, 1 - tiny))
-             - logit(np.clip(surface_at_edge, tiny, 1 - tiny)))
-    with np.errstate(divide="ignore"):
-        return expit(logit(np.clip(p_edge, 0.0, 1.0)) + shift)
+    s, s_edge = np.clip(surface, tiny, 1 - tiny), np.clip(surface_at_edge, tiny, 1 - tiny)
+    return (s / (1.0 - s)) / (s_edge / (1.0 - s_edge))
+
+
+def _carried(p_edge, odds):
+    """P outside a grid: logit P = logit p_edge + ln ``odds`` (:func:`_odds_ratio`, one
+    value per point), as P = p odds / (1 - p + p odds): no logarithm per grid of a stack
+    ``p_edge`` (in [0, 1], changed in place); P 0 and 1 stay so, and where odds is 1
+    (inside the grid) P = p exactly ((1 - p) + p rounds to 1 for any p in [0, 1])."""
+    spread = 1.0 - p_edge
+    p_edge *= odds
+    spread += p_edge
+    p_edge /= spread
+    return p_edge
