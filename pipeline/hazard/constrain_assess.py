@@ -116,9 +116,7 @@ def constrain_tree(tree, specimens, ratio_model, ages, rule, floor, draws, seed,
            else _statistics(tree, posterior[other])},
         ground_motion_at_rates=_motions(tree, prior_stats, post_stats),
         members=members, monte_carlo=carlo,
-        sites=[SiteRow(site=g.site, specimens=list(g.members),
-                       pgv_pga=ABSENT if g.ratio_model is None else g.ratio_model.describe())
-               for g in groups],
+        sites=_site_rows(groups),
         branch_test=test,
         hazard=TreeHazard(source=dict(tree.source), notes=list(tree.notes),
                           interpolation="linear in (ln PGA, ln rate)",
@@ -131,9 +129,17 @@ def constrain_tree(tree, specimens, ratio_model, ages, rule, floor, draws, seed,
               "prior_weights": tree.weights, "posterior_weights": posterior[rule],
               "prior": prior_stats, "posterior": post_stats, "rule": rule,
               "ages": list(ages),
-              "target_rates": TARGET_RATES, "branch_ids": tree.branch_ids}
-    figure["branch_test"] = test
+              "target_rates": TARGET_RATES, "branch_ids": tree.branch_ids,
+              "branch_test": test}
     return summary, summary.branches, figure
+
+
+def _site_rows(groups):
+    """constrain.json's ``sites``: each site's specimens and, where it has its own, the
+    PGV/PGA it took."""
+    return [SiteRow(site=g.site, specimens=list(g.members),
+                    pgv_pga=ABSENT if g.ratio_model is None else g.ratio_model.describe())
+            for g in groups]
 
 
 class AgeIntegration(Enum):
