@@ -17,7 +17,7 @@ MAX_PANELS = 8          # more roses side by side would not be read
 def panel_title(falls):
     """What a panel states of a :class:`~pipeline.stats.colonnade_falls.FallDirections`:
     the columns fallen of those shaken, their circular mean and spread (deg)."""
-    head = f"{falls.group}: {falls.fallen} of {falls.shaken} columns fell ({falls.runs} runs)"
+    head = f"{falls.group}: {falls.fallen} of {falls.shaken} columns fell ({falls.runs} run{'' if falls.runs == 1 else 's'})"
     if falls.mean_deg is None:
         return head + ("\nno mean direction" if falls.fallen else "")
     return head + f"\nmean {falls.mean_deg:.0f}°, spread {falls.spread_deg:.0f}°"
