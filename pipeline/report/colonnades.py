@@ -121,7 +121,7 @@ def _per_pulse(results, folder):
 
 
 def _proportion(q, counts=False):
-    """A :class:`~pipeline.stats.colonnade.Proportion` as "p [lo, hi]" (and its counts)."""
+    """A :class:`~pipeline.stats.colonnade_counts.Proportion` as "p [lo, hi]" (and its counts)."""
     if q.p is None:
         return "- (0 of 0)" if counts else "-"
     lo, hi = q.ci95

@@ -13,87 +13,30 @@ written by :meth:`save`, read only by :meth:`load`.
 import math
 from dataclasses import dataclass
 
-from pipeline.files import InputError, csv_true, read_run_json, write_json
-from pipeline.stats.ensemble import wilson_interval
+from pipeline.files import InputError, csv_true
+from pipeline.stats.colonnade_counts import FallCounts, Proportion, WilsonFile
 
 FILE = "colonnade_statistics.json"
 ALL_RECORDS = "all records"
-CONFIDENCE = 0.95
-_TOLERANCE = 1e-9            # a stated probability or interval bound against its counts
-
-
-@dataclass(frozen=True)
-class Proportion:
-    """``count`` runs of ``of``: the fraction (None without runs) and its Wilson 95 %
-    interval ([0, 1] without runs)."""
-    count: int
-    of: int
-
-    def __post_init__(self):
-        for key in ("count", "of"):
-            value = getattr(self, key)
-            if isinstance(value, bool) or not isinstance(value, int) or value < 0:
-                raise InputError(f"{key} must be a count, got {value!r}")
-        if self.count > self.of:
-            raise InputError(f"count {self.count} of {self.of}: more than there are")
-
-    @property
-    def p(self):
-        return self.count / self.of if self.of else None
-
-    @property
-    def ci95(self):
-        return wilson_interval(self.count, self.of, CONFIDENCE)
-
-    def to_json(self):
-        return {"count": self.count, "of": self.of, "p": self.p, "ci95": self.ci95}
-
-    @classmethod
-    def from_json(cls, data, where):
-        if not isinstance(data, dict):
-            raise InputError(f"{where} must be an object")
-        try:
-            out = cls(data.get("count"), data.get("of"))
-        except InputError as exc:
-            raise InputError(f"{where}: {exc}") from None
-        stated = [data.get("p"), *(data.get("ci95") or [None, None])]
-        for value, own in zip(stated, [out.p, *out.ci95]):
-            if (value is None) != (own is None) or (
-                    own is not None and not abs(float(value) - own) <= _TOLERANCE):
-                raise InputError(f"{where}: p and ci95 {stated} are not those of "
-                                 f"{out.count} of {out.of}")
-        return out
 
 
 @dataclass(frozen=True, kw_only=True)
-class GroupStatistics:
+class GroupStatistics(FallCounts):
     """A colonnade of ``columns`` columns over ``runs`` runs of one ``group`` (a record,
-    :data:`ALL_RECORDS`, or a direction of shaking): ``fallen`` the runs with k columns fallen, k = 0..columns (a
-    :class:`Proportion` of the runs each), ``parallel`` of the runs in which at least two
-    fell with azimuths, ``in_sequence`` of the runs in which at least three fell with
-    impact times, ``in_sequence_of_all`` the same count of all runs."""
+    :data:`ALL_RECORDS`, or a direction of shaking): ``fallen`` the runs with k columns
+    fallen, k = 0..columns (a :class:`~pipeline.stats.colonnade_counts.Proportion` of the
+    runs each), ``parallel`` of the runs in which at least two fell with azimuths,
+    ``in_sequence`` of the runs in which at least three fell with impact times,
+    ``in_sequence_of_all`` the same count of all runs."""
     colonnade: str
     group: str
-    columns: int
-    runs: int
-    fallen: tuple
     parallel: Proportion
     in_sequence: Proportion
     in_sequence_of_all: Proportion
 
     def __post_init__(self):
-        object.__setattr__(self, "fallen", tuple(self.fallen))
-        where = f"{self.colonnade}, {self.group}"
-        if isinstance(self.columns, bool) or not isinstance(self.columns, int) or \
-                self.columns < 1:
-            raise InputError(f"{where}: columns must be a count >= 1, got {self.columns!r}")
-        if len(self.fallen) != self.columns + 1:
-            raise InputError(f"{where}: {len(self.fallen)} counts of columns fallen, not "
-                             f"{self.columns + 1} (0 to {self.columns})")
-        if any(f.of != self.runs for f in self.fallen) or \
-                sum(f.count for f in self.fallen) != self.runs:
-            raise InputError(f"{where}: the counts of columns fallen do not add up to the "
-                             f"{self.runs} runs")
+        super().__post_init__()
+        where = self.where()
         if self.parallel.of > sum(f.count for f in self.fallen[2:]):
             raise InputError(f"{where}: parallel of {self.parallel.of} runs, more than "
                              "those in which two or more columns fell")
@@ -105,43 +48,32 @@ class GroupStatistics:
             raise InputError(f"{where}: in_sequence_of_all must count the runs in "
                              "sequence of all runs")
 
+    def where(self):
+        return f"{self.colonnade}, {self.group}"
+
     def to_json(self):
-        return {"colonnade": self.colonnade, "group": self.group, "columns": self.columns,
-                "runs": self.runs,
-                "fallen": [{"k": k, **f.to_json()} for k, f in enumerate(self.fallen)],
+        return {"colonnade": self.colonnade, "group": self.group, **self.counts_json(),
                 "parallel_given_two_fell": self.parallel.to_json(),
                 "in_sequence_given_three_fell": self.in_sequence.to_json(),
                 "in_sequence": self.in_sequence_of_all.to_json()}
 
     @classmethod
-    def from_json(cls, data, where):
-        if not isinstance(data, dict) or not isinstance(data.get("fallen"), list):
-            raise InputError(f"{where} must be an object with 'fallen'")
-        fallen = data["fallen"]
-        if [f.get("k") if isinstance(f, dict) else None for f in fallen] != \
-                list(range(len(fallen))):
-            raise InputError(f"{where}.fallen: k must run 0, 1, ... in order")
-        try:
-            return cls(colonnade=str(data.get("colonnade")), group=str(data.get("group")),
-                       columns=data.get("columns"), runs=data.get("runs"),
-                       fallen=[Proportion.from_json(f, f"fallen[{k}]")
-                               for k, f in enumerate(fallen)],
-                       parallel=Proportion.from_json(data.get("parallel_given_two_fell"),
-                                                     "parallel_given_two_fell"),
-                       in_sequence=Proportion.from_json(
-                           data.get("in_sequence_given_three_fell"),
-                           "in_sequence_given_three_fell"),
-                       in_sequence_of_all=Proportion.from_json(data.get("in_sequence"),
-                                                               "in_sequence"))
-        except InputError as exc:
-            raise InputError(f"{where}: {exc}") from None
+    def own_from_json(cls, data):
+        return {"colonnade": str(data.get("colonnade")), "group": str(data.get("group")),
+                "parallel": Proportion.from_json(data.get("parallel_given_two_fell"),
+                                                 "parallel_given_two_fell"),
+                "in_sequence": Proportion.from_json(data.get("in_sequence_given_three_fell"),
+                                                    "in_sequence_given_three_fell"),
+                "in_sequence_of_all": Proportion.from_json(data.get("in_sequence"),
+                                                           "in_sequence")}
 
 
 @dataclass(frozen=True)
-class ColonnadeStatistics:
+class ColonnadeStatistics(WilsonFile):
     """``groups``: a :class:`GroupStatistics` per colonnade and group (record, or
     ``grouped_by``'s value), then per colonnade over all its records when it ran under
     several (``pooled``)."""
+    FILE, ITEMS, ITEM = FILE, "groups", GroupStatistics
     groups: tuple
     grouped_by: str = "record_id"
 
@@ -169,45 +101,25 @@ class ColonnadeStatistics:
                 groups.append(_group(name, pooled, sub))
         return cls(tuple(groups), by)
 
-    def to_json(self):
-        return {"confidence": CONFIDENCE, "interval": "Wilson score",
-                "grouped_by": self.grouped_by, "groups": [g.to_json() for g in self.groups]}
-
-    def save(self, directory):
-        """Write ``directory``/colonnade_statistics.json (atomically)."""
-        write_json(directory / FILE, self.to_json())
+    def head_json(self):
+        return {"grouped_by": self.grouped_by}
 
     @classmethod
-    def load(cls, path):
-        """Read a colonnade_statistics.json (``path`` the file or its directory); a
-        one-line InputError for a file that is not one."""
-        path = path / FILE if path.is_dir() else path
-        path, data = read_run_json(path, FILE)
-        if not isinstance(data, dict) or not isinstance(data.get("groups"), list):
-            raise InputError(f"{path}: not a {FILE} (no 'groups')")
-        return cls(tuple(GroupStatistics.from_json(g, f"{path}: groups[{k}]")
-                         for k, g in enumerate(data["groups"])),
-                   data.get("grouped_by", "record_id"))
+    def from_items(cls, items, data):
+        return cls(items, data.get("grouped_by", "record_id"))
 
 
 def _group(name, group, rows):
     """The :class:`GroupStatistics` of the colonnade ``name``'s ``rows`` (one group's,
     or all)."""
-    counts = set(int(c) for c in rows["columns"])
-    if len(counts) != 1:
-        raise InputError(f"colonnades.csv: colonnade {name} has {sorted(counts)} columns "
-                         "in different runs")
-    n, runs = counts.pop(), len(rows)
-    fallen = [int(k) for k in rows["columns_fallen"]]
     parallel = [csv_true(v) for v in rows["parallel"] if _known(v)]
     sequence = [csv_true(v) for v in rows["in_sequence"] if _known(v)]
     in_sequence = sum(sequence)
-    return GroupStatistics(
-        colonnade=str(name), group=str(group), columns=n, runs=runs,
-        fallen=[Proportion(fallen.count(k), runs) for k in range(n + 1)],
+    return GroupStatistics.counted(
+        rows, f"colonnade {name}", colonnade=str(name), group=str(group),
         parallel=Proportion(sum(parallel), len(parallel)),
         in_sequence=Proportion(in_sequence, len(sequence)),
-        in_sequence_of_all=Proportion(in_sequence, runs))
+        in_sequence_of_all=Proportion(in_sequence, len(rows)))
 
 
 def _known(value):

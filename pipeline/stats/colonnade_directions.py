@@ -1,22 +1,22 @@
 """A colonnade shaken in several directions (``direction_statistics.json``, beside the
 directions campaign's ``colonnades.csv``): per direction of shaking and pulse, the
 probability that k of its n columns fell, k = 0..n, over the runs of that direction and
-pulse, each a :class:`~pipeline.stats.colonnade.Proportion` with its Wilson 95 %
+pulse, each a :class:`~pipeline.stats.colonnade_counts.Proportion` with its Wilson 95 %
 interval (the Monte Carlo error of a probability from that many runs).
 
 :class:`DirectionStatistics` is the one type: built from the table by :meth:`of`,
 written by :meth:`save`, read only by :meth:`load`."""
 from dataclasses import dataclass
 
-from pipeline.files import InputError, read_run_json, write_json
-from pipeline.stats.colonnade import CONFIDENCE, Proportion
+from pipeline.files import InputError
+from pipeline.stats.colonnade_counts import FallCounts, WilsonFile
 
 FILE = "direction_statistics.json"
 KEYS = ("direction", "angle_from_row_deg", "azimuth_deg", "pga_g", "pgv_pga_s")
 
 
 @dataclass(frozen=True, kw_only=True)
-class PulseFalls:
+class PulseFalls(FallCounts):
     """The runs of one ``direction`` (its angle from the row and its azimuth, deg
     clockwise from North) and pulse (PGA, g; PGV/PGA, s): ``fallen`` the runs in which
     k of the ``columns`` columns fell, k = 0..columns, a Proportion of ``runs`` each."""
@@ -25,13 +25,9 @@ class PulseFalls:
     azimuth_deg: float
     pga_g: float
     pgv_pga_s: float
-    columns: int
-    runs: int
-    fallen: tuple
 
     def __post_init__(self):
-        object.__setattr__(self, "fallen", tuple(self.fallen))
-        where = f"{self.direction}, {self.pga_g} g, {self.pgv_pga_s} s"
+        where = self.where()
         if not isinstance(self.direction, str) or not self.direction:
             raise InputError(f"{where}: direction must be named")
         for key, low, high in (("angle_from_row_deg", 0.0, 180.0), ("azimuth_deg", 0.0, 360.0),
@@ -42,40 +38,23 @@ class PulseFalls:
                     (key == "azimuth_deg" and value == high):
                 raise InputError(f"{where}: {key} {value!r} outside its range "
                                  f"[{low:g}, {high if high is not None else 'inf'}]")
-        for key in ("columns", "runs"):
-            value = getattr(self, key)
-            if isinstance(value, bool) or not isinstance(value, int) or value < 1:
-                raise InputError(f"{where}: {key} must be a count >= 1, got {value!r}")
-        if len(self.fallen) != self.columns + 1 or \
-                not all(isinstance(f, Proportion) and f.of == self.runs for f in self.fallen) \
-                or sum(f.count for f in self.fallen) != self.runs:
-            raise InputError(f"{where}: the runs with k = 0..{self.columns} columns fallen "
-                             f"must add up to the {self.runs} runs")
+        super().__post_init__()
+
+    def where(self):
+        return f"{self.direction}, {self.pga_g} g, {self.pgv_pga_s} s"
 
     def to_json(self):
-        return {**{k: getattr(self, k) for k in KEYS}, "columns": self.columns,
-                "runs": self.runs,
-                "fallen": [{"k": k, **f.to_json()} for k, f in enumerate(self.fallen)]}
+        return {**{k: getattr(self, k) for k in KEYS}, **self.counts_json()}
 
     @classmethod
-    def from_json(cls, data, where):
-        if not isinstance(data, dict) or not isinstance(data.get("fallen"), list):
-            raise InputError(f"{where} must be an object with 'fallen'")
-        fallen = data["fallen"]
-        if [f.get("k") if isinstance(f, dict) else None for f in fallen] != \
-                list(range(len(fallen))):
-            raise InputError(f"{where}.fallen: k must run 0, 1, ... in order")
-        try:
-            return cls(**{k: data.get(k) for k in (*KEYS, "columns", "runs")},
-                       fallen=[Proportion.from_json(f, f"fallen[{k}]")
-                               for k, f in enumerate(fallen)])
-        except InputError as exc:
-            raise InputError(f"{where}: {exc}") from None
+    def own_from_json(cls, data):
+        return {k: data.get(k) for k in KEYS}
 
 
 @dataclass(frozen=True)
-class DirectionStatistics:
+class DirectionStatistics(WilsonFile):
     """``cases``: a :class:`PulseFalls` per direction and pulse of the ``colonnade``."""
+    FILE, ITEMS, ITEM = FILE, "cases", PulseFalls
     colonnade: str
     cases: tuple
 
@@ -95,35 +74,14 @@ class DirectionStatistics:
         names = set(table["colonnade"])
         if len(names) != 1:
             raise InputError(f"colonnades.csv: one colonnade expected, got {sorted(names)}")
-        cases = []
-        for key, rows in table.groupby(list(KEYS), sort=False):
-            counts = set(int(c) for c in rows["columns"])
-            if len(counts) != 1:
-                raise InputError(f"colonnades.csv: {key[0]} has {sorted(counts)} columns "
-                                 "in different runs")
-            n, fallen = counts.pop(), [int(k) for k in rows["columns_fallen"]]
-            cases.append(PulseFalls(
-                **{k: (str(v) if k == "direction" else float(v)) for k, v in zip(KEYS, key)},
-                columns=n, runs=len(rows),
-                fallen=[Proportion(fallen.count(k), len(rows)) for k in range(n + 1)]))
+        cases = [PulseFalls.counted(rows, key[0], **{
+                     k: (str(v) if k == "direction" else float(v)) for k, v in zip(KEYS, key)})
+                 for key, rows in table.groupby(list(KEYS), sort=False)]
         return cls(str(names.pop()), tuple(cases))
 
-    def to_json(self):
-        return {"confidence": CONFIDENCE, "interval": "Wilson score",
-                "colonnade": self.colonnade, "cases": [c.to_json() for c in self.cases]}
-
-    def save(self, directory):
-        """Write ``directory``/direction_statistics.json (atomically)."""
-        write_json(directory / FILE, self.to_json())
+    def head_json(self):
+        return {"colonnade": self.colonnade}
 
     @classmethod
-    def load(cls, path):
-        """Read a direction_statistics.json (``path`` the file or its directory); a
-        one-line InputError for a file that is not one."""
-        path = path / FILE if path.is_dir() else path
-        path, data = read_run_json(path, FILE)
-        if not isinstance(data, dict) or not isinstance(data.get("cases"), list):
-            raise InputError(f"{path}: not a {FILE} (no 'cases')")
-        return cls(str(data.get("colonnade")),
-                   tuple(PulseFalls.from_json(c, f"{path}: cases[{k}]")
-                         for k, c in enumerate(data["cases"])))
+    def from_items(cls, items, data):
+        return cls(str(data.get("colonnade")), items)

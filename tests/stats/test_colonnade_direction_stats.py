@@ -2,15 +2,15 @@
 hand-counted directions table, Wilson intervals from their closed form, and the file's
 one writer and reader (a stated p that its counts do not give is refused)."""
 import json
-import math
 
 import pandas as pd
 import pytest
-from scipy import stats
 
 from pipeline.files import InputError
-from pipeline.stats.colonnade import Proportion
+from pipeline.stats.colonnade import ColonnadeStatistics
+from pipeline.stats.colonnade_counts import Proportion
 from pipeline.stats.colonnade_directions import FILE, DirectionStatistics, PulseFalls
+from tests.stats.test_colonnade_stats import wilson
 
 # a row of 3 columns, two members per direction and pulse; by hand (k = 0 1 2 3):
 #   in-plane 0.3 g: 1 0 1 0   in-plane 0.6 g: 0 0 0 2   out-of-plane 0.3 g: 0 1 0 1
@@ -22,14 +22,6 @@ TABLE = pd.DataFrame(ROWS, columns=["direction", "angle_from_row_deg", "azimuth_
     pgv_pga_s=0.3, columns=3, colonnade="row", member=[0, 1] * 3)
 HAND = {("in-plane", 0.3): [1, 0, 1, 0], ("in-plane", 0.6): [0, 0, 0, 2],
         ("out-of-plane", 0.3): [0, 1, 0, 1]}
-
-
-def wilson(k, n, z=stats.norm.ppf(0.975)):
-    """The Wilson score interval's closed form."""
-    p = k / n
-    centre = (p + z * z / (2 * n)) / (1 + z * z / n)
-    half = z / (1 + z * z / n) * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n))
-    return centre - half, centre + half
 
 
 def _check(statistics):
@@ -71,3 +63,15 @@ def test_inconsistent_cases_refused():
                    fallen=[Proportion(1, 1), Proportion(0, 1)])
     with pytest.raises(InputError, match="one colonnade"):
         DirectionStatistics.of(TABLE.assign(colonnade=["a", "b"] * 3))
+
+
+def test_one_pulse_per_direction_counts_as_the_statistics_grouped_by_direction():
+    """Both files count P(k columns fall) by one rule: with one pulse per direction the
+    cases and the groups by direction hold the same counts."""
+    one_pulse = TABLE[TABLE["pga_g"] == 0.3].assign(parallel=None, in_sequence=None)
+    cases = DirectionStatistics.of(one_pulse).cases
+    groups = ColonnadeStatistics.of(one_pulse, by="direction", pooled=None).groups
+    assert [c.direction for c in cases] == [g.group for g in groups]
+    assert [c.fallen for c in cases] == [g.fallen for g in groups]
+    assert [c.counts_json() for c in cases] == [g.counts_json() for g in groups]
+    assert [[f.count for f in c.fallen] for c in cases] == [[1, 0, 1, 0], [0, 1, 0, 1]]

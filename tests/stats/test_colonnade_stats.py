@@ -8,8 +8,8 @@ import pytest
 from scipy import stats
 
 from pipeline.files import InputError
-from pipeline.stats.colonnade import (ALL_RECORDS, FILE, ColonnadeStatistics, Proportion,
-                                      GroupStatistics)
+from pipeline.stats.colonnade import ALL_RECORDS, FILE, ColonnadeStatistics, GroupStatistics
+from pipeline.stats.colonnade_counts import Proportion
 
 NAN = math.nan
 # colonnade "row" of 4 columns; record A's nominal run (member -1) would change every count
@@ -101,6 +101,11 @@ def test_counts_are_checked_on_construction():
         GroupStatistics(colonnade="row", group="A", columns=1, runs=2, fallen=runs,
                          parallel=Proportion(0, 0), in_sequence=Proportion(0, 0),
                          in_sequence_of_all=Proportion(0, 2))
+    with pytest.raises(InputError, match="runs must be a count >= 1"):
+        GroupStatistics(colonnade="row", group="A", columns=1, runs=0,
+                        fallen=[Proportion(0, 0), Proportion(0, 0)],
+                        parallel=Proportion(0, 0), in_sequence=Proportion(0, 0),
+                        in_sequence_of_all=Proportion(0, 0))
 
 
 def test_grouped_by_another_column_without_pooling():
