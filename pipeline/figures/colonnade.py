@@ -7,14 +7,15 @@ import numpy as np
 
 from pipeline.figures.style import figure
 from pipeline.files import save_figure
+from pipeline.stats.colonnade import ALL_RECORDS
 
 MAX_GROUPS = 8          # the pooled group and the first records; more would not be read
 
 
 def _shown(statistics):
     """The groups drawn: the pooled ones first, then records up to MAX_GROUPS."""
-    pooled = [g for g in statistics.groups if g.group == "all records"]
-    rest = [g for g in statistics.groups if g.group != "all records"]
+    pooled = [g for g in statistics.groups if g.group == ALL_RECORDS]
+    rest = [g for g in statistics.groups if g.group != ALL_RECORDS]
     return (pooled + rest)[:MAX_GROUPS]
 
 
