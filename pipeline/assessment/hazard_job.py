@@ -71,7 +71,10 @@ def hazard_job(job_options, constrain_options):
     {step: engine wall time s})."""
     job = load_job(job_options.oq_job)
     _check_sites(job_options, constrain_options)
-    check_engine(job_options.oq_python)
+    # absolute, its symlinks kept (a venv's python is one): the engine runs in a temporary
+    # directory
+    python = Path(os.path.abspath(job_options.oq_python))
+    check_engine(python)
     out = constrain_options.out
     times = {}
     with tempfile.TemporaryDirectory(prefix="oq-job-") as tmp:
@@ -85,15 +88,15 @@ def hazard_job(job_options, constrain_options):
         for name, text in (("classical", classical_text(job, tmp, sites)),
                            ("disaggregation", disaggregation_text(job, tmp, sites))):
             (tmp / f"{name}.ini").write_text(text, encoding="utf-8")
-            calc[name], times[name] = _engine(job_options.oq_python, tmp, name, env)
+            calc[name], times[name] = _engine(python, tmp, name, env)
         for f in (tmp / "out_classical").glob("*.csv"):
             if f.name.startswith(("hazard_curve-", "realizations_")):
                 shutil.copy(f, export / f.name)
-        _per_realisation(job_options.oq_python, tmp, calc["disaggregation"], env)
+        _per_realisation(python, tmp, calc["disaggregation"], env)
         for f in (tmp / "out_disaggregation").glob("Mag_Dist-*.csv"):
             shutil.copy(f, export / "disaggregation" / f.name)
         start = time.monotonic()
-        _run([str(job_options.oq_python), str(MRD_TOOL),
+        _run([str(python), str(MRD_TOOL),
               str(tmp / "oqdata" / f"calc_{calc['classical']}.hdf5"),
               str(export / "mrd_pga_pgv.hdf5")], tmp, env, "the PGA-PGV rate density")
         times["mrd"] = time.monotonic() - start

@@ -13,6 +13,8 @@
 # (each holds its run's date and checksum).
 set -eu
 OQ_PYTHON=${1:?usage: run_oq_case_mrd.sh OQ_PYTHON [OUT_DIR]}
+# absolute, its symlinks kept (a venv's python is one): the steps run in a temporary directory
+OQ_PYTHON=$(realpath -s -- "$OQ_PYTHON")
 OUT=$(realpath -m "${2:-results/oq_case_mrd}")
 HERE=$(cd "$(dirname "$0")/../.." && pwd)
 if ! "$OQ_PYTHON" -c "import openquake.engine" 2>/dev/null; then
