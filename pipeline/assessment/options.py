@@ -24,6 +24,7 @@ from pipeline.hazard.fragility.kinds import BETA_RANGE, MEDIAN_G_RANGE
 from pipeline.hazard.fragility.load import FRAGILITY_FORMS
 from pipeline.hazard.fragility.ratio import DEFAULT_VS30_M_S, PGA_PGV_CORRELATION
 from pipeline.hazard.pga_pgv_correlation import BRADLEY_2012
+from pipeline.hazard.site_motion import PGV_PGA_RANGE_S
 from pipeline.records import rotd50_fraction
 from pipeline.scenario.parameters import check_fields, param
 
@@ -233,7 +234,7 @@ class SurvivalOptions(SpecimenOptions):
         flag="--state-lognormal", metavar="STATE,MEDIAN_G,BETA",
         optional="with --fragility, the lognormal PGA fits of its damage_states")
     at_pgv_pga: float = param(None, "s", "the PGV/PGA at which the PGA range is stated (for "
-                              "a fragility over PGA and PGV/PGA)", 0.001, 10,
+                              "a fragility over PGA and PGV/PGA)", *PGV_PGA_RANGE_S,
                               flag="--at-pgv-pga", metavar="S", optional=True)
     disaggregation: Path = disaggregation_param("of the first --hazard curve")
     disaggregation_column: str = param(

@@ -10,8 +10,7 @@ from pathlib import Path
 
 from pipeline.cli._fields import add_arguments, from_args
 from pipeline.files import InputError
-from pipeline.inversion.options import CANDIDATE_PRESETS, InversionOptions
-from pipeline.userfiles import number
+from pipeline.inversion.options import CANDIDATE_PRESETS, InversionOptions, SiteMotionOptions
 
 NAME = "invert"
 ORDER = 45
@@ -60,22 +59,9 @@ def setup(p):
     _forward_grid(p.add_argument_group("forward grid (the table: one ensemble per node)"),
                   GRIDS["full"], MECHANISMS)
     _candidates(p.add_argument_group("candidates and prior"))
-    _site_motion(p.add_argument_group("the motion at each site from its standing and fallen "
-                                      "columns (with an OBSERVATIONS.json)"))
-
-
-def _site_motion(g):
-    g.add_argument("--site-fragility", type=Path, default=None, metavar="FILE",
-                   help="a column fragility.json of campaign fragility (or its directory), "
-                   "one entry per column type of the observations: writes site_motion.json "
-                   "beside the posterior, the PGA range (RotD50) each site's outcome allows "
-                   "(docs/survival.md)")
-    g.add_argument("--site-fragility-form", choices=("pga", "pga-pgv"), default="pga",
-                   help="its lognormal PGA fit (pga, default) or its logistic surface in PGA "
-                   "and PGV/PGA (pga-pgv, with --at-pgv-pga)")
-    g.add_argument("--at-pgv-pga", type=float, default=None, metavar="S",
-                   help="the PGV/PGA (s, 0.001-10) at which the PGA range is stated for "
-                   "--site-fragility-form pga-pgv")
+    add_arguments(p.add_argument_group("the motion at each site from its standing and "
+                                       "fallen columns (with an OBSERVATIONS.json)"),
+                  SiteMotionOptions)
 
 
 def _what_to_run(p, grids):
@@ -208,21 +194,11 @@ def run(args):
 def _check_site_motion(args):
     """The site-motion options checked before any work: (fragility_for(column type),
     at_pgv_pga) or None."""
-    given = (args.site_fragility is not None, args.at_pgv_pga is not None,
-             args.site_fragility_form != "pga")
-    if not any(given):
-        return None
-    if args.site_fragility is None:
-        raise InputError("--site-fragility-form and --at-pgv-pga go with --site-fragility")
-    if args.observations is None:
+    if args.site_fragility is not None and args.observations is None:
         raise InputError("--site-fragility goes with an OBSERVATIONS.json file")
-    if args.at_pgv_pga is not None:
-        number(args.at_pgv_pga, "--at-pgv-pga", 0.001, 10, "s")
-    if args.site_fragility_form == "pga-pgv" and args.at_pgv_pga is None:
-        raise InputError("--site-fragility-form pga-pgv needs --at-pgv-pga (the PGV/PGA at "
-                         "which the PGA range is stated)")
-    if args.site_fragility_form == "pga" and args.at_pgv_pga is not None:
-        raise InputError("--at-pgv-pga goes with --site-fragility-form pga-pgv")
+    site = from_args(SiteMotionOptions, args)
+    if site.site_fragility is None:
+        return None
     from pipeline.hazard.fragility import load_campaign_fragility  # lazy: the stage runs only with the command (light start-up and --help)
     from pipeline.inversion.observations import load_observations  # lazy: the stage runs only with the command (light start-up and --help)
     from pipeline.records import rotd50_fraction  # lazy: the stage runs only with the command (light start-up and --help)
@@ -231,9 +207,9 @@ def _check_site_motion(args):
     def fragility_for(column):
         if column not in cache:
             cache[column] = load_campaign_fragility(
-                args.site_fragility, column, args.site_fragility_form, component="rotd50",
+                site.site_fragility, column, site.site_fragility_form, component="rotd50",
                 record_fraction=rotd50_fraction, members=False)
         return cache[column]
     for column in load_observations(args.observations).column_types():
         fragility_for(column)                  # a missing column type refused before work
-    return fragility_for, args.at_pgv_pga
+    return fragility_for, site.at_pgv_pga

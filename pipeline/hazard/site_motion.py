@@ -23,6 +23,7 @@ from pipeline.hazard.damage_states import COLLAPSE, STATES, StateFragility
 
 LR_DROP_95 = 0.5 * stats.chi2.ppf(0.95, 1)     # 1.92: ln L below the maximum at the ends
 PGA_RANGE_M_S2 = (1e-3, 1e3)                   # the search range, 0.0001-100 g
+PGV_PGA_RANGE_S = (0.001, 10.0)                # a stated PGV/PGA (s) the range is found at
 GRID = 2001
 
 

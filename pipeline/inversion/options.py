@@ -1,12 +1,13 @@
 """The ``invert`` command's options, declared as :func:`~pipeline.scenario.parameters.param`
-fields (the command builds their flags from them), and the candidate grids' presets
-(km, deg); checked on creation, before any work.  Light: the command imports it at
+fields (the command builds their flags from them): the workflows' and the site motion's,
+and the candidate grids' presets (km, deg); checked on creation, before any work.  Light: the command imports it at
 start-up, the workflows (:mod:`pipeline.inversion.workflows`) only when it runs."""
 from dataclasses import dataclass
 from pathlib import Path
 
 from pipeline import RESULTS_DIR
 from pipeline.files import LONG_RUN_S, InputError, check_jobs
+from pipeline.hazard.site_motion import PGV_PGA_RANGE_S
 from pipeline.inversion.likelihood import DEFAULT_FLOOR, DEFAULT_KERNEL_DEG, DEFAULT_LIKELIHOOD, \
     LIKELIHOODS, check_model_options
 from pipeline.scenario.parameters import check_fields, param
@@ -62,6 +63,34 @@ class InversionOptions:
         if self.table is not None and self.extend_table is not None:
             raise InputError("give --table (a table used as it is) or --extend-table (a "
                              "table to extend by rings), not both")
+
+
+@dataclass(frozen=True)
+class SiteMotionOptions:
+    """The PGA range each site's standing and fallen columns allow (site_motion.json beside
+    the posterior): the fragility it is read from, checked on creation, before any work."""
+    site_fragility: Path = param(
+        None, "", "a column fragility.json of campaign fragility (or its directory), one "
+        "entry per column type of the observations: writes site_motion.json beside the "
+        "posterior, the PGA range (RotD50) each site's outcome allows (docs/survival.md)",
+        flag="--site-fragility", metavar="FILE", optional=True)
+    site_fragility_form: str = param(
+        "pga", "", "its lognormal PGA fit (pga) or its logistic surface in PGA and PGV/PGA "
+        "(pga-pgv, with --at-pgv-pga)", flag="--site-fragility-form", choices=("pga", "pga-pgv"))
+    at_pgv_pga: float = param(None, "s", "the PGV/PGA at which the PGA range is stated for "
+                              "--site-fragility-form pga-pgv", *PGV_PGA_RANGE_S,
+                              flag="--at-pgv-pga", metavar="S", optional=True)
+
+    def __post_init__(self):
+        surface = self.site_fragility_form == "pga-pgv"
+        if self.site_fragility is None and (self.at_pgv_pga is not None or surface):
+            raise InputError("--site-fragility-form and --at-pgv-pga go with --site-fragility")
+        check_fields(self)
+        if surface and self.at_pgv_pga is None:
+            raise InputError("--site-fragility-form pga-pgv needs --at-pgv-pga (the PGV/PGA "
+                             "at which the PGA range is stated)")
+        if not surface and self.at_pgv_pga is not None:
+            raise InputError("--at-pgv-pga goes with --site-fragility-form pga-pgv")
 
 
 CANDIDATE_PRESETS = {"quick": {"radius_km": 12.0, "step_km": 1.0, "strike_step_deg": 90.0},

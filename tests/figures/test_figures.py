@@ -12,6 +12,7 @@ from pipeline.figures import campaign as campaign_figures
 from pipeline.files import InputError
 from pipeline.motion import Motion
 from pipeline.outcome import Trajectory
+from tests.refusal import refused
 
 
 def test_figures_write_pngs(tmp_path, runs_table):
@@ -82,6 +83,29 @@ def test_a_run_directory_animates_on_the_record_clock(tmp_path):
     pvd = animation.export_vtk(tmp_path, tmp_path / "vtk", every=1)
     entries = ET.parse(pvd).getroot().find("Collection").findall("DataSet")
     assert [float(e.get("timestep")) for e in entries] == [-30.0, -29.0]
+
+
+def _run_dir(path):
+    """A run directory of the lying column's trajectory (no motion.npz: its own clock)."""
+    traj = lying_east_trajectory()
+    path.mkdir()
+    np.savez(path / "trajectory.npz", t=traj.t, pos=traj.pos, quat=traj.quat,
+             bodies=np.array(json.dumps(traj.bodies)), vel=traj.vel, angvel=traj.angvel,
+             pedestal_disp=traj.pedestal_disp, dt=1e-4, motion_end=1.0, stopped_early=False)
+    return path
+
+
+@pytest.mark.parametrize("option, words", [
+    (["--fps", "0"], "--fps 0 outside the allowed range (0, inf]"),
+    (["--fps", "-5"], "--fps -5 outside the allowed range (0, inf]"),
+    (["--fps", "nan"], "--fps must be a finite number"),
+    (["--max-seconds", "-1"], "--max-seconds -1 outside the allowed range (0, inf] s"),
+])
+def test_animate_refuses_a_frame_rate_or_length_it_cannot_draw(tmp_path, capsys, option, words):
+    """No frames at 0 or fewer per second, nor before the run starts: one line, no file."""
+    run = _run_dir(tmp_path / "run")
+    out = tmp_path / "a.gif"
+    refused(capsys, ["animate", run, "--out", out, *option], words, out)
 
 
 def test_animation_gif(tmp_path):

@@ -155,6 +155,14 @@ def test_invert_reports_each_sites_motion_beside_the_source(tmp_path, capsys, ma
     (["--site-fragility", "FRAG", "--site-fragility-form", "pga-pgv"], "needs --at-pgv-pga"),
     (["--site-fragility", "FRAG", "--at-pgv-pga", "0.1"], "goes with --site-fragility-form"),
     (["--site-fragility", "MONO"], "no column 'drums'"),
+    (["--site-fragility", "FRAG", "--site-fragility-form", "pga-pgv", "--at-pgv-pga", "0"],
+     "--at-pgv-pga 0 outside the allowed range [0.001, 10] s"),
+    (["--site-fragility", "FRAG", "--site-fragility-form", "pga-pgv", "--at-pgv-pga", "11"],
+     "--at-pgv-pga 11 outside the allowed range [0.001, 10] s"),
+    (["--site-fragility", "FRAG", "--site-fragility-form", "pga-pgv", "--at-pgv-pga", "nan"],
+     "--at-pgv-pga must be a finite number"),
+    (["--site-fragility", "FRAG", "--site-fragility-form", "pga-pgv", "--at-pgv-pga", "0.1",
+      "--at-pgv-pga", "0.2"], "--at-pgv-pga given more than once"),
 ])
 def test_invert_site_motion_refuses_in_one_line(tmp_path, capsys, extra, message,
                                                  make_away_table):
@@ -168,6 +176,21 @@ def test_invert_site_motion_refuses_in_one_line(tmp_path, capsys, extra, message
     err = capsys.readouterr().err.strip()
     assert message in err and len(err.splitlines()) == 1
     assert not out.exists()
+
+
+def test_invert_help_states_the_at_pgv_pga_range_survival_states(capsys, monkeypatch):
+    """--at-pgv-pga is the PGV/PGA (s) at which the site's PGA range is stated, in invert
+    as in survival: one range, 0.001-10 s, in both helps."""
+    monkeypatch.setenv("COLUMNS", "200")            # no flag broken at its hyphen
+    said = {}
+    for command in ("invert", "survival"):
+        with pytest.raises(SystemExit):
+            cli.main([command, "--help"])
+        said[command] = " ".join(capsys.readouterr().out.split()) + " "
+    assert "--at-pgv-pga S the PGV/PGA at which the PGA range is stated for " \
+        "--site-fragility-form pga-pgv (s); 0.001-10 " in said["invert"]
+    assert "--at-pgv-pga S the PGV/PGA at which the PGA range is stated (for a fragility " \
+        "over PGA and PGV/PGA) (s); 0.001-10 " in said["survival"]
 
 
 def test_invert_refuses_a_damage_state_its_site_fragility_cannot_weigh(tmp_path, capsys,
