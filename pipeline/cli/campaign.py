@@ -40,7 +40,7 @@ def setup(p):
         q.add_argument("--out", type=Path, default=None, metavar="DIR",
                        help=f"campaign directory (default results/{name})")
         q.add_argument("--animations", type=int, default=1,
-                       help="number of toppled runs to animate as GIF (default 1)")
+                       help="number of toppled runs to animate as GIF (default 1; 0: none)")
         q.add_argument("--allow-long", action="store_true",
                        help=f"start a campaign estimated to take over "
                        f"{LONG_RUN_S / 3600:g} h on --jobs cores (refused otherwise, before "
@@ -50,6 +50,9 @@ def setup(p):
 
 
 def run(args):
+    if args.animations < 0:
+        raise InputError(f"--animations {args.animations}: the number of toppled runs to "
+                         "animate is 0 or more")
     records = [r for r in args.records.split(",") if r] if args.records else None
     repeated = sorted({r for r in records or [] if records.count(r) > 1})
     if repeated:

@@ -325,3 +325,12 @@ def test_every_campaign_without_records_passes_the_gate_before_its_runs(tmp_path
         campaign.run_campaign(name, campaign_dir=tmp_path / name, jobs=2, allow_long=False)
     assert [name for name, _ in reached] == ["verification", "slenderness", "friction"]
     assert all(n > 0 for _, n in reached)
+
+
+def test_a_negative_number_of_animations_is_refused_before_any_run(tmp_path, capsys):
+    """--animations -1 animated every toppled run but the last, without a word."""
+    out = tmp_path / "out"
+    err, _ = one_line_error(capsys, cli.main(["campaign", "verification", "--out", str(out),
+                                              "--animations", "-1"]))
+    assert "--animations -1" in err and "0 or more" in err
+    assert not out.exists()
