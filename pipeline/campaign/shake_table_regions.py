@@ -87,9 +87,9 @@ def region_errors(tests, kind):
             for label, vs in sorted(groups.items(), key=lambda kv: _order(kv[0]))]
 
 
-PARAMETER_LABELS = (("kn_n_per_m", "kn", "{:.3g} N/m"), ("damping", "damping", "{:.3f}"),
-                    ("mu_s", "mu_s", "{:.3f}"),
-                    ("footprint_tolerance_m", "footprint", "{:.2e} m"))
+PARAMETER_LABELS = (("kn_n_per_m", "kn", "{:.3g} N/m", 1.0),
+                    ("damping", "damping", "{:.3f}", 1.0), ("mu_s", "mu_s", "{:.3f}", 1.0),
+                    ("footprint_tolerance_m", "footprint tolerance", "{:.2f} mm", 1e3))
 
 
 @dataclass(frozen=True)
@@ -153,7 +153,7 @@ def summary_lines(tests, wrong, regions):
             continue
         counts = {m: sum(t.mechanism is m for t in mine) for m in Mechanism}
         timed = sum(t.runs_timed for t in mine)
-        out.append(f"  {verdict.value}s ({len(mine)}): most members "
+        out.append(f"  {verdict.value}s ({len(mine)} tests): members mostly "
                    + ", ".join(f"{m.value} in {n}" for m, n in counts.items() if n)
                    + f"; median theta_max/alpha "
                    f"{np.nanmedian([t.median_tilt_over_critical for t in mine]):.2f}; slid "
@@ -162,12 +162,12 @@ def summary_lines(tests, wrong, regions):
     split = [t for t in tests if 0 < t.overturned < t.runs]
     if split:
         parts = []
-        for name, label, form in PARAMETER_LABELS:
+        for name, label, form, scale in PARAMETER_LABELS:
             up = np.array([getattr(t, f"{name}_overturned") for t in split])
             down = np.array([getattr(t, f"{name}_standing") for t in split])
             if np.isfinite(up).any() and np.isfinite(down).any():
-                parts.append(f"{label} {form.format(np.nanmedian(up))} against "
-                             f"{form.format(np.nanmedian(down))}")
+                parts.append(f"{label} {form.format(scale * np.nanmedian(up))} against "
+                             f"{form.format(scale * np.nanmedian(down))}")
         out.append(f"  on the {len(split)} tests whose members split, the overturned "
                    "members' median contact against the standing ones': "
                    + ("; ".join(parts) or "none in the runs' files"))

@@ -15,6 +15,7 @@ import numpy as np
 import pandas as pd
 
 from pipeline.campaign import shake_table_experiments
+from pipeline.campaign.shake_table_disagreements import write_disagreements
 from pipeline.campaign.shake_table_folds import fold_table
 from pipeline.files import InputError, write_csv, write_json
 from pipeline.records import RECORDS_DIR
@@ -99,6 +100,9 @@ def write_scores(per_test, campaign_dir, options, full, settled, choice=None):
     threshold_g = math.tan(math.radians(critical))
     path, providers = providers_of(options)
     write_csv(campaign_dir / "members.csv", per_test)
+    disagreements = write_disagreements(
+        campaign_dir, f"{specimen.name}: where the members' majority (P > 0.5) and the "
+        "laboratory disagree")
     scored = per_test[per_test["P"].notna()]
     splits = {split: split_scores(scored if split == "all" else
                                   scored[scored["split"] == split], threshold_g, providers)
@@ -118,7 +122,9 @@ def write_scores(per_test, campaign_dir, options, full, settled, choice=None):
                                                    .sum()),
         "runs_at_most": len(full), "adaptive_settled": settled,
         "rules": CLIP_RULE, "bin_edges": [float(e) for e in BIN_EDGES],
-        "ranges_choice": choice, "splits": splits, "lines": choice_lines(choice) + lines_of(splits)}
+        "ranges_choice": choice, "splits": splits,
+        "disagreements": disagreements.to_json(),
+        "lines": choice_lines(choice) + lines_of(splits) + list(disagreements.lines)}
     write_json(campaign_dir / "shake_table_members.json", result)
     from pipeline.figures.reliability import plot_reliability  # lazy: matplotlib, not imported by a run or after Ctrl-C
     plot_reliability({s: v["members"]["reliability_diagram"] for s, v in splits.items()},

@@ -2,6 +2,7 @@
 PGA x PGV/PGA plane, right or wrong by kind, the split marked; and the error rate of the
 members' majority per region with its Wilson 95 % interval."""
 import numpy as np
+from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
 
 from pipeline.figures.style import figure
 from pipeline.files import save_figure
@@ -30,6 +31,10 @@ def plot_disagreements(tests, regions, path, title):
     if len(positive) == len(tests) and tests:
         left.set_xscale("log")
         left.set_yscale("log")
+        for axis in (left.xaxis, left.yaxis):
+            axis.set_major_locator(LogLocator(subs=(1.0, 2.0, 5.0)))
+            axis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
+            axis.set_minor_formatter(NullFormatter())
     left.set_xlabel("PGA (g)")
     left.set_ylabel("PGV/PGA (s)")
     left.set_title("tests: the members' majority against the laboratory")

@@ -6,6 +6,9 @@ import json
 
 import pandas as pd
 
+from pipeline.campaign.shake_table_disagreement_file import FILE, DisagreementTable
+from pipeline.campaign.shake_table_disagreements import FIGURE, SLIDE_RATIO, UPLIFT_RATIO
+from pipeline.campaign.shake_table_regions import DisagreementSummary
 from pipeline.report.common import _figure, _table
 
 FULL = "shake-table-scores"
@@ -49,7 +52,33 @@ def shake_table_scores_section(results, name=FULL):
     lines.append(_figure(results, results / name / "shake_table_reliability.png",
                          "Reliability diagram: observed overturning rate against the "
                          "predicted P, per bin, with Wilson 95 % intervals"))
+    lines.append(_disagreements(results, results / name))
     return "\n".join(lines)
+
+
+def _disagreements(results, directory):
+    """Where the members' majority and the laboratory disagree, from disagreements.csv:
+    the summary's lines, the error rate per region and the figure; "" without the file."""
+    if not (directory / FILE).is_file():
+        return ""
+    table = DisagreementTable.load(directory / FILE)
+    summary = DisagreementSummary.of(table)
+    rows = pd.DataFrame([{"region": f"{r.kind.label} {r.label}", "tests": r.wrong.of,
+                          "wrong": r.wrong.count,
+                          "error rate [Wilson 95 %]": f"{r.wrong.p:.2f} [{r.wrong.ci95[0]:.2f}, "
+                                                      f"{r.wrong.ci95[1]:.2f}]",
+                          "missed overturns": r.missed, "false overturns": r.false}
+                         for r in summary.regions])
+    return ("**Where the members and the laboratory disagree** (`" + FILE + "`: per test "
+            "its region, the members' verdict and what decided their runs; a run uplifted "
+            f"when theta_max/alpha reached {UPLIFT_RATIO:g}, slid when its residual base "
+            f"slide reached {SLIDE_RATIO:g} of the base width, the damage states' first "
+            "limits):\n\n"
+            + "\n".join(f"- {line.strip()}" for line in summary.lines) + "\n\n"
+            + _table(rows) + "\n\n"
+            + _figure(results, directory / FIGURE, "Tests in the PGA x PGV/PGA plane, right "
+                      "or wrong by kind (filled: calibration, open: held out), and the "
+                      "error rate per region with its Wilson 95 % interval"))
 
 
 def _intro(summary, quick):
