@@ -153,7 +153,8 @@ def summary_lines(tests, wrong, regions):
             continue
         counts = {m: sum(t.mechanism is m for t in mine) for m in Mechanism}
         timed = sum(t.runs_timed for t in mine)
-        out.append(f"  {verdict.value}s ({len(mine)} tests): members mostly "
+        out.append(f"  {verdict.value}s ({len(mine)} test{'' if len(mine) == 1 else 's'}): "
+                   "members mostly "
                    + ", ".join(f"{m.value} in {n}" for m, n in counts.items() if n)
                    + f"; median theta_max/alpha "
                    f"{np.nanmedian([t.median_tilt_over_critical for t in mine]):.2f}; slid "

@@ -1,9 +1,15 @@
 """The REPORT section of the members mode: the scores it quotes are the file's, and its
-verdict on the held-out tests follows from them (a file written here, not by a run)."""
+verdict on the held-out tests follows from them, and where the members and the laboratory
+disagree is read from disagreements.csv (files written here, not by a run)."""
 import json
+import math
 
+from scipy.stats import norm
+
+from pipeline.campaign.shake_table_disagreements import FIGURE, write_disagreements
 from pipeline.report.shake_table_scores import (FULL, QUICK, HELD_OUT_ACCURACY_GOAL,
                                                 shake_table_scores_section)
+from tests.campaign.tiny_members_campaign import member_run, write_campaign
 
 
 def _scores(ll, brier, accuracy):
@@ -82,3 +88,31 @@ def test_the_folds_are_quoted_with_the_bins_their_interval_misses(tmp_path):
     row = [line for line in text.splitlines() if "-0.432" in line]
     assert len(row) == 1 and "2021-06-21 to 2021-06-25" in row[0]
     assert row[0].rstrip(" |").endswith("P = 0")
+
+
+def test_the_disagreements_are_quoted_from_their_file_with_the_figure(tmp_path):
+    """The section quotes disagreements.csv: its regions' counts, each error rate's
+    Wilson interval (closed form), the summary's lines, and shows the figure."""
+    _write(tmp_path, QUICK, members_accuracy=0.8, provider_ll=-0.9, provider_brier=0.09)
+    directory = tmp_path / QUICK
+    slid = member_run(tilt_deg=0.1, residual_slide_m=0.005)
+    toppled = member_run(toppled=True, tilt_deg=90.0, residual_slide_m=0.2)
+    write_campaign(directory, [
+        {"test": "Test001", "date": "2021-07-13", "split": "calibration", "pga_g": 0.15,
+         "pgv_pga_s": 0.1, "observed": True, "runs": [slid, slid]},
+        {"test": "Test002", "date": "2021-07-13", "split": "calibration", "pga_g": 0.12,
+         "pgv_pga_s": 0.1, "observed": False, "runs": [toppled, toppled]},
+        {"test": "Test003", "date": "2021-08-13", "split": "validation", "pga_g": 0.18,
+         "pgv_pga_s": 0.1, "observed": False, "runs": [slid, slid]}])
+    write_disagreements(directory, "tiny")
+    text = shake_table_scores_section(tmp_path, QUICK)
+    assert f"]({QUICK}/{FIGURE})" in text
+    k, n, z = 2, 3, norm.ppf(0.975)
+    centre = (k / n + z * z / (2 * n)) / (1 + z * z / n)
+    half = z / (1 + z * z / n) * math.sqrt(k / n * (1 - k / n) / n + z * z / (4 * n * n))
+    row = next(line for line in text.splitlines() if "| PGA (g) 0.1-0.2" in line)
+    cells = [c.strip() for c in row.strip("|").split("|")]
+    assert cells[1:4] == ["3", "2", f"0.67 [{centre - half:.2f}, {centre + half:.2f}]"]
+    assert cells[4:] == ["1", "1"]                   # one missed, one false overturn
+    assert "wrong on 2 of 3" in text and "missed overturns (1 test): members mostly " \
+        "sliding in 1" in text
