@@ -22,7 +22,9 @@ with the baselines "never overturns", "PGA >= g tan(critical angle)" and other m
 models of SP1, fitted on these tests: in-sample).  Outputs (the campaign directory):
 ``members.csv`` (per test: runs, overturned, P, its Wilson interval, the single set's
 prediction), ``shake_table_members.json`` (scores per split,
-:func:`pipeline.stats.forecast.forecast_scores`) and ``shake_table_reliability.png``.
+:func:`pipeline.stats.forecast.forecast_scores`), ``shake_table_reliability.png`` and
+where the members and the laboratory disagree (``disagreements.csv``,
+``shake_table_disagreements.png``).
 """
 import logging
 import sys

@@ -5,7 +5,9 @@ baselines, every one scored as a probability forecast the same way
 (:func:`pipeline.stats.forecast.forecast_scores`: a 0/1 forecast is P = 0 or 1).
 Files: ``members.csv``, ``shake_table_members.json``, ``shake_table_reliability.png``;
 with the ranges chosen over folds, ``folds.csv`` and ``shake_table_folds_reliability.png``
-(per fold, the reliability of the ranges chosen without it)."""
+(per fold, the reliability of the ranges chosen without it); where the members and the
+laboratory disagree, ``disagreements.csv`` and ``shake_table_disagreements.png``
+(:mod:`pipeline.campaign.shake_table_disagreements`)."""
 import io
 import logging
 import math
