@@ -73,7 +73,9 @@ def _measure(value, name, minimum=0.0):
     return value
 
 
-PARAMETERS = ("kn_n_per_m", "damping", "mu_s", "footprint_tolerance_m")
+PARAMETERS = ("kn_n_per_m", "damping", "mu_s", "footprint_tolerance_m", "motion_turn_deg")
+SIGNED = ("first_uplift_s", "first_slip_s", "motion_turn_deg_overturned",
+          "motion_turn_deg_standing")           # values that may be negative
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -85,7 +87,8 @@ class Disagreement:
     uplifted (or without); the members' median theta_max / alpha, largest base slip
     (centre of mass) and residual slide, median first uplift and first slip times; the
     median of each contact parameter over the members that overturned and those that
-    stood (NaN: none, or not in the runs' files)."""
+    stood, and of the table motion's turn (deg in (-180, 180]: a member's yaw, the sign
+    reversed) (NaN: none, or not in the runs' files)."""
     test: str
     date: str
     split: str
@@ -111,6 +114,8 @@ class Disagreement:
     mu_s_standing: float
     footprint_tolerance_m_overturned: float
     footprint_tolerance_m_standing: float
+    motion_turn_deg_overturned: float
+    motion_turn_deg_standing: float
 
     def __post_init__(self):
         where = f"test {self.test}"
@@ -131,7 +136,7 @@ class Disagreement:
                                                         f"{where}: {f.name}"))
             elif f.type is float:
                 value = _measure(getattr(self, f.name), f"{where}: {f.name}",
-                                 -math.inf if f.name.startswith("first_") else 0.0)
+                                 -math.inf if f.name in SIGNED else 0.0)
                 object.__setattr__(self, f.name, value)
         for name in ("pga_g", "pgv_pga_s"):
             if math.isnan(getattr(self, name)):

@@ -19,7 +19,7 @@ import numpy as np
 import pandas as pd
 from scipy.spatial.transform import Rotation
 
-from pipeline.campaign.shake_table_disagreement_file import (FILE, Disagreement,
+from pipeline.campaign.shake_table_disagreement_file import (FILE, PARAMETERS, Disagreement,
                                                              DisagreementTable, Mechanism)
 from pipeline.campaign.shake_table_regions import DisagreementSummary
 from pipeline.files import InputError, csv_true_column
@@ -68,12 +68,16 @@ def run_evidence(run_dir):
 
 
 def contact_parameters(parameters):
-    """kn (N/m), damping, mu_s and the mesh's footprint tolerance (m) of a run's
-    parameters (summary.json ``parameters``); NaN for one it does not hold."""
+    """kn (N/m), damping, mu_s, the mesh's footprint tolerance (m) and the table motion's
+    turn (deg, ``rotate_deg`` in (-180, 180]) of a run's parameters (summary.json
+    ``parameters``); NaN for one it does not hold."""
     geometry = parameters.get("geometry")
     footprint = geometry.get("footprint_tolerance_m") if isinstance(geometry, dict) else None
+    turn = parameters.get("rotate_deg")
     values = {"kn_n_per_m": parameters.get("kn"), "damping": parameters.get("damping"),
-              "mu_s": parameters.get("mu_s"), "footprint_tolerance_m": footprint}
+              "mu_s": parameters.get("mu_s"), "footprint_tolerance_m": footprint,
+              "motion_turn_deg": None if turn is None else
+              180.0 - (180.0 - float(turn)) % 360.0}
     return {k: math.nan if v is None else float(v) for k, v in values.items()}
 
 
@@ -140,8 +144,7 @@ def test_disagreement(row, evidence):
         max_residual_slide_m=max(e["residual_slide_m"] for e in evidence),
         first_uplift_s=_median([e["first_uplift_s"] for e in timed]),
         first_slip_s=_median([e["first_slip_s"] for e in timed]),
-        **{f"{p}_{side}": over(which, p) for p in ("kn_n_per_m", "damping", "mu_s",
-                                                   "footprint_tolerance_m")
+        **{f"{p}_{side}": over(which, p) for p in PARAMETERS
            for side, which in (("overturned", True), ("standing", False))})
 
 

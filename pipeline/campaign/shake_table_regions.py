@@ -89,7 +89,8 @@ def region_errors(tests, kind):
 
 PARAMETER_LABELS = (("kn_n_per_m", "kn", "{:.3g} N/m", 1.0),
                     ("damping", "damping", "{:.3f}", 1.0), ("mu_s", "mu_s", "{:.3f}", 1.0),
-                    ("footprint_tolerance_m", "footprint tolerance", "{:.2f} mm", 1e3))
+                    ("footprint_tolerance_m", "footprint tolerance", "{:.2f} mm", 1e3),
+                    ("motion_turn_deg", "table motion's turn", "{:.1f} deg", 1.0))
 
 
 @dataclass(frozen=True)

@@ -27,7 +27,7 @@ STILL = member_run()
 SLID = member_run(tilt_deg=0.1, base_slip_m=0.004, residual_slide_m=0.005)   # no uplift
 ROCKED = member_run(tilt_deg=2.0, base_slip_m=0.01, residual_slide_m=0.003)
 TOPPLED = member_run(toppled=True, tilt_deg=90.0, base_slip_m=0.4, residual_slide_m=0.2,
-                     kn=1e9, damping=0.05, mu_s=0.8, footprint_m=0.0015)
+                     kn=1e9, damping=0.05, mu_s=0.8, footprint_m=0.0015, rotate_deg=357.0)
 
 
 def _test(name, observed, runs, pga_g=0.15, pgv_pga_s=0.1, day="2021-07-13",
@@ -76,6 +76,9 @@ def test_a_run_that_slid_without_uplift_is_sliding(campaign):
     # the contact of the overturned members against the standing one's, as the files say
     assert (second.kn_n_per_m_overturned, second.kn_n_per_m_standing) == (1e9, 1e8)
     assert second.footprint_tolerance_m_overturned == pytest.approx(0.0015)
+    # rotate_deg 357: the table motion turned 3 deg clockwise back (a yaw of +3 deg)
+    assert (second.motion_turn_deg_overturned, second.motion_turn_deg_standing) == \
+        pytest.approx((-3.0, 0.0))
     assert math.isnan(first.kn_n_per_m_overturned)            # none overturned
 
 

@@ -9,11 +9,11 @@ CRITICAL_DEG = 5.0
 
 
 def member_run(toppled=False, tilt_deg=0.0, base_slip_m=0.0, residual_slide_m=0.0,
-               kn=1e8, damping=0.1, mu_s=0.7, footprint_m=0.001):
+               kn=1e8, damping=0.1, mu_s=0.7, footprint_m=0.001, rotate_deg=0.0):
     """One member run's values (angles deg, lengths m, kn N/m)."""
     return {"toppled": toppled, "tilt_deg": tilt_deg, "base_slip_m": base_slip_m,
             "residual_slide_m": residual_slide_m, "kn": kn, "damping": damping,
-            "mu_s": mu_s, "footprint_m": footprint_m}
+            "mu_s": mu_s, "footprint_m": footprint_m, "rotate_deg": rotate_deg}
 
 
 def summary(test, run):
@@ -25,6 +25,7 @@ def summary(test, run):
               "toppled": run["toppled"]}
     return {"record": f"{test}.txt",
             "parameters": {"kn": run["kn"], "damping": run["damping"], "mu_s": run["mu_s"],
+                           "rotate_deg": run["rotate_deg"],
                            "geometry": {"name": "SP1",
                                         "footprint_tolerance_m": run["footprint_m"]}},
             "columns": [{"column": "monolithic", "toppled": run["toppled"],
