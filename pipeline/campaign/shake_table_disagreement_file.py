@@ -104,6 +104,7 @@ class Disagreement:
     median_tilt_over_critical: float
     max_base_slip_m: float
     max_residual_slide_m: float
+    max_residual_twist_deg: float
     first_uplift_s: float
     first_slip_s: float
     kn_n_per_m_overturned: float

@@ -38,7 +38,7 @@ RUNS_COLUMNS = ("test", "member", "predicted", "run_id")
 
 def run_evidence(run_dir):
     """What one member run did: {toppled, mechanism, tilt_over_critical, base_slip_m,
-    residual_slide_m, first_uplift_s, first_slip_s (record clock; NaN: never, or no
+    residual_slide_m, residual_twist_deg, first_uplift_s, first_slip_s (record clock; NaN: never, or no
     trajectory), timed, and its contact parameters (NaN where its summary holds none)}."""
     summary = RunSummary.load(Path(run_dir) / "summary.json")
     column = summary.columns[0]
@@ -63,6 +63,7 @@ def run_evidence(run_dir):
     return {"toppled": column.toppled, "mechanism": mechanism,
             "tilt_over_critical": math.nan if ratio is None else ratio,
             "base_slip_m": column.base_slip_m, "residual_slide_m": slide,
+            "residual_twist_deg": damage.max_residual_twist_deg,
             "first_uplift_s": uplift_s, "first_slip_s": slip_s, "timed": timed,
             **contact_parameters(summary.parameters)}
 
@@ -142,6 +143,7 @@ def test_disagreement(row, evidence):
         median_tilt_over_critical=_median([e["tilt_over_critical"] for e in evidence]),
         max_base_slip_m=max(e["base_slip_m"] for e in evidence),
         max_residual_slide_m=max(e["residual_slide_m"] for e in evidence),
+        max_residual_twist_deg=max(e["residual_twist_deg"] for e in evidence),
         first_uplift_s=_median([e["first_uplift_s"] for e in timed]),
         first_slip_s=_median([e["first_slip_s"] for e in timed]),
         **{f"{p}_{side}": over(which, p) for p in PARAMETERS

@@ -158,8 +158,11 @@ def summary_lines(tests, wrong, regions):
                    "members mostly "
                    + ", ".join(f"{m.value} in {n}" for m, n in counts.items() if n)
                    + f"; median theta_max/alpha "
-                   f"{np.nanmedian([t.median_tilt_over_critical for t in mine]):.2f}; slid "
-                   f"before any uplift in {sum(t.runs_slip_first for t in mine)} of "
+                   f"{np.nanmedian([t.median_tilt_over_critical for t in mine]):.2f}; "
+                   "largest residual base slide (median over the tests) "
+                   f"{1e3 * np.median([t.max_residual_slide_m for t in mine]):.1f} mm with a "
+                   f"twist of {np.median([t.max_residual_twist_deg for t in mine]):.2f} deg; "
+                   f"slid before any uplift in {sum(t.runs_slip_first for t in mine)} of "
                    f"{timed} member runs with a trajectory")
     split = [t for t in tests if 0 < t.overturned < t.runs]
     if split:

@@ -24,7 +24,8 @@ from pipeline.outcome import Trajectory
 from tests.campaign.tiny_members_campaign import CRITICAL_DEG, member_run, write_campaign
 
 STILL = member_run()
-SLID = member_run(tilt_deg=0.1, base_slip_m=0.004, residual_slide_m=0.005)   # no uplift
+SLID = member_run(tilt_deg=0.1, base_slip_m=0.004, residual_slide_m=0.005,  # no uplift
+                  twist_deg=-1.5)
 ROCKED = member_run(tilt_deg=2.0, base_slip_m=0.01, residual_slide_m=0.003)
 TOPPLED = member_run(toppled=True, tilt_deg=90.0, base_slip_m=0.4, residual_slide_m=0.2,
                      kn=1e9, damping=0.05, mu_s=0.8, footprint_m=0.0015, rotate_deg=357.0)
@@ -71,6 +72,7 @@ def test_a_run_that_slid_without_uplift_is_sliding(campaign):
     assert (first.runs_sliding, first.runs_uplift, first.overturned) == (3, 0, 0)
     assert first.median_tilt_over_critical == pytest.approx(0.1 / CRITICAL_DEG)
     assert first.max_residual_slide_m == pytest.approx(0.005)
+    assert first.max_residual_twist_deg == pytest.approx(1.5)     # either way round
     assert second.mechanisms == {Mechanism.TOPPLED: 3, Mechanism.ROCKING: 1,
                                  Mechanism.SLIDING: 0, Mechanism.STILL: 0}
     # the contact of the overturned members against the standing one's, as the files say

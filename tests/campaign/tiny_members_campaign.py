@@ -9,11 +9,13 @@ CRITICAL_DEG = 5.0
 
 
 def member_run(toppled=False, tilt_deg=0.0, base_slip_m=0.0, residual_slide_m=0.0,
-               kn=1e8, damping=0.1, mu_s=0.7, footprint_m=0.001, rotate_deg=0.0):
+               kn=1e8, damping=0.1, mu_s=0.7, footprint_m=0.001, rotate_deg=0.0,
+               twist_deg=0.0):
     """One member run's values (angles deg, lengths m, kn N/m)."""
     return {"toppled": toppled, "tilt_deg": tilt_deg, "base_slip_m": base_slip_m,
             "residual_slide_m": residual_slide_m, "kn": kn, "damping": damping,
-            "mu_s": mu_s, "footprint_m": footprint_m, "rotate_deg": rotate_deg}
+            "mu_s": mu_s, "footprint_m": footprint_m, "rotate_deg": rotate_deg,
+            "twist_deg": twist_deg}
 
 
 def summary(test, run):
@@ -21,7 +23,7 @@ def summary(test, run):
     damage = {"peak_capital_displacement_m": 0.0, "base_width_m": BASE_WIDTH_M,
               "max_rotation_deg": run["tilt_deg"], "critical_angle_deg": CRITICAL_DEG,
               "joints": [{"lower": "pedestal", "upper": "monolithic[0]",
-                          "slide_m": run["residual_slide_m"], "twist_deg": 0.0}],
+                          "slide_m": run["residual_slide_m"], "twist_deg": run["twist_deg"]}],
               "toppled": run["toppled"]}
     return {"record": f"{test}.txt",
             "parameters": {"kn": run["kn"], "damping": run["damping"], "mu_s": run["mu_s"],
