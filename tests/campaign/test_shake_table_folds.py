@@ -16,6 +16,7 @@ from pipeline.campaign.shake_table_folds import choose_ranges, date_folds
 from pipeline.campaign.shake_table_scores import write_scores
 from pipeline.files import InputError
 from pipeline.stats.forecast import reliability_with_ends
+from tests.campaign.tiny_members_campaign import write_member_runs
 
 Z = 1.959963984540054                 # the normal quantile of a two-sided 95 % interval
 
@@ -139,6 +140,7 @@ def test_the_scores_write_the_folds_table_and_diagram(tmp_path):
     full = [SimpleNamespace(tags=SimpleNamespace(member=m, point={"m": m})) for m in (-1, 0)]
     options = {"specimen": SPECIMEN, "experiments": EXPERIMENTS, "outcome": OUTCOME,
                "validate_from": "2021-08-01", "members": 8, "axis_deg": 90.0}
+    write_member_runs(tmp_path, per_test)
     write_scores(per_test, tmp_path, options, full, True, choice)
     table = pd.read_csv(tmp_path / "folds.csv")
     assert sorted(set(table["fold"])) == [0, 1, 2]

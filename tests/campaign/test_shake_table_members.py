@@ -15,7 +15,7 @@ from pipeline.campaign.shake_table_experiments import EXPERIMENTS, OUTCOME, SPEC
 from pipeline.campaign.shake_table_members import choose_ranges, member_sets, run_params
 from pipeline.campaign.shake_table_scores import write_scores
 from pipeline.scenario.geometry import ColumnGeometry
-from tests.campaign.tiny_members_campaign import member_run, write_campaign
+from tests.campaign.tiny_members_campaign import write_member_runs
 
 
 @pytest.mark.parametrize("args, said", [
@@ -108,10 +108,7 @@ def test_scores_of_a_synthetic_threshold_model(tmp_path):
     full = [SimpleNamespace(tags=SimpleNamespace(member=m, point={"m": m})) for m in (-1, 0, 1)]
     options = {"specimen": SPECIMEN, "experiments": EXPERIMENTS, "outcome": OUTCOME,
                "validate_from": "2021-08-01", "members": 8, "axis_deg": 90.0}
-    write_campaign(tmp_path, [{**row, "runs": [member_run(toppled=j < row["overturned"],
-                                                          tilt_deg=90.0 * (j < row["overturned"]))
-                                               for j in range(8)]}
-                              for row in per_test.to_dict("records")])
+    write_member_runs(tmp_path, per_test)
     write_scores(per_test, tmp_path, options, full, True)
     result = json.loads((tmp_path / "shake_table_members.json").read_text())
     for split in ("calibration", "validation", "all"):

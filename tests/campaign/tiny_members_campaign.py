@@ -60,3 +60,12 @@ def write_campaign(directory, tests):
                      "predicted": False, "max_tilt_deg": 0.0, "run_id": "single"})
     pd.DataFrame(members).to_csv(directory / "members.csv", index=False)
     pd.DataFrame(runs).to_csv(directory / "members_runs.csv", index=False)
+
+
+def write_member_runs(directory, per_test):
+    """The member runs of members.csv rows ``per_test`` (runs, overturned): the first
+    ``overturned`` toppled, the others still."""
+    write_campaign(directory, [{**row, "runs": [member_run(toppled=j < row["overturned"],
+                                                           tilt_deg=90.0 * (j < row["overturned"]))
+                                                for j in range(row["runs"])]}
+                               for row in per_test.to_dict("records")])
