@@ -39,7 +39,7 @@ def plot_disagreements(tests, regions, path, title):
     left.set_ylabel("PGV/PGA (s)")
     left.set_title("tests: the members' majority against the laboratory")
     left.grid(True, which="both", alpha=0.3)
-    left.legend(fontsize=8, loc="best")
+    left.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.12), ncol=2)
     y = np.arange(len(regions))[::-1]
     for k, (label, wrong, n, lo, hi) in enumerate(regions):
         rate = wrong / n
