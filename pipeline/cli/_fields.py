@@ -57,7 +57,7 @@ def add_arguments(parser, cls, names=None):
     """Add the flagged fields of parameter dataclass ``cls`` to an argparse parser (their
     defaults None: the dataclass decides).  Field types: int, float, str, Path; bool is a
     switch, tuple a flag that may be given several times (``tuple[float, ...]``: each
-    value of that type)."""
+    value of that type), or once with several values when declared :func:`several`."""
     for f in dataclasses.fields(cls):
         meta = f.metadata
         if not meta.get("flag") or (names is not None and f.name not in names):
@@ -72,6 +72,8 @@ def add_arguments(parser, cls, names=None):
         elif kind is bool:
             kwargs["action"] = "store_const"
             kwargs["const"] = True
+        elif meta.get("several"):
+            kwargs.update(nargs="+", type=typing.get_args(kind)[0], action=_Once)
         elif kind is tuple or typing.get_origin(kind) is tuple:
             kwargs.update(_tuple_kwargs(typing.get_args(kind)))
         else:
@@ -79,6 +81,13 @@ def add_arguments(parser, cls, names=None):
         if "action" not in kwargs and "nargs" not in kwargs:
             kwargs["action"] = _Once
         parser.add_argument(meta["flag"], **kwargs)
+
+
+def several(declared):
+    """A ``tuple[float, ...]`` field declared by ``param`` as one flag followed by its
+    values (``--mu-s 0.3 0.2``), given once, rather than a flag given once per value."""
+    return dataclasses.field(default=declared.default,
+                             metadata={**declared.metadata, "several": True})
 
 
 class _Once(argparse.Action):
@@ -89,9 +98,14 @@ class _Once(argparse.Action):
         if getattr(namespace, self.dest, None) is not None:
             repeated = getattr(namespace, "_repeated", [])
             setattr(namespace, "_repeated", repeated + [
-                f"{option_string} given more than once ({getattr(namespace, self.dest)} "
-                f"and {values}); give it once"])
+                f"{option_string} given more than once ({_shown(getattr(namespace, self.dest))} "
+                f"and {_shown(values)}); give it once"])
         setattr(namespace, self.dest, values)
+
+
+def _shown(values):
+    """A flag's parsed value as typed: its values of a list apart by spaces."""
+    return " ".join(map(str, values)) if isinstance(values, list) else values
 
 
 def _tuple_kwargs(args):
