@@ -57,7 +57,8 @@ def add_arguments(parser, cls, names=None):
     """Add the flagged fields of parameter dataclass ``cls`` to an argparse parser (their
     defaults None: the dataclass decides).  Field types: int, float, str, Path; bool is a
     switch, tuple a flag that may be given several times (``tuple[float, ...]``: each
-    value of that type), or once with several values when declared :func:`several`."""
+    value of that type), or once with several values when declared :func:`several`, or
+    once with values apart by commas when its metadata says ``commas``."""
     for f in dataclasses.fields(cls):
         meta = f.metadata
         if not meta.get("flag") or (names is not None and f.name not in names):
@@ -74,6 +75,8 @@ def add_arguments(parser, cls, names=None):
             kwargs["const"] = True
         elif meta.get("several"):
             kwargs.update(nargs="+", type=typing.get_args(kind)[0], action=_Once)
+        elif meta.get("commas"):
+            kwargs.update(type=str, action=_Once)        # split by from_args
         elif kind is tuple or typing.get_origin(kind) is tuple:
             kwargs.update(_tuple_kwargs(typing.get_args(kind)))
         else:
@@ -103,9 +106,25 @@ class _Once(argparse.Action):
         setattr(namespace, self.dest, values)
 
 
+def _comma_list(text, f):
+    """The values of field ``f`` (``tuple[kind, ...]``) from ``A,B,...``; InputError
+    naming its flag."""
+    kind, flag = typing.get_args(f.type)[0], f.metadata["flag"]
+    try:
+        values = tuple(kind(v.strip()) for v in text.split(",") if v.strip())
+    except ValueError:
+        raise InputError(f"{flag}: not a comma-separated list of {kind.__name__} values: "
+                         f"{text!r}") from None
+    if not values:
+        raise InputError(f"{flag}: give at least one value, got {text!r}")
+    return values
+
+
 def _shown(values):
-    """A flag's parsed value as typed: its values of a list apart by spaces."""
-    return " ".join(map(str, values)) if isinstance(values, list) else values
+    """A flag's parsed value as typed: a list's values apart by spaces, a tuple's by commas."""
+    if isinstance(values, (list, tuple)):
+        return (" " if isinstance(values, list) else ",").join(map(str, values))
+    return values
 
 
 def _tuple_kwargs(args):
@@ -134,9 +153,11 @@ def from_args(cls, args, **fixed):
     repeated = getattr(args, "_repeated", None)
     if repeated:
         raise InputError(repeated[0])
-    values = {f.name: getattr(args, f.name) for f in dataclasses.fields(cls)
-              if getattr(args, f.name, None) is not None}
-    values = {k: _tuples(v) for k, v in values.items()}
+    fields = {f.name: f for f in dataclasses.fields(cls)}
+    values = {name: getattr(args, name) for name in fields
+              if getattr(args, name, None) is not None}
+    values = {k: _comma_list(v, fields[k]) if fields[k].metadata.get("commas") else _tuples(v)
+              for k, v in values.items()}
     return cls(**{**values, **fixed})
 
 

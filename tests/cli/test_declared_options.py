@@ -113,3 +113,75 @@ def test_verify_help_states_default_and_range(capsys, test, phrases):
     text = help_text(capsys, ["verify", test])
     for phrase in phrases:
         assert phrase in text, text
+
+
+# ---------------------------------------------------------------- invert's grid options
+@pytest.mark.parametrize("values, words", [
+    (["--depths", "6,nan"], "--depths must be a finite number, got nan"),
+    (["--depths", "6,41"], "--depths 41 outside the allowed range (0, 40] km"),
+    (["--magnitudes", "4"], "--magnitudes 4 outside the allowed range [4.5, 7.5]"),
+    (["--distances", "0,5"], "--distances 0 outside the allowed range (0, 100] km"),
+    (["--azimuth-step", "nan"], "--azimuth-step must be a finite number"),
+    (["--members", "1001"], "--members 1001 outside the allowed range [0, 1000]"),
+    (["--fmax", "0.1"], "--fmax 0.1 outside the allowed range [0.5, 20] Hz"),
+    (["--duration", "inf"], "--duration must be a finite number"),
+    (["--radius", "101"], "--radius 101 outside the allowed range (0, 100] km"),
+    (["--step", "0"], "--step 0 outside the allowed range (0, inf] km"),
+    (["--strike-step", "-30"], "--strike-step -30 outside the allowed range (0, 360] deg"),
+    (["--gr-b", "nan"], "--gr-b must be a finite number"),
+    (["--depths", "6", "--depths", "12"], "--depths given more than once (6 and 12)"),
+    (["--radius", "10", "--radius", "20"], "--radius given more than once (10.0 and 20.0)"),
+    (["--grid", "demo", "--grid", "quick"], "--grid given more than once (demo and quick)"),
+    (["--mechanisms", "thrust", "--mechanisms", "normal"], "--mechanisms given more than once"),
+])
+def test_invert_grid_options_refused_before_any_work(tmp_path, capsys, monkeypatch, values,
+                                                     words):
+    from pipeline.inversion import EXAMPLES_DIR, workflows
+    monkeypatch.setattr(workflows, "invert_file", lambda *a, **k: pytest.fail("work started"))
+    out, forward = tmp_path / "out", tmp_path / "forward"
+    refused(capsys, ["invert", EXAMPLES_DIR / "two_sites.json", "--out", out, "--forward-dir",
+                     forward, *values], words, out)
+    assert not forward.exists()
+
+
+def test_invert_help_states_each_presets_value_and_the_range(capsys):
+    """An option left unset takes the preset's value: the help says each preset's (the
+    presets of docs/inversion.md) and the range."""
+    text = help_text(capsys, ["invert"])
+    for phrase in [
+            "--grid {demo,full,quick,study} forward-grid and candidates preset",
+            "unset: full; --quick: quick; --member-study: study",
+            "--depths KM,KM hypocentre depths (km); unset: the --grid preset's (full 6,12; "
+            "demo 10; study 10; quick 10); 0-40 (above 0)",
+            "--magnitudes MW,MW moment magnitudes; unset: the --grid preset's (full 6.5,7; "
+            "demo 6.5; study 6,7; quick 6.5); 4.5-7.5",
+            "(full 2.5,5,10,20,30; demo 2.5,5,10,20; study 2.5,5,10,20; quick 2.5,6); "
+            "0-100 (above 0)",
+            "(full 8; demo 6; study 64; quick 2); 0-1000",
+            "--seed SEED Latin-hypercube seed; unset: the --grid preset's (20091001 in each)",
+            "(full 30; demo 25; study 15; quick 12); 0-100 (above 0)",
+            "--step KM epicentre grid spacing (at most half the radius) (km); unset: the "
+            "--grid preset's (1 in each); above 0",
+            "(full 30; demo 30; study 30; quick 90); 0-360 (above 0)",
+            "--gr-b B Gutenberg-Richter prior on magnitude, 10^(-B M); unset: uniform; 0-3",
+            "rings 2.5,6 km every 90 deg, 2 members, 15 s motions to 5 Hz; candidates "
+            "within 12 km, strike every 90 deg"]:
+        assert phrase in text, phrase
+
+
+@pytest.mark.parametrize("argv, preset", [([], "full"), (["--quick"], "quick"),
+                                          (["--grid", "demo"], "demo")])
+def test_an_unset_grid_option_is_its_presets_value(argv, preset):
+    from pipeline.cli import build_parser
+    from pipeline.cli._fields import from_args
+    from pipeline.inversion.grid_options import GridOptions
+    from pipeline.inversion.presets import PRESETS
+    args = build_parser().parse_args(["invert", "obs.json", *argv])
+    assert from_args(GridOptions, args).grids() == (preset, PRESETS[preset].table,
+                                                     PRESETS[preset].candidates)
+    args = build_parser().parse_args(["invert", "obs.json", *argv, "--radius", "7",
+                                      "--depths", "8,4"])
+    _, table, candidates = from_args(GridOptions, args).grids()
+    assert table.depths_km == (4.0, 8.0) and candidates.radius_km == 7.0
+    assert candidates.step_km == PRESETS[preset].candidates.step_km
+    assert table.members == PRESETS[preset].table.members
