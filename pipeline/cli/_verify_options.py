@@ -63,12 +63,20 @@ class _Checked:
         check_fields(self)
 
 
+def _sized(block):
+    """A base of the options of a test of a block: its three sizes (m), their defaults
+    ``block``'s, their ranges Block's."""
+    return dataclasses.make_dataclass(
+        "_Block", [(k, float, _block(k, block)) for k in ("height", "width", "depth")],
+        bases=(_Checked,), frozen=True)
+
+
+_Marble, _Pulse, _MakrisRoussos = _sized(MARBLE_BLOCK), _sized(PULSE_BLOCK), _sized(MR_BLOCK)
+
+
 @dataclass(frozen=True)
-class HousnerOptions(_Checked):
+class HousnerOptions(_Marble):
     """Free rocking of a block released from a tilt (Housner 1963)."""
-    height: float = _block("height", MARBLE_BLOCK)
-    width: float = _block("width", MARBLE_BLOCK)
-    depth: float = _block("depth", MARBLE_BLOCK)
     theta0_ratio: float = param(0.5, "", "initial tilt over the critical angle, theta0 / alpha",
                                 0.0, 1.0, "--theta0-ratio", low_open=True, high_open=True)
     impacts: int = param(5, "", "impacts compared", 1, MAX_IMPACTS, "--impacts")
@@ -77,11 +85,8 @@ class HousnerOptions(_Checked):
 
 
 @dataclass(frozen=True)
-class SinePulseOptions(_Checked):
+class SinePulseOptions(_Pulse):
     """A block under a one-sine pulse (Zhang & Makris 2000)."""
-    height: float = _block("height", PULSE_BLOCK)
-    width: float = _block("width", PULSE_BLOCK)
-    depth: float = _block("depth", PULSE_BLOCK)
     amplitude_ratio: float = param(None, "", "pulse amplitude over alpha g, A / (alpha g)", 0.0,
                                    MAX_AMPLITUDE_RATIO, "--amplitude-ratio", low_open=True,
                                    required=True)
@@ -108,11 +113,8 @@ class SlidingOptions(_Checked):
 
 
 @dataclass(frozen=True)
-class OneCosineOptions(_Checked):
+class OneCosineOptions(_MakrisRoussos):
     """The smallest overturning amplitude under a one-cosine pulse (Makris & Roussos 2000)."""
-    height: float = _block("height", MR_BLOCK)
-    width: float = _block("width", MR_BLOCK)
-    depth: float = _block("depth", MR_BLOCK)
     period: float = _period()
     runs: int = _runs()
     kn: float = _kn(PAPER_KN)

@@ -1,11 +1,17 @@
-"""Options declared once (``param`` fields) of records, synthetics and verify: a value
-out of its range, not a number, or a flag given twice is refused in one line before any
-work, with nothing written; the help states each option's default (or what unset means)
-and its range, from the declaration."""
+"""Options declared once (``param`` fields) of records, synthetics, verify and invert's
+grid: a value out of its range, not a number, or a flag given twice is refused in one line
+before any work, with nothing written; the help states each option's default (or what
+unset means) and its range, from the declaration."""
 import pytest
 
 from pipeline import cli
 from tests.refusal import refused
+
+
+def cases(table):
+    """(argv, words) of each line ``ARGS | WORDS`` of a table of refusals."""
+    return [(args.split(), words) for args, words in
+            (line.split(" | ") for line in table.splitlines())]
 
 
 def help_text(capsys, argv):
@@ -25,12 +31,15 @@ def nothing_done(tmp_path, monkeypatch):
 
 
 # ---------------------------------------------------------------- records, synthetics
-@pytest.mark.parametrize("values, words", [
-    (["360"], "--back-azimuth 360 outside the allowed range [0, 360) deg"),
-    (["-0.5"], "--back-azimuth -0.5 outside the allowed range [0, 360) deg"),
-    (["nan"], "--back-azimuth must be a finite number, got nan"),
-    (["10", "--back-azimuth", "20"], "--back-azimuth given more than once (10.0 and 20.0)"),
-])
+BACK_AZIMUTH = """\
+360 | --back-azimuth 360 outside the allowed range [0, 360) deg
+-0.5 | --back-azimuth -0.5 outside the allowed range [0, 360) deg
+nan | --back-azimuth must be a finite number, got nan
+10 --back-azimuth 20 | --back-azimuth given more than once (10.0 and 20.0)
+"""
+
+
+@pytest.mark.parametrize("values, words", cases(BACK_AZIMUTH))
 def test_records_back_azimuth_refused_before_any_record(tmp_path, capsys, monkeypatch,
                                                         values, words):
     from pipeline.cli import records
@@ -39,11 +48,14 @@ def test_records_back_azimuth_refused_before_any_record(tmp_path, capsys, monkey
     refused(capsys, ["records", "GM20", "--out", out, "--back-azimuth", *values], words, out)
 
 
-@pytest.mark.parametrize("values, words", [
-    (["0.001"], "--step 0.001 outside the allowed range [0.01, 360] deg"),
-    (["inf"], "--step must be a finite number, got inf"),
-    (["30", "--step", "60"], "--step given more than once (30.0 and 60.0)"),
-])
+STEP = """\
+0.001 | --step 0.001 outside the allowed range [0.01, 360] deg
+inf | --step must be a finite number, got inf
+30 --step 60 | --step given more than once (30.0 and 60.0)
+"""
+
+
+@pytest.mark.parametrize("values, words", cases(STEP))
 def test_synthetics_step_refused_before_any_motion(tmp_path, capsys, monkeypatch, values,
                                                    words):
     from pipeline.cli import synthetics
@@ -62,28 +74,28 @@ def test_records_and_synthetics_help_state_default_and_range(capsys):
 
 
 # ---------------------------------------------------------------- verify
-@pytest.mark.parametrize("argv, words", [
-    (["housner", "--theta0-ratio", "1"], "--theta0-ratio 1 outside the allowed range (0, 1)"),
-    (["housner", "--impacts", "21"], "--impacts 21 outside the allowed range [1, 20]"),
-    (["housner", "--depth", "nan"], "--depth must be a finite number, got nan"),
-    (["housner", "--kn", "1e12"], "--kn 1e+12 outside the allowed range [100000, 1e+11] N/m"),
-    (["housner", "--width", "0.1", "--width", "0.2"], "--width given more than once"),
-    (["sine-pulse"], "give --amplitude-ratio"),
-    (["sine-pulse", "--amplitude-ratio", "0"], "--amplitude-ratio 0 outside the allowed range "
-     "(0, 50]"),
-    (["sine-pulse", "--amplitude-ratio", "6", "--omega-ratio", "nan"],
-     "--omega-ratio must be a finite number"),
-    (["sliding", "--theta0-deg", "90"], "--theta0-deg 90 outside the allowed range"),
-    (["sliding", "--mu-s", "0.1", "nan"], "--mu-s must be a finite number, got nan"),
-    (["sliding", "--mu-s", "0.1", "--mu-s", "0.2"], "--mu-s given more than once (0.1 and "
-     "0.2)"),
-    (["sliding", "--damping", "-0.1"], "--damping -0.1 outside the allowed range [0, 1]"),
-    (["one-cosine", "--runs", "21"], "--runs 21 outside the allowed range [3, 20]"),
-    (["one-cosine", "--period", "inf"], "--period must be a finite number"),
-    (["frame", "--gamma", "1001"], "--gamma 1001 outside the allowed range [0, 1000]"),
-    (["frame", "--columns", "1"], "--columns 1 outside the allowed range [2, inf]"),
-    (["frame", "--period", "1", "--period", "2"], "--period given more than once"),
-])
+VERIFY = """\
+housner --theta0-ratio 1 | --theta0-ratio 1 outside the allowed range (0, 1)
+housner --impacts 21 | --impacts 21 outside the allowed range [1, 20]
+housner --depth nan | --depth must be a finite number, got nan
+housner --kn 1e12 | --kn 1e+12 outside the allowed range [100000, 1e+11] N/m
+housner --width 0.1 --width 0.2 | --width given more than once
+sine-pulse | give --amplitude-ratio
+sine-pulse --amplitude-ratio 0 | --amplitude-ratio 0 outside the allowed range (0, 50]
+sine-pulse --amplitude-ratio 6 --omega-ratio nan | --omega-ratio must be a finite number
+sliding --theta0-deg 90 | --theta0-deg 90 outside the allowed range
+sliding --mu-s 0.1 nan | --mu-s must be a finite number, got nan
+sliding --mu-s 0.1 --mu-s 0.2 | --mu-s given more than once (0.1 and 0.2)
+sliding --damping -0.1 | --damping -0.1 outside the allowed range [0, 1]
+one-cosine --runs 21 | --runs 21 outside the allowed range [3, 20]
+one-cosine --period inf | --period must be a finite number
+frame --gamma 1001 | --gamma 1001 outside the allowed range [0, 1000]
+frame --columns 1 | --columns 1 outside the allowed range [2, inf]
+frame --period 1 --period 2 | --period given more than once
+"""
+
+
+@pytest.mark.parametrize("argv, words", cases(VERIFY))
 def test_verify_options_refused_before_any_run(nothing_done, capsys, argv, words):
     out = nothing_done / "out.json"
     refused(capsys, ["verify", *argv, "--out", out], words, out)
@@ -116,24 +128,27 @@ def test_verify_help_states_default_and_range(capsys, test, phrases):
 
 
 # ---------------------------------------------------------------- invert's grid options
-@pytest.mark.parametrize("values, words", [
-    (["--depths", "6,nan"], "--depths must be a finite number, got nan"),
-    (["--depths", "6,41"], "--depths 41 outside the allowed range (0, 40] km"),
-    (["--magnitudes", "4"], "--magnitudes 4 outside the allowed range [4.5, 7.5]"),
-    (["--distances", "0,5"], "--distances 0 outside the allowed range (0, 100] km"),
-    (["--azimuth-step", "nan"], "--azimuth-step must be a finite number"),
-    (["--members", "1001"], "--members 1001 outside the allowed range [0, 1000]"),
-    (["--fmax", "0.1"], "--fmax 0.1 outside the allowed range [0.5, 20] Hz"),
-    (["--duration", "inf"], "--duration must be a finite number"),
-    (["--radius", "101"], "--radius 101 outside the allowed range (0, 100] km"),
-    (["--step", "0"], "--step 0 outside the allowed range (0, inf] km"),
-    (["--strike-step", "-30"], "--strike-step -30 outside the allowed range (0, 360] deg"),
-    (["--gr-b", "nan"], "--gr-b must be a finite number"),
-    (["--depths", "6", "--depths", "12"], "--depths given more than once (6 and 12)"),
-    (["--radius", "10", "--radius", "20"], "--radius given more than once (10.0 and 20.0)"),
-    (["--grid", "demo", "--grid", "quick"], "--grid given more than once (demo and quick)"),
-    (["--mechanisms", "thrust", "--mechanisms", "normal"], "--mechanisms given more than once"),
-])
+INVERT = """\
+--depths 6,nan | --depths must be a finite number, got nan
+--depths 6,41 | --depths 41 outside the allowed range (0, 40] km
+--magnitudes 4 | --magnitudes 4 outside the allowed range [4.5, 7.5]
+--distances 0,5 | --distances 0 outside the allowed range (0, 100] km
+--azimuth-step nan | --azimuth-step must be a finite number
+--members 1001 | --members 1001 outside the allowed range [0, 1000]
+--fmax 0.1 | --fmax 0.1 outside the allowed range [0.5, 20] Hz
+--duration inf | --duration must be a finite number
+--radius 101 | --radius 101 outside the allowed range (0, 100] km
+--step 0 | --step 0 outside the allowed range (0, inf] km
+--strike-step -30 | --strike-step -30 outside the allowed range (0, 360] deg
+--gr-b nan | --gr-b must be a finite number
+--depths 6 --depths 12 | --depths given more than once (6 and 12)
+--radius 10 --radius 20 | --radius given more than once (10.0 and 20.0)
+--grid demo --grid quick | --grid given more than once (demo and quick)
+--mechanisms thrust --mechanisms normal | --mechanisms given more than once
+"""
+
+
+@pytest.mark.parametrize("values, words", cases(INVERT))
 def test_invert_grid_options_refused_before_any_work(tmp_path, capsys, monkeypatch, values,
                                                      words):
     from pipeline.inversion import EXAMPLES_DIR, workflows
