@@ -59,6 +59,8 @@ THETA0_DEG = tuple(math.degrees(_declared(Block, "theta0_rad")[k]) for k in ("lo
 
 
 class _Checked:
+    """Options checked against their declarations on creation."""
+
     def __post_init__(self):
         check_fields(self)
 
