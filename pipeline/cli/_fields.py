@@ -57,7 +57,8 @@ def add_arguments(parser, cls, names=None):
     """Add the flagged fields of parameter dataclass ``cls`` to an argparse parser (their
     defaults None: the dataclass decides).  Field types: int, float, str, Path; bool is a
     switch, tuple a flag that may be given several times (``tuple[float, ...]``: each
-    value of that type)."""
+    value of that type), or once with several values when declared :func:`several`, or
+    once with values apart by commas when its metadata says ``commas``."""
     for f in dataclasses.fields(cls):
         meta = f.metadata
         if not meta.get("flag") or (names is not None and f.name not in names):
@@ -72,6 +73,10 @@ def add_arguments(parser, cls, names=None):
         elif kind is bool:
             kwargs["action"] = "store_const"
             kwargs["const"] = True
+        elif meta.get("several"):
+            kwargs.update(nargs="+", type=typing.get_args(kind)[0], action=_Once)
+        elif meta.get("commas"):
+            kwargs.update(type=str, action=_Once)        # split by from_args
         elif kind is tuple or typing.get_origin(kind) is tuple:
             kwargs.update(_tuple_kwargs(typing.get_args(kind)))
         else:
@@ -79,6 +84,13 @@ def add_arguments(parser, cls, names=None):
         if "action" not in kwargs and "nargs" not in kwargs:
             kwargs["action"] = _Once
         parser.add_argument(meta["flag"], **kwargs)
+
+
+def several(declared):
+    """A ``tuple[float, ...]`` field declared by ``param`` as one flag followed by its
+    values (``--mu-s 0.3 0.2``), given once, rather than a flag given once per value."""
+    return dataclasses.field(default=declared.default,
+                             metadata={**declared.metadata, "several": True})
 
 
 class _Once(argparse.Action):
@@ -89,9 +101,30 @@ class _Once(argparse.Action):
         if getattr(namespace, self.dest, None) is not None:
             repeated = getattr(namespace, "_repeated", [])
             setattr(namespace, "_repeated", repeated + [
-                f"{option_string} given more than once ({getattr(namespace, self.dest)} "
-                f"and {values}); give it once"])
+                f"{option_string} given more than once ({_shown(getattr(namespace, self.dest))} "
+                f"and {_shown(values)}); give it once"])
         setattr(namespace, self.dest, values)
+
+
+def _comma_list(text, f):
+    """The values of field ``f`` (``tuple[kind, ...]``) from ``A,B,...``; InputError
+    naming its flag."""
+    kind, flag = typing.get_args(f.type)[0], f.metadata["flag"]
+    try:
+        values = tuple(kind(v.strip()) for v in text.split(",") if v.strip())
+    except ValueError:
+        raise InputError(f"{flag}: not a comma-separated list of {kind.__name__} values: "
+                         f"{text!r}") from None
+    if not values:
+        raise InputError(f"{flag}: give at least one value, got {text!r}")
+    return values
+
+
+def _shown(values):
+    """A flag's parsed value as typed: a list's values apart by spaces, a tuple's by commas."""
+    if isinstance(values, (list, tuple)):
+        return (" " if isinstance(values, list) else ",").join(map(str, values))
+    return values
 
 
 def _tuple_kwargs(args):
@@ -120,9 +153,11 @@ def from_args(cls, args, **fixed):
     repeated = getattr(args, "_repeated", None)
     if repeated:
         raise InputError(repeated[0])
-    values = {f.name: getattr(args, f.name) for f in dataclasses.fields(cls)
-              if getattr(args, f.name, None) is not None}
-    values = {k: _tuples(v) for k, v in values.items()}
+    fields = {f.name: f for f in dataclasses.fields(cls)}
+    values = {name: getattr(args, name) for name in fields
+              if getattr(args, name, None) is not None}
+    values = {k: _comma_list(v, fields[k]) if fields[k].metadata.get("commas") else _tuples(v)
+              for k, v in values.items()}
     return cls(**{**values, **fixed})
 
 

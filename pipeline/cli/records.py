@@ -6,6 +6,8 @@ from pathlib import Path
 import pandas as pd
 
 from pipeline import RESULTS_DIR, files
+from pipeline.cli._fields import add_arguments, from_args
+from pipeline.cli._record_options import RecordsOptions
 from pipeline.files import InputError, check_jobs, die_with_parent
 from pipeline.motion import Motion
 from pipeline.motion.measures import record_parameters
@@ -28,8 +30,7 @@ def setup(parser):
                         help="process every usable catalogued record (= --set all)")
     parser.add_argument("--set", dest="record_set", choices=sets.names(), default=None,
                         help="process a record set: " + ", ".join(sets.names()))
-    parser.add_argument("--back-azimuth", type=float, metavar="DEG",
-                        help="back azimuth (deg, [0, 360)) for files without coordinates")
+    add_arguments(parser, RecordsOptions)
     parser.add_argument("--out", type=Path, default=None,
                         help="output directory (default results/records)")
     parser.add_argument("--no-figures", action="store_true", help="skip the per-record figures")
@@ -52,14 +53,13 @@ def parameters_table(motions):
 
 
 def run(args):
+    back_azimuth = from_args(RecordsOptions, args).back_azimuth
     specs = sets.record_ids("all") if args.all else []
     if args.record_set:
         specs += [i for i in sets.record_ids(args.record_set) if i not in specs]
     specs += [spec for spec in args.records if spec not in specs]
     if not specs:
         raise InputError("name records (ids or files) or use --all or --set NAME")
-    if args.back_azimuth is not None and not 0.0 <= args.back_azimuth < 360.0:
-        raise InputError(f"--back-azimuth {args.back_azimuth:g} not in [0, 360)")
     jobs = check_jobs(args.jobs)
     out_dir = args.out if args.out is not None else DEFAULT_OUT
     if out_dir.exists() and not out_dir.is_dir():
@@ -69,7 +69,7 @@ def run(args):
     motions, seen = [], {}
     for spec in specs:
         source = resolve(spec)
-        key = None if source.processed else source.key(args.back_azimuth)
+        key = None if source.processed else source.key(back_azimuth)
         record_id = source.id
         if seen.get(record_id, key) != key:
             record_id = f"{record_id}-{key[:6]}"          # two inputs with one name
@@ -83,7 +83,7 @@ def run(args):
             motions.append((record_id, current, out_path, False))
             print(f"{record_id}: up to date", flush=True)
         else:
-            motions.append((record_id, _motion(spec, source, args.back_azimuth, key, out_dir),
+            motions.append((record_id, _motion(spec, source, back_azimuth, key, out_dir),
                             out_path, True))
             print(f"{record_id}: processed", flush=True)
 

@@ -1,11 +1,12 @@
 """``synthetics``: synthetic near-field motions (pyprop8) around two M 6.5 sources."""
 import time
 
+from pipeline.cli._fields import add_arguments, from_args
+from pipeline.cli._record_options import SyntheticsOptions
 from pipeline.files import LONG_RUN_S, InputError, check_jobs
 from pipeline.motion.synthetics import (AZIMUTH_STEP_DEG, GMM_VS30_M_S, QUICK_DURATION_S,
                                         QUICK_FMAX_HZ, RINGS_KM, SOURCES, generate_sources,
                                         source_parameters, write_gmm_summary)
-from pipeline.motion.synthetics.sites import MIN_AZIMUTH_STEP_DEG
 
 NAME = "synthetics"
 ORDER = 50
@@ -28,9 +29,7 @@ def setup(parser):
     parser.add_argument("--source", default="all", help=f"one of {', '.join(SOURCES)} or 'all'")
     parser.add_argument("--rings", default=",".join(f"{r:g}" for r in RINGS_KM),
                         help="ring radii in km (default %(default)s)")
-    parser.add_argument("--step", type=float, default=AZIMUTH_STEP_DEG,
-                        help=f"azimuth step between sites in degrees, "
-                        f"{MIN_AZIMUTH_STEP_DEG:g}-360 (default %(default)g)")
+    add_arguments(parser, SyntheticsOptions)
     parser.add_argument("--quick", action="store_true",
                         help=f"fmax {QUICK_FMAX_HZ:g} Hz, {QUICK_DURATION_S:g} s, "
                         "written to results/synthetics-quick")
@@ -47,16 +46,17 @@ def setup(parser):
 
 
 def run(args):
+    step = from_args(SyntheticsOptions, args).step
     jobs = check_jobs(args.jobs)
     names = list(SOURCES) if args.source == "all" else [args.source]
     for name in names:
         source_parameters(name)
     rings = _float_list(args.rings)
-    if args.ship and (args.quick or rings != RINGS_KM or args.step != AZIMUTH_STEP_DEG):
+    if args.ship and (args.quick or rings != RINGS_KM or step != AZIMUTH_STEP_DEG):
         raise InputError("--ship writes the displacements of the default settings only: "
                          "drop --quick, --rings and --step")
     started = time.monotonic()
-    generated = generate_sources(names, rings, args.step, quick=args.quick,
+    generated = generate_sources(names, rings, step, quick=args.quick,
                                  jobs=jobs, ship=args.ship, allow_long=args.allow_long)
     for name, paths in generated.items():
         print(f"{name}: {len(paths)} sites in {paths[0].parent}")

@@ -21,6 +21,9 @@ from scipy.special import logsumexp
 from pipeline.files import InputError
 from pipeline.inversion.observations import Observations, Site
 
+MAX_RADIUS_KM = 100.0    # candidates within this of a site at most
+MAX_GR_B = 3.0           # the Gutenberg-Richter prior's b value at most
+
 
 class OutOfReach(InputError):
     """No candidate epicentre lies within the forward table's reach of every site."""
@@ -38,8 +41,9 @@ class CandidateGrid:
     gr_b: float = None
 
     def __post_init__(self):
-        if not (0 < self.radius_km <= 100):
-            raise InputError(f"--radius must lie in (0, 100] km, got {self.radius_km:g}")
+        if not (0 < self.radius_km <= MAX_RADIUS_KM):
+            raise InputError(f"--radius must lie in (0, {MAX_RADIUS_KM:g}] km, got "
+                             f"{self.radius_km:g}")
         if not (0 < self.step_km <= self.radius_km / 2):
             raise InputError(f"--step must lie in (0, radius/2] km, got {self.step_km:g}")
         if (self.radius_km / self.step_km) > 400:
@@ -48,8 +52,8 @@ class CandidateGrid:
         n = 360.0 / self.strike_step_deg if self.strike_step_deg > 0 else 0
         if not (0 < self.strike_step_deg <= 360 and abs(n - round(n)) < 1e-9):
             raise InputError(f"--strike-step must divide 360, got {self.strike_step_deg:g}")
-        if self.gr_b is not None and not (0 <= self.gr_b <= 3):
-            raise InputError(f"--gr-b must lie in [0, 3], got {self.gr_b:g}")
+        if self.gr_b is not None and not (0 <= self.gr_b <= MAX_GR_B):
+            raise InputError(f"--gr-b must lie in [0, {MAX_GR_B:g}], got {self.gr_b:g}")
 
     @property
     def strikes_deg(self):

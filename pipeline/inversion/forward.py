@@ -36,7 +36,8 @@ from pipeline.scenario.parameters import param
 from pipeline.campaign.runs import column_specs, run_column_spec
 from pipeline.files import InputError, write_csv
 from pipeline.inversion.options import DEFAULT_FORWARD_DIR
-from pipeline.inversion.grid import GRIDS, TableGrid, node_positions, slice_motions
+from pipeline.inversion.grid import TableGrid, node_positions, slice_motions
+from pipeline.inversion.presets import GRIDS
 from pipeline.inversion.table import ForwardTable
 from pipeline.campaign.column_file import column_kn
 from pipeline.campaign.ensemble_members import nominal, sample_members

@@ -1,6 +1,7 @@
 """The forward table's grid: mechanisms, depths, magnitudes and the polar grid of sites
-around the epicentre (:class:`TableGrid`, presets ``GRIDS``), and the pyprop8 motions at
-its nodes (:func:`slice_motions`).  Symmetries and sources: :mod:`pipeline.inversion.forward`."""
+around the epicentre (:class:`TableGrid`; its presets in :mod:`pipeline.inversion.presets`),
+and the pyprop8 motions at its nodes (:func:`slice_motions`).  Symmetries and sources:
+:mod:`pipeline.inversion.forward`."""
 import dataclasses
 import json
 import logging
@@ -34,6 +35,15 @@ MECHANISMS = {
     "thrust": (40.0, 90.0),         # the paper's thrust source
     "normal": (50.0, -90.0),        # an Andersonian normal fault
 }
+
+# the forward grid's ranges (the invert options' too: pipeline.inversion.grid_options)
+DEPTH_KM = (0.0, 40.0)           # hypocentre depths, above 0
+MAGNITUDE = (4.5, 7.5)           # moment magnitudes
+DISTANCE_KM = (0.0, 100.0)       # the table's rings, above 0
+MAX_AZIMUTH_STEP_DEG = 180.0     # the table's azimuth step, which divides 360
+MEMBERS = (0, 1000)              # ensemble members per node
+FMAX_HZ = (0.5, 20.0)            # the synthetics' highest frequency
+DURATION_S = (5.0, 120.0)        # the synthetics' duration
 
 
 def parse_mechanisms(text):
@@ -95,23 +105,31 @@ class TableGrid:
                 raise InputError(f"forward grid: {name} must be distinct finite numbers, "
                                  f"got {getattr(self, name)}")
             object.__setattr__(self, name, values)
-        if min(self.depths_km) <= 0 or max(self.depths_km) > 40:
-            raise InputError(f"--depths must lie in (0, 40] km, got {self.depths_km}")
-        if min(self.magnitudes) < 4.5 or max(self.magnitudes) > 7.5:
-            raise InputError(f"--magnitudes must lie in [4.5, 7.5], got {self.magnitudes}")
-        if min(self.distances_km) <= 0 or max(self.distances_km) > 100:
-            raise InputError(f"--distances must lie in (0, 100] km, got {self.distances_km}")
+        if min(self.depths_km) <= DEPTH_KM[0] or max(self.depths_km) > DEPTH_KM[1]:
+            raise InputError(f"--depths must lie in ({DEPTH_KM[0]:g}, {DEPTH_KM[1]:g}] km, "
+                             f"got {self.depths_km}")
+        if min(self.magnitudes) < MAGNITUDE[0] or max(self.magnitudes) > MAGNITUDE[1]:
+            raise InputError(f"--magnitudes must lie in [{MAGNITUDE[0]:g}, {MAGNITUDE[1]:g}], "
+                             f"got {self.magnitudes}")
+        if min(self.distances_km) <= DISTANCE_KM[0] or max(self.distances_km) > DISTANCE_KM[1]:
+            raise InputError(f"--distances must lie in ({DISTANCE_KM[0]:g}, "
+                             f"{DISTANCE_KM[1]:g}] km, got {self.distances_km}")
         step = float(self.azimuth_step_deg)
-        if not (0 < step <= 180 and abs(360.0 / step - round(360.0 / step)) < 1e-9):
-            raise InputError(f"--azimuth-step must divide 360 (<= 180), got {step:g}")
-        if not (isinstance(self.members, int) and 0 <= self.members <= 1000):
-            raise InputError(f"--members must be an integer in [0, 1000], got {self.members!r}")
+        if not (0 < step <= MAX_AZIMUTH_STEP_DEG and
+                abs(360.0 / step - round(360.0 / step)) < 1e-9):
+            raise InputError(f"--azimuth-step must divide 360 (<= {MAX_AZIMUTH_STEP_DEG:g}), "
+                             f"got {step:g}")
+        if not (isinstance(self.members, int) and MEMBERS[0] <= self.members <= MEMBERS[1]):
+            raise InputError(f"--members must be an integer in [{MEMBERS[0]}, {MEMBERS[1]}], "
+                             f"got {self.members!r}")
         if self.members == 0 and not self.nominal:
             raise InputError("a forward table needs members or the nominal run")
-        if not (0.5 <= self.fmax_hz <= 20 and 5 <= self.duration_s <= 120
+        if not (FMAX_HZ[0] <= self.fmax_hz <= FMAX_HZ[1]
+                and DURATION_S[0] <= self.duration_s <= DURATION_S[1]
                 and 0 <= self.tail_s <= 60):
-            raise InputError(f"forward grid: fmax {self.fmax_hz:g} Hz (0.5-20), duration "
-                             f"{self.duration_s:g} s (5-120), tail {self.tail_s:g} s (0-60)")
+            raise InputError(f"forward grid: fmax {self.fmax_hz:g} Hz ({FMAX_HZ[0]:g}-"
+                             f"{FMAX_HZ[1]:g}), duration {self.duration_s:g} s ({DURATION_S[0]:g}"
+                             f"-{DURATION_S[1]:g}), tail {self.tail_s:g} s (0-60)")
 
     @property
     def azimuths_deg(self):
@@ -143,23 +161,6 @@ class TableGrid:
 
     def replace(self, **changes):
         return dataclasses.replace(self, **{k: v for k, v in changes.items() if v is not None})
-
-
-# Grid presets.  quick: a smoke run of a few minutes; demo: what `make invert-demo` runs on
-# a 2-core machine (~700 runs); full: the default of `invert`.
-GRIDS = {
-    "quick": TableGrid(distances_km=(2.5, 6.0), azimuth_step_deg=90.0, members=2,
-                       nominal=False, fmax_hz=5.0, duration_s=15.0, tail_s=3.0),
-    "demo": TableGrid(members=6),
-    # the member study (invert --member-study): one mechanism, two magnitudes, 64 members
-    # per node (48 for the likelihoods, 16 observed), rings to 20 km: 3,072 runs
-    "study": TableGrid(mechanisms=("strike-slip",), magnitudes=(6.0, 7.0),
-                       distances_km=(2.5, 5.0, 10.0, 20.0), azimuth_step_deg=60.0, members=64,
-                       nominal=False),
-    "full": TableGrid(mechanisms=("strike-slip", "thrust", "normal"), depths_km=(6.0, 12.0),
-                      magnitudes=(6.5, 7.0), distances_km=(2.5, 5.0, 10.0, 20.0, 30.0),
-                      members=8),
-}
 
 
 # ---------------------------------------------------------------- motions (pyprop8)

@@ -1,7 +1,8 @@
 """The ``invert`` command's options, declared as :func:`~pipeline.scenario.parameters.param`
-fields (the command builds their flags from them): the workflows' and the site motion's,
-and the candidate grids' presets (km, deg); checked on creation, before any work.  Light: the command imports it at
-start-up, the workflows (:mod:`pipeline.inversion.workflows`) only when it runs."""
+fields (the command builds their flags from them): the workflows' and the site motion's
+(the grids' in :mod:`pipeline.inversion.grid_options`); checked on creation, before any
+work.  Light: the command imports it at start-up, the workflows
+(:mod:`pipeline.inversion.workflows`) only when it runs."""
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -92,8 +93,3 @@ class SiteMotionOptions:
         if not surface and self.at_pgv_pga is not None:
             raise InputError("--at-pgv-pga goes with --site-fragility-form pga-pgv")
 
-
-CANDIDATE_PRESETS = {"quick": {"radius_km": 12.0, "step_km": 1.0, "strike_step_deg": 90.0},
-                     "study": {"radius_km": 15.0, "step_km": 1.0, "strike_step_deg": 30.0},
-                     "demo": {"radius_km": 25.0, "step_km": 1.0, "strike_step_deg": 30.0},
-                     "full": {"radius_km": 30.0, "step_km": 1.0, "strike_step_deg": 30.0}}

@@ -7,7 +7,7 @@ import pandas as pd
 from pipeline.report.common import _figure, _fmt, _pct, _table
 from pipeline.inversion.demo import (BOUND_ANSWER_KEY, BOUND_DEG, BOUND_TEXT,
                                      BOUNDED_FRACTION_KEY, SITES_WITHIN_KEY)
-from pipeline.inversion.grid import GRIDS
+from pipeline.inversion.presets import GRIDS
 from pipeline.simulate import run_code_version
 
 

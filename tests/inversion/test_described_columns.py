@@ -11,7 +11,8 @@ from pipeline import cli
 from pipeline.campaign.column_file import column_kn, description
 from pipeline.files import InputError, write_json
 from pipeline.inversion.forward import ForwardTags, member_parameters, table_path
-from pipeline.inversion.grid import GRIDS, TableGrid, node_positions
+from pipeline.inversion.grid import TableGrid, node_positions
+from pipeline.inversion.presets import GRIDS
 from pipeline.inversion.table import ForwardTable
 from pipeline.scenario import RunParams
 

@@ -8,7 +8,8 @@ from pipeline.campaign.spec import RunSpec
 from pipeline.outcome.summary import RunSummary
 from pipeline.files import InputError
 from pipeline.inversion.forward import ForwardTags, member_parameters
-from pipeline.inversion.grid import GRIDS, TableGrid, node_positions, subevent_layout
+from pipeline.inversion.grid import TableGrid, node_positions, subevent_layout
+from pipeline.inversion.presets import GRIDS
 from pipeline.inversion.table import ForwardTable
 from pipeline.motion.synthetics import SOURCES, subevents
 from pipeline.scenario import RunParams

@@ -142,7 +142,7 @@ def test_missing_file_and_option_errors(tmp_path, capsys):
     good = tmp_path / "good.json"
     good.write_text(json.dumps({"sites": [GOOD_SITE]}))
     for argv, message in (([], "give one of an OBSERVATIONS.json file, --demo"),
-                          (["--radius", "-3"], "--radius must lie in"),
+                          (["--radius", "-3"], "--radius -3 outside the allowed range (0, 100] km"),
                           (["--quick", "--grid", "full"], "--quick is --grid quick"),
                           (["--azimuth-step", "7"], "--azimuth-step must divide 360"),
                           (["--mechanisms", "oblique"], "unknown mechanism"),

@@ -5,7 +5,7 @@ from pathlib import Path
 
 import numpy as np
 
-from pipeline.inversion.grid import GRIDS
+from pipeline.inversion.presets import GRIDS
 from pipeline.inversion.table import ForwardTable
 
 SHIPPED = Path(__file__).resolve().parents[2] / "records" / "inversion" / "forward_table_study.npz"
