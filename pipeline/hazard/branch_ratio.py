@@ -134,6 +134,7 @@ def mrd_ratios(joint, site, tree):
     ids = realisation_ids(tree)
     count = joint.realisations
     route = "rate density of PGA and PGV (mrd) " + str(joint.source.get("file"))
+    _check_same_place(joint.site(site), tree)
     if count and ids is not None and all(k < count for k in ids):
         return BranchRatios(tuple(ratio_from_mrd(joint, site, k) for k in ids),
                             tuple(np.array([b]) for b in range(tree.size)), True,
@@ -149,6 +150,23 @@ def mrd_ratios(joint, site, tree):
                f"realisations' (0-{count - 1}), the tree's branches go to {max(ids)}")
     return BranchRatios((ratio_from_mrd(joint, site),), (np.arange(tree.size),), False,
                         why, route)
+
+
+SAME_PLACE_DEG = 1e-3    # a rate density's site and the curves' agree within this (deg)
+
+
+def _check_same_place(joint, tree):
+    """InputError when ``tree``'s curves state a place (an OpenQuake export) and the one
+    site of ``joint`` lies elsewhere: another calculation's rate density."""
+    lon, lat = tree.source.get("lon"), tree.source.get("lat")
+    if lon is None or lat is None:
+        return                                  # a plain table states no place
+    (at_lon, at_lat), = joint.sites
+    if abs((at_lon - lon + 180.0) % 360.0 - 180.0) > SAME_PLACE_DEG or \
+            abs(at_lat - lat) > SAME_PLACE_DEG:
+        raise InputError(f"{joint.source.get('file')}: site {joint.source['site_index']} "
+                         f"lies at ({at_lon:g}, {at_lat:g}), the logic tree's curves at "
+                         f"({lon:g}, {lat:g}): a rate density of another place")
 
 
 def rates_by_ratio(cells, levels_m_s2, rates_per_yr, ratio_model, probability_of):
