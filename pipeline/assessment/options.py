@@ -25,6 +25,7 @@ from pipeline.hazard.fragility.kinds import BETA_RANGE, MEDIAN_G_RANGE
 from pipeline.hazard.fragility.load import FRAGILITY_FORMS
 from pipeline.hazard.fragility.ratio import DEFAULT_VS30_M_S, PGA_PGV_CORRELATION
 from pipeline.hazard.pga_pgv_correlation import BRADLEY_2012
+from pipeline.hazard.same_place import check_same_place
 from pipeline.hazard.site_motion import PGV_PGA_RANGE_S
 from pipeline.records import rotd50_fraction
 from pipeline.scenario.parameters import check_fields, param
@@ -319,6 +320,8 @@ class SurvivalOptions(SpecimenOptions):
         (:class:`~pipeline.hazard.disagg_ratio.RatioMixture`), its bins first checked to
         add up to ``curve``'s rate at each level."""
         disaggregation = load_mag_dist(self.disaggregation)
+        check_same_place(str(self.disaggregation), disaggregation.site, curve.source,
+                         "the hazard curve")
         disaggregation.check_curve(self.disaggregation_column, curve)
         return ratio_mixture(disaggregation, self.disaggregation_column, self.vs30,
                              self.mechanism, self.pga_pgv_correlation)

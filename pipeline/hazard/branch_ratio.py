@@ -14,6 +14,7 @@ from pipeline.hazard.constrain import branch_rates
 from pipeline.hazard.constrain_parts import SitesRatio
 from pipeline.hazard.disagg_ratio import ratio_mixture
 from pipeline.hazard.mrd_ratio import ratio_from_mrd
+from pipeline.hazard.same_place import check_same_place
 
 MEAN = "mean"
 
@@ -89,6 +90,8 @@ def disaggregation_ratios(disaggregation, tree, column, vs30_m_s, mechanism, cor
     else the mean; a column named: that one for every branch.  Each column's bins are
     checked to add up to its curve: a branch's own curve, the mean over branches for
     "mean", realisation K's for rlzK."""
+    check_same_place(str(disaggregation.source.get("file")), disaggregation.site,
+                     tree.source, "the logic tree's curves")
     ids = realisation_ids(tree)
     own = None if ids is None else [f"rlz{k}" for k in ids]
     route = "magnitude-distance disaggregation " + str(disaggregation.source.get("file"))
@@ -134,7 +137,8 @@ def mrd_ratios(joint, site, tree):
     ids = realisation_ids(tree)
     count = joint.realisations
     route = "rate density of PGA and PGV (mrd) " + str(joint.source.get("file"))
-    _check_same_place(joint.site(site), tree)
+    check_same_place(f"{joint.source.get('file')}: site {site}", joint.site(site).sites[0],
+                     tree.source, "the logic tree's curves")
     if count and ids is not None and all(k < count for k in ids):
         return BranchRatios(tuple(ratio_from_mrd(joint, site, k) for k in ids),
                             tuple(np.array([b]) for b in range(tree.size)), True,
@@ -150,23 +154,6 @@ def mrd_ratios(joint, site, tree):
                f"realisations' (0-{count - 1}), the tree's branches go to {max(ids)}")
     return BranchRatios((ratio_from_mrd(joint, site),), (np.arange(tree.size),), False,
                         why, route)
-
-
-SAME_PLACE_DEG = 1e-3    # a rate density's site and the curves' agree within this (deg)
-
-
-def _check_same_place(joint, tree):
-    """InputError when ``tree``'s curves state a place (an OpenQuake export) and the one
-    site of ``joint`` lies elsewhere: another calculation's rate density."""
-    lon, lat = tree.source.get("lon"), tree.source.get("lat")
-    if lon is None or lat is None:
-        return                                  # a plain table states no place
-    (at_lon, at_lat), = joint.sites
-    if abs((at_lon - lon + 180.0) % 360.0 - 180.0) > SAME_PLACE_DEG or \
-            abs(at_lat - lat) > SAME_PLACE_DEG:
-        raise InputError(f"{joint.source.get('file')}: site {joint.source['site_index']} "
-                         f"lies at ({at_lon:g}, {at_lat:g}), the logic tree's curves at "
-                         f"({lon:g}, {lat:g}): a rate density of another place")
 
 
 def rates_by_ratio(cells, levels_m_s2, rates_per_yr, ratio_model, probability_of):

@@ -79,3 +79,20 @@ def test_a_rate_density_of_another_place_is_one_line(tmp_path, capsys):
     assert main(["constrain", "--logic-tree", str(CASE), "--joint-hazard", MRD,
                  "--logistic=-2,3,1", "--draws", "0", "--age-ka", "10", "--out",
                  str(tmp_path / "same")]) == 0
+
+
+CASE_19 = RECORDS_DIR / "hazard" / "openquake_logictree_case_19"
+
+
+@pytest.mark.parametrize("argv", [
+    ["survival", "--hazard", str(CASE / "hazard_curve-mean-PGA_6.csv"), "--disaggregation",
+     str(CASE_19 / "disaggregation" / "Mag_Dist-mean-0_16.csv")],
+    ["constrain", "--logic-tree", str(CASE_19), "--disaggregation",
+     str(CASE / "disaggregation" / "Mag_Dist-0_7.csv")],
+])
+def test_a_disaggregation_of_another_place_is_one_line(tmp_path, capsys, argv):
+    """The mrd case's site (11.202, 42.424) and case 19's (16.2657, 39.3002), each stated
+    by its curves and its disaggregation."""
+    said = _refused(tmp_path, capsys, [*argv, "--logistic=-2,3,1", "--draws", "0",
+                                       "--age-ka", "10"])
+    assert "of another place" in said and "42.424" in said and "39.3002" in said
