@@ -98,6 +98,7 @@ class ConstrainOptions(SpecimenOptions):
         if self.age_ka:
             _per_specimen(self.age_sd_ka, n, "--age-sd-ka")
         self._check_route(self.specimen_sites())
+        self.check_model_flags()
         _check_out(self.out)
 
     def _check_route(self, sites):

@@ -13,6 +13,7 @@ from pipeline import RESULTS_DIR
 from pipeline.constants import STANDARD_GRAVITY
 from pipeline.files import InputError
 from pipeline.assessment.age_options import age_kinds, check_age_kinds
+from pipeline.assessment.distinct_files import distinct_files
 from pipeline.assessment.state_options import parse_state_lognormal
 from pipeline.hazard.ages import LowerBound, TruncatedNormal, UniformInterval, load_age_samples
 from pipeline.hazard.fragility.components import COMPONENTS
@@ -24,6 +25,7 @@ from pipeline.hazard.fragility.kinds import BETA_RANGE, MEDIAN_G_RANGE
 from pipeline.hazard.fragility.load import FRAGILITY_FORMS
 from pipeline.hazard.fragility.ratio import DEFAULT_VS30_M_S, PGA_PGV_CORRELATION
 from pipeline.hazard.pga_pgv_correlation import BRADLEY_2012
+from pipeline.hazard.same_place import check_same_place
 from pipeline.hazard.site_motion import PGV_PGA_RANGE_S
 from pipeline.records import rotd50_fraction
 from pipeline.scenario.parameters import check_fields, param
@@ -34,6 +36,8 @@ CONSTRAIN_OUT = RESULTS_DIR / "constrain"
 MAX_SPECIMENS = 20
 MAX_AGE_KA = 10000.0
 KA = 1000.0                 # years in a thousand years
+MODEL_FLAGS = (("--vs30", "vs30"), ("--mechanism", "mechanism"),
+               ("--pga-pgv-correlation", "pga_pgv_correlation"))   # the model's inputs
 AGE_FLAGS = ("age_ka", "age_sd_ka", "age_min_ka", "age_range_ka", "age_samples",
              "age_column")
 
@@ -124,7 +128,7 @@ class SpecimenOptions:
         if not self.median_g and not self.fragility and not self.logistic:
             raise InputError("no fragility: give --median-g and --beta, --logistic or "
                              "--fragility")
-        _distinct_files(self.fragility, "--fragility", "specimen", "fragility.json")
+        distinct_files(self.fragility, "--fragility", "specimen", "fragility.json")
         self._check_ratio()
 
     def _check_ratio(self):
@@ -137,10 +141,16 @@ class SpecimenOptions:
             raise InputError("give both --pgv-pga-median and --pgv-pga-sigma")
         if any(v is not None for v in modelled) and None in modelled:
             raise InputError("give both --magnitude and --distance-km")
-        if self.magnitude is None and getattr(self, "disaggregation", None) is None and \
-                self.pga_pgv_correlation != _default("pga_pgv_correlation"):
-            raise InputError("--pga-pgv-correlation applies with --magnitude and "
-                             "--distance-km")
+
+    def check_model_flags(self):
+        """--vs30, --mechanism and --pga-pgv-correlation refused where no ground-motion
+        model gives PGV/PGA (only --magnitude/--distance-km and --disaggregation use one)."""
+        if self.magnitude is not None or getattr(self, "disaggregation", None) is not None:
+            return
+        for flag, name in MODEL_FLAGS:
+            if getattr(self, name) != _default(name):
+                raise InputError(f"{flag} applies with --magnitude/--distance-km or "
+                                 "--disaggregation (the ground-motion model's PGV/PGA)")
 
     @property
     def specimen_count(self):
@@ -262,11 +272,12 @@ class SurvivalOptions(SpecimenOptions):
         check_age_kinds(self, given)
         self._check_observations()
         self.check_specimens()
-        _distinct_files(self.hazard, "--hazard", "curve")
+        distinct_files(self.hazard, "--hazard", "curve")
         if self.observations is not None and self.column is not None:
             raise InputError("--column does not apply with --observations (each column's own "
                              "type is read from the file)")
         _check_column_site(self)
+        self.check_model_flags()
         _check_out(self.out)
 
     def _check_joint(self):
@@ -309,6 +320,8 @@ class SurvivalOptions(SpecimenOptions):
         (:class:`~pipeline.hazard.disagg_ratio.RatioMixture`), its bins first checked to
         add up to ``curve``'s rate at each level."""
         disaggregation = load_mag_dist(self.disaggregation)
+        check_same_place(str(self.disaggregation), disaggregation.site, curve.source,
+                         "the hazard curve")
         disaggregation.check_curve(self.disaggregation_column, curve)
         return ratio_mixture(disaggregation, self.disaggregation_column, self.vs30,
                              self.mechanism, self.pga_pgv_correlation)
@@ -369,24 +382,6 @@ def _per_specimen(values, n, flag):
         raise InputError(f"give one {flag} per specimen ({n}) or one for all, got "
                          f"{len(values)}")
     return list(values)
-
-
-def _distinct_files(paths: tuple[Path, ...], flag: str, what: str,
-                   inside: str | None = None) -> None:
-    """Refuse one file named twice by ``flag`` (as a file or, with ``inside``, its
-    directory; by another path or a link): one ``what`` is not two."""
-    seen = {}
-    for path in paths:
-        file = path / inside if inside is not None and path.is_dir() else path
-        try:
-            stat = file.stat()
-            key = (stat.st_dev, stat.st_ino)
-        except OSError:
-            key = file.resolve()
-        if key in seen:
-            raise InputError(f"{flag} {path} and {seen[key]} are one file: the same {what} "
-                             "twice (a set needs distinct ones)")
-        seen[key] = path
 
 
 def parse_logistic(text):

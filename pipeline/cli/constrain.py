@@ -15,6 +15,7 @@ from pipeline.assessment.constrain import constrain_files
 from pipeline.files import display_path
 from pipeline.assessment.constrain_options import ConstrainOptions
 from pipeline.assessment.options import AGE_FLAGS
+from pipeline.hazard.constrain_parts import SitesRatio
 
 NAME = "constrain"
 ORDER = 46
@@ -64,6 +65,11 @@ def _print(summary, out):
         print(f"warning: {line}")
     print(f"{summary.branch_count} branches, {summary.specimen_count} specimen(s); "
           f"rule {summary.rule}")
+    ratio = summary.pgv_pga
+    if isinstance(ratio, SitesRatio):
+        print(f"PGV/PGA: {ratio.source} (sites "
+              f"{', '.join(str(s) for s in ratio.site_indices)}), each site's in "
+              "constrain.json sites[].pgv_pga")
     for row in summary.ground_motion_at_rates:
         if row.curve not in ("mean", "range 0.05-0.95"):
             continue

@@ -11,8 +11,10 @@ import numpy as np
 
 from pipeline.files import InputError
 from pipeline.hazard.constrain import branch_rates
+from pipeline.hazard.constrain_parts import SitesRatio
 from pipeline.hazard.disagg_ratio import ratio_mixture
 from pipeline.hazard.mrd_ratio import ratio_from_mrd
+from pipeline.hazard.same_place import check_same_place
 
 MEAN = "mean"
 
@@ -46,6 +48,35 @@ class BranchRatios:
                            for m, rows in zip(self.models, self.rows)]}
 
 
+EACH_SITE = ("each site's specimens take PGV/PGA from the rate density at their own site "
+             "(the file's site index), as sites[].pgv_pga describes it: no one site's "
+             "rate density holds for every specimen")
+
+
+def ratio_described(ratio_model, site_models):
+    """constrain.json's ``pgv_pga``: ``ratio_model``'s description (None: null), or where
+    the specimens stand at two sites or more each with its own model (``site_models``,
+    {site: :class:`BranchRatios`, or None where a site takes ``ratio_model``}) the route
+    and that each site takes its own (:func:`sites_ratio`)."""
+    own = {s: m for s, m in site_models.items() if m is not None}
+    if len(site_models) > 1 and own:
+        return sites_ratio(own)
+    return None if ratio_model is None else ratio_model.describe()
+
+
+def sites_ratio(models):
+    """constrain.json's ``pgv_pga`` (a :class:`~pipeline.hazard.constrain_parts.
+    SitesRatio`) for ``models`` ({site: :class:`BranchRatios`}, two sites or more, each
+    the rate density at its own site)."""
+    first = next(iter(models.values()))
+    why = {m.why for m in models.values()}
+    return SitesRatio(
+        source="rate density of PGA and PGV (mrd) at each specimen's site",
+        file=first.describe().get("file"), per_site=True, site_indices=list(models),
+        sites=EACH_SITE, per_branch=all(m.per_branch for m in models.values()),
+        branches=why.pop() if len(why) == 1 else "as each site's (sites[].pgv_pga)")
+
+
 def realisation_ids(tree):
     """Each branch's realisation number (int), or None when a branch id is no number."""
     ids = [str(b) for b in tree.branch_ids]
@@ -59,6 +90,8 @@ def disaggregation_ratios(disaggregation, tree, column, vs30_m_s, mechanism, cor
     else the mean; a column named: that one for every branch.  Each column's bins are
     checked to add up to its curve: a branch's own curve, the mean over branches for
     "mean", realisation K's for rlzK."""
+    check_same_place(str(disaggregation.source.get("file")), disaggregation.site,
+                     tree.source, "the logic tree's curves")
     ids = realisation_ids(tree)
     own = None if ids is None else [f"rlz{k}" for k in ids]
     route = "magnitude-distance disaggregation " + str(disaggregation.source.get("file"))
@@ -104,6 +137,8 @@ def mrd_ratios(joint, site, tree):
     ids = realisation_ids(tree)
     count = joint.realisations
     route = "rate density of PGA and PGV (mrd) " + str(joint.source.get("file"))
+    check_same_place(f"{joint.source.get('file')}: site {site}", joint.site(site).sites[0],
+                     tree.source, "the logic tree's curves")
     if count and ids is not None and all(k < count for k in ids):
         return BranchRatios(tuple(ratio_from_mrd(joint, site, k) for k in ids),
                             tuple(np.array([b]) for b in range(tree.size)), True,

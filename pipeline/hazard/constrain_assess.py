@@ -7,7 +7,7 @@ import numpy as np
 from threadpoolctl import threadpool_limits
 
 from pipeline.constants import STANDARD_GRAVITY
-from pipeline.hazard.branch_ratio import rates_by_ratio
+from pipeline.hazard.branch_ratio import rates_by_ratio, ratio_described
 from pipeline.hazard.constrain import (FRACTILES, TARGET_RATES, bayes, cell_matrix,
                                        change_percent, draw_chunk, eliminate,
                                        log_survival_fixed, log_survival_sampled,
@@ -121,7 +121,7 @@ def constrain_tree(tree, specimens, ratio_model, ages, rule, floor, draws, seed,
         hazard=TreeHazard(source=dict(tree.source), notes=list(tree.notes),
                           interpolation="linear in (ln PGA, ln rate)",
                           cells_per_interval=cells[2]),
-        pgv_pga=None if ratio_model is None else ratio_model.describe(),
+        pgv_pga=ratio_described(ratio_model, {g.site: g.ratio_model for g in groups}),
         warnings=warnings,
         assumptions=ASSUMPTIONS + ([SITE_ASSUMPTION] if len(groups) > 1 else []),
         draws=draws, seed=seed, software=software_versions())

@@ -54,6 +54,10 @@ def bin_shares(anchors, shares, pga_m_s2):
     return shares[np.clip(k, 0, len(anchors) - 1)]
 
 
+MODEL_KEYS = ("model", "vs30_m_s", "mechanism", "pga_pgv_correlation",
+              "pga_pgv_correlation_source")      # the bins' model, as each bin states it
+
+
 @dataclass(frozen=True)
 class RatioMixture:
     """PGV/PGA at each PGA level as a mixture over disaggregation bins: ``anchors``
@@ -64,10 +68,14 @@ class RatioMixture:
     models: tuple
 
     def describe(self):
-        used = [(m.magnitude, m.distance_km) for m in self.models if m is not None]
+        used = [m for m in self.models if m is not None]
+        model = {k: v for k, v in used[0].describe().items() if k in MODEL_KEYS} if used \
+            else {}
         return {"source": "magnitude-distance disaggregation", "bins_used": len(used),
-                "bins": used, "anchors_m_s2": self.anchors.tolist(),
-                "shares": "between disaggregated levels: the events falling between them"}
+                "bins": [(m.magnitude, m.distance_km) for m in used],
+                "anchors_m_s2": self.anchors.tolist(),
+                "shares": "between disaggregated levels: the events falling between them",
+                **model}
 
 
 def ratio_mixture(disaggregation, column="mean", vs30_m_s=DEFAULT_VS30_M_S, mechanism="SS",

@@ -40,3 +40,13 @@ BRADLEY_2012 = NamedCorrelation(
     "predicted: Bradley (2012), Earthq. Spectra 28(1) 17-35, PGV with SA(T < 0.01 s); "
     "OpenQuake Bradley2012")
 BY_NAME = {c.name: c for c in (BAKER_BRADLEY_2017, BRADLEY_2012)}
+
+
+def correlation_source(value):
+    """Where the correlation ``value`` comes from, in words: a named correlation's source,
+    or that neither gives it (the user's own)."""
+    named = [c for c in BY_NAME.values() if c.value == value]
+    if named:
+        return named[0].source
+    return (f"given: neither {BAKER_BRADLEY_2017.value:g} (observed, Baker & Bradley 2017) "
+            f"nor {BRADLEY_2012.value:g} (predicted, Bradley 2012)")

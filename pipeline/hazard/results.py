@@ -11,7 +11,7 @@ from pathlib import Path
 
 from pipeline.files import InputError, result_json_text
 from pipeline.hazard.constrain_parts import (CONSTRAIN_PARTS, CurveStatistics, Members,
-                                             MonteCarlo)
+                                             MonteCarlo, SitesRatio)
 from pipeline.hazard.ages import AgeDescription
 from pipeline.hazard.constrain_sites import BranchTest
 from pipeline.hazard.hazard_described import (CurveHazard, JointHazardDescribed, TreeHazard,
@@ -111,7 +111,8 @@ class ConstrainResult(_ResultFile):
     rule, ``posterior_bayes`` or ``posterior_eliminate`` under the other), the ground
     motion at the stated rates, the members' and draws' spread, the branch test
     (:class:`~pipeline.hazard.constrain_sites.BranchTest`), the hazard and the PGV/PGA
-    model as described, warnings, assumptions, draws and seed, software, and the files
+    model as described (a :class:`~pipeline.hazard.constrain_parts.SitesRatio` where each
+    site takes its own), warnings, assumptions, draws and seed, software, and the files
     of the set (the parts' types in :mod:`pipeline.hazard.constrain_parts`)."""
     rule: str
     headline: str
@@ -134,7 +135,7 @@ class ConstrainResult(_ResultFile):
     sites: list
     branch_test: BranchTest
     hazard: TreeHazard
-    pgv_pga: dict | None
+    pgv_pga: dict | SitesRatio | None
     warnings: list
     assumptions: list
     draws: int

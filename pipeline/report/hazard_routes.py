@@ -7,6 +7,7 @@ disaggregation and (c) the PGA curve with PGV given PGA from one scenario
 holds it, the mean's otherwise: the table says which."""
 import pandas as pd
 
+from pipeline.hazard.constrain_parts import SitesRatio
 from pipeline.hazard.results import read_constrain_result, read_survival_result
 from pipeline.report.common import _table
 
@@ -81,6 +82,10 @@ def _constrain_rows(path, words):
 
 def _branch_words(pgv_pga, k):
     """What branch ``k``'s PGV/PGA came from (constrain.json's pgv_pga), in a few words."""
+    if isinstance(pgv_pga, SitesRatio):
+        return ("each site's own rate density, "
+                + ("its own realisation's" if pgv_pga.per_branch else
+                   "the mean's for every branch"))
     if pgv_pga is None or "per_branch" not in pgv_pga:
         return _ratio_words(pgv_pga)
     if not pgv_pga["per_branch"]:

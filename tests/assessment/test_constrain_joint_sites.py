@@ -1,7 +1,8 @@
 """constrain --joint-hazard with specimens at several sites: each specimen takes PGV/PGA
 from its own site's rate density, so the set's survival under a branch equals the
-single-site runs (each at its site of the file) multiplied; a site index beyond the file
-is refused in one line with nothing written."""
+single-site runs (each at its site of the file) multiplied, and the file's top-level
+pgv_pga says that each site takes its own; a site index beyond the file is refused in one
+line with nothing written."""
 import json
 
 import h5py
@@ -9,6 +10,8 @@ import numpy as np
 
 from pipeline import RECORDS_DIR
 from pipeline.cli import main
+from pipeline.hazard.constrain_parts import SitesRatio
+from pipeline.hazard.results import read_constrain_result
 from tests.refusal import refused
 
 SHIPPED = RECORDS_DIR / "hazard" / "openquake_postproc_case_mrd" / "mrd_pga_pgv.hdf5"
@@ -92,3 +95,40 @@ def test_a_site_beyond_the_file_is_refused_in_one_line(tmp_path, capsys):
                      "0", "--out", out, "--logistic=-2,3,1", "--logistic=-1,3,1", "--age-ka", "10",
                      "--specimen-site", "0", "--specimen-site", "2"],
             "site 2 beyond the file's 2 site(s)", out)
+
+
+def test_the_top_level_says_each_site_takes_its_own_density(tmp_path, capsys):
+    mrd, tree = _two_site_mrd(tmp_path / "mrd.hdf5"), _tree(tmp_path / "tree.csv", 2)
+    out = tmp_path / "both"
+    code = main(["constrain", "--logic-tree", str(tree), "--joint-hazard", str(mrd),
+                 "--draws", "0", "--out", str(out), "--logistic=-2,3,1", "--logistic=-1,3,1",
+                 "--age-ka", "10", "--specimen-site", "0", "--specimen-site", "1"])
+    printed = capsys.readouterr().out
+    assert code == 0
+    data = json.loads((out / "constrain.json").read_text())
+    top, sites = data["pgv_pga"], data["sites"]
+    assert [s["pgv_pga"]["site_index"] for s in sites] == [0, 1]
+    # the route, every site, and no one site's density described as if it held for all
+    assert top["per_site"] is True and top["site_indices"] == [0, 1]
+    assert "mrd" in top["source"] and top["file"] == str(mrd)
+    assert "sites[].pgv_pga" in top["sites"]
+    assert "site_index" not in top and "pga_cells_with_events" not in top
+    assert top["per_branch"] is sites[0]["pgv_pga"]["per_branch"] is False
+    assert top["branches"] == sites[1]["pgv_pga"]["branches"]
+    assert "PGV/PGA: rate density of PGA and PGV (mrd) at each specimen's site (sites 0, 1)" \
+        in printed
+    result = read_constrain_result(out / "constrain.json")
+    assert isinstance(result.pgv_pga, SitesRatio)
+    assert result.text() == (out / "constrain.json").read_text()
+
+
+def test_one_site_keeps_that_sites_density_at_the_top(tmp_path, capsys):
+    mrd, tree = _two_site_mrd(tmp_path / "mrd.hdf5"), _tree(tmp_path / "tree.csv", 2)
+    by_site, _ = _survival(capsys, tree, mrd, tmp_path / "site", "--logistic=-1,3,1",
+                           "--age-ka", "12", "--site", "1")
+    by_specimen, _ = _survival(capsys, tree, mrd, tmp_path / "specimen", "--logistic=-1,3,1",
+                               "--age-ka", "12", "--specimen-site", "1")
+    assert by_site["pgv_pga"]["site_index"] == 1 and "per_site" not in by_site["pgv_pga"]
+    assert by_specimen["pgv_pga"] == by_specimen["sites"][0]["pgv_pga"] == by_site["pgv_pga"]
+    assert not isinstance(read_constrain_result(tmp_path / "site" / "constrain.json").pgv_pga,
+                          SitesRatio)

@@ -1,7 +1,7 @@
 """Bad input to the joint-hazard routes of survival and constrain: one line naming the
 problem, a non-zero exit and nothing written (a disaggregation on levels outside its
-curve; to constrain, an mrd of other intensity measures, a site beyond the files, an age
-interval upside down)."""
+curve; to constrain, an mrd of other intensity measures, a site beyond the files, an mrd
+of another place than the curves, an age interval upside down)."""
 import math
 
 import pytest
@@ -66,3 +66,33 @@ def test_an_mrd_site_beyond_its_file_is_one_line(tmp_path, capsys):
                                        "--joint-hazard", MRD, "--logistic=-2,3,1",
                                        "--draws", "0", "--age-ka", "10"])
     assert "site 1 beyond the file's 1 site(s)" in said
+
+
+def test_a_rate_density_of_another_place_is_one_line(tmp_path, capsys):
+    """OpenQuake's curves state their site (case 11 at (0, 0)), the rate density its own
+    (the mrd case at (11.202, 42.424)): not one place, refused; the mrd case's own curves
+    at the same place are taken."""
+    said = _refused(tmp_path, capsys, [
+        "constrain", "--logic-tree", str(RECORDS_DIR / "hazard" / "openquake_logictree_case_11"),
+        "--joint-hazard", MRD, "--logistic=-2,3,1", "--draws", "0", "--age-ka", "10"])
+    assert "lies at (11.202, 42.424), the logic tree's curves at (0, 0)" in said
+    assert main(["constrain", "--logic-tree", str(CASE), "--joint-hazard", MRD,
+                 "--logistic=-2,3,1", "--draws", "0", "--age-ka", "10", "--out",
+                 str(tmp_path / "same")]) == 0
+
+
+CASE_19 = RECORDS_DIR / "hazard" / "openquake_logictree_case_19"
+
+
+@pytest.mark.parametrize("argv", [
+    ["survival", "--hazard", str(CASE / "hazard_curve-mean-PGA_6.csv"), "--disaggregation",
+     str(CASE_19 / "disaggregation" / "Mag_Dist-mean-0_16.csv")],
+    ["constrain", "--logic-tree", str(CASE_19), "--disaggregation",
+     str(CASE / "disaggregation" / "Mag_Dist-0_7.csv")],
+])
+def test_a_disaggregation_of_another_place_is_one_line(tmp_path, capsys, argv):
+    """The mrd case's site (11.202, 42.424) and case 19's (16.2657, 39.3002), each stated
+    by its curves and its disaggregation."""
+    said = _refused(tmp_path, capsys, [*argv, "--logistic=-2,3,1", "--draws", "0",
+                                       "--age-ka", "10"])
+    assert "of another place" in said and "42.424" in said and "39.3002" in said

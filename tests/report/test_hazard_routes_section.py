@@ -1,11 +1,13 @@
 """The REPORT section of the three routes to the joint hazard: it says when nothing has run,
 quotes each route's survival.json and constrain.json as written, each branch's PGV/PGA
-its own realisation's or the mean's as the file says."""
+its own realisation's or the mean's as the file says (with specimens at several sites, each
+site's own)."""
 import json
 
 from pipeline.cli import main
 from pipeline.report import hazard_routes_section
 from pipeline.report.hazard_routes import HAZARD_ROUTES
+from tests.assessment.test_constrain_joint_sites import _tree, _two_site_mrd
 
 CASE = "records/hazard/openquake_postproc_case_mrd"
 CURVE = f"{CASE}/hazard_curve-mean-PGA_6.csv"
@@ -50,3 +52,15 @@ def test_each_route_is_quoted_from_its_files(tmp_path):
     assert "rate density, the mean's for every branch" in text
     assert text.count("magnitude-distance bins, its own realisation's") == 2
     assert "not run" not in text
+
+
+def test_specimens_at_several_sites_are_said_to_take_each_sites_density(tmp_path):
+    mrd, tree = _two_site_mrd(tmp_path / "mrd.hdf5"), _tree(tmp_path / "tree.csv", 2)
+    assert main(["constrain", "--logic-tree", str(tree), "--joint-hazard", str(mrd),
+                 "--logistic=-2,3,1", "--logistic=-1,3,1", "--age-ka", "10",
+                 "--specimen-site", "0", "--specimen-site", "1", "--draws", "0", "--out",
+                 str(tmp_path / HAZARD_ROUTES / "joint-constrain")]) == 0
+    assert main(["survival", "--joint-hazard", f"{CASE}/mrd_pga_pgv.hdf5", *ROCK, "--draws",
+                 "0", "--out", str(tmp_path / HAZARD_ROUTES / "joint-survival")]) == 0
+    text = hazard_routes_section(tmp_path)
+    assert text.count("each site's own rate density, the mean's for every branch") == 2

@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from pipeline.constants import STANDARD_GRAVITY
-from pipeline.hazard.pga_pgv_correlation import BAKER_BRADLEY_2017
+from pipeline.hazard.pga_pgv_correlation import BAKER_BRADLEY_2017, correlation_source
 
 RATIO_NODES = 24                  # Gauss-Hermite nodes over ln(PGV/PGA)
 PGA_PGV_CORRELATION = BAKER_BRADLEY_2017.value   # ln PGA, ln PGV residuals, observed
@@ -74,6 +74,7 @@ class RatioFromGmm:
                 "magnitude": self.magnitude, "distance_jb_km": self.distance_km,
                 "vs30_m_s": self.vs30_m_s, "mechanism": self.mechanism,
                 "pga_pgv_correlation": self.correlation,
+                "pga_pgv_correlation_source": correlation_source(self.correlation),
                 "median_pga_m_s2": self.medians["pga_m_s2"],
                 "median_pgv_m_s": self.medians["pgv_m_s"],
                 "ln_std_pga": self.medians["ln_std_pga"], "ln_std_pgv": self.medians["ln_std_pgv"],
