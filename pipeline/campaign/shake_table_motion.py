@@ -137,7 +137,8 @@ class TableMotionSummary:
     peak as a share of the angular velocity that tips the rock from rest at its least
     stable seating (p Dv / (2 g sin(alpha/2)), p <= sqrt(g/R)), and the shift (percentage
     points) of the laboratory's overturning probability a PGA or PGV change moves at most
-    (slope of its logistic surface over the measured tests / 4)."""
+    (slope of its logistic surface over the measured tests / 4).  NaN where no test (or too
+    few for the surface) gives the number."""
     tests: int
     measured: int
     lost_median_pct: float
@@ -189,6 +190,12 @@ def loss_frame(rows, experiments):
     return frame
 
 
+def pct(values, q):
+    """The ``q`` th percentile of ``values`` (fractions) in %; NaN for no value."""
+    values = np.asarray(values, float)
+    return float(np.percentile(values, q)) * 100 if values.size else math.nan
+
+
 def table_motion_summary(rows, experiments, specimen, weak_pga_g=0.1, short_pgv_pga_s=0.05):
     """:class:`TableMotionSummary` of ``rows`` (:func:`load_table_motion`) over the tests of
     ``experiments`` (:func:`~pipeline.campaign.shake_table_experiments.load_experiments`),
@@ -204,8 +211,8 @@ def table_motion_summary(rows, experiments, specimen, weak_pga_g=0.1, short_pgv_
     p_max = math.sqrt(MODEL_GRAVITY * math.cos(alpha) / rock.com[2])   # I_O >= m R^2
     above = frame["above_shipped_m_s"].to_numpy()
     lab = logistic_surface(measured["pga_g"] * STANDARD_GRAVITY, measured["pgv_pga_s"],
-                           measured["observed"])["coefficients"]
-    pct = lambda values, q: float(np.percentile(values, q)) * 100   # noqa: E731
+                           measured["observed"])["coefficients"] or \
+        {"b1": math.nan, "b2": math.nan}             # too few tests, or one outcome only
     kept = measured["pga_lost"].to_numpy()
     weak, short = measured["pga_g"] < weak_pga_g, measured["pgv_pga_s"] < short_pgv_pga_s
     return TableMotionSummary(
