@@ -2,9 +2,16 @@
 per test, against the test's PGA and PGV/PGA."""
 import numpy as np
 from matplotlib.colors import LogNorm
+from matplotlib.ticker import FuncFormatter
 
 from pipeline.figures.style import DPI, figure
 from pipeline.files import save_figure
+
+
+def _two_and_five(value, _):
+    """A log axis's minor label at 2 and 5 times a power of ten, else none."""
+    mantissa = round(value / 10 ** np.floor(np.log10(value)), 6)
+    return f"{value:g}" if mantissa in (2.0, 5.0) else ""
 
 
 def plot_table_motion(pga_g, pgv_pga_s, observed, pga_lost, run_pga_change, run_pgv_change,
@@ -30,7 +37,9 @@ def plot_table_motion(pga_g, pgv_pga_s, observed, pga_lost, run_pga_change, run_
         ax.set_xlabel(label)
         ax.set_ylabel("800 Hz PGA missing from the 200 Hz file (%)")
         ax.legend(loc="upper right", fontsize=8)
-        fig.colorbar(image, ax=ax, label=clabel)
+        bar = fig.colorbar(image, ax=ax, label=clabel)
+        bar.ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
+        bar.ax.yaxis.set_minor_formatter(FuncFormatter(_two_and_five))
     axes[0].set_title("raw peak lost by the decimation")
     axes[1].set_title("against the motion's period")
     ax = axes[2]
