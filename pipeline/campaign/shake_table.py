@@ -46,7 +46,7 @@ from pipeline.campaign.shake_table_experiments import (AXIS_DEG, DEFAULT_GRID, E
                                                        load_experiments, parse_grid)
 from pipeline.campaign.shake_table_folds import DEFAULT_FOLDS, date_folds
 from pipeline.campaign.shake_table_motion import (TABLE_MOTION, load_table_motion,
-                                                  write_table_motion_figure)
+                                                  shared_tests, write_table_motion_figure)
 from pipeline.campaign.tags import ShakeTableTags
 
 log = logging.getLogger(__name__)
@@ -134,7 +134,7 @@ def drive(run, records, campaign_dir, options, gate=None):
         return MODES["members"].drive(run, records, campaign_dir, options, gate)
     campaign_dir = Path(campaign_dir)
     frame = load_experiments(options["experiments"], options["outcome"])
-    motion_rows = _table_motion(Path(options["experiments"]))    # checked before any run
+    motion_rows = _table_motion(Path(options["experiments"]), frame)   # checked before any run
     if options.get("tests"):
         frame = frame[frame["test"].isin(options["tests"])]
     simulated = frame[[p is not None for p in frame["motion_path"]]]
@@ -176,14 +176,17 @@ def drive(run, records, campaign_dir, options, gate=None):
     return {**validation, "summary": result}
 
 
-def _table_motion(experiments):
+def _table_motion(experiments, frame):
     """The table of what the 200 Hz motions lose (:mod:`pipeline.campaign.shake_table_motion`)
-    when it lies beside the experiment table (the shipped tests have one), else None."""
+    when it lies beside the experiment table (the shipped tests have one; its tests must be
+    of ``frame``, the experiments), else None."""
     path = experiments.parent / TABLE_MOTION.name
     if not path.is_file():
         log.info(f"no {TABLE_MOTION.name} beside {experiments.name}: no shake_table_motion.png")
         return None
-    return load_table_motion(path)
+    rows = load_table_motion(path)
+    shared_tests(rows, frame)
+    return rows
 
 
 def _experiment_table(frame, campaign_dir, label, validate_from):

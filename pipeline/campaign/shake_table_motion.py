@@ -33,7 +33,7 @@ class TableMotionLoss:
     (g) and their ratio; the peak velocity (m/s) of each as a run processes it and the
     ratio of their processed peaks; the 800 Hz signal's energy share above 25, 80 and
     100 Hz; the time (s) the 800 Hz |a| spends above the shipped peak and the velocity
-    (m/s) it carries there.  Checks itself on construction (one-line InputError)."""
+    (m/s) it carries there; the duration (s) of the one-sided pulse holding its peak.  Checks itself on construction (one-line InputError)."""
     test: str
     pga_800hz_g: float
     pga_200hz_g: float
@@ -46,6 +46,7 @@ class TableMotionLoss:
     energy_above_100hz: float
     above_shipped_s: float
     above_shipped_m_s: float
+    peak_pulse_s: float
 
     def __post_init__(self):
         if not (isinstance(self.test, str) and self.test.strip() and self.test.isprintable()):
@@ -57,7 +58,7 @@ class TableMotionLoss:
                     not math.isfinite(value) or value < 0:
                 raise InputError(f"table motion {self.test}: {f.name} {value!r} must be a "
                                  "finite number >= 0")
-        for name in ("pga_800hz_g", "pga_200hz_g", "run_pga_ratio"):
+        for name in ("pga_800hz_g", "pga_200hz_g", "run_pga_ratio", "peak_pulse_s"):
             if getattr(self, name) == 0:
                 raise InputError(f"table motion {self.test}: {name} must be above 0")
         self._check_relations()
@@ -131,7 +132,8 @@ class TableMotionSummary:
     tests, whose summary PGA is not nominal, medians below and above ``weak_pga_g`` and
     ``short_pgv_pga_s``), tests whose 200 Hz peak is the higher,
     the 800 Hz energy above 25 and 80 Hz (%), the time (ms) and velocity (mm/s) above the
-    shipped peak, the change of a run's peak acceleration and velocity (|%|; the tests
+    shipped peak, the duration (ms) of the pulse holding the 800 Hz peak (median, 5th
+    percentile), the change of a run's peak acceleration and velocity (|%|; the tests
     whose peak velocity changes by more than 5 %), and what
     these can do to the rock (over all ``tests``): ``tip_share_pct``, the largest velocity above the shipped
     peak as a share of the angular velocity that tips the rock from rest at its least
@@ -158,6 +160,8 @@ class TableMotionSummary:
     above_max_ms: float
     above_median_mm_s: float
     above_max_mm_s: float
+    pulse_median_ms: float
+    pulse_p5_ms: float
     run_pga_p95_pct: float
     run_pga_max_pct: float
     run_pgv_median_pct: float
@@ -190,6 +194,15 @@ def loss_frame(rows, experiments):
     return frame
 
 
+def shared_tests(rows, experiments):
+    """:func:`loss_frame`, refused in one line when no test of ``rows`` is in
+    ``experiments`` (a table beside another experiment table)."""
+    frame = loss_frame(rows, experiments)
+    if frame.empty:
+        raise InputError(f"{TABLE_MOTION.name}: none of its tests is in the experiment table")
+    return frame
+
+
 def pct(values, q):
     """The ``q`` th percentile of ``values`` (fractions) in %; NaN for no value."""
     values = np.asarray(values, float)
@@ -199,9 +212,9 @@ def pct(values, q):
 def table_motion_summary(rows, experiments, specimen, weak_pga_g=0.1, short_pgv_pga_s=0.05):
     """:class:`TableMotionSummary` of ``rows`` (:func:`load_table_motion`) over the tests of
     ``experiments`` (:func:`~pipeline.campaign.shake_table_experiments.load_experiments`),
-    for ``specimen`` (a ColumnGeometry
-    description dict) at its least stable calibration seating."""
-    frame = loss_frame(rows, experiments)
+    for ``specimen`` (a ColumnGeometry description dict) at its least stable calibration
+    seating."""
+    frame = shared_tests(rows, experiments)
     measured = frame[frame["pga_nominal"].astype(int) == 0]
     lost, run_a, run_v = (frame[c].to_numpy() for c in ("pga_lost", "run_pga_change",
                                                           "run_pgv_change"))
@@ -228,6 +241,8 @@ def table_motion_summary(rows, experiments, specimen, weak_pga_g=0.1, short_pgv_
         above_median_ms=pct(frame["above_shipped_s"], 50) * 10,
         above_max_ms=pct(frame["above_shipped_s"], 100) * 10,
         above_median_mm_s=pct(above, 50) * 10, above_max_mm_s=pct(above, 100) * 10,
+        pulse_median_ms=pct(frame["peak_pulse_s"], 50) * 10,
+        pulse_p5_ms=pct(frame["peak_pulse_s"], 5) * 10,
         run_pga_p95_pct=pct(abs(run_a), 95), run_pga_max_pct=pct(abs(run_a), 100),
         run_pgv_median_pct=pct(abs(run_v), 50), run_pgv_p95_pct=pct(abs(run_v), 95),
         run_pgv_max_pct=pct(abs(run_v), 100), run_pgv_over_5pct=int((abs(run_v) > 0.05).sum()),
@@ -243,7 +258,7 @@ def write_table_motion_figure(rows, experiments, path):
     """The figure (:func:`pipeline.figures.table_motion.plot_table_motion`) of ``rows``
     against the tests of ``experiments`` whose PGA is measured; returns the path."""
     from pipeline.figures.table_motion import plot_table_motion  # lazy: matplotlib
-    frame = loss_frame(rows, experiments)
+    frame = shared_tests(rows, experiments)
     frame = frame[frame["pga_nominal"].astype(int) == 0]
     return plot_table_motion(frame["pga_g"], frame["pgv_pga_s"], frame["observed"],
                              frame["pga_lost"], frame["run_pga_change"],

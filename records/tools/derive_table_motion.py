@@ -21,6 +21,8 @@ writes deterministically (reruns give the same bytes), per test:
 * ``above_shipped_s``: time (s) the 800 Hz |a| spends above the shipped PGA;
   ``above_shipped_m_s``: the velocity it carries there, integral of (|a| - pga_200hz)+ dt
   (m/s): the part of the peaks the shipped file does not have.
+* ``peak_pulse_s``: duration (s) of the one-sided pulse of the 800 Hz acceleration (its
+  mean removed) that holds its peak: the samples of the peak's sign around it.
 
 Usage: derive_table_motion.py [MIRROR_GIT_DIR] [--out CSV]
 Needs numpy, scipy, pandas and the toolkit (``pipeline``) importable.
@@ -45,7 +47,7 @@ NAME = "table_motion_800hz.csv"
 BANDS_HZ = (25.0, 80.0, 100.0)
 COLUMNS = ("test", "pga_800hz_g", "pga_200hz_g", "pga_ratio", "pgv_800hz_m_s",
            "pgv_200hz_m_s", "run_pga_ratio", *(f"energy_above_{f:g}hz" for f in BANDS_HZ),
-           "above_shipped_s", "above_shipped_m_s")
+           "above_shipped_s", "above_shipped_m_s", "peak_pulse_s")
 
 
 def run_peaks(acc_g: np.ndarray, fs: float, name: str) -> tuple[float, float]:
@@ -68,6 +70,17 @@ def energy_above(acc_g: np.ndarray, fs: float, freqs_hz) -> list[float]:
     return [float(np.sum(power[f > fc])) / total for fc in freqs_hz]
 
 
+def peak_pulse_s(acc_g: np.ndarray, fs: float) -> float:
+    """Duration (s) of the run of samples of one sign, the record's mean removed, that holds
+    the largest |a|."""
+    x = acc_g - np.mean(acc_g)
+    k = int(np.argmax(np.abs(x)))
+    other = np.flatnonzero(np.sign(x) != np.sign(x[k]))
+    start = other[other < k].max() + 1 if np.any(other < k) else 0
+    end = other[other > k].min() if np.any(other > k) else len(x)
+    return (end - start) / fs
+
+
 def measures(test: str, acc_800_g: np.ndarray) -> list:
     """One row of the table (COLUMNS) for the raw 800 Hz acceleration (g)."""
     acc_200_g = decimated(acc_800_g)
@@ -78,7 +91,7 @@ def measures(test: str, acc_800_g: np.ndarray) -> list:
     return [test, pga_800, pga_200, pga_200 / pga_800, run_800[1], run_200[1],
             run_200[0] / run_800[0], *energy_above(acc_800_g, FS_RAW, BANDS_HZ),
             np.count_nonzero(excess) / FS_RAW,
-            float(np.sum(excess)) / FS_RAW * STANDARD_GRAVITY]
+            float(np.sum(excess)) / FS_RAW * STANDARD_GRAVITY, peak_pulse_s(acc_800_g, FS_RAW)]
 
 
 def table_text(rows: list[list]) -> str:

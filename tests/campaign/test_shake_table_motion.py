@@ -15,8 +15,8 @@ from pipeline.records.readers import read_record
 from pipeline.scenario.geometry import ColumnGeometry
 
 GOOD = (",".join(COLUMNS) + "\n"
-        "T1,0.1,0.09,0.9,0.05,0.05,1.001,0.2,0.05,0.04,0.0025,0.0001\n"
-        "T2,0.2,0.201,1.005,0.1,0.12,0.999,0.1,0.01,0.005,0,0\n")
+        "T1,0.1,0.09,0.9,0.05,0.05,1.001,0.2,0.05,0.04,0.0025,0.0001,0.01\n"
+        "T2,0.2,0.201,1.005,0.1,0.12,0.999,0.1,0.01,0.005,0,0,0.2\n")
 
 
 @pytest.fixture(scope="module")
@@ -36,8 +36,9 @@ def test_a_bad_table_is_refused_in_one_line(tmp_path):
                         (GOOD.replace(",0.05,0.05,", ",-0.05,0.05,"), ">= 0"),
                         (GOOD.replace("0.2,0.05,0.04", "1.2,0.05,0.04"), "in \\[0, 1\\]"),
                         (GOOD.replace("0.2,0.05,0.04", "0.2,0.05,0.06"), "not grow"),
-                        (GOOD.replace("0.0025,0.0001", "0.0025,0"), "both zero"),
-                        (GOOD.replace(",0,0\n", ",0.001,0.0001\n"), "800 Hz peak is below"),
+                        (GOOD.replace("0.0025,0.0001,", "0.0025,0,"), "both zero"),
+                        (GOOD.replace(",0,0,", ",0.001,0.0001,"), "800 Hz peak is below"),
+                        (GOOD.replace(",0.2\n", ",0\n"), "peak_pulse_s must be above 0"),
                         (GOOD.replace("T2,", "T1,"), "T1 appears twice"),
                         (GOOD.replace("T2,", "nan,").replace(",0.2,0.201", ",nan,0.201"),
                          "finite")):
@@ -72,8 +73,10 @@ def test_shipped_columns_hold_together(shipped):
     for row in rows:
         assert row.pga_ratio == pytest.approx(row.pga_200hz_g / row.pga_800hz_g, rel=2e-5)
         assert 1 >= row.energy_above_25hz >= row.energy_above_80hz >= row.energy_above_100hz >= 0
-        # a count of 800 Hz samples
+        # counts of 800 Hz samples, the pulse at least one
         assert row.above_shipped_s * 800 == pytest.approx(round(row.above_shipped_s * 800))
+        assert row.peak_pulse_s * 800 == pytest.approx(round(row.peak_pulse_s * 800))
+        assert row.peak_pulse_s >= 1 / 800
         # the excess over the shipped peak is at most the peak difference over that time
         # (reached where the source repeats its peak value; each written to six digits)
         difference = row.pga_800hz_g - row.pga_200hz_g + 1e-5 * row.pga_800hz_g
@@ -114,6 +117,7 @@ def test_summary_counts_the_rows_it_is_given(tmp_path):
     assert np.isnan(out.lab_b_pga)                      # two tests: no logistic surface
     assert (out.run_pgv_over_5pct, out.run_pgv_tests) == (1, "T2")        # 0.12 / 0.1
     assert out.above_max_mm_s == pytest.approx(0.1) and out.above_max_ms == pytest.approx(2.5)
+    assert out.pulse_median_ms == pytest.approx(105)                      # 10 ms, 200 ms
     # SP1 on its lowest asperities (README.md: 5.4 deg toward +x, pivot 0.30 m away):
     # p <= sqrt(g / R); a velocity dv tips it from rest at p dv / (2 g sin(alpha/2))
     assert out.alpha_deg == pytest.approx(5.4, abs=0.1)
@@ -133,10 +137,14 @@ def test_campaign_refuses_a_bad_table_beside_its_experiments_before_any_run(tmp_
     experiments.write_text("test,date,pga_g,pgv_pga_s,sp1_overturned,motion_file\n"
                            "T1,2021-06-01,0.1,0.05,1,\n")
     options = {"experiments": experiments, "outcome": "sp1_overturned"}
-    assert shake_table._table_motion(experiments) is None            # none beside: no figure
-    (tmp_path / TABLE_MOTION.name).write_text(GOOD.replace("0.9,", "0.8,"))
+    frame = load_experiments(experiments)
+    assert shake_table._table_motion(experiments, frame) is None      # none beside: no figure
+    beside = tmp_path / TABLE_MOTION.name
 
     def run(_):
         raise AssertionError("a run started")
-    with pytest.raises(InputError, match="is not pga_200hz_g"):
-        shake_table.drive(run, [], tmp_path / "out", options)
+    for text, words in ((GOOD.replace("0.9,", "0.8,"), "is not pga_200hz_g"),
+                        (GOOD.replace("T1,", "T3,"), "none of its tests")):
+        beside.write_text(text)
+        with pytest.raises(InputError, match=words):
+            shake_table.drive(run, [], tmp_path / "out", options)
