@@ -11,7 +11,9 @@ only the chosen set runs on the validation tests.  Scores (accuracy, precision, 
 F1, confusion) are reported per split beside the trivial baselines ("never overturns";
 "overturns when PGA >= g tan(critical angle)").  Outputs in the campaign directory:
 ``experiments.csv`` (per test and parameter set), ``shake_table.json`` (scores), the
-figure ``shake_table_rates.png`` (observed and predicted rate per PGA x PGV/PGA bin).
+figure ``shake_table_rates.png`` (observed and predicted rate per PGA x PGV/PGA bin) and,
+for tests with ``table_motion_800hz.csv`` beside their table, ``shake_table_motion.png``
+(what the 200 Hz motions lose against the 800 Hz records).
 
 With ``--members N`` the campaign runs in its members mode instead
 (:mod:`pipeline.campaign.shake_table_members`, which enters itself in :data:`MODES`):
@@ -43,6 +45,8 @@ from pipeline.campaign.shake_table_experiments import (AXIS_DEG, DEFAULT_GRID, E
                                                        VALIDATE_FROM, grid_run_params,
                                                        load_experiments, parse_grid)
 from pipeline.campaign.shake_table_folds import DEFAULT_FOLDS, date_folds
+from pipeline.campaign.shake_table_motion import (TABLE_MOTION, load_table_motion,
+                                                  shared_tests, write_table_motion_figure)
 from pipeline.campaign.tags import ShakeTableTags
 
 log = logging.getLogger(__name__)
@@ -130,6 +134,7 @@ def drive(run, records, campaign_dir, options, gate=None):
         return MODES["members"].drive(run, records, campaign_dir, options, gate)
     campaign_dir = Path(campaign_dir)
     frame = load_experiments(options["experiments"], options["outcome"])
+    motion_rows = _table_motion(Path(options["experiments"]), frame)   # checked before any run
     if options.get("tests"):
         frame = frame[frame["test"].isin(options["tests"])]
     simulated = frame[[p is not None for p in frame["motion_path"]]]
@@ -164,9 +169,24 @@ def drive(run, records, campaign_dir, options, gate=None):
     from pipeline.figures.shake_table import plot_rates  # lazy: matplotlib, not imported by a run or after Ctrl-C
     plot_rates(table, campaign_dir / "shake_table_rates.png", result, PGA_EDGES_G,
                PGV_PGA_EDGES_S)
+    if motion_rows is not None:
+        write_table_motion_figure(motion_rows, frame, campaign_dir / "shake_table_motion.png")
     for line in result["lines"]:
         log.info(line)
     return {**validation, "summary": result}
+
+
+def _table_motion(experiments, frame):
+    """The table of what the 200 Hz motions lose (:mod:`pipeline.campaign.shake_table_motion`)
+    when it lies beside the experiment table (the shipped tests have one; its tests must be
+    of ``frame``, the experiments), else None."""
+    path = experiments.parent / TABLE_MOTION.name
+    if not path.is_file():
+        log.info(f"no {TABLE_MOTION.name} beside {experiments.name}: no shake_table_motion.png")
+        return None
+    rows = load_table_motion(path)
+    shared_tests(rows, frame)
+    return rows
 
 
 def _experiment_table(frame, campaign_dir, label, validate_from):

@@ -11,8 +11,8 @@ from pipeline.report import docs_numbers
 NUMBERS = ("bench_convergence_table", "bench_value", "bench_speed_table", "column_examples",
            "column_sources", "engine_shares", "member_ranges_table", "record_rocking_hd",
            "record_value",
-           "run_all_minutes", "run_all_steps", "setting", "time_step_table", "twin_time_step",
-           "value")
+           "run_all_minutes", "run_all_steps", "setting", "table_motion_value",
+           "time_step_table", "twin_time_step", "value")
 WITH_FIGURES = ("report", "report_section")
 
 

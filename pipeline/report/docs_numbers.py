@@ -7,13 +7,15 @@ command writes it."""
 import importlib
 import json
 import re
-from functools import reduce
+from functools import cache, reduce
 
 import pandas as pd
 
 from pipeline import RESULTS_DIR, paper
 from pipeline.constants import MODEL_GRAVITY
 from pipeline.campaign.column_file import matched_kn
+from pipeline.campaign.shake_table_experiments import SPECIMEN, load_experiments
+from pipeline.campaign.shake_table_motion import load_table_motion, table_motion_summary
 from pipeline.report import campaigns
 from pipeline.scenario import Column, Contact, scene_params
 from pipeline.scenario.column_format import example_names
@@ -133,6 +135,19 @@ def setting(name, fmt="{:g}", times=1):
     home."""
     module, _, attribute = name.rpartition(".")
     return fmt.format(getattr(importlib.import_module(module), attribute) * times)
+
+
+@cache
+def _table_motion_summary():
+    return table_motion_summary(load_table_motion(), load_experiments(),
+                                ColumnGeometry.load(SPECIMEN).to_dict())
+
+
+def table_motion_value(name, fmt="{:.1f}"):
+    """One number of what the shipped 200 Hz table motions lose against the 800 Hz records,
+    by its field ``name`` of :class:`~pipeline.campaign.shake_table_motion.TableMotionSummary`
+    (computed from the shipped files of records/shake_table/)."""
+    return fmt.format(getattr(_table_motion_summary(), name))
 
 
 def member_ranges_table():

@@ -159,13 +159,18 @@ def gzip_bytes(text: bytes) -> bytes:
     return buf.getvalue()
 
 
+def decimated(acc: np.ndarray) -> np.ndarray:
+    """The 800 Hz acceleration as shipped: 200 Hz, zero-phase FIR anti-alias filter."""
+    return signal.decimate(acc, DECIM, ftype="fir", zero_phase=True)
+
+
 def motion_text(test: str, sha: str, t: np.ndarray, acc: np.ndarray) -> bytes:
     # the source time column is k/800 s printed with 6 significant digits
     # (steps alternate 0.0012/0.0013 s after 10 s); write exact k/200 s
     k = np.arange(len(t))
     if t[0] != 0 or np.max(np.abs(t - k / FS_RAW)) > 1e-4:
         raise ValueError(f"{test}: time column is not k/{FS_RAW:g} s")
-    a_dec = signal.decimate(acc, DECIM, ftype="fir", zero_phase=True)
+    a_dec = decimated(acc)
     t_dec = np.arange(len(a_dec)) / FS_OUT
     assert len(a_dec) == len(t[::DECIM])
     head = (
