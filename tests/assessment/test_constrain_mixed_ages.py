@@ -4,6 +4,9 @@ of exp(-rate t) over the age computed here; the age chain of mixed kinds against
 closed form; bad ages refused in one line with nothing written."""
 import json
 import math
+import re
+import shlex
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -13,6 +16,7 @@ from pipeline import RECORDS_DIR
 from pipeline.cli import main
 from tests.refusal import refused
 
+ROOT = Path(__file__).resolve().parents[2]
 EXAMPLE = RECORDS_DIR / "hazard" / "two_site_example"
 TREE = EXAMPLE / "logic_tree_two_sites.csv"
 SAMPLES = EXAMPLE / "age_samples_synthetic.csv"
@@ -167,3 +171,28 @@ def test_an_age_badly_given_is_one_line_and_nothing_written(tmp_path, capsys, ag
     refused(capsys, ["constrain", "--logic-tree", TREE, *_rock(0), *_rock(1), *_rock(2),
                      "--specimen-site", 0, "--draws", 0, "--out", out,
                      *[a.format(**files) for a in ages]], words, out)
+
+
+def _docs_examples():
+    """The docs' commands that use the shipped example, as written."""
+    for page in ("constrained-hazard.md", "survival.md"):
+        text = (ROOT / "docs" / page).read_text()
+        for line in re.findall(r"\.venv/bin/python -m pipeline (.*two_site_example.*)", text):
+            yield pytest.param(shlex.split(line), id=f"{page}: {line[:50]}")
+
+
+@pytest.mark.parametrize("argv", list(_docs_examples()))
+def test_the_docs_examples_on_the_shipped_example_run(tmp_path, capsys, monkeypatch, argv):
+    """Run from the repository root as the docs give them (the output elsewhere)."""
+    monkeypatch.chdir(ROOT)
+    out = tmp_path / "out"
+    assert main([*argv, "--out", str(out)]) == 0, capsys.readouterr().err
+    name = "constrain.json" if argv[0] == "constrain" else "survival.json"
+    result = json.loads((out / name).read_text())
+    if argv[0] == "constrain":
+        assert [(s["site"], s["specimens"]) for s in result["sites"]] == [(0, [0]),
+                                                                          (1, [1, 2])]
+        assert [s["age"]["kind"] for s in result["specimens"]] == [
+            "lower_bound", "interval", "samples"]
+    else:
+        assert result["age"]["samples"] == 200
