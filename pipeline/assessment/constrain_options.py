@@ -57,8 +57,8 @@ class ConstrainOptions(SpecimenOptions):
     age: tuple[str, ...] = param(
         (), "ka", "or each specimen's age of its own kind: lower_bound:MIN, interval:LO,HI "
         "(uniform), normal:MEAN[,SD] (truncated at 0) or samples:FILE (as --age-samples); "
-        "one per specimen, in the order of the fragilities, or one for all",
-        flag="--age", metavar="KIND:VALUES", optional=True)
+        "one per specimen, in the order of the fragilities, or one for all; values up to "
+        f"{MAX_AGE_KA:g}", flag="--age", metavar="KIND:VALUES", optional=True)
     age_column: str = param(None, "", "the column of --age-samples (and of --age "
                             "samples:FILE)", flag="--age-column", metavar="NAME",
                             optional="each file's only column")
