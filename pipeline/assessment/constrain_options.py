@@ -4,9 +4,10 @@ fields beside the fragility and PGV/PGA options it shares with ``survival``
 from dataclasses import dataclass
 from pathlib import Path
 
-from pipeline.assessment.age_options import AGE_VALUES, age_kinds, check_age_kinds
-from pipeline.assessment.options import (CONSTRAIN_OUT, KA, MAX_AGE_KA, MAX_SPECIMENS,
-                                         SpecimenOptions, _check_column_site, _check_out,
+from pipeline.assessment.age_options import (AGE_VALUES, StatedAge, age_kinds,
+                                             check_age_kinds)
+from pipeline.assessment.options import (AGE_FLAGS, CONSTRAIN_OUT, KA, MAX_AGE_KA,
+                                         MAX_SPECIMENS, SpecimenOptions, _check_column_site, _check_out,
                                          _per_specimen, disaggregation_param)
 from pipeline.files import InputError
 from pipeline.hazard.ages import LowerBound, TruncatedNormal, UniformInterval, load_age_samples
@@ -50,11 +51,17 @@ class ConstrainOptions(SpecimenOptions):
         "specimen or one for all", 0, MAX_AGE_KA, flag="--age-range-ka",
         metavar=("LO", "HI"), optional=True)
     age_samples: tuple[Path, ...] = param(
-        (), "", "or samples of a specimen's age (ka) in the column --age-column of a CSV "
-        "file: one file per specimen or one for all", flag="--age-samples", metavar="FILE",
-        optional=True)
-    age_column: str = param(None, "", "the column of --age-samples", flag="--age-column",
-                            metavar="NAME", optional=True)
+        (), "", "or samples of a specimen's age (ka) in a column of a CSV file (its only "
+        "one, or --age-column): one file per specimen or one for all",
+        flag="--age-samples", metavar="FILE", optional=True)
+    age: tuple[str, ...] = param(
+        (), "ka", "or each specimen's age of its own kind: lower_bound:MIN, interval:LO,HI "
+        "(uniform), normal:MEAN[,SD] (truncated at 0) or samples:FILE (as --age-samples); "
+        "one per specimen, in the order of the fragilities, or one for all; values up to "
+        f"{MAX_AGE_KA:g}", flag="--age", metavar="KIND:VALUES", optional=True)
+    age_column: str = param(None, "", "the column of --age-samples (and of --age "
+                            "samples:FILE)", flag="--age-column", metavar="NAME",
+                            optional="each file's only column")
     rule: str = param("bayes", "", "the headline's rule: bayes (weights x survival "
                       "probability) or eliminate (branches of survival below --floor "
                       "dropped); both are written", flag="--rule",
@@ -79,6 +86,9 @@ class ConstrainOptions(SpecimenOptions):
 
     RATIO_FLAGS = (*SpecimenOptions.RATIO_FLAGS, "joint_hazard", "disaggregation",
                    "disaggregation_column")
+    AGE_FLAGS = (*AGE_FLAGS[:-1], "age", AGE_FLAGS[-1])
+    AGE_GROUP = "the specimens' ages, as they are dated (one kind for all: one of " \
+        "--age-ka, --age-min-ka, --age-range-ka, --age-samples; or --age per specimen)"
 
     def __post_init__(self):
         check_fields(self)
@@ -87,19 +97,34 @@ class ConstrainOptions(SpecimenOptions):
         if n > MAX_SPECIMENS:
             raise InputError(f"{n} specimens (at most {MAX_SPECIMENS})")
         _check_column_site(self)
+        self._check_ages(n)
+        self._check_route(self.specimen_sites())
+        self.check_model_flags()
+        _check_out(self.out)
+
+    def _check_ages(self, n):
+        """One kind of age for all (--age-ka, ...) or one --age per specimen."""
         given = age_kinds(self)
+        if self.age:
+            if given or self.age_sd_ka != (0.0,):
+                other = given[0] if given else "--age-sd-ka"
+                raise InputError(f"--age gives each specimen's age: not with {other}")
+            stated = [StatedAge.parse(text, MAX_AGE_KA) for text in self.age]
+            _per_specimen(stated, n, "--age")
+            if self.age_column is not None and all(a.file is None for a in stated):
+                raise InputError("--age-column applies with --age-samples or --age "
+                                 "samples:FILE")
+            return
         if not given:
             raise InputError("give the specimens' ages: --age-ka, --age-min-ka, "
                              "--age-range-ka or --age-samples (one per specimen, or one "
-                             "for all)")
-        check_age_kinds(self, given)
+                             "for all), or --age KIND:VALUES per specimen")
+        check_age_kinds(self, given, "; ages of several kinds: one --age KIND:VALUES per "
+                        "specimen")
         flag, values = AGE_VALUES[given[0]](self)
         _per_specimen(values, n, flag)
         if self.age_ka:
             _per_specimen(self.age_sd_ka, n, "--age-sd-ka")
-        self._check_route(self.specimen_sites())
-        self.check_model_flags()
-        _check_out(self.out)
 
     def _check_route(self, sites):
         """One source of PGV/PGA; --disaggregation (one site's) for specimens at one."""
@@ -156,6 +181,11 @@ class ConstrainOptions(SpecimenOptions):
         """One :class:`~pipeline.hazard.ages.AgeModel` (years) per specimen (an
         --age-samples file read here, each once)."""
         n = self.specimen_count
+        if self.age:
+            stated = _per_specimen([StatedAge.parse(t, MAX_AGE_KA) for t in self.age], n,
+                                   "--age")
+            read = {a.file: a.model(self.age_column) for a in stated if a.file is not None}
+            return [read[a.file] if a.file is not None else a.model() for a in stated]
         if self.age_ka:
             return [TruncatedNormal(a * KA, s * KA) for a, s in zip(*self.ages())]
         if self.age_min_ka:

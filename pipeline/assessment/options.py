@@ -12,7 +12,7 @@ from pathlib import Path
 from pipeline import RESULTS_DIR
 from pipeline.constants import STANDARD_GRAVITY
 from pipeline.files import InputError
-from pipeline.assessment.age_options import age_kinds, check_age_kinds
+from pipeline.assessment.age_options import KA, age_kinds, check_age_kinds
 from pipeline.assessment.distinct_files import distinct_files
 from pipeline.assessment.state_options import parse_state_lognormal
 from pipeline.hazard.ages import LowerBound, TruncatedNormal, UniformInterval, load_age_samples
@@ -35,7 +35,6 @@ SURVIVAL_OUT = RESULTS_DIR / "survival"
 CONSTRAIN_OUT = RESULTS_DIR / "constrain"
 MAX_SPECIMENS = 20
 MAX_AGE_KA = 10000.0
-KA = 1000.0                 # years in a thousand years
 MODEL_FLAGS = (("--vs30", "vs30"), ("--mechanism", "mechanism"),
                ("--pga-pgv-correlation", "pga_pgv_correlation"))   # the model's inputs
 AGE_FLAGS = ("age_ka", "age_sd_ka", "age_min_ka", "age_range_ka", "age_samples",
@@ -223,11 +222,11 @@ class SurvivalOptions(SpecimenOptions):
         "deglaciation)", 0, MAX_AGE_KA, flag="--age-range-ka", metavar=("LO", "HI"),
         optional=True)
     age_samples: Path = param(None, "", "or samples of the age's distribution: a CSV file "
-                              "(a header line; # comments) with the ages in ka in the column "
-                              "--age-column", flag="--age-samples", metavar="FILE",
-                              optional=True)
+                              "(a header line; # comments) with the ages in ka in a column "
+                              "(its only one, or --age-column)", flag="--age-samples",
+                              metavar="FILE", optional=True)
     age_column: str = param(None, "", "the column of --age-samples", flag="--age-column",
-                            metavar="NAME", optional=True)
+                            metavar="NAME", optional="the file's only column")
     observations: Path = param(
         None, "", "an observations file of invert (sites with fallen and standing columns): "
         "writes site_motion.json, the PGA range consistent with the site's outcome; "

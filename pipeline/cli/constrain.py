@@ -14,7 +14,6 @@ from pipeline.cli._fields import add_arguments, from_args
 from pipeline.assessment.constrain import constrain_files
 from pipeline.files import display_path
 from pipeline.assessment.constrain_options import ConstrainOptions
-from pipeline.assessment.options import AGE_FLAGS
 from pipeline.hazard.constrain_parts import SitesRatio
 
 NAME = "constrain"
@@ -47,7 +46,7 @@ def add_specimen_arguments(p):
     o = ConstrainOptions
     add_arguments(p, o, ("site", "specimen_site"))
     add_arguments(p, o, o.FRAGILITY_FLAGS)
-    add_arguments(p.add_argument_group(o.AGE_GROUP), o, AGE_FLAGS)
+    add_arguments(p.add_argument_group(o.AGE_GROUP), o, o.AGE_FLAGS)
     add_arguments(p, o, ("rule", "floor"))
     add_arguments(p.add_argument_group(o.RATIO_GROUP), o, o.RATIO_FLAGS)
     add_arguments(p, o, (*o.DRAW_FLAGS, "out"))

@@ -267,10 +267,11 @@ class TruncatedNormal(AgeModel):
                               "form)")
 
 
-def load_age_samples(path, column, scale_to_yr=1.0):
+def load_age_samples(path, column=None, scale_to_yr=1.0):
     """:class:`AgeSamples` from the column named ``column`` of the CSV file ``path`` (a
-    header line, comment lines starting with ``#``); ``scale_to_yr`` converts the
-    column's unit to years (1000 for ka).  Every row must hold a number there."""
+    header line, comment lines starting with ``#``; ``column`` None: the file's only
+    column); ``scale_to_yr`` converts the column's unit to years (1000 for ka).  Every
+    row must hold a number there."""
     text = read_user_text(path, "age samples file", DATA_FILE_BYTES)
     lines = [line for line in text.splitlines() if line.strip()
              and not line.lstrip().startswith("#")]
@@ -278,6 +279,10 @@ def load_age_samples(path, column, scale_to_yr=1.0):
         raise InputError(f"age samples file {path} is empty")
     rows = csv.reader(io.StringIO("\n".join(lines)))
     header = [h.strip() for h in next(rows)]
+    if column is None and len(header) != 1:
+        raise InputError(f"{path}: {len(header)} columns ({', '.join(map(show, header))}): "
+                         "name the one holding the ages (--age-column)")
+    column = header[0] if column is None else column
     if column not in header:
         raise InputError(f"{path}: no column {show(column)} (has "
                          f"{', '.join(map(show, header))})")

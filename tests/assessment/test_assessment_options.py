@@ -98,13 +98,30 @@ def test_ages_as_dated_give_their_closed_forms(tmp_path, capsys):
     (("--age-ka", "15", "--age-min-ka", "10"), "give one kind of age: --age-ka or "
      "--age-min-ka"),
     (("--age-min-ka", "15", "--age-sd-ka", "2"), "--age-sd-ka applies with --age-ka"),
-    (("--age-samples", "ages.csv"), "--age-samples needs --age-column"),
     (("--age-min-ka", "0"), "--age-min-ka 0 outside the allowed range (0, 10000] ka"),
 ])
 def test_an_age_badly_given_is_one_line_and_nothing_written(tmp_path, capsys, age, words):
     code, said = _survival(tmp_path, capsys, *age)
     assert code == 2 and said.startswith(f"error: {words}")
     assert not (tmp_path / "out").exists()
+
+
+def test_age_samples_of_one_column_need_no_column_name(tmp_path, capsys):
+    """A file of one column: that column, as when named; several and none named: one
+    line naming them, nothing written."""
+    one = tmp_path / "one.csv"
+    one.write_text("# exposure ages\nage_ka\n12\n15\n21\n")
+    _, taken = _survival(tmp_path, capsys, "--age-samples", str(one))
+    _, named = _survival(tmp_path, capsys, "--age-samples", str(one), "--age-column",
+                         "age_ka")
+    assert taken["survival_probability"] == named["survival_probability"]
+    assert taken["age"]["samples"] == 3
+    two = tmp_path / "two.csv"
+    two.write_text("sample,age_ka\n1,12\n")
+    code, said = _survival(tmp_path / "refused", capsys, "--age-samples", str(two))
+    assert code == 2 and said == (f"error: {two}: 2 columns ('sample', 'age_ka'): name the "
+                                  "one holding the ages (--age-column)")
+    assert not (tmp_path / "refused").exists()
 
 
 def test_constrain_takes_an_interval_age_for_every_specimen():
