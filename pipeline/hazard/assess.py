@@ -31,8 +31,10 @@ ASSUMPTIONS = [
     "The hazard curve is interpolated linearly in (ln PGA, ln rate); no extrapolation: "
     "nothing below its first level, and every exceedance of its last level counted at the "
     "last level (a lower bound on the rate; what it could add is reported).",
-    "An uncertain age is normal (mean, sd) truncated at 0 and integrated over: the "
-    "survival probability is its mean over the age, not an interval.",
+    "An age is taken as dated (survival.json age): known; normal (mean, sd) truncated at "
+    "0, uniform on an interval or samples from a file, integrated over: the survival "
+    "probability is its mean over the age, not an interval; a lower bound taken as the "
+    "age, so that the survival is an upper bound.",
     "PGV/PGA at each PGA level is lognormal (from the user, or from the ground-motion "
     "model at the stated magnitude and distance); the fragility is averaged over it.",
     "survival_interval: 95 % of the survival probabilities of fragility parameters drawn "

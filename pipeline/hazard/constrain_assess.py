@@ -42,8 +42,11 @@ ASSUMPTIONS = [
     "shaking (P(any overturns) = 1 - prod(1 - P_j), averaged over PGV/PGA).  With differing "
     "ages the joint survival is the product over the age intervals (youngest first) of the "
     "survival of the specimens standing through each interval: exact for a Poisson process.",
-    "An uncertain age is normal (mean, sd) truncated at 0.  One age for all specimens: "
-    "integrated in closed form.  Differing ages, some uncertain: Monte Carlo over "
+    "An age is taken as dated (each specimen's age): known; normal (mean, sd) truncated "
+    "at 0, uniform on an interval or samples from a file, integrated over; a lower bound "
+    "taken as the age (the specimen's survival an upper bound, the constraint the weakest "
+    "the bound allows).  One age for all specimens: integrated exactly.  Differing ages, "
+    "some uncertain: Monte Carlo over "
     f"independent ages ({AGE_SAMPLES} samples; the standard error is reported), and for the "
     "fragility draws the ages at their means.",
     "Each branch's curve is interpolated linearly in (ln PGA, ln rate), nothing counted "
