@@ -39,8 +39,8 @@ from obspy.geodetics import gps2dist_azimuth
 REPO = Path(__file__).resolve().parents[2]
 RECORDS = REPO / "records"
 sys.path.insert(0, str(REPO))
-from pipeline.files import InputError
-from pipeline.records.readers import read_record
+from pipeline.files import InputError  # noqa: E402 (after the path)
+from pipeline.records.readers import read_record  # noqa: E402
 
 COLUMNS = [
     "id", "label", "event", "date", "magnitude", "mechanism", "station",
