@@ -114,7 +114,7 @@ def check_leaves(record, *names):
             continue
         kinds = f.type.__args__ if isinstance(f.type, types.UnionType) else (f.type,)
         if not any(_of_kind(value, kind) for kind in kinds):
-            said = " or ".join(getattr(k, "__name__", str(k)) for k in kinds)
+            said = " or ".join("null" if k is type(None) else k.__name__ for k in kinds)
             raise ValueError(f"{f.name} is not {said}: {value!r:.60}")
 
 
