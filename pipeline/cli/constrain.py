@@ -14,7 +14,7 @@ from pipeline.cli._fields import add_arguments, from_args
 from pipeline.assessment.constrain import constrain_files
 from pipeline.files import display_path
 from pipeline.assessment.constrain_options import ConstrainOptions
-from pipeline.hazard.constrain_parts import SitesRatio
+from pipeline.hazard.ratio_described import SitesRatio
 
 NAME = "constrain"
 ORDER = 46

@@ -5,15 +5,15 @@ realisation, :func:`mrd_ratios`), otherwise the mean's for every branch, and the
 says which and why.  A branch of an OpenQuake export is realisation K when its id is K
 (``realizations.csv``'s ``rlz_id``); a plain table's branches match where they are named
 0, 1, ...  :func:`rates_by_ratio` integrates each group of branches sharing a model."""
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
 from pipeline.files import InputError
 from pipeline.hazard.constrain import branch_rates
-from pipeline.hazard.constrain_parts import SitesRatio
 from pipeline.hazard.disagg_ratio import ratio_mixture
 from pipeline.hazard.mrd_ratio import ratio_from_mrd
+from pipeline.hazard.ratio_described import DensityRatio, GroupsRatio, SitesRatio
 from pipeline.hazard.same_place import check_same_place
 
 MEAN = "mean"
@@ -36,16 +36,20 @@ class BranchRatios:
             raise InputError("PGV/PGA per branch: one model per group of branches")
 
     def describe(self):
-        """constrain.json's pgv_pga: the one model's description and how the branches take
-        it, or each group's."""
-        said = {"per_branch": self.per_branch, "branches": self.why}
+        """constrain.json's pgv_pga: the one model's description
+        (:class:`~pipeline.hazard.ratio_described.MixtureRatio` or
+        :class:`~pipeline.hazard.ratio_described.DensityRatio`) with how the branches take
+        it, or each group's (:class:`~pipeline.hazard.ratio_described.GroupsRatio`)."""
         if len(self.models) == 1:
-            return {**self.models[0].describe(), **said}
-        first = self.models[0].describe()
-        return {"source": self.route, **said,
-                **{k: v for k, v in first.items() if k in ("file", "site_index")},
-                "groups": [{"branch_indices": [int(b) for b in rows], **m.describe()}
-                           for m, rows in zip(self.models, self.rows)]}
+            return replace(self.models[0].describe(), per_branch=self.per_branch,
+                           branches=self.why)
+        groups = [replace(m.describe(), branch_indices=[int(b) for b in rows])
+                  for m, rows in zip(self.models, self.rows)]
+        first = groups[0]
+        where = {"file": first.file, "site_index": first.site_index} \
+            if isinstance(first, DensityRatio) else {}
+        return GroupsRatio(source=self.route, per_branch=self.per_branch, branches=self.why,
+                           **where, groups=groups)
 
 
 EACH_SITE = ("each site's specimens take PGV/PGA from the rate density at their own site "
@@ -65,14 +69,14 @@ def ratio_described(ratio_model, site_models):
 
 
 def sites_ratio(models):
-    """constrain.json's ``pgv_pga`` (a :class:`~pipeline.hazard.constrain_parts.
+    """constrain.json's ``pgv_pga`` (a :class:`~pipeline.hazard.ratio_described.
     SitesRatio`) for ``models`` ({site: :class:`BranchRatios`}, two sites or more, each
     the rate density at its own site)."""
     first = next(iter(models.values()))
     why = {m.why for m in models.values()}
     return SitesRatio(
         source="rate density of PGA and PGV (mrd) at each specimen's site",
-        file=first.describe().get("file"), per_site=True, site_indices=list(models),
+        file=first.describe().given("file"), per_site=True, site_indices=list(models),
         sites=EACH_SITE, per_branch=all(m.per_branch for m in models.values()),
         branches=why.pop() if len(why) == 1 else "as each site's (sites[].pgv_pga)")
 

@@ -1,14 +1,15 @@
 """The parts of ``constrain.json`` (:class:`~pipeline.hazard.results.ConstrainResult`) that
 are records of their own, each written key for key in its field order and read back by
 ``from_json``: each specimen, each branch's row, the statistics of a set of curves, the
-ground motion at a rate, the members' and the draws' spread, the sites, and the PGV/PGA
-of sites that each take their own.  Rates in
-1/yr, PGA in m/s^2 or g as named, ages in ka or years as named."""
+ground motion at a rate, the members' and the draws' spread and the sites (their PGV/PGA
+in :mod:`pipeline.hazard.ratio_described`).  Rates in 1/yr, PGA in m/s^2 or g as named,
+ages in ka or years as named."""
 from dataclasses import dataclass
 
 from pipeline.hazard.ages import AgeDescription
-from pipeline.hazard.record import (ABSENT, Record, check_probability, check_rate, each,
-                                    optional)
+from pipeline.hazard.ratio_described import DensityRatio, GroupsRatio, read_ratio
+from pipeline.hazard.record import (ABSENT, Record, check_leaves, check_probability,
+                                    check_rate, each, optional)
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -132,43 +133,16 @@ class MonteCarlo(Record):
 @dataclass(frozen=True, kw_only=True)
 class SiteRow(Record):
     """A site of the tree (None: its only one), the specimens standing there (indices)
-    and, where the site takes its own, its PGV/PGA (as ``pgv_pga`` says it)."""
+    and, where the site takes its own, its PGV/PGA (its rate density's, one or per group
+    of branches)."""
     site: int | None
     specimens: list
-    pgv_pga: dict = ABSENT
+    pgv_pga: DensityRatio | GroupsRatio = ABSENT
     NAME = "sites"
-
-
-@dataclass(frozen=True, kw_only=True)
-class SitesRatio(Record):
-    """constrain.json's ``pgv_pga`` when the specimens stand at several sites and each
-    site's take PGV/PGA from the rate density at their own site (``--joint-hazard`` with
-    ``--specimen-site``): the route (``source``) and its file, the sites (``site_indices``,
-    the file's), in words that each takes its own (described under ``sites[].pgv_pga``),
-    and how the branches take it (``per_branch``, ``branches``: the same at every site,
-    one file and one tree's branches)."""
-    source: str
-    file: str | None
-    per_site: bool
-    site_indices: list
-    sites: str
-    per_branch: bool
-    branches: str
-    NAME = "pgv_pga"
+    PARTS = {"pgv_pga": read_ratio}
 
     def __post_init__(self):
-        if self.per_site is not True or len(self.site_indices) < 2:
-            raise ValueError("pgv_pga per site: per_site true, two sites or more")
-
-
-def read_pgv_pga(data):
-    """constrain.json's ``pgv_pga``: a :class:`SitesRatio` where it holds ``per_site``,
-    else the one PGV/PGA model's description as written (an object or null)."""
-    if isinstance(data, dict) and "per_site" in data:
-        return SitesRatio.from_json(data)
-    if data is not None and not isinstance(data, dict):
-        raise ValueError(f"pgv_pga is not an object: {type(data).__name__}")
-    return data
+        check_leaves(self, "pgv_pga")
 
 
 CONSTRAIN_PARTS = {"specimens": each(ConstrainSpecimen.from_json),
@@ -181,5 +155,5 @@ CONSTRAIN_PARTS = {"specimens": each(ConstrainSpecimen.from_json),
                    "members": optional(Members.from_json),
                    "monte_carlo": optional(MonteCarlo.from_json),
                    "sites": each(SiteRow.from_json),
-                   "pgv_pga": read_pgv_pga}
+                   "pgv_pga": optional(read_ratio)}
 """Readers of constrain.json's fields that are records (field name to reader)."""

@@ -21,6 +21,7 @@ import numpy as np
 from pipeline.files import InputError
 from pipeline.hazard.fragility.ratio import DEFAULT_VS30_M_S, RatioFromGmm
 from pipeline.hazard.pga_pgv_correlation import BAKER_BRADLEY_2017
+from pipeline.hazard.ratio_described import MixtureRatio
 
 
 def level_shares(disaggregation, column):
@@ -54,10 +55,6 @@ def bin_shares(anchors, shares, pga_m_s2):
     return shares[np.clip(k, 0, len(anchors) - 1)]
 
 
-MODEL_KEYS = ("model", "vs30_m_s", "mechanism", "pga_pgv_correlation",
-              "pga_pgv_correlation_source")      # the bins' model, as each bin states it
-
-
 @dataclass(frozen=True)
 class RatioMixture:
     """PGV/PGA at each PGA level as a mixture over disaggregation bins: ``anchors``
@@ -67,15 +64,18 @@ class RatioMixture:
     shares: np.ndarray
     models: tuple
 
-    def describe(self):
+    def describe(self) -> MixtureRatio:
+        """The mixture as results describe it: its bins with events and their model (the
+        same at every bin but the magnitude and distance)."""
         used = [m for m in self.models if m is not None]
-        model = {k: v for k, v in used[0].describe().items() if k in MODEL_KEYS} if used \
-            else {}
-        return {"source": "magnitude-distance disaggregation", "bins_used": len(used),
-                "bins": [(m.magnitude, m.distance_km) for m in used],
-                "anchors_m_s2": self.anchors.tolist(),
-                "shares": "between disaggregated levels: the events falling between them",
-                **model}
+        model = used[0].describe()
+        return MixtureRatio(
+            bins_used=len(used), bins=[[m.magnitude, m.distance_km] for m in used],
+            anchors_m_s2=self.anchors.tolist(),
+            shares="between disaggregated levels: the events falling between them",
+            model=model.model, vs30_m_s=model.vs30_m_s, mechanism=model.mechanism,
+            pga_pgv_correlation=model.pga_pgv_correlation,
+            pga_pgv_correlation_source=model.pga_pgv_correlation_source)
 
 
 def ratio_mixture(disaggregation, column="mean", vs30_m_s=DEFAULT_VS30_M_S, mechanism="SS",

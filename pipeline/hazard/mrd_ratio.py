@@ -11,18 +11,20 @@ from dataclasses import dataclass
 import numpy as np
 
 from pipeline.files import InputError
+from pipeline.hazard.ratio_described import DensityRatio
+from pipeline.hazard.record import ABSENT
 
 
 @dataclass(frozen=True)
 class RatioFromMrd:
     """ln(PGV/PGA) (PGV m/s, PGA m/s^2: ln s) given PGA at ``pga_m_s2`` (the PGA cells
-    with events): ``ln_mean`` and ``ln_sd``; ``source``: the file and site; ``kind``:
-    "mean" or the realisation ("rlz-K") whose rate density it is."""
+    with events): ``ln_mean`` and ``ln_sd``; ``source``: the file and site;
+    ``realisation``: the realisation whose rate density it is (None: the mean's)."""
     pga_m_s2: np.ndarray
     ln_mean: np.ndarray
     ln_sd: np.ndarray
     source: dict
-    kind: str = "mean"
+    realisation: int | None = None
 
     def __post_init__(self):
         if self.pga_m_s2.size < 1 or not (self.pga_m_s2.shape == self.ln_mean.shape ==
@@ -37,13 +39,17 @@ class RatioFromMrd:
         x = np.log(self.pga_m_s2)
         return np.interp(ln_a, x, self.ln_mean), np.interp(ln_a, x, self.ln_sd)
 
-    def describe(self):
-        return {"source": "mean rate density of PGA and PGV (mrd)" if self.kind == "mean"
-                else f"rate density of PGA and PGV (mrd) of realisation {self.kind}",
-                **{k: v for k, v in self.source.items() if k in ("file", "site_index")},
-                "pga_cells_with_events": int(self.pga_m_s2.size),
-                "distribution": "lognormal given PGA: the rate-weighted mean and sd of the "
-                                "events' ln(PGV/PGA) in each PGA cell (geometric centres)"}
+    def describe(self) -> DensityRatio:
+        """The rate density as results describe it (its file and site where it was read
+        from a file)."""
+        return DensityRatio(
+            source="mean rate density of PGA and PGV (mrd)" if self.realisation is None
+            else f"rate density of PGA and PGV (mrd) of realisation rlz-{self.realisation}",
+            file=self.source.get("file", ABSENT),
+            site_index=self.source.get("site_index", ABSENT),
+            pga_cells_with_events=int(self.pga_m_s2.size),
+            distribution="lognormal given PGA: the rate-weighted mean and sd of the events' "
+                         "ln(PGV/PGA) in each PGA cell (geometric centres)")
 
 
 def ratio_from_mrd(joint, site, realisation=None):
@@ -60,5 +66,4 @@ def ratio_from_mrd(joint, site, realisation=None):
     w = rates[keep] / total[keep][:, None]
     mean = (w * ln_ratio).sum(axis=1)
     sd = np.sqrt(np.maximum((w * (ln_ratio - mean[:, None]) ** 2).sum(axis=1), 0.0))
-    return RatioFromMrd(pga[keep], mean, sd, dict(one.source),
-                        "mean" if realisation is None else f"rlz-{realisation}")
+    return RatioFromMrd(pga[keep], mean, sd, dict(one.source), realisation)

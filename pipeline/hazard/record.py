@@ -2,6 +2,7 @@
 as a JSON object (its fields in their order, a field left :data:`ABSENT` not written) and
 read back from one (:meth:`Record.from_json`: unknown and missing keys named, the parts
 that are records themselves read as their types)."""
+import types
 from dataclasses import MISSING, fields
 from enum import Enum
 
@@ -101,3 +102,27 @@ def check_rate(record, *names):
         rate = record.given(name)
         if rate is not None and rate < 0.0:
             raise InputError(f"{record.NAME}: {name} {rate!r} < 0")
+
+
+def check_leaves(record, *names):
+    """ValueError unless each field ``names`` of ``record`` (every field if none named)
+    given is of its declared type: a float a number (an int too, not a bool), an int an
+    int (not a bool), ``X | None`` an X or None, any other type an instance of it."""
+    for f in fields(record):
+        value = getattr(record, f.name)
+        if (names and f.name not in names) or value is ABSENT:
+            continue
+        kinds = f.type.__args__ if isinstance(f.type, types.UnionType) else (f.type,)
+        if not any(_of_kind(value, kind) for kind in kinds):
+            said = " or ".join("null" if k is type(None) else k.__name__ for k in kinds)
+            raise ValueError(f"{f.name} is not {said}: {value!r:.60}")
+
+
+def _of_kind(value, kind):
+    if kind is type(None):
+        return value is None
+    if kind is float:
+        return isinstance(value, int | float) and not isinstance(value, bool)
+    if kind is int:
+        return isinstance(value, int) and not isinstance(value, bool)
+    return isinstance(value, kind)

@@ -11,12 +11,15 @@ from pathlib import Path
 
 from pipeline.files import InputError, result_json_text
 from pipeline.hazard.constrain_parts import (CONSTRAIN_PARTS, CurveStatistics, Members,
-                                             MonteCarlo, SitesRatio)
+                                             MonteCarlo)
 from pipeline.hazard.ages import AgeDescription
 from pipeline.hazard.constrain_sites import BranchTest
 from pipeline.hazard.hazard_described import (CurveHazard, JointHazardDescribed, TreeHazard,
                                               read_survival_hazard)
-from pipeline.hazard.record import ABSENT, Record, check_probability, check_rate
+from pipeline.hazard.ratio_described import (MixtureRatio, RatioDescribed, ScenarioRatio,
+                                              StatedRatio, read_ratio)
+from pipeline.hazard.record import (ABSENT, Record, check_leaves, check_probability,
+                                    check_rate, optional)
 from pipeline.hazard.survival_parts import (SURVIVAL_PARTS, CurveEnds, HazardRoute,
                                             OutsideGrid, Route, SiteSet)
 from pipeline.userfiles import DATA_FILE_BYTES, read_json
@@ -75,7 +78,7 @@ class SurvivalResult(_ResultFile):
     definitions: dict = ABSENT
     specimens: list
     hazard: CurveHazard | JointHazardDescribed
-    pgv_pga: dict | None
+    pgv_pga: StatedRatio | ScenarioRatio | MixtureRatio | None
     pgv_pga_used: bool
     assumptions: list
     warnings: list
@@ -91,9 +94,10 @@ class SurvivalResult(_ResultFile):
 
     NAME = "survival.json"
     PARTS = {**SURVIVAL_PARTS, "age": AgeDescription.from_json,
-             "hazard": read_survival_hazard}
+             "hazard": read_survival_hazard, "pgv_pga": optional(read_ratio)}
 
     def __post_init__(self):
+        check_leaves(self, "pgv_pga")
         joint = isinstance(self.hazard, JointHazardDescribed)
         if joint != (self.hazard_route.route is Route.JOINT):
             raise InputError(f"{self.NAME}: the hazard is not of the route "
@@ -111,8 +115,7 @@ class ConstrainResult(_ResultFile):
     rule, ``posterior_bayes`` or ``posterior_eliminate`` under the other), the ground
     motion at the stated rates, the members' and draws' spread, the branch test
     (:class:`~pipeline.hazard.constrain_sites.BranchTest`), the hazard and the PGV/PGA
-    model as described (a :class:`~pipeline.hazard.constrain_parts.SitesRatio` where each
-    site takes its own), warnings, assumptions, draws and seed, software, and the files
+    model as described (by its route, :mod:`pipeline.hazard.ratio_described`), warnings, assumptions, draws and seed, software, and the files
     of the set (the parts' types in :mod:`pipeline.hazard.constrain_parts`)."""
     rule: str
     headline: str
@@ -135,7 +138,7 @@ class ConstrainResult(_ResultFile):
     sites: list
     branch_test: BranchTest
     hazard: TreeHazard
-    pgv_pga: dict | SitesRatio | None
+    pgv_pga: RatioDescribed | None
     warnings: list
     assumptions: list
     draws: int
@@ -162,6 +165,7 @@ class ConstrainResult(_ResultFile):
                              f"{self.branch_count}")
         if not isinstance(self.branch_test, BranchTest):
             raise InputError(f"{self.NAME}: branch_test is not a BranchTest")
+        check_leaves(self, "pgv_pga")
 
 
 def read_survival_result(path: Path) -> SurvivalResult:

@@ -1,6 +1,7 @@
 """REPORT section of ``survival`` (``make rock-survival`` writes results/rock-survival)."""
 import pandas as pd
 
+from pipeline.hazard.ratio_described import ScenarioRatio
 from pipeline.hazard.results import read_survival_result
 from pipeline.report.common import _figure, _fmt, _table
 
@@ -17,16 +18,15 @@ def survival_section(results, name=ROCK_SURVIVAL):
                 "fragility under the USGS 2014 hazard curve at 34 N, 118 W).\n")
     s = read_survival_result(path)
     specimen = s.specimens[0]
-    fragility, hazard, ratio = specimen.fragility, s.hazard, s.pgv_pga or {}
+    fragility, hazard, ratio = specimen.fragility, s.hazard, s.pgv_pga
     interval = s.survival_interval
     sets = s.given("survival_parameter_set_range")
     lines = [f"## {heading}\n",
              f"Fragility: {fragility['label']} ({fragility.get('inside', fragility['form'])}"
              f"; outside the grid: {fragility.get('outside', '-')}). Hazard: "
              f"{hazard.format or ''} `{hazard.file or ''}`" + _where(hazard.source)
-             + (f"; PGV/PGA from {ratio.get('model', ratio.get('source'))} at M "
-                f"{ratio['magnitude']:g}, {ratio['distance_jb_km']:g} km"
-                if "magnitude" in ratio else "")
+             + (f"; PGV/PGA from {ratio.model} at M {ratio.magnitude:g}, "
+                f"{ratio.distance_jb_km:g} km" if isinstance(ratio, ScenarioRatio) else "")
              + f". Age {_age(s)}.\n",
              f"Annual overturning rate {s.annual_overturning_rate_per_yr:.3g} /yr; "
              f"survival probability {s.survival_probability:.3g}"

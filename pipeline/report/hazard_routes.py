@@ -7,7 +7,9 @@ disaggregation and (c) the PGA curve with PGV given PGA from one scenario
 holds it, the mean's otherwise: the table says which."""
 import pandas as pd
 
-from pipeline.hazard.constrain_parts import SitesRatio
+from pipeline.hazard.ratio_described import (DensityRatio, GroupsRatio, MixtureRatio,
+                                              ScenarioRatio, SitesRatio)
+from pipeline.hazard.record import ABSENT
 from pipeline.hazard.results import read_constrain_result, read_survival_result
 from pipeline.report.common import _table
 
@@ -80,29 +82,32 @@ def _constrain_rows(path, words):
             for k, b in enumerate(c.branches)]
 
 
-def _branch_words(pgv_pga, k):
+def _branch_words(ratio, k):
     """What branch ``k``'s PGV/PGA came from (constrain.json's pgv_pga), in a few words."""
-    if isinstance(pgv_pga, SitesRatio):
-        return ("each site's own rate density, "
-                + ("its own realisation's" if pgv_pga.per_branch else
-                   "the mean's for every branch"))
-    if pgv_pga is None or "per_branch" not in pgv_pga:
-        return _ratio_words(pgv_pga)
-    if not pgv_pga["per_branch"]:
-        return f"{_ratio_words(pgv_pga)}, the mean's for every branch"
-    group = next(g for g in pgv_pga["groups"] if k in g["branch_indices"])
-    return f"{_ratio_words(group)}, its own realisation's"
+    match ratio:
+        case SitesRatio():
+            return ("each site's own rate density, "
+                    + ("its own realisation's" if ratio.per_branch else
+                       "the mean's for every branch"))
+        case GroupsRatio():
+            return f"{_ratio_words(ratio.group_of(k))}, its own realisation's"
+        case MixtureRatio() | DensityRatio() if ratio.per_branch is not ABSENT:
+            return f"{_ratio_words(ratio)}, " + (
+                "its own realisation's" if ratio.per_branch else "the mean's for every branch")
+    return _ratio_words(ratio)
 
 
-def _ratio_words(pgv_pga):
-    """What the file says PGV/PGA came from, in a few words."""
-    if pgv_pga is None:
-        return "each event of the rate density"
-    if "bins_used" in pgv_pga:
-        return f"{pgv_pga['bins_used']} magnitude-distance bins"
-    if "pga_cells_with_events" in pgv_pga:
-        return "rate density"
-    if "magnitude" in pgv_pga:
-        return (f"M {pgv_pga['magnitude']:g}, {pgv_pga['distance_jb_km']:g} km, correlation "
-                f"{pgv_pga['pga_pgv_correlation']:g}")
-    return pgv_pga.get("source", "-")
+def _ratio_words(ratio):
+    """What the file says PGV/PGA came from (one route's record, or None), in a few
+    words."""
+    match ratio:
+        case None:
+            return "each event of the rate density"
+        case MixtureRatio():
+            return f"{ratio.bins_used} magnitude-distance bins"
+        case DensityRatio():
+            return "rate density"
+        case ScenarioRatio():
+            return (f"M {ratio.magnitude:g}, {ratio.distance_jb_km:g} km, correlation "
+                    f"{ratio.pga_pgv_correlation:g}")
+    return ratio.source

@@ -10,7 +10,7 @@ import numpy as np
 
 from pipeline import RECORDS_DIR
 from pipeline.cli import main
-from pipeline.hazard.constrain_parts import SitesRatio
+from pipeline.hazard.ratio_described import SitesRatio
 from pipeline.hazard.results import read_constrain_result
 from tests.refusal import refused
 

@@ -23,4 +23,4 @@ def test_a_scenario_gives_the_bivariate_normals_conditional():
     expected = MU_V + RHO * S_V / S_A * (np.log(at) - MU_A) - np.log(at)
     np.testing.assert_allclose(mean, expected, atol=0.01)
     np.testing.assert_allclose(sd, S_V * math.sqrt(1 - RHO ** 2), rtol=0.02)
-    assert ratio.describe()["source"].startswith("mean rate density")
+    assert ratio.describe().source.startswith("mean rate density")

@@ -16,11 +16,14 @@ import numpy as np
 
 from pipeline.constants import STANDARD_GRAVITY
 from pipeline.hazard.pga_pgv_correlation import BAKER_BRADLEY_2017, correlation_source
+from pipeline.hazard.ratio_described import ScenarioRatio, StatedRatio
 
 RATIO_NODES = 24                  # Gauss-Hermite nodes over ln(PGV/PGA)
 PGA_PGV_CORRELATION = BAKER_BRADLEY_2017.value   # ln PGA, ln PGV residuals, observed
 DEFAULT_VS30_M_S = 760.0          # the model's site: rock (B/C), the USGS hazard curves' Vs30
 GMM_MECHANISMS = ("SS", "NS", "RS")
+GMM_MODEL = ("Boore, Stewart, Seyhan & Atkinson (2014), pygmm BooreStewartSeyhanAtkinson2014 "
+             "(RotD50)")
 
 
 @dataclass(frozen=True)
@@ -33,9 +36,9 @@ class RatioLognormal:
         pga = np.asarray(pga_m_s2, float)
         return np.full(pga.shape, math.log(self.median_s)), np.full(pga.shape, self.sigma_ln)
 
-    def describe(self):
-        return {"source": "user", "distribution": "lognormal, the same at every PGA",
-                "median_s": self.median_s, "sigma_ln": self.sigma_ln}
+    def describe(self) -> StatedRatio:
+        return StatedRatio(distribution="lognormal, the same at every PGA",
+                           median_s=self.median_s, sigma_ln=self.sigma_ln)
 
 
 @dataclass(frozen=True)
@@ -67,19 +70,17 @@ class RatioFromGmm:
         sd = m["ln_std_pgv"] * math.sqrt(1.0 - rho ** 2)
         return mean_v - ln_a, np.full(ln_a.shape, sd)
 
-    def describe(self):
-        return {"source": "ground-motion model",
-                "model": "Boore, Stewart, Seyhan & Atkinson (2014), pygmm "
-                         "BooreStewartSeyhanAtkinson2014 (RotD50)",
-                "magnitude": self.magnitude, "distance_jb_km": self.distance_km,
-                "vs30_m_s": self.vs30_m_s, "mechanism": self.mechanism,
-                "pga_pgv_correlation": self.correlation,
-                "pga_pgv_correlation_source": correlation_source(self.correlation),
-                "median_pga_m_s2": self.medians["pga_m_s2"],
-                "median_pgv_m_s": self.medians["pgv_m_s"],
-                "ln_std_pga": self.medians["ln_std_pga"], "ln_std_pgv": self.medians["ln_std_pgv"],
-                "pygmm": importlib.metadata.version("pygmm"),
-                "distribution": "lognormal given PGA: ln PGV | ln PGA by their correlation"}
+    def describe(self) -> ScenarioRatio:
+        m = self.medians
+        return ScenarioRatio(
+            model=GMM_MODEL, magnitude=self.magnitude, distance_jb_km=self.distance_km,
+            vs30_m_s=self.vs30_m_s, mechanism=self.mechanism,
+            pga_pgv_correlation=self.correlation,
+            pga_pgv_correlation_source=correlation_source(self.correlation),
+            median_pga_m_s2=m["pga_m_s2"], median_pgv_m_s=m["pgv_m_s"],
+            ln_std_pga=m["ln_std_pga"], ln_std_pgv=m["ln_std_pgv"],
+            pygmm=importlib.metadata.version("pygmm"),
+            distribution="lognormal given PGA: ln PGV | ln PGA by their correlation")
 
 
 @functools.cache
