@@ -51,10 +51,22 @@ def _run(argv, out):
     return out / name, read
 
 
+@pytest.fixture(scope="module")
+def routed(tmp_path_factory):
+    """Each route's result file, run once for the module (the tests only read it)."""
+    done = {}
+
+    def run(name):
+        if name not in done:
+            done[name] = _run(ROUTES[name][0], tmp_path_factory.mktemp(name))
+        return done[name]
+    return run
+
+
 @pytest.mark.parametrize("name", ROUTES)
-def test_each_route_read_back_is_written_back_byte_for_byte(tmp_path, name):
-    argv, kind = ROUTES[name]
-    path, read = _run(argv, tmp_path / name)
+def test_each_route_read_back_is_written_back_byte_for_byte(routed, name):
+    kind = ROUTES[name][1]
+    path, read = routed(name)
     result = read(path)
     assert result.text() == path.read_text()
     assert type(result.pgv_pga) is kind
@@ -99,8 +111,8 @@ def test_groups_of_densities_and_sites_read_back_byte_for_byte(tmp_path):
     ("tree-density", lambda r: r.update(pga_cells_with_events=0), "< 1"),
     ("tree-density", lambda r: r.update(wobble=1), "unknown keys wobble"),
 ])
-def test_a_malformed_route_is_refused_in_one_line(tmp_path, route, change, said):
-    path, read = _run(ROUTES[route][0], tmp_path / "run")
+def test_a_malformed_route_is_refused_in_one_line(tmp_path, routed, route, change, said):
+    path, read = routed(route)
     data = json.loads(path.read_text())
     change(data["pgv_pga"])
     bad = tmp_path / "bad.json"
@@ -116,8 +128,8 @@ def test_a_malformed_route_is_refused_in_one_line(tmp_path, route, change, said)
     ("scenario", "pgv_pga", None, None),                          # null: no PGV/PGA taken
     ("stated", "pgv_pga", "density", "not a JSON object"),
 ])
-def test_the_route_part_is_an_object_or_null(tmp_path, route, where, value, said):
-    path, read = _run(ROUTES[route][0], tmp_path / "run")
+def test_the_route_part_is_an_object_or_null(tmp_path, routed, route, where, value, said):
+    path, read = routed(route)
     data = {**json.loads(path.read_text()), where: value}
     bad = tmp_path / "bad.json"
     bad.write_text(json.dumps(data))
@@ -128,12 +140,12 @@ def test_the_route_part_is_an_object_or_null(tmp_path, route, where, value, said
         read(bad)
 
 
-def test_a_route_of_another_result_is_refused(tmp_path):
+def test_a_route_of_another_result_is_refused(tmp_path, routed):
     """survival.json holds no rate density's PGV/PGA (its joint route takes each event's
     own), a site of constrain.json no stated one."""
-    path, _ = _run(ROUTES["tree-density"][0], tmp_path / "c")
+    path, _ = routed("tree-density")
     density = json.loads(path.read_text())["pgv_pga"]
-    survival, _ = _run(ROUTES["stated"][0], tmp_path / "s")
+    survival, _ = routed("stated")
     bad = tmp_path / "bad.json"
     bad.write_text(json.dumps({**json.loads(survival.read_text()), "pgv_pga": density}))
     with pytest.raises(InputError, match="pgv_pga is not StatedRatio or ScenarioRatio or "
